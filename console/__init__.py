@@ -1,0 +1,1 @@
+"""stairbot.console: the Textual operator console."""

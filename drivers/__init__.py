@@ -1,0 +1,1 @@
+"""stairbot.drivers: the boards' protocol, serial and CAN transports, URL registry."""

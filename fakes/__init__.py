@@ -1,0 +1,1 @@
+"""stairbot.fakes: the simulated robot (pymunk world, sensor and motor models)."""

@@ -1,0 +1,328 @@
+"""Robot config: the seed's constants under their seed names, in SI units,
+the mechanical parameters they come from, and what follows from them.
+
+Loaded from TOML (``--config FILE``); the shipped default describes the
+reference robot.  Turn counts that follow from geometry are computed, never
+typed in.  Bad files raise :class:`~stairbot.errors.ConfigError` naming the
+file, the field and what is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Any
+
+import msgspec
+
+from stairbot.errors import ConfigError
+
+Pos = Annotated[float, msgspec.Meta(gt=0)]
+NonNeg = Annotated[float, msgspec.Meta(ge=0)]
+
+
+class Geometry(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    LENGTH_OF_FIRST_MODULE: Pos
+    LENGTH_OF_SECOND_MODULE: Pos
+    LENGTH_OF_THIRD_MODULE: Pos
+    segment_height: Pos
+    track_width: Pos
+    wheel_radius: Pos
+    wheel_inset: Pos
+    LENGTH_OF_A_ROBOT: Pos | None = None  # optional; must equal the sum of the segments
+
+
+class Masses(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    first_module: Pos
+    second_module: Pos
+    third_module: Pos
+    wheel: Pos
+
+
+class Motors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    wheel_speed: Pos
+    wheel_torque: Pos
+    lift_travel_per_turn: Pos
+    lift_speed: Pos
+    lift_travel: Pos
+    lift_force: Pos
+
+
+class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    front_height: Pos
+    front_lateral: NonNeg
+    front_min_range: NonNeg
+    front_max_range: Pos
+    back_from_rear: NonNeg
+    back_height: Pos
+    back_lateral: NonNeg
+    back_min_range: NonNeg
+    back_max_range: Pos
+    resolution: NonNeg
+
+
+class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    SAFE_DISTANCE_IN_FRONT_OF_STEP: Pos
+    SAFE_LENGTH: Pos
+    LENGTH_OF_INFINITY: Pos
+    approach_gap: NonNeg
+    clearance_lift: Pos
+    drive_clearance: Pos
+    equal_tolerance: Pos
+    standing_wait: Pos
+    max_steps: Annotated[int, msgspec.Meta(ge=1, le=20)]
+    tick: Annotated[float, msgspec.Meta(gt=0, le=0.5)]
+
+
+class ConfigFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    geometry: Geometry
+    masses: Masses
+    motors: Motors
+    sensors: Sensors
+    algorithm: Algorithm
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """The resolved config: the file's values plus everything derived from them."""
+
+    source: str
+    geometry: Geometry
+    masses: Masses
+    motors: Motors
+    sensors: Sensors
+    algorithm: Algorithm
+
+    # -- seed constants that are lengths (metres) -------------------------------
+    @property
+    def LENGTH_OF_FIRST_MODULE(self) -> float:  # noqa: N802 - the seed's name
+        return self.geometry.LENGTH_OF_FIRST_MODULE
+
+    @property
+    def LENGTH_OF_SECOND_MODULE(self) -> float:  # noqa: N802
+        return self.geometry.LENGTH_OF_SECOND_MODULE
+
+    @property
+    def LENGTH_OF_THIRD_MODULE(self) -> float:  # noqa: N802
+        return self.geometry.LENGTH_OF_THIRD_MODULE
+
+    @property
+    def LENGTH_OF_A_ROBOT(self) -> float:  # noqa: N802
+        g = self.geometry
+        return g.LENGTH_OF_FIRST_MODULE + g.LENGTH_OF_SECOND_MODULE + g.LENGTH_OF_THIRD_MODULE
+
+    @property
+    def SAFE_DISTANCE_IN_FRONT_OF_STEP(self) -> float:  # noqa: N802
+        return self.algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP
+
+    @property
+    def SAFE_LENGTH(self) -> float:  # noqa: N802
+        return self.algorithm.SAFE_LENGTH
+
+    @property
+    def LENGTH_OF_INFINITY(self) -> float:  # noqa: N802
+        return self.algorithm.LENGTH_OF_INFINITY
+
+    @property
+    def BACK_CLEARANCE(self) -> float:  # noqa: N802
+        """SBR/SBL reading when segment 3 stands on the floor."""
+        return self.sensors.back_height
+
+    # -- seed constants that are turn counts (computed) -------------------------
+    @property
+    def wheel_circumference(self) -> float:
+        return 2.0 * math.pi * self.geometry.wheel_radius
+
+    def wheel_turns(self, metres: float) -> float:
+        return metres / self.wheel_circumference
+
+    def lift_turns(self, metres: float) -> float:
+        return metres / self.motors.lift_travel_per_turn
+
+    @property
+    def MAX_OF_VERTICAL_TURNS(self) -> float:  # noqa: N802
+        return self.lift_turns(self.motors.lift_travel)
+
+    @property
+    def NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE(self) -> float:  # noqa: N802
+        return self.lift_turns(self.algorithm.clearance_lift)
+
+    @property
+    def NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH(self) -> float:  # noqa: N802
+        a = self.algorithm
+        return self.wheel_turns(a.SAFE_DISTANCE_IN_FRONT_OF_STEP - a.approach_gap)
+
+    @property
+    def NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE(self) -> float:  # noqa: N802
+        return self.wheel_turns(self.geometry.LENGTH_OF_FIRST_MODULE)
+
+    @property
+    def NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE(self) -> float:  # noqa: N802
+        return self.wheel_turns(self.geometry.LENGTH_OF_SECOND_MODULE)
+
+    @property
+    def initial_number_of_vertical_turns(self) -> float:
+        """MTF turns past the moment the front sensors see over the step: the beam
+        height above the wheels plus the drive clearance."""
+        return self.lift_turns(self.sensors.front_height + self.algorithm.drive_clearance)
+
+    # -- what the robot can climb ------------------------------------------------
+    @property
+    def max_step_rise_m(self) -> float:
+        """Highest rise the ascent accepts: the sensors must see over it before MTF
+        has made MAX_OF_VERTICAL_TURNS - number_of_vertical_turns turns."""
+        lift_at_sight = self.motors.lift_travel - (
+            self.sensors.front_height + self.algorithm.drive_clearance
+        )
+        return lift_at_sight + self.sensors.front_height
+
+    @property
+    def min_tread_m(self) -> float:
+        """Shortest tread it enters: after the approach the sensors stand approach_gap
+        before the riser and must then read at least LENGTH_OF_A_ROBOT + SAFE_LENGTH."""
+        return self.LENGTH_OF_A_ROBOT + self.SAFE_LENGTH - self.algorithm.approach_gap
+
+    @property
+    def wheel_speed_m_s(self) -> float:
+        return self.motors.wheel_speed * self.wheel_circumference
+
+    @property
+    def lift_speed_m_s(self) -> float:
+        return self.motors.lift_speed * self.motors.lift_travel_per_turn
+
+    def derived(self) -> dict[str, float]:
+        """Everything that follows from the file, for ``config show``."""
+        return {
+            "LENGTH_OF_A_ROBOT": self.LENGTH_OF_A_ROBOT,
+            "BACK_CLEARANCE": self.BACK_CLEARANCE,
+            "MAX_OF_VERTICAL_TURNS": self.MAX_OF_VERTICAL_TURNS,
+            "NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE": self.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE,
+            "NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH": self.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
+            "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE": (
+                self.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE
+            ),
+            "NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE": (
+                self.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE
+            ),
+            "number_of_vertical_turns": self.initial_number_of_vertical_turns,
+            "wheel_circumference_m": self.wheel_circumference,
+            "wheel_speed_m_s": self.wheel_speed_m_s,
+            "lift_speed_m_s": self.lift_speed_m_s,
+            "max_step_rise_m": self.max_step_rise_m,
+            "min_tread_m": self.min_tread_m,
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """The resolved config as plain data: the file's sections plus ``derived``."""
+        out: dict[str, Any] = {
+            name: msgspec.to_builtins(getattr(self, name))
+            for name in ("geometry", "masses", "motors", "sensors", "algorithm")
+        }
+        out["geometry"]["LENGTH_OF_A_ROBOT"] = self.LENGTH_OF_A_ROBOT
+        out["derived"] = {k: round(v, 6) for k, v in self.derived().items()}
+        out["source"] = self.source
+        return out
+
+
+DEFAULT_CONFIG_NAME = "default_robot.toml"
+
+
+def _field_from_path(path: str) -> str:
+    # msgspec paths look like "$.geometry.wheel_radius" or "$.algorithm"
+    return path.removeprefix("$").lstrip(".") or "(top level)"
+
+
+def _split_msgspec_error(message: str) -> tuple[str | None, str]:
+    if " - at `" in message:
+        problem, _, rest = message.partition(" - at `")
+        return _field_from_path(rest.rstrip("`")), problem
+    return None, message
+
+
+def parse_config(text: str, source: str) -> RobotConfig:
+    """Parse and validate a config document.  Raises ConfigError."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(source, None, f"not valid TOML: {exc}") from None
+    try:
+        data = msgspec.convert(raw, ConfigFile, strict=True)
+    except msgspec.ValidationError as exc:
+        field, problem = _split_msgspec_error(str(exc))
+        raise ConfigError(source, field, _explain(problem)) from None
+    cfg = RobotConfig(source, data.geometry, data.masses, data.motors, data.sensors,
+                      data.algorithm)
+    _check_consistency(cfg)
+    return cfg
+
+
+def _explain(problem: str) -> str:
+    if problem.startswith("Object contains unknown field"):
+        name = problem.split("`")[1] if "`" in problem else "?"
+        return f"unknown key {name!r}; see the shipped default for the allowed keys"
+    return problem
+
+
+def _check_consistency(cfg: RobotConfig) -> None:
+    src = cfg.source
+    g, s, m, a = cfg.geometry, cfg.sensors, cfg.motors, cfg.algorithm
+    if g.LENGTH_OF_A_ROBOT is not None and abs(g.LENGTH_OF_A_ROBOT - cfg.LENGTH_OF_A_ROBOT) > 1e-3:
+        raise ConfigError(
+            src, "geometry.LENGTH_OF_A_ROBOT",
+            f"{g.LENGTH_OF_A_ROBOT} m, but the segments add up to {cfg.LENGTH_OF_A_ROBOT:.4f} m; "
+            "the robot is its three segments end to end (leave the key out to derive it)",
+        )
+    for name in ("LENGTH_OF_FIRST_MODULE", "LENGTH_OF_SECOND_MODULE", "LENGTH_OF_THIRD_MODULE"):
+        length = getattr(g, name)
+        if 2 * g.wheel_inset > length or g.wheel_inset < g.wheel_radius:
+            raise ConfigError(
+                src, "geometry.wheel_inset",
+                f"{g.wheel_inset} m does not fit {name} = {length} m with wheel_radius "
+                f"{g.wheel_radius} m; allowed: wheel_radius <= wheel_inset <= {length / 2} m",
+            )
+    if s.front_min_range >= s.front_max_range:
+        raise ConfigError(src, "sensors.front_min_range", "must be below front_max_range")
+    if s.back_min_range >= s.back_max_range:
+        raise ConfigError(src, "sensors.back_min_range", "must be below back_max_range")
+    if s.back_height < s.back_min_range:
+        raise ConfigError(src, "sensors.back_height",
+                          f"must be at least back_min_range ({s.back_min_range} m)")
+    if a.LENGTH_OF_INFINITY > s.front_max_range:
+        raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
+                          f"must not exceed sensors.front_max_range ({s.front_max_range} m)")
+    if a.SAFE_DISTANCE_IN_FRONT_OF_STEP <= a.approach_gap:
+        raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
+                          f"must exceed approach_gap ({a.approach_gap} m)")
+    if a.SAFE_DISTANCE_IN_FRONT_OF_STEP < s.front_min_range:
+        raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
+                          f"must be at least sensors.front_min_range ({s.front_min_range} m)")
+    if a.SAFE_LENGTH < s.front_min_range:
+        raise ConfigError(src, "algorithm.SAFE_LENGTH",
+                          f"must be at least sensors.front_min_range ({s.front_min_range} m): "
+                          "the last drive of each step stops at that reading")
+    if s.front_height + a.drive_clearance >= m.lift_travel:
+        raise ConfigError(src, "motors.lift_travel",
+                          "must exceed sensors.front_height + algorithm.drive_clearance")
+    if a.clearance_lift >= m.lift_travel:
+        raise ConfigError(src, "algorithm.clearance_lift", "must be below motors.lift_travel")
+    if a.LENGTH_OF_INFINITY <= cfg.LENGTH_OF_A_ROBOT + a.SAFE_LENGTH:
+        raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
+                          "must exceed LENGTH_OF_A_ROBOT + SAFE_LENGTH")
+
+
+def load_config(path: str | Path | None = None) -> RobotConfig:
+    """Load a config file, or the shipped default when ``path`` is None."""
+    if path is None:
+        text = resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
+        return parse_config(text, f"<default {DEFAULT_CONFIG_NAME}>")
+    p = Path(path)
+    try:
+        text = p.read_text("utf-8")
+    except OSError as exc:
+        raise ConfigError(str(p), None, f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ConfigError(str(p), None, "not a UTF-8 text file") from None
+    return parse_config(text, str(p))

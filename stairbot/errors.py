@@ -1,0 +1,45 @@
+"""The typed errors of stairbot: one root, a few children a caller can act on."""
+
+from __future__ import annotations
+
+
+class StairbotError(Exception):
+    """Root of every error stairbot raises on purpose."""
+
+
+class InputError(StairbotError):
+    """Bad user input (config, scenario, URL): the CLI exits 2 with the message.
+
+    The message names the file, the field and what is allowed.
+    """
+
+    def __init__(self, source: str, field: str | None, problem: str) -> None:
+        self.source = source
+        self.field = field
+        self.problem = problem
+        where = f"{source}: {field}" if field else source
+        super().__init__(f"{where}: {problem}")
+
+
+class ConfigError(InputError):
+    """A robot config file is malformed or describes an impossible robot."""
+
+
+class ScenarioError(InputError):
+    """A scenario file is malformed or describes impossible stairs."""
+
+
+class RobotUrlError(InputError):
+    """A robot URL names an unknown scheme or cannot be opened."""
+
+
+class HardwareError(StairbotError):
+    """The robot (real or simulated) failed: the run stops in a safe state."""
+
+
+class LinkLostError(HardwareError):
+    """The link to a board is lost: no valid reply within the allowed time."""
+
+
+class RobotFellError(HardwareError):
+    """The simulated world detected instability: pitch beyond the limit, a fall."""
