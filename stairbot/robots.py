@@ -1,0 +1,95 @@
+"""Open a robot by URL, the way pyserial's ``serial_for_url`` picks a transport.
+
+URL schemes (each handler documents its own grammar in its module header):
+
+* ``sim://``                      the in-process pymunk simulation (stairbot.fakes.sim)
+* ``serial://PORT?baud=...``      boards on a serial link; PORT is any pyserial URL
+* ``can://INTERFACE/CHANNEL?...`` boards on a CAN bus, any python-can interface
+
+Third parties add schemes with an entry point in the ``stairbot.robots`` group,
+whose value is a factory ``f(url, config, scenario, options) -> RobotSession``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib import import_module
+from importlib.metadata import entry_points
+from urllib.parse import urlsplit
+
+from stairbot.config import RobotConfig
+from stairbot.errors import RobotUrlError
+from stairbot.hardware import Clock, Robot
+from stairbot.scenario import Scenario
+
+
+@dataclass(frozen=True)
+class RobotOptions:
+    """How to run: ``realtime`` paces a simulation to the wall clock;
+    ``time_scale`` (sim seconds per wall second) paces it faster or slower."""
+
+    realtime: bool = False
+    time_scale: float | None = None
+
+
+@dataclass
+class RobotSession:
+    """An opened robot with the clock that goes with it."""
+
+    robot: Robot
+    clock: Clock
+    url: str
+    simulated: bool
+    sim: object | None = None  # the simulation object, for pictures and truth
+
+    def close(self) -> None:
+        self.robot.close()
+
+
+RobotFactory = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
+
+# Built-in schemes, imported lazily so the core never imports pymunk/serial/can.
+_BUILTIN: dict[str, str] = {
+    "sim": "stairbot.fakes.sim:open_sim_robot",
+    "serial": "stairbot.drivers.serial_robot:open_serial_robot",
+    "can": "stairbot.drivers.can_robot:open_can_robot",
+}
+
+ENTRY_POINT_GROUP = "stairbot.robots"
+
+
+def known_schemes() -> dict[str, str]:
+    """Scheme -> "module:attribute" for every robot URL scheme available."""
+    found = dict(_BUILTIN)
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        found.setdefault(ep.name, ep.value)
+    return found
+
+
+def _load(target: str, url: str) -> RobotFactory:
+    module_name, _, attr = target.partition(":")
+    try:
+        module = import_module(module_name)
+        factory: RobotFactory = getattr(module, attr)
+    except (ImportError, AttributeError) as exc:
+        raise RobotUrlError(url, None, f"the handler {target} cannot be loaded: {exc}") from exc
+    return factory
+
+
+def open_robot(
+    url: str,
+    config: RobotConfig,
+    scenario: Scenario,
+    options: RobotOptions | None = None,
+) -> RobotSession:
+    """Open the robot named by ``url``.  Raises RobotUrlError for an unknown
+    scheme or a robot that cannot be opened (the handler says why)."""
+    scheme = urlsplit(url).scheme if "://" in url else ""
+    schemes = known_schemes()
+    if scheme not in schemes:
+        allowed = ", ".join(f"{s}://" for s in sorted(schemes))
+        what = f"unknown scheme {scheme!r}" if scheme else "not a robot URL"
+        raise RobotUrlError(url, None, f"{what}; allowed: {allowed}")
+    factory = _load(schemes[scheme], url)
+    return factory(url, config, scenario, options or RobotOptions())

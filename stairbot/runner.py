@@ -1,0 +1,205 @@
+"""The run loop: read the robot, tick the controller, command the motors, let
+the clock advance; and the summary of a run.
+
+The loop is the same for the simulation and for boards on a wire: the
+session's clock decides whether time is simulated or waited for.  Operator
+controls (stop, pause, emergency stop) come in through a thread-safe
+:class:`RunControl`, so a console can run the loop on a worker thread.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from stairbot.config import RobotConfig
+from stairbot.controller import Controller
+from stairbot.errors import HardwareError, RobotFellError
+from stairbot.events import Event, EventKind, EventSink, discard
+from stairbot.hardware import MotorId
+from stairbot.phases import Mode
+from stairbot.robots import RobotSession
+
+ZERO_SPEEDS: dict[MotorId, float] = {m: 0.0 for m in MotorId}
+
+
+class RunControl:
+    """Operator requests to a running loop; every method is thread-safe.
+
+    The emergency stop is latched: the loop commands zero speeds from the next
+    command on and the controller is held until :meth:`clear_estop` *and*
+    :meth:`resume` (clearing alone never restarts motion)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._stop_reason: str | None = None
+        self._estopped = False
+        self._paused = False
+
+    def request_stop(self, reason: str = "stopped by the operator") -> None:
+        with self._lock:
+            self._stop_reason = reason
+
+    def estop(self) -> None:
+        with self._lock:
+            self._estopped = True
+            self._paused = True
+
+    def clear_estop(self) -> None:
+        with self._lock:
+            self._estopped = False
+
+    def pause(self) -> None:
+        with self._lock:
+            self._paused = True
+
+    def resume(self) -> None:
+        with self._lock:
+            if not self._estopped:
+                self._paused = False
+
+    @property
+    def estopped(self) -> bool:
+        with self._lock:
+            return self._estopped
+
+    @property
+    def paused(self) -> bool:
+        with self._lock:
+            return self._paused
+
+    @property
+    def stop_reason(self) -> str | None:
+        with self._lock:
+            return self._stop_reason
+
+
+@dataclass
+class RunResult:
+    """The summary of one run (``stairbot run --json`` prints ``to_dict()``)."""
+
+    outcome: str  # completed | stopped | error | fell
+    ascent_end: str | None
+    steps_climbed: int
+    steps_descended: int
+    pauses: int
+    error: str | None
+    fell: bool
+    max_pitch_deg: float | None
+    final_offset_m: float | None
+    sim_time_s: float
+    wall_time_s: float
+    realtime_factor: float | None
+
+    def to_dict(self) -> dict[str, Any]:
+        out = asdict(self)
+        for key in ("max_pitch_deg", "final_offset_m", "sim_time_s", "wall_time_s",
+                    "realtime_factor"):
+            if isinstance(out[key], float):
+                out[key] = round(out[key], 4)
+        return out
+
+
+def _float_or_none(value: object) -> float | None:
+    return float(value) if isinstance(value, int | float) else None
+
+
+def run(
+    session: RobotSession,
+    config: RobotConfig,
+    sink: EventSink = discard,
+    mode: Mode = Mode.FULL,
+    control: RunControl | None = None,
+    *,
+    controller: Controller | None = None,
+    max_sim_time_s: float = 3600.0,
+    wall: Callable[[], float] = time.perf_counter,
+    on_tick: Callable[[Controller, Any], None] | None = None,
+) -> RunResult:
+    """Run the program on ``session`` until the controller finishes.
+
+    Never raises for a robot failure: a HardwareError ends the run with outcome
+    "error" (or "fell" for a RobotFellError) after every motor is stopped.
+    ``on_tick(controller, snapshot)`` is called after each tick (for a console).
+    """
+    robot, clock = session.robot, session.clock
+    ctl = controller or Controller(config, sink, mode)
+    tick = config.algorithm.tick
+    t0, wall0 = clock.now(), wall()
+    fell = False
+    try:
+        while not ctl.finished:
+            if control is not None:
+                _apply(control, ctl, robot)
+                if ctl.finished:
+                    break
+            snap = robot.read()
+            speeds = ctl.tick(snap)
+            if control is not None and control.estopped:
+                speeds = ZERO_SPEEDS
+            robot.command(speeds)
+            if on_tick is not None:
+                on_tick(ctl, snap)
+            clock.advance(tick)
+            if clock.now() - t0 > max_sim_time_s:
+                ctl.abort(f"the run took longer than {max_sim_time_s:.0f} s", "error")
+    except RobotFellError as exc:
+        fell = True
+        ctl.abort(f"robot fell: {exc}", "error")
+    except HardwareError as exc:
+        ctl.abort(f"hardware failure: {exc}", "error")
+    finally:
+        robot.stop_all()
+    wall_time = wall() - wall0
+    sim_time = clock.now() - t0
+    diag = robot.diagnostics()
+    res = ctl.result
+    fell = fell or bool(diag.get("fell", False))
+    result = RunResult(
+        outcome="fell" if fell else res.outcome,
+        ascent_end=res.ascent_end,
+        steps_climbed=res.steps_climbed,
+        steps_descended=res.steps_descended,
+        pauses=res.pauses,
+        error=res.error,
+        fell=fell,
+        max_pitch_deg=_float_or_none(diag.get("max_pitch_deg")),
+        final_offset_m=_float_or_none(diag.get("offset_m")),
+        sim_time_s=sim_time,
+        wall_time_s=wall_time,
+        realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
+    )
+    sink(Event(clock.now(), EventKind.END, _summary_line(result), None, result.to_dict()))
+    return result
+
+
+def _apply(control: RunControl, ctl: Controller, robot: Any) -> None:
+    reason = control.stop_reason
+    if reason is not None:
+        robot.stop_all()
+        ctl.abort(reason, "stopped")
+        return
+    if control.estopped:
+        robot.stop_all()
+        if not ctl.held:
+            ctl.hold("emergency stop")
+    elif control.paused:
+        if not ctl.held:
+            ctl.hold("paused by the operator")
+    elif ctl.held:
+        ctl.release()
+
+
+def _summary_line(r: RunResult) -> str:
+    parts = [f"run {r.outcome}"]
+    if r.ascent_end:
+        parts.append(f"ascent ended: {r.ascent_end}")
+    parts.append(f"climbed {r.steps_climbed}, descended {r.steps_descended}")
+    if r.pauses:
+        parts.append(f"{r.pauses} pause(s)")
+    if r.error:
+        parts.append(f"error: {r.error}")
+    return "; ".join(parts)
