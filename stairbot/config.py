@@ -10,7 +10,6 @@ file, the field and what is allowed.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -18,6 +17,7 @@ from typing import Annotated, Any
 
 import msgspec
 
+from stairbot._schema import convert, load_toml
 from stairbot.errors import ConfigError
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
@@ -221,7 +221,7 @@ class RobotConfig:
             name: msgspec.to_builtins(getattr(self, name))
             for name in ("geometry", "masses", "motors", "sensors", "algorithm")
         }
-        out["geometry"]["LENGTH_OF_A_ROBOT"] = self.LENGTH_OF_A_ROBOT
+        out["geometry"]["LENGTH_OF_A_ROBOT"] = round(self.LENGTH_OF_A_ROBOT, 6)
         out["derived"] = {k: round(v, 6) for k, v in self.derived().items()}
         out["source"] = self.source
         return out
@@ -230,40 +230,15 @@ class RobotConfig:
 DEFAULT_CONFIG_NAME = "default_robot.toml"
 
 
-def _field_from_path(path: str) -> str:
-    # msgspec paths look like "$.geometry.wheel_radius" or "$.algorithm"
-    return path.removeprefix("$").lstrip(".") or "(top level)"
-
-
-def _split_msgspec_error(message: str) -> tuple[str | None, str]:
-    if " - at `" in message:
-        problem, _, rest = message.partition(" - at `")
-        return _field_from_path(rest.rstrip("`")), problem
-    return None, message
-
-
 def parse_config(text: str, source: str) -> RobotConfig:
-    """Parse and validate a config document.  Raises ConfigError."""
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(source, None, f"not valid TOML: {exc}") from None
-    try:
-        data = msgspec.convert(raw, ConfigFile, strict=True)
-    except msgspec.ValidationError as exc:
-        field, problem = _split_msgspec_error(str(exc))
-        raise ConfigError(source, field, _explain(problem)) from None
+    """Parse and validate a config document.  Raises ConfigError naming the
+    file, the field and what it allows."""
+    raw = load_toml(text, source, ConfigError)
+    data = convert(raw, ConfigFile, source, ConfigError)
     cfg = RobotConfig(source, data.geometry, data.masses, data.motors, data.sensors,
                       data.algorithm)
     _check_consistency(cfg)
     return cfg
-
-
-def _explain(problem: str) -> str:
-    if problem.startswith("Object contains unknown field"):
-        name = problem.split("`")[1] if "`" in problem else "?"
-        return f"unknown key {name!r}; see the shipped default for the allowed keys"
-    return problem
 
 
 def _check_consistency(cfg: RobotConfig) -> None:

@@ -8,14 +8,15 @@ allowed.  The parsed :class:`Scenario` is plain data the simulation builds from.
 
 from __future__ import annotations
 
-import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import msgspec
 
+from stairbot._schema import convert, load_toml
 from stairbot.errors import ScenarioError
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
@@ -99,28 +100,11 @@ class Scenario:
 DEFAULT_STAIRS = Stairs(count=5, rise=0.17, tread=0.28)
 
 
-def _split(message: str) -> tuple[str | None, str]:
-    if " - at `" in message:
-        problem, _, rest = message.partition(" - at `")
-        field = rest.rstrip("`").removeprefix("$").lstrip(".")
-        return field or None, problem
-    return None, message
-
-
 def parse_scenario(text: str, source: str) -> Scenario:
-    """Parse and validate a scenario document.  Raises ScenarioError."""
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(source, None, f"not valid TOML: {exc}") from None
-    try:
-        data = msgspec.convert(raw, ScenarioFile, strict=True)
-    except msgspec.ValidationError as exc:
-        field, problem = _split(str(exc))
-        if problem.startswith("Object contains unknown field"):
-            problem = f"unknown key {problem.split('`')[1]!r}; the schema is in docs/scenarios.md"
-        raise ScenarioError(source, field, problem) from None
-    return _resolve(data, source)
+    """Parse and validate a scenario document.  Raises ScenarioError naming the
+    file, the field and what it allows."""
+    raw = load_toml(text, source, ScenarioError)
+    return _resolve(convert(raw, ScenarioFile, source, ScenarioError), source)
 
 
 def _resolve(data: ScenarioFile, source: str) -> Scenario:
@@ -137,8 +121,10 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
             raise ScenarioError(source, f"stairs.{missing}",
                                 "required with count > 0 (a length in metres, > 0)")
         steps = tuple(Step(st.rise or 0.0, st.tread or 0.0) for _ in range(count))
-    if steps and st.top == "wall" and len(steps) == 0:
-        raise ScenarioError(source, "stairs.top", "a wall needs at least one step")
+    if st.top == "wall" and not steps:
+        raise ScenarioError(source, "stairs.top",
+                            "'wall' needs at least one step; open floor is count = 0 "
+                            "with top = 'landing'")
     for fi, fault in enumerate(data.faults):
         if fault.kind == "offset" and fault.offset == 0.0:
             raise ScenarioError(source, f"faults[{fi}].offset",
@@ -163,12 +149,35 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
     )
 
 
+SHIPPED_DIR = "scenarios"
+
+
+def shipped_scenarios() -> list[str]:
+    """Names of the scenarios shipped with stairbot (``--scenario NAME``)."""
+    folder = resources.files("stairbot").joinpath(SHIPPED_DIR)
+    return sorted(f.name.removesuffix(".toml") for f in folder.iterdir()
+                  if f.name.endswith(".toml"))
+
+
+def _is_name(text: str) -> bool:
+    return "/" not in text and "\\" not in text and not text.endswith(".toml")
+
+
 def load_scenario(path: str | Path | None = None) -> Scenario:
-    """Load a scenario file, or the default stairs when ``path`` is None."""
+    """Load a scenario file, a shipped scenario by name (``"wall_at_top"``: a
+    plain word that is no existing file), or the default stairs when ``path``
+    is None.  Raises ScenarioError."""
     if path is None:
         text = resources.files("stairbot").joinpath("default_scenario.toml").read_text("utf-8")
         return parse_scenario(text, "<default scenario>")
     p = Path(path)
+    if isinstance(path, str) and _is_name(path) and not p.exists():
+        names = shipped_scenarios()
+        if path not in names:
+            raise ScenarioError(path, None, "no such file, nor a shipped scenario; shipped: "
+                                + ", ".join(names))
+        entry = resources.files("stairbot").joinpath(SHIPPED_DIR, f"{path}.toml")
+        return parse_scenario(entry.read_text("utf-8"), f"<scenario {path}>")
     try:
         text = p.read_text("utf-8")
     except OSError as exc:
@@ -176,3 +185,31 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
     except UnicodeDecodeError:
         raise ScenarioError(str(p), None, "not a UTF-8 text file") from None
     return parse_scenario(text, str(p))
+
+
+def expectation_mismatches(expect: Expect | None, result: Mapping[str, Any]) -> list[str]:
+    """Compare a run's result (``RunResult.to_dict()``) with ``[expect]``.
+
+    Returns one line per field that differs (empty: the run ended as expected).
+    Without ``[expect]`` the run is expected to complete.
+    """
+    if expect is None:
+        expect = Expect(outcome="completed")
+    out: list[str] = []
+    for name in ("outcome", "steps_climbed", "steps_descended", "pauses"):
+        want = getattr(expect, name)
+        if want is not None and result.get(name) != want:
+            out.append(f"{name}: expected {want!r}, got {result.get(name)!r}")
+    if expect.ascent_end is not None:
+        want_end = None if expect.ascent_end == "none" else expect.ascent_end
+        if result.get("ascent_end") != want_end:
+            out.append(f"ascent_end: expected {want_end!r}, got {result.get('ascent_end')!r}")
+    if expect.error_contains is not None:
+        err = result.get("error") or ""
+        if expect.error_contains.lower() not in str(err).lower():
+            out.append(f"error: expected text containing {expect.error_contains!r}, got {err!r}")
+    if expect.max_final_offset_m is not None:
+        off = result.get("final_offset_m")
+        if off is None or off > expect.max_final_offset_m:
+            out.append(f"final_offset_m: expected at most {expect.max_final_offset_m}, got {off!r}")
+    return out

@@ -1,0 +1,135 @@
+"""Strict TOML-to-struct conversion with messages a person can act on.
+
+``convert`` turns msgspec's validation errors ("Expected `float` > 0.0 - at
+`$.stairs.rise`") into ``InputError`` messages that name the file, the field
+(``stairs.rise``), the value found and what is allowed.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from typing import Any, TypeVar
+
+import msgspec
+import msgspec.inspect as mi
+
+from stairbot.errors import InputError
+
+T = TypeVar("T")
+
+_PATH = re.compile(r"^(?P<problem>.*) - at `\$(?P<path>[^`]*)`$", re.S)
+_TOKEN = re.compile(r"\.([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]")
+
+
+def load_toml(text: str, source: str, error: type[InputError]) -> dict[str, Any]:
+    """Parse TOML text.  Raises ``error`` (an InputError class) when it is not TOML."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(source, None, f"not valid TOML: {exc}") from None
+
+
+def convert(raw: dict[str, Any], kind: type[T], source: str, error: type[InputError]) -> T:
+    """Convert parsed TOML to the struct ``kind``.  Raises ``error`` whose message
+    names ``source``, the dotted field and what the field allows."""
+    try:
+        return msgspec.convert(raw, kind, strict=True)
+    except msgspec.ValidationError as exc:
+        field, problem = explain(str(exc), raw, kind)
+        raise error(source, field, problem) from None
+
+
+def _tokens(path: str) -> list[str | int]:
+    return [name if name else int(index) for name, index in _TOKEN.findall(path)]
+
+
+def _dotted(tokens: list[str | int]) -> str:
+    out = ""
+    for t in tokens:
+        out += f"[{t}]" if isinstance(t, int) else (f".{t}" if out else t)
+    return out
+
+
+def _strip_optional(t: mi.Type) -> mi.Type:
+    if isinstance(t, mi.UnionType):
+        rest = [u for u in t.types if not isinstance(u, mi.NoneType)]
+        if len(rest) == 1:
+            return rest[0]
+    return t
+
+
+def _type_at(kind: Any, tokens: list[str | int]) -> mi.Type | None:
+    t: mi.Type | None = mi.type_info(kind)
+    for tok in tokens:
+        t = _strip_optional(t) if t is not None else None
+        if isinstance(tok, int):
+            t = t.item_type if isinstance(t, mi.ListType) else None
+        elif isinstance(t, mi.StructType):
+            t = next((f.type for f in t.fields if f.encode_name == tok), None)
+        else:
+            return None
+    return t
+
+
+def _value_at(raw: Any, tokens: list[str | int]) -> Any:
+    for tok in tokens:
+        try:
+            raw = raw[tok]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return raw
+
+
+def _literals(t: mi.Type) -> list[str]:
+    values: list[str] = []
+    for u in t.types if isinstance(t, mi.UnionType) else (t,):
+        if isinstance(u, mi.LiteralType):
+            values += [str(v) for v in u.values]
+    return values
+
+
+def describe(t: mi.Type | None) -> str:
+    """What a field allows, in words: "a number > 0", "one of 'a', 'b'"."""
+    if t is None:
+        return "see the schema"
+    t = _strip_optional(t)
+    lits = _literals(t)
+    if lits:
+        return "one of " + ", ".join(repr(v) for v in lits)
+    if isinstance(t, mi.UnionType):
+        return " or ".join(describe(u) for u in t.types if not isinstance(u, mi.NoneType))
+    if isinstance(t, mi.FloatType | mi.IntType):
+        noun = "a number" if isinstance(t, mi.FloatType) else "a whole number"
+        bounds = [f"{op} {v:g}" for op, v in
+                  ((">", t.gt), (">=", t.ge), ("<", t.lt), ("<=", t.le)) if v is not None]
+        return noun + (" " + " and ".join(bounds) if bounds else "")
+    if isinstance(t, mi.StrType):
+        return "text"
+    if isinstance(t, mi.BoolType):
+        return "true or false"
+    if isinstance(t, mi.ListType):
+        return "a list of " + describe(t.item_type)
+    if isinstance(t, mi.StructType):
+        return "a table with keys " + ", ".join(f.encode_name for f in t.fields)
+    return "see the schema"
+
+
+def explain(message: str, raw: dict[str, Any], kind: Any) -> tuple[str | None, str]:
+    """Turn one msgspec validation message into (dotted field, problem)."""
+    m = _PATH.match(message)
+    problem, tokens = (m["problem"], _tokens(m["path"])) if m else (message, [])
+    unknown = re.match(r"Object contains unknown field `(.*)`", problem)
+    if unknown:
+        owner = _strip_optional(_type_at(kind, tokens) or mi.AnyType())
+        allowed = (", ".join(f.encode_name for f in owner.fields)
+                   if isinstance(owner, mi.StructType) else "see the schema")
+        return _dotted([*tokens, unknown[1]]), f"unknown key; allowed keys here: {allowed}"
+    missing = re.match(r"Object missing required field `(.*)`", problem)
+    if missing:
+        full = [*tokens, missing[1]]
+        return _dotted(full), f"required but missing; allowed: {describe(_type_at(kind, full))}"
+    field = _dotted(tokens) or None
+    value = _value_at(raw, tokens)
+    shown = f"{value!r}" if not isinstance(value, dict | list) else type(value).__name__
+    return field, f"{shown} is not allowed; allowed: {describe(_type_at(kind, tokens))}"
