@@ -1,0 +1,380 @@
+"""The ``stairbot`` command: headless runs, the robot config, scenarios.
+
+Exit codes (every subcommand):
+
+* 0  the run ended as the scenario's ``[expect]`` says (or the command worked)
+* 1  the run ended otherwise (the mismatching fields are named)
+* 2  bad input: config, scenario, robot URL, options; one line on stderr
+* 130  interrupted with Ctrl-C (the robot is stopped first)
+
+The subcommands ``console`` and ``fake-boards`` live in their own subpackages
+and are imported only when used, so ``stairbot run`` never loads textual.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from importlib import import_module
+from types import FrameType
+from typing import IO, Any, TextIO
+
+from stairbot import __version__
+from stairbot.config import RobotConfig, load_config
+from stairbot.errors import HardwareError, InputError
+from stairbot.events import Event, EventKind
+from stairbot.scenario import (
+    Scenario,
+    expectation_mismatches,
+    load_scenario,
+    shipped_scenarios,
+)
+
+PROG = "stairbot"
+EXIT_OK, EXIT_MISMATCH, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+# Subcommands that other subpackages implement: name -> ("module:function", help).
+# The function takes the remaining argv (list[str]) and returns an exit code.
+EXTERNAL: dict[str, tuple[str, str]] = {
+    "console": ("stairbot.console.cli:main",
+                "the operator console: a terminal UI that watches and commands the robot"),
+    "fake-boards": ("stairbot.fakes.boards_cli:main",
+                    "serve simulated motor and sensor boards on a pseudo-terminal or CAN bus"),
+}
+
+ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N, "
+              "can://INTERFACE/CHANNEL?bitrate=N")
+SCENARIO_HELP = ("scenario TOML file, or the name of a shipped scenario (see "
+                 "`stairbot scenario list`); default: five residential steps")
+CONFIG_HELP = "robot config TOML file (default: the shipped reference robot)"
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Keep the descriptions' line breaks and show defaults where they help."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The whole command line, every subcommand with its --help."""
+    p = argparse.ArgumentParser(
+        prog=PROG, formatter_class=_Formatter,
+        description="Host software for a three-segment stair-climbing robot.",
+        epilog="Exit codes: 0 as expected, 1 not as expected, 2 bad input, "
+               "130 interrupted.\nSee `stairbot COMMAND --help` and README.md.",
+    )
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    r = sub.add_parser(
+        "run", formatter_class=_Formatter,
+        help="run the robot headless: calibrate, climb, descend, summarise",
+        description="Run the whole program (calibration, ascent, descent) on a robot,\n"
+                    "headless.  Prints each phase change as one line, then a summary.\n"
+                    "Exit 0 when the run ends as the scenario's [expect] says (without\n"
+                    "[expect]: when it completes), 1 when it does not, 2 on bad input.",
+    )
+    r.add_argument("--robot", metavar="URL", default="sim://", help=ROBOT_HELP)
+    r.add_argument("--scenario", metavar="FILE|NAME", help=SCENARIO_HELP)
+    r.add_argument("--config", metavar="FILE", help=CONFIG_HELP)
+    r.add_argument("--json", action="store_true",
+                   help="print one JSON object (the result) on stdout; progress goes to stderr")
+    r.add_argument("--realtime", action="store_true",
+                   help="pace a simulated robot to the wall clock (default: as fast as possible)")
+    r.add_argument("--time-scale", metavar="X", type=_positive_float,
+                   help="pace a simulated robot at X simulated seconds per wall second")
+    r.add_argument("--record", metavar="FILE",
+                   help="write the event stream to FILE, one JSON object a line")
+    r.add_argument("--calibrate-only", action="store_true",
+                   help="only square up to the first riser (calibration), then stop; "
+                        "[expect] is not checked: exit 0 when calibration completes")
+    r.add_argument("-q", "--quiet", action="store_true",
+                   help="print no progress lines, only the summary (or the JSON)")
+    r.set_defaults(func=cmd_run)
+
+    c = sub.add_parser("config", help="show the robot config and what follows from it",
+                       description="Robot config commands.")
+    csub = c.add_subparsers(dest="config_command", metavar="SUBCOMMAND", required=True)
+    cs = csub.add_parser(
+        "show", formatter_class=_Formatter,
+        help="print the resolved config and its derived values",
+        description="Print the resolved robot config: every section of the file and the\n"
+                    "values derived from it (turn counts, max_step_rise_m, min_tread_m).",
+    )
+    cs.add_argument("--config", metavar="FILE", help=CONFIG_HELP)
+    cs.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    cs.set_defaults(func=cmd_config_show)
+
+    s = sub.add_parser("scenario", help="check and list scenarios",
+                       description="Scenario commands (the schema: docs/scenarios.md).")
+    ssub = s.add_subparsers(dest="scenario_command", metavar="SUBCOMMAND", required=True)
+    sc = ssub.add_parser("check", help="validate scenario files without running them",
+                         description="Validate scenario files (or shipped names).  Exit 0 "
+                                     "when all are valid, 2 when any is not.")
+    sc.add_argument("files", nargs="+", metavar="FILE|NAME", help="scenario files or names")
+    sc.set_defaults(func=cmd_scenario_check)
+    sl = ssub.add_parser("list", help="list the shipped scenarios",
+                         description="List the shipped scenarios: name and description.")
+    sl.set_defaults(func=cmd_scenario_list)
+
+    for name, (_target, text) in EXTERNAL.items():
+        e = sub.add_parser(name, help=text, add_help=False, prefix_chars="\0",
+                           description=text)
+        e.add_argument("rest", nargs=argparse.REMAINDER)
+        e.set_defaults(func=_external(name))
+    return p
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+    return value
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code (the console script exits with it)."""
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    if args_list and args_list[0] in EXTERNAL:  # the subcommand parses its own options
+        return _external(args_list[0])(argparse.Namespace(rest=args_list[1:]))
+    args = build_parser().parse_args(args_list)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except InputError as exc:
+        return _input_error(exc)
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # `stairbot run | head`: the reader left, nothing to say
+        return EXIT_OK
+
+
+def _input_error(exc: Exception) -> int:
+    print(f"{PROG}: error: {exc}", file=sys.stderr)
+    return EXIT_INPUT
+
+
+def _external(name: str) -> Callable[[argparse.Namespace], int]:
+    def call(args: argparse.Namespace) -> int:
+        target = EXTERNAL[name][0]
+        module_name, _, attr = target.partition(":")
+        try:
+            func: Callable[[list[str]], int] = getattr(import_module(module_name), attr)
+        except (ImportError, AttributeError) as exc:
+            print(f"{PROG}: error: `{PROG} {name}` is not available in this build ({exc})",
+                  file=sys.stderr)
+            return EXIT_INPUT
+        try:
+            return func(list(args.rest))
+        except InputError as exc:
+            return _input_error(exc)
+        except KeyboardInterrupt:
+            print(f"{PROG}: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+    return call
+
+
+# -- run ---------------------------------------------------------------------------
+
+
+def _load_inputs(args: argparse.Namespace) -> tuple[RobotConfig, Scenario]:
+    return load_config(args.config), load_scenario(args.scenario)
+
+
+@contextmanager
+def _record_file(path: str | None) -> Iterator[IO[str] | None]:
+    if path is None:
+        yield None
+        return
+    try:
+        f = open(path, "w", encoding="utf-8")  # noqa: SIM115 - closed below
+    except OSError as exc:
+        raise InputError(path, None, f"cannot write the record: {exc.strerror or exc}") from None
+    with f:
+        yield f
+
+
+@contextmanager
+def _ctrl_c_stops(request_stop: Callable[[str], None]) -> Iterator[None]:
+    """First Ctrl-C asks the run loop to stop the robot and end cleanly; a second
+    one raises KeyboardInterrupt at once (the loop's finally still stops it)."""
+    pressed = False
+
+    def handler(_sig: int, _frame: FrameType | None) -> None:
+        nonlocal pressed
+        if pressed:
+            raise KeyboardInterrupt
+        pressed = True
+        request_stop("interrupted by Ctrl-C")
+
+    try:
+        previous = signal.signal(signal.SIGINT, handler)
+    except ValueError:  # not the main thread: leave Ctrl-C as it is
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    """``stairbot run``: open the robot, run the program, summarise, judge."""
+    # Imported here: the runner pulls in the controller, which `config show` needs not.
+    from stairbot.phases import Mode
+    from stairbot.robots import RobotOptions, open_robot
+    from stairbot.runner import RunControl, run
+
+    config, scenario = _load_inputs(args)
+    progress: TextIO = sys.stderr if args.json else sys.stdout
+    options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale)
+    mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
+    with _record_file(args.record) as record:
+        def sink(event: Event) -> None:
+            if record is not None:
+                record.write(event.to_json() + "\n")
+            if not args.quiet and event.kind is not EventKind.END:
+                print(event.line(), file=progress, flush=True)
+
+        try:
+            session = open_robot(args.robot, config, scenario, options)
+        except HardwareError as exc:
+            print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
+            return EXIT_MISMATCH
+        control = RunControl()
+        try:
+            with _ctrl_c_stops(control.request_stop):
+                result = run(session, config, sink=sink, mode=mode, control=control)
+        except KeyboardInterrupt:
+            session.robot.stop_all()
+            print(f"{PROG}: interrupted: every motor stopped", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        finally:
+            session.close()
+    data = result.to_dict()
+    interrupted = control.stop_reason is not None
+    if args.calibrate_only:
+        mismatches = [] if result.outcome == "completed" else [
+            f"outcome: expected 'completed', got {result.outcome!r}"]
+    else:
+        mismatches = expectation_mismatches(scenario.expect, data)
+    if args.json:
+        out = {**data, "robot": args.robot, "scenario": scenario.name,
+               "config": config.source, "as_expected": not mismatches,
+               "mismatches": mismatches}
+        print(json.dumps(out, sort_keys=True))
+    else:
+        _print_summary(data, scenario, args.robot, mismatches)
+    if interrupted:
+        print(f"{PROG}: interrupted: every motor stopped", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if mismatches:
+        print(f"{PROG}: the run did not end as {scenario.source} expects: "
+              + "; ".join(mismatches), file=sys.stderr)
+        return EXIT_MISMATCH
+    return EXIT_OK
+
+
+def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
+    if value is None:
+        return "n/a"
+    if isinstance(value, float):
+        return f"{value:.{digits}f}{unit}"
+    return f"{value}{unit}"
+
+
+def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
+                   mismatches: list[str]) -> None:
+    rtf = d.get("realtime_factor")
+    lines = [
+        "",
+        f"summary ({scenario.name} on {robot})",
+        f"  outcome           {d['outcome']}"
+        + (f" (ascent ended: {d['ascent_end']})" if d.get("ascent_end") else ""),
+        f"  steps             climbed {d['steps_climbed']}, descended {d['steps_descended']}",
+        f"  pauses            {d['pauses']}",
+        f"  error             {d['error'] or 'none'}",
+        f"  fell              {'yes' if d['fell'] else 'no'}"
+        f" (max pitch {_fmt(d.get('max_pitch_deg'), ' deg', 1)})",
+        f"  offset from start {_fmt(d.get('final_offset_m'), ' m')}",
+        f"  time              {_fmt(d['sim_time_s'], ' s', 2)} robot time, "
+        f"{_fmt(d['wall_time_s'], ' s', 2)} wall"
+        + (f" (realtime x{rtf:.0f})" if isinstance(rtf, float | int) else ""),
+        "  expected          " + ("yes" if not mismatches else "NO: " + "; ".join(mismatches)),
+    ]
+    print("\n".join(lines), flush=True)
+
+
+# -- config show ---------------------------------------------------------------------
+
+_DERIVED_UNITS = {"_m_s": "m/s", "_m": "m", "TURNS": "turns", "turns": "turns"}
+
+
+def _unit(name: str) -> str:
+    for suffix, unit in _DERIVED_UNITS.items():
+        if name.endswith(suffix) or suffix in name:
+            return unit
+    return "m"
+
+
+def cmd_config_show(args: argparse.Namespace) -> int:
+    """``stairbot config show``: the resolved config and its derived values."""
+    cfg = load_config(args.config)
+    data = cfg.to_dict()
+    if args.json:
+        print(json.dumps(data, indent=2, sort_keys=True))
+        return EXIT_OK
+    print(f"# robot config from {data['source']}")
+    for section in ("geometry", "masses", "motors", "sensors", "algorithm"):
+        print(f"\n[{section}]")
+        for key, value in data[section].items():
+            print(f"{key} = {value!r}")
+    print("\n[derived]  # computed from the values above, not read from the file")
+    width = max(len(k) for k in data["derived"])
+    for key, value in data["derived"].items():
+        print(f"{key:<{width}} = {value:<10g} # {_unit(key)}")
+    return EXIT_OK
+
+
+# -- scenarios ---------------------------------------------------------------------
+
+
+def _describe(s: Scenario) -> str:
+    stairs = (f"{len(s.steps)} steps, top {s.top}" if s.steps else "open floor")
+    exp = s.expect
+    want = "completed" if exp is None else ", ".join(
+        f"{k}={v}" for k, v in (
+            ("outcome", exp.outcome), ("ascent_end", exp.ascent_end),
+            ("steps_climbed", exp.steps_climbed), ("steps_descended", exp.steps_descended),
+            ("pauses", exp.pauses)) if v is not None)
+    return f"{stairs}; {len(s.faults)} fault(s); expects {want}"
+
+
+def cmd_scenario_check(args: argparse.Namespace) -> int:
+    """``stairbot scenario check``: validate each file; exit 2 if any is invalid."""
+    bad = 0
+    for name in args.files:
+        try:
+            s = load_scenario(name)
+        except InputError as exc:
+            print(f"{PROG}: error: {exc}", file=sys.stderr)
+            bad += 1
+            continue
+        print(f"ok  {name}: {_describe(s)}")
+    return EXIT_INPUT if bad else EXIT_OK
+
+
+def cmd_scenario_list(_args: argparse.Namespace) -> int:
+    """``stairbot scenario list``: the shipped scenarios with their descriptions."""
+    names = shipped_scenarios()
+    width = max((len(n) for n in names), default=0)
+    for name in names:
+        s = load_scenario(name)
+        print(f"{name:<{width}}  {s.description}")
+    return EXIT_OK
