@@ -75,6 +75,7 @@ class MotorFault(IntEnum):
     ENCODER = 5
     LIMIT = 6  # a lift at the end of its stroke refused to go further
     DRIVER = 7  # motor driver chip fault
+    SIMULATION = 8  # fake boards only: the simulated world failed (a fall); see Truth
 
 
 class SensorCode(IntEnum):
@@ -289,6 +290,15 @@ class StepTo(Message):
     time_us: int
 
 
+@dataclass(frozen=True, slots=True)
+class GetTruth(Message):
+    """Simulation only: ask the fake boards for the simulated world's truth
+    (not something a real robot knows).  Sent to the motor board.  Reply: Truth."""
+
+    TYPE = 0x7D
+    IDEMPOTENT = True
+
+
 # ---- board -> host ---------------------------------------------------------
 
 
@@ -376,12 +386,25 @@ class StepDone(Message):
     time_us: int
 
 
+@dataclass(frozen=True, slots=True)
+class Truth(Message):
+    """Simulation only: bit 0 of ``flags`` = the robot fell; the largest pitch
+    so far in centi-degrees; the robot's offset from its start in mm."""
+
+    TYPE = 0xFD
+    FORMAT = "<Bxhi"
+    REPLY = True
+    flags: int
+    max_pitch_cdeg: int
+    offset_mm: int
+
+
 MESSAGES: dict[int, type[Message]] = {
     cls.TYPE: cls
     for cls in (
         Identify, Heartbeat, GetStatus, SetWatchdog, EStop, Clear, ReadAll, GetMotor,
-        GetSensor, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, StepTo,
-        Ident, Status, MotorTelemetry, SensorTelemetry, Ack, StepDone,
+        GetSensor, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, StepTo, GetTruth,
+        Ident, Status, MotorTelemetry, SensorTelemetry, Ack, StepDone, Truth,
     )
 }
 _STRUCTS: dict[int, struct.Struct] = {t: struct.Struct(c.FORMAT) for t, c in MESSAGES.items()}
