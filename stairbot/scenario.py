@@ -97,7 +97,8 @@ class Scenario:
     expect: Expect | None
 
 
-DEFAULT_STAIRS = Stairs(count=5, rise=0.17, tread=0.28)
+DEFAULT_COUNT, DEFAULT_RISE, DEFAULT_TREAD = 5, 0.17, 0.28
+DEFAULT_STAIRS = Stairs(count=DEFAULT_COUNT, rise=DEFAULT_RISE, tread=DEFAULT_TREAD)
 
 
 def parse_scenario(text: str, source: str) -> Scenario:
@@ -115,12 +116,11 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
                                 "give either steps = [...] or count + rise + tread, not both")
         steps = tuple(st.steps)
     else:
-        count = 5 if st.count is None else st.count
-        if count > 0 and (st.rise is None or st.tread is None):
-            missing = "rise" if st.rise is None else "tread"
-            raise ScenarioError(source, f"stairs.{missing}",
-                                "required with count > 0 (a length in metres, > 0)")
-        steps = tuple(Step(st.rise or 0.0, st.tread or 0.0) for _ in range(count))
+        # a key left out takes the default stairs' value
+        count = DEFAULT_COUNT if st.count is None else st.count
+        step = Step(DEFAULT_RISE if st.rise is None else st.rise,
+                    DEFAULT_TREAD if st.tread is None else st.tread)
+        steps = tuple(step for _ in range(count))
     if st.top == "wall" and not steps:
         raise ScenarioError(source, "stairs.top",
                             "'wall' needs at least one step; open floor is count = 0 "

@@ -1,0 +1,116 @@
+"""The robot config: seed names, derived turn counts, and errors that name the
+file, the field and what is allowed."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+import pytest
+
+from stairbot.config import load_config, parse_config
+from stairbot.errors import ConfigError
+
+DEFAULT_TEXT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
+
+
+def with_change(section: str, key: str, value: str | None) -> str:
+    """The default config text with one key replaced (value None: removed)."""
+    out, current = [], None
+    for line in DEFAULT_TEXT.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("["):
+            current = stripped.strip("[]")
+        if current == section and stripped.split("=")[0].strip() == key:
+            if value is not None:
+                out.append(f"{key} = {value}")
+            continue
+        out.append(line)
+    text = "\n".join(out) + "\n"
+    assert text != DEFAULT_TEXT + "\n" or value is not None
+    return text
+
+
+def test_default_loads_and_derives_the_reference_robot() -> None:
+    cfg = load_config()
+    assert cfg.LENGTH_OF_A_ROBOT == pytest.approx(0.225)
+    assert cfg.wheel_circumference == pytest.approx(2 * math.pi * 0.016)
+    assert cfg.MAX_OF_VERTICAL_TURNS == pytest.approx(105)
+    assert cfg.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE == pytest.approx(5)
+    assert cfg.initial_number_of_vertical_turns == pytest.approx(19)
+    approach = cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+    assert approach == pytest.approx(0.09 / cfg.wheel_circumference)
+    assert cfg.BACK_CLEARANCE == pytest.approx(0.04)
+
+
+def test_the_reference_robot_climbs_residential_stairs() -> None:
+    cfg = load_config()
+    assert cfg.max_step_rise_m >= 0.18  # rise 0.15-0.18 m
+    assert cfg.min_tread_m <= 0.26  # tread 0.26-0.30 m
+
+
+def test_to_dict_has_every_section_and_the_derived_values() -> None:
+    d = load_config().to_dict()
+    assert set(d) >= {"geometry", "masses", "motors", "sensors", "algorithm", "derived", "source"}
+    assert d["derived"]["max_step_rise_m"] == pytest.approx(0.202)
+    assert d["derived"]["min_tread_m"] == pytest.approx(0.255)
+    assert d["geometry"]["LENGTH_OF_A_ROBOT"] == 0.225
+
+
+def test_turn_counts_follow_the_geometry() -> None:
+    cfg = parse_config(with_change("geometry", "wheel_radius", "0.018"), "big.toml")
+    assert cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE == pytest.approx(
+        0.075 / (2 * math.pi * 0.018))
+
+
+def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
+    text = DEFAULT_TEXT.replace("[geometry]\n", "[geometry]\nLENGTH_OF_A_ROBOT = 0.225\n")
+    assert parse_config(text, "x.toml").LENGTH_OF_A_ROBOT == pytest.approx(0.225)
+
+
+@pytest.mark.parametrize(
+    ("text", "field", "words"),
+    [
+        (DEFAULT_TEXT.replace("[geometry]\n", "[geometry]\nLENGTH_OF_A_ROBOT = 0.3\n"),
+         "geometry.LENGTH_OF_A_ROBOT", "add up to"),
+        (with_change("geometry", "wheel_radius", "-0.016"), "geometry.wheel_radius", "> 0"),
+        (with_change("motors", "lift_speed", '"fast"'), "motors.lift_speed", "a number"),
+        (with_change("masses", "wheel", None), "masses.wheel", "required"),
+        (DEFAULT_TEXT.replace("[masses]\n", "[masses]\nbattery = 1.0\n"), "masses.battery",
+         "allowed keys here: first_module"),
+        (DEFAULT_TEXT + "\n[extra]\nx = 1\n", "extra", "allowed keys here: geometry"),
+        (with_change("algorithm", "max_steps", "25"), "algorithm.max_steps", "<= 20"),
+        (with_change("algorithm", "LENGTH_OF_INFINITY", "2.0"), "algorithm.LENGTH_OF_INFINITY",
+         "front_max_range"),
+        (with_change("sensors", "front_min_range", "1.5"), "sensors.front_min_range", "below"),
+    ],
+)
+def test_bad_configs_name_the_file_the_field_and_what_is_allowed(
+        text: str, field: str, words: str) -> None:
+    with pytest.raises(ConfigError) as info:
+        parse_config(text, "robot.toml")
+    err = info.value
+    assert err.source == "robot.toml"
+    assert err.field == field
+    assert words in str(err)
+    assert str(err).startswith(f"robot.toml: {field}: ")
+
+
+def test_not_toml_is_a_config_error() -> None:
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        parse_config("[geometry\nx = ", "broken.toml")
+
+
+def test_missing_file_is_a_config_error(tmp_path: Path) -> None:
+    missing = tmp_path / "nope.toml"
+    with pytest.raises(ConfigError, match="cannot read") as info:
+        load_config(missing)
+    assert info.value.source == str(missing)
+
+
+def test_the_default_file_is_valid_toml_with_seed_names() -> None:
+    raw = tomllib.loads(DEFAULT_TEXT)
+    assert "SAFE_DISTANCE_IN_FRONT_OF_STEP" in raw["algorithm"]
+    assert "LENGTH_OF_FIRST_MODULE" in raw["geometry"]
