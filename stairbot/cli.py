@@ -226,12 +226,12 @@ def _ctrl_c_stops(request_stop: Callable[[str], None]) -> Iterator[None]:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """``stairbot run``: open the robot, run the program, summarise, judge."""
+    config, scenario = _load_inputs(args)
     # Imported here: the runner pulls in the controller, which `config show` needs not.
     from stairbot.phases import Mode
     from stairbot.robots import RobotOptions, open_robot
     from stairbot.runner import RunControl, run
 
-    config, scenario = _load_inputs(args)
     progress: TextIO = sys.stderr if args.json else sys.stdout
     options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale)
     mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
