@@ -1,0 +1,310 @@
+"""The operator console: one function, :func:`build_app`, builds it (the tests
+build it the same way).
+
+The run goes on a worker thread (the runner's loop); the screen redraws ten
+times a second from a copy of the live state, however fast or slow the control
+loop ticks.  The emergency stop is a priority binding: it works on every
+screen, even over a text prompt.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+from stairbot.console.modals import AskScreen, ConfirmScreen
+from stairbot.console.runner_thread import SPEEDS, ConsoleEngine
+from stairbot.console.state import LiveState, StateView
+from stairbot.console.widgets.banner import Banner
+from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
+from stairbot.console.widgets.event_log import EventLog
+from stairbot.console.widgets.link import LinkPanel
+from stairbot.console.widgets.motors import MotorPanel
+from stairbot.console.widgets.phase import PhasePanel
+from stairbot.console.widgets.picture import StairsPicture
+from stairbot.console.widgets.sensors import SensorPanel
+from textual import work
+from textual.app import App, ComposeResult, SystemCommand
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.screen import Screen
+from textual.widgets import Footer
+
+from stairbot.config import RobotConfig, load_config
+from stairbot.errors import InputError, StairbotError
+from stairbot.hardware import MotorId
+
+REFRESH_HZ = 10.0
+SPEED_ORDER = tuple(SPEEDS)
+
+# (action, palette title, palette help) for every operator action.
+COMMANDS: tuple[tuple[str, str, str], ...] = (
+    ("estop", "EMERGENCY STOP", "Stop every motor now (key: space)"),
+    ("clear_estop", "Clear emergency stop", "Allow motion again; resume with p (key: c)"),
+    ("start('full')", "Start full run", "Calibrate, climb, descend (key: s)"),
+    ("start('calibrate')", "Calibrate only", "Run the calibration and stop (key: k)"),
+    ("pause", "Pause / resume", "Hold the run where it is, or go on (key: p)"),
+    ("stop_run", "Stop the run", "End the run, motors stopped (key: x)"),
+    ("reset", "Reset the simulated scenario", "Reopen the simulation at its start (key: r)"),
+    ("choose_robot", "Choose robot URL", "sim://, serial://PORT, can://IF/CH (key: u)"),
+    ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
+    ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
+    ("record", "Record events", "Start/stop writing events as JSON lines (key: w)"),
+)
+
+
+class StairbotConsole(App[None]):
+    """The stairbot operator console."""
+
+    CSS_PATH = "console.tcss"
+    TITLE = "stairbot console"
+    BINDINGS = [
+        Binding(ESTOP_KEY, "estop", "E-STOP", priority=True),
+        Binding("c", "clear_estop", "clear"),
+        Binding("s", "start('full')", "start"),
+        Binding("p", "pause", "pause"),
+        Binding("f", "speed", "speed"),
+        Binding("k", "start('calibrate')", "calib"),
+        Binding("r", "reset", "reset"),
+        Binding("u", "choose_robot", "robot"),
+        Binding("o", "choose_scenario", "scenario"),
+        Binding("w", "record", "rec"),
+        Binding("x", "stop_run", "stop"),
+        Binding("q", "quit", "quit"),
+    ]
+
+    def __init__(self, engine: ConsoleEngine, url: str, scenario: str | None,
+                 record: str | None = None) -> None:
+        super().__init__()
+        self.engine = engine
+        self.state = engine.state
+        self.url = url
+        self.scenario = scenario
+        self._record = record
+        self._shown_version = -1
+        self._shown_event = 0
+
+    # -- layout ------------------------------------------------------------------
+    def compose(self) -> ComposeResult:
+        tol = self.engine.config.algorithm.equal_tolerance
+        with Horizontal(id="top"):
+            yield Banner(id="banner")
+            yield EStopButton(id="estop")
+        with Horizontal(id="main"):
+            with Vertical(id="left"):
+                yield StairsPicture(id="picture")
+                yield EventLog(id="log")
+            with Vertical(id="right"):
+                yield SensorPanel(tol, id="sensors")
+                yield MotorPanel(id="motors")
+                yield PhasePanel(id="phase")
+                yield LinkPanel(id="link")
+        yield Footer(compact=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#picture").border_title = "side view"
+        if self._record:
+            try:
+                self.engine.start_recording(self._record)
+            except InputError as exc:
+                self.notify(str(exc), severity="error", timeout=8)
+        self.refresh_view()
+        self.set_interval(1 / REFRESH_HZ, self.refresh_view)
+        self.open_robot(self.url, self.scenario)
+
+    # -- the view ------------------------------------------------------------------
+    def refresh_view(self) -> None:
+        """Copy the live state and update every panel that changed."""
+        view = self.state.view(events_after=self._shown_event)
+        if view.version == self._shown_version:
+            return
+        self._shown_version = view.version
+        self._show(view)
+
+    def _show(self, v: StateView) -> None:
+        self.query_one(Banner).show(v.url, v.scenario, v.status)
+        snap = v.snapshot
+        lifts = None
+        if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
+            per_turn = self.engine.config.motors.lift_travel_per_turn
+            lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
+        note = "" if v.simulated or v.scene is not None else \
+            "wired robot: stairs from the scenario, no robot pose"
+        self.query_one(StairsPicture).show(v.scene, v.stairs, lifts, note)
+        self.query_one(SensorPanel).show(snap)
+        self.query_one(MotorPanel).show(snap, v.commands)
+        self.query_one(PhasePanel).show(v.phase, v.flow, v.context)
+        self.query_one(LinkPanel).show(v.simulated, snap.time_s if snap else None, v.ticks,
+                                       v.speed, v.health, v.recording)
+        if v.events:
+            log = self.query_one(EventLog)
+            log.add(v.events)
+            self._shown_event = log.last_seq
+
+    # -- workers -------------------------------------------------------------------
+    @work(thread=True, group="robot", exclusive=True, exit_on_error=False)
+    def open_robot(self, url: str, scenario: str | None) -> None:
+        """Open a robot off the UI thread; on bad input say so and keep the old one."""
+        previous = (self.url, self.scenario) if self.engine.session is not None else None
+        try:
+            self.engine.open(url, scenario)
+        except (StairbotError, OSError) as exc:
+            self._tell(f"cannot open {url}: {exc}", "error")
+            self.state.set_status(robot="fault", severity="error",
+                                  message=f"cannot open {url}: {exc}")
+            if previous is not None and self.engine.session is None and previous != (url,
+                                                                                       scenario):
+                try:
+                    self.engine.open(*previous)
+                    self.state.set_status(message=f"kept {previous[0]}: {url} failed: {exc}",
+                                          severity="error")
+                except (StairbotError, OSError):
+                    pass
+            return
+        self.url, self.scenario = url, scenario
+
+    @work(thread=True, group="run", exclusive=False, exit_on_error=False)
+    def run_program(self, mode: str) -> None:
+        result = self.engine.run(mode)
+        if result is not None:
+            self._tell(f"run {result.get('outcome')}", "information")
+
+    def _tell(self, message: str, severity: str) -> None:
+        self.call_from_thread(self.notify, message, severity=severity,
+                              timeout=6)
+
+    # -- actions -------------------------------------------------------------------
+    def action_estop(self) -> None:
+        """Stop every motor now, whatever the console is doing."""
+        self.engine.estop()
+        self.refresh_view()
+
+    def action_clear_estop(self) -> None:
+        if not self.engine.clear_estop():
+            self.notify("the emergency stop is not set")
+        self.refresh_view()
+
+    def action_start(self, mode: str) -> None:
+        if self.engine.running:
+            self.notify("a run is already going on", severity="warning")
+            return
+        if self.engine.session is None:
+            self.notify("no robot open: choose one with u", severity="error")
+            return
+        if self.engine.simulated:
+            self.run_program(mode)
+            return
+        what = "calibration" if mode == "calibrate" else "the full run"
+
+        def answered(yes: bool | None) -> None:
+            if yes:
+                self.run_program(mode)
+            else:
+                self.notify("not started")
+
+        self.push_screen(ConfirmScreen(
+            f"Start {what} on the WIRED robot {self.engine.session.url}?\n"
+            "The motors will move. Space stops every motor."), answered)
+
+    def action_pause(self) -> None:
+        if not self.engine.running:
+            self.notify("no run is going on")
+        elif self.state.view().status.paused:
+            self.engine.resume()
+        else:
+            self.engine.pause()
+        self.refresh_view()
+
+    def action_stop_run(self) -> None:
+        if self.engine.running:
+            self.engine.stop()
+        else:
+            self.notify("no run is going on")
+
+    def action_reset(self) -> None:
+        if self.engine.running:
+            self.notify("stop the run first (x)", severity="warning")
+        elif self.engine.session is not None and not self.engine.simulated:
+            self.notify("reset is for a simulated robot", severity="warning")
+        else:
+            self.query_one(EventLog).reset_log()
+            self.open_robot(self.url, self.scenario)
+
+    def action_choose_robot(self) -> None:
+        if self.engine.running:
+            self.notify("stop the run first (x)", severity="warning")
+            return
+
+        def chosen(url: str | None) -> None:
+            if url:
+                self.open_robot(url, self.scenario)
+
+        self.push_screen(AskScreen("Robot URL", self.url, "sim://",
+                                   "sim://  serial://PORT?baud=N  can://IF/CHANNEL"), chosen)
+
+    def action_choose_scenario(self) -> None:
+        if self.engine.running:
+            self.notify("stop the run first (x)", severity="warning")
+            return
+
+        def chosen(name: str | None) -> None:
+            if name is not None:
+                self.open_robot(self.url, name or None)
+
+        self.push_screen(AskScreen("Scenario file or shipped name (empty: default stairs)",
+                                   self.scenario or "", "default"), chosen)
+
+    def action_speed(self) -> None:
+        current = self.state.view().speed
+        nxt = SPEED_ORDER[(SPEED_ORDER.index(current) + 1) % len(SPEED_ORDER)]
+        self.engine.set_speed(nxt)
+        self.refresh_view()
+
+    def action_record(self) -> None:
+        if self.engine.recorder is not None:
+            path = self.engine.recorder.path
+            self.engine.stop_recording()
+            self.notify(f"recording stopped: {path}")
+            return
+
+        def chosen(path: str | None) -> None:
+            if not path:
+                return
+            try:
+                self.engine.start_recording(path)
+            except InputError as exc:
+                self.notify(str(exc), severity="error", timeout=8)
+                return
+            self.notify(f"recording events to {path}")
+
+        self.push_screen(AskScreen("Record the event stream (JSON lines) to", "events.jsonl"),
+                         chosen)
+
+    def get_system_commands(self, screen: Screen) -> Iterable[SystemCommand]:
+        yield from super().get_system_commands(screen)
+        for action, title, help_text in COMMANDS:
+            yield SystemCommand(title, help_text, self._runner(action))
+
+    def _runner(self, action: str) -> Callable[[], Any]:
+        async def go() -> None:
+            await self.run_action(action)
+        return go
+
+    def on_unmount(self) -> None:
+        self.engine.shutdown()
+
+
+def build_app(config: RobotConfig | str | Path | None = None, *, url: str = "sim://",
+              scenario: str | None = None, record: str | None = None, speed: str = "1x",
+              **engine_hooks: Any) -> StairbotConsole:
+    """Build the console.  ``config`` is a RobotConfig, a file, or None for the
+    shipped robot (raises ConfigError for a bad file).  ``engine_hooks``
+    (open_fn, run_fn, control_fn, wall, sleep) replace the engine's defaults."""
+    cfg = config if isinstance(config, RobotConfig) else load_config(config)
+    if speed not in SPEEDS:
+        raise InputError("--speed", None, f"{speed!r}; allowed: {', '.join(SPEEDS)}")
+    state = LiveState(url=url)
+    engine = ConsoleEngine(state, cfg, **engine_hooks)
+    engine.set_speed(speed)
+    return StairbotConsole(engine, url, scenario, record)

@@ -1,0 +1,179 @@
+"""The latest state of the robot and the run, shared between the run thread
+(which writes it every tick) and the UI (which reads a copy ten times a second).
+
+Every method takes one lock for a short time; the UI never waits for a tick.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import deque
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from stairbot.console.scene import SceneView
+
+from stairbot.events import Event
+from stairbot.hardware import MotorId, Snapshot
+
+LOG_LENGTH = 1000
+
+
+@dataclass(frozen=True)
+class RunStatus:
+    """Where the console stands, for the banner."""
+
+    robot: str = "no robot"  # "connecting" | "ready" | "running" | "ended" | "fault" | "no robot"
+    estopped: bool = False
+    paused: bool = False
+    message: str = ""  # how the run ended, or what went wrong
+    severity: str = "info"  # info | good | warning | error
+
+
+@dataclass(frozen=True)
+class StateView:
+    """An immutable copy of the live state, taken by the UI."""
+
+    version: int
+    url: str
+    scenario: str
+    simulated: bool
+    status: RunStatus
+    snapshot: Snapshot | None
+    commands: dict[MotorId, float]
+    ticks: int
+    phase: str
+    flow: str
+    context: dict[str, Any]
+    scene: SceneView | None
+    stairs: tuple[tuple[float, float], ...]
+    health: dict[str, float]
+    result: dict[str, Any] | None
+    speed: str
+    recording: str | None
+    events: tuple[tuple[int, Event], ...] = field(default=())
+
+
+class LiveState:
+    """Thread-safe latest state.  Writers: the run thread and the UI's actions."""
+
+    def __init__(self, *, url: str = "", scenario: str = "", simulated: bool = True) -> None:
+        self._lock = threading.Lock()
+        self._version = 0
+        self._url = url
+        self._scenario = scenario
+        self._simulated = simulated
+        self._status = RunStatus()
+        self._snapshot: Snapshot | None = None
+        self._commands: dict[MotorId, float] = {}
+        self._ticks = 0
+        self._phase = "—"
+        self._flow = "idle"
+        self._context: dict[str, Any] = {}
+        self._scene: SceneView | None = None
+        self._stairs: tuple[tuple[float, float], ...] = ()
+        self._health: dict[str, float] = {}
+        self._result: dict[str, Any] | None = None
+        self._speed = "max"
+        self._recording: str | None = None
+        self._events: deque[tuple[int, Event]] = deque(maxlen=LOG_LENGTH)
+        self._event_seq = 0
+
+    # -- writers -----------------------------------------------------------------
+    def _bump(self) -> None:
+        self._version += 1
+
+    def set_robot(self, url: str, scenario: str, simulated: bool,
+                  stairs: tuple[tuple[float, float], ...] = ()) -> None:
+        """A new robot was opened: forget the previous one's readings."""
+        with self._lock:
+            self._url, self._scenario, self._simulated = url, scenario, simulated
+            self._snapshot, self._commands, self._ticks = None, {}, 0
+            self._phase, self._flow, self._context = "—", "idle", {}
+            self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
+            self._bump()
+
+    def set_status(self, **changes: Any) -> None:
+        with self._lock:
+            self._status = replace(self._status, **changes)
+            self._bump()
+
+    def on_read(self, snap: Snapshot) -> None:
+        with self._lock:
+            self._snapshot = snap
+            self._ticks += 1
+            if snap.health:
+                self._health = dict(snap.health)
+            self._bump()
+
+    def on_command(self, speeds: dict[MotorId, float]) -> None:
+        with self._lock:
+            self._commands = speeds
+            self._bump()
+
+    def on_phase(self, label: str, flow: str, context: dict[str, Any] | None) -> None:
+        with self._lock:
+            self._phase, self._flow = label, flow
+            if context is not None:
+                self._context = context
+            self._bump()
+
+    def on_scene(self, scene: SceneView) -> None:
+        with self._lock:
+            self._scene = scene
+            self._bump()
+
+    def on_event(self, event: Event) -> None:
+        with self._lock:
+            self._event_seq += 1
+            self._events.append((self._event_seq, event))
+            if event.kind.value == "link" and event.data:
+                self._health.update(
+                    {k: float(v) for k, v in event.data.items() if isinstance(v, int | float)}
+                )
+            self._bump()
+
+    def on_result(self, result: dict[str, Any]) -> None:
+        with self._lock:
+            self._result = result
+            self._bump()
+
+    def set_speed(self, speed: str) -> None:
+        with self._lock:
+            self._speed = speed
+            self._bump()
+
+    def set_recording(self, path: str | None) -> None:
+        with self._lock:
+            self._recording = path
+            self._bump()
+
+    # -- readers -----------------------------------------------------------------
+    @property
+    def version(self) -> int:
+        with self._lock:
+            return self._version
+
+    def view(self, events_after: int = 0) -> StateView:
+        """A copy of everything; ``events`` holds only those numbered after ``events_after``."""
+        with self._lock:
+            return StateView(
+                version=self._version,
+                url=self._url,
+                scenario=self._scenario,
+                simulated=self._simulated,
+                status=self._status,
+                snapshot=self._snapshot,
+                commands=dict(self._commands),
+                ticks=self._ticks,
+                phase=self._phase,
+                flow=self._flow,
+                context=dict(self._context),
+                scene=self._scene,
+                stairs=self._stairs,
+                health=dict(self._health),
+                result=self._result,
+                speed=self._speed,
+                recording=self._recording,
+                events=tuple(e for e in self._events if e[0] > events_after),
+            )

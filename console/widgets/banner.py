@@ -1,0 +1,45 @@
+"""The banner: which robot, the run's state, and the one thing the operator must
+know now (an emergency stop, a lost link, how the run ended)."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from stairbot.console.state import RunStatus
+from textual.widgets import Static
+
+SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
+
+
+def banner_text(url: str, scenario: str, status: RunStatus) -> Text:
+    if status.estopped:
+        state = "E-STOP"
+    elif status.paused and status.robot == "running":
+        state = "PAUSED"
+    else:
+        state = status.robot.upper()
+    out = Text(f" {state} ", "bold reverse")
+    out.append(f" {url or '—'}", "bold")
+    if scenario:
+        out.append(f" · {scenario}")
+    if status.message:
+        out.append(f" · {status.message}")
+    return out
+
+
+class Banner(Static):
+    """One line, coloured by severity; red while the emergency stop is set."""
+
+    DEFAULT_CSS = "Banner { height: 1; width: 1fr; }"
+
+    def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
+        super().__init__(id=id)
+        self._last: object = None
+
+    def show(self, url: str, scenario: str, status: RunStatus) -> None:
+        key = (url, scenario, status)
+        if key == self._last:
+            return
+        self._last = key
+        self.update(banner_text(url, scenario, status))
+        self.remove_class(*SEVERITY_CLASSES)
+        self.add_class("-estop" if status.estopped else f"-{status.severity}")

@@ -1,0 +1,67 @@
+"""The current phase as the seed names it, where it stands in the flow, and the
+seed's variables the operator watches: ``number_of_steps`` and
+``tab_length_to_edge``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from rich.text import Text
+from textual.widgets import Static
+
+FLOWS = ("calibration", "ascent", "descent")
+
+
+def flow_text(flow: str) -> Text:
+    """``calibration › ascent › descent`` with the current one highlighted."""
+    out = Text()
+    for i, name in enumerate(FLOWS):
+        if i:
+            out.append(" › ", "dim")
+        if name == flow:
+            out.append(name.upper(), "bold reverse")
+        else:
+            out.append(name, "dim")
+    if flow not in FLOWS and flow not in ("", "idle"):
+        out.append(f"  {flow}", "bold")
+    return out
+
+
+def tab_text(context: Mapping[str, Any]) -> Text:
+    """``number_of_steps N`` and the filled entries of ``tab_length_to_edge`` (m)."""
+    out = Text("number_of_steps ", "bold")
+    out.append(str(context.get("number_of_steps", "—")))
+    tab = context.get("tab_length_to_edge")
+    out.append("\ntab_length_to_edge ", "bold")
+    values: list[str] = []
+    if isinstance(tab, Sequence) and not isinstance(tab, str):
+        n = context.get("number_of_steps")
+        used = tab[: n] if isinstance(n, int) and n > 0 else [v for v in tab if v]
+        values = [f"{float(v):.3f}" if isinstance(v, int | float) else "—" for v in used]
+    out.append(" ".join(values) if values else "—")
+    return out
+
+
+class PhasePanel(Static):
+    """Phase label, flow, number_of_steps and tab_length_to_edge."""
+
+    DEFAULT_CSS = "PhasePanel { height: auto; }"
+
+    def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
+        super().__init__(id=id)
+        self._last: object = None
+        self.border_title = "phase"
+
+    def show(self, label: str, flow: str, context: Mapping[str, Any]) -> None:
+        key = (label, flow, repr(context.get("number_of_steps")),
+               repr(context.get("tab_length_to_edge")))
+        if key == self._last:
+            return
+        self._last = key
+        out = Text(label or "—", "bold")
+        out.append("\n")
+        out.append_text(flow_text(flow))
+        out.append("\n")
+        out.append_text(tab_text(context))
+        self.update(out)
