@@ -1,0 +1,76 @@
+"""``stairbot console [--robot URL] [--scenario FILE|NAME] [--config FILE]
+[--record FILE] [--speed 1x|10x|max]``: the operator console.
+
+Bad input (config, scenario, an unknown URL scheme, an unwritable record file)
+is found before the screen opens and raises InputError, which ``stairbot``
+turns into one line on stderr and exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from urllib.parse import urlsplit
+
+from stairbot.console.runner_thread import SPEEDS
+
+from stairbot.config import load_config
+from stairbot.errors import InputError, RobotUrlError
+from stairbot.robots import known_schemes
+from stairbot.scenario import load_scenario
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="stairbot console",
+        description="The operator console: watch and command the robot in a terminal.\n"
+                    "Keys: space EMERGENCY STOP (everywhere), c clear it, s start, k calibrate\n"
+                    "only, p pause/resume, x stop, r reset the simulation, u robot URL,\n"
+                    "o scenario, f simulation speed, w record events, q quit; ctrl+p lists all.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--robot", metavar="URL", default="sim://",
+                   help="robot URL: sim:// (default), serial://PORT?baud=N, "
+                        "can://INTERFACE/CHANNEL?bitrate=N")
+    p.add_argument("--scenario", metavar="FILE|NAME",
+                   help="scenario TOML file or shipped scenario name (default stairs)")
+    p.add_argument("--config", metavar="FILE", help="robot config TOML file")
+    p.add_argument("--record", metavar="FILE",
+                   help="write the event stream to FILE, one JSON object a line")
+    p.add_argument("--speed", choices=tuple(SPEEDS), default="1x",
+                   help="simulation speed: 1x real time (default), 10x, max")
+    return p
+
+
+def _check_url(url: str) -> None:
+    scheme = urlsplit(url).scheme if "://" in url else ""
+    schemes = known_schemes()
+    if scheme not in schemes:
+        allowed = ", ".join(f"{s}://" for s in sorted(schemes))
+        raise RobotUrlError(url, None, f"unknown scheme {scheme!r}; allowed: {allowed}")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the console until the operator quits; returns the exit code.
+    Raises InputError (exit 2 in ``stairbot``) for bad input."""
+    args = build_parser().parse_args(list(argv) if argv is not None else None)
+    config = load_config(args.config)
+    load_scenario(args.scenario)  # a bad scenario fails here, not behind the screen
+    _check_url(args.robot)
+    if args.record:
+        from pathlib import Path
+
+        try:
+            Path(args.record).open("a", encoding="utf-8").close()
+        except OSError as exc:
+            raise InputError(args.record, None,
+                                f"cannot write the record: {exc.strerror or exc}") from None
+    from stairbot.console.app import build_app  # textual loads only when the screen opens
+
+    app = build_app(config, url=args.robot, scenario=args.scenario, record=args.record,
+                    speed=args.speed)
+    app.run()
+    return 0
+
+
+console_main = main
