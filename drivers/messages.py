@@ -169,7 +169,6 @@ class SetWatchdog(Message):
 
     TYPE = 0x04
     FORMAT = "<H"
-    IDEMPOTENT = True
     timeout_ms: int
 
 
@@ -178,7 +177,6 @@ class EStop(Message):
     """Latch the emergency stop: every motor stops, lifts hold.  Reply: Status."""
 
     TYPE = 0x05
-    IDEMPOTENT = True
 
 
 @dataclass(frozen=True, slots=True)
