@@ -1,0 +1,108 @@
+"""`stairbot run` end to end: progress lines, the summary, --json, --record,
+exit codes against [expect], --calibrate-only, Ctrl-C."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from stairbot.cli import main
+
+RESULT_KEYS = {"outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "error",
+               "fell", "max_pitch_deg", "final_offset_m", "sim_time_s", "wall_time_s",
+               "realtime_factor"}
+
+
+def console_script() -> list[str]:
+    exe = shutil.which("stairbot", path=str(Path(sys.executable).parent))
+    return [exe] if exe else [sys.executable, "-m", "stairbot"]
+
+
+def test_json_prints_one_object_and_progress_goes_to_stderr(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--json", "--scenario", "step_too_high"]) == 0
+    out, err = capsys.readouterr()
+    data = json.loads(out)  # one object, nothing else on stdout
+    assert RESULT_KEYS <= set(data)
+    assert data["outcome"] == "completed" and data["ascent_end"] == "obstacle"
+    assert data["as_expected"] is True and data["mismatches"] == []
+    assert data["scenario"] == "step_too_high" and data["robot"] == "sim://"
+    assert "ascent 3" in err  # the phase lines went to stderr
+
+
+def test_text_mode_prints_phase_lines_then_a_summary(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--scenario", "step_too_high"]) == 0
+    out = capsys.readouterr().out
+    lines = out.splitlines()
+    assert any("phase" in line and "calibration" in line for line in lines)
+    summary = out[out.index("summary (step_too_high on sim://)"):]
+    assert "outcome           completed (ascent ended: obstacle)" in summary
+    assert "expected          yes" in summary
+
+
+def test_record_writes_the_event_stream(tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    record = tmp_path / "events.jsonl"
+    assert main(["run", "-q", "--scenario", "calibration_case1_open_floor",
+                 "--record", str(record)]) == 0
+    events = [json.loads(line) for line in record.read_text().splitlines()]
+    assert events, "nothing recorded"
+    assert {"time_s", "kind", "phase", "message", "data"} <= set(events[0])
+    assert events[-1]["kind"] == "end"
+    assert events[-1]["data"]["outcome"] == "stopped"
+    assert [e["time_s"] for e in events] == sorted(e["time_s"] for e in events)
+    out = capsys.readouterr().out
+    assert "phase" not in out.split("summary")[0]  # -q: no progress lines
+
+
+def test_a_run_that_differs_from_expect_exits_1_naming_the_field(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    p = tmp_path / "wrong.toml"
+    p.write_text("[stairs]\ncount = 0\n[expect]\noutcome = 'stopped'\nsteps_climbed = 3\n")
+    assert main(["run", "--json", "--scenario", str(p)]) == 1
+    out, err = capsys.readouterr()
+    assert json.loads(out)["mismatches"] == ["steps_climbed: expected 3, got 0"]
+    assert "steps_climbed: expected 3, got 0" in err.splitlines()[-1]
+
+
+def test_without_expect_a_run_must_complete(tmp_path: Path) -> None:
+    p = tmp_path / "open.toml"
+    p.write_text("[stairs]\ncount = 0\n")  # open floor ends "stopped", not "completed"
+    assert main(["run", "-q", "--scenario", str(p)]) == 1
+
+
+def test_calibrate_only_squares_up_and_stops(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--json", "--calibrate-only", "--scenario",
+                 "calibration_case2_yaw_left"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["outcome"] == "completed"
+    assert data["steps_climbed"] == 0 and data["ascent_end"] is None
+
+
+def test_the_console_script_runs_the_default_job(tmp_path: Path) -> None:
+    proc = subprocess.run([*console_script(), "run", "--json"], capture_output=True,
+                          text=True, cwd=tmp_path, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads(proc.stdout)
+    assert (data["outcome"], data["ascent_end"], data["steps_climbed"],
+            data["steps_descended"]) == ("completed", "top_reached", 5, 5)
+
+
+def test_ctrl_c_stops_the_robot_and_exits_130(tmp_path: Path) -> None:
+    proc = subprocess.Popen([*console_script(), "run", "--realtime"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    assert proc.stdout is not None
+    first = proc.stdout.readline()  # the run has started: a phase line is out
+    assert "phase" in first
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert "interrupted" in err and "every motor stopped" in err
+    assert "outcome           stopped" in out
+    assert "Traceback" not in err
