@@ -1,0 +1,76 @@
+"""The top view of the simulated robot: lateral position, yaw, side walls.
+
+The pymunk world is a side view along x (towards the risers).  The top view
+adds what calibration needs: the robot's yaw (+ = turned left, counter-clockwise
+seen from above) and the lateral position ``y`` of segment 2's centre (+ = left
+of the flight's centre line).  Risers are planes x = const across the flight's
+width; side walls, where the scenario puts them, are planes y = +-width/2 that
+run the whole length of the stairwell.  A front beam that leaves the flight's
+width before it reaches what the side view says it hits meets that side wall,
+or nothing where there is no wall.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass
+class Plan:
+    """Top-view state: lateral offset and yaw of segment 2's centre."""
+
+    width: float
+    side_wall: str  # "none" | "left" | "right" | "both"
+    y: float = 0.0
+    yaw: float = 0.0  # radians, + = left
+
+    @property
+    def left_wall(self) -> bool:
+        return self.side_wall in ("left", "both")
+
+    @property
+    def right_wall(self) -> bool:
+        return self.side_wall in ("right", "both")
+
+    def move(self, dx: float) -> None:
+        """The robot advanced ``dx`` along x (towards the risers) on its heading."""
+        self.y += dx * math.tan(self.yaw)
+
+    def turn(self, dyaw: float) -> None:
+        """The robot turned ``dyaw`` radians about segment 2's centre (+ = left)."""
+        self.yaw += dyaw
+
+    def front_distance(self, forward: float, lateral: float, hit_dx: float | None,
+                       slant: float) -> float | None:
+        """Distance along a forward-looking beam to what it hits, or None.
+
+        ``forward``: the mount's distance ahead of segment 2's centre along the
+        robot's axis; ``lateral``: the mount's offset (+ = left); ``hit_dx``: how
+        far ahead in x the side view's ray from the same mount hits the stairs
+        (None: nothing); ``slant``: beam length per metre of x travelled in the
+        side view (1 / cos(pitch)).  Valid for |yaw| < 90 degrees.
+        """
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        # the side view puts the mount at `forward` straight ahead; in the top view it
+        # sits forward*cos - lateral*sin ahead of the centre and y_m to the side
+        y_m = self.y + forward * s + lateral * c
+        best: float | None = None
+        if hit_dx is not None and c > 1e-9:
+            dx = hit_dx + forward * (1.0 - c) + lateral * s
+            if dx > 0.0:
+                y_hit = y_m + dx * s / c
+                if abs(y_hit) <= self.width / 2:
+                    best = dx / c * slant
+        wall = self._wall_distance(y_m, s)
+        if wall is not None and (best is None or wall * slant < best):
+            best = wall * slant
+        return best
+
+    def _wall_distance(self, y_m: float, s: float) -> float | None:
+        half = self.width / 2
+        if s > 1e-9 and self.left_wall:
+            return max(0.0, (half - y_m) / s)
+        if s < -1e-9 and self.right_wall:
+            return max(0.0, (-half - y_m) / s)
+        return None

@@ -1,0 +1,337 @@
+"""The side view of the simulated robot on its stairs: a pymunk world.
+
+x points forward (towards the stairs), y up, gravity -9.81 m/s^2, metres and
+kilograms throughout.  Riser 1 stands at x = 0; the robot starts with its front
+face ``scenario.start.distance`` before it.  The robot is three box segments
+(index 0 = segment 1, the front) with two wheels each; segments 1 and 3 slide
+vertically against segment 2 on lead-screw lifts (a groove keeps them in line,
+a gear joint keeps them parallel, a pin joint whose length moves with the
+commanded speed sets the offset and holds it when stopped).  Segments do not
+collide with each other.
+
+Python work per physics step is kept to the lift targets; everything else
+(motor rates, stability checks) happens once per :meth:`World.advance` call,
+which the simulated clock makes once per control tick.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pymunk
+
+from stairbot.config import RobotConfig
+from stairbot.scenario import Scenario
+
+TWO_PI = 2.0 * math.pi
+FLOOR_BEHIND = 30.0  # floor length behind riser 1, m
+LANDING = 3.0  # flat landing beyond the last tread, m
+OPEN_FLOOR = 30.0  # floor ahead when there are no stairs, m
+WALL_HEIGHT = 2.0
+_PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's axles
+
+CAT_STAIRS = 0b01
+CAT_ROBOT = 0b10
+ROBOT_GROUP = 1
+STAIRS_ONLY = pymunk.ShapeFilter(mask=CAT_STAIRS)
+
+
+@dataclass(frozen=True)
+class WorldParams:
+    """Physics and instability settings (not part of the robot config)."""
+
+    dt: float = 1.0 / 200.0
+    iterations: int = 10
+    stairs_friction: float = 1.0  # combined by product with the wheels' 0.9
+    wheel_friction: float = 0.9  # rubber on wood
+    body_friction: float = 0.3  # ABS chassis on wood
+    chamfer: float = 0.005  # bottom edges of each segment's chassis, m
+    stairs_radius: float = 0.001  # rounds the step nosings
+    collision_slop: float = 0.0005
+    lift_stall: float = 0.002  # a lift's target never runs further ahead than this, m
+    pitch_limit_deg: float = 35.0
+    fall_speed: float = 1.0  # m/s downward counts as falling
+    airborne_limit_s: float = 0.3  # every wheel off every support this long: fell
+
+
+def stairs_outline(scenario: Scenario) -> list[tuple[float, float]]:
+    """The stairs' surface as one polyline from far behind the start to the end."""
+    pts: list[tuple[float, float]] = [(-FLOOR_BEHIND, 0.0)]
+    if not scenario.steps:
+        pts.append((OPEN_FLOOR, 0.0))
+        return pts
+    x = y = 0.0
+    pts.append((x, y))
+    last = len(scenario.steps) - 1
+    for i, step in enumerate(scenario.steps):
+        y += step.rise
+        pts.append((x, y))
+        x += step.tread
+        if i == last:
+            if scenario.top == "wall":
+                pts.append((x, y))
+                pts.append((x, y + WALL_HEIGHT))
+            else:
+                pts.append((x + LANDING, y))
+        else:
+            pts.append((x, y))
+    return pts
+
+
+class World:
+    """The pymunk world: static stairs, the robot's bodies, joints and motors."""
+
+    def __init__(self, config: RobotConfig, scenario: Scenario,
+                 params: WorldParams | None = None) -> None:
+        self.config = config
+        self.scenario = scenario
+        self.params = p = params or WorldParams()
+        g = config.geometry
+        self.space = space = pymunk.Space()
+        space.gravity = (0.0, -9.81)
+        space.iterations = p.iterations
+        space.collision_slop = p.collision_slop
+        self.time = 0.0
+        self._steps_done = 0
+        self.outline = stairs_outline(scenario)
+        for a, b in zip(self.outline, self.outline[1:], strict=False):
+            seg = pymunk.Segment(space.static_body, a, b, p.stairs_radius)
+            seg.friction = p.stairs_friction
+            seg.filter = pymunk.ShapeFilter(categories=CAT_STAIRS)
+            space.add(seg)
+
+        self.lengths = (g.LENGTH_OF_FIRST_MODULE, g.LENGTH_OF_SECOND_MODULE,
+                        g.LENGTH_OF_THIRD_MODULE)
+        self.height = g.segment_height
+        self.radius = r = g.wheel_radius
+        masses = (config.masses.first_module, config.masses.second_module,
+                  config.masses.third_module)
+        robot_filter = pymunk.ShapeFilter(group=ROBOT_GROUP, categories=CAT_ROBOT,
+                                          mask=CAT_STAIRS)
+        front = -scenario.start.distance
+        self.segments: list[pymunk.Body] = []
+        self.boxes: list[pymunk.Poly] = []
+        self.wheels: list[tuple[pymunk.Body, pymunk.Body]] = []  # (rear, front)
+        self.motors: list[tuple[pymunk.SimpleMotor, pymunk.SimpleMotor]] = []
+        self.wheel_x: list[float] = []  # axle x from the segment centre (+ = front)
+        left = front
+        for length, mass in zip(self.lengths, masses, strict=True):
+            body = pymunk.Body()
+            # local frame: origin at the segment's centre on its axle line
+            body.position = (left - length / 2, r)
+            half, c = length / 2, min(p.chamfer, length / 4, self.height / 4)
+            # the chassis' bottom edges are chamfered, as a real one's would be
+            box = pymunk.Poly(body, [(-half + c, 0.0), (half - c, 0.0), (half, c),
+                                     (half, self.height), (-half, self.height), (-half, c)])
+            box.mass = mass
+            box.friction = p.body_friction
+            box.filter = robot_filter
+            space.add(body, box)
+            ax = length / 2 - g.wheel_inset
+            self.wheel_x.append(ax)
+            pair: list[pymunk.Body] = []
+            mots: list[pymunk.SimpleMotor] = []
+            for sx in (-ax, ax):
+                wheel = pymunk.Body()
+                wheel.position = body.local_to_world((sx, 0.0))
+                circle = pymunk.Circle(wheel, r)
+                circle.mass = 2 * config.masses.wheel  # the left and right wheel
+                circle.friction = p.wheel_friction
+                circle.filter = robot_filter
+                pivot = pymunk.PivotJoint(body, wheel, (sx, 0.0), (0.0, 0.0))
+                pivot.collide_bodies = False
+                # rate = body.w - wheel.w: positive rolls forward (clockwise)
+                motor = pymunk.SimpleMotor(body, wheel, 0.0)
+                motor.max_force = config.motors.wheel_torque
+                space.add(wheel, circle, pivot, motor)
+                pair.append(wheel)
+                mots.append(motor)
+            self.segments.append(body)
+            self.boxes.append(box)
+            self.wheels.append((pair[0], pair[1]))
+            self.motors.append((mots[0], mots[1]))
+            left -= length
+        s1, s2, s3 = self.segments
+        self._lift_x = ((self.lengths[0] + self.lengths[1]) / 2,
+                        -(self.lengths[1] + self.lengths[2]) / 2)
+        travel = config.motors.lift_travel + 0.02
+        self.pins: list[pymunk.PinJoint] = []
+        for end, gx in ((s1, self._lift_x[0]), (s3, self._lift_x[1])):
+            groove = pymunk.GrooveJoint(s2, end, (gx, -travel), (gx, travel), (0.0, 0.0))
+            gear = pymunk.GearJoint(s2, end, 0.0, 1.0)
+            pin = pymunk.PinJoint(s2, end, (gx, -_PIN_REACH), (0.0, 0.0))
+            pin.distance = _PIN_REACH
+            pin.max_force = config.motors.lift_force
+            # lead screws: correct half the error every step, no soft lag
+            for c in (groove, gear, pin):
+                c.error_bias = 0.5 ** (1.0 / p.dt)
+                c.collide_bodies = False
+                space.add(c)
+            self.pins.append(pin)
+        self.lift_target = [0.0, 0.0]  # metres, + = end segment up
+        self.lift_speed = [0.0, 0.0]  # metres per second (already clamped)
+        self._wheel_zero = [(w0.angle - b.angle, w1.angle - b.angle)
+                            for b, (w0, w1) in zip(self.segments, self.wheels, strict=True)]
+        self.all_wheels = [w for pair in self.wheels for w in pair]
+        self.start_x = s2.position.x
+        self.max_pitch_deg = 0.0
+        self.fell = False
+        self.fall_reason: str | None = None
+        self._airborne_s = 0.0
+
+    # -- actuators ------------------------------------------------------------------
+    def set_wheel_speed(self, segment: int, turns_per_s: float) -> None:
+        """Drive both wheels of a segment at ``turns_per_s`` (+ = forward)."""
+        rate = turns_per_s * TWO_PI
+        for m in self.motors[segment]:
+            m.rate = rate
+
+    def set_lift_speed(self, lift: int, metres_per_s: float) -> None:
+        """Move lift 0 (MTF) or 1 (MTB) at ``metres_per_s`` (+ = end segment up); 0 holds."""
+        self.lift_speed[lift] = metres_per_s
+
+    # -- state ----------------------------------------------------------------------
+    def lift_offset(self, lift: int) -> float:
+        """Actual height of segment 1 (lift 0) or 3 (lift 1) over segment 2, m."""
+        end = self.segments[0 if lift == 0 else 2]
+        return float(self.segments[1].world_to_local(end.position).y)
+
+    def wheel_turns(self, segment: int) -> float:
+        """Turns of a segment's front wheel relative to the segment (+ = forward)."""
+        body = self.segments[segment]
+        wheel = self.wheels[segment][1]
+        rel = wheel.angle - body.angle - self._wheel_zero[segment][1]
+        return float(-rel / TWO_PI)
+
+    def wheel_speed(self, segment: int) -> float:
+        """Measured turns/s of a segment's front wheel relative to the segment."""
+        body = self.segments[segment]
+        return float((body.angular_velocity - self.wheels[segment][1].angular_velocity) / TWO_PI)
+
+    def pitch_deg(self, segment: int = 1) -> float:
+        """Nose-up pitch of a segment in degrees."""
+        return math.degrees(self.segments[segment].angle)
+
+    def centre_x(self) -> float:
+        """x of segment 2's centre (its axle line)."""
+        return float(self.segments[1].position.x)
+
+    # -- stepping -------------------------------------------------------------------
+    def _steps_for(self, seconds: float) -> int:
+        target = round((self.time + seconds) / self.params.dt)
+        n = max(0, target - self._steps_done)
+        return n
+
+    def step_bare(self, seconds: float) -> None:
+        """Step the physics ``seconds`` with nothing else: no lifts, no checks."""
+        n = self._steps_for(seconds)
+        step, dt = self.space.step, self.params.dt
+        for _ in range(n):
+            step(dt)
+        self._steps_done += n
+        self.time = self._steps_done * dt
+
+    def advance(self, seconds: float) -> None:
+        """Step the physics ``seconds`` (whole physics steps), moving the lifts at
+        their set speeds within their stroke, then check stability."""
+        n = self._steps_for(seconds)
+        if n == 0:
+            return
+        dt = self.params.dt
+        step = self.space.step
+        moving = [i for i in (0, 1) if self.lift_speed[i] != 0.0]
+        if not moving:
+            for _ in range(n):
+                step(dt)
+        else:
+            stroke = self.config.motors.lift_travel
+            stall = self.params.lift_stall
+            for i in moving:
+                # a stalled lead screw does not run ahead of its nut
+                actual = self.lift_offset(i)
+                self.lift_target[i] = min(max(self.lift_target[i], actual - stall),
+                                          actual + stall)
+            pins = [(self.pins[i], i, self.lift_speed[i] * dt) for i in moving]
+            targets = self.lift_target
+            for _ in range(n):
+                for pin, i, inc in pins:
+                    t = targets[i] + inc
+                    t = stroke if t > stroke else (-stroke if t < -stroke else t)
+                    targets[i] = t
+                    pin.distance = _PIN_REACH + t
+                step(dt)
+        self._steps_done += n
+        self.time = self._steps_done * dt
+        self._check(n * dt)
+
+    # -- instability ----------------------------------------------------------------
+    def _wheel_in_contact(self) -> bool:
+        found = False
+
+        def seen(_arb: pymunk.Arbiter) -> None:
+            nonlocal found
+            found = True
+
+        for w in self.all_wheels:
+            w.each_arbiter(seen)
+            if found:
+                return True
+        return False
+
+    def _check(self, elapsed: float) -> None:
+        if self.fell:
+            return
+        p = self.params
+        for i, body in enumerate(self.segments):
+            pitch = abs(math.degrees(body.angle))
+            if pitch > self.max_pitch_deg:
+                self.max_pitch_deg = pitch
+            if pitch > p.pitch_limit_deg:
+                self._fall(f"segment {i + 1} pitched {pitch:.0f} deg (limit "
+                           f"{p.pitch_limit_deg:.0f})")
+                return
+            if body.velocity.y < -p.fall_speed:
+                self._fall(f"segment {i + 1} falling at {-body.velocity.y:.1f} m/s")
+                return
+            if body.position.y < -0.1:
+                self._fall(f"segment {i + 1} below the floor")
+                return
+        if self._wheel_in_contact():
+            self._airborne_s = 0.0
+        else:
+            self._airborne_s += elapsed
+            if self._airborne_s > p.airborne_limit_s:
+                self._fall(f"no wheel on any support for {self._airborne_s:.2f} s")
+
+    def _fall(self, reason: str) -> None:
+        self.fell = True
+        self.fall_reason = reason
+
+    # -- queries --------------------------------------------------------------------
+    def ray(self, start: tuple[float, float], end: tuple[float, float]
+            ) -> tuple[float, float] | None:
+        """First point of the stairs on the segment start -> end, or None."""
+        hit = self.space.segment_query_first(start, end, 0.0, STAIRS_ONLY)
+        if hit is None:
+            return None
+        return (float(hit.point.x), float(hit.point.y))
+
+    def clear_of_ground(self, segment: int, clearance: float) -> bool:
+        """True when nothing of the stairs lies within ``clearance`` under the
+        segment's wheels."""
+        r = self.radius
+        for w in self.wheels[segment]:
+            c = w.position
+            if self.ray((c.x, c.y), (c.x, c.y - r - clearance)) is not None:
+                return False
+            for dx in (-r, r):
+                if self.ray((c.x + dx * 0.7, c.y), (c.x + dx * 0.7, c.y - r - clearance)):
+                    return False
+        return True
+
+    def segment_corners(self, segment: int) -> list[tuple[float, float]]:
+        """The segment chassis' outline in world metres (a closed polygon, CCW)."""
+        return [(float(v.x), float(v.y))
+                for v in (self.segments[segment].local_to_world(q)
+                          for q in self.boxes[segment].get_vertices())]
