@@ -1,0 +1,374 @@
+"""The robot's two boards on one serial link.
+
+URL format: ``serial://PORT[?option=value[&option=value...]]``
+
+* ``PORT`` -- a device path (``serial:///dev/ttyUSB0``, a pty such as
+  ``serial:///dev/pts/4``) or any pyserial URL, handed to
+  ``serial.serial_for_url``: ``loop://``, ``socket://HOST:PORT``,
+  ``rfc2217://HOST:PORT``, ``spy://PORT`` ...
+  (``serial://socket://127.0.0.1:5000?baud=1000000``).
+* options (the query after the last ``?``; keys not listed here go back to
+  the pyserial URL, e.g. ``logging=debug`` for ``socket://``):
+
+  - ``baud=N``        bit rate, default 1000000 (UART 8N1)
+  - ``timeout=S``     seconds to wait for a reply, default 0.05
+  - ``retries=N``     re-sends of a query that timed out, default 2
+  - ``lost=N``        unanswered commands in a row that mean the link is
+                      lost, default 3
+  - ``watchdog=MS``   the boards' watchdog, set at open, default 250 (0 = off)
+  - ``lockstep=1``    simulation only: the fake boards' world advances only
+                      when the host's clock sends StepTo, once per tick
+  - ``time_scale=X``  simulation only: the fake boards run X times real time;
+                      the host's wall clock runs at the same rate
+
+The driver implements the Robot protocol: ``read()`` is one ReadAll to each
+board (both in flight at once), ``command()`` one frame of SetWheelSpeeds +
+SetLiftSpeeds whose Ack is collected on the next call.  Link health goes into
+``Snapshot.health``, ``diagnostics()`` and LINK events (``attach_sink``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import time
+from collections.abc import Mapping
+from typing import Any
+from urllib.parse import parse_qsl, urlencode
+
+import serial
+from stairbot.drivers import messages as m
+from stairbot.drivers.link import FdChannel, Link, Pending, PortChannel
+
+from stairbot.clock import WallClock
+from stairbot.config import RobotConfig
+from stairbot.errors import HardwareError, LinkLostError, RobotFellError, RobotUrlError
+from stairbot.events import Event, EventKind, EventSink, discard
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.robots import RobotOptions, RobotSession
+from stairbot.scenario import Scenario
+
+DEFAULTS: dict[str, float] = {
+    "baud": 1_000_000, "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250,
+    "lockstep": 0, "time_scale": 1.0,
+}
+_INTS = {"baud", "retries", "lost", "watchdog", "lockstep"}
+EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
+
+
+def parse_serial_url(url: str) -> tuple[str, dict[str, float]]:
+    """(pyserial port, options) of a ``serial://`` URL.  RobotUrlError names
+    the option and what is allowed."""
+    if not url.startswith("serial://") or len(url) == len("serial://"):
+        raise RobotUrlError(url, None, "expected serial://PORT[?baud=N&timeout=S...]")
+    rest = url[len("serial://"):]
+    port, _, query = rest.rpartition("?") if "?" in rest else (rest, "", "")
+    opts = dict(DEFAULTS)
+    passthrough: list[tuple[str, str]] = []
+    for key, value in parse_qsl(query, keep_blank_values=True):
+        if key not in DEFAULTS:
+            passthrough.append((key, value))
+            continue
+        try:
+            number = int(value) if key in _INTS else float(value)
+        except ValueError:
+            kind = "an integer" if key in _INTS else "a number"
+            raise RobotUrlError(url, key, f"{value!r} is not {kind}") from None
+        if number < 0 or (key in {"baud", "timeout", "time_scale"} and number == 0):
+            raise RobotUrlError(url, key, f"{value} is out of range; allowed: > 0"
+                                if key in {"baud", "timeout", "time_scale"} else ">= 0")
+        if key == "lockstep" and number not in (0, 1):
+            raise RobotUrlError(url, key, f"{value} is not allowed; allowed: 0 or 1")
+        opts[key] = number
+    if passthrough:
+        port += ("&" if "?" in port else "?") + urlencode(passthrough)
+    if not port:
+        raise RobotUrlError(url, None, "no port; e.g. serial:///dev/ttyUSB0")
+    return port, opts
+
+
+def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
+    """Open a pyserial port; a tty gets the fast fd channel.  RobotUrlError
+    in one line when it cannot open."""
+    try:
+        ser = serial.serial_for_url(port, baudrate=baud, timeout=0)
+    except (serial.SerialException, ValueError, OSError) as exc:
+        raise RobotUrlError(url, None, f"cannot open port {port}: {exc}") from None
+    try:
+        fd = ser.fileno()
+    except (AttributeError, io.UnsupportedOperation, serial.SerialException, OSError):
+        return PortChannel(ser)
+    return FdChannel(fd, owner=ser)
+
+
+class LockstepClock:
+    """The host's clock against lockstep fake boards: ``advance(dt)`` asks the
+    motor board to step the world to the new time and waits until it has."""
+
+    def __init__(self, robot: SerialRobot) -> None:
+        self._robot = robot
+        self._us = 0
+
+    def now(self) -> float:
+        return self._us / 1e6
+
+    def advance(self, dt: float) -> None:
+        self._us += round(dt * 1e6)
+        self._robot.step_to(self._us)
+
+
+class SerialRobot:
+    """Both boards over one Link (see the module docstring)."""
+
+    def __init__(self, link: Link, url: str, watchdog_ms: int = 250,
+                 lockstep: bool = False, sink: EventSink = discard) -> None:
+        self.link = link
+        self.url = url
+        self.lockstep = lockstep
+        self.sink = sink
+        self.clock: Any = None  # set by open_serial_robot
+        self.idents: dict[int, m.Ident] = {}
+        self.status: dict[int, m.Status] = {}
+        self.refused = 0
+        self._commands: list[Pending] = []
+        self._reported: dict[str, float] = {}
+        self._last_event = float("-inf")
+        self._closed = False
+        self._last_tx: dict[int, float] = {}
+        self.watchdog_ms = watchdog_ms
+        self._handshake()
+
+    # -- setting up ------------------------------------------------------------
+    def _handshake(self) -> None:
+        for board in m.Board:
+            name = board.name.lower()
+            try:
+                reply = self.link.exchange(board, [m.Identify(), m.GetStatus()])
+            except LinkLostError:
+                raise RobotUrlError(self.url, None, f"no {name} board answered on the port "
+                                    f"({self.link.retries + 1} tries of "
+                                    f"{self.link.timeout_s * 1e3:.0f} ms)") from None
+            ident, status = (reply.messages + (None, None))[:2]
+            if not isinstance(ident, m.Ident) or not isinstance(status, m.Status):
+                raise RobotUrlError(self.url, None, f"the {name} board gave an unexpected "
+                                    f"answer to Identify: {reply.messages}")
+            if ident.protocol_major != m.PROTOCOL_MAJOR:
+                raise RobotUrlError(self.url, None, f"the {name} board speaks protocol "
+                                    f"{ident.protocol_major}.{ident.protocol_minor}; "
+                                    f"this host speaks {m.PROTOCOL_MAJOR}.x")
+            board_lockstep = bool(status.flags & m.StatusFlag.LOCKSTEP)
+            if board_lockstep != self.lockstep:
+                hint = ("add ?lockstep=1 to the URL" if board_lockstep
+                        else "start the fake boards with --lockstep")
+                state = "run" if board_lockstep else "do not run"
+                raise RobotUrlError(self.url, "lockstep",
+                                    f"the boards {state} in lockstep; {hint}")
+            self.idents[board] = ident
+            # Opening the robot is the explicit clear of a watchdog latch left by
+            # an earlier session; an emergency stop stays latched.  Setting up is
+            # the one place where a command frame is sent again after a timeout.
+            for attempt in range(self.link.retries + 1):
+                try:
+                    reply = self.link.exchange(board, [m.SetWatchdog(self.watchdog_ms),
+                                                       m.Clear(m.ClearMask.WATCHDOG)])
+                    break
+                except LinkLostError:
+                    if attempt == self.link.retries:
+                        raise RobotUrlError(self.url, None, f"the {name} board did not "
+                                            "answer SetWatchdog") from None
+            status = reply.messages[-1]
+            if isinstance(status, m.Status):
+                self.status[board] = status
+
+    @property
+    def simulated(self) -> bool:
+        return any(s.flags & m.StatusFlag.SIMULATED for s in self.status.values())
+
+    def attach_sink(self, sink: EventSink) -> None:
+        """Send LINK events to ``sink`` from now on."""
+        self.sink = sink
+
+    def _now(self) -> float:
+        return float(self.clock.now()) if self.clock is not None else 0.0
+
+    # -- the Robot protocol ----------------------------------------------------
+    def read(self) -> Snapshot:
+        """One ReadAll to each board.  Raises LinkLostError (no reply, or a
+        board's watchdog tripped), RobotFellError (fake boards: the simulated
+        robot fell) or HardwareError (e-stop latched on a board, bad reply)."""
+        self._reap()
+        pm = self.link.request(m.Board.MOTOR, [m.ReadAll()])
+        ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
+        fm, fs = self._wait([pm, ps])
+        motors = self._motors(fm.messages)
+        sensors = self._sensors(fs.messages)
+        health = self.health()
+        self._maybe_event(health)
+        return Snapshot(self._now(), sensors, motors, health)
+
+    def command(self, speeds: Mapping[MotorId, float]) -> None:
+        """Send every motor's speed in one frame; its Ack is checked later."""
+        self._reap()
+        if self.link.lost_streak >= self.link.max_lost:
+            self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
+        wheels, lifts = m.speeds_to_wire(speeds)
+        self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts]))
+
+    def stop_all(self) -> None:
+        """Stop every motor (lifts hold); never raises."""
+        with contextlib.suppress(Exception):
+            self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
+
+    def estop(self) -> None:
+        """Latch the emergency stop on both boards."""
+        self._wait([self._request(b, [m.EStop()]) for b in m.Board])
+
+    def clear(self, mask: int = m.ClearMask.ALL) -> None:
+        """Clear latches (e-stop, watchdog, faults) on both boards."""
+        self._wait([self._request(b, [m.Clear(mask)]) for b in m.Board])
+
+    def step_to(self, time_us: int) -> None:
+        """Lockstep: the world advances to ``time_us``; waits until it has."""
+        (reply,) = self._wait([self._request(m.Board.MOTOR, [m.StepTo(time_us)])])
+        if not reply.messages or not isinstance(reply.messages[0], m.StepDone):
+            raise HardwareError(f"the motor board refused StepTo: {reply.messages}")
+
+    def heartbeat(self) -> None:
+        """Feed the watchdog of a board that was sent nothing for a quarter of
+        its timeout (the control loop's own frames normally do this)."""
+        now = time.monotonic()
+        for board in m.Board:
+            if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:
+                self._commands.append(self._request(board, [m.Heartbeat()]))
+
+    def diagnostics(self) -> dict[str, object]:
+        out: dict[str, object] = {"url": self.url, "lockstep": self.lockstep,
+                                  "link": self.health(),
+                                  "boards": {m.Board(b).name.lower(): vars_of(i)
+                                             for b, i in self.idents.items()}}
+        if self.simulated and not self._closed:
+            with contextlib.suppress(Exception):
+                (reply,) = self._wait([self._request(m.Board.MOTOR, [m.GetTruth()])])
+                truth = reply.messages[0]
+                if isinstance(truth, m.Truth):
+                    out.update(fell=bool(truth.flags & 1),
+                               max_pitch_deg=truth.max_pitch_cdeg / 100,
+                               offset_m=truth.offset_mm / 1000)
+        return out
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self.stop_all()
+        self._closed = True
+        self.link.close()
+
+    def health(self) -> dict[str, float]:
+        h = self.link.stats.as_dict()
+        h["refused"] = float(self.refused)
+        return h
+
+    # -- internals ---------------------------------------------------------------
+    def _request(self, board: int, msgs: list[m.Message]) -> Pending:
+        self._last_tx[board] = time.monotonic()
+        return self.link.request(board, msgs)
+
+    def _wait(self, pendings: list[Pending]) -> list[Any]:
+        try:
+            return self.link.wait(pendings)
+        except LinkLostError as exc:
+            self._lost(str(exc))
+            raise  # unreachable: _lost raises
+
+    def _lost(self, reason: str) -> None:
+        self.sink(Event(self._now(), EventKind.LINK, f"link lost: {reason}", None,
+                        self.health()))
+        raise LinkLostError(f"{self.url}: {reason}")
+
+    def _reap(self) -> None:
+        self.link.poll()
+        still = []
+        for p in self._commands:
+            if p.reply is not None:
+                for msg in p.reply.messages:
+                    if isinstance(msg, m.Ack) and msg.result != m.AckResult.OK:
+                        self.refused += 1
+            elif not p.failed:
+                still.append(p)
+        self._commands = still
+
+    def _check_status(self, board: m.Board, status: m.Status) -> None:
+        self.status[board] = status
+        name = board.name.lower()
+        if status.flags & m.StatusFlag.WATCHDOG:
+            self._lost(f"the {name} board's watchdog tripped (nothing from the host for "
+                       f"{status.watchdog_ms} ms): its motors are stopped until cleared")
+        if status.fault == m.MotorFault.SIMULATION:
+            truth = self.diagnostics()
+            if truth.get("fell"):
+                raise RobotFellError("the simulated robot fell (reported by the fake boards)")
+            raise HardwareError(f"the {name} board's simulated world failed")
+        if status.flags & m.StatusFlag.ESTOP:
+            raise HardwareError(f"the {name} board has its emergency stop latched")
+
+    def _motors(self, msgs: tuple[Any, ...]) -> dict[MotorId, MotorState]:
+        if not msgs or not isinstance(msgs[0], m.Status):
+            raise HardwareError(f"the motor board answered ReadAll with {msgs!r}")
+        self._check_status(m.Board.MOTOR, msgs[0])
+        out = {m.MOTOR_CHANNELS[t.channel]: m.state_from_wire(t) for t in msgs[1:]
+               if isinstance(t, m.MotorTelemetry) and t.channel < len(m.MOTOR_CHANNELS)}
+        if len(out) != len(m.MOTOR_CHANNELS):
+            raise HardwareError(f"the motor board's ReadAll reply lacks motors: {msgs!r}")
+        return out
+
+    def _sensors(self, msgs: tuple[Any, ...]) -> dict[SensorId, SensorReading]:
+        if not msgs or not isinstance(msgs[0], m.Status):
+            raise HardwareError(f"the sensor board answered ReadAll with {msgs!r}")
+        self._check_status(m.Board.SENSOR, msgs[0])
+        out = {m.SENSOR_CHANNELS[t.channel]: m.reading_from_wire(t) for t in msgs[1:]
+               if isinstance(t, m.SensorTelemetry) and t.channel < len(m.SENSOR_CHANNELS)}
+        if len(out) != len(m.SENSOR_CHANNELS):
+            raise HardwareError(f"the sensor board's ReadAll reply lacks sensors: {msgs!r}")
+        return out
+
+    def _maybe_event(self, health: dict[str, float]) -> None:
+        keys = ("retries", "timeouts", "lost", "late", "stray", "crc_errors", "malformed",
+                "refused")
+        changed = {k: health[k] - self._reported.get(k, 0.0) for k in keys
+                   if health[k] != self._reported.get(k, 0.0)}
+        now = self._now()
+        if changed and now - self._last_event >= EVENT_EVERY_S:
+            self._last_event = now
+            self._reported = dict(health)
+            what = ", ".join(f"+{v:g} {k}" for k, v in changed.items())
+            self.sink(Event(now, EventKind.LINK, f"link: {what} (rtt median "
+                            f"{health['rtt_median_ms']:.2f} ms)", None, dict(health)))
+
+
+def vars_of(ident: m.Ident) -> dict[str, int]:
+    return {"protocol": ident.protocol_major * 256 + ident.protocol_minor,
+            "firmware": ident.firmware, "serial": ident.serial, "channels": ident.channels}
+
+
+def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
+                      options: RobotOptions) -> RobotSession:
+    """Open ``serial://PORT?...``.  RobotUrlError (one line) when the URL is
+    malformed, the port cannot open or no board answers."""
+    port, opts = parse_serial_url(url)
+    channel = open_channel(port, int(opts["baud"]), url)
+    link = Link(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
+                max_lost=int(opts["lost"]))
+    try:
+        robot = SerialRobot(link, url, int(opts["watchdog"]), bool(opts["lockstep"]))
+    except BaseException:
+        link.close()
+        raise
+    clock: Any
+    if robot.lockstep:
+        clock = LockstepClock(robot)
+    else:
+        scale = options.time_scale or opts["time_scale"]
+        clock = WallClock(monotonic=lambda: time.monotonic() * scale,
+                          sleep=lambda s: time.sleep(s / scale))
+    robot.clock = clock
+    return RobotSession(robot=robot, clock=clock, url=url, simulated=robot.simulated, sim=None)

@@ -1,0 +1,114 @@
+"""``stairbot fake-boards``: serve the emulated motor and sensor boards.
+
+    stairbot fake-boards --serial [--scenario FILE] [--config FILE]
+                         [--time-scale X | --lockstep] [fault options]
+
+opens a pseudo-terminal, prints its path (the line ``serial://PATH``, plus
+``?lockstep=1`` when in lockstep) and serves both boards on it, backed by the
+same physics world as ``sim://``, until interrupted.  ``--can ...`` is handed
+to the CAN fake (``stairbot.fakes.can_boards.main``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from importlib import import_module
+
+from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
+from stairbot.fakes.sim import SimClock, SimRobot
+
+from stairbot.config import RobotConfig, load_config
+from stairbot.scenario import Scenario, load_scenario
+
+
+def _probability(text: str) -> float:
+    value = float(text)
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"{text} is not a probability; allowed: 0..1")
+    return value
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"{text} is out of range; allowed: > 0")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="stairbot fake-boards", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    wire = p.add_mutually_exclusive_group(required=True)
+    wire.add_argument("--serial", action="store_true", help="serve on a new pseudo-terminal")
+    wire.add_argument("--can", metavar="INTERFACE/CHANNEL", help="serve on a CAN bus")
+    p.add_argument("--scenario", help="scenario TOML file or shipped scenario name")
+    p.add_argument("--config", help="robot config TOML file")
+    pace = p.add_mutually_exclusive_group()
+    pace.add_argument("--time-scale", type=_positive, default=1.0, metavar="X",
+                      help="simulated seconds per wall second (default 1: real time)")
+    pace.add_argument("--lockstep", action="store_true",
+                      help="advance the world only on the host's StepTo (host URL ?lockstep=1)")
+    f = p.add_argument_group("fault injection on the wire (probabilities per frame)")
+    f.add_argument("--drop", type=_probability, default=0.0)
+    f.add_argument("--corrupt", type=_probability, default=0.0)
+    f.add_argument("--duplicate", type=_probability, default=0.0)
+    f.add_argument("--late", type=_probability, default=0.0)
+    f.add_argument("--late-s", type=_positive, default=0.1, help="delay of a late frame, s")
+    f.add_argument("--silent-after", type=float, default=None, metavar="S",
+                   help="boards stop answering after S seconds of board time")
+    f.add_argument("--silent-board", choices=("motor", "sensor"), default=None,
+                   help="only this board goes silent")
+    f.add_argument("--fault-seed", type=int, default=0)
+    return p
+
+
+def make_world(config: RobotConfig, scenario: Scenario, lockstep: bool) -> BoardWorld:
+    """The simulated robot behind the fake boards (never paced by its clock:
+    the server paces it)."""
+    robot = SimRobot(config, scenario)
+    return BoardWorld(robot, SimClock(robot, None), lockstep=lockstep)
+
+
+def faults_from(args: argparse.Namespace) -> WireFaults:
+    board = {"motor": 1, "sensor": 2}.get(args.silent_board or "")
+    return WireFaults(drop=args.drop, corrupt=args.corrupt, duplicate=args.duplicate,
+                      late=args.late, late_s=args.late_s, silent_board=board,
+                      silent_after_s=args.silent_after, seed=args.fault_seed)
+
+
+def main(argv: list[str]) -> int:
+    """Run the subcommand; returns the exit code (InputError propagates to the
+    CLI, which prints one line and exits 2)."""
+    args = build_parser().parse_args(argv)
+    if args.can is not None:
+        can_main = import_module("stairbot.fakes.can_boards").main
+        code: int = can_main(argv)
+        return code
+    config = load_config(args.config)
+    scenario = load_scenario(args.scenario)
+    world = make_world(config, scenario, args.lockstep)
+    pty = PtyPair()
+    server = SerialBoardServer(pty.master, world, make_boards(world), faults_from(args),
+                               time_scale=args.time_scale)
+    suffix = "?lockstep=1" if args.lockstep else (
+        f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
+    print(f"serial://{pty.path}{suffix}", flush=True)
+    print(f"fake boards serving on {pty.path} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+    try:
+        server.serve()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        pty.close()
+        s = server.stats
+        print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.crc_errors} CRC "
+              f"errors, {s.malformed} malformed, {s.duplicates} repeats, {s.injected} faults "
+              "injected", file=sys.stderr)
+    return 0
+
+
+fake_boards_main = main
+
+__all__ = ["build_parser", "fake_boards_main", "main", "make_world"]
