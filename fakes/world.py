@@ -120,10 +120,10 @@ class World:
             body = pymunk.Body()
             # local frame: origin at the segment's centre on its axle line
             body.position = (left - length / 2, r)
-            half, c = length / 2, min(p.chamfer, length / 4, self.height / 4)
+            half, ch = length / 2, min(p.chamfer, length / 4, self.height / 4)
             # the chassis' bottom edges are chamfered, as a real one's would be
-            box = pymunk.Poly(body, [(-half + c, 0.0), (half - c, 0.0), (half, c),
-                                     (half, self.height), (-half, self.height), (-half, c)])
+            box = pymunk.Poly(body, [(-half + ch, 0.0), (half - ch, 0.0), (half, ch),
+                                     (half, self.height), (-half, self.height), (-half, ch)])
             box.mass = mass
             box.friction = p.body_friction
             box.filter = robot_filter
