@@ -1,0 +1,139 @@
+"""The controller's context: the seed's variables under their seed names, plus
+the bookkeeping the phases need to be restartable.
+
+Everything a phase needs to carry on is here, and motion targets are absolute
+counter values (not "N more turns"), so a controller restored from
+:meth:`Context.to_dict` — or resumed after the standing rule's wait — picks up
+exactly where it stopped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+from stairbot.errors import InputError
+
+TAB_SIZE = 20
+"""Length of tab_length_to_edge, as the seed declares it."""
+
+
+def _empty_tab() -> list[float | None]:
+    return [None] * TAB_SIZE
+
+
+@dataclass
+class Context:
+    """The state of one run of the algorithm.  Plain data; JSON-serialisable."""
+
+    # -- the seed's variables ----------------------------------------------------
+    length_of_next_step: float | None = None
+    """Total length of the next step, metres (None: not measurable, e.g. the top)."""
+    number_of_vertical_turns: float = 0.0
+    """Extra MTF turns past the point where the sensors see over the step."""
+    number_of_turns_for_step_height: float = 0.0
+    """Lift turns for the height of the present step (ascent 3, descent 2)."""
+    number_of_steps: int = 0
+    """Steps climbed."""
+    tab_length_to_edge: list[float | None] = field(default_factory=_empty_tab)
+    """Per step (0-based: the step's number before it was counted): the SFR/SFL
+    reading at which segment 3 hangs over the edge; None when not measurable."""
+
+    # -- where the program stands ---------------------------------------------------
+    phase: str = "cal_check"
+    """Value of the present :class:`~stairbot.phases.Phase`."""
+    purpose: str = "start"
+    """What the calibration phases are doing: "start", "ascent" or "descent"."""
+    calibration_case: str | None = None
+    """The first calibration's case: "1", "2", "3A" or "3B"."""
+    start_reading: float | None = None
+    """Mean SFR/SFL reading when the first calibration ended: the start position."""
+    steps_descended: int = 0
+    pauses: int = 0
+    ascent_end: str | None = None
+    """"top_reached" | "obstacle" | "step_limit" once the ascent has ended."""
+    outcome: str | None = None
+    error: str | None = None
+
+    # -- timers (controller clock: Snapshot.time_s) ---------------------------------
+    phase_started_s: float | None = None
+    pause_started_s: float | None = None
+    resume_phase: str | None = None
+    """The phase the standing rule stopped in, resumed when readings agree."""
+    disagree_ticks: int = 0
+
+    # -- motion targets: absolute counter values ------------------------------------
+    target_wheel: float | None = None
+    """Target for the mean of the four wheel counters (drives)."""
+    target_reading: float | None = None
+    """Mean SFR/SFL reading a drive ends at (None: a drive by turns only)."""
+    target_mtf: float | None = None
+    target_mtb: float | None = None
+    entry_wheel: float = 0.0
+    entry_mtf: float = 0.0
+    entry_mtb: float = 0.0
+    """Counters when the present phase began."""
+    return_mtf: float = 0.0
+    return_mtb: float = 0.0
+    """Lift counters to come back to: before the calibration lift, before ascent 3
+    (and where descent 2 began lowering MTB)."""
+    turn_direction: int = 0
+    """Calibration turns: +1 left (counter-clockwise), -1 right."""
+    turn_origin: float = 0.0
+    """MWR counter when calibration began turning: bounds the total turn."""
+    probe_sfr: float = 0.0
+    probe_sfl: float = 0.0
+    """SFR/SFL when the case-3 probe turn began (or, in case 3B, the largest SFR)."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data (JSON-serialisable) that :meth:`from_dict` restores."""
+        data = asdict(self)
+        data["tab_length_to_edge"] = list(self.tab_length_to_edge)
+        return data
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], source: str = "<context>") -> Context:
+        """Restore a context saved with :meth:`to_dict`.
+
+        Raises InputError naming the key when a key is unknown or a value has
+        the wrong type.
+        """
+        known = {f.name: f for f in fields(cls)}
+        kwargs: dict[str, Any] = {}
+        for key, value in data.items():
+            if key not in known:
+                raise InputError(source, key, "unknown key; allowed: " + ", ".join(known))
+            kwargs[key] = value
+        tab = kwargs.get("tab_length_to_edge")
+        if tab is not None:
+            if not isinstance(tab, list) or len(tab) != TAB_SIZE or not all(
+                v is None or isinstance(v, int | float) for v in tab
+            ):
+                raise InputError(source, "tab_length_to_edge",
+                                 f"must be a list of {TAB_SIZE} numbers or nulls")
+            kwargs["tab_length_to_edge"] = [None if v is None else float(v) for v in tab]
+        ctx = cls(**kwargs)
+        for name, f in known.items():
+            value = getattr(ctx, name)
+            if name == "tab_length_to_edge":
+                continue
+            if not _type_ok(value, str(f.type)):
+                raise InputError(source, name, f"{value!r} is not of type {f.type}")
+        return ctx
+
+
+def _type_ok(value: object, annotation: str) -> bool:
+    allowed: list[type] = []
+    if "None" in annotation:
+        allowed.append(type(None))
+    if "float" in annotation:
+        allowed += [float, int]
+    if "int" in annotation:
+        allowed.append(int)
+    if "str" in annotation:
+        allowed.append(str)
+    if "bool" in annotation:
+        allowed = [bool]
+    if isinstance(value, bool) and bool not in allowed:
+        return False
+    return isinstance(value, tuple(allowed))

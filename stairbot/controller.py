@@ -1,0 +1,297 @@
+"""The controller: the seed's algorithm advanced one tick at a time.
+
+Each :meth:`Controller.tick` takes one :class:`~stairbot.hardware.Snapshot`
+and returns a speed for all six motors.  Faults are checked before the
+phase's own logic (a motor fault, a sensor error on a sensor the phase needs,
+a phase that takes too long), then the standing rule, then the phase's
+handler.  The clock is ``Snapshot.time_s`` alone; nothing here sleeps.  Every
+phase change is checked against :data:`~stairbot.transitions.TRANSITIONS` and
+told as an event.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from stairbot import ascent, calibration, descent, motion, standing
+from stairbot.config import RobotConfig
+from stairbot.context import Context
+from stairbot.events import Event, EventKind, EventSink, discard
+from stairbot.handler import Handler, PhaseIO
+from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, LIFT_MOTORS, MotorId, SensorId, Snapshot
+from stairbot.phases import Mode, Phase
+from stairbot.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
+
+PHASE_TIMEOUT_S = 60.0
+"""A phase (other than the standing rule's wait) that lasts longer than this,
+in controller time, ends the program with an error: something is stuck."""
+
+OUTCOMES = ("completed", "stopped", "error")
+
+HANDLERS: dict[Phase, Handler] = {
+    **calibration.HANDLERS, **ascent.HANDLERS, **descent.HANDLERS, **standing.HANDLERS,
+}
+
+
+@dataclass(frozen=True)
+class ControllerResult:
+    """How the program ended (``outcome`` is "running" until it has)."""
+
+    outcome: str  # "completed" | "stopped" | "error" | "running"
+    ascent_end: str | None  # "top_reached" | "obstacle" | "step_limit" | None
+    error: str | None
+    steps_climbed: int
+    steps_descended: int
+    pauses: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class Controller:
+    """Runs the algorithm against snapshots of a robot.
+
+    ``context`` restores a saved run (:meth:`Context.to_dict`); the snapshots
+    must then come from the same clock.  ``hold``/``release``/``abort`` are
+    for the operator and must be called from the thread that ticks.
+    """
+
+    def __init__(self, config: RobotConfig, sink: EventSink = discard,
+                 mode: Mode = Mode.FULL, context: Context | None = None) -> None:
+        self.config = config
+        self.mode = mode
+        self._sink = sink
+        if context is None:
+            context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns)
+        self._ctx = context
+        self._started = context.phase_started_s is not None
+        self._held: str | None = None
+        self._held_since: float | None = None
+        self._time = context.phase_started_s or 0.0
+
+    # -- what the outside sees --------------------------------------------------------
+    @property
+    def phase(self) -> Phase:
+        return Phase(self._ctx.phase)
+
+    @property
+    def context(self) -> Context:
+        return self._ctx
+
+    @property
+    def finished(self) -> bool:
+        return self.phase.terminal
+
+    @property
+    def held(self) -> bool:
+        return self._held is not None
+
+    @property
+    def result(self) -> ControllerResult:
+        ctx = self._ctx
+        return ControllerResult(ctx.outcome or "running", ctx.ascent_end, ctx.error,
+                                ctx.number_of_steps, ctx.steps_descended, ctx.pauses)
+
+    # -- operator ---------------------------------------------------------------------
+    def hold(self, reason: str) -> None:
+        """Stop every motor from the next tick on and freeze the timers, until
+        :meth:`release`.  The phase carries on from where it was afterwards."""
+        if self.finished or self._held is not None:
+            return
+        self._held = reason
+        self._emit(EventKind.INFO, f"held: {reason}", self._time, {"held": True})
+
+    def release(self) -> None:
+        """Let a held controller go on where it was."""
+        if self._held is None:
+            return
+        self._held = None
+        self._emit(EventKind.INFO, "released: carrying on", self._time, {"held": False})
+
+    def abort(self, reason: str, outcome: str = "error") -> None:
+        """End the program now with ``outcome`` ("error" or "stopped"); every
+        later tick commands zero.  Outside the transition table on purpose: it
+        is the operator's (or the run loop's) decision, not the algorithm's."""
+        if outcome not in OUTCOMES:
+            raise ValueError(f"outcome {outcome!r}; allowed: {', '.join(OUTCOMES)}")
+        if self.finished:
+            return
+        self._finish(Phase.ERROR if outcome == "error" else Phase.DONE, outcome, reason,
+                     self._time)
+
+    # -- the tick ---------------------------------------------------------------------
+    def tick(self, snap: Snapshot) -> dict[MotorId, float]:
+        """Advance the program by one snapshot; returns a speed (turns/s) for
+        every motor.  After the end, and while held, every speed is 0."""
+        self._time = snap.time_s
+        if self.finished:
+            return _zeros()
+        if self._held is not None:
+            if self._held_since is None:
+                self._held_since = snap.time_s
+            return _zeros()
+        if self._held_since is not None:
+            self._shift_timers(snap.time_s - self._held_since)
+            self._held_since = None
+        io = PhaseIO(snap, self.config, self._ctx, self.mode, self)
+        if not self._started:
+            self._started = True
+            self._enter(self.phase, "program start", snap)
+        fault = self._fault(snap)
+        if fault is not None:
+            self.fail(fault, snap)
+            return _zeros()
+        if standing.watch(io):
+            return _zeros()
+        phase = self.phase
+        speeds = HANDLERS[phase].step(io)
+        if self.phase is not phase or self.phase is Phase.PAUSED:
+            return _zeros()
+        return self._limit(speeds, snap)
+
+    def _fault(self, snap: Snapshot) -> str | None:
+        for motor in MotorId:
+            fault = snap.motors[motor].fault
+            if fault:
+                return f"motor fault: {motor} reports {fault!r} in {self.phase.label}"
+        phase = self.phase
+        errors = motion.sensor_errors(snap, _needed_sensors(phase, self._ctx))
+        if errors:
+            names = ", ".join(str(s) for s in errors)
+            return f"sensor error: {names} report{'s' if len(errors) == 1 else ''} an error " \
+                   f"in {phase.label}"
+        started = self._ctx.phase_started_s
+        if phase is not Phase.PAUSED and started is not None \
+                and snap.time_s - started > PHASE_TIMEOUT_S:
+            return f"phase timeout: {phase.label} took longer than {PHASE_TIMEOUT_S:g} s"
+        return None
+
+    def _limit(self, speeds: dict[MotorId, float], snap: Snapshot) -> dict[MotorId, float]:
+        """Every motor gets a speed within its maximum; a lift at the end of its
+        stroke is not driven further."""
+        motors = self.config.motors
+        stroke = self.config.MAX_OF_VERTICAL_TURNS
+        out = _zeros()
+        for motor, v in speeds.items():
+            vmax = motors.lift_speed if motor in LIFT_MOTORS else motors.wheel_speed
+            v = max(-vmax, min(vmax, v))
+            if motor in LIFT_MOTORS:
+                turns = snap.turns(motor)
+                if (v > 0 and turns >= stroke) or (v < 0 and turns <= -stroke):
+                    v = 0.0
+            out[motor] = v
+        return out
+
+    # -- phase changes (the Machine the handlers reach) -------------------------------------
+    def transition(self, phase: Phase, why: str, snap: Snapshot) -> None:
+        """Enter ``phase``; raises TransitionError when the table does not allow it."""
+        if not allowed(self.phase, phase):
+            raise TransitionError(f"{self.phase.value} -> {phase.value} is not in the "
+                                  "transition table")
+        self._enter(phase, why, snap)
+
+    def fail(self, reason: str, snap: Snapshot) -> None:
+        """End the program with an error (a transition the table allows)."""
+        if self.finished:
+            return
+        if not allowed(self.phase, Phase.ERROR):
+            raise TransitionError(f"{self.phase.value} -> error is not in the transition table")
+        self._finish(Phase.ERROR, "error", reason, snap.time_s)
+
+    def end(self, outcome: str, reason: str, snap: Snapshot) -> None:
+        """End the program with ``outcome`` (a transition to DONE the table allows)."""
+        if not allowed(self.phase, Phase.DONE):
+            raise TransitionError(f"{self.phase.value} -> done is not in the transition table")
+        self._finish(Phase.DONE, outcome, reason, snap.time_s)
+
+    def pause(self, reason: str, snap: Snapshot) -> None:
+        self._emit(EventKind.PAUSE, reason, snap.time_s, {"resume_phase": self._ctx.resume_phase})
+        self.transition(Phase.PAUSED, TRANSITIONS[self.phase][Phase.PAUSED], snap)
+
+    def resume(self, reason: str, snap: Snapshot) -> None:
+        ctx = self._ctx
+        assert ctx.resume_phase is not None and ctx.pause_started_s is not None
+        target = Phase(ctx.resume_phase)
+        if not allowed(Phase.PAUSED, target):
+            raise TransitionError(f"paused -> {target.value} is not in the transition table")
+        if ctx.phase_started_s is not None:
+            ctx.phase_started_s += snap.time_s - ctx.pause_started_s
+        ctx.resume_phase = ctx.pause_started_s = None
+        self._emit(EventKind.RESUME, reason, snap.time_s, {"phase": target.value})
+        self._enter(target, TRANSITIONS[Phase.PAUSED][target], snap, fresh=False)
+
+    def emit(self, kind: EventKind, message: str, snap: Snapshot,
+             data: dict[str, Any] | None = None) -> None:
+        self._emit(kind, message, snap.time_s, data or {})
+
+    # -- inside ---------------------------------------------------------------------------
+    def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True) -> None:
+        ctx = self._ctx
+        previous = ctx.phase
+        ctx.phase = phase.value
+        ctx.disagree_ticks = 0
+        if fresh and phase is not Phase.PAUSED:
+            ctx.phase_started_s = snap.time_s
+            ctx.entry_wheel = motion.wheel_position(snap)
+            ctx.entry_mtf = snap.turns(MotorId.MTF)
+            ctx.entry_mtb = snap.turns(MotorId.MTB)
+        where = self._where(phase)
+        self._emit(EventKind.PHASE, f"{phase.label}{where}" + ("" if fresh else " (resumed)"),
+                   snap.time_s, {"phase": phase.value, "flow": phase.flow, "from": previous,
+                                 "why": why})
+        if fresh and phase in HANDLERS:
+            HANDLERS[phase].enter(PhaseIO(snap, self.config, ctx, self.mode, self))
+
+    def _finish(self, phase: Phase, outcome: str, reason: str, time_s: float) -> None:
+        ctx = self._ctx
+        previous = ctx.phase
+        ctx.outcome = outcome
+        ctx.phase = phase.value
+        if outcome == "error":
+            ctx.error = reason
+            self._emit(EventKind.ERROR, reason, time_s, {"from": previous})
+        self._emit(EventKind.PHASE, phase.label, time_s,
+                   {"phase": phase.value, "flow": phase.flow, "from": previous, "why": reason})
+        self._emit(EventKind.END, f"program ended ({outcome}): {reason}", time_s,
+                   self.result.to_dict())
+
+    def _shift_timers(self, delta: float) -> None:
+        ctx = self._ctx
+        if ctx.phase_started_s is not None:
+            ctx.phase_started_s += delta
+        if ctx.pause_started_s is not None:
+            ctx.pause_started_s += delta
+
+    def _where(self, phase: Phase) -> str:
+        ctx = self._ctx
+        if phase.flow == "calibration":
+            if ctx.purpose == "start":
+                return " (start)"
+            if ctx.purpose == "ascent":
+                return f" (ascent 1, step {ctx.number_of_steps + 1})"
+            return f" (descent 1, step {ctx.number_of_steps - ctx.steps_descended})"
+        if phase.flow == "ascent":
+            counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
+            return f" (step {ctx.number_of_steps + (0 if counted else 1)})"
+        if phase.flow == "descent" and phase is not Phase.DESCENT_FINISH:
+            return f" (step {ctx.number_of_steps - ctx.steps_descended})"
+        return ""
+
+    def _emit(self, kind: EventKind, message: str, time_s: float,
+              data: dict[str, Any]) -> None:
+        phase = self.phase.label
+        self._sink(Event(time_s, kind, message, phase, data))
+
+
+def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
+    """The sensors whose ERROR status ends the program in ``phase``."""
+    if phase is Phase.PAUSED and ctx.resume_phase is not None:
+        phase = Phase(ctx.resume_phase)
+    if phase.terminal:
+        return ()
+    return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
+
+
+def _zeros() -> dict[MotorId, float]:
+    return {m: 0.0 for m in MotorId}
