@@ -304,13 +304,13 @@ class ConsoleEngine:
         if self._running.is_set():
             return None
         self._running.set()
-        self.control = self._control_fn()
         session = RobotSession(self.robot, self.clock, self.session.url,
                                self.session.simulated, self.session.sim)
         self.state.on_result({})
         self.state.set_status(robot="running", paused=False, severity="info",
                               message="calibrating only" if mode == "calibrate" else "full run")
         try:
+            self.control = self._control_fn()
             result = self._run_fn(session, self.config, self._sink, mode, self.control,
                                   self._on_tick)
         except Exception as exc:  # noqa: BLE001 - a fault shows as a banner, not a traceback
@@ -325,6 +325,8 @@ class ConsoleEngine:
         self.robot.refresh_scene()
         self.state.on_result(out)
         line, severity = describe_result(out)
+        if self.robot.estopped:
+            line += " · EMERGENCY STOP still set: c clears it"
         self.state.set_status(robot="ended", paused=False, message=line, severity=severity)
         return out
 

@@ -1,0 +1,58 @@
+"""The braille canvas and the scene model the picture draws from."""
+
+from __future__ import annotations
+
+from stairbot.console.canvas import BrailleCanvas
+from stairbot.console.scene import SceneView, scene_from_sim, stairs_from_scenario
+
+from stairbot.config import load_config
+from stairbot.scenario import load_scenario
+
+
+def test_dots_map_to_braille_bits() -> None:
+    c = BrailleCanvas(2, 1)
+    c.plot(0, 0)
+    c.plot(1, 3)
+    c.plot(2, 1)
+    text = c.to_text().plain
+    assert text == chr(0x2800 + 0x01 + 0x80) + chr(0x2800 + 0x02)
+
+
+def test_off_canvas_dots_are_ignored_and_polygon_fills() -> None:
+    c = BrailleCanvas(3, 2)
+    c.plot(-1, 0)
+    c.plot(100, 100)
+    assert c.to_text().plain == "   \n   "
+    c.polygon([(0, 0), (5, 0), (5, 7), (0, 7)], "red")
+    assert c.to_text().plain == "⣿⣿⣿\n⣿⣿⣿"
+
+
+def test_scenario_stairs_outline() -> None:
+    sc = load_scenario()  # five steps 0.17 / 0.28
+    pts = stairs_from_scenario(sc, 0.225)
+    view = SceneView(stairs=pts)
+    assert [round(x, 6) for x in view.risers()] == [0.0, 0.28, 0.56, 0.84, 1.12]
+    assert abs(max(p[1] for p in pts) - 0.85) < 1e-9
+    assert view.step_under(-0.1) == 0
+    assert view.step_under(0.3) == 2
+
+
+def test_scene_from_the_simulation_shows_the_robot_before_the_stairs() -> None:
+    from stairbot.fakes.sim import open_sim_robot
+
+    from stairbot.robots import RobotOptions
+
+    session = open_sim_robot("sim://", load_config(), load_scenario(), RobotOptions())
+    view = scene_from_sim(session.sim.scene())  # type: ignore[union-attr]
+    assert len(view.segments) == 3
+    assert view.segment_steps() == [0, 0, 0]
+    front = max(p[0] for p in view.segments[0])
+    assert abs(front + 0.5) < 0.01  # the scenario puts the front 0.5 m before the riser
+    assert len(view.wheels) == 6
+
+
+def test_scene_accepts_mappings() -> None:
+    raw = {"stairs": [(0, 0), (1, 0)], "segments": [{"corners": [(0, 0), (1, 0), (1, 1)]}],
+           "wheels": [{"x": 0.5, "y": 0.1, "r": 0.02}]}
+    view = scene_from_sim(raw)
+    assert view.wheels == ((0.5, 0.1, 0.02),)

@@ -1,0 +1,142 @@
+"""The console engine: the run on a worker thread, the latched emergency stop,
+pause, and bad input, against the real simulated robot."""
+
+from __future__ import annotations
+
+import threading
+from types import SimpleNamespace
+from typing import Any
+
+import pytest
+from stairbot.console.runner_thread import ConsoleEngine, describe_result
+from stairbot.console.state import LiveState
+
+from stairbot.config import load_config
+from stairbot.errors import InputError
+from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
+
+FORWARD = {m: 1.0 for m in WHEEL_MOTORS}
+
+
+class Control:
+    """The RunControl contract (stairbot.runner), for the stand-in loop."""
+
+    def __init__(self) -> None:
+        self.stop_reason: str | None = None
+        self.estopped = self.paused = False
+
+    def request_stop(self, reason: str = "stopped") -> None:
+        self.stop_reason = reason
+
+    def estop(self) -> None:
+        self.estopped = self.paused = True
+
+    def clear_estop(self) -> None:
+        self.estopped = False
+
+    def pause(self) -> None:
+        self.paused = True
+
+    def resume(self) -> None:
+        self.paused = self.estopped
+
+
+class DriveLoop:
+    """Stands in for runner.run: the same read/command/advance loop with a
+    controller that only drives forward, and that IGNORES the e-stop and pause
+    (so the test proves the console's own gate stops the robot)."""
+
+    def __init__(self) -> None:
+        self.snaps: list[Snapshot] = []
+        self.started = threading.Event()
+
+    def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: Any,
+                 on_tick: Any) -> dict[str, Any]:
+        robot, clock = session.robot, session.clock
+        while control.stop_reason is None and len(self.snaps) < 20000:
+            snap = robot.read()
+            self.snaps.append(snap)
+            robot.command(FORWARD)
+            on_tick(SimpleNamespace(phase="drive", context=None), snap)
+            clock.advance(config.algorithm.tick)
+            self.started.set()
+        robot.stop_all()
+        return {"outcome": "stopped", "ascent_end": None, "steps_climbed": 0,
+                "steps_descended": 0, "error": None}
+
+
+def wait_for(cond: Any, what: str) -> None:
+    """Wait on a condition the run thread makes true (no timing assertion: the
+    limit only keeps a broken test from hanging)."""
+    ev = threading.Event()
+    for _ in range(20000):
+        if cond():
+            return
+        ev.wait(0.001)
+    raise AssertionError(f"never happened: {what}")
+
+
+@pytest.fixture
+def engine_and_loop() -> tuple[ConsoleEngine, DriveLoop]:
+    loop = DriveLoop()
+    engine = ConsoleEngine(LiveState(), load_config(), run_fn=loop, control_fn=Control)
+    engine.open("sim://", None)
+    return engine, loop
+
+
+def test_estop_stops_every_motor_even_if_the_loop_ignores_it(
+        engine_and_loop: tuple[ConsoleEngine, DriveLoop]) -> None:
+    engine, loop = engine_and_loop
+    worker = threading.Thread(target=engine.run, args=("full",))
+    worker.start()
+    try:
+        wait_for(lambda: len(loop.snaps) > 100, "100 ticks")
+        moving = loop.snaps[-1]
+        assert moving.motors[MotorId.MWF].speed_tps > 0.5
+        engine.estop()
+        assert engine.robot is not None
+        stop_tick = engine.robot.estop_tick
+        assert stop_tick is not None
+        wait_for(lambda: len(loop.snaps) > stop_tick + 100, "100 ticks after the stop")
+    finally:
+        engine.stop()
+        worker.join()
+    # From the first reading after the stop on, every motor is still (the
+    # physics settles within a hundredth of a turn/s) and no counter moves by
+    # more than 1 mm of wheel travel (0.01 turn) or 0.1 mm of lift (0.05 turn).
+    after = loop.snaps[stop_tick:]
+    first = after[0]
+    for snap in after:
+        for m in MotorId:
+            assert abs(snap.motors[m].speed_tps) < 0.02, (m, snap.time_s)
+            tol = 0.05 if m in LIFT_MOTORS else 0.01
+            assert snap.motors[m].turns == pytest.approx(first.motors[m].turns, abs=tol)
+    assert first.motors[MotorId.MWF].turns - moving.motors[MotorId.MWF].turns < 0.05
+    view = engine.state.view()
+    assert view.status.estopped
+    assert "EMERGENCY STOP" in view.status.message
+
+
+def test_a_run_cannot_start_until_the_estop_is_cleared(
+        engine_and_loop: tuple[ConsoleEngine, DriveLoop]) -> None:
+    engine, loop = engine_and_loop
+    engine.estop()
+    assert engine.run("full") is None
+    assert "clear it" in engine.state.view().status.message
+    assert engine.clear_estop()
+    assert not engine.state.view().status.estopped
+
+
+def test_bad_scenario_and_url_raise_input_errors() -> None:
+    engine = ConsoleEngine(LiveState(), load_config())
+    with pytest.raises(InputError, match="cannot read"):
+        engine.open("sim://", "/nonexistent/stairs.toml")
+    with pytest.raises(InputError, match="unknown scheme"):
+        engine.open("bogus://x", None)
+
+
+def test_describe_result() -> None:
+    line, severity = describe_result({"outcome": "completed", "ascent_end": "top_reached",
+                                      "steps_climbed": 5, "steps_descended": 5})
+    assert line == "Run completed · ascent ended: top reached · climbed 5, descended 5"
+    assert severity == "good"
