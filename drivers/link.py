@@ -119,20 +119,35 @@ class LinkStats:
     crc_errors: int = 0
     malformed: int = 0
     rtt_s: deque[float] = field(default_factory=lambda: deque(maxlen=2048))
+    rtt_count: int = 0  # replies timed so far
+    _rtt_cache: tuple[int, float, float] = (-1, 0.0, 0.0)
+
+    def add_rtt(self, seconds: float) -> None:
+        self.rtt_s.append(seconds)
+        self.rtt_count += 1
+
+    def _rtt(self) -> tuple[float, float]:
+        # Sorting 2048 samples costs more than a whole control cycle: redo it
+        # only every 64 new samples (and whenever few are kept).
+        n, med, p99 = self._rtt_cache
+        if self.rtt_s and (n < 0 or self.rtt_count - n >= 64 or len(self.rtt_s) < 64):
+            ordered = sorted(self.rtt_s)
+            med = statistics.median(ordered)
+            p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))]
+            self._rtt_cache = (self.rtt_count, med, p99)
+        return med, p99
 
     def rtt_median_ms(self) -> float:
-        return statistics.median(self.rtt_s) * 1e3 if self.rtt_s else 0.0
+        return self._rtt()[0] * 1e3
 
     def rtt_p99_ms(self) -> float:
-        if not self.rtt_s:
-            return 0.0
-        ordered = sorted(self.rtt_s)
-        return ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))] * 1e3
+        return self._rtt()[1] * 1e3
 
     def as_dict(self) -> dict[str, float]:
         """Counters and RTT figures, flat, for Snapshot.health and events."""
         out: dict[str, float] = {
-            k: float(v) for k, v in vars(self).items() if isinstance(v, int)
+            k: float(v) for k, v in vars(self).items()
+            if isinstance(v, int) and not k.startswith("_")
         }
         out["rtt_median_ms"] = round(self.rtt_median_ms(), 3)
         out["rtt_p99_ms"] = round(self.rtt_p99_ms(), 3)
@@ -178,6 +193,7 @@ class Link:
         self._pending: dict[tuple[int, int], Pending] = {}
         self._expired: deque[tuple[int, int]] = deque(maxlen=64)
         self._seq = 0
+        self._out = bytearray()
         self.lost_streak = 0
         self.stats = LinkStats()
 
@@ -189,25 +205,36 @@ class Link:
                 return self._seq
         raise LinkLostError("256 requests in flight: the boards do not answer")
 
-    def request(self, board: int, messages: Sequence[Message]) -> Pending:
+    def request(self, board: int, messages: Sequence[Message], send: bool = True) -> Pending:
         """Send one request frame to ``board``; its reply is collected by
-        :meth:`wait` or :meth:`poll`."""
+        :meth:`wait` or :meth:`poll`.  With ``send=False`` the frame waits in
+        the output buffer for :meth:`flush` (or the next request that sends),
+        so that several frames go out in one write."""
         seq = self._next_seq(board)
         wire = encode_frame(Frame(board, seq, tuple(messages)))
         now = self._now()
         p = Pending(board, seq, wire, all(m.IDEMPOTENT for m in messages), now,
                     now + self.timeout_s)
         self._pending[(board, seq)] = p
-        self._send(wire)
+        self._send(wire, send)
         return p
 
-    def _send(self, wire: bytes) -> None:
-        try:
-            self.channel.write(wire)
-        except OSError as exc:
-            raise LinkLostError(f"cannot write to the port: {exc}") from exc
+    def _send(self, wire: bytes, flush: bool = True) -> None:
+        self._out += wire
         self.stats.frames_tx += 1
         self.stats.bytes_tx += len(wire)
+        if flush:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write every frame still in the output buffer (one write)."""
+        if not self._out:
+            return
+        data, self._out = bytes(self._out), bytearray()
+        try:
+            self.channel.write(data)
+        except OSError as exc:
+            raise LinkLostError(f"cannot write to the port: {exc}") from exc
 
     # -- receiving -------------------------------------------------------------
     def _receive(self, timeout_s: float) -> None:
@@ -229,7 +256,7 @@ class Link:
                     self.stats.stray += 1
                 continue
             self.stats.frames_rx += 1
-            self.stats.rtt_s.append(self._now() - p.sent_at)
+            self.stats.add_rtt(self._now() - p.sent_at)
             p.reply = frame
             del self._pending[key]
             if not p.idempotent:
@@ -258,6 +285,7 @@ class Link:
 
     def poll(self) -> None:
         """Take in whatever has arrived, without waiting; expire old requests."""
+        self.flush()
         self._receive(0.0)
         self._expire()
 
@@ -265,6 +293,7 @@ class Link:
         """The replies of ``pendings``, in order.  Re-sends idempotent requests
         that time out; raises LinkLostError when one gets no reply at all, or
         when ``max_lost`` commands in a row went unanswered."""
+        self.flush()
         while True:
             self._expire()
             failed = [p for p in pendings if p.failed]

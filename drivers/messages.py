@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Mapping
-from dataclasses import astuple, dataclass
+from dataclasses import dataclass
+from dataclasses import fields as dataclass_fields
 from enum import IntEnum, IntFlag
 from typing import ClassVar, TypeVar
 
@@ -113,6 +114,7 @@ class AckResult(IntEnum):
 
 
 M = TypeVar("M", bound="Message")
+_NAMES: dict[type, tuple[str, ...]] = {}
 
 
 @dataclass(frozen=True, slots=True)
@@ -127,7 +129,10 @@ class Message:
 
     def fields(self) -> tuple[int, ...]:
         """The integers packed into the payload, in FORMAT order."""
-        return tuple(int(v) for v in astuple(self))
+        names = _NAMES.get(type(self))
+        if names is None:
+            names = _NAMES[type(self)] = tuple(f.name for f in dataclass_fields(self))
+        return tuple([int(getattr(self, name)) for name in names])
 
     @classmethod
     def from_fields(cls: type[M], values: tuple[int, ...]) -> M:

@@ -197,7 +197,7 @@ class SerialRobot:
         board's watchdog tripped), RobotFellError (fake boards: the simulated
         robot fell) or HardwareError (e-stop latched on a board, bad reply)."""
         self._reap()
-        pm = self.link.request(m.Board.MOTOR, [m.ReadAll()])
+        pm = self.link.request(m.Board.MOTOR, [m.ReadAll()], send=False)
         ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
         fm, fs = self._wait([pm, ps])
         motors = self._motors(fm.messages)
@@ -213,6 +213,14 @@ class SerialRobot:
             self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
         wheels, lifts = m.speeds_to_wire(speeds)
         self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts]))
+
+    def flush(self) -> None:
+        """Wait for the Acks of every command still in flight (LinkLostError
+        if one never comes)."""
+        pending = [p for p in self._commands if not p.done]
+        if pending:
+            self._wait(pending)
+        self._reap()
 
     def stop_all(self) -> None:
         """Stop every motor (lifts hold); never raises."""

@@ -80,6 +80,7 @@ class SerialBoardServer:
         self._late: list[tuple[float, bytes]] = []
         self._stop = threading.Event()
         self._crc_seen = 0
+        self._out = bytearray()
 
     # -- faults ------------------------------------------------------------------
     def _chance(self, p: float) -> bool:
@@ -108,9 +109,8 @@ class SerialBoardServer:
             self._late.append((time.monotonic() + self.faults.late_s, wire))
             return
         copies = 2 if self._chance(self.faults.duplicate) else 1
-        for _ in range(copies):
-            self._write_all(wire)
-            self.stats.frames_tx += 1
+        self._out += wire * copies
+        self.stats.frames_tx += copies
 
     def _write_all(self, data: bytes) -> None:
         view = memoryview(data)
@@ -142,6 +142,9 @@ class SerialBoardServer:
             self._handle(frame)
             if self._chance(f.duplicate):
                 self._handle(frame)
+        if self._out:
+            out, self._out = bytes(self._out), bytearray()
+            self._write_all(out)  # every reply to this read in one write
         rs = self._reader.stats
         self.stats.malformed = rs.malformed + rs.overruns
         self._crc_seen, new = rs.crc_errors, rs.crc_errors - self._crc_seen
