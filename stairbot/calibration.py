@@ -22,6 +22,11 @@ PROBE_YAW_RAD = math.radians(10.0)
 changed by 2 × equal_tolerance before."""
 MAX_TURN_YAW_RAD = math.radians(90.0)
 """A calibration that turns this far without SFR = SFL ends with an error."""
+DIFF_SMOOTHING = 0.3
+"""Weight of the newest SFL − SFR in the smoothed difference that ends a turn:
+it averages the sensors' noise over a few ticks."""
+TURN_SLOW_FLOOR = 0.25
+"""The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
 
 
 def _readings(io: PhaseIO) -> tuple[float, float]:
@@ -99,19 +104,24 @@ def _turn_enter(io: PhaseIO) -> None:
     sfr, sfl = _readings(io)
     # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
     io.ctx.turn_direction = 1 if sfl < sfr else -1
+    io.ctx.turn_diff = sfl - sfr
 
 
 def _turn(io: PhaseIO) -> Speeds:
+    ctx, cfg = io.ctx, io.cfg
     sfr, sfl = _readings(io)
+    ctx.turn_diff += DIFF_SMOOTHING * ((sfl - sfr) - ctx.turn_diff)
     # Turning left closes SFL - SFR from below, turning right from above: stop
-    # when it is within half the tolerance or has changed sign.
-    if -io.ctx.turn_direction * (sfl - sfr) <= io.cfg.algorithm.equal_tolerance / 2:
+    # when the smoothed difference has reached zero.
+    remaining = -ctx.turn_direction * ctx.turn_diff
+    if remaining <= 0.0:
         io.info(f"squared up: SFR {sfr:.3f} m, SFL {sfl:.3f} m", SFR=sfr, SFL=sfl)
         io.go(Phase.CAL_LOWER)
         return {}
     if _turned_too_far(io):
         return {}
-    return motion.turn(io.ctx.turn_direction, io.cfg)
+    slow = min(1.0, max(TURN_SLOW_FLOOR, remaining / (2 * cfg.algorithm.equal_tolerance)))
+    return motion.turn(ctx.turn_direction, cfg, slow)
 
 
 def _probe_enter(io: PhaseIO) -> None:

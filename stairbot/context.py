@@ -79,6 +79,8 @@ class Context:
     (and where descent 2 began lowering MTB)."""
     turn_direction: int = 0
     """Calibration turns: +1 left (counter-clockwise), -1 right."""
+    turn_diff: float = 0.0
+    """Calibration turns: SFL − SFR, smoothed over a few ticks."""
     turn_origin: float = 0.0
     """MWR counter when calibration began turning: bounds the total turn."""
     probe_sfr: float = 0.0

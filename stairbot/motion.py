@@ -98,9 +98,10 @@ def drive(cfg: RobotConfig, direction: int, remaining_turns: float) -> Speeds:
     return {m: v for m in WHEEL_MOTORS}
 
 
-def turn(direction: int, cfg: RobotConfig) -> Speeds:
-    """Turn in place on segment 2's wheels: +1 left (MWR forward, MWL back)."""
-    v = min(TURN_SPEED, cfg.motors.wheel_speed)
+def turn(direction: int, cfg: RobotConfig, fraction: float = 1.0) -> Speeds:
+    """Turn in place on segment 2's wheels: +1 left (MWR forward, MWL back), at
+    ``fraction`` of TURN_SPEED."""
+    v = min(TURN_SPEED, cfg.motors.wheel_speed) * fraction
     return {MotorId.MWR: direction * v, MotorId.MWL: -direction * v}
 
 
