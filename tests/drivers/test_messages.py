@@ -1,0 +1,95 @@
+"""The message model: every type round-trips, payloads fit a CAN frame, units
+convert as documented, and no byte string makes a decoder raise anything but
+CodecError."""
+
+from __future__ import annotations
+
+import struct
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stairbot.drivers import messages as m
+from stairbot.hardware import MotorId, SensorStatus
+
+RANGES = {"B": (0, 255), "H": (0, 65535), "h": (-32768, 32767), "I": (0, 2**32 - 1),
+          "i": (-(2**31), 2**31 - 1)}
+
+
+def field_values(cls: type[m.Message]) -> st.SearchStrategy[tuple[int, ...]]:
+    chars = [c for c in cls.FORMAT[1:] if c != "x"]
+    if cls is m.MotorTelemetry:  # channel and mode share one byte
+        return st.tuples(st.integers(0, 15), st.integers(0, 15), st.integers(0, 255),
+                         st.integers(*RANGES["h"]), st.integers(*RANGES["i"]))
+    return st.tuples(*(st.integers(*RANGES[c]) for c in chars))
+
+
+@pytest.mark.parametrize("cls", list(m.MESSAGES.values()), ids=lambda c: c.__name__)
+def test_payload_fits_a_can_frame(cls: type[m.Message]) -> None:
+    assert struct.calcsize(cls.FORMAT) <= 8
+    assert m.payload_size(cls.TYPE) == struct.calcsize(cls.FORMAT)
+
+
+def test_type_codes_are_unique_and_replies_have_the_high_bit() -> None:
+    assert len(m.MESSAGES) == len({c.TYPE for c in m.MESSAGES.values()})
+    for code, cls in m.MESSAGES.items():
+        assert bool(code & 0x80) == cls.REPLY, cls.__name__
+
+
+@pytest.mark.parametrize("cls", list(m.MESSAGES.values()), ids=lambda c: c.__name__)
+@settings(max_examples=25, deadline=None)
+@given(data=st.data())
+def test_every_message_round_trips(cls: type[m.Message], data: st.DataObject) -> None:
+    msg = cls(*data.draw(field_values(cls)))
+    code, payload = m.encode(msg)
+    assert code == cls.TYPE
+    assert len(payload) == m.payload_size(code)
+    assert m.decode(code, payload) == msg
+
+
+def test_out_of_range_field_is_a_codec_error() -> None:
+    with pytest.raises(m.CodecError, match="SetLiftSpeeds"):
+        m.encode(m.SetLiftSpeeds(40000, 0))
+
+
+def test_wrong_length_and_unknown_type_are_codec_errors() -> None:
+    with pytest.raises(m.CodecError, match="expected 8"):
+        m.decode(m.SetWheelSpeeds.TYPE, b"\x00" * 7)
+    with pytest.raises(m.CodecError, match="unknown message type 0x33"):
+        m.decode(0x33, b"")
+
+
+@given(st.integers(0, 255), st.binary(max_size=12))
+def test_decode_raises_only_codec_error(code: int, payload: bytes) -> None:
+    try:
+        msg = m.decode(code, payload)
+    except m.CodecError:
+        return
+    assert m.encode(msg) == (code, payload)
+
+
+def test_units() -> None:
+    assert m.speed_to_wire(1.0) == 1000
+    assert m.speed_to_wire(-10.0) == -10000
+    assert m.speed_to_wire(1e9) == 32767 and m.speed_to_wire(-1e9) == -32767
+    assert m.turns_to_wire(-19.0004) == -19000
+    assert m.distance_to_wire(0.4975) in (497, 498)
+    assert m.distance_to_wire(-1.0) == 0 and m.distance_to_wire(100.0) == 65535
+    state = m.state_from_wire(m.MotorTelemetry(4, 1, 2, -1500, 105000))
+    assert (state.turns, state.speed_tps, state.fault) == (105.0, -1.5, "watchdog")
+    reading = m.reading_from_wire(m.SensorTelemetry(0, 1, 1300, 3))
+    assert (reading.distance_m, reading.status) == (1.3, SensorStatus.OUT_OF_RANGE)
+    assert m.reading_from_wire(m.SensorTelemetry(0, 9, 0, 0)).status is SensorStatus.ERROR
+
+
+def test_speeds_to_wire_sends_zero_for_motors_left_out() -> None:
+    wheels, lifts = m.speeds_to_wire({MotorId.MWL: -0.5, MotorId.MTB: 10.0})
+    assert wheels == m.SetWheelSpeeds(0, 0, 0, -500)
+    assert lifts == m.SetLiftSpeeds(0, 10000)
+
+
+def test_only_queries_and_step_to_are_idempotent() -> None:
+    idempotent = {c.__name__ for c in m.MESSAGES.values() if c.IDEMPOTENT}
+    assert idempotent == {"Identify", "Heartbeat", "GetStatus", "ReadAll", "GetMotor",
+                          "GetSensor", "StepTo", "GetTruth"}

@@ -1,0 +1,136 @@
+"""The serial wire: CRC, COBS framing, the test vectors, resynchronisation,
+and arbitrary bytes never crashing a decoder."""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+from typing import Any
+
+import pytest
+from crc import Calculator, Crc16
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stairbot.drivers import messages as m
+from stairbot.drivers.serial_wire import (
+    MAX_FRAME,
+    CodecError,
+    CrcError,
+    Frame,
+    FrameReader,
+    RawMessage,
+    crc16,
+    decode_frame,
+    encode_frame,
+    frame_body,
+    parse_body,
+)
+
+VECTORS: dict[str, Any] = json.loads(
+    resources.files("stairbot.drivers").joinpath("vectors_serial.json").read_text())
+REFERENCE_CRC = Calculator(Crc16.IBM_3740)  # = CRC-16/CCITT-FALSE
+
+
+def frame_of(spec: dict[str, Any]) -> Frame:
+    msgs = tuple(getattr(m, x["type"])(**x["fields"]) for x in spec["messages"])
+    return Frame(spec["board"], spec["seq"], msgs, spec["from_board"])
+
+
+def test_crc_is_ccitt_false() -> None:
+    assert crc16(b"123456789") == 0x29B1
+    assert REFERENCE_CRC.checksum(b"123456789") == 0x29B1
+
+
+@given(st.binary(max_size=300))
+def test_crc_matches_the_crc_package(data: bytes) -> None:
+    assert crc16(data) == REFERENCE_CRC.checksum(data)
+
+
+@pytest.mark.parametrize("vec", VECTORS["vectors"], ids=lambda v: v["name"])
+def test_vector(vec: dict[str, Any]) -> None:
+    frame = frame_of(vec["frame"])
+    assert frame_body(frame).hex(" ") == vec["body_hex"]
+    assert encode_frame(frame).hex(" ") == vec["wire_hex"]
+    wire = bytes.fromhex(vec["wire_hex"])
+    assert wire.count(0) == 1 and wire.endswith(b"\x00")
+    assert decode_frame(wire[:-1]) == frame
+
+
+@pytest.mark.parametrize("stream", VECTORS["streams"], ids=lambda v: v["name"])
+@pytest.mark.parametrize("chunk", [None, 1, 3])
+def test_stream_resynchronises(stream: dict[str, Any], chunk: int | None) -> None:
+    by_name = {v["name"]: frame_of(v["frame"]) for v in VECTORS["vectors"]}
+    wire = bytes.fromhex(stream["wire_hex"])
+    reader = FrameReader()
+    got: list[Frame] = []
+    step = chunk or len(wire)
+    for i in range(0, len(wire), step):
+        got += reader.feed(wire[i:i + step])
+    assert got == [by_name[n] for n in stream["frames"]]
+    assert reader.stats.crc_errors == stream["crc_errors"]
+    assert reader.stats.malformed == stream["malformed"]
+
+
+def test_bad_crc_is_a_crc_error() -> None:
+    body = bytearray(frame_body(Frame(1, 7, (m.ReadAll(),))))
+    body[-1] ^= 0x80
+    with pytest.raises(CrcError):
+        parse_body(bytes(body))
+
+
+def test_unknown_type_is_kept_raw_and_bad_length_rejected() -> None:
+    frame = Frame(2, 5, (RawMessage(0x33, b"\x01\x02"), m.GetStatus()))
+    assert decode_frame(encode_frame(frame)[:-1]) == frame
+    body = bytearray(frame_body(Frame(1, 1, (m.Heartbeat(3),))))
+    body[3] = 9  # a length beyond the frame
+    body[-2:] = crc16(bytes(body[:-2])).to_bytes(2, "big")
+    with pytest.raises(CodecError, match="bad length"):
+        parse_body(bytes(body))
+
+
+def test_overrun_is_dropped_and_the_reader_resyncs() -> None:
+    reader = FrameReader()
+    good = encode_frame(Frame(1, 9, (m.ReadAll(),)))
+    assert reader.feed(b"\x55" * (MAX_FRAME + 10)) == []
+    assert reader.feed(b"\x55" * 5 + b"\x00" + good) == [Frame(1, 9, (m.ReadAll(),))]
+    assert reader.stats.overruns == 1 and reader.stats.malformed == 0
+
+
+messages_st = st.sampled_from([
+    m.ReadAll(), m.Identify(), m.GetStatus(), m.Heartbeat(7), m.Stop(0x3F),
+    m.SetWheelSpeeds(1000, -1000, 0, 5), m.SetLiftSpeeds(10000, -10000),
+    m.MotorTelemetry(3, 1, 0, -250, -123456), m.SensorTelemetry(2, 1, 1300, 65535),
+    m.Status(0xC0, 0, 250, 2**32 - 1), m.Ack(0x20, 1), m.StepTo(20000), m.Move(5, -19000, 10000),
+])
+
+
+@given(st.integers(0, 15), st.integers(0, 255), st.booleans(),
+       st.lists(messages_st, min_size=1, max_size=8))
+def test_frame_round_trip(board: int, seq: int, from_board: bool, msgs: list[m.Message]) -> None:
+    frame = Frame(board, seq, tuple(msgs), from_board)
+    wire = encode_frame(frame)
+    assert wire.count(0) == 1
+    assert FrameReader().feed(wire) == [frame]
+
+
+@settings(max_examples=300)
+@given(st.binary(max_size=400))
+def test_arbitrary_bytes_never_crash_the_decoders(data: bytes) -> None:
+    try:
+        decode_frame(data)
+    except CodecError:
+        pass
+    try:
+        parse_body(data)
+    except CodecError:
+        pass
+    reader = FrameReader()
+    frames = reader.feed(data)
+    s = reader.stats
+    if s.overruns == 0:  # every complete chunk is either a frame or counted as an error
+        chunks = [c for c in data.split(b"\x00")[:-1] if c]
+        assert len(frames) + s.crc_errors + s.malformed == len(chunks)
+    assert s.frames == len(frames)
+    assert reader.feed(encode_frame(Frame(1, 1, (m.ReadAll(),))) * 2)[-1:] == [
+        Frame(1, 1, (m.ReadAll(),))]
