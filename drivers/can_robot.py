@@ -1,0 +1,239 @@
+"""The robot on a CAN bus, through any python-can interface.
+
+URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
+
+* ``INTERFACE`` -- a python-can interface name (``virtual``, ``udp_multicast``,
+  ``socketcan``, ``slcan``, ``pcan``, ...).  ``default`` or empty takes it
+  from python-can's own configuration: ``can.rc``, the ``CAN_INTERFACE``
+  environment variable, ``~/.canrc`` / ``~/.can`` / ``/etc/can.conf``.
+* ``CHANNEL`` -- the rest of the path, percent-decoded, handed to python-can
+  as it is: ``vcan0``, ``bus0``, ``PCAN_USBBUS1``, a multicast group for
+  ``udp_multicast`` (``239.74.163.2`` or ``ff15::1``), a device path for
+  ``slcan`` (``can://slcan//dev/ttyACM0``).  Empty: from the configuration
+  (``CAN_CHANNEL``...), else the interface's own default.
+* options (the rest, like ``serial://``):
+
+  - ``bitrate=N``     bit/s, given to the interface (else ``CAN_BITRATE``...)
+  - ``context=NAME``  the section of python-can's config file to read
+  - ``timeout=S``     seconds to wait for a board's replies, default 0.1
+  - ``retries=N``     re-sends of a query that timed out, default 2
+  - ``lost=N``        unanswered commands in a row that mean the link is
+                      lost, default 3
+  - ``watchdog=MS``   the boards' watchdog, set at open, default 250 (0 = off)
+  - ``lockstep=1``    simulation only: the fake boards' world advances only
+                      when the host's clock sends StepTo, once per tick
+  - ``time_scale=X``  simulation only: the fake boards run X times real time;
+                      the host's wall clock runs at the same rate
+  - any other ``key=value`` is passed to ``can.Bus`` as a keyword, its value
+    cast as python-can casts its config files (``port=43200``,
+    ``receive_own_messages=False``).
+
+``udp_multicast`` is kept to this host: unless the URL says otherwise its
+``hop_limit`` is 0, so frames never leave the machine; use a different
+``port=`` to keep two buses on one group apart.
+
+Examples::
+
+    can://virtual/bus0
+    can://udp_multicast/239.74.163.2?port=43114&lockstep=1
+    can://socketcan/vcan0?bitrate=1000000
+    can://default/                      (everything from python-can's config)
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import time
+from dataclasses import dataclass, field
+from typing import Any
+from urllib.parse import parse_qsl, unquote
+
+import can
+import can.util
+from stairbot.drivers import messages as m
+from stairbot.drivers.can_link import CanLink
+from stairbot.drivers.serial_robot import LockstepClock, SerialRobot
+
+from stairbot.clock import WallClock
+from stairbot.config import RobotConfig
+from stairbot.errors import RobotUrlError
+from stairbot.robots import RobotOptions, RobotSession
+from stairbot.scenario import Scenario
+
+OPTION_DEFAULTS: dict[str, float] = {
+    "timeout": 0.1, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
+}
+_INTS = {"retries", "lost", "watchdog", "lockstep"}
+_ALLOWED = {"timeout": "seconds, 0 < timeout <= 60", "retries": "a whole number >= 0",
+            "lost": "a whole number >= 1", "watchdog": "ms, 0..65535 (0 = off)",
+            "lockstep": "0 or 1", "time_scale": "a number > 0"}
+
+
+@dataclass(frozen=True)
+class CanUrl:
+    """A parsed ``can://`` URL: how to open the bus, and the driver's own options."""
+
+    url: str
+    interface: str | None
+    channel: str | None
+    bus_kwargs: dict[str, Any] = field(default_factory=dict)
+    context: str | None = None
+    options: dict[str, float] = field(default_factory=lambda: dict(OPTION_DEFAULTS))
+
+    @property
+    def label(self) -> str:
+        """``INTERFACE/CHANNEL`` as given (``default`` where left to the config)."""
+        return f"{self.interface or 'default'}/{self.channel or ''}"
+
+
+def _option(url: str, key: str, text: str) -> float:
+    try:
+        value = int(text) if key in _INTS else float(text)
+    except ValueError:
+        raise RobotUrlError(url, key, f"{text!r}; allowed: {_ALLOWED[key]}") from None
+    ok = {"timeout": 0 < value <= 60, "retries": value >= 0, "lost": value >= 1,
+          "watchdog": 0 <= value <= 65535, "lockstep": value in (0, 1),
+          "time_scale": value > 0}[key]
+    if not ok:
+        raise RobotUrlError(url, key, f"{text}; allowed: {_ALLOWED[key]}")
+    return value
+
+
+def parse_can_url(url: str) -> CanUrl:
+    """Split a ``can://`` URL (grammar in the module header) without opening
+    anything.  Raises RobotUrlError naming the bad part and what is allowed."""
+    if not url.startswith("can://"):
+        raise RobotUrlError(url, None, "not a CAN URL; expected can://INTERFACE/CHANNEL?...")
+    rest, _, query = url[len("can://"):].partition("?")
+    iface_text, _, channel_text = rest.partition("/")
+    interface = unquote(iface_text).strip() or None
+    if interface == "default":
+        interface = None
+    if interface is not None and interface not in can.VALID_INTERFACES:
+        allowed = ", ".join(sorted(can.VALID_INTERFACES))
+        raise RobotUrlError(url, "interface", f"unknown python-can interface {interface!r}; "
+                            f"allowed: {allowed}, or default")
+    channel = unquote(channel_text) or None
+    kwargs: dict[str, Any] = {}
+    options = dict(OPTION_DEFAULTS)
+    context: str | None = None
+    try:
+        pairs = parse_qsl(query, keep_blank_values=True, strict_parsing=bool(query))
+    except ValueError as exc:
+        raise RobotUrlError(url, "query", f"malformed options ({exc}); "
+                            "expected key=value&key=value") from exc
+    for key, value in pairs:
+        if key in OPTION_DEFAULTS:
+            options[key] = _option(url, key, value)
+        elif key == "context":
+            context = value or None
+        elif key in ("interface", "bustype", "channel"):
+            raise RobotUrlError(url, key, "give the interface and channel in the path: "
+                                "can://INTERFACE/CHANNEL")
+        else:
+            kwargs[key] = can.util.cast_from_string(value)
+    if "bitrate" in kwargs and not (isinstance(kwargs["bitrate"], int) and kwargs["bitrate"] > 0):
+        raise RobotUrlError(url, "bitrate", f"{kwargs['bitrate']!r} is not a positive "
+                            "whole number of bit/s")
+    if interface == "udp_multicast" and channel is not None:
+        _check_multicast(url, channel)
+    return CanUrl(url, interface, channel, kwargs, context, options)
+
+
+def _check_multicast(url: str, channel: str) -> None:
+    try:
+        addr = ipaddress.ip_address(channel)
+    except ValueError as exc:
+        raise RobotUrlError(url, "channel", f"udp_multicast needs a multicast group address "
+                            f"as the channel, e.g. 239.74.163.2 or ff15::1; got {channel!r}"
+                            ) from exc
+    if not addr.is_multicast:
+        raise RobotUrlError(url, "channel", f"{channel} is not a multicast group; allowed: "
+                            "224.0.0.0/4 (IPv4) or ff00::/8 (IPv6)")
+
+
+def resolve_bus_config(spec: CanUrl) -> dict[str, Any]:
+    """The bus settings python-can would use for ``spec``: the URL first, then
+    python-can's config (``can.rc``, ``CAN_*`` variables, config files).
+    Raises RobotUrlError when no interface is named anywhere."""
+    given: dict[str, Any] = dict(spec.bus_kwargs)
+    if spec.interface is not None:
+        given["interface"] = spec.interface
+    if spec.channel is not None:
+        given["channel"] = spec.channel
+    try:
+        resolved: dict[str, Any] = dict(can.util.load_config(config=given, context=spec.context))
+    except can.CanInterfaceNotImplementedError as exc:
+        what = str(exc) if spec.interface else "no CAN interface given"
+        raise RobotUrlError(spec.url, "interface", f"{what}; name one in the URL "
+                            "(can://virtual/bus0) or in python-can's config "
+                            "(CAN_INTERFACE, ~/.canrc)") from exc
+    except Exception as exc:  # a malformed config file or CAN_CONFIG
+        raise RobotUrlError(spec.url, "python-can config", f"{type(exc).__name__}: {exc}") from exc
+    if resolved.get("interface") == "udp_multicast":
+        if resolved.get("channel") is not None:
+            _check_multicast(spec.url, str(resolved["channel"]))
+        resolved.setdefault("hop_limit", 0)
+        resolved.setdefault("fd", False)
+    return resolved
+
+
+def open_bus(spec: CanUrl) -> can.BusABC:
+    """Open the bus ``spec`` names.  Any failure of the interface (missing
+    driver library, device absent, address family unsupported) becomes one
+    RobotUrlError line naming the interface and channel."""
+    cfg = resolve_bus_config(spec)
+    where = f"{cfg.get('interface')}/{cfg.get('channel') if cfg.get('channel') is not None else ''}"
+    try:
+        return can.Bus(ignore_config=True, **cfg)
+    except Exception as exc:  # vendor back ends raise anything: OSError, NameError...
+        detail = str(exc).strip() or type(exc).__name__
+        raise RobotUrlError(spec.url, None, f"cannot open CAN bus {where}: {detail}") from exc
+
+
+class CanRobot(SerialRobot):
+    """Both boards on one CAN bus.  The board logic -- handshake, ReadAll to
+    each board, speeds in SetWheelSpeeds + SetLiftSpeeds with their Acks
+    checked on the next call, watchdog and e-stop handling, link health into
+    ``Snapshot.health`` and LINK events, LinkLostError -- is the serial
+    driver's; only the link differs.  An emergency stop is one broadcast frame
+    with the bus's highest-priority id."""
+
+    link: CanLink  # type: ignore[assignment]
+
+    def estop(self) -> None:
+        """Latch the emergency stop on both boards with one EStop_All frame
+        (id 0x00F) and wait for both boards' Status."""
+        self._wait(self.link.broadcast([m.EStop()]))  # type: ignore[arg-type]
+
+    def diagnostics(self) -> dict[str, object]:
+        out = super().diagnostics()
+        bus = self.link.bus
+        out["bus"] = {"interface": type(bus).__name__, "channel": str(bus.channel_info)}
+        return out
+
+
+def open_can_robot(url: str, config: RobotConfig, scenario: Scenario,
+                   options: RobotOptions) -> RobotSession:
+    """Open ``can://INTERFACE/CHANNEL?...``.  RobotUrlError (one line) when the
+    URL is malformed, the bus cannot open or no board answers."""
+    spec = parse_can_url(url)
+    opts = spec.options
+    bus = open_bus(spec)
+    link = CanLink(bus, timeout_s=opts["timeout"], retries=int(opts["retries"]),
+                   max_lost=int(opts["lost"]))
+    try:
+        robot = CanRobot(link, url, int(opts["watchdog"]),  # type: ignore[arg-type]
+                         bool(opts["lockstep"]))
+    except BaseException:
+        link.close()
+        raise
+    clock: Any
+    if robot.lockstep:
+        clock = LockstepClock(robot)
+    else:
+        scale = options.time_scale or opts["time_scale"]
+        clock = WallClock(monotonic=lambda: time.monotonic() * scale,
+                          sleep=lambda s: time.sleep(s / scale))
+    robot.clock = clock
+    return RobotSession(robot=robot, clock=clock, url=url, simulated=robot.simulated, sim=None)

@@ -1,0 +1,209 @@
+"""Both fake boards served on a python-can bus.
+
+    stairbot fake-boards --can INTERFACE/CHANNEL [--scenario FILE] [--config FILE]
+                         [--time-scale X | --lockstep] [fault options]
+
+serves the emulated motor and sensor boards (``fakes.boards``, backed by the
+same physics world as ``sim://``) on any python-can bus, e.g.
+``udp_multicast/239.74.163.2`` (other processes on this host join it with
+``can://udp_multicast/239.74.163.2``); ``INTERFACE/CHANNEL`` may carry the
+URL's bus options (``udp_multicast/239.74.163.2?port=43200``).  It prints the
+``can://`` URL a host opens, then serves until interrupted.
+
+:class:`CanBoardServer` decodes each frame with the DBC (``drivers.can_wire``),
+hands a host frame to the board it is for (both boards for id ``..F``), and
+sends each reply as one frame from that board.  Frames from boards (its own
+echo on ``udp_multicast``) are ignored; unknown ids and wrong lengths are
+counted and ignored, as CAN firmware ignores frames it does not understand.
+Fault injection (``WireFaults``, as on the serial wire) acts on whole frames:
+dropped, corrupted (the receiver's CAN controller rejects it: modelled as an
+error frame), duplicated, late, and a board that goes silent.
+"""
+
+from __future__ import annotations
+
+import random
+import sys
+import threading
+import time
+from dataclasses import dataclass
+
+import can
+from stairbot.drivers import messages as m
+from stairbot.drivers.can_robot import open_bus, parse_can_url
+from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
+from stairbot.fakes.boards import Board, BoardWorld, make_boards
+from stairbot.fakes.serial_boards import WireFaults
+
+from stairbot.config import load_config
+from stairbot.errors import RobotUrlError
+from stairbot.scenario import load_scenario
+
+
+@dataclass
+class CanServerStats:
+    frames_rx: int = 0  # host frames handled
+    frames_tx: int = 0
+    error_frames: int = 0
+    malformed: int = 0  # unknown ids, wrong lengths
+    ignored: int = 0  # frames from boards (our own echo included)
+    stray: int = 0  # host frames for a board not served here
+    injected: int = 0  # faults injected
+
+
+class CanBoardServer:
+    """Serve ``boards`` (address -> Board) on ``bus``."""
+
+    def __init__(self, bus: can.BusABC, world: BoardWorld, boards: dict[int, Board],
+                 faults: WireFaults | None = None, time_scale: float = 1.0,
+                 step_s: float = 0.005, codec: CanWire | None = None) -> None:
+        self.bus = bus
+        self.world = world
+        self.boards = boards
+        self.faults = faults or WireFaults()
+        self.time_scale = time_scale
+        self.step_s = step_s
+        self.codec = codec or wire()
+        self.stats = CanServerStats()
+        self._rng = random.Random(self.faults.seed)
+        self._late: list[tuple[float, can.Message]] = []
+        self._stop = threading.Event()
+
+    # -- faults ------------------------------------------------------------------
+    def _chance(self, p: float) -> bool:
+        if p and self._rng.random() < p:
+            self.stats.injected += 1
+            return True
+        return False
+
+    def _silent(self, board: int) -> bool:
+        f = self.faults
+        return (f.silent_after_s is not None and self.world.now() >= f.silent_after_s
+                and f.silent_board in (None, board))
+
+    # -- frames --------------------------------------------------------------------
+    def _send(self, frame: can.Message) -> None:
+        f = self.faults
+        if self._chance(f.drop):
+            return
+        if self._chance(f.corrupt):
+            frame = can.Message(arbitration_id=frame.arbitration_id, is_error_frame=True,
+                                is_extended_id=False, data=b"")
+        if self._chance(f.late):
+            self._late.append((time.monotonic() + f.late_s, frame))
+            return
+        for _ in range(2 if self._chance(f.duplicate) else 1):
+            self.bus.send(frame)
+            self.stats.frames_tx += 1
+
+    def _flush_late(self) -> None:
+        now = time.monotonic()
+        due = [fr for t, fr in self._late if t <= now]
+        self._late = [(t, fr) for t, fr in self._late if t > now]
+        for frame in due:
+            self.bus.send(frame)
+            self.stats.frames_tx += 1
+
+    def receive(self, frame: can.Message) -> None:
+        """Handle one frame from the bus."""
+        if frame.is_error_frame:
+            self.stats.error_frames += 1
+            return
+        try:
+            board_id, msg = self.codec.from_can(frame)
+        except m.CodecError:
+            self.stats.malformed += 1
+            return
+        if msg.REPLY:
+            self.stats.ignored += 1
+            return
+        f = self.faults
+        if self._chance(f.drop):
+            return
+        if self._chance(f.corrupt):
+            self.stats.error_frames += 1
+            return
+        targets = list(self.boards) if board_id == BROADCAST else [board_id]
+        for _ in range(2 if self._chance(f.duplicate) else 1):
+            for address in targets:
+                self._handle(address, msg)
+
+    def _handle(self, address: int, msg: m.Message) -> None:
+        board = self.boards.get(address)
+        if board is None:
+            self.stats.stray += 1
+            return
+        self.stats.frames_rx += 1
+        replies = board.handle([msg])
+        if self._silent(address):
+            return
+        for reply in replies:
+            self._send(self.codec.to_can(address, reply))
+
+    # -- serving -------------------------------------------------------------------
+    def stop(self) -> None:
+        self._stop.set()
+
+    def serve(self) -> None:
+        """Serve until :meth:`stop`.  In real time the world advances in
+        ``step_s`` steps to keep up with the wall clock times ``time_scale``;
+        in lockstep only StepTo advances it."""
+        lockstep = self.world.lockstep
+        wall0, sim0 = time.monotonic(), self.world.now()
+        while not self._stop.is_set():
+            timeout = 0.05
+            if not lockstep:
+                due = sim0 + (time.monotonic() - wall0) * self.time_scale
+                while self.world.now() + self.step_s <= due:
+                    self.world.advance(self.step_s)
+                    for board in self.boards.values():
+                        board.poll()
+                timeout = min(timeout, (self.world.now() + self.step_s - due) / self.time_scale)
+            if self._late:
+                timeout = min(timeout, max(0.0, min(t for t, _ in self._late) - time.monotonic()))
+            frame = self.bus.recv(timeout=max(0.0, timeout))
+            while frame is not None:
+                self.receive(frame)
+                frame = self.bus.recv(timeout=0.0)
+            self._flush_late()
+
+
+def host_url(spec: str) -> str:
+    """The ``can://`` URL for a ``--can INTERFACE/CHANNEL[?options]`` argument."""
+    return spec if spec.startswith("can://") else f"can://{spec}"
+
+
+def main(argv: list[str]) -> int:
+    """``stairbot fake-boards --can ...`` (the serial engineer's parser hands
+    over here).  Bad input raises InputError: the CLI prints one line, exits 2."""
+    from stairbot.fakes.boards_cli import build_parser, faults_from, make_world
+
+    args = build_parser().parse_args(argv)
+    url = host_url(args.can)
+    spec = parse_can_url(url)
+    if spec.interface == "virtual":
+        raise RobotUrlError(url, "interface", "a virtual bus lives inside one process; "
+                            "serve other processes with udp_multicast/GROUP")
+    config = load_config(args.config)
+    scenario = load_scenario(args.scenario)
+    world = make_world(config, scenario, args.lockstep)
+    bus = open_bus(spec)
+    server = CanBoardServer(bus, world, make_boards(world), faults_from(args),
+                            time_scale=args.time_scale)
+    sep = "&" if "?" in url else "?"
+    suffix = f"{sep}lockstep=1" if args.lockstep else (
+        f"{sep}time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
+    print(f"{url}{suffix}", flush=True)
+    print(f"fake boards serving on CAN {spec.label} (Ctrl-C to stop)", file=sys.stderr,
+          flush=True)
+    try:
+        server.serve()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        bus.shutdown()
+        s = server.stats
+        print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.error_frames} "
+              f"error frames, {s.malformed} malformed, {s.injected} faults injected",
+              file=sys.stderr)
+    return 0
