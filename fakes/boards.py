@@ -276,7 +276,8 @@ class MotorBoard(Board):
     def answer(self, msg: m.Message) -> list[m.Message]:
         sp = m.speed_from_wire
         if isinstance(msg, m.ReadAll):
-            return [self.status(), *(self.telemetry(ch) for ch in range(self.CHANNELS))]
+            tel = [self.telemetry(ch) for ch in range(self.CHANNELS)]  # reads the world first
+            return [self.status(), *tel]
         if isinstance(msg, m.GetMotor):
             if msg.channel >= self.CHANNELS:
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]
@@ -353,7 +354,8 @@ class SensorBoard(Board):
 
     def answer(self, msg: m.Message) -> list[m.Message]:
         if isinstance(msg, m.ReadAll):
-            return [self.status(), *(self.telemetry(ch) for ch in range(self.CHANNELS))]
+            tel = [self.telemetry(ch) for ch in range(self.CHANNELS)]  # reads the world first
+            return [self.status(), *tel]
         if isinstance(msg, m.GetSensor):
             if msg.channel >= self.CHANNELS:
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]

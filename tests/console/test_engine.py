@@ -138,5 +138,5 @@ def test_bad_scenario_and_url_raise_input_errors() -> None:
 def test_describe_result() -> None:
     line, severity = describe_result({"outcome": "completed", "ascent_end": "top_reached",
                                       "steps_climbed": 5, "steps_descended": 5})
-    assert line == "Run completed · ascent ended: top reached · climbed 5, descended 5"
+    assert line == "run completed · top reached · climbed 5, descended 5"
     assert severity == "good"

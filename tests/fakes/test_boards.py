@@ -1,0 +1,203 @@
+"""The emulated board firmware, without a wire: watchdog trip and clear,
+latched emergency stop, Move by turns, refusals, unknown messages."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import pytest
+from stairbot.drivers import messages as m
+from stairbot.drivers.serial_wire import RawMessage
+from stairbot.fakes.boards import BoardWorld, MotorBoard, SensorBoard, make_boards
+
+from stairbot.errors import RobotFellError
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+
+
+class StubRobot:
+    """Turns integrate the commanded speeds; ``fail`` makes read() raise."""
+
+    def __init__(self) -> None:
+        self.t = 0.0
+        self.speeds = {mid: 0.0 for mid in MotorId}
+        self.turns = {mid: 0.0 for mid in MotorId}
+        self.reads = 0
+        self.commands = 0
+        self.fail = False
+
+    def read(self) -> Snapshot:
+        if self.fail:
+            raise RobotFellError("pitch beyond 35 degrees")
+        self.reads += 1
+        return Snapshot(self.t, {s: SensorReading(0.5 + i / 10) for i, s in enumerate(SensorId)},
+                        {k: MotorState(v, self.speeds[k]) for k, v in self.turns.items()})
+
+    def command(self, speeds: Mapping[MotorId, float]) -> None:
+        self.commands += 1
+        self.speeds = {mid: float(speeds.get(mid, 0.0)) for mid in MotorId}
+
+    def stop_all(self) -> None:
+        self.speeds = {mid: 0.0 for mid in MotorId}
+
+    def diagnostics(self) -> dict[str, object]:
+        return {"fell": self.fail, "max_pitch_deg": 3.25, "offset_m": 0.012}
+
+    def close(self) -> None:
+        pass
+
+
+class StubClock:
+    def __init__(self, robot: StubRobot) -> None:
+        self.robot = robot
+
+    def now(self) -> float:
+        return self.robot.t
+
+    def advance(self, dt: float) -> None:
+        r = self.robot
+        for mid in MotorId:
+            r.turns[mid] += r.speeds[mid] * dt
+        r.t += dt
+
+
+@pytest.fixture
+def rig() -> tuple[StubRobot, BoardWorld, MotorBoard, SensorBoard]:
+    robot = StubRobot()
+    world = BoardWorld(robot, StubClock(robot), lockstep=True)
+    boards = make_boards(world)
+    motor, sensor = boards[1], boards[2]
+    assert isinstance(motor, MotorBoard) and isinstance(sensor, SensorBoard)
+    return robot, world, motor, sensor
+
+
+def step(motor: MotorBoard, world: BoardWorld, seconds: float) -> None:
+    """Advance board time without a host frame (what a silent host looks like)."""
+    world.step_to(round(world.now() * 1e6 + seconds * 1e6))
+    motor.after_step()
+
+
+def test_identify_and_read_all(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    (ident,) = motor.handle([m.Identify()])
+    assert ident == m.Ident(1, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, 6, 0x0100, 1)
+    replies = sensor.handle([m.ReadAll()])
+    assert isinstance(replies[0], m.Status)
+    assert replies[0].flags & m.StatusFlag.SIMULATED and replies[0].flags & m.StatusFlag.LOCKSTEP
+    assert [r.distance_mm for r in replies[1:]] == [500, 600, 700, 800]
+    motor.handle([m.ReadAll()])
+    assert robot.reads == 1  # both boards share one read per instant
+
+
+def test_speeds_reach_the_robot_and_telemetry_follows(rig: tuple) -> None:
+    robot, world, motor, _ = rig
+    acks = motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(-2000, 0)])
+    assert acks == [m.Ack(0x20, 0), m.Ack(0x21, 0)]
+    assert robot.speeds[MotorId.MWF] == 1.0 and robot.speeds[MotorId.MTF] == -2.0
+    motor.handle([m.StepTo(200_000)])  # within the 250 ms watchdog
+    tel = motor.handle([m.ReadAll()])[1:]
+    assert tel[0] == m.MotorTelemetry(0, m.MotorMode.RUN, 0, 1000, 200)
+    assert tel[4] == m.MotorTelemetry(4, m.MotorMode.RUN, 0, -2000, -400)
+    assert tel[5].mode == m.MotorMode.IDLE
+
+
+def test_watchdog_trips_stops_every_motor_and_latches_until_cleared(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    motor.handle([m.SetWatchdog(100), m.SetWheelSpeeds(500, 500, 500, 500)])
+    step(motor, world, 0.05)
+    assert not motor.watchdog_tripped
+    step(motor, world, 0.2)  # 250 ms without a host frame
+    assert motor.watchdog_tripped and sensor.watchdog_tripped is False  # sensor never armed
+    assert all(v == 0.0 for v in robot.speeds.values())
+    status = motor.handle([m.GetStatus()])[0]
+    assert status.flags & m.StatusFlag.WATCHDOG and status.fault == m.MotorFault.WATCHDOG
+    # frames alone do not reset it; motion is refused until a Clear
+    assert motor.handle([m.SetWheelSpeeds(500, 0, 0, 0)]) == [m.Ack(0x20, m.AckResult.WATCHDOG)]
+    assert robot.speeds[MotorId.MWF] == 0.0
+    assert motor.handle([m.ReadAll()])[1].mode == m.MotorMode.HOLD
+    motor.handle([m.Clear(m.ClearMask.WATCHDOG)])
+    assert motor.handle([m.SetWheelSpeeds(500, 0, 0, 0)]) == [m.Ack(0x20, m.AckResult.OK)]
+    assert robot.speeds[MotorId.MWF] == 0.5
+
+
+def test_watchdog_zero_disables_it(rig: tuple) -> None:
+    _, world, motor, _ = rig
+    motor.handle([m.SetWatchdog(0)])
+    step(motor, world, 10.0)
+    assert not motor.watchdog_tripped
+
+
+def test_estop_latches_until_an_explicit_clear(rig: tuple) -> None:
+    robot, _, motor, _ = rig
+    motor.handle([m.SetLiftSpeeds(10000, 10000)])
+    status = motor.handle([m.EStop()])[0]
+    assert status.flags & m.StatusFlag.ESTOP and status.fault == m.MotorFault.ESTOP
+    assert all(v == 0.0 for v in robot.speeds.values())
+    assert motor.handle([m.Run(4, 100)]) == [m.Ack(0x22, m.AckResult.ESTOP)]
+    assert motor.handle([m.Move(0, 100, 100)]) == [m.Ack(0x23, m.AckResult.ESTOP)]
+    motor.handle([m.Clear(m.ClearMask.WATCHDOG)])  # the wrong latch: still stopped
+    assert motor.handle([m.Run(4, 100)]) == [m.Ack(0x22, m.AckResult.ESTOP)]
+    status = motor.handle([m.Clear(m.ClearMask.ESTOP)])[0]
+    assert not status.flags & m.StatusFlag.ESTOP
+    assert motor.handle([m.Run(4, 100)]) == [m.Ack(0x22, m.AckResult.OK)]
+
+
+def test_move_stops_after_the_turns(rig: tuple) -> None:
+    robot, world, motor, _ = rig
+    assert motor.handle([m.Move(5, -1500, 1000)]) == [m.Ack(0x23, 0)]
+    assert robot.speeds[MotorId.MTB] == -1.0
+    for _ in range(10):
+        motor.handle([m.StepTo(round(world.now() * 1e6) + 200_000)])
+    assert robot.speeds[MotorId.MTB] == 0.0
+    tel = motor.handle([m.GetMotor(5)])[0]
+    assert tel.mode == m.MotorMode.IDLE and tel.turns_mt == -1600  # stopped at the next poll
+
+
+def test_stop_and_brake(rig: tuple) -> None:
+    robot, _, motor, _ = rig
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(1000, 1000)])
+    motor.handle([m.Brake(0b010001)])  # MWF and MTF
+    tel = motor.handle([m.ReadAll()])[1:]
+    assert tel[0].mode == m.MotorMode.BRAKE and tel[4].mode == m.MotorMode.IDLE
+    assert robot.speeds[MotorId.MWF] == 0.0 and robot.speeds[MotorId.MWB] == 1.0
+    motor.handle([m.Stop()])
+    assert all(v == 0.0 for v in robot.speeds.values())
+
+
+def test_refusals_and_unknown_messages(rig: tuple) -> None:
+    robot, _, motor, sensor = rig
+    assert motor.handle([m.GetMotor(6)]) == [m.Ack(0x11, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([m.Move(1, 10, 0)]) == [m.Ack(0x23, m.AckResult.BAD_VALUE)]
+    assert motor.handle([m.Stop(0x40)]) == [m.Ack(0x24, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([RawMessage(0x33, b"")]) == [m.Ack(0x33, m.AckResult.UNKNOWN_TYPE)]
+    assert sensor.handle([m.SetLiftSpeeds(1, 1)]) == [m.Ack(0x21, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([m.GetSensor(4)]) == [m.Ack(0x12, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([m.Ack(0, 0)]) == [m.Ack(0xA0, m.AckResult.NOT_SUPPORTED)]
+    assert robot.speeds[MotorId.MTF] == 0.0
+
+
+def test_step_to_is_idempotent_and_lockstep_only(rig: tuple) -> None:
+    robot, world, motor, _ = rig
+    assert motor.handle([m.StepTo(20_000)]) == [m.StepDone(20_000)]
+    assert motor.handle([m.StepTo(20_000)]) == [m.StepDone(20_000)]
+    assert motor.handle([m.StepTo(10_000)]) == [m.StepDone(20_000)]
+    assert robot.t == pytest.approx(0.02)
+    world.lockstep = False
+    assert motor.handle([m.StepTo(40_000)]) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+
+
+def test_sensor_sample_counter_advances_with_new_measurements(rig: tuple) -> None:
+    _, world, motor, sensor = rig
+    a = sensor.handle([m.GetSensor(0)])[0].sample
+    assert sensor.handle([m.GetSensor(1)])[0].sample == a
+    motor.handle([m.StepTo(20_000)])
+    assert sensor.handle([m.GetSensor(0)])[0].sample == (a + 1) & 0xFFFF
+
+
+def test_a_failed_world_is_a_latched_simulation_fault(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    robot.fail = True
+    motor.handle([m.StepTo(20_000)])
+    status = sensor.handle([m.ReadAll()])[0]
+    assert status.fault == m.MotorFault.SIMULATION and status.flags & m.StatusFlag.FAULT
+    truth = motor.handle([m.GetTruth()])[0]
+    assert truth == m.Truth(1, 325, 12)
