@@ -309,8 +309,9 @@ class SerialRobot:
         self.status[board] = status
         name = board.name.lower()
         if status.flags & m.StatusFlag.WATCHDOG:
+            what = ": its motors are stopped until cleared" if board == m.Board.MOTOR else ""
             self._lost(f"the {name} board's watchdog tripped (nothing from the host for "
-                       f"{status.watchdog_ms} ms): its motors are stopped until cleared")
+                       f"{status.watchdog_ms} ms){what}")
         if status.fault == m.MotorFault.SIMULATION:
             truth = self.diagnostics()
             if truth.get("fell"):

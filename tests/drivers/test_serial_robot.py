@@ -1,0 +1,221 @@
+"""The serial:// driver against the fake boards on a pseudo-terminal (and a
+TCP socket): reading, commanding, e-stop, watchdog, a silent board, fault
+injection on the wire, and bad URLs."""
+
+from __future__ import annotations
+
+import socket
+import threading
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import pytest
+from stairbot.drivers import messages as m
+from stairbot.drivers.serial_robot import SerialRobot, parse_serial_url
+from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
+
+from stairbot.config import RobotConfig, load_config
+from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.events import Event, EventKind
+from stairbot.hardware import MotorId, SensorId
+from stairbot.robots import RobotOptions, RobotSession, open_robot
+from stairbot.runner import run
+from stairbot.scenario import Scenario, load_scenario
+
+CONFIG: RobotConfig = load_config()
+SCENARIO: Scenario = load_scenario()
+
+
+@dataclass
+class Fake:
+    path: str
+    world: BoardWorld
+    server: SerialBoardServer
+
+    def open(self, query: str = "lockstep=1&timeout=0.5") -> RobotSession:
+        return open_robot(f"serial://{self.path}?{query}", CONFIG, SCENARIO, RobotOptions())
+
+
+def serve(faults: WireFaults | None = None) -> Iterator[Fake]:
+    world = make_world(CONFIG, SCENARIO, lockstep=True)
+    pty = PtyPair()
+    server = SerialBoardServer(pty.master, world, make_boards(world), faults)
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    try:
+        yield Fake(pty.path, world, server)
+    finally:
+        server.stop()
+        thread.join(5)
+        pty.close()
+
+
+@pytest.fixture
+def fake() -> Iterator[Fake]:
+    yield from serve()
+
+
+def robot_of(session: RobotSession) -> SerialRobot:
+    assert isinstance(session.robot, SerialRobot)
+    return session.robot
+
+
+def test_read_command_and_lockstep_clock(fake: Fake) -> None:
+    session = fake.open()
+    try:
+        assert session.simulated
+        snap = session.robot.read()
+        assert set(snap.sensors) == set(SensorId) and set(snap.motors) == set(MotorId)
+        assert snap.sensors[SensorId.SFR].distance_m == pytest.approx(
+            SCENARIO.start.distance, abs=0.01)
+        for _ in range(25):
+            session.robot.read()
+            session.robot.command({MotorId.MTF: 10.0})
+            session.clock.advance(CONFIG.algorithm.tick)
+        snap = session.robot.read()
+        assert session.clock.now() == pytest.approx(0.5)
+        assert snap.time_s == pytest.approx(0.5)
+        assert 4.0 < snap.motors[MotorId.MTF].turns <= 5.05  # 10 turns/s for 0.5 s, loaded
+        assert snap.health["frames_rx"] == snap.health["frames_tx"] > 50
+        assert snap.health["lost"] == 0 and snap.health["rtt_median_ms"] > 0
+        diag = session.robot.diagnostics()
+        assert diag["fell"] is False and diag["boards"]["motor"]["channels"] == 6
+    finally:
+        session.close()
+    assert fake.world.speeds()[MotorId.MTF] == 0.0  # close stops every motor
+
+
+def test_estop_latches_on_the_boards_until_cleared(fake: Fake) -> None:
+    session = fake.open()
+    robot = robot_of(session)
+    robot.command({MotorId.MWF: 1.0})
+    robot.estop()
+    assert fake.world.speeds()[MotorId.MWF] == 0.0
+    with pytest.raises(HardwareError, match="emergency stop latched"):
+        robot.read()
+    robot.command({MotorId.MWF: 1.0})
+    robot.flush()
+    assert robot.refused == 2 and fake.world.speeds()[MotorId.MWF] == 0.0
+    robot.clear(m.ClearMask.ESTOP)
+    robot.read()
+    session.close()
+
+
+def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake: Fake) -> None:
+    session = fake.open("lockstep=1&timeout=0.5&watchdog=100")
+    robot = robot_of(session)
+    robot.read()
+    robot.command({MotorId.MWF: 1.0})
+    robot.step_to(300_000)  # 300 ms of board time without another host frame
+    assert fake.world.speeds()[MotorId.MWF] == 0.0
+    with pytest.raises(LinkLostError, match="motor board's watchdog tripped"):
+        robot.read()
+    session.close()
+    again = fake.open()
+    again.robot.read()  # opening is the explicit clear of a watchdog latch
+    again.close()
+
+
+def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
+    for fake in serve(WireFaults(silent_board=2, silent_after_s=0.2)):
+        session = fake.open("lockstep=1&timeout=0.02&retries=1")
+        events: list[Event] = []
+        robot_of(session).attach_sink(events.append)
+        result = run(session, CONFIG, sink=events.append)
+        assert result.outcome == "error"
+        assert result.error is not None and "did not answer" in result.error
+        assert any(e.kind is EventKind.LINK and "link lost" in e.message for e in events)
+        assert robot_of(session).link.stats.retries >= 1
+        session.close()
+
+
+def test_faults_on_the_wire_are_survived_and_counted() -> None:
+    faults = WireFaults(drop=0.03, corrupt=0.03, duplicate=0.03, seed=7)
+    for fake in serve(faults):
+        session = fake.open("lockstep=1&timeout=0.02&retries=8&lost=5")
+        robot = robot_of(session)
+        for _ in range(150):
+            robot.read()
+            robot.command({MotorId.MWF: 0.5})
+            session.clock.advance(0.02)
+        h = robot.health()
+        assert h["retries"] > 0 and h["crc_errors"] + h["malformed"] > 0
+        assert h["stray"] > 0  # duplicated replies
+        assert fake.server.stats.duplicates > 0 and fake.server.stats.injected > 0
+        session.close()
+
+
+def test_a_duplicated_move_is_executed_once() -> None:
+    for fake in serve(WireFaults(duplicate=1.0)):
+        session = fake.open()
+        robot = robot_of(session)
+        reply = robot.link.exchange(m.Board.MOTOR, [m.Move(4, 2000, 10000)])
+        assert reply.messages == (m.Ack(m.Move.TYPE, m.AckResult.OK),)
+        for _ in range(20):
+            snap = robot.read()  # keeps the sensor board's watchdog fed too
+            session.clock.advance(0.05)
+        snap = robot.read()
+        assert snap.motors[MotorId.MTF].turns == pytest.approx(2.0, abs=0.6)
+        assert fake.server.stats.duplicates > 0
+        session.close()
+
+
+def test_any_pyserial_url_works_as_the_port_socket() -> None:
+    world = make_world(CONFIG, SCENARIO, lockstep=True)
+    listener = socket.create_server(("127.0.0.1", 0))
+    port = listener.getsockname()[1]
+    servers: list[SerialBoardServer] = []
+
+    def accept() -> None:
+        conn, _ = listener.accept()
+        server = SerialBoardServer(conn.fileno(), world, make_boards(world))
+        servers.append(server)
+        server.serve()
+        conn.close()
+
+    thread = threading.Thread(target=accept, daemon=True)
+    thread.start()
+    session = open_robot(f"serial://socket://127.0.0.1:{port}?lockstep=1&timeout=0.5",
+                         CONFIG, SCENARIO, RobotOptions())
+    try:
+        assert session.robot.read().sensors[SensorId.SFL].ok
+        session.robot.command({MotorId.MWB: 1.0})
+        session.clock.advance(0.1)
+        assert session.robot.read().motors[MotorId.MWB].turns > 0.05
+    finally:
+        session.close()
+        servers[0].stop()
+        thread.join(5)
+        listener.close()
+
+
+def test_lockstep_must_match_the_boards(fake: Fake) -> None:
+    with pytest.raises(RobotUrlError, match="run in lockstep; add \\?lockstep=1"):
+        fake.open("timeout=0.2")
+
+
+def test_url_options() -> None:
+    port, opts = parse_serial_url(
+        "serial://socket://127.0.0.1:5000?baud=115200&timeout=0.2&logging=debug")
+    assert port == "socket://127.0.0.1:5000?logging=debug"
+    assert opts["baud"] == 115200 and opts["timeout"] == 0.2
+    assert parse_serial_url("serial:///dev/ttyUSB0")[0] == "/dev/ttyUSB0"
+    with pytest.raises(RobotUrlError, match="baud: 'fast' is not an integer"):
+        parse_serial_url("serial:///dev/ttyUSB0?baud=fast")
+    with pytest.raises(RobotUrlError, match="lockstep"):
+        parse_serial_url("serial:///dev/ttyUSB0?lockstep=2")
+    with pytest.raises(RobotUrlError, match="timeout"):
+        parse_serial_url("serial:///dev/ttyUSB0?timeout=0")
+
+
+@pytest.mark.parametrize("url, problem", [
+    ("serial:///dev/no-such-port", "cannot open port /dev/no-such-port"),
+    ("serial://loop://?timeout=0.01&retries=0", "no motor board answered"),
+    ("serial://", "expected serial://PORT"),
+])
+def test_a_port_that_cannot_be_used_is_one_clear_line(url: str, problem: str) -> None:
+    with pytest.raises(RobotUrlError) as info:
+        open_robot(url, CONFIG, SCENARIO, RobotOptions())
+    assert problem in str(info.value) and "\n" not in str(info.value)
