@@ -1,12 +1,13 @@
 """Whole runs on the simulated robot: every shipped scenario ends as its
-[expect] says, and the default stairs are climbed and descended back to the
-start at several yaw offsets and noise seeds."""
+[expect] says (and takes the path its case names), and the default stairs are
+climbed and descended back to the start at several yaw offsets and noise seeds."""
 
 from __future__ import annotations
 
 import pytest
 
 from stairbot.config import load_config
+from stairbot.events import Event, EventKind
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import RunResult, run
 from stairbot.scenario import Scenario, expectation_mismatches, load_scenario, parse_scenario
@@ -15,19 +16,51 @@ from stairbot.scenario import shipped_scenarios as shipped
 CONFIG = load_config()
 
 
-def run_sim(scenario: Scenario) -> RunResult:
+def run_sim(scenario: Scenario) -> tuple[RunResult, list[Event]]:
+    events: list[Event] = []
     session = open_robot("sim://", CONFIG, scenario, RobotOptions())
     try:
-        return run(session, CONFIG)
+        return run(session, CONFIG, sink=events.append), events
     finally:
         session.close()
+
+
+# Phases (Phase.value) a scenario must pass through, and must not: proof that the
+# scenario exercises the case it is named after, not only that it ends right.
+PATHS: dict[str, tuple[set[str], set[str]]] = {
+    "calibration_case1_open_floor": (set(), {"cal_lift", "ascent_approach"}),
+    "calibration_case1_sensor_error": (set(), {"cal_lift", "ascent_approach"}),
+    "calibration_case2_yaw_left": ({"cal_turn"}, {"cal_probe", "cal_corner"}),
+    "calibration_case2_yaw_right": ({"cal_turn"}, {"cal_probe", "cal_corner"}),
+    "calibration_case3a_square": ({"cal_probe", "cal_turn"}, {"cal_corner"}),
+    "calibration_case3b_corner": ({"cal_probe", "cal_corner", "cal_turn"}, set()),
+    "wall_at_top": ({"ascent_lower_obstacle"}, set()),
+    "step_too_high": ({"ascent_lower_obstacle"}, {"ascent_drive_first"}),
+    "tread_too_short": ({"ascent_lower_obstacle"}, {"ascent_drive_first"}),
+    "passing_disagreement": ({"paused"}, set()),
+    "lasting_disagreement": ({"paused"}, set()),
+    "floor_not_found": ({"descent_lower_third"}, {"descent_drive_second"}),
+}
+
+
+def phases_visited(events: list[Event]) -> set[str]:
+    return {str(e.data.get("phase")) for e in events if e.kind is EventKind.PHASE}
 
 
 @pytest.mark.parametrize("name", shipped())
 def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
     scenario = load_scenario(name)
-    result = run_sim(scenario)
+    result, events = run_sim(scenario)
     assert expectation_mismatches(scenario.expect, result.to_dict()) == [], result.to_dict()
+    assert not result.fell
+    must, must_not = PATHS.get(name, (set(), set()))
+    visited = phases_visited(events)
+    assert must <= visited, f"{name} never entered {must - visited}"
+    assert not (must_not & visited), f"{name} entered {must_not & visited}"
+
+
+def test_every_calibration_case_and_error_situation_has_a_scenario() -> None:
+    assert set(PATHS) <= set(shipped())
 
 
 DEFAULT_AT = """
@@ -44,13 +77,12 @@ seed = {seed}
 """
 
 
-@pytest.mark.parametrize("seed", [2, 7, 13])
-@pytest.mark.parametrize("yaw", [15.0, -15.0, 8.0, -8.0])
+@pytest.mark.parametrize(("yaw", "seed"), [(15.0, 2), (-15.0, 3), (8.0, 5), (-8.0, 7),
+                                           (15.0, 11), (-15.0, 13), (0.0, 17)])
 def test_default_stairs_up_and_back_at_a_yaw_and_seed(yaw: float, seed: int) -> None:
     scenario = parse_scenario(DEFAULT_AT.format(yaw=yaw, seed=seed), f"yaw{yaw}_seed{seed}")
-    r = run_sim(scenario)
+    r, _ = run_sim(scenario)
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
         "completed", "top_reached", 5, 5), r.to_dict()
     assert not r.fell
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
-
