@@ -20,7 +20,7 @@ from stairbot.context import Context
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.handler import Handler, PhaseIO
 from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, LIFT_MOTORS, MotorId, SensorId, Snapshot
-from stairbot.phases import Mode, Phase
+from stairbot.phases import BY_VALUE, Mode, Phase
 from stairbot.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
 
 PHASE_TIMEOUT_S = 60.0
@@ -73,7 +73,7 @@ class Controller:
     # -- what the outside sees --------------------------------------------------------
     @property
     def phase(self) -> Phase:
-        return Phase(self._ctx.phase)
+        return BY_VALUE[self._ctx.phase]
 
     @property
     def context(self) -> Context:
@@ -151,7 +151,7 @@ class Controller:
         return self._limit(speeds, snap)
 
     def _fault(self, snap: Snapshot) -> str | None:
-        for motor in MotorId:
+        for motor in ALL_MOTORS:
             fault = snap.motors[motor].fault
             if fault:
                 return f"motor fault: {motor} reports {fault!r} in {self.phase.label}"
@@ -293,5 +293,9 @@ def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
 
+ALL_MOTORS: tuple[MotorId, ...] = tuple(MotorId)
+_ZEROS: dict[MotorId, float] = dict.fromkeys(ALL_MOTORS, 0.0)
+
+
 def _zeros() -> dict[MotorId, float]:
-    return {m: 0.0 for m in MotorId}
+    return _ZEROS.copy()

@@ -20,7 +20,7 @@ from stairbot.config import RobotConfig
 from stairbot.context import Context
 from stairbot.events import EventKind
 from stairbot.hardware import MotorId, Snapshot
-from stairbot.phases import Mode, Phase
+from stairbot.phases import BY_VALUE, Mode, Phase
 from stairbot.transitions import TRANSITIONS
 
 Speeds = dict[MotorId, float]
@@ -55,7 +55,7 @@ class PhaseIO:
 
     @property
     def phase(self) -> Phase:
-        return Phase(self.ctx.phase)
+        return BY_VALUE[self.ctx.phase]
 
     def go(self, phase: Phase) -> None:
         """Enter ``phase``; the table's condition is the reason given."""

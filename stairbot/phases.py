@@ -104,5 +104,8 @@ _LABELS: dict[Phase, tuple[str, str]] = {
     Phase.ERROR: ("end — program ended with an error", "end"),
 }
 
+BY_VALUE: dict[str, Phase] = {p.value: p for p in Phase}
+"""Phase by its value (faster than ``Phase(value)`` in the control tick)."""
+
 FLOWS: tuple[str, ...] = ("calibration", "ascent", "descent")
 """The flows drawn as flowcharts, in order."""
