@@ -1,0 +1,131 @@
+"""Calibration cases 2, 3A and 3B: which way it turns, how it tells A from B,
+and that it ends square with segments 1 and 3 back down."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from kinematic import KinematicRobot, run
+
+from stairbot.config import load_config
+from stairbot.controller import Controller
+from stairbot.events import Event, EventKind
+from stairbot.hardware import MotorId, SensorId
+from stairbot.phases import Mode, Phase
+
+CFG = load_config()
+CLEARANCE = CFG.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE
+SQUARE = math.radians(0.6)  # what a smoothed 1 mm difference over 0.1 m allows
+
+
+def calibrate(**kw: object) -> tuple[Controller, KinematicRobot, list[Event], list[Phase]]:
+    events: list[Event] = []
+    ctrl = Controller(CFG, events.append, Mode.CALIBRATE_ONLY)
+    robot = KinematicRobot(CFG, **kw)  # type: ignore[arg-type]
+    seen: list[Phase] = []
+    turning: list[float] = []
+
+    def watch(c: Controller) -> bool:
+        if not seen or seen[-1] is not c.phase:
+            seen.append(c.phase)
+        if c.phase in (Phase.CAL_TURN, Phase.CAL_PROBE, Phase.CAL_CORNER):
+            # turning happens only with both end segments lifted for clearance
+            turning.append(min(robot.counters[MotorId.MTF], robot.counters[MotorId.MTB]))
+        return False
+
+    run(ctrl, robot, until=watch)
+    assert all(lift >= CLEARANCE - 0.05 for lift in turning)
+    assert ctrl.result.outcome == "completed"
+    assert robot.counters[MotorId.MTF] == pytest.approx(0.0, abs=0.02)
+    assert robot.counters[MotorId.MTB] == pytest.approx(0.0, abs=0.02)
+    return ctrl, robot, events, seen
+
+
+def first_turn(events: list[Event]) -> str:
+    return next(e.message for e in events if e.kind is EventKind.INFO and "case" in e.message)
+
+
+@pytest.mark.parametrize("yaw", [15.0, 3.0, -3.0, -15.0])
+def test_case_2_turns_towards_the_nearer_side_until_square(yaw: float) -> None:
+    ctrl, robot, events, seen = calibrate(yaw_deg=yaw, noise=0.001)
+    assert ctrl.context.calibration_case == "2"
+    assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_TURN, Phase.CAL_LOWER]
+    # turned left (+) for SFL < SFR, i.e. when yawed right (-), and vice versa
+    assert ctrl.context.turn_direction == (1 if yaw < 0 else -1)
+    assert abs(robot.yaw) < SQUARE
+    assert "not equal, case 2" in first_turn(events)
+
+
+def test_case_3a_probes_left_then_turns_back_square() -> None:
+    ctrl, robot, events, seen = calibrate(noise=0.001)
+    assert ctrl.context.calibration_case == "3A"
+    assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_TURN,
+                    Phase.CAL_LOWER]
+    assert ctrl.context.turn_direction == -1  # back right
+    assert abs(robot.yaw) < SQUARE
+    assert any("case 3A" in e.message for e in events)
+
+
+def corner(wall_yaw_deg: float) -> KinematicRobot:
+    """A robot yawed right before a riser with a wall on the right, placed so
+    that SFR sees the wall at the same distance as SFL sees the riser: case 3,
+    but a corner."""
+    lat = CFG.sensors.front_lateral
+    riser_l = KinematicRobot(CFG, yaw_deg=wall_yaw_deg)._beam(lat, 0.05)
+    assert riser_l is not None
+    side = riser_l * math.sin(-math.radians(wall_yaw_deg))  # the wall's distance
+
+    def front(robot: KinematicRobot) -> tuple[float, float]:
+        riser_r = robot._beam(-lat, 0.05) or 9.0
+        s = math.sin(-robot.yaw)
+        wall = side / s if s > 1e-6 else 9.0
+        return min(wall, riser_r), robot._beam(lat, 0.05) or 9.0
+
+    return KinematicRobot(CFG, yaw_deg=wall_yaw_deg, front_override=front)
+
+
+def test_case_3b_a_corner_turns_left_until_both_shrink_then_squares_up() -> None:
+    robot = corner(-20.0)
+    ctrl = Controller(CFG, mode=Mode.CALIBRATE_ONLY)
+    first = robot.read().sensors
+    assert abs(first[SensorId.SFR].distance_m - first[SensorId.SFL].distance_m) <= 0.002
+    seen: list[Phase] = []
+
+    def watch(c: Controller) -> bool:
+        if not seen or seen[-1] is not c.phase:
+            seen.append(c.phase)
+        return False
+
+    run(ctrl, robot, until=watch)
+    assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_CORNER,
+                    Phase.CAL_TURN, Phase.CAL_LOWER]
+    assert ctrl.context.calibration_case == "3B"
+    assert abs(robot.yaw) < SQUARE
+    assert ctrl.result.outcome == "completed"
+
+
+def test_later_steps_calibrate_only_when_the_readings_differ() -> None:
+    events: list[Event] = []
+    ctrl = Controller(CFG, events.append)
+    robot = KinematicRobot(CFG, steps=[(0.17, 0.28)] * 3)
+    run(ctrl, robot)
+    lifts = [e for e in events if e.kind is EventKind.PHASE and e.data["phase"] == "cal_lift"]
+    assert len(lifts) == 1  # square all the way: only the start lifts and turns
+    checks = [e.message for e in events if e.kind is EventKind.PHASE
+              and e.data["phase"] == "cal_check"]
+    assert checks[0].endswith("(start)")
+    assert "(ascent 1, step 2)" in checks[1]
+    assert "(descent 1, step 2)" in checks[-2] and "(descent 1, step 1)" in checks[-1]
+
+
+def test_later_steps_square_up_again_when_yawed() -> None:
+    ctrl = Controller(CFG)
+    robot = KinematicRobot(CFG, steps=[(0.17, 0.28)] * 2)
+    run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_CHECK and c.context.purpose == "ascent")
+    robot.yaw = math.radians(6.0)  # knocked sideways on the first tread
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+    assert ctrl.context.calibration_case == "2"
+    assert abs(robot.yaw) < SQUARE
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "completed"

@@ -1,0 +1,215 @@
+"""Errors, the standing rule, the operator's hold and abort: the controller
+stops safely, says why, and never moves again once it has ended."""
+
+from __future__ import annotations
+
+import pytest
+from kinematic import Fault, KinematicRobot, run
+
+from stairbot.config import load_config
+from stairbot.controller import PHASE_TIMEOUT_S, Controller
+from stairbot.events import Event, EventKind
+from stairbot.hardware import MotorId, SensorId
+from stairbot.phases import Phase
+
+CFG = load_config()
+STEPS = [(0.17, 0.28)] * 2
+WAIT = CFG.algorithm.standing_wait
+TICK = CFG.algorithm.tick
+
+
+def start(**kw: object) -> tuple[Controller, KinematicRobot, list[Event]]:
+    events: list[Event] = []
+    kw.setdefault("steps", STEPS)
+    return Controller(CFG, events.append), KinematicRobot(CFG, **kw), events  # type: ignore[arg-type]
+
+
+def of(events: list[Event], kind: EventKind) -> list[Event]:
+    return [e for e in events if e.kind is kind]
+
+
+def still(sent: list[dict[MotorId, float]]) -> bool:
+    return all(v == 0.0 for speeds in sent for v in speeds.values())
+
+
+def finish_and_check_zero(ctrl: Controller, robot: KinematicRobot) -> None:
+    """After the end every tick commands zero, whatever the robot reads."""
+    assert ctrl.finished
+    for _ in range(5):
+        speeds = ctrl.tick(robot.read())
+        assert speeds == dict.fromkeys(MotorId, 0.0)
+        robot.advance(TICK)
+
+
+def test_a_sensor_error_at_the_start_is_case_1_and_an_error() -> None:
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 0.0, error=True)])
+    sent = run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert ctrl.result.error is not None and "sensor error: SFL" in ctrl.result.error
+    assert still(sent)
+    assert of(events, EventKind.ERROR) and of(events, EventKind.END)
+    finish_and_check_zero(ctrl, robot)
+
+
+def test_a_sensor_error_mid_ascent_stops_everything() -> None:
+    ctrl, robot, _ = start(faults=[Fault(SensorId.SFR, 25.0, error=True)])
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "sensor error: SFR" in str(ctrl.result.error)
+    assert 25.0 <= robot.t < 25.0 + 2 * TICK
+    finish_and_check_zero(ctrl, robot)
+
+
+def test_a_back_sensor_error_only_matters_while_descent_2_uses_them() -> None:
+    ctrl, robot, _ = start(faults=[Fault(SensorId.SBL, 0.0, error=True)])
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "SBL" in str(ctrl.result.error) and "descent 2" in str(ctrl.result.error)
+    assert ctrl.result.steps_climbed == 2
+
+
+def test_a_motor_fault_ends_with_an_error_naming_the_motor() -> None:
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_LIFT_FIRST)
+    robot.motor_faults[MotorId.MTF] = "overcurrent"
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "MTF" in str(ctrl.result.error) and "overcurrent" in str(ctrl.result.error)
+    finish_and_check_zero(ctrl, robot)
+
+
+def test_floor_not_found_when_descending() -> None:
+    # the back sensors see a floor 0.5 m further down than it is: MTB runs out of stroke
+    ctrl, robot, _ = start(back_offset=0.5)
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "floor not found" in str(ctrl.result.error)
+    assert "MAX_OF_VERTICAL_TURNS" in str(ctrl.result.error)
+    assert robot.counters[MotorId.MTB] == pytest.approx(-CFG.MAX_OF_VERTICAL_TURNS, abs=0.05)
+
+
+def test_back_clearance_already_read_before_lowering_is_an_error() -> None:
+    ctrl, robot, _ = start(back_offset=-0.3)
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "before segment 3 was lowered" in str(ctrl.result.error)
+    assert robot.counters[MotorId.MTB] == pytest.approx(0.0, abs=0.05)
+
+
+def test_a_passing_disagreement_pauses_for_the_wait_and_resumes_where_it_stopped() -> None:
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 5.0, 7.0, offset=0.05)])
+    run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
+    paused_at, stopped_in = robot.t, Phase(ctrl.context.resume_phase)
+    assert stopped_in is Phase.ASCENT_APPROACH
+    sent = run(ctrl, robot, until=lambda c: c.phase is not Phase.PAUSED)
+    assert still(sent)
+    assert robot.t - paused_at == pytest.approx(WAIT, abs=2 * TICK)
+    assert ctrl.phase is stopped_in
+    run(ctrl, robot)
+    r = ctrl.result
+    assert (r.outcome, r.pauses, r.steps_climbed, r.steps_descended) == ("completed", 1, 2, 2)
+    assert len(of(events, EventKind.PAUSE)) == len(of(events, EventKind.RESUME)) == 1
+    assert robot.front_x == pytest.approx(robot.start_front_x, abs=0.003)
+
+
+def test_a_lasting_disagreement_ends_with_an_error_after_the_wait() -> None:
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 5.0, offset=0.05)])
+    run(ctrl, robot)
+    r = ctrl.result
+    assert (r.outcome, r.pauses) == ("error", 1)
+    assert "still disagree" in str(r.error)
+    pause = of(events, EventKind.PAUSE)[0]
+    assert of(events, EventKind.ERROR)[0].time_s - pause.time_s == pytest.approx(WAIT, abs=0.1)
+
+
+def test_a_disagreement_shorter_than_the_debounce_does_not_stop() -> None:
+    ctrl, robot, _ = start(faults=[Fault(SensorId.SFL, 5.0, 5.0 + 2 * TICK, offset=0.05)])
+    run(ctrl, robot)
+    assert (ctrl.result.outcome, ctrl.result.pauses) == ("completed", 0)
+
+
+def test_the_back_pair_is_watched_while_segment_3_is_lowered() -> None:
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.DESCENT_LOWER_THIRD)
+    robot.faults.append(Fault(SensorId.SBR, robot.t + 0.5, robot.t + 1.0, offset=0.03))
+    run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
+    assert ctrl.context.resume_phase == Phase.DESCENT_LOWER_THIRD.value
+    run(ctrl, robot)
+    assert (ctrl.result.outcome, ctrl.result.pauses) == ("completed", 1)
+
+
+def test_disagreement_is_not_watched_while_calibration_turns() -> None:
+    ctrl, robot, _ = start(yaw_deg=10.0)
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+    assert ctrl.result.pauses == 0
+
+
+def test_hold_stops_every_motor_and_freezes_the_timers() -> None:
+    ctrl, robot, events = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_LIFT_FIRST)
+    ctrl.hold("paused by the operator")
+    assert ctrl.held
+    held_phase, mtf = ctrl.phase, robot.counters[MotorId.MTF]
+    sent = run(ctrl, robot, until=lambda _c: robot.t > 40 + 2 * PHASE_TIMEOUT_S)
+    assert still(sent) and ctrl.phase is held_phase  # no timeout while held
+    assert robot.counters[MotorId.MTF] == mtf
+    ctrl.release()
+    assert not ctrl.held
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "completed"
+    assert [e.data.get("held") for e in of(events, EventKind.INFO) if "held" in e.data] == \
+        [True, False]
+
+
+def test_hold_during_the_standing_wait_extends_it() -> None:
+    ctrl, robot, _ = start(faults=[Fault(SensorId.SFL, 5.0, 7.0, offset=0.05)])
+    run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
+    paused_at = robot.t
+    ctrl.hold("operator")
+    run(ctrl, robot, until=lambda _c: robot.t > paused_at + 10.0)
+    ctrl.release()
+    run(ctrl, robot, until=lambda c: c.phase is not Phase.PAUSED)
+    assert robot.t - paused_at == pytest.approx(10.0 + WAIT, abs=3 * TICK)
+
+
+def test_abort_ends_now_with_the_outcome_given() -> None:
+    ctrl, robot, events = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_DRIVE_FIRST)
+    ctrl.abort("stopped by the operator", "stopped")
+    assert ctrl.finished and ctrl.phase is Phase.DONE
+    assert ctrl.result.outcome == "stopped" and ctrl.result.error is None
+    assert of(events, EventKind.END)[-1].data["outcome"] == "stopped"
+    finish_and_check_zero(ctrl, robot)
+    ctrl.abort("again", "error")  # no effect once ended
+    assert ctrl.result.outcome == "stopped"
+
+
+def test_abort_with_an_error_and_a_bad_outcome() -> None:
+    ctrl, robot, _ = start()
+    ctrl.tick(robot.read())
+    with pytest.raises(ValueError, match="allowed: completed, stopped, error"):
+        ctrl.abort("x", "exploded")
+    ctrl.abort("link lost", "error")
+    r = ctrl.result
+    assert (r.outcome, r.error, ctrl.phase) == ("error", "link lost", Phase.ERROR)
+
+
+def test_a_phase_that_never_ends_times_out() -> None:
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+    entered = robot.t
+    while not ctrl.finished:  # the robot ignores every command
+        ctrl.tick(robot.read())
+        robot.advance(TICK)
+    assert "phase timeout" in str(ctrl.result.error)
+    assert robot.t - entered == pytest.approx(PHASE_TIMEOUT_S, abs=2 * TICK)
+
+
+def test_a_turn_that_never_squares_up_ends_with_an_error() -> None:
+    def skewed(robot: KinematicRobot) -> tuple[float, float]:
+        return 0.5, 0.55  # SFL always 5 cm further: no turn makes them equal
+
+    ctrl, robot, _ = start(front_override=skewed)
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "turned 90°" in str(ctrl.result.error)

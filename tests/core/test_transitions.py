@@ -1,0 +1,104 @@
+"""The phase list and the transition table: complete, consistent, enforced."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from stairbot.config import load_config
+from stairbot.controller import HANDLERS, Controller
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.phases import FLOWS, Phase
+from stairbot.transitions import (
+    BACK_PAIR_PHASES,
+    STANDING_ARMED,
+    TRANSITIONS,
+    TransitionError,
+    allowed,
+    mermaid,
+)
+
+CFG = load_config()
+
+
+def snapshot(t: float = 0.0, front: float = 0.5) -> Snapshot:
+    sensors = {SensorId.SFR: SensorReading(front), SensorId.SFL: SensorReading(front),
+               SensorId.SBR: SensorReading(0.04), SensorId.SBL: SensorReading(0.04)}
+    return Snapshot(t, sensors, {m: MotorState(0.0) for m in MotorId})
+
+
+def test_every_phase_has_a_seed_label_and_a_flow() -> None:
+    for phase in Phase:
+        assert phase.flow in (*FLOWS, "end")
+        assert phase.label and "—" in phase.label
+        if phase.flow in ("ascent", "descent"):
+            assert re.match(rf"{phase.flow} \d — ", phase.label), phase.label
+    assert Phase.ASCENT_LIFT_FIRST.label == "ascent 3 — lift segment 1"
+
+
+def test_seed_steps_each_have_a_phase() -> None:
+    labels = [p.label for p in Phase]
+    for n in range(2, 10):
+        assert any(label.startswith(f"ascent {n} — ") for label in labels), n
+    for n in range(1, 8):
+        assert any(label.startswith(f"descent {n} — ") for label in labels), n
+    for case in ("case 2", "case 3", "case 3B"):
+        assert any(case in label for label in labels), case
+
+
+def test_the_table_covers_every_phase_and_every_active_phase_has_a_handler() -> None:
+    assert set(TRANSITIONS) == set(Phase)
+    for phase in Phase:
+        if phase.terminal:
+            assert TRANSITIONS[phase] == {}
+            assert phase not in HANDLERS
+        else:
+            assert phase in HANDLERS, phase
+            assert Phase.ERROR in TRANSITIONS[phase], phase  # faults end anywhere
+
+
+def test_every_phase_is_reachable_from_the_start() -> None:
+    seen, todo = {Phase.CAL_CHECK}, [Phase.CAL_CHECK]
+    while todo:
+        for nxt in TRANSITIONS[todo.pop()]:
+            if nxt not in seen:
+                seen.add(nxt)
+                todo.append(nxt)
+    assert seen == set(Phase)
+
+
+def test_standing_rule_is_armed_where_the_table_says_and_not_while_turning_or_rising() -> None:
+    assert Phase.CAL_TURN not in STANDING_ARMED
+    assert Phase.CAL_PROBE not in STANDING_ARMED
+    assert Phase.ASCENT_LIFT_FIRST not in STANDING_ARMED
+    assert Phase.ASCENT_LIFT_FIRST_MORE not in STANDING_ARMED
+    assert Phase.ASCENT_APPROACH in STANDING_ARMED
+    assert BACK_PAIR_PHASES == {Phase.DESCENT_LOWER_THIRD}
+    for phase in STANDING_ARMED:
+        assert allowed(Phase.PAUSED, phase)
+
+
+def test_a_transition_outside_the_table_raises() -> None:
+    ctrl = Controller(CFG)
+    snap = snapshot()
+    ctrl.tick(snap)
+    assert ctrl.phase is Phase.CAL_LIFT
+    with pytest.raises(TransitionError, match="cal_lift -> descent_finish"):
+        ctrl.transition(Phase.DESCENT_FINISH, "no such edge", snap)
+    with pytest.raises(TransitionError):
+        ctrl.end("completed", "not from here", snap)
+    ctrl.transition(Phase.CAL_PROBE, "allowed", snap)
+    assert ctrl.phase is Phase.CAL_PROBE
+
+
+def test_mermaid_draws_every_edge_of_its_flow() -> None:
+    for flow in FLOWS:
+        chart = mermaid(flow)
+        for src, nexts in TRANSITIONS.items():
+            if src.flow != flow:
+                continue
+            for dst, label in nexts.items():
+                assert f'{src.value} -->|"{label}"| {dst.value}' in chart
+    with pytest.raises(ValueError, match="unknown flow"):
+        mermaid("sideways")
