@@ -185,21 +185,27 @@ class CanLink:
             raise LinkLostError(f"cannot receive from the CAN bus: {exc}") from exc
         if frame is None:
             return False
+        self.take(frame)
+        return True
+
+    def take(self, frame: can.Message) -> None:
+        """Handle one received frame: a board's reply is matched to what waits
+        for it; anything else is counted (error frames as ``crc_errors``,
+        undecodable ones as ``malformed``, host frames as ``ignored``)."""
         self.stats.bits_rx += frame_bits(min(len(frame.data), 8))
         self.stats.bytes_rx += len(frame.data)
         if frame.is_error_frame:
             self.stats.crc_errors += 1
-            return True
+            return
         try:
             board, msg = self.codec.from_can(frame)
         except m.CodecError:
             self.stats.malformed += 1
-            return True
+            return
         if not msg.REPLY:
             self.stats.ignored += 1
-            return True
+            return
         self._match(board, msg)
-        return True
 
     def _match(self, board: int, msg: m.Message) -> None:
         for p in self._pending.get(board, ()):

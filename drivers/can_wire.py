@@ -20,7 +20,7 @@ the flags or the bytes.
 
 from __future__ import annotations
 
-from dataclasses import astuple, fields
+from dataclasses import fields
 from functools import lru_cache
 from importlib import resources
 from typing import Any
@@ -54,6 +54,8 @@ class CanWire:
         by_name = {cls.__name__: cls for cls in m.MESSAGES.values()}
         self._by_id: dict[int, tuple[int, type[m.Message], Any, tuple[str, ...]]] = {}
         self._by_key: dict[tuple[int, int], tuple[int, Any, tuple[str, ...]]] = {}
+        # per message class: (field name, signal name, lowest raw, highest raw)
+        self._layout: dict[type[m.Message], tuple[tuple[str, str, int, int], ...]] = {}
         self.kinds: dict[int, int] = {}  # message type code -> kind
         for frame in db.messages:
             cls_name, _, suffix = frame.name.rpartition("_")
@@ -78,6 +80,11 @@ class CanWire:
                 raise ValueError(f"{DBC_NAME}: {frame.name} has {len(names)} signals; "
                                  f"{cls_name} has {n_fields} fields")
             self._by_id[fid] = (board, cls, frame, names)
+            self._layout[cls] = tuple(
+                (f.name, sig.name, -(1 << (sig.length - 1)) if sig.is_signed else 0,
+                 (1 << (sig.length - 1)) - 1 if sig.is_signed else (1 << sig.length) - 1)
+                for f, sig in zip(fields(cls), sorted(frame.signals, key=lambda s: s.start),
+                                  strict=True))
             self._by_key[(cls.TYPE, board)] = (fid, frame, names)
 
     def frame_id(self, board: int, msg_type: type[m.Message]) -> int:
@@ -94,10 +101,17 @@ class CanWire:
         entry = self._by_key.get((msg.TYPE, board))
         if entry is None:
             raise m.CodecError(f"no CAN frame for {type(msg).__name__} and board {board}")
-        fid, frame, names = entry
+        fid, frame, _ = entry
+        raw: dict[str, int] = {}
+        for name, signal, low, high in self._layout[type(msg)]:
+            value = getattr(msg, name)
+            if not (isinstance(value, int) and low <= value <= high):
+                raise m.CodecError(f"{type(msg).__name__}.{name} = {value!r} does not fit "
+                                   f"signal {signal} ({low}..{high})")
+            raw[signal] = value
         try:
-            data = frame.encode(dict(zip(names, astuple(msg), strict=True)),
-                                scaling=False, strict=True)
+            # the ranges are checked above, on the raw integers
+            data = frame.encode(raw, scaling=False, strict=False)
         except (cantools.database.EncodeError, ValueError, TypeError) as exc:
             raise m.CodecError(f"{type(msg).__name__}: {exc}") from None
         return fid, bytes(data)
