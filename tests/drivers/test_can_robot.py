@@ -1,0 +1,249 @@
+"""The can:// driver against the fake boards on python-can's virtual bus:
+the URL grammar and python-can's config, bad URLs in one line, watchdog trip
+and clear, the emergency stop, a silent board, link health; and socketcan,
+which needs a kernel CAN device."""
+
+from __future__ import annotations
+
+import itertools
+import os
+import threading
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import can
+import pytest
+from stairbot.drivers import messages as m
+from stairbot.drivers.can_link import CanLink
+from stairbot.drivers.can_robot import CanRobot, open_can_robot, parse_can_url, resolve_bus_config
+from stairbot.drivers.serial_robot import LockstepClock
+from stairbot.fakes.boards import Board, BoardWorld, make_boards
+from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.can_boards import CanBoardServer, InlineBus
+from stairbot.fakes.serial_boards import WireFaults
+
+from stairbot.config import load_config
+from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.events import Event
+from stairbot.hardware import MotorId
+from stairbot.robots import RobotOptions, open_robot
+from stairbot.scenario import load_scenario
+
+_names = itertools.count()
+FORWARD = {MotorId.MWF: 1.0, MotorId.MWB: 1.0, MotorId.MWR: 1.0, MotorId.MWL: 1.0}
+
+
+@dataclass
+class Rig:
+    robot: CanRobot
+    clock: LockstepClock
+    server: CanBoardServer
+    world: BoardWorld
+    boards: dict[int, Board]
+
+    def tick(self, speeds: dict[MotorId, float] | None = None) -> None:
+        self.robot.read()
+        self.robot.command(speeds or {})
+        self.clock.advance(0.02)
+
+
+def make_rig(faults: WireFaults | None = None, timeout: float = 0.05) -> Rig:
+    """Both fake boards in lockstep, served inline on a fresh virtual channel."""
+    channel = f"rig-{next(_names)}"
+    world = make_world(load_config(), load_scenario(), True)
+    boards = make_boards(world)
+    server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world, boards, faults)
+    link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), server),
+                   timeout_s=timeout, retries=1)
+    robot = CanRobot(link, f"can://virtual/{channel}?lockstep=1", lockstep=True)  # type: ignore[arg-type]
+    clock = LockstepClock(robot)
+    robot.clock = clock
+    return Rig(robot, clock, server, world, boards)
+
+
+@pytest.fixture
+def rig() -> Iterator[Rig]:
+    r = make_rig()
+    yield r
+    r.robot.close()
+    r.server.bus.shutdown()
+
+
+# -- the URL ------------------------------------------------------------------------
+
+def test_url_grammar() -> None:
+    s = parse_can_url("can://udp_multicast/ff15::7?port=43210&timeout=0.5&lockstep=1&fd=False")
+    assert (s.interface, s.channel) == ("udp_multicast", "ff15::7")
+    assert s.bus_kwargs == {"port": 43210, "fd": False}
+    assert s.options["timeout"] == 0.5 and s.options["lockstep"] == 1
+    s = parse_can_url("can://slcan//dev/ttyACM0?bitrate=500000")
+    assert (s.interface, s.channel, s.bus_kwargs) == ("slcan", "/dev/ttyACM0", {"bitrate": 500000})
+    s = parse_can_url("can://default/")
+    assert (s.interface, s.channel) == (None, None)
+
+
+def test_missing_parts_come_from_python_cans_config(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CAN_INTERFACE", "virtual")
+    monkeypatch.setenv("CAN_CHANNEL", "from-env")
+    monkeypatch.setenv("CAN_BITRATE", "250000")
+    cfg = resolve_bus_config(parse_can_url("can://default/"))
+    assert (cfg["interface"], cfg["channel"], cfg["bitrate"]) == ("virtual", "from-env", 250000)
+    cfg = resolve_bus_config(parse_can_url("can://virtual/mine?bitrate=1000000"))
+    assert (cfg["channel"], cfg["bitrate"]) == ("mine", 1000000)  # the URL wins
+
+
+@pytest.mark.parametrize(("url", "words"), [
+    ("can://nosuch/x", "unknown python-can interface 'nosuch'"),
+    ("can://virtual/x?timeout=-1", "timeout"),
+    ("can://virtual/x?lockstep=2", "0 or 1"),
+    ("can://virtual/x?bitrate=fast", "bitrate"),
+    ("can://udp_multicast/10.0.0.1", "not a multicast group"),
+    ("can://udp_multicast/not-an-address", "multicast group address"),
+    ("can://virtual/x?channel=y", "in the path"),
+])
+def test_bad_urls_say_what_is_allowed(url: str, words: str) -> None:
+    with pytest.raises(RobotUrlError, match=words) as info:
+        parse_can_url(url)
+    assert "\n" not in str(info.value)
+
+
+def test_no_interface_anywhere_is_one_clear_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    for var in ("CAN_INTERFACE", "CAN_CHANNEL", "CAN_BITRATE", "CAN_CONFIG"):
+        monkeypatch.delenv(var, raising=False)
+    monkeypatch.setattr(can, "rc", {})
+    monkeypatch.setenv("HOME", "/nonexistent")
+    with pytest.raises(RobotUrlError, match="no CAN interface given"):
+        resolve_bus_config(parse_can_url("can://default/"))
+
+
+def test_a_bus_that_cannot_open_is_one_line_and_no_boards_is_one_line() -> None:
+    config, scenario = load_config(), load_scenario()
+    with pytest.raises(RobotUrlError, match="cannot open CAN bus slcan//dev/nonexistent"):
+        open_robot("can://slcan//dev/nonexistent", config, scenario, RobotOptions())
+    with pytest.raises(RobotUrlError, match="no motor board answered"):
+        open_robot(f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0", config,
+                   scenario, RobotOptions())
+
+
+@pytest.mark.skipif(not os.path.exists("/sys/class/net/vcan0"),
+                    reason="no kernel CAN support on this machine")
+def test_socketcan_vcan0_opens() -> None:  # pragma: no cover - needs a kernel CAN device
+    s = parse_can_url("can://socketcan/vcan0")
+    from stairbot.drivers.can_robot import open_bus
+    bus = open_bus(s)
+    bus.shutdown()
+
+
+# -- the boards over the wire ----------------------------------------------------------
+
+def test_reads_commands_and_counts_link_health(rig: Rig) -> None:
+    start = rig.robot.read().turns(MotorId.MWF)
+    for _ in range(25):
+        rig.tick(FORWARD)
+    snap = rig.robot.read()
+    assert snap.turns(MotorId.MWF) - start == pytest.approx(0.48, abs=0.05)  # 1 turn/s
+    assert snap.time_s == pytest.approx(0.5)
+    h = snap.health
+    assert h["lost"] == h["timeouts"] == h["malformed"] == 0
+    assert h["frames_rx"] > 0 and h["rtt_median_ms"] > 0 and h["bits_tx"] > 0
+
+
+def test_watchdog_trips_when_the_host_goes_quiet_and_only_a_clear_resets_it(rig: Rig) -> None:
+    rig.tick(FORWARD)
+    # the host says nothing while 0.3 s of board time pass (watchdog 250 ms)
+    rig.world.step_to(round((rig.clock.now() + 0.3) * 1e6))
+    for board in rig.boards.values():
+        board.poll()
+    with pytest.raises(LinkLostError, match="watchdog tripped"):
+        rig.robot.read()
+    motor = rig.boards[m.Board.MOTOR]
+    assert motor.watchdog_tripped
+    assert all(mode == m.MotorMode.HOLD for mode in motor.modes)  # lifts hold
+    assert rig.world.speeds()[MotorId.MWF] == 0.0
+    rig.robot.command(FORWARD)  # refused while latched
+    rig.robot.flush()
+    assert rig.robot.health()["refused"] >= 1
+    rig.robot.clear(m.ClearMask.WATCHDOG)
+    rig.clock.advance(0.02)
+    rig.tick(FORWARD)
+    assert rig.robot.read().motors[MotorId.MWF].fault is None
+    assert rig.world.speeds()[MotorId.MWF] == 1.0
+
+
+def test_emergency_stop_is_one_broadcast_frame_and_latches(rig: Rig) -> None:
+    rig.tick(FORWARD)
+    tx = rig.robot.link.stats.frames_tx
+    rig.robot.estop()
+    assert rig.robot.link.stats.frames_tx == tx + 1  # EStop_All, id 0x00F
+    assert rig.world.speeds() == {mid: 0.0 for mid in MotorId}
+    with pytest.raises(HardwareError, match="emergency stop latched"):
+        rig.robot.read()
+    rig.robot.command(FORWARD)
+    rig.robot.flush()
+    assert rig.world.speeds()[MotorId.MWF] == 0.0  # refused
+    rig.robot.clear(m.ClearMask.ESTOP)
+    rig.robot.read()
+    rig.robot.command(FORWARD)
+    rig.robot.flush()
+    assert rig.world.speeds()[MotorId.MWF] == 1.0
+
+
+def test_a_silent_board_means_link_lost_and_a_link_event() -> None:
+    r = make_rig(WireFaults(silent_board=2, silent_after_s=0.1), timeout=0.01)
+    events: list[Event] = []
+    r.robot.attach_sink(events.append)
+    try:
+        for _ in range(4):
+            r.tick()
+        with pytest.raises(LinkLostError, match="board 2 did not answer ReadAll"):
+            for _ in range(10):
+                r.tick()
+        assert r.robot.health()["lost"] >= 1 and r.robot.health()["retries"] >= 1
+        assert any(e.kind.value == "link" and "link lost" in e.message for e in events)
+    finally:
+        r.robot.close()
+        r.server.bus.shutdown()
+
+
+def test_dropped_and_late_frames_are_counted_not_fatal() -> None:
+    r = make_rig(WireFaults(drop=0.01, seed=3), timeout=0.01)
+    try:
+        lost = 0
+        for _ in range(60):
+            try:
+                r.tick()
+            except LinkLostError:
+                lost += 1
+        h = r.robot.health()
+        assert h["timeouts"] >= 1 and h["retries"] >= 1  # dropped replies were asked again
+        assert lost < 10  # a retry mostly recovers; the link is not given up for good
+        assert r.server.stats.injected >= 1
+    finally:
+        r.robot.close()
+        r.server.bus.shutdown()
+
+
+def test_threaded_server_on_a_virtual_bus_via_open_robot() -> None:
+    """The real arrangement in one process: the server on its own thread,
+    the host opened by URL."""
+    channel = f"threaded-{next(_names)}"
+    world = make_world(load_config(), load_scenario(), True)
+    server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
+                            make_boards(world))
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    try:
+        session = open_can_robot(f"can://virtual/{channel}?lockstep=1&timeout=1",
+                                 load_config(), load_scenario(), RobotOptions())
+        assert session.simulated
+        for _ in range(10):
+            session.robot.read()
+            session.robot.command(FORWARD)
+            session.clock.advance(0.02)
+        diag = session.robot.diagnostics()
+        assert diag["fell"] is False and "bus" in diag
+        session.close()
+    finally:
+        server.stop()
+        thread.join(5)
+        server.bus.shutdown()
