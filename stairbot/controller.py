@@ -69,11 +69,23 @@ class Controller:
         self._held: str | None = None
         self._held_since: float | None = None
         self._time = context.phase_started_s or 0.0
+        m = config.motors
+        self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
+        self._stroke = config.MAX_OF_VERTICAL_TURNS
 
     # -- what the outside sees --------------------------------------------------------
     @property
     def phase(self) -> Phase:
         return BY_VALUE[self._ctx.phase]
+
+    @property
+    def flow(self) -> str:
+        """Where the program stands: the present phase's flow, or, while the
+        standing rule waits, the flow of the phase it stopped in."""
+        ctx = self._ctx
+        if ctx.phase == Phase.PAUSED.value and ctx.resume_phase is not None:
+            return BY_VALUE[ctx.resume_phase].flow
+        return self.phase.flow
 
     @property
     def context(self) -> Context:
@@ -151,11 +163,10 @@ class Controller:
         return self._limit(speeds, snap)
 
     def _fault(self, snap: Snapshot) -> str | None:
-        for motor in ALL_MOTORS:
-            fault = snap.motors[motor].fault
-            if fault:
-                return f"motor fault: {motor} reports {fault!r} in {self.phase.label}"
         phase = self.phase
+        for motor, state in snap.motors.items():
+            if state.fault:
+                return f"motor fault: {motor} reports {state.fault!r} in {phase.label}"
         errors = motion.sensor_errors(snap, _needed_sensors(phase, self._ctx))
         if errors:
             names = ", ".join(str(s) for s in errors)
@@ -170,11 +181,10 @@ class Controller:
     def _limit(self, speeds: dict[MotorId, float], snap: Snapshot) -> dict[MotorId, float]:
         """Every motor gets a speed within its maximum; a lift at the end of its
         stroke is not driven further."""
-        motors = self.config.motors
-        stroke = self.config.MAX_OF_VERTICAL_TURNS
+        stroke = self._stroke
         out = _zeros()
         for motor, v in speeds.items():
-            vmax = motors.lift_speed if motor in LIFT_MOTORS else motors.wheel_speed
+            vmax = self._vmax[motor]
             v = max(-vmax, min(vmax, v))
             if motor in LIFT_MOTORS:
                 turns = snap.turns(motor)

@@ -101,6 +101,7 @@ def test_a_passing_disagreement_pauses_for_the_wait_and_resumes_where_it_stopped
     run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
     paused_at, stopped_in = robot.t, Phase(ctrl.context.resume_phase)
     assert stopped_in is Phase.ASCENT_APPROACH
+    assert ctrl.flow == "ascent" and ctrl.phase.flow == "end"
     sent = run(ctrl, robot, until=lambda c: c.phase is not Phase.PAUSED)
     assert still(sent)
     assert robot.t - paused_at == pytest.approx(WAIT, abs=2 * TICK)
