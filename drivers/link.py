@@ -284,8 +284,8 @@ class Link:
                 self.lost_streak += 1
 
     def poll(self) -> None:
-        """Take in whatever has arrived, without waiting; expire old requests."""
-        self.flush()
+        """Take in whatever has arrived, without waiting; expire old requests.
+        Frames held back with ``send=False`` stay held."""
         self._receive(0.0)
         self._expire()
 

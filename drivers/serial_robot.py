@@ -120,6 +120,8 @@ class LockstepClock:
 class SerialRobot:
     """Both boards over one Link (see the module docstring)."""
 
+    PIPELINED_STEP = True
+
     def __init__(self, link: Link, url: str, watchdog_ms: int = 250,
                  lockstep: bool = False, sink: EventSink = discard) -> None:
         self.link = link
@@ -131,6 +133,7 @@ class SerialRobot:
         self.status: dict[int, m.Status] = {}
         self.refused = 0
         self._commands: list[Pending] = []
+        self._step: Pending | None = None
         self._reported: dict[str, float] = {}
         self._last_event = float("-inf")
         self._closed = False
@@ -199,7 +202,12 @@ class SerialRobot:
         self._reap()
         pm = self.link.request(m.Board.MOTOR, [m.ReadAll()], send=False)
         ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
-        fm, fs = self._wait([pm, ps])
+        step, self._step = self._step, None
+        if step is None:
+            fm, fs = self._wait([pm, ps])
+        else:  # the boards stepped the world before they answered ReadAll
+            done, fm, fs = self._wait([step, pm, ps])
+            self._check_step(done)
         motors = self._motors(fm.messages)
         sensors = self._sensors(fs.messages)
         health = self.health()
@@ -212,7 +220,10 @@ class SerialRobot:
         if self.link.lost_streak >= self.link.max_lost:
             self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
         wheels, lifts = m.speeds_to_wire(speeds)
-        self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts]))
+        # In lockstep the StepTo that follows every command carries it out in
+        # the same write.
+        self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
+                                            send=not self.lockstep))
 
     def flush(self) -> None:
         """Wait for the Acks of every command still in flight (LinkLostError
@@ -236,8 +247,22 @@ class SerialRobot:
         self._wait([self._request(b, [m.Clear(mask)]) for b in m.Board])
 
     def step_to(self, time_us: int) -> None:
-        """Lockstep: the world advances to ``time_us``; waits until it has."""
-        (reply,) = self._wait([self._request(m.Board.MOTOR, [m.StepTo(time_us)])])
+        """Lockstep: the world advances to ``time_us``.  With PIPELINED_STEP
+        the StepDone is awaited by the next read() (the boards handle frames
+        in order, so that read sees the stepped world): one round trip per
+        tick instead of two.  Otherwise waits here."""
+        if self._step is not None:
+            self._check_step(self._wait([self._step])[0])
+        # Pipelined, the StepTo waits in the output buffer with the speeds
+        # before it, and the next read's requests carry all of them in one
+        # write: a pty write costs a context switch, the dearest part of a tick.
+        self._step = self._request(m.Board.MOTOR, [m.StepTo(time_us)],
+                                   send=not self.PIPELINED_STEP)
+        if not self.PIPELINED_STEP:
+            step, self._step = self._step, None
+            self._check_step(self._wait([step])[0])
+
+    def _check_step(self, reply: Any) -> None:
         if not reply.messages or not isinstance(reply.messages[0], m.StepDone):
             raise HardwareError(f"the motor board refused StepTo: {reply.messages}")
 
@@ -277,9 +302,9 @@ class SerialRobot:
         return h
 
     # -- internals ---------------------------------------------------------------
-    def _request(self, board: int, msgs: list[m.Message]) -> Pending:
+    def _request(self, board: int, msgs: list[m.Message], send: bool = True) -> Pending:
         self._last_tx[board] = time.monotonic()
-        return self.link.request(board, msgs)
+        return self.link.request(board, msgs, send=send)
 
     def _wait(self, pendings: list[Pending]) -> list[Any]:
         try:

@@ -12,6 +12,8 @@ to the CAN fake (``stairbot.fakes.can_boards.main``).
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
 from importlib import import_module
 
@@ -96,6 +98,11 @@ def main(argv: list[str]) -> int:
         f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"serial://{pty.path}{suffix}", flush=True)
     print(f"fake boards serving on {pty.path} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+    def on_term(_sig: int, _frame: object) -> None:
+        server.stop()
+
+    with contextlib.suppress(ValueError):  # not the main thread: no handler
+        signal.signal(signal.SIGTERM, on_term)
     try:
         server.serve()
     except KeyboardInterrupt:

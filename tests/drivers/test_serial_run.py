@@ -1,0 +1,51 @@
+"""The whole ascent and descent over the wire: `stairbot fake-boards --serial
+--lockstep` in another process, the runner in this one on serial://<pty>,
+ending exactly as sim:// does."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from collections.abc import Iterator
+
+import pytest
+
+from stairbot.config import load_config
+from stairbot.robots import RobotOptions, open_robot
+from stairbot.runner import RunResult, run
+from stairbot.scenario import load_scenario
+
+SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "fell")
+
+
+@pytest.fixture
+def fake_boards_url() -> Iterator[str]:
+    proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial",
+                             "--lockstep"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    assert proc.stdout is not None
+    url = proc.stdout.readline().strip()
+    try:
+        assert url.startswith("serial:///dev/") and url.endswith("?lockstep=1"), url
+        yield url
+    finally:
+        proc.terminate()
+        _, err = proc.communicate(timeout=10)
+        assert proc.returncode == 0, err
+        assert "frames in" in err  # the fake reports its own counters on SIGTERM
+
+
+def test_full_ascent_and_descent_over_a_pty_ends_as_sim_does(fake_boards_url: str) -> None:
+    config, scenario = load_config(), load_scenario()
+    sim = run(open_robot("sim://", config, scenario, RobotOptions()), config)
+    session = open_robot(fake_boards_url + "&timeout=2", config, scenario, RobotOptions())
+    try:
+        wire: RunResult = run(session, config)
+        health = session.robot.diagnostics()["link"]
+    finally:
+        session.close()
+    assert sim.outcome == "completed" and sim.steps_climbed == 5
+    assert {k: getattr(wire, k) for k in SAME} == {k: getattr(sim, k) for k in SAME}
+    assert wire.sim_time_s == pytest.approx(sim.sim_time_s, abs=1.0)
+    assert wire.final_offset_m is not None and wire.final_offset_m < 0.05
+    assert isinstance(health, dict) and health["lost"] == 0 and health["crc_errors"] == 0
