@@ -51,6 +51,7 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
     ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
     ("record", "Record events", "Start/stop writing events as JSON lines (key: w)"),
+    ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
 )
 
 
@@ -71,6 +72,7 @@ class StairbotConsole(App[None]):
         Binding("o", "choose_scenario", "scenario"),
         Binding("w", "record", "rec"),
         Binding("x", "stop_run", "stop"),
+        Binding("z", "zoom", "zoom"),
         Binding("q", "quit", "quit"),
     ]
 
@@ -103,7 +105,6 @@ class StairbotConsole(App[None]):
         yield Footer(compact=True)
 
     def on_mount(self) -> None:
-        self.query_one("#picture").border_title = "side view"
         if self._record:
             try:
                 self.engine.start_recording(self._record)
@@ -124,6 +125,8 @@ class StairbotConsole(App[None]):
 
     def _show(self, v: StateView) -> None:
         self.query_one(Banner).show(v.url, v.scenario, v.status)
+        picture = self.query_one(StairsPicture)
+        picture.border_title = f"side view · {v.url} · {v.scenario}"
         snap = v.snapshot
         lifts = None
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
@@ -131,7 +134,7 @@ class StairbotConsole(App[None]):
             lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
         note = "" if v.simulated or v.scene is not None else \
             "wired robot: stairs from the scenario, no robot pose"
-        self.query_one(StairsPicture).show(v.scene, v.stairs, lifts, note)
+        picture.show(v.scene, v.stairs, lifts, note)
         self.query_one(SensorPanel).show(snap)
         self.query_one(MotorPanel).show(snap, v.commands)
         self.query_one(PhasePanel).show(v.phase, v.flow, v.context)
@@ -280,6 +283,11 @@ class StairbotConsole(App[None]):
 
         self.push_screen(AskScreen("Record the event stream (JSON lines) to", "events.jsonl"),
                          chosen)
+
+    def action_zoom(self) -> None:
+        mode = self.query_one(StairsPicture).cycle_zoom()
+        names = {"auto": "auto zoom", "flight": "whole flight", "robot": "following the robot"}
+        self.notify(f"picture: {names[mode]}")
 
     def get_system_commands(self, screen: Screen) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)

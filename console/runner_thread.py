@@ -205,9 +205,9 @@ def _default_control() -> Any:
 def describe_result(result: dict[str, Any]) -> tuple[str, str]:
     """One line saying how a run ended, and its severity (good/warning/error)."""
     outcome = result.get("outcome", "?")
-    parts = [f"Run {outcome}"]
+    parts = [f"run {outcome}"]
     if result.get("ascent_end"):
-        parts.append(f"ascent ended: {str(result['ascent_end']).replace('_', ' ')}")
+        parts.append(str(result["ascent_end"]).replace("_", " "))
     parts.append(f"climbed {result.get('steps_climbed', 0)}, "
                  f"descended {result.get('steps_descended', 0)}")
     if result.get("error"):
@@ -243,6 +243,12 @@ class ConsoleEngine:
         self._last_ctx = -1.0
 
     # -- robot -----------------------------------------------------------------
+    @property
+    def robot_lock(self) -> threading.RLock:
+        """Held around every call to the robot and the clock (take it to look at
+        the simulation from another thread)."""
+        return self._lock
+
     @property
     def running(self) -> bool:
         return self._running.is_set()
@@ -280,7 +286,7 @@ class ConsoleEngine:
             return
         self.robot.refresh_scene()
         self.state.set_status(robot="ready", estopped=False, paused=False,
-                              message="ready", severity="info")
+                              message="", severity="info")
 
     def close(self) -> None:
         """Stop and release the robot (never raises)."""

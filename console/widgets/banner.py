@@ -18,11 +18,7 @@ def banner_text(url: str, scenario: str, status: RunStatus) -> Text:
     else:
         state = status.robot.upper()
     out = Text(f" {state} ", "bold reverse")
-    out.append(f" {url or '—'}", "bold")
-    if scenario:
-        out.append(f" · {scenario}")
-    if status.message:
-        out.append(f" · {status.message}")
+    out.append(f" {status.message}" if status.message else f" {url or '—'} · {scenario}")
     return out
 
 
@@ -34,12 +30,15 @@ class Banner(Static):
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id)
         self._last: object = None
+        self.plain = ""  # the text shown, for tests and logs
 
     def show(self, url: str, scenario: str, status: RunStatus) -> None:
         key = (url, scenario, status)
         if key == self._last:
             return
         self._last = key
-        self.update(banner_text(url, scenario, status))
+        text = banner_text(url, scenario, status)
+        self.plain = text.plain
+        self.update(text)
         self.remove_class(*SEVERITY_CLASSES)
         self.add_class("-estop" if status.estopped else f"-{status.severity}")

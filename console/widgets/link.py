@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from rich.text import Text
 from textual.widgets import Static
 
-SPEED_NAMES = {"1x": "1×", "10x": "10×", "max": "max (as fast as it goes)"}
+SPEED_NAMES = {"1x": "1×", "10x": "10×", "max": "max"}
 # Health keys worth a short name; anything else is shown as it comes.
 SHORT = {"frames_per_s": "fps", "rtt_ms": "rtt ms", "rtt_p99_ms": "rtt p99",
          "crc_errors": "crc err", "retries": "retries", "lost": "lost", "late": "late"}

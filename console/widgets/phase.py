@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
@@ -15,7 +16,7 @@ FLOWS = ("calibration", "ascent", "descent")
 
 def flow_text(flow: str) -> Text:
     """``calibration › ascent › descent`` with the current one highlighted."""
-    out = Text()
+    out = Text(no_wrap=True, overflow="ellipsis")
     for i, name in enumerate(FLOWS):
         if i:
             out.append(" › ", "dim")
@@ -23,22 +24,23 @@ def flow_text(flow: str) -> Text:
             out.append(name.upper(), "bold reverse")
         else:
             out.append(name, "dim")
-    if flow not in FLOWS and flow not in ("", "idle"):
+    if flow == "end":
+        out.append(" › ", "dim")
+        out.append("END", "bold reverse")
+    elif flow not in FLOWS and flow not in ("", "idle"):
         out.append(f"  {flow}", "bold")
     return out
 
 
 def tab_text(context: Mapping[str, Any]) -> Text:
-    """``number_of_steps N`` and the filled entries of ``tab_length_to_edge`` (m)."""
-    out = Text("number_of_steps ", "bold")
-    out.append(str(context.get("number_of_steps", "—")))
+    """The filled entries of ``tab_length_to_edge``, in millimetres."""
+    out = Text("tab_length_to_edge mm ", "bold")
     tab = context.get("tab_length_to_edge")
-    out.append("\ntab_length_to_edge ", "bold")
     values: list[str] = []
     if isinstance(tab, Sequence) and not isinstance(tab, str):
         n = context.get("number_of_steps")
         used = tab[: n] if isinstance(n, int) and n > 0 else [v for v in tab if v]
-        values = [f"{float(v):.3f}" if isinstance(v, int | float) else "—" for v in used]
+        values = [f"{float(v) * 1000:.0f}" if isinstance(v, int | float) else "—" for v in used]
     out.append(" ".join(values) if values else "—")
     return out
 
@@ -59,9 +61,11 @@ class PhasePanel(Static):
         if key == self._last:
             return
         self._last = key
-        out = Text(label or "—", "bold")
-        out.append("\n")
-        out.append_text(flow_text(flow))
-        out.append("\n")
-        out.append_text(tab_text(context))
-        self.update(out)
+        steps = Text("number_of_steps ", "bold", no_wrap=True)
+        steps.append(str(context.get("number_of_steps", "—")))
+        self.update(Group(
+            Text(label or "—", "bold", no_wrap=True, overflow="ellipsis"),
+            flow_text(flow),
+            steps,
+            tab_text(context),
+        ))

@@ -14,6 +14,9 @@ WHEEL_STYLE = "bold white"
 MARGIN_M = 0.05
 FLOOR_BEHIND_M = 0.3  # floor drawn behind the robot's rear end
 TOP_AHEAD_M = 0.6  # landing drawn past the last riser
+MIN_ROBOT_DOTS = 12  # "auto" zoom follows the robot when the flight draws it shorter
+FOLLOW_DOTS = 14  # the robot's length in dots when following it
+ZOOMS = ("auto", "flight", "robot")
 
 
 class StairsPicture(Widget):
@@ -32,6 +35,8 @@ class StairsPicture(Widget):
         self._note = ""
         self._bounds: tuple[float, float, float, float] | None = None
         self._key: object = None
+        self.zoom = "auto"
+        self.following = False
 
     def show(self, scene: SceneView | None, stairs: tuple[Point, ...],
              lifts_m: tuple[float, float] | None, note: str = "") -> None:
@@ -84,10 +89,30 @@ class StairsPicture(Widget):
         out.append_text(self._caption(view, width))
         return out
 
+    def _follow_bounds(self, view: SceneView, dw: int,
+                       dh: int) -> tuple[float, float, float, float]:
+        """A window that moves with the robot: the robot FOLLOW_DOTS long, a fifth
+        of the way in from the left and a sixth of the way up."""
+        rx0, ry0, rx1, ry1 = SceneView(stairs=(), segments=view.segments,
+                                       wheels=view.wheels).bounds()
+        scale = FOLLOW_DOTS / max(rx1 - rx0, 1e-6)
+        width, height = dw / scale, dh / scale
+        x0 = (rx0 + rx1) / 2 - width / 5
+        y0 = ry0 - height / 6
+        return (x0, y0, x0 + width, y0 + height)
+
     def _draw(self, canvas: BrailleCanvas, view: SceneView) -> None:
-        x0, y0, x1, y1 = self._world_bounds(view)
         dw, dh = canvas.dot_width, canvas.dot_height
+        x0, y0, x1, y1 = self._world_bounds(view)
         scale = min((dw - 1) / max(x1 - x0, 1e-6), (dh - 1) / max(y1 - y0, 1e-6))
+        self.following = False
+        if view.segments:
+            rx0, _, rx1, _ = SceneView(stairs=(), segments=view.segments).bounds()
+            if self.zoom == "robot" or (self.zoom == "auto"
+                                        and (rx1 - rx0) * scale < MIN_ROBOT_DOTS):
+                x0, y0, x1, y1 = self._follow_bounds(view, dw, dh)
+                scale = min((dw - 1) / (x1 - x0), (dh - 1) / (y1 - y0))
+                self.following = True
 
         def to_dots(p: Point) -> Point:
             return ((p[0] - x0) * scale, (dh - 1) - (p[1] - y0) * scale)
@@ -98,6 +123,12 @@ class StairsPicture(Widget):
             canvas.polygon([to_dots(p) for p in poly], style, 3)
         for x, y, r in view.wheels:
             canvas.circle(to_dots((x, y)), r * scale, WHEEL_STYLE, 4)
+
+    def cycle_zoom(self) -> str:
+        """auto -> whole flight -> follow the robot -> auto; returns the new mode."""
+        self.zoom = ZOOMS[(ZOOMS.index(self.zoom) + 1) % len(ZOOMS)]
+        self.refresh()
+        return self.zoom
 
     def _caption(self, view: SceneView, width: int) -> Text:
         out = Text(no_wrap=True, overflow="ellipsis")
@@ -115,5 +146,7 @@ class StairsPicture(Widget):
             out.append(f"{mtf * 1000:+4.0f} mm  ")
             out.append("MTB ", SEGMENT_STYLES[2])
             out.append(f"{mtb * 1000:+4.0f} mm")
+        if self.following:
+            out.append("  zoomed", "dim")
         out.truncate(width)
         return out

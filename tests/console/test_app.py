@@ -1,0 +1,219 @@
+"""The console driven from the keyboard with App.run_test() and the Pilot,
+against the real simulated robot and the real run loop."""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+from stairbot.console.app import StairbotConsole, build_app
+from stairbot.console.widgets.banner import Banner
+from textual import events
+from textual.widgets import Input
+
+from stairbot.hardware import MotorId, Speeds
+from stairbot.robots import RobotSession, open_robot
+
+
+class SpyRobot:
+    """Passes every call to the simulated robot and logs it, so a test can see
+    exactly what reached the robot and in which order."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner = inner
+        self.calls: list[tuple[str, dict[MotorId, float] | None]] = []
+
+    def read(self) -> Any:
+        self.calls.append(("read", None))
+        return self.inner.read()
+
+    def command(self, speeds: Speeds) -> None:
+        self.calls.append(("command", dict(speeds)))
+        self.inner.command(speeds)
+
+    def stop_all(self) -> None:
+        self.calls.append(("stop_all", None))
+        self.inner.stop_all()
+
+    def diagnostics(self) -> dict[str, object]:
+        return self.inner.diagnostics()
+
+    def close(self) -> None:
+        self.inner.close()
+
+
+def spied_open(spies: list[SpyRobot]) -> Callable[..., RobotSession]:
+    def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
+        session = open_robot(url, config, scenario, options)
+        spy = SpyRobot(session.robot)
+        spies.append(spy)
+        return RobotSession(spy, session.clock, session.url, session.simulated, session.sim)
+    return open_fn
+
+
+async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:
+    """Let the app run until ``cond`` holds (the bound only stops a broken test)."""
+    for _ in range(1200):
+        if cond():
+            await pilot.pause(0.01)
+            return
+        await asyncio.sleep(0.05)
+    raise AssertionError(f"never happened: {what}")
+
+
+async def press(pilot: Any, *keys: str) -> None:
+    """Send key events the way the terminal driver does and let the app handle
+    them.  (Pilot.press also waits for the process to go idle, up to 2 s a key,
+    which a running simulation never does.)"""
+    for key in keys:
+        char = " " if key == "space" else (key if len(key) == 1 else None)
+        pilot.app.post_message(events.Key(key, char))
+        await pilot.pause(0.02)
+
+
+def banner(app: StairbotConsole) -> str:
+    return app.screen_stack[0].query_one(Banner).plain
+
+
+async def ready(pilot: Any) -> None:
+    await pilot.app.workers.wait_for_complete()
+    await until(pilot, lambda: "READY" in banner(pilot.app), "the robot is ready")
+
+
+def test_a_full_run_started_from_the_keyboard_reaches_the_end() -> None:
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(120, 40)) as pilot:
+            await ready(pilot)
+            await press(pilot, "s")
+            await until(pilot, lambda: app.engine.running or "ENDED" in banner(app), "started")
+            await until(pilot, lambda: not app.engine.running, "the run ends")
+            await app.workers.wait_for_complete()
+            await pilot.pause(0.2)
+            result = app.state.view().result
+            assert result and result["outcome"] in ("completed", "stopped", "error", "fell")
+            text = banner(app)
+            assert "ENDED" in text
+            assert f"run {result['outcome']}" in text
+            assert f"climbed {result['steps_climbed']}" in text
+            assert app.state.view().flow == "end"
+    asyncio.run(go())
+
+
+def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
+    spies: list[SpyRobot] = []
+
+    async def go() -> None:
+        app = build_app(speed="10x", open_fn=spied_open(spies))
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, "s")
+            spy = spies[-1]
+            await until(pilot, lambda: any(
+                c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())
+                for c in spy.calls[-5:]), "the robot moves")
+            await press(pilot, "space")
+            n_stop = len(spy.calls)
+            # The key handler itself stopped every motor: the last call that
+            # reached the robot when the key returned is stop_all.
+            assert ("stop_all", None) in spy.calls[n_stop - 2:n_stop]
+            assert app.state.view().status.estopped
+            sim = app.engine.session.sim  # type: ignore[union-attr]
+
+            def reads_since_stop() -> int:
+                return sum(c[0] == "read" for c in spy.calls[n_stop:])
+
+            def truth() -> tuple[Any, Any]:
+                with app.engine.robot_lock:
+                    return sim.scene(), sim.read()
+
+            # Gravity may still settle the robot for a moment (a stopped motor
+            # does not stop a tip onto the next support): look after 25 ticks.
+            await until(pilot, lambda: reads_since_stop() > 25, "25 ticks after the stop")
+            scene0, snap0 = truth()
+            await until(pilot, lambda: reads_since_stop() > 100, "100 ticks after the stop")
+            scene1, snap1 = truth()
+            # No motion command reached the robot after the stop ...
+            moving = [c for c in spy.calls[n_stop:] if c[0] == "command"
+                      and c[1] and any(v != 0 for v in c[1].values())]
+            assert moving == []
+            # ... no motor turns, and the robot stays where it is (within 1 mm).
+            for m in MotorId:
+                assert snap1.motors[m].speed_tps == pytest.approx(0.0, abs=0.02)
+                assert snap1.motors[m].turns == pytest.approx(snap0.motors[m].turns, abs=0.01)
+            for a, b in zip(scene0.segments, scene1.segments, strict=True):
+                for (ax, ay), (bx, by) in zip(a, b, strict=True):
+                    assert abs(ax - bx) < 1e-3 and abs(ay - by) < 1e-3
+            assert "E-STOP" in banner(app)
+            # Resume is refused until the stop is cleared.
+            await press(pilot, "p")
+            assert app.state.view().status.estopped
+            assert "clear the emergency stop" in banner(app)
+            await press(pilot, "c")
+            assert not app.state.view().status.estopped
+            await press(pilot, "p")  # resume
+            n_resume = len(spy.calls)
+            await until(pilot, lambda: any(
+                c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())
+                for c in spy.calls[n_resume:]), "motion after clear + resume")
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
+
+
+def test_pause_and_resume() -> None:
+    spies: list[SpyRobot] = []
+
+    async def go() -> None:
+        app = build_app(speed="10x", open_fn=spied_open(spies))
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, "s")
+            spy = spies[-1]
+            await until(pilot, lambda: len(spy.calls) > 100, "100 calls")
+            await press(pilot, "p")
+            assert "PAUSED" in banner(app)
+            n_pause = len(spy.calls)
+            await until(pilot, lambda: len(spy.calls) > n_pause + 60, "ticks while paused")
+            # From the tick after the pause on, every command is all zeros.
+            cmds = [c[1] for c in spy.calls[n_pause + 6:] if c[0] == "command"]
+            assert cmds and all(not any(v != 0 for v in (c or {}).values()) for c in cmds)
+            t_paused = app.state.view().snapshot.time_s  # type: ignore[union-attr]
+            await press(pilot, "p")
+            assert "PAUSED" not in banner(app)
+            n_resume = len(spy.calls)
+            await until(pilot, lambda: any(
+                c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())
+                for c in spy.calls[n_resume:]), "motion after resume")
+            assert app.state.view().snapshot.time_s > t_paused  # type: ignore[union-attr]
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
+
+
+@pytest.mark.parametrize(("key", "value", "expect"), [
+    ("u", "bogus://nowhere", "unknown scheme 'bogus'"),
+    ("u", "sim://with/a/path", "takes no host"),
+    ("o", "/no/such/stairs.toml", "cannot read"),
+])
+def test_invalid_robot_or_scenario_gives_a_message(key: str, value: str, expect: str) -> None:
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, key)
+            await until(pilot, lambda: bool(app.screen.query(Input)), "the prompt")
+            app.screen.query_one(Input).value = value
+            await press(pilot, "enter")
+            await until(pilot, lambda: expect in banner(app), "the message")
+            await app.workers.wait_for_complete()
+            await until(pilot, lambda: len(app.screen_stack) == 1, "the prompt closes")
+            assert app.state.view().url == "sim://"  # the previous robot is kept
+            assert app.engine.session is not None
+            await press(pilot, "s")  # and still runs
+            await until(pilot, lambda: app.engine.running or "ENDED" in banner(app), "a run")
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
