@@ -1,0 +1,167 @@
+"""Control-cycle rate and latency over python-can against the fake boards,
+and the share of a 1 Mbit/s CAN bus the control loop uses.
+
+A cycle is what the run loop does each tick over the wire: read every sensor
+and motor (ReadAll to each board, both in flight at once) and send the
+commands (SetWheelSpeeds + SetLiftSpeeds, their Acks checked on the next
+cycle, or awaited in the same cycle).  The fake boards run in real time, as
+`stairbot fake-boards --can` does: on ``virtual`` in a thread of this process,
+on ``udp_multicast`` in another process on this host.  Beside the measured
+figures it prints, for exactly the frames a cycle puts on the bus, the bits
+they take at worst (bit stuffing: 135 bits for an 8-byte frame, see
+``drivers.can_wire.frame_bits``), the rate a 1 Mbit/s bus would allow, and the
+bus load at the controller's own tick (0.02 s), which must stay <= 20 %.
+
+    python benchmarks/bench_link_can.py [--cycles N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import random
+import statistics
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+
+import can
+from stairbot.drivers import messages as m
+from stairbot.drivers.can_robot import open_can_robot
+from stairbot.drivers.can_wire import frame_bits, wire
+from stairbot.fakes.boards import make_boards
+from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.can_boards import CanBoardServer
+
+from stairbot.config import load_config
+from stairbot.hardware import MotorId
+from stairbot.robots import RobotOptions
+from stairbot.scenario import load_scenario
+
+BITRATE = 1_000_000
+LOAD_LIMIT = 0.20
+
+
+def cycle_frames() -> list[tuple[str, int, int]]:
+    """(frame name, data bytes, count) of every frame one control cycle puts on
+    the bus, both ways, taken from the DBC."""
+    w = wire()
+    sent = [(1, m.ReadAll()), (2, m.ReadAll()), (1, m.SetWheelSpeeds(0, 0, 0, 0)),
+            (1, m.SetLiftSpeeds(0, 0)),
+            (1, m.Status(0, 0, 250, 0)), (2, m.Status(0, 0, 250, 0)),
+            *((1, m.MotorTelemetry(c, 1, 0, 0, 0)) for c in range(6)),
+            *((2, m.SensorTelemetry(c, 0, 0, 0)) for c in range(4)),
+            (1, m.Ack(0x20, 0)), (1, m.Ack(0x21, 0))]
+    counts: dict[str, list[int]] = {}
+    for board, msg in sent:
+        fid, data = w.encode(board, msg)
+        name = w.db.get_message_by_frame_id(fid).name
+        counts.setdefault(name, [len(data), 0])[1] += 1
+    return [(name, size, n) for name, (size, n) in counts.items()]
+
+
+def percentile(values: list[float], q: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
+
+def measure(robot: object, cycles: int, acked: bool) -> tuple[float, list[float]]:
+    speeds = {mid: 0.0 for mid in MotorId}
+    read, command = robot.read, robot.command  # type: ignore[attr-defined]
+    flush = robot.flush  # type: ignore[attr-defined]
+    for _ in range(100):
+        read()
+        command(speeds)
+    flush()
+    lat: list[float] = []
+    t0 = time.perf_counter()
+    for _ in range(cycles):
+        c0 = time.perf_counter()
+        read()
+        command(speeds)
+        if acked:
+            flush()
+        lat.append(time.perf_counter() - c0)
+    return cycles / (time.perf_counter() - t0), lat
+
+
+def report(label: str, url: str, cycles: int) -> None:
+    session = open_can_robot(url, load_config(), load_scenario(), RobotOptions())
+    robot = session.robot
+    print(f"{label} ({url}), fake boards in real time, {cycles} cycles")
+    for acked, name in ((False, "pipelined (Acks checked next cycle)"),
+                        (True, "each Ack awaited in its cycle")):
+        rate, lat = measure(robot, cycles, acked)
+        print(f"  {name:38s} {rate:8.0f} cycles/s   latency median "
+              f"{statistics.median(lat) * 1e3:.3f} ms  p99 {percentile(lat, 0.99) * 1e3:.3f} ms"
+              f"  max {max(lat) * 1e3:.3f} ms")
+    h = robot.health()  # type: ignore[attr-defined]
+    print(f"  link: {h['frames_tx']:.0f} frames out, {h['frames_rx']:.0f} in, "
+          f"{h['retries']:.0f} retries, {h['lost']:.0f} lost, {h['late']:.0f} late, "
+          f"{h['malformed']:.0f} malformed, rtt median {h['rtt_median_ms']:.3f} ms "
+          f"p99 {h['rtt_p99_ms']:.3f} ms")
+    session.close()
+
+
+def on_virtual(cycles: int) -> None:
+    channel = f"bench-{random.randrange(1 << 30)}"
+    world = make_world(load_config(), load_scenario(), False)
+    server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
+                            make_boards(world))
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    try:
+        report("CAN on python-can virtual, boards on a thread", f"can://virtual/{channel}",
+               cycles)
+    finally:
+        server.stop()
+        thread.join(5)
+        server.bus.shutdown()
+
+
+def on_udp_multicast(cycles: int) -> None:
+    group = f"239.74.{random.randrange(1, 255)}.{random.randrange(1, 255)}"
+    spec = f"udp_multicast/{group}?port={random.randrange(40000, 60000)}"
+    proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--can", spec],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert proc.stdout is not None
+        url = proc.stdout.readline().strip()
+        report("CAN on python-can udp_multicast, boards in another process", url, cycles)
+    finally:
+        proc.terminate()
+        proc.wait(5)
+
+
+def bus_budget(tick_s: float) -> None:
+    frames = cycle_frames()
+    bits = sum(frame_bits(size) * n for _, size, n in frames)
+    count = sum(n for _, _, n in frames)
+    load = bits / tick_s / BITRATE
+    print(f"CAN bus budget at {BITRATE / 1e6:g} Mbit/s, worst-case stuffing "
+          f"({frame_bits(8)} bits per 8-byte frame):")
+    for name, size, n in frames:
+        print(f"  {n} x {name:24s} {size} B  {frame_bits(size):3d} bits")
+    print(f"  {count} frames, {bits} bits per cycle -> the bus allows "
+          f"{BITRATE / bits:.0f} cycles/s")
+    verdict = "ok" if load <= LOAD_LIMIT else "OVER THE LIMIT"
+    print(f"  at the controller's tick of {tick_s} s: {bits / tick_s / 1e3:.1f} kbit/s = "
+          f"{load:.1%} of the bus (limit {LOAD_LIMIT:.0%}: {verdict})")
+    step = frame_bits(4) * 2  # lockstep only: StepTo + StepDone (simulation)
+    print(f"  (lockstep simulation adds StepTo + StepDone: {step} bits, "
+          f"{(bits + step) / tick_s / BITRATE:.1%})")
+
+
+def main(argv: list[str] | None = None) -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    p.add_argument("--cycles", type=int, default=3000)
+    args = p.parse_args(argv if argv is not None else [])
+    runs: list[Callable[[int], None]] = [on_virtual, on_udp_multicast]
+    for bench in runs:
+        bench(args.cycles)
+    bus_budget(load_config().algorithm.tick)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
