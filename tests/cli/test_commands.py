@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -77,9 +78,10 @@ def test_scenario_check_accepts_every_shipped_scenario(
     assert capsys.readouterr().out.count("ok  ") == len(shipped_scenarios())
 
 
-def test_python_dash_m_stairbot_is_the_same_command() -> None:
+def test_python_dash_m_stairbot_is_the_same_command(tmp_path: Path) -> None:
+    # cwd elsewhere: the installed package runs, not a source tree that happens to be here
     proc = subprocess.run([sys.executable, "-m", "stairbot", "config", "show", "--json"],
-                          capture_output=True, text=True, timeout=60)
+                          capture_output=True, text=True, timeout=60, cwd=tmp_path)
     assert proc.returncode == 0
     assert "max_step_rise_m" in json.loads(proc.stdout)["derived"]
 
