@@ -22,9 +22,6 @@ PROBE_YAW_RAD = math.radians(10.0)
 changed by 2 × equal_tolerance before."""
 MAX_TURN_YAW_RAD = math.radians(90.0)
 """A calibration that turns this far without SFR = SFL ends with an error."""
-DIFF_SMOOTHING = 0.3
-"""Weight of the newest SFL − SFR in the smoothed difference that ends a turn:
-it averages the sensors' noise over a few ticks."""
 TURN_SLOW_FLOOR = 0.25
 """The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
 
@@ -110,7 +107,7 @@ def _turn_enter(io: PhaseIO) -> None:
 def _turn(io: PhaseIO) -> Speeds:
     ctx, cfg = io.ctx, io.cfg
     sfr, sfl = _readings(io)
-    ctx.turn_diff += DIFF_SMOOTHING * ((sfl - sfr) - ctx.turn_diff)
+    ctx.turn_diff = motion.smooth(ctx.turn_diff, sfl - sfr)
     # Turning left closes SFL - SFR from below, turning right from above: stop
     # when the smoothed difference has reached zero.
     remaining = -ctx.turn_direction * ctx.turn_diff

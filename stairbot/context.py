@@ -61,6 +61,8 @@ class Context:
     resume_phase: str | None = None
     """The phase the standing rule stopped in, resumed when readings agree."""
     disagree_ticks: int = 0
+    standing_diff: float | None = None
+    """The standing rule's smoothed difference of the watched pair (left − right)."""
 
     # -- motion targets: absolute counter values ------------------------------------
     target_wheel: float | None = None

@@ -241,6 +241,7 @@ class Controller:
         previous = ctx.phase
         ctx.phase = phase.value
         ctx.disagree_ticks = 0
+        ctx.standing_diff = None
         if fresh and phase is not Phase.PAUSED:
             ctx.phase_started_s = snap.time_s
             ctx.entry_wheel = motion.wheel_position(snap)

@@ -30,6 +30,9 @@ WHEEL_DONE = 0.002
 """A drive is done within this many wheel turns of its target (0.2 mm)."""
 LIFT_DONE = 0.01
 """A lift is done within this many turns of its target (0.02 mm)."""
+DIFF_SMOOTHING = 0.3
+"""Weight of the newest reading in a smoothed difference of a sensor pair: it
+averages the sensors' noise over a few ticks (calibration turns, standing rule)."""
 TURN_SPEED = 0.15
 """Calibration turning speed of MWR/MWL, turns/s: slow, so noise cannot stop it early."""
 
@@ -66,15 +69,21 @@ def measurable(snap: Snapshot, cfg: RobotConfig) -> bool:
     return all(r.ok and r.distance_m < cfg.LENGTH_OF_INFINITY for r in pair(snap))
 
 
-def disagree(snap: Snapshot, cfg: RobotConfig, back: bool = False) -> bool:
-    """The standing rule's test: both sensors of the pair give a usable distance
-    and they differ by more than equal_tolerance."""
+def pair_difference(snap: Snapshot, cfg: RobotConfig, back: bool = False) -> float | None:
+    """Left minus right reading of the pair (SFL − SFR, or SBL − SBR) when both
+    give a usable distance (status OK, and for the front pair closer than
+    LENGTH_OF_INFINITY); None otherwise."""
     r, left = pair(snap, back)
     if not (r.ok and left.ok):
-        return False
+        return None
     if not back and max(r.distance_m, left.distance_m) >= cfg.LENGTH_OF_INFINITY:
-        return False
-    return abs(r.distance_m - left.distance_m) > cfg.algorithm.equal_tolerance
+        return None
+    return left.distance_m - r.distance_m
+
+
+def smooth(previous: float | None, newest: float) -> float:
+    """One step of the exponential smoothing (DIFF_SMOOTHING) of a difference."""
+    return newest if previous is None else previous + DIFF_SMOOTHING * (newest - previous)
 
 
 def sensor_errors(snap: Snapshot, sensors: tuple[SensorId, ...]) -> list[SensorId]:

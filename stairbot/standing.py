@@ -5,8 +5,10 @@ resume exactly where it stopped if they agree, end with an error if not.
 Armed in the phases whose table entry lists :attr:`Phase.PAUSED` (where both
 sensors of the pair look at the same flat surface), watching SBR/SBL in
 descent 2 and SFR/SFL elsewhere.  A disagreement only counts when both sensors
-give a usable distance, and it must last DEBOUNCE_TICKS ticks in a row, so
-that one noisy tick does not stop the robot.
+give a usable distance, and both the difference and its smoothed value
+(:data:`~stairbot.motion.DIFF_SMOOTHING`) must exceed equal_tolerance for
+DEBOUNCE_TICKS ticks in a row: neither a short spike nor sensor noise stops
+the robot.
 """
 
 from __future__ import annotations
@@ -38,6 +40,19 @@ def _readings(io: PhaseIO, back: bool) -> str:
     return f"{r.distance_m:.3f} m / {left.distance_m:.3f} m"
 
 
+def _disagree(io: PhaseIO, back: bool) -> bool:
+    """Update the smoothed difference; True when it and the newest difference
+    both exceed equal_tolerance."""
+    ctx = io.ctx
+    diff = motion.pair_difference(io.snap, io.cfg, back)
+    if diff is None:
+        ctx.standing_diff = None
+        return False
+    ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
+    tol = io.cfg.algorithm.equal_tolerance
+    return abs(diff) > tol and abs(ctx.standing_diff) > tol
+
+
 def watch(io: PhaseIO) -> bool:
     """Apply the rule in an armed phase; True when it has just stopped the robot."""
     phase = io.phase
@@ -45,7 +60,7 @@ def watch(io: PhaseIO) -> bool:
         return False
     ctx = io.ctx
     back = phase in BACK_PAIR_PHASES
-    if not motion.disagree(io.snap, io.cfg, back):
+    if not _disagree(io, back):
         ctx.disagree_ticks = 0
         return False
     ctx.disagree_ticks += 1
@@ -65,10 +80,11 @@ def _paused(io: PhaseIO) -> Speeds:
     ctx = io.ctx
     assert ctx.resume_phase is not None and ctx.pause_started_s is not None
     resume = Phase(ctx.resume_phase)
+    back = resume in BACK_PAIR_PHASES
+    disagree = _disagree(io, back)  # kept up to date through the wait
     if io.snap.time_s - ctx.pause_started_s < io.cfg.algorithm.standing_wait:
         return {}
-    back = resume in BACK_PAIR_PHASES
-    if not motion.disagree(io.snap, io.cfg, back):
+    if not disagree:
         ctx.disagree_ticks = 0
         io.machine.resume(f"standing rule: {_pair_name(back)} agree again "
                           f"({_readings(io, back)}): resuming {resume.label}", io.snap)

@@ -129,6 +129,12 @@ def test_a_disagreement_shorter_than_the_debounce_does_not_stop() -> None:
     assert (ctrl.result.outcome, ctrl.result.pauses) == ("completed", 0)
 
 
+def test_sensor_noise_alone_does_not_stop_the_robot() -> None:
+    ctrl, robot, _ = start(noise=0.002, seed=3, yaw_deg=5.0)
+    run(ctrl, robot)
+    assert (ctrl.result.outcome, ctrl.result.pauses) == ("completed", 0)
+
+
 def test_the_back_pair_is_watched_while_segment_3_is_lowered() -> None:
     ctrl, robot, _ = start()
     run(ctrl, robot, until=lambda c: c.phase is Phase.DESCENT_LOWER_THIRD)
