@@ -262,15 +262,17 @@ def cmd_run(args: argparse.Namespace) -> int:
             session.close()
     data = result.to_dict()
     interrupted = control.stop_reason is not None
-    if args.calibrate_only:
+    if interrupted:
+        mismatches = ["interrupted: not judged"]
+    elif args.calibrate_only:
         mismatches = [] if result.outcome == "completed" else [
             f"outcome: expected 'completed', got {result.outcome!r}"]
     else:
         mismatches = expectation_mismatches(scenario.expect, data)
     if args.json:
         out = {**data, "robot": args.robot, "scenario": scenario.name,
-               "config": config.source, "as_expected": not mismatches,
-               "mismatches": mismatches}
+               "config": config.source, "interrupted": interrupted,
+               "as_expected": not mismatches, "mismatches": mismatches}
         print(json.dumps(out, sort_keys=True))
     else:
         _print_summary(data, scenario, args.robot, mismatches)
@@ -309,7 +311,9 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
         f"  time              {_fmt(d['sim_time_s'], ' s', 2)} robot time, "
         f"{_fmt(d['wall_time_s'], ' s', 2)} wall"
         + (f" (realtime x{rtf:.0f})" if isinstance(rtf, float | int) else ""),
-        "  expected          " + ("yes" if not mismatches else "NO: " + "; ".join(mismatches)),
+        "  expected          " + ("yes" if not mismatches else "; ".join(mismatches)
+                                    if mismatches[0].startswith("interrupted")
+                                    else "NO: " + "; ".join(mismatches)),
     ]
     print("\n".join(lines), flush=True)
 
