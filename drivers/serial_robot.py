@@ -182,6 +182,7 @@ class SerialRobot:
             status = reply.messages[-1]
             if isinstance(status, m.Status):
                 self.status[board] = status
+            self._last_tx[board] = time.monotonic()
 
     @property
     def simulated(self) -> bool:
@@ -269,6 +270,8 @@ class SerialRobot:
     def heartbeat(self) -> None:
         """Feed the watchdog of a board that was sent nothing for a quarter of
         its timeout (the control loop's own frames normally do this)."""
+        if not self.watchdog_ms:
+            return
         now = time.monotonic()
         for board in m.Board:
             if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:

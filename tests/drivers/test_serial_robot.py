@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import socket
 import threading
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -103,6 +104,19 @@ def test_estop_latches_on_the_boards_until_cleared(fake: Fake) -> None:
     session.close()
 
 
+def test_heartbeat_feeds_boards_the_host_has_not_addressed_lately(fake: Fake) -> None:
+    session = fake.open("lockstep=1&timeout=0.5&watchdog=60000")
+    robot = robot_of(session)
+    before = robot.link.stats.frames_tx
+    robot.heartbeat()  # both boards were just addressed while opening
+    assert robot.link.stats.frames_tx == before
+    robot._last_tx = {b: time.monotonic() - 20.0 for b in robot._last_tx}  # 20 s ago
+    robot.heartbeat()
+    robot.flush()
+    assert robot.link.stats.frames_tx == before + 2
+    session.close()
+
+
 def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake: Fake) -> None:
     session = fake.open("lockstep=1&timeout=0.5&watchdog=100")
     robot = robot_of(session)
@@ -136,6 +150,8 @@ def test_faults_on_the_wire_are_survived_and_counted() -> None:
     for fake in serve(faults):
         session = fake.open("lockstep=1&timeout=0.02&retries=8&lost=5")
         robot = robot_of(session)
+        events: list[Event] = []
+        robot.attach_sink(events.append)
         for _ in range(150):
             robot.read()
             robot.command({MotorId.MWF: 0.5})
@@ -144,6 +160,9 @@ def test_faults_on_the_wire_are_survived_and_counted() -> None:
         assert h["retries"] > 0 and h["crc_errors"] + h["malformed"] > 0
         assert h["stray"] > 0  # duplicated replies
         assert fake.server.stats.duplicates > 0 and fake.server.stats.injected > 0
+        link_events = [e for e in events if e.kind is EventKind.LINK]
+        assert link_events and "retries" in link_events[0].message
+        assert 1 <= len(link_events) <= 3  # at most one a second of robot time (3 s here)
         session.close()
 
 

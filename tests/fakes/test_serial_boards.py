@@ -1,0 +1,111 @@
+"""The fake boards' serial server: arbitrary bytes and arbitrary well-framed
+messages never crash it (they are counted), repeats are answered from the
+cache, and the host's link survives whatever comes back."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+
+import pytest
+from cobs import cobs
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from stairbot.drivers import messages as m
+from stairbot.drivers.link import FdChannel, Link
+from stairbot.drivers.serial_wire import Frame, FrameReader, crc16, encode_frame
+from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.serial_boards import SerialBoardServer
+from test_boards import StubClock, StubRobot
+
+
+@pytest.fixture
+def server() -> Iterator[tuple[SerialBoardServer, int]]:
+    """A server writing into a pipe; yields it and the pipe's read end."""
+    robot = StubRobot()
+    world = BoardWorld(robot, StubClock(robot), lockstep=True)
+    r, w = os.pipe()
+    os.set_blocking(r, False)
+    yield SerialBoardServer(w, world, make_boards(world)), r
+    os.close(r)
+    os.close(w)
+
+
+def drain(fd: int) -> bytes:
+    out = b""
+    while True:
+        try:
+            chunk = os.read(fd, 65536)
+        except BlockingIOError:
+            return out
+        if not chunk:
+            return out
+        out += chunk
+
+
+@settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.binary(max_size=600))
+def test_arbitrary_bytes_never_crash_the_server(server: tuple, data: bytes) -> None:
+    srv, r = server
+    srv.receive(b"\x00")  # start from a clean receiver
+    s = srv.stats
+    before = s.crc_errors + s.malformed + s.frames_rx + s.stray
+    overruns = srv._reader.stats.overruns
+    srv.receive(data + b"\x00")
+    drain(r)
+    if srv._reader.stats.overruns == overruns:  # every chunk is handled or counted
+        chunks = [c for c in (data + b"\x00").split(b"\x00")[:-1] if c]
+        assert s.crc_errors + s.malformed + s.frames_rx + s.stray - before == len(chunks)
+    # and it still answers a good frame afterwards
+    srv.receive(b"\x00" + encode_frame(Frame(1, 77, (m.GetStatus(),))))
+    replies = FrameReader().feed(drain(r))
+    assert replies and replies[-1].seq == 77 and isinstance(replies[-1].messages[0], m.Status)
+
+
+bodies = st.lists(st.tuples(st.integers(0, 255), st.binary(max_size=8)), min_size=1,
+                  max_size=6)
+
+
+@settings(max_examples=300, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.integers(0, 15), st.integers(0, 255), bodies)
+def test_arbitrary_messages_in_valid_frames_never_crash_a_board(
+        server: tuple, board: int, seq: int, msgs: list[tuple[int, bytes]]) -> None:
+    srv, r = server
+    # keep the stub world's time small: a StepTo to an hour would be obeyed
+    msgs = [(c, p) for c, p in msgs if c != m.StepTo.TYPE]
+    body = bytes((board, seq)) + b"".join(bytes((c, len(p))) + p for c, p in msgs)
+    body += crc16(body).to_bytes(2, "big")
+    srv.receive(cobs.encode(body) + b"\x00")
+    out = FrameReader().feed(drain(r))
+    for frame in out:  # whatever it answered is well-formed and from that board
+        assert frame.from_board and frame.board == board and frame.seq == seq
+
+
+def test_a_repeated_frame_is_answered_again_but_executed_once(server: tuple) -> None:
+    srv, r = server
+    move = encode_frame(Frame(1, 5, (m.Move(0, 1000, 1000),)))
+    srv.receive(move)
+    first = drain(r)
+    srv.receive(move)
+    assert drain(r) == first and srv.stats.duplicates == 1
+    robot = srv.world.robot
+    assert isinstance(robot, StubRobot)
+    assert robot.commands == 1
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.binary(max_size=600))
+def test_arbitrary_bytes_from_the_boards_never_crash_the_host(data: bytes) -> None:
+    r, w = os.pipe()
+    try:
+        link = Link(FdChannel(r), timeout_s=0.001)
+        os.write(w, data + b"\x00")
+        link.poll()
+        s = link.stats
+        assert s.frames_rx == 0  # nothing was asked, so nothing is a reply
+        chunks = [c for c in (data + b"\x00").split(b"\x00")[:-1] if c]
+        if len(data) <= 254:  # no overrun possible: every chunk is counted
+            assert s.stray + s.crc_errors + s.malformed == len(chunks)
+    finally:
+        os.close(r)
+        os.close(w)
