@@ -54,6 +54,8 @@ class Context:
     """"top_reached" | "obstacle" | "step_limit" once the ascent has ended."""
     outcome: str | None = None
     error: str | None = None
+    end_reason: str | None = None
+    """Why the program ended, whatever the outcome."""
 
     # -- timers (controller clock: Snapshot.time_s) ---------------------------------
     phase_started_s: float | None = None

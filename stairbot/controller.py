@@ -44,6 +44,7 @@ class ControllerResult:
     steps_climbed: int
     steps_descended: int
     pauses: int
+    reason: str | None = None  # why it ended, whatever the outcome
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -103,7 +104,8 @@ class Controller:
     def result(self) -> ControllerResult:
         ctx = self._ctx
         return ControllerResult(ctx.outcome or "running", ctx.ascent_end, ctx.error,
-                                ctx.number_of_steps, ctx.steps_descended, ctx.pauses)
+                                ctx.number_of_steps, ctx.steps_descended, ctx.pauses,
+                                ctx.end_reason)
 
     # -- operator ---------------------------------------------------------------------
     def hold(self, reason: str) -> None:
@@ -258,6 +260,7 @@ class Controller:
         ctx = self._ctx
         previous = ctx.phase
         ctx.outcome = outcome
+        ctx.end_reason = reason
         ctx.phase = phase.value
         if outcome == "error":
             ctx.error = reason

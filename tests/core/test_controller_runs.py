@@ -141,6 +141,7 @@ def test_nothing_ahead_is_case_1_and_stops_without_moving() -> None:
     ctrl, _, events, sent = go(steps=[])
     r = ctrl.result
     assert (r.outcome, r.ascent_end, r.error) == ("stopped", None, None)
+    assert r.reason is not None and r.reason.startswith("nothing ahead")
     assert ctrl.context.calibration_case == "1"
     assert all(v == 0.0 for speeds in sent for v in speeds.values())
     assert "nothing ahead" in events[-1].message
