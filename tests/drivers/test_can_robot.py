@@ -247,3 +247,17 @@ def test_threaded_server_on_a_virtual_bus_via_open_robot() -> None:
         server.stop()
         thread.join(5)
         server.bus.shutdown()
+
+
+@pytest.mark.parametrize(("spec", "words"), [
+    ("virtual/x", "a virtual bus lives inside one process"),
+    ("udp_multicast/10.0.0.1", "not a multicast group"),
+    ("nosuch/1", "unknown python-can interface"),
+])
+def test_fake_boards_on_a_bad_bus_exit_2_with_one_line(
+        spec: str, words: str, capsys: pytest.CaptureFixture[str]) -> None:
+    from stairbot.cli import main
+
+    assert main(["fake-boards", "--can", spec]) == 2
+    err = capsys.readouterr().err.strip()
+    assert words in err and "\n" not in err and "Traceback" not in err
