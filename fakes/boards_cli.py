@@ -94,15 +94,16 @@ def main(argv: list[str]) -> int:
     pty = PtyPair()
     server = SerialBoardServer(pty.master, world, make_boards(world), faults_from(args),
                                time_scale=args.time_scale)
-    suffix = "?lockstep=1" if args.lockstep else (
-        f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
-    print(f"serial://{pty.path}{suffix}", flush=True)
-    print(f"fake boards serving on {pty.path} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+
     def on_term(_sig: int, _frame: object) -> None:
         server.stop()
 
     with contextlib.suppress(ValueError):  # not the main thread: no handler
         signal.signal(signal.SIGTERM, on_term)
+    suffix = "?lockstep=1" if args.lockstep else (
+        f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
+    print(f"serial://{pty.path}{suffix}", flush=True)
+    print(f"fake boards serving on {pty.path} (Ctrl-C to stop)", file=sys.stderr, flush=True)
     try:
         server.serve()
     except KeyboardInterrupt:
@@ -112,7 +113,7 @@ def main(argv: list[str]) -> int:
         s = server.stats
         print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.crc_errors} CRC "
               f"errors, {s.malformed} malformed, {s.duplicates} repeats, {s.injected} faults "
-              "injected", file=sys.stderr)
+              f"injected, {s.overflows} replies nobody read", file=sys.stderr)
     return 0
 
 

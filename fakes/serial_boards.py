@@ -59,6 +59,7 @@ class ServerStats:
     duplicates: int = 0  # repeated frames answered from the cache
     stray: int = 0  # frames for no board here, or from a board
     injected: int = 0  # faults injected
+    overflows: int = 0  # replies dropped because nobody read the line
 
 
 class SerialBoardServer:
@@ -68,6 +69,7 @@ class SerialBoardServer:
                  faults: WireFaults | None = None, time_scale: float = 1.0,
                  step_s: float = 0.005) -> None:
         self.fd = fd
+        os.set_blocking(fd, False)
         self.world = world
         self.boards = boards
         self.faults = faults or WireFaults()
@@ -113,12 +115,18 @@ class SerialBoardServer:
         self.stats.frames_tx += copies
 
     def _write_all(self, data: bytes) -> None:
+        """Write, or drop what the line will not take: with no host reading
+        the pty its buffer fills, and a UART would send into the void too.
+        Never blocks for long, so the server always stays stoppable."""
         view = memoryview(data)
         while view:
             try:
                 view = view[os.write(self.fd, view):]
             except BlockingIOError:
-                select.select([], [self.fd], [], 0.05)
+                _, ready, _ = select.select([], [self.fd], [], 0.05)
+                if not ready:
+                    self.stats.overflows += 1
+                    return
 
     def _flush_late(self) -> None:
         now = time.monotonic()
