@@ -40,9 +40,9 @@ def _readings(io: PhaseIO, back: bool) -> str:
     return f"{r.distance_m:.3f} m / {left.distance_m:.3f} m"
 
 
-def _disagree(io: PhaseIO, back: bool) -> bool:
-    """Update the smoothed difference; True when it and the newest difference
-    both exceed equal_tolerance."""
+def _disagree(io: PhaseIO, back: bool, raw_too: bool = True) -> bool:
+    """Update the smoothed difference; True when it exceeds equal_tolerance
+    (and, with ``raw_too``, the newest difference does as well)."""
     ctx = io.ctx
     diff = motion.pair_difference(io.snap, io.cfg, back)
     if diff is None:
@@ -50,7 +50,7 @@ def _disagree(io: PhaseIO, back: bool) -> bool:
         return False
     ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
     tol = io.cfg.algorithm.equal_tolerance
-    return abs(diff) > tol and abs(ctx.standing_diff) > tol
+    return abs(ctx.standing_diff) > tol and (not raw_too or abs(diff) > tol)
 
 
 def watch(io: PhaseIO) -> bool:
@@ -81,7 +81,9 @@ def _paused(io: PhaseIO) -> Speeds:
     assert ctx.resume_phase is not None and ctx.pause_started_s is not None
     resume = Phase(ctx.resume_phase)
     back = resume in BACK_PAIR_PHASES
-    disagree = _disagree(io, back)  # kept up to date through the wait
+    # Standing still, the smoothed difference alone decides: it has been kept up
+    # to date through the wait, and one noisy tick must not decide either way.
+    disagree = _disagree(io, back, raw_too=False)
     if io.snap.time_s - ctx.pause_started_s < io.cfg.algorithm.standing_wait:
         return {}
     if not disagree:
