@@ -3,9 +3,9 @@
 The same phases serve the start of the program (every case), ascent step 1 on
 later steps and descent step 1 (case 2 only); ``Context.purpose`` says which.
 Turning happens on segment 2's wheels with segments 1 and 3 lifted by
-NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE, slowly, and stops when SFL − SFR
-changes sign or comes within half of equal_tolerance, so that sensor noise
-cannot stop it early.
+NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE, slowly, and stops when the smoothed
+SFL − SFR reaches zero, so that sensor noise neither stops it early nor
+leaves the robot askew.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from stairbot import motion
-from stairbot.handler import Handler, PhaseIO, Speeds, lift
+from stairbot.handler import Handler, PhaseIO, Speeds, lift, where
 from stairbot.hardware import MotorId
 from stairbot.phases import Mode, Phase
 
@@ -32,12 +32,7 @@ def _readings(io: PhaseIO) -> tuple[float, float]:
 
 
 def _where(io: PhaseIO) -> str:
-    ctx = io.ctx
-    if ctx.purpose == "start":
-        return "start"
-    if ctx.purpose == "ascent":
-        return f"ascent 1, step {ctx.number_of_steps + 1}"
-    return f"descent 1, step {io.descent_index + 1}"
+    return where(io.ctx, io.phase)
 
 
 def _after_calibration(io: PhaseIO) -> None:

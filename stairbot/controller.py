@@ -18,7 +18,7 @@ from stairbot import ascent, calibration, descent, motion, standing
 from stairbot.config import RobotConfig
 from stairbot.context import Context
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.handler import Handler, PhaseIO
+from stairbot.handler import Handler, PhaseIO, where
 from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, LIFT_MOTORS, MotorId, SensorId, Snapshot
 from stairbot.phases import BY_VALUE, Mode, Phase
 from stairbot.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
@@ -249,8 +249,9 @@ class Controller:
             ctx.entry_wheel = motion.wheel_position(snap)
             ctx.entry_mtf = snap.turns(MotorId.MTF)
             ctx.entry_mtb = snap.turns(MotorId.MTB)
-        where = self._where(phase)
-        self._emit(EventKind.PHASE, f"{phase.label}{where}" + ("" if fresh else " (resumed)"),
+        note = where(ctx, phase)
+        where_text = f" ({note})" if note else ""
+        self._emit(EventKind.PHASE, f"{phase.label}{where_text}" + ("" if fresh else " (resumed)"),
                    snap.time_s, {"phase": phase.value, "flow": phase.flow, "from": previous,
                                  "why": why})
         if fresh and phase in HANDLERS:
@@ -277,20 +278,6 @@ class Controller:
         if ctx.pause_started_s is not None:
             ctx.pause_started_s += delta
 
-    def _where(self, phase: Phase) -> str:
-        ctx = self._ctx
-        if phase.flow == "calibration":
-            if ctx.purpose == "start":
-                return " (start)"
-            if ctx.purpose == "ascent":
-                return f" (ascent 1, step {ctx.number_of_steps + 1})"
-            return f" (descent 1, step {ctx.number_of_steps - ctx.steps_descended})"
-        if phase.flow == "ascent":
-            counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
-            return f" (step {ctx.number_of_steps + (0 if counted else 1)})"
-        if phase.flow == "descent" and phase is not Phase.DESCENT_FINISH:
-            return f" (step {ctx.number_of_steps - ctx.steps_descended})"
-        return ""
 
     def _emit(self, kind: EventKind, message: str, time_s: float,
               data: dict[str, Any]) -> None:

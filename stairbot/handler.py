@@ -79,6 +79,23 @@ class PhaseIO:
         return self.ctx.number_of_steps - self.ctx.steps_descended - 1
 
 
+def where(ctx: Context, phase: Phase) -> str:
+    """Where in the program ``phase`` stands, for messages: "start", "ascent 1,
+    step 3", "step 2"; empty outside the steps."""
+    if phase.flow == "calibration":
+        if ctx.purpose == "start":
+            return "start"
+        if ctx.purpose == "ascent":
+            return f"ascent 1, step {ctx.number_of_steps + 1}"
+        return f"descent 1, step {ctx.number_of_steps - ctx.steps_descended}"
+    if phase.flow == "ascent":
+        counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
+        return f"step {ctx.number_of_steps + (0 if counted else 1)}"
+    if phase.flow == "descent" and phase is not Phase.DESCENT_FINISH:
+        return f"step {ctx.number_of_steps - ctx.steps_descended}"
+    return ""
+
+
 def _nothing(_io: PhaseIO) -> None:
     return None
 
