@@ -261,6 +261,8 @@ class CanLink:
         that time out; raises LinkLostError when one gets no complete reply
         after its retries, or ``max_lost`` commands in a row went unanswered."""
         while True:
+            while self._receive(0.0):  # what has arrived counts before any timeout
+                pass
             self._expire()
             failed = [p for p in pendings if p.failed]
             if failed:

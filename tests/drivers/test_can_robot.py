@@ -261,3 +261,33 @@ def test_fake_boards_on_a_bad_bus_exit_2_with_one_line(
     assert main(["fake-boards", "--can", spec]) == 2
     err = capsys.readouterr().err.strip()
     assert words in err and "\n" not in err and "Traceback" not in err
+
+
+def test_faster_than_real_time_without_lockstep() -> None:
+    """--time-scale on both sides: the fake's world runs 20x the wall clock and
+    so does the host's clock; the robot drives forward as commanded."""
+    channel = f"scaled-{next(_names)}"
+    world = make_world(load_config(), load_scenario(), False)
+    server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
+                            make_boards(world), time_scale=20.0)
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    try:
+        # watchdog off: 250 board-ms are 12.5 wall-ms at 20x, less than a
+        # loaded machine may leave this thread idle (its trip is tested above)
+        session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1&watchdog=0",
+                                 load_config(), load_scenario(), RobotOptions())
+        first = session.robot.read()
+        for _ in range(25):
+            session.robot.read()
+            session.robot.command(FORWARD)
+            session.clock.advance(0.02)
+        last = session.robot.read()
+        assert last.time_s > first.time_s
+        assert last.turns(MotorId.MWF) > first.turns(MotorId.MWF)
+        assert world.now() > 0
+        session.close()
+    finally:
+        server.stop()
+        thread.join(5)
+        server.bus.shutdown()
