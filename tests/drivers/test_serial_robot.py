@@ -166,6 +166,22 @@ def test_faults_on_the_wire_are_survived_and_counted() -> None:
         session.close()
 
 
+def test_late_replies_cause_retries_and_the_copies_are_not_acted_upon() -> None:
+    # half the replies come 50 ms late, after the host's 40 ms timeout
+    for fake in serve(WireFaults(late=0.5, late_s=0.05, seed=3)):
+        session = fake.open("lockstep=1&timeout=0.04&retries=5")
+        robot = robot_of(session)
+        h = robot.link.stats
+        lost_opening = h.lost  # SetWatchdog is a command: late means lost, then sent anew
+        for _ in range(10):
+            robot.read()
+        assert h.retries >= 1 and h.lost == lost_opening  # queries always got through
+        while h.stray + h.late == 0:  # the retried copy's answer arrives later still
+            robot.link.poll()
+            time.sleep(0.01)
+        session.close()
+
+
 def test_a_duplicated_move_is_executed_once() -> None:
     for fake in serve(WireFaults(duplicate=1.0)):
         session = fake.open()
