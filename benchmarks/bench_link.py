@@ -24,6 +24,7 @@ import time
 from pathlib import Path
 
 from stairbot.drivers import messages as m
+from stairbot.drivers import units as u
 from stairbot.drivers.serial_robot import open_serial_robot
 from stairbot.drivers.serial_wire import Frame, encode_frame
 
@@ -40,7 +41,7 @@ def cycle_bytes() -> tuple[int, int]:
     """(host -> boards, boards -> host) bytes on the wire per cycle."""
     status = m.Status(0, 0, 250, 0)
     tx = [Frame(1, 1, (m.ReadAll(),)), Frame(2, 2, (m.ReadAll(),)),
-          Frame(1, 3, m.speeds_to_wire({}))]
+          Frame(1, 3, u.speeds_to_wire({}))]
     rx = [Frame(1, 1, (status, *(m.MotorTelemetry(c, 1, 0, 1000, 123456) for c in range(6))),
                 True),
           Frame(2, 2, (status, *(m.SensorTelemetry(c, 0, 500, 7) for c in range(4))), True),

@@ -38,6 +38,7 @@ from urllib.parse import parse_qsl, urlencode
 
 import serial
 from stairbot.drivers import messages as m
+from stairbot.drivers import units as u
 from stairbot.drivers.link import FdChannel, Link, Pending, PortChannel
 
 from stairbot.clock import WallClock
@@ -220,7 +221,7 @@ class SerialRobot:
         self._reap()
         if self.link.lost_streak >= self.link.max_lost:
             self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
-        wheels, lifts = m.speeds_to_wire(speeds)
+        wheels, lifts = u.speeds_to_wire(speeds)
         # In lockstep the StepTo that follows every command carries it out in
         # the same write.
         self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
@@ -352,7 +353,7 @@ class SerialRobot:
         if not msgs or not isinstance(msgs[0], m.Status):
             raise HardwareError(f"the motor board answered ReadAll with {msgs!r}")
         self._check_status(m.Board.MOTOR, msgs[0])
-        out = {m.MOTOR_CHANNELS[t.channel]: m.state_from_wire(t) for t in msgs[1:]
+        out = {m.MOTOR_CHANNELS[t.channel]: u.state_from_wire(t) for t in msgs[1:]
                if isinstance(t, m.MotorTelemetry) and t.channel < len(m.MOTOR_CHANNELS)}
         if len(out) != len(m.MOTOR_CHANNELS):
             raise HardwareError(f"the motor board's ReadAll reply lacks motors: {msgs!r}")
@@ -362,7 +363,7 @@ class SerialRobot:
         if not msgs or not isinstance(msgs[0], m.Status):
             raise HardwareError(f"the sensor board answered ReadAll with {msgs!r}")
         self._check_status(m.Board.SENSOR, msgs[0])
-        out = {m.SENSOR_CHANNELS[t.channel]: m.reading_from_wire(t) for t in msgs[1:]
+        out = {m.SENSOR_CHANNELS[t.channel]: u.reading_from_wire(t) for t in msgs[1:]
                if isinstance(t, m.SensorTelemetry) and t.channel < len(m.SENSOR_CHANNELS)}
         if len(out) != len(m.SENSOR_CHANNELS):
             raise HardwareError(f"the sensor board's ReadAll reply lacks sensors: {msgs!r}")

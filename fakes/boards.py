@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from stairbot.drivers import messages as m
+from stairbot.drivers import units as u
 from stairbot.drivers.serial_wire import RawMessage
 
 from stairbot.errors import HardwareError
@@ -249,8 +250,8 @@ class MotorBoard(Board):
         if fault == m.MotorFault.NONE and snap and snap.motors[mid].fault:
             fault = int(m.MotorFault.LIMIT if "limit" in str(snap.motors[mid].fault)
                         else m.MotorFault.DRIVER)
-        return m.MotorTelemetry(ch, int(self.modes[ch]), fault, m.speed_to_wire(speed),
-                                m.turns_to_wire(turns))
+        return m.MotorTelemetry(ch, int(self.modes[ch]), fault, u.speed_to_wire(speed),
+                                u.turns_to_wire(turns))
 
     def poll(self) -> None:
         super().poll()
@@ -274,7 +275,7 @@ class MotorBoard(Board):
         return [m.Ack(msg.TYPE, m.AckResult.OK)]
 
     def answer(self, msg: m.Message) -> list[m.Message]:
-        sp = m.speed_from_wire
+        sp = u.speed_from_wire
         if isinstance(msg, m.ReadAll):
             tel = [self.telemetry(ch) for ch in range(self.CHANNELS)]  # reads the world first
             return [self.status(), *tel]
@@ -317,9 +318,9 @@ class MotorBoard(Board):
         if snap is None:
             return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
         start = snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns
-        speed = m.speed_from_wire(msg.speed_mtps) * (1 if msg.turns_mt >= 0 else -1)
+        speed = u.speed_from_wire(msg.speed_mtps) * (1 if msg.turns_mt >= 0 else -1)
         self._set({msg.channel: speed}, m.MotorMode.MOVE)
-        self._move_target[msg.channel] = start + m.turns_from_wire(msg.turns_mt)
+        self._move_target[msg.channel] = start + u.turns_from_wire(msg.turns_mt)
         if msg.turns_mt == 0:
             self._set({msg.channel: 0.0})
         return [m.Ack(msg.TYPE, m.AckResult.OK)]
@@ -349,7 +350,7 @@ class SensorBoard(Board):
             self._sample_time = snap.time_s
             self._sample = (self._sample + 1) & 0xFFFF
         r = snap.sensors[m.SENSOR_CHANNELS[ch]]
-        return m.SensorTelemetry(ch, m.sensor_code(r.status), m.distance_to_wire(r.distance_m),
+        return m.SensorTelemetry(ch, u.sensor_code(r.status), u.distance_to_wire(r.distance_m),
                                  self._sample)
 
     def answer(self, msg: m.Message) -> list[m.Message]:

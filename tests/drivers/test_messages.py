@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from stairbot.drivers import messages as m
+from stairbot.drivers import units as u
 
 from stairbot.hardware import MotorId, SensorStatus
 
@@ -70,21 +71,21 @@ def test_decode_raises_only_codec_error(code: int, payload: bytes) -> None:
 
 
 def test_units() -> None:
-    assert m.speed_to_wire(1.0) == 1000
-    assert m.speed_to_wire(-10.0) == -10000
-    assert m.speed_to_wire(1e9) == 32767 and m.speed_to_wire(-1e9) == -32767
-    assert m.turns_to_wire(-19.0004) == -19000
-    assert m.distance_to_wire(0.4975) in (497, 498)
-    assert m.distance_to_wire(-1.0) == 0 and m.distance_to_wire(100.0) == 65535
-    state = m.state_from_wire(m.MotorTelemetry(4, 1, 2, -1500, 105000))
+    assert u.speed_to_wire(1.0) == 1000
+    assert u.speed_to_wire(-10.0) == -10000
+    assert u.speed_to_wire(1e9) == 32767 and u.speed_to_wire(-1e9) == -32767
+    assert u.turns_to_wire(-19.0004) == -19000
+    assert u.distance_to_wire(0.4975) in (497, 498)
+    assert u.distance_to_wire(-1.0) == 0 and u.distance_to_wire(100.0) == 65535
+    state = u.state_from_wire(m.MotorTelemetry(4, 1, 2, -1500, 105000))
     assert (state.turns, state.speed_tps, state.fault) == (105.0, -1.5, "watchdog")
-    reading = m.reading_from_wire(m.SensorTelemetry(0, 1, 1300, 3))
+    reading = u.reading_from_wire(m.SensorTelemetry(0, 1, 1300, 3))
     assert (reading.distance_m, reading.status) == (1.3, SensorStatus.OUT_OF_RANGE)
-    assert m.reading_from_wire(m.SensorTelemetry(0, 9, 0, 0)).status is SensorStatus.ERROR
+    assert u.reading_from_wire(m.SensorTelemetry(0, 9, 0, 0)).status is SensorStatus.ERROR
 
 
 def test_speeds_to_wire_sends_zero_for_motors_left_out() -> None:
-    wheels, lifts = m.speeds_to_wire({MotorId.MWL: -0.5, MotorId.MTB: 10.0})
+    wheels, lifts = u.speeds_to_wire({MotorId.MWL: -0.5, MotorId.MTB: 10.0})
     assert wheels == m.SetWheelSpeeds(0, 0, 0, -500)
     assert lifts == m.SetLiftSpeeds(0, 10000)
 
