@@ -135,6 +135,8 @@ class SerialRobot:
         self.refused = 0
         self._commands: list[Pending] = []
         self._step: Pending | None = None
+        self._rate_mark = (time.monotonic(), 0)
+        self._fps = 0.0
         self._reported: dict[str, float] = {}
         self._last_event = float("-inf")
         self._closed = False
@@ -301,8 +303,19 @@ class SerialRobot:
         self.link.close()
 
     def health(self) -> dict[str, float]:
-        h = self.link.stats.as_dict()
+        """The link's counters, RTT figures, ``rtt_ms`` (the latest round
+        trip) and ``frames_per_s`` (frames both ways, over the last second or
+        so of wall time)."""
+        stats = self.link.stats
+        h = stats.as_dict()
         h["refused"] = float(self.refused)
+        h["rtt_ms"] = round(stats.rtt_s[-1] * 1e3, 3) if stats.rtt_s else 0.0
+        now, frames = time.monotonic(), stats.frames_tx + stats.frames_rx
+        t0, f0 = self._rate_mark
+        if now - t0 >= 1.0:
+            self._fps = (frames - f0) / (now - t0)
+            self._rate_mark = (now, frames)
+        h["frames_per_s"] = round(self._fps, 1)
         return h
 
     # -- internals ---------------------------------------------------------------
