@@ -92,10 +92,13 @@ def report(label: str, url: str, cycles: int) -> None:
     print(f"{label} ({url}), fake boards in real time, {cycles} cycles")
     for acked, name in ((False, "pipelined (Acks checked next cycle)"),
                         (True, "each Ack awaited in its cycle")):
+        before = robot.health()  # type: ignore[attr-defined]
         rate, lat = measure(robot, cycles, acked)
+        after = robot.health()  # type: ignore[attr-defined]
+        bits = sum(after[k] - before[k] for k in ("bits_tx", "bits_rx")) / (cycles + 100)
         print(f"  {name:38s} {rate:8.0f} cycles/s   latency median "
               f"{statistics.median(lat) * 1e3:.3f} ms  p99 {percentile(lat, 0.99) * 1e3:.3f} ms"
-              f"  max {max(lat) * 1e3:.3f} ms")
+              f"  max {max(lat) * 1e3:.3f} ms   ({bits:.0f} bus bits a cycle, counted)")
     h = robot.health()  # type: ignore[attr-defined]
     print(f"  link: {h['frames_tx']:.0f} frames out, {h['frames_rx']:.0f} in, "
           f"{h['retries']:.0f} retries, {h['lost']:.0f} lost, {h['late']:.0f} late, "

@@ -55,7 +55,8 @@ def expected_replies(board: int, msg: m.Message) -> list[type[m.Message]]:
 
 @dataclass
 class CanStats(LinkStats):
-    """LinkStats plus the bus time used (worst-case stuffed bits) each way."""
+    """LinkStats plus the bus time used (worst-case stuffed bits) by the frames
+    sent and by the boards' frames received."""
 
     bits_tx: int = 0
     bits_rx: int = 0
@@ -192,8 +193,6 @@ class CanLink:
         """Handle one received frame: a board's reply is matched to what waits
         for it; anything else is counted (error frames as ``crc_errors``,
         undecodable ones as ``malformed``, host frames as ``ignored``)."""
-        self.stats.bits_rx += frame_bits(min(len(frame.data), 8))
-        self.stats.bytes_rx += len(frame.data)
         if frame.is_error_frame:
             self.stats.crc_errors += 1
             return
@@ -203,8 +202,10 @@ class CanLink:
             self.stats.malformed += 1
             return
         if not msg.REPLY:
-            self.stats.ignored += 1
+            self.stats.ignored += 1  # not counted in bits_rx: our own echo is in bits_tx
             return
+        self.stats.bits_rx += frame_bits(len(frame.data))
+        self.stats.bytes_rx += len(frame.data)
         self._match(board, msg)
 
     def _match(self, board: int, msg: m.Message) -> None:
