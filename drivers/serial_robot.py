@@ -95,6 +95,10 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
         ser = serial.serial_for_url(port, baudrate=baud, timeout=0)
     except (serial.SerialException, ValueError, OSError) as exc:
         raise RobotUrlError(url, None, f"cannot open port {port}: {exc}") from None
+    # Only a plain POSIX port may be read around pyserial's back: a wrapper
+    # such as spy:// must see every byte.
+    if type(ser).__module__ != "serial.serialposix":
+        return PortChannel(ser)
     try:
         fd = ser.fileno()
     except (AttributeError, io.UnsupportedOperation, serial.SerialException, OSError):

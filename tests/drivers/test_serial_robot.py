@@ -9,6 +9,7 @@ import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import pytest
 from stairbot.drivers import messages as m
@@ -224,6 +225,16 @@ def test_any_pyserial_url_works_as_the_port_socket() -> None:
         servers[0].stop()
         thread.join(5)
         listener.close()
+
+
+def test_spy_wrapper_sees_the_traffic(fake: Fake, tmp_path: Path) -> None:
+    dump = tmp_path / "spy.txt"
+    session = open_robot(f"serial://spy://{fake.path}?file={dump}&lockstep=1&timeout=0.5",
+                         CONFIG, SCENARIO, RobotOptions())
+    session.robot.read()
+    session.close()
+    text = dump.read_text()
+    assert "TX" in text and "RX" in text  # pyserial's spy:// hex dump of both directions
 
 
 def test_lockstep_must_match_the_boards(fake: Fake) -> None:
