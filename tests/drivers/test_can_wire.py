@@ -177,3 +177,33 @@ def test_arbitrary_frames_never_crash_the_decoders_and_are_counted(
     assert ls["crc_errors"] + ls["malformed"] == bad
     assert ls["ignored"] + ls["stray"] + ls["late"] == len(batch) - bad
     assert s["ignored"] + s["frames_rx"] + s["stray"] >= len(batch) - bad
+
+
+def test_link_matches_interleaved_replies_and_counts_late_and_stray() -> None:
+    """Replies of two boards interleaved on the bus reach their own requests;
+    a reply after its request was given up is late, one nobody asked for stray."""
+    t = [0.0]
+    host = can.Bus(interface="virtual", channel="link-unit")
+    boards = can.Bus(interface="virtual", channel="link-unit")
+    link = CanLink(host, timeout_s=0.1, retries=0, now=lambda: t[0])
+    w = wire()
+    status = m.Status(0x40, 0, 250, 1)
+    pm = link.request(1, [m.ReadAll()])
+    ps = link.request(2, [m.GetStatus()])
+    replies = [(1, status), (2, status)] + [(1, m.MotorTelemetry(c, 0, 0, 0, c)) for c in range(6)]
+    for board, msg in replies:
+        boards.send(w.to_can(board, msg))
+    motor, sensor = link.wait([pm, ps])
+    assert motor.messages[0] == status and len(motor.messages) == 7
+    assert [x.turns_mt for x in motor.messages[1:]] == list(range(6))  # type: ignore[attr-defined]
+    assert sensor.messages == (status,)
+    late = link.request(2, [m.GetStatus()])
+    t[0] = 1.0  # its time is up: given up (no retries)
+    link.poll()
+    assert late.failed and link.stats.lost == 1
+    boards.send(w.to_can(2, status))  # the reply it was owed, too late
+    boards.send(w.to_can(1, m.Ack(0x20, 0)))  # an Ack nobody waits for
+    link.poll()
+    assert (link.stats.late, link.stats.stray) == (1, 1)
+    for bus in (host, boards):
+        bus.shutdown()
