@@ -15,7 +15,8 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
   - ``retries=N``     re-sends of a query that timed out, default 2
   - ``lost=N``        unanswered commands in a row that mean the link is
                       lost, default 3
-  - ``watchdog=MS``   the boards' watchdog, set at open, default 250 (0 = off)
+  - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
+                      default 250 (0 = off)
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
@@ -128,7 +129,8 @@ class SerialRobot:
     PIPELINED_STEP = True
 
     def __init__(self, link: Link, url: str, watchdog_ms: int = 250,
-                 lockstep: bool = False, sink: EventSink = discard) -> None:
+                 lockstep: bool = False, sink: EventSink = discard,
+                 time_scale: float = 1.0) -> None:
         self.link = link
         self.url = url
         self.lockstep = lockstep
@@ -145,7 +147,11 @@ class SerialRobot:
         self._last_event = float("-inf")
         self._closed = False
         self._last_tx: dict[int, float] = {}
-        self.watchdog_ms = watchdog_ms
+        self.watchdog_ms = watchdog_ms  # in wall-clock ms
+        # Fake boards paced at X times real time count the watchdog in their
+        # simulated time: X times the wall time the host has to feed it.
+        scale = 1.0 if lockstep else time_scale
+        self.board_watchdog_ms = min(65535, round(watchdog_ms * scale))
         self._handshake()
 
     # -- setting up ------------------------------------------------------------
@@ -179,7 +185,7 @@ class SerialRobot:
             # the one place where a command frame is sent again after a timeout.
             for attempt in range(self.link.retries + 1):
                 try:
-                    reply = self.link.exchange(board, [m.SetWatchdog(self.watchdog_ms),
+                    reply = self.link.exchange(board, [m.SetWatchdog(self.board_watchdog_ms),
                                                        m.Clear(m.ClearMask.WATCHDOG)])
                     break
                 except LinkLostError:
@@ -414,7 +420,9 @@ def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
     link = Link(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
                 max_lost=int(opts["lost"]))
     try:
-        robot = SerialRobot(link, url, int(opts["watchdog"]), bool(opts["lockstep"]))
+        scale = options.time_scale or opts["time_scale"]
+        robot = SerialRobot(link, url, int(opts["watchdog"]), bool(opts["lockstep"]),
+                            time_scale=scale)
     except BaseException:
         link.close()
         raise
@@ -422,7 +430,6 @@ def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
     if robot.lockstep:
         clock = LockstepClock(robot)
     else:
-        scale = options.time_scale or opts["time_scale"]
         clock = WallClock(monotonic=lambda: time.monotonic() * scale,
                           sleep=lambda s: time.sleep(s / scale))
     robot.clock = clock
