@@ -109,3 +109,15 @@ def test_external_commands_get_their_own_arguments(
     monkeypatch.setitem(EXTERNAL, "console", ("stairbot_fake_external:main", "fake"))
     assert main(["console", "--robot", "sim://", "--help"]) == 7
     assert seen == [["--robot", "sim://", "--help"]]
+
+
+def test_python_dash_m_stairbot_from_the_checkout_root_has_every_subpackage() -> None:
+    root = Path(__file__).resolve().parents[2]
+    if not (root / "stairbot" / "__main__.py").is_file() or not (root / "fakes").is_dir():
+        pytest.skip("not run from a source checkout")
+    # cwd = the checkout: Python finds ./stairbot before the installed package
+    for command in (["fake-boards", "--help"], ["console", "--help"]):
+        proc = subprocess.run([sys.executable, "-m", "stairbot", *command],
+                              capture_output=True, text=True, timeout=60, cwd=root)
+        assert proc.returncode == 0, proc.stderr
+        assert proc.stdout.startswith(f"usage: stairbot {command[0]}")
