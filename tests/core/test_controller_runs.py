@@ -97,10 +97,16 @@ def test_commands_cover_six_motors_within_their_limits(default_run) -> None:  # 
 
 
 def test_approach_stops_approach_gap_before_the_riser() -> None:
-    robot = KinematicRobot(CFG, steps=[STEP])
+    robot = KinematicRobot(CFG, steps=[STEP] * 2)
     ctrl = Controller(CFG)
+    gap = CFG.algorithm.approach_gap
     run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_LIFT_FIRST)
-    assert robot.front_x == pytest.approx(-CFG.algorithm.approach_gap, abs=0.002)
+    assert robot.front_x == pytest.approx(-gap, abs=0.002)
+    # the second approach starts nearer than SAFE_DISTANCE_IN_FRONT_OF_STEP
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+    assert STEP[1] - robot.front_x < CFG.SAFE_DISTANCE_IN_FRONT_OF_STEP
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_LIFT_FIRST)
+    assert robot.front_x == pytest.approx(STEP[1] - gap, abs=0.002)
 
 
 def test_a_wall_at_the_top_ends_the_ascent_as_an_obstacle_and_descends() -> None:
