@@ -42,8 +42,12 @@ class RangeSensor:
         self.max_range = max_range
         self.resolution = resolution
         self.noise = noise
-        self._rng = sensor_rng(seed, sensor)
+        self._gauss = sensor_rng(seed, sensor).gauss
         self.faults = tuple(f for f in faults if f.sensor == sensor.value)
+        self._far = SensorReading(max_range, SensorStatus.OUT_OF_RANGE)
+        self._near = SensorReading(min_range, SensorStatus.OUT_OF_RANGE)
+        self._error = SensorReading(0.0, SensorStatus.ERROR)
+        self._by_step: dict[int, SensorReading] = {}
 
     def _active(self, t: float) -> tuple[float, bool]:
         offset, error = 0.0, False
@@ -58,18 +62,26 @@ class RangeSensor:
     def measure(self, true_distance: float | None, t: float) -> SensorReading:
         """The reading at simulated time ``t`` of a target ``true_distance`` metres
         away (None: nothing in the beam)."""
-        noise = self._rng.gauss(0.0, self.noise) if self.noise > 0.0 else 0.0
-        offset, error = self._active(t) if self.faults else (0.0, False)
-        if error:
-            return SensorReading(0.0, SensorStatus.ERROR)
+        noise = self._gauss(0.0, self.noise) if self.noise > 0.0 else 0.0
+        if self.faults:
+            offset, error = self._active(t)
+            if error:
+                return self._error
+        else:
+            offset = 0.0
         if true_distance is None:
-            return SensorReading(self.max_range, SensorStatus.OUT_OF_RANGE)
+            return self._far
         d = true_distance + offset + noise
         if d > self.max_range:
-            return SensorReading(self.max_range, SensorStatus.OUT_OF_RANGE)
+            return self._far
         if d < self.min_range:
-            return SensorReading(self.min_range, SensorStatus.OUT_OF_RANGE)
-        if self.resolution > 0.0:
-            d = round(round(d / self.resolution) * self.resolution, 9)
-            d = min(max(d, self.min_range), self.max_range)
-        return SensorReading(d, SensorStatus.OK)
+            return self._near
+        if self.resolution <= 0.0:
+            return SensorReading(d, SensorStatus.OK)
+        # readings are whole multiples of the resolution: share one object per value
+        k = round(d / self.resolution)
+        reading = self._by_step.get(k)
+        if reading is None:
+            value = min(max(round(k * self.resolution, 9), self.min_range), self.max_range)
+            reading = self._by_step[k] = SensorReading(value, SensorStatus.OK)
+        return reading

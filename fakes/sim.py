@@ -37,7 +37,6 @@ from stairbot.hardware import (
     MotorId,
     MotorState,
     SensorId,
-    SensorReading,
     Snapshot,
     Speeds,
 )
@@ -83,35 +82,56 @@ class SimRobot:
                 (SensorId.SBL, s.back_min_range, s.back_max_range),
             )
         }
-        self._speeds: dict[MotorId, float] = dict.fromkeys(MotorId, 0.0)
+        self._zero: dict[MotorId, float] = dict.fromkeys(MotorId, 0.0)
+        m = config.motors
+        self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
+                        for mid in MotorId}
+        self._speeds = dict(self._zero)
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
+        self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
+        self._lift_turns = [0.0, 0.0]
+        self._lift_tps = [0.0, 0.0]  # measured over the last advance
+        self._snap: Snapshot | None = None
+        self._snap_at = -1
+        r = config.geometry.wheel_radius
+        # sensor mounts in their segment's frame (origin: centre of the axle line)
+        self._front_mount = (self.world.lengths[0] / 2, s.front_height - r,
+                             s.front_max_range * 1.05)
+        self._back_mount = (-self.world.lengths[2] / 2 + s.back_from_rear,
+                            s.back_height - r, s.back_max_range * 1.05)
         self.closed = False
 
     # -- the Robot protocol ------------------------------------------------------
     def read(self) -> Snapshot:
         """Read every sensor and motor.  Raises RobotFellError once the world has
-        detected instability."""
+        detected instability.  Reading twice with no simulated time between gives
+        the same snapshot (a sensor samples once per physics state)."""
         w = self.world
         if w.fell:
             raise RobotFellError(w.fall_reason or "unstable")
+        if self._snap is not None and self._snap_at == w.steps_done:
+            return self._snap
         t = w.time
-        front, back = self._front_truth(), self._back_truth()
-        sensors: dict[SensorId, SensorReading] = {
-            SensorId.SFR: self.sensors[SensorId.SFR].measure(front[0], t),
-            SensorId.SFL: self.sensors[SensorId.SFL].measure(front[1], t),
-            SensorId.SBR: self.sensors[SensorId.SBR].measure(back, t),
-            SensorId.SBL: self.sensors[SensorId.SBL].measure(back, t),
-        }
-        return Snapshot(time_s=t, sensors=sensors, motors=self._motor_states(), health={})
+        sfr, sfl = self._front_truth()
+        back = self._back_truth()
+        sensors = self.sensors
+        snap = Snapshot(time_s=t, sensors={
+            SensorId.SFR: sensors[SensorId.SFR].measure(sfr, t),
+            SensorId.SFL: sensors[SensorId.SFL].measure(sfl, t),
+            SensorId.SBR: sensors[SensorId.SBR].measure(back, t),
+            SensorId.SBL: sensors[SensorId.SBL].measure(back, t),
+        }, motors=self._motor_states(), health={})
+        self._snap, self._snap_at = snap, w.steps_done
+        return snap
 
     def command(self, speeds: Speeds) -> None:
         """Set every motor's speed in turns/s (clamped to the motor's limit)."""
-        m = self.config.motors
-        new = dict.fromkeys(MotorId, 0.0)
+        new = dict(self._zero)
+        limits = self._limits
         for motor, value in speeds.items():
-            limit = m.lift_speed if motor in LIFT_MOTORS else m.wheel_speed
+            limit = limits[motor]
             v = float(value)
-            new[MotorId(motor)] = limit if v > limit else (-limit if v < -limit else v)
+            new[motor] = limit if v > limit else (-limit if v < -limit else v)
         self._apply(new)
 
     def stop_all(self) -> None:
@@ -151,12 +171,20 @@ class SimRobot:
         x0, t0 = w.centre_x(), w.time
         w.advance(dt)
         elapsed = w.time - t0
+        if elapsed <= 0.0:
+            return
         self.plan.move(w.centre_x() - x0)
+        self._diff_speed = diff
         if diff != 0.0:
             self._diff_turns += diff * elapsed
             if turning:
                 v = 2.0 * diff * self.config.wheel_circumference  # vR - vL, m/s
                 self.plan.turn(v / self.config.geometry.track_width * elapsed)
+        per_turn = self.config.motors.lift_travel_per_turn
+        for i in (0, 1):
+            turns = w.lift_offset(i) / per_turn
+            self._lift_tps[i] = (turns - self._lift_turns[i]) / elapsed
+            self._lift_turns[i] = turns
 
     def offset_m(self) -> float:
         """Top-view distance of segment 2's centre from where it started."""
@@ -191,46 +219,46 @@ class SimRobot:
     def _motor_states(self) -> dict[MotorId, MotorState]:
         w = self.world
         per_turn = self.config.motors.lift_travel_per_turn
-        mean, mean_speed = w.wheel_turns(1), w.wheel_speed(1)
-        d = self._diff_turns
-        ds = (self._speeds[MotorId.MWR] - self._speeds[MotorId.MWL]) / 2.0
+        mean, mean_speed = w.wheel_state(1)
+        d, ds = self._diff_turns, self._diff_speed
         return {
-            MotorId.MWF: MotorState(w.wheel_turns(0), w.wheel_speed(0)),
-            MotorId.MWB: MotorState(w.wheel_turns(2), w.wheel_speed(2)),
+            MotorId.MWF: MotorState(*w.wheel_state(0)),
+            MotorId.MWB: MotorState(*w.wheel_state(2)),
             MotorId.MWR: MotorState(mean + d, mean_speed + ds),
             MotorId.MWL: MotorState(mean - d, mean_speed - ds),
-            MotorId.MTF: MotorState(w.lift_offset(0) / per_turn, self._speeds[MotorId.MTF]),
-            MotorId.MTB: MotorState(w.lift_offset(1) / per_turn, self._speeds[MotorId.MTB]),
+            MotorId.MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
+            MotorId.MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
         }
 
     def _front_truth(self) -> tuple[float | None, float | None]:
         """True distances seen by SFR and SFL (None: nothing within range)."""
-        w, s, g = self.world, self.config.sensors, self.config.geometry
-        seg1 = w.segments[0]
-        mount_local = (w.lengths[0] / 2, s.front_height - g.wheel_radius)
-        mount = seg1.local_to_world(mount_local)
-        reach = s.front_max_range * 1.05
-        ahead = seg1.local_to_world((mount_local[0] + reach, mount_local[1]))
-        hit = w.ray((mount.x, mount.y), (ahead.x, ahead.y))
-        slant = 1.0 / max(math.cos(seg1.angle), 1e-6)
-        hit_dx = None if hit is None else hit[0] - mount.x
+        w = self.world
+        lx, ly, reach = self._front_mount
+        x1, y1, a1 = w.pose(0)
+        c, s = math.cos(a1), math.sin(a1)
+        mx, my = x1 + c * lx - s * ly, y1 + s * lx + c * ly
+        hit = w.ray((mx, my), (mx + c * reach, my + s * reach))
+        hit_dx = None if hit is None else hit[0] - mx
+        slant = 1.0 / max(c, 1e-6)
         # the mount's distance ahead of segment 2's centre, along the robot
-        forward = float(w.segments[1].world_to_local(mount).x)
-        lat = s.front_lateral
-        return (self.plan.front_distance(forward, -lat, hit_dx, slant),
-                self.plan.front_distance(forward, lat, hit_dx, slant))
+        x2, y2, a2 = w.pose(1)
+        forward = math.cos(a2) * (mx - x2) + math.sin(a2) * (my - y2)
+        lat = self.config.sensors.front_lateral
+        front_distance = self.plan.front_distance
+        return (front_distance(forward, -lat, hit_dx, slant),
+                front_distance(forward, lat, hit_dx, slant))
 
     def _back_truth(self) -> float | None:
         """True distance seen by SBR/SBL straight down from segment 3."""
-        w, s, g = self.world, self.config.sensors, self.config.geometry
-        seg3 = w.segments[2]
-        local = (-w.lengths[2] / 2 + s.back_from_rear, s.back_height - g.wheel_radius)
-        mount = seg3.local_to_world(local)
-        below = seg3.local_to_world((local[0], local[1] - s.back_max_range * 1.05))
-        hit = w.ray((mount.x, mount.y), (below.x, below.y))
+        w = self.world
+        lx, ly, reach = self._back_mount
+        x3, y3, a3 = w.pose(2)
+        c, s = math.cos(a3), math.sin(a3)
+        mx, my = x3 + c * lx - s * ly, y3 + s * lx + c * ly
+        hit = w.ray((mx, my), (mx + s * reach, my - c * reach))
         if hit is None:
             return None
-        return math.hypot(hit[0] - mount.x, hit[1] - mount.y)
+        return math.hypot(hit[0] - mx, hit[1] - my)
 
 
 class SimClock:

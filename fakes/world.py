@@ -20,15 +20,12 @@ import math
 from dataclasses import dataclass
 
 import pymunk
+from stairbot.fakes.stairs import StairsProfile, stairs_outline
 
 from stairbot.config import RobotConfig
 from stairbot.scenario import Scenario
 
 TWO_PI = 2.0 * math.pi
-FLOOR_BEHIND = 30.0  # floor length behind riser 1, m
-LANDING = 3.0  # flat landing beyond the last tread, m
-OPEN_FLOOR = 30.0  # floor ahead when there are no stairs, m
-WALL_HEIGHT = 2.0
 _PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's axles
 
 CAT_STAIRS = 0b01
@@ -50,33 +47,11 @@ class WorldParams:
     stairs_radius: float = 0.001  # rounds the step nosings
     collision_slop: float = 0.0005
     lift_stall: float = 0.002  # a lift's target never runs further ahead than this, m
+    lift_hold_speed: float = 0.02  # a held lift corrects any creep at most this fast, m/s
     pitch_limit_deg: float = 35.0
     fall_speed: float = 1.0  # m/s downward counts as falling
     airborne_limit_s: float = 0.3  # every wheel off every support this long: fell
-
-
-def stairs_outline(scenario: Scenario) -> list[tuple[float, float]]:
-    """The stairs' surface as one polyline from far behind the start to the end."""
-    pts: list[tuple[float, float]] = [(-FLOOR_BEHIND, 0.0)]
-    if not scenario.steps:
-        pts.append((OPEN_FLOOR, 0.0))
-        return pts
-    x = y = 0.0
-    pts.append((x, y))
-    last = len(scenario.steps) - 1
-    for i, step in enumerate(scenario.steps):
-        y += step.rise
-        pts.append((x, y))
-        x += step.tread
-        if i == last:
-            if scenario.top == "wall":
-                pts.append((x, y))
-                pts.append((x, y + WALL_HEIGHT))
-            else:
-                pts.append((x + LANDING, y))
-        else:
-            pts.append((x, y))
-    return pts
+    contact_check_s: float = 0.1  # how often the wheels' contacts are looked up
 
 
 class World:
@@ -95,6 +70,7 @@ class World:
         self.time = 0.0
         self._steps_done = 0
         self.outline = stairs_outline(scenario)
+        self.profile = StairsProfile(self.outline, p.stairs_radius)
         for a, b in zip(self.outline, self.outline[1:], strict=False):
             seg = pymunk.Segment(space.static_body, a, b, p.stairs_radius)
             seg.friction = p.stairs_friction
@@ -163,7 +139,6 @@ class World:
             pin = pymunk.PinJoint(s2, end, (gx, -_PIN_REACH), (0.0, 0.0))
             pin.distance = _PIN_REACH
             pin.max_force = config.motors.lift_force
-            # lead screws: correct half the error every step, no soft lag
             for c in (groove, gear, pin):
                 c.error_bias = 0.5 ** (1.0 / p.dt)
                 c.collide_bodies = False
@@ -171,57 +146,95 @@ class World:
             self.pins.append(pin)
         self.lift_target = [0.0, 0.0]  # metres, + = end segment up
         self.lift_speed = [0.0, 0.0]  # metres per second (already clamped)
-        self._wheel_zero = [(w0.angle - b.angle, w1.angle - b.angle)
-                            for b, (w0, w1) in zip(self.segments, self.wheels, strict=True)]
+        self._wheel_zero = [w1.angle - b.angle
+                            for b, (_w0, w1) in zip(self.segments, self.wheels, strict=True)]
         self.all_wheels = [w for pair in self.wheels for w in pair]
-        self.start_x = s2.position.x
         self.max_pitch_deg = 0.0
         self.fell = False
         self.fall_reason: str | None = None
         self._airborne_s = 0.0
+        self._since_contact_check = 0.0
+        self._rates = [0.0, 0.0, 0.0]
+        self._bias = [-1.0, -1.0]
+        self._moving = [False, False]
+        self._pose_at = -1
+        self._px, self._py, self._pa = [0.0] * 3, [0.0] * 3, [0.0] * 3
+        self._fetch()
+        self._check_y, self._check_t = list(self._py), 0.0
+        self.start_x = self._px[1]
 
     # -- actuators ------------------------------------------------------------------
     def set_wheel_speed(self, segment: int, turns_per_s: float) -> None:
         """Drive both wheels of a segment at ``turns_per_s`` (+ = forward)."""
         rate = turns_per_s * TWO_PI
-        for m in self.motors[segment]:
-            m.rate = rate
+        if rate != self._rates[segment]:  # setting a pymunk attribute is not free
+            self._rates[segment] = rate
+            for m in self.motors[segment]:
+                m.rate = rate
 
     def set_lift_speed(self, lift: int, metres_per_s: float) -> None:
         """Move lift 0 (MTF) or 1 (MTB) at ``metres_per_s`` (+ = end segment up); 0 holds."""
         self.lift_speed[lift] = metres_per_s
 
-    # -- state ----------------------------------------------------------------------
+    # -- state (read once per physics state, then from the cache) -----------------
+    def _fetch(self) -> None:
+        if self._pose_at == self._steps_done:
+            return
+        px, py, pa = self._px, self._py, self._pa
+        for i, body in enumerate(self.segments):
+            pos = body.position
+            px[i], py[i], pa[i] = pos.x, pos.y, body.angle
+        self._pose_at = self._steps_done
+
     def lift_offset(self, lift: int) -> float:
         """Actual height of segment 1 (lift 0) or 3 (lift 1) over segment 2, m."""
-        end = self.segments[0 if lift == 0 else 2]
-        return float(self.segments[1].world_to_local(end.position).y)
+        self._fetch()
+        e = 0 if lift == 0 else 2
+        a = self._pa[1]
+        return (-math.sin(a) * (self._px[e] - self._px[1])
+                + math.cos(a) * (self._py[e] - self._py[1]))
 
     def wheel_turns(self, segment: int) -> float:
         """Turns of a segment's front wheel relative to the segment (+ = forward)."""
-        body = self.segments[segment]
-        wheel = self.wheels[segment][1]
-        rel = wheel.angle - body.angle - self._wheel_zero[segment][1]
-        return float(-rel / TWO_PI)
+        return self.wheel_state(segment)[0]
 
     def wheel_speed(self, segment: int) -> float:
         """Measured turns/s of a segment's front wheel relative to the segment."""
+        return self.wheel_state(segment)[1]
+
+    def wheel_state(self, segment: int) -> tuple[float, float]:
+        """(turns, turns/s) of a segment's front wheel relative to the segment
+        (+ = forward): what the wheel motor's encoder reports."""
+        self._fetch()
         body = self.segments[segment]
-        return float((body.angular_velocity - self.wheels[segment][1].angular_velocity) / TWO_PI)
+        wheel = self.wheels[segment][1]
+        rel = wheel.angle - self._pa[segment] - self._wheel_zero[segment]
+        return -rel / TWO_PI, (body.angular_velocity - wheel.angular_velocity) / TWO_PI
 
     def pitch_deg(self, segment: int = 1) -> float:
         """Nose-up pitch of a segment in degrees."""
-        return math.degrees(self.segments[segment].angle)
+        self._fetch()
+        return math.degrees(self._pa[segment])
+
+    def pose(self, segment: int) -> tuple[float, float, float]:
+        """(x, y, angle) of a segment's local origin: its centre on the axle line."""
+        self._fetch()
+        return self._px[segment], self._py[segment], self._pa[segment]
 
     def centre_x(self) -> float:
         """x of segment 2's centre (its axle line)."""
-        return float(self.segments[1].position.x)
+        self._fetch()
+        return self._px[1]
+
+    @property
+    def steps_done(self) -> int:
+        """Physics steps taken so far: identifies the physics state."""
+        return self._steps_done
 
     # -- stepping -------------------------------------------------------------------
     def _steps_for(self, seconds: float) -> int:
         target = round((self.time + seconds) / self.params.dt)
-        n = max(0, target - self._steps_done)
-        return n
+        return max(0, target - self._steps_done)
 
     def step_bare(self, seconds: float) -> None:
         """Step the physics ``seconds`` with nothing else: no lifts, no checks."""
@@ -239,31 +252,40 @@ class World:
         if n == 0:
             return
         dt = self.params.dt
+        self._set_lifts(n * dt)
         step = self.space.step
-        moving = [i for i in (0, 1) if self.lift_speed[i] != 0.0]
-        if not moving:
-            for _ in range(n):
-                step(dt)
-        else:
-            stroke = self.config.motors.lift_travel
-            stall = self.params.lift_stall
-            for i in moving:
-                # a stalled lead screw does not run ahead of its nut
-                actual = self.lift_offset(i)
-                self.lift_target[i] = min(max(self.lift_target[i], actual - stall),
-                                          actual + stall)
-            pins = [(self.pins[i], i, self.lift_speed[i] * dt) for i in moving]
-            targets = self.lift_target
-            for _ in range(n):
-                for pin, i, inc in pins:
-                    t = targets[i] + inc
-                    t = stroke if t > stroke else (-stroke if t < -stroke else t)
-                    targets[i] = t
-                    pin.distance = _PIN_REACH + t
-                step(dt)
+        for _ in range(n):
+            step(dt)
         self._steps_done += n
         self.time = self._steps_done * dt
         self._check(n * dt)
+
+    def _set_lifts(self, seconds: float) -> None:
+        """Aim each moving lift's pin at where the screw will be in ``seconds``; the
+        pin's max_bias makes it travel there at the lift's speed, so no Python runs
+        between physics steps."""
+        stroke = self.config.motors.lift_travel
+        stall = self.params.lift_stall
+        for i in (0, 1):
+            v = self.lift_speed[i]
+            pin = self.pins[i]
+            if v != 0.0:
+                # a stalled lead screw does not run ahead of its nut
+                actual = self.lift_offset(i)
+                t = min(max(self.lift_target[i], actual - stall), actual + stall) + v * seconds
+                t = stroke if t > stroke else (-stroke if t < -stroke else t)
+                self.lift_target[i] = t
+                pin.distance = _PIN_REACH + t
+            elif self._moving[i]:
+                # just stopped: the screw stands where the nut is now, no coasting on
+                t = self.lift_offset(i)
+                self.lift_target[i] = t
+                pin.distance = _PIN_REACH + t
+            self._moving[i] = v != 0.0
+            bias = abs(v) if v != 0.0 else self.params.lift_hold_speed
+            if bias != self._bias[i]:
+                self._bias[i] = bias
+                pin.max_bias = bias
 
     # -- instability ----------------------------------------------------------------
     def _wheel_in_contact(self) -> bool:
@@ -280,29 +302,41 @@ class World:
         return False
 
     def _check(self, elapsed: float) -> None:
+        """Track the pitch; detect a pitch beyond the limit, a segment falling (by
+        its height change since the last check) and every wheel off every support."""
         if self.fell:
             return
         p = self.params
-        for i, body in enumerate(self.segments):
-            pitch = abs(math.degrees(body.angle))
+        self._fetch()
+        prev_y, self._check_y = self._check_y, list(self._py)
+        elapsed = max(self.time - self._check_t, 1e-9)
+        self._check_t = self.time
+        for i in range(3):
+            pitch = abs(math.degrees(self._pa[i]))
             if pitch > self.max_pitch_deg:
                 self.max_pitch_deg = pitch
             if pitch > p.pitch_limit_deg:
                 self._fall(f"segment {i + 1} pitched {pitch:.0f} deg (limit "
                            f"{p.pitch_limit_deg:.0f})")
                 return
-            if body.velocity.y < -p.fall_speed:
-                self._fall(f"segment {i + 1} falling at {-body.velocity.y:.1f} m/s")
+            vy = (self._py[i] - prev_y[i]) / elapsed
+            if vy < -p.fall_speed:
+                self._fall(f"segment {i + 1} falling at {-vy:.1f} m/s")
                 return
-            if body.position.y < -0.1:
+            if self._py[i] < -0.1:
                 self._fall(f"segment {i + 1} below the floor")
                 return
+        # contacts are looked up a few times a second: enough for a 0.3 s limit
+        self._since_contact_check += elapsed
+        if self._since_contact_check < p.contact_check_s - 1e-9:
+            return
         if self._wheel_in_contact():
             self._airborne_s = 0.0
         else:
-            self._airborne_s += elapsed
+            self._airborne_s += self._since_contact_check
             if self._airborne_s > p.airborne_limit_s:
                 self._fall(f"no wheel on any support for {self._airborne_s:.2f} s")
+        self._since_contact_check = 0.0
 
     def _fall(self, reason: str) -> None:
         self.fell = True
@@ -311,7 +345,12 @@ class World:
     # -- queries --------------------------------------------------------------------
     def ray(self, start: tuple[float, float], end: tuple[float, float]
             ) -> tuple[float, float] | None:
-        """First point of the stairs on the segment start -> end, or None."""
+        """First point of the stairs' surface on the segment start -> end, or None."""
+        return self.profile.ray(start[0], start[1], end[0], end[1])
+
+    def ray_pymunk(self, start: tuple[float, float], end: tuple[float, float]
+                   ) -> tuple[float, float] | None:
+        """The same through pymunk's segment query (slower; for checking :meth:`ray`)."""
         hit = self.space.segment_query_first(start, end, 0.0, STAIRS_ONLY)
         if hit is None:
             return None

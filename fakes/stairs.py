@@ -1,0 +1,117 @@
+"""The stairs in the side view: one polyline, and rays cast against it.
+
+Riser 1 stands at x = 0 on a floor at y = 0 that runs ``FLOOR_BEHIND`` metres
+back.  Each step rises by its ``rise`` and runs its ``tread``.  After the last
+riser the top is a ``LANDING`` metres long flat landing with nothing beyond
+(``top = "landing"``) or, at the end of the last tread, a wall
+``WALL_HEIGHT`` high (``top = "wall"``).  No steps: open floor far ahead.
+
+The distance sensors cast their rays here rather than through pymunk's query
+API: the outline is monotonic in x, so a ray meets its first surface among the
+few segments its x-range spans, found by bisection, which costs a fraction of
+a pymunk segment query.  Surfaces are offset by the physics segments' radius so
+that the sensors see the same surface the wheels roll on.
+"""
+
+from __future__ import annotations
+
+import math
+from bisect import bisect_left, bisect_right
+
+from stairbot.scenario import Scenario
+
+FLOOR_BEHIND = 30.0  # floor length behind riser 1, m
+LANDING = 3.0  # flat landing beyond the last tread, m
+OPEN_FLOOR = 30.0  # floor ahead when there are no stairs, m
+WALL_HEIGHT = 2.0
+
+Point = tuple[float, float]
+
+
+def stairs_outline(scenario: Scenario) -> list[Point]:
+    """The stairs' surface as one polyline from far behind the start to the end."""
+    pts: list[Point] = [(-FLOOR_BEHIND, 0.0)]
+    if not scenario.steps:
+        pts.append((OPEN_FLOOR, 0.0))
+        return pts
+    x = y = 0.0
+    pts.append((x, y))
+    last = len(scenario.steps) - 1
+    for i, step in enumerate(scenario.steps):
+        y += step.rise
+        pts.append((x, y))
+        x += step.tread
+        if i == last:
+            if scenario.top == "wall":
+                pts.append((x, y))
+                pts.append((x, y + WALL_HEIGHT))
+            else:
+                pts.append((x + LANDING, y))
+        else:
+            pts.append((x, y))
+    return pts
+
+
+class StairsProfile:
+    """Ray casts against an x-monotonic polyline whose surface is ``radius`` thick."""
+
+    def __init__(self, outline: list[Point], radius: float = 0.0) -> None:
+        self.segments: list[tuple[float, float, float, float]] = []
+        for (ax, ay), (bx, by) in zip(outline, outline[1:], strict=False):
+            if ax > bx:
+                raise ValueError("the stairs outline must not run backwards in x")
+            self.segments.append((ax, ay, bx, by))
+        self.radius = radius
+        self._xmin = [s[0] for s in self.segments]
+        self._xmax = [s[2] for s in self.segments]
+
+    def ray(self, x0: float, y0: float, x1: float, y1: float) -> Point | None:
+        """The first point of the surface on the segment (x0, y0) -> (x1, y1), or
+        None when it meets nothing."""
+        r = self.radius
+        lo, hi = (x0, x1) if x0 <= x1 else (x1, x0)
+        first = bisect_left(self._xmax, lo - r)
+        last = bisect_right(self._xmin, hi + r)
+        if first >= last:
+            return None
+        dx, dy = x1 - x0, y1 - y0
+        idx = range(first, last) if dx >= 0 else range(last - 1, first - 1, -1)
+        best = math.inf
+        for i in idx:
+            t = self._hit(self.segments[i], x0, y0, dx, dy, r)
+            if t < best:
+                best = t
+            elif best < math.inf and dx != 0.0:
+                break  # x-monotonic: later segments lie further along the ray
+        if best == math.inf:
+            return None
+        return (x0 + dx * best, y0 + dy * best)
+
+    @staticmethod
+    def _hit(seg: tuple[float, float, float, float], x0: float, y0: float,
+             dx: float, dy: float, r: float) -> float:
+        """Ray parameter in [0, 1] where it crosses the segment's surface (the
+        segment moved ``r`` towards the ray's origin), or inf."""
+        ax, ay, bx, by = seg
+        ex, ey = bx - ax, by - ay
+        length = math.hypot(ex, ey)
+        if length == 0.0:
+            return math.inf
+        nx, ny = -ey / length, ex / length
+        side = (x0 - ax) * nx + (y0 - ay) * ny
+        if side < 0.0:
+            nx, ny, side = -nx, -ny, -side
+        if side < r:
+            along = ((x0 - ax) * ex + (y0 - ay) * ey) / (length * length)
+            # inside the surface: touching it; beside the segment's end: not this one
+            return 0.0 if -r / length <= along <= 1.0 + r / length else math.inf
+        ax, ay = ax + nx * r, ay + ny * r
+        denom = dx * ey - dy * ex
+        if denom == 0.0:
+            return math.inf
+        wx, wy = ax - x0, ay - y0
+        t = (wx * ey - wy * ex) / denom
+        u = (wx * dy - wy * dx) / denom
+        if 0.0 <= t <= 1.0 and -r / length <= u <= 1.0 + r / length:
+            return t
+        return math.inf
