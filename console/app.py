@@ -24,7 +24,7 @@ from stairbot.console.widgets.motors import MotorPanel
 from stairbot.console.widgets.phase import PhasePanel
 from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
-from textual import work
+from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
@@ -86,22 +86,30 @@ class StairbotConsole(App[None]):
         self._record = record
         self._shown_version = -1
         self._shown_event = 0
+        # The panels, kept here: refresh_view must reach them while a modal
+        # screen is on top (app.query_one looks only at the top screen).
+        self.banner = Banner(id="banner")  # the line that says how things stand
+        self.picture = StairsPicture(id="picture")
+        self.sensors = SensorPanel(engine.config.algorithm.equal_tolerance, id="sensors")
+        self.motors = MotorPanel(id="motors")
+        self.phase = PhasePanel(id="phase")
+        self.link = LinkPanel(id="link")
+        self.log_panel = EventLog(id="log")
 
     # -- layout ------------------------------------------------------------------
     def compose(self) -> ComposeResult:
-        tol = self.engine.config.algorithm.equal_tolerance
         with Horizontal(id="top"):
-            yield Banner(id="banner")
+            yield self.banner
             yield EStopButton(id="estop")
         with Horizontal(id="main"):
             with Vertical(id="left"):
-                yield StairsPicture(id="picture")
-                yield EventLog(id="log")
+                yield self.picture
+                yield self.log_panel
             with Vertical(id="right"):
-                yield SensorPanel(tol, id="sensors")
-                yield MotorPanel(id="motors")
-                yield PhasePanel(id="phase")
-                yield LinkPanel(id="link")
+                yield self.sensors
+                yield self.motors
+                yield self.phase
+                yield self.link
         yield Footer(compact=True)
 
     def on_mount(self) -> None:
@@ -124,8 +132,8 @@ class StairbotConsole(App[None]):
         self._show(view)
 
     def _show(self, v: StateView) -> None:
-        self.query_one(Banner).show(v.url, v.scenario, v.status)
-        picture = self.query_one(StairsPicture)
+        self.banner.show(v.url, v.scenario, v.status)
+        picture = self.picture
         picture.border_title = f"side view · {v.url} · {v.scenario}"
         snap = v.snapshot
         lifts = None
@@ -133,15 +141,15 @@ class StairbotConsole(App[None]):
             per_turn = self.engine.config.motors.lift_travel_per_turn
             lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
         note = "" if v.simulated or v.scene is not None else \
-            "wired robot: stairs from the scenario, no robot pose"
+            "no pose from a wired robot"
         picture.show(v.scene, v.stairs, lifts, note)
-        self.query_one(SensorPanel).show(snap)
-        self.query_one(MotorPanel).show(snap, v.commands)
-        self.query_one(PhasePanel).show(v.phase, v.flow, v.context)
-        self.query_one(LinkPanel).show(v.simulated, snap.time_s if snap else None, v.ticks,
+        self.sensors.show(snap)
+        self.motors.show(snap, v.commands)
+        self.phase.show(v.phase, v.flow, v.context)
+        self.link.show(v.simulated, snap.time_s if snap else None, v.ticks,
                                        v.speed, v.health, v.recording)
         if v.events:
-            log = self.query_one(EventLog)
+            log = self.log_panel
             log.add(v.events)
             self._shown_event = log.last_seq
 
@@ -178,6 +186,17 @@ class StairbotConsole(App[None]):
                               timeout=6)
 
     # -- actions -------------------------------------------------------------------
+    async def on_event(self, event: events.Event) -> None:
+        """The emergency stop key is taken here, before any screen or widget sees
+        it: modal screens and text inputs would otherwise keep it from the
+        app's bindings."""
+        if (isinstance(event, events.Key) and not event.is_forwarded
+                and event.key == ESTOP_KEY):
+            event.stop()
+            self.action_estop()
+            return
+        await super().on_event(event)
+
     def action_estop(self) -> None:
         """Stop every motor now, whatever the console is doing."""
         self.engine.estop()
@@ -231,7 +250,7 @@ class StairbotConsole(App[None]):
         elif self.engine.session is not None and not self.engine.simulated:
             self.notify("reset is for a simulated robot", severity="warning")
         else:
-            self.query_one(EventLog).reset_log()
+            self.log_panel.reset_log()
             self.open_robot(self.url, self.scenario)
 
     def action_choose_robot(self) -> None:
@@ -285,7 +304,7 @@ class StairbotConsole(App[None]):
                          chosen)
 
     def action_zoom(self) -> None:
-        mode = self.query_one(StairsPicture).cycle_zoom()
+        mode = self.picture.cycle_zoom()
         names = {"auto": "auto zoom", "flight": "whole flight", "robot": "following the robot"}
         self.notify(f"picture: {names[mode]}")
 

@@ -23,8 +23,8 @@ class ConfirmScreen(ModalScreen[bool]):
         with Vertical(classes="dialog"):
             yield Label(self.question, classes="question")
             with Horizontal(classes="buttons"):
-                yield Button("Yes, start [y]", variant="warning", id="yes", compact=True)
-                yield Button("No [n]", variant="primary", id="no", compact=True)
+                yield Button("Yes, start (y)", variant="warning", id="yes", compact=True)
+                yield Button("No (n)", variant="primary", id="no", compact=True)
 
     def on_mount(self) -> None:
         self.query_one("#no", Button).focus()

@@ -15,6 +15,6 @@ class EStopButton(Button):
     """
 
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
-        super().__init__("■ E-STOP [space]", variant="error", compact=True, id=id,
+        super().__init__("■ E-STOP (space)", variant="error", compact=True, id=id,
                          action="app.estop")
         self.can_focus = False  # space must never be taken by a focused button

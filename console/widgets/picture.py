@@ -146,7 +146,7 @@ class StairsPicture(Widget):
             out.append(f"{mtf * 1000:+4.0f} mm  ")
             out.append("MTB ", SEGMENT_STYLES[2])
             out.append(f"{mtb * 1000:+4.0f} mm")
-        if self.following:
+        if self.following and out.cell_len + 8 <= width:
             out.append("  zoomed", "dim")
         out.truncate(width)
         return out

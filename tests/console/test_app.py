@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 from stairbot.console.app import StairbotConsole, build_app
-from stairbot.console.widgets.banner import Banner
+from stairbot.console.modals import ConfirmScreen
 from textual import events
 from textual.widgets import Input
 
@@ -74,7 +74,7 @@ async def press(pilot: Any, *keys: str) -> None:
 
 
 def banner(app: StairbotConsole) -> str:
-    return app.screen_stack[0].query_one(Banner).plain
+    return app.banner.plain
 
 
 async def ready(pilot: Any) -> None:
@@ -87,8 +87,17 @@ def test_a_full_run_started_from_the_keyboard_reaches_the_end() -> None:
         app = build_app(speed="max")
         async with app.run_test(size=(120, 40)) as pilot:
             await ready(pilot)
+            at_start = app.picture.render().plain
+            assert "steps 0|0|0" in at_start
             await press(pilot, "s")
-            await until(pilot, lambda: app.engine.running or "ENDED" in banner(app), "started")
+
+            def on_a_step() -> bool:
+                scene = app.state.view().scene
+                return scene is not None and max(scene.segment_steps()) >= 1
+
+            await until(pilot, on_a_step, "a segment over the first tread")
+            climbing = app.picture.render().plain
+            assert climbing != at_start  # the picture follows the robot
             await until(pilot, lambda: not app.engine.running, "the run ends")
             await app.workers.wait_for_complete()
             await pilot.pause(0.2)
@@ -214,6 +223,48 @@ def test_invalid_robot_or_scenario_gives_a_message(key: str, value: str, expect:
             assert app.engine.session is not None
             await press(pilot, "s")  # and still runs
             await until(pilot, lambda: app.engine.running or "ENDED" in banner(app), "a run")
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
+
+
+def test_starting_a_wired_robot_asks_first(still_app: Callable[..., StairbotConsole]) -> None:
+    async def go() -> None:
+        app = still_app(simulated=False, url="serial://loop://")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            robot = app.engine.session.robot  # type: ignore[union-attr]
+            await press(pilot, "s")
+            await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
+            await press(pilot, "n")
+            await until(pilot, lambda: len(app.screen_stack) == 1, "the answer")
+            await pilot.pause(0.1)
+            assert not app.engine.running and robot.commands == []
+            await press(pilot, "s")
+            await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
+            await press(pilot, "y")
+            await until(pilot, lambda: len(robot.commands) > 0, "the run starts")
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
+
+
+def test_estop_key_works_over_a_text_prompt(still_app: Callable[..., StairbotConsole]) -> None:
+    async def go() -> None:
+        app = still_app()
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, "s")
+            await until(pilot, lambda: app.engine.running, "the run starts")
+            await press(pilot, "w")  # the record prompt: allowed during a run
+            await until(pilot, lambda: bool(app.screen.query(Input)), "the prompt")
+            robot = app.engine.session.robot  # type: ignore[union-attr]
+            stops = robot.stops
+            await press(pilot, "space")
+            assert app.state.view().status.estopped
+            assert robot.stops > stops
+            assert " " not in app.screen.query_one(Input).value
+            await press(pilot, "escape")
             await press(pilot, "x")
             await until(pilot, lambda: not app.engine.running, "the run stops")
     asyncio.run(go())

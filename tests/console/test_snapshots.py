@@ -1,0 +1,42 @@
+"""The layout pinned at 80x24 and 120x40 (pytest-textual-snapshot; update with
+``pytest tests/console --snapshot-update`` after checking the new pictures)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+from conftest import show_climbing
+from stairbot.console.app import StairbotConsole
+
+
+async def climbing(pilot: Any) -> None:
+    await pilot.app.workers.wait_for_complete()
+    show_climbing(pilot.app)
+    await pilot.pause(0.3)
+
+
+@pytest.mark.parametrize("size", [(80, 24), (120, 40)])
+def test_layout_while_climbing(snap_compare: Any, still_app: Callable[..., StairbotConsole],
+                               size: tuple[int, int]) -> None:
+    assert snap_compare(still_app(), terminal_size=size, run_before=climbing)
+
+
+def test_layout_emergency_stop(snap_compare: Any,
+                               still_app: Callable[..., StairbotConsole]) -> None:
+    async def stopped(pilot: Any) -> None:
+        await climbing(pilot)
+        await pilot.press("space")
+        await pilot.pause(0.3)
+    assert snap_compare(still_app(), terminal_size=(80, 24), run_before=stopped)
+
+
+def test_layout_wired_robot_confirmation(snap_compare: Any,
+                                         still_app: Callable[..., StairbotConsole]) -> None:
+    async def asked(pilot: Any) -> None:
+        await pilot.app.workers.wait_for_complete()
+        await pilot.press("s")
+        await pilot.pause(0.3)
+    assert snap_compare(still_app(simulated=False, url="serial://loop://"),
+                        terminal_size=(80, 24), run_before=asked)
