@@ -12,6 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+import serial
+import serial.rfc2217
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_robot import SerialRobot, parse_serial_url
 from stairbot.fakes.boards import BoardWorld, make_boards
@@ -225,6 +227,74 @@ def test_any_pyserial_url_works_as_the_port_socket() -> None:
         servers[0].stop()
         thread.join(5)
         listener.close()
+
+
+class _PtyPort(serial.Serial):
+    """A pty has no modem lines: report them idle, ignore setting them."""
+
+    cts = dsr = ri = cd = property(lambda self: False)  # type: ignore[assignment]
+
+    def _update_rts_state(self) -> None:
+        pass
+
+    def _update_dtr_state(self) -> None:
+        pass
+
+
+class _Rfc2217Bridge:
+    """A minimal RFC 2217 server (pyserial's PortManager) in front of the fake
+    boards' pty, the way examples/rfc2217_server.py bridges a real port."""
+
+    def __init__(self, device_path: str) -> None:
+        self.device = _PtyPort(device_path, timeout=0.01)
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.port = self.listener.getsockname()[1]
+        self.alive = True
+        self.threads = [threading.Thread(target=self._serve, daemon=True)]
+        self.threads[0].start()
+
+    def write(self, data: bytes) -> None:  # PortManager's connection
+        self.conn.sendall(data)
+
+    def _serve(self) -> None:
+        self.conn, _ = self.listener.accept()
+        manager = serial.rfc2217.PortManager(self.device, self)
+
+        def device_to_net() -> None:
+            while self.alive:
+                data = self.device.read(self.device.in_waiting or 1)
+                if data:
+                    self.conn.sendall(b"".join(manager.escape(data)))
+
+        self.threads.append(threading.Thread(target=device_to_net, daemon=True))
+        self.threads[-1].start()
+        while self.alive:
+            data = self.conn.recv(4096)
+            if not data:
+                break
+            self.device.write(b"".join(manager.filter(data)))
+
+    def close(self) -> None:
+        self.alive = False
+        for t in self.threads:
+            t.join(5)
+        self.conn.close()
+        self.listener.close()
+        self.device.close()
+
+
+@pytest.mark.filterwarnings("ignore:set(Daemon|Name)\\(\\) is deprecated:DeprecationWarning")
+def test_any_pyserial_url_works_as_the_port_rfc2217(fake: Fake) -> None:
+    bridge = _Rfc2217Bridge(fake.path)
+    session = open_robot(f"serial://rfc2217://127.0.0.1:{bridge.port}?baud=115200&lockstep=1&timeout=1",
+                         CONFIG, SCENARIO, RobotOptions())
+    try:
+        session.robot.command({MotorId.MTB: -10.0})
+        session.clock.advance(0.1)
+        assert session.robot.read().motors[MotorId.MTB].turns < -0.5
+    finally:
+        session.close()
+        bridge.close()
 
 
 def test_spy_wrapper_sees_the_traffic(fake: Fake, tmp_path: Path) -> None:
