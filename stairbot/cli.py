@@ -250,6 +250,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         except HardwareError as exc:
             print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
+        if not args.quiet:
+            what = f" ({scenario.description})" if scenario.description else ""
+            print(f"running {scenario.name}{what} on {args.robot}"
+                  + (", calibration only" if args.calibrate_only else ""),
+                  file=progress, flush=True)
         control = RunControl()
         try:
             with _ctrl_c_stops(control.request_stop):

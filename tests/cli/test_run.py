@@ -40,6 +40,7 @@ def test_text_mode_prints_phase_lines_then_a_summary(capsys: pytest.CaptureFixtu
     assert main(["run", "--scenario", "step_too_high"]) == 0
     out = capsys.readouterr().out
     lines = out.splitlines()
+    assert lines[0].startswith("running step_too_high (A 0.25 m rise")
     assert any("phase" in line and "calibration" in line for line in lines)
     summary = out[out.index("summary (step_too_high on sim://)"):]
     assert "outcome           completed (ascent ended: obstacle)" in summary
@@ -98,8 +99,8 @@ def test_ctrl_c_stops_the_robot_and_exits_130(tmp_path: Path) -> None:
     proc = subprocess.Popen([*console_script(), "run", "--realtime"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     assert proc.stdout is not None
-    first = proc.stdout.readline()  # the run has started: a phase line is out
-    assert "phase" in first
+    assert proc.stdout.readline().startswith("running default")
+    assert "phase" in proc.stdout.readline()  # the run has started
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 130
