@@ -2,7 +2,7 @@
 and the share of a 1 Mbit/s CAN bus the control loop uses.
 
 A cycle is what the run loop does each tick over the wire: read every sensor
-and motor (ReadAll to each board, both in flight at once) and send the
+and motor (ReadAll to both boards: one broadcast frame) and send the
 commands (SetWheelSpeeds + SetLiftSpeeds, their Acks checked on the next
 cycle, or awaited in the same cycle).  The fake boards run in real time, as
 `stairbot fake-boards --can` does: on ``virtual`` in a thread of this process,
@@ -47,7 +47,7 @@ def cycle_frames() -> list[tuple[str, int, int]]:
     """(frame name, data bytes, count) of every frame one control cycle puts on
     the bus, both ways, taken from the DBC."""
     w = wire()
-    sent = [(1, m.ReadAll()), (2, m.ReadAll()), (1, m.SetWheelSpeeds(0, 0, 0, 0)),
+    sent = [(15, m.ReadAll()), (1, m.SetWheelSpeeds(0, 0, 0, 0)),
             (1, m.SetLiftSpeeds(0, 0)),
             (1, m.Status(0, 0, 250, 0)), (2, m.Status(0, 0, 250, 0)),
             *((1, m.MotorTelemetry(c, 1, 0, 0, 0)) for c in range(6)),

@@ -128,6 +128,7 @@ class CanLink:
         self._pending: dict[int, deque[CanPending]] = {}
         self._owed: dict[int, int] = {}  # replies still due to requests given up
         self._seq = 0
+        self._held: list[CanPending] = []
         self.lost_streak = 0
         self.stats = CanStats()
 
@@ -135,35 +136,48 @@ class CanLink:
     def request(self, board: int, messages: Sequence[m.Message], send: bool = True
                 ) -> CanPending:
         """Send ``messages`` to ``board``, one frame each; the replies are
-        collected by :meth:`wait` or :meth:`poll`.  (``send`` is accepted for
-        the serial link's interface: CAN frames always go out at once.)"""
+        collected by :meth:`wait` or :meth:`poll`.  With ``send=False`` the
+        frames wait for :meth:`flush` (or the next request that sends), as on
+        the serial link; then one message asked of every board in a row goes
+        out once, as a broadcast frame (board 15)."""
         self._seq = (self._seq + 1) & 0xFFFF
         now = self._now()
         p = CanPending(board, self._seq, tuple(messages), all(x.IDEMPOTENT for x in messages),
                        now, now + self.timeout_s)
         p.expect()
         self._pending.setdefault(board, deque()).append(p)
-        self._send(p)
+        self._held.append(p)
+        if send:
+            self.flush()
         return p
+
+    def flush(self) -> None:
+        """Send every held request, in order; a single message held for every
+        board in a row (ReadAll to both) becomes one broadcast frame."""
+        held, self._held = self._held, []
+        everyone = set(_CHANNELS)
+        i = 0
+        while i < len(held):
+            p = held[i]
+            group = held[i:i + len(everyone)]
+            if (len(p.messages) == 1 and {q.board for q in group} == everyone
+                    and all(q.messages == p.messages for q in group)):
+                self.send(BROADCAST, p.messages[0])
+                i += len(group)
+            else:
+                self._send(p)
+                i += 1
 
     def _send(self, p: CanPending) -> None:
         for msg in p.messages:
             self.send(p.board, msg)
 
-    def broadcast(self, messages: Sequence[m.Message]) -> list[CanPending]:
-        """Send ``messages`` once to every board (board 15), and wait for each
-        board's replies as for a request of its own."""
-        now = self._now()
-        out = []
-        for board in _CHANNELS:
-            self._seq = (self._seq + 1) & 0xFFFF
-            p = CanPending(board, self._seq, tuple(messages),
-                           all(x.IDEMPOTENT for x in messages), now, now + self.timeout_s)
-            p.expect()
-            self._pending.setdefault(board, deque()).append(p)
-            out.append(p)
-        for msg in messages:
-            self.send(BROADCAST, msg)
+    def broadcast(self, msg: m.Message) -> list[CanPending]:
+        """Send ``msg`` once to every board (one frame to board 15) and wait
+        for each board's replies as for a request of its own."""
+        self.flush()
+        out = [self.request(board, [msg], send=False) for board in _CHANNELS]
+        self.flush()
         return out
 
     def send(self, board: int, msg: m.Message) -> None:
@@ -253,6 +267,7 @@ class CanLink:
 
     def poll(self) -> None:
         """Take in whatever has arrived, without waiting; expire old requests."""
+        self.flush()
         while self._receive(0.0):
             pass
         self._expire()
@@ -261,6 +276,7 @@ class CanLink:
         """The replies of ``pendings``, in order.  Re-sends idempotent requests
         that time out; raises LinkLostError when one gets no complete reply
         after its retries, or ``max_lost`` commands in a row went unanswered."""
+        self.flush()
         while True:
             while self._receive(0.0):  # what has arrived counts before any timeout
                 pass
@@ -283,9 +299,6 @@ class CanLink:
     def exchange(self, board: int, messages: Sequence[m.Message]) -> Frame:
         """Send one request and wait for its reply."""
         return self.wait([self.request(board, messages)])[0]
-
-    def flush(self) -> None:
-        """Frames go out as they are requested; nothing is buffered."""
 
     def close(self) -> None:
         self.bus.shutdown()

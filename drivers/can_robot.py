@@ -204,7 +204,7 @@ class CanRobot(SerialRobot):
     def estop(self) -> None:
         """Latch the emergency stop on both boards with one EStop_All frame
         (id 0x00F) and wait for both boards' Status."""
-        self._wait(self.link.broadcast([m.EStop()]))  # type: ignore[arg-type]
+        self._wait(self.link.broadcast(m.EStop()))  # type: ignore[arg-type]
 
     def diagnostics(self) -> dict[str, object]:
         out = super().diagnostics()

@@ -172,6 +172,7 @@ def test_watchdog_trips_when_the_host_goes_quiet_and_only_a_clear_resets_it(rig:
 
 def test_emergency_stop_is_one_broadcast_frame_and_latches(rig: Rig) -> None:
     rig.tick(FORWARD)
+    rig.robot.link.flush()  # the tick's held command and StepTo go out first
     tx = rig.robot.link.stats.frames_tx
     rig.robot.estop()
     assert rig.robot.link.stats.frames_tx == tx + 1  # EStop_All, id 0x00F
