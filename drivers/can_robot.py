@@ -19,7 +19,8 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
   - ``retries=N``     re-sends of a query that timed out, default 2
   - ``lost=N``        unanswered commands in a row that mean the link is
                       lost, default 3
-  - ``watchdog=MS``   the boards' watchdog, set at open, default 250 (0 = off)
+  - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
+                      default 250 (0 = off); time-scaled fake boards get X times it
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
@@ -222,9 +223,10 @@ def open_can_robot(url: str, config: RobotConfig, scenario: Scenario,
     bus = open_bus(spec)
     link = CanLink(bus, timeout_s=opts["timeout"], retries=int(opts["retries"]),
                    max_lost=int(opts["lost"]))
+    scale = options.time_scale or opts["time_scale"]
     try:
         robot = CanRobot(link, url, int(opts["watchdog"]),  # type: ignore[arg-type]
-                         bool(opts["lockstep"]))
+                         bool(opts["lockstep"]), time_scale=scale)
     except BaseException:
         link.close()
         raise
@@ -232,7 +234,6 @@ def open_can_robot(url: str, config: RobotConfig, scenario: Scenario,
     if robot.lockstep:
         clock = LockstepClock(robot)
     else:
-        scale = options.time_scale or opts["time_scale"]
         clock = WallClock(monotonic=lambda: time.monotonic() * scale,
                           sleep=lambda s: time.sleep(s / scale))
     robot.clock = clock

@@ -202,12 +202,8 @@ def main(argv: list[str]) -> int:
     server = CanBoardServer(bus, world, make_boards(world), faults_from(args),
                             time_scale=args.time_scale)
     sep = "&" if "?" in url else "?"
-    # Faster than real time, the watchdog (in board time) is stretched by the
-    # same factor, so that the host keeps the 250 ms of wall time it has at 1x.
-    watchdog = min(65535, round(250 * args.time_scale))
     suffix = f"{sep}lockstep=1" if args.lockstep else (
-        f"{sep}time_scale={args.time_scale:g}&watchdog={watchdog}"
-        if args.time_scale != 1.0 else "")
+        f"{sep}time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"{url}{suffix}", flush=True)
     print(f"fake boards serving on CAN {spec.label} (Ctrl-C to stop)", file=sys.stderr,
           flush=True)

@@ -274,9 +274,7 @@ def test_faster_than_real_time_without_lockstep() -> None:
     thread = threading.Thread(target=server.serve, daemon=True)
     thread.start()
     try:
-        # watchdog off: 250 board-ms are 12.5 wall-ms at 20x, less than a
-        # loaded machine may leave this thread idle (its trip is tested above)
-        session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1&watchdog=0",
+        session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1",
                                  load_config(), load_scenario(), RobotOptions())
         first = session.robot.read()
         for _ in range(25):
@@ -287,6 +285,8 @@ def test_faster_than_real_time_without_lockstep() -> None:
         assert last.time_s > first.time_s
         assert last.turns(MotorId.MWF) > first.turns(MotorId.MWF)
         assert world.now() > 0
+        # the watchdog is wall-clock ms: the boards count 20x as many of theirs
+        assert session.robot.board_watchdog_ms == 5000  # type: ignore[attr-defined]
         session.close()
     finally:
         server.stop()
