@@ -295,6 +295,9 @@ class Link:
         when ``max_lost`` commands in a row went unanswered."""
         self.flush()
         while True:
+            # Take in what has already arrived before judging deadlines: a host
+            # descheduled past a timeout must not call a waiting reply late.
+            self._receive(0.0)
             self._expire()
             failed = [p for p in pendings if p.failed]
             if failed:
