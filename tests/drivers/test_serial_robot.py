@@ -137,7 +137,7 @@ def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake:
 
 def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
     for fake in serve(WireFaults(silent_board=2, silent_after_s=0.2)):
-        session = fake.open("lockstep=1&timeout=0.02&retries=1")
+        session = fake.open("lockstep=1&timeout=0.1&retries=1")
         events: list[Event] = []
         robot_of(session).attach_sink(events.append)
         result = run(session, CONFIG, sink=events.append)
@@ -151,7 +151,7 @@ def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
 def test_faults_on_the_wire_are_survived_and_counted() -> None:
     faults = WireFaults(drop=0.03, corrupt=0.03, duplicate=0.03, seed=7)
     for fake in serve(faults):
-        session = fake.open("lockstep=1&timeout=0.02&retries=8&lost=5")
+        session = fake.open("lockstep=1&timeout=0.05&retries=8&lost=10")
         robot = robot_of(session)
         events: list[Event] = []
         robot.attach_sink(events.append)
@@ -170,9 +170,9 @@ def test_faults_on_the_wire_are_survived_and_counted() -> None:
 
 
 def test_late_replies_cause_retries_and_the_copies_are_not_acted_upon() -> None:
-    # half the replies come 50 ms late, after the host's 40 ms timeout
-    for fake in serve(WireFaults(late=0.5, late_s=0.05, seed=3)):
-        session = fake.open("lockstep=1&timeout=0.04&retries=5")
+    # half the replies come 200 ms late, after the host's 100 ms timeout
+    for fake in serve(WireFaults(late=0.5, late_s=0.2, seed=3)):
+        session = fake.open("lockstep=1&timeout=0.1&retries=5")
         robot = robot_of(session)
         h = robot.link.stats
         lost_opening = h.lost  # SetWatchdog is a command: late means lost, then sent anew
