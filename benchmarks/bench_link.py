@@ -107,11 +107,40 @@ def bench_serial(cycles: int) -> None:
         proc.wait(5)
 
 
+def bench_lockstep(ticks: int) -> None:
+    """Ticks per second of a lockstep run's loop over the pty (speeds, StepTo
+    and both ReadAlls in one write, physics included): what bounds a full
+    simulated run over the wire."""
+    proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial",
+                             "--lockstep"], stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert proc.stdout is not None
+        url = proc.stdout.readline().strip()
+        config = load_config()
+        session = open_serial_robot(url, config, load_scenario(), RobotOptions())
+        robot, clock, tick = session.robot, session.clock, config.algorithm.tick
+        speeds = {MotorId.MWF: 0.5, MotorId.MWB: 0.5, MotorId.MWR: 0.5, MotorId.MWL: 0.5}
+        t0 = time.perf_counter()
+        for _ in range(ticks):
+            robot.read()
+            robot.command(speeds)
+            clock.advance(tick)
+        rate = ticks / (time.perf_counter() - t0)
+        print(f"lockstep over the pty ({url}): {rate:.0f} ticks/s = "
+              f"{rate * tick:.1f} x real time with the {tick * 1e3:.0f} ms tick")
+        session.close()
+    finally:
+        proc.terminate()
+        proc.wait(5)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--cycles", type=int, default=5000)
     args = p.parse_args()
     bench_serial(args.cycles)
+    bench_lockstep(args.cycles // 2)
     can = Path(__file__).with_name("bench_link_can.py")
     if can.exists():
         spec = importlib.util.spec_from_file_location("bench_link_can", can)
