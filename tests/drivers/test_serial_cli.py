@@ -1,0 +1,33 @@
+"""The command line with serial URLs: a port that cannot open, or a fake-boards
+invocation with bad input, is one line and exit 2."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+
+def stairbot(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "stairbot", *args], capture_output=True,
+                          text=True, timeout=60)
+
+
+@pytest.mark.parametrize("url, says", [
+    ("serial:///dev/no-such-port", "cannot open port /dev/no-such-port"),
+    ("serial://loop://?timeout=0.01&retries=0", "no motor board answered"),
+    ("serial:///dev/ttyS0?baud=fast", "baud: 'fast' is not an integer"),
+])
+def test_run_with_an_unusable_serial_port_exits_2_with_one_line(url: str, says: str) -> None:
+    proc = stairbot("run", "--robot", url)
+    assert proc.returncode == 2
+    assert says in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert "Traceback" not in proc.stderr
+
+
+def test_fake_boards_bad_input_exits_2() -> None:
+    proc = stairbot("fake-boards", "--serial", "--drop", "1.5")
+    assert proc.returncode == 2 and "allowed: 0..1" in proc.stderr
+    proc = stairbot("fake-boards", "--serial", "--scenario", "/no/such/scenario.toml")
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
