@@ -242,7 +242,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         def sink(event: Event) -> None:
             if record is not None:
                 record.write(event.to_json() + "\n")
-            if not args.quiet and event.kind is not EventKind.END:
+            if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(event.line(), file=progress, flush=True)
 
         try:

@@ -21,7 +21,8 @@ class EventKind(StrEnum):
     WARNING = "warning"
     ERROR = "error"  # the program ends with an error
     LINK = "link"  # link health from a driver
-    END = "end"  # the run ended (data holds the outcome)
+    END = "end"  # the program ended (data holds the controller's result)
+    SUMMARY = "summary"  # the run loop's summary after the end (data: RunResult)
 
 
 @dataclass(frozen=True, slots=True)

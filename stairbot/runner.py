@@ -127,6 +127,9 @@ def run(
     """
     robot, clock = session.robot, session.clock
     ctl = controller or Controller(config, sink, mode)
+    attach = getattr(robot, "attach_sink", None)
+    if callable(attach):  # wired robots report link health as LINK events
+        attach(sink)
     tick = config.algorithm.tick
     t0, wall0 = clock.now(), wall()
     fell = False
@@ -172,7 +175,7 @@ def run(
         wall_time_s=wall_time,
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
     )
-    sink(Event(clock.now(), EventKind.END, _summary_line(result), None, result.to_dict()))
+    sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
 
 

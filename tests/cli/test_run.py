@@ -55,8 +55,9 @@ def test_record_writes_the_event_stream(tmp_path: Path,
     events = [json.loads(line) for line in record.read_text().splitlines()]
     assert events, "nothing recorded"
     assert {"time_s", "kind", "phase", "message", "data"} <= set(events[0])
-    assert events[-1]["kind"] == "end"
+    assert [e["kind"] for e in events[-2:]] == ["end", "summary"]
     assert events[-1]["data"]["outcome"] == "stopped"
+    assert events[-2]["data"]["outcome"] == "stopped"
     assert [e["time_s"] for e in events] == sorted(e["time_s"] for e in events)
     out = capsys.readouterr().out
     assert "phase" not in out.split("summary")[0]  # -q: no progress lines
