@@ -132,7 +132,7 @@ class StairbotConsole(App[None]):
         self._show(view)
 
     def _show(self, v: StateView) -> None:
-        self.banner.show(v.url, v.scenario, v.status)
+        self.banner.show(v.url, v.scenario, v.status, v.recording)
         picture = self.picture
         picture.border_title = f"side view · {v.url} · {v.scenario}"
         snap = v.snapshot
@@ -146,8 +146,7 @@ class StairbotConsole(App[None]):
         self.sensors.show(snap)
         self.motors.show(snap, v.commands)
         self.phase.show(v.phase, v.flow, v.context)
-        self.link.show(v.simulated, snap.time_s if snap else None, v.ticks,
-                                       v.speed, v.health, v.recording)
+        self.link.show(v.simulated, snap.time_s if snap else None, v.speed, v.health)
         if v.events:
             log = self.log_panel
             log.add(v.events)

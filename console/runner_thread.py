@@ -273,6 +273,9 @@ class ConsoleEngine:
         if session.simulated and sim is not None and hasattr(sim, "scene"):
             def scene_fn() -> SceneView | None:
                 return scene_from_sim(sim.scene())
+        attach = getattr(session.robot, "attach_sink", None)
+        if callable(attach):  # a driver's LINK events go to the log and the record
+            attach(self._sink)
         self.robot = WatchedRobot(session.robot, self.state, self._lock, scene_fn, self._wall)
         self.clock = PacedClock(session.clock, self._lock, self._wall, self._sleep)
         self.clock.set_scale(SPEEDS[self._speed] if session.simulated else None)

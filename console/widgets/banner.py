@@ -10,7 +10,8 @@ from textual.widgets import Static
 SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
 
 
-def banner_text(url: str, scenario: str, status: RunStatus) -> Text:
+def banner_text(url: str, scenario: str, status: RunStatus,
+                recording: str | None = None) -> Text:
     if status.estopped:
         state = "E-STOP"
     elif status.paused and status.robot == "running":
@@ -18,6 +19,8 @@ def banner_text(url: str, scenario: str, status: RunStatus) -> Text:
     else:
         state = status.robot.upper()
     out = Text(f" {state} ", "bold reverse")
+    if recording:
+        out.append(" ● REC", "bold")
     out.append(f" {status.message}" if status.message else f" {url or '—'} · {scenario}")
     return out
 
@@ -32,12 +35,13 @@ class Banner(Static):
         self._last: object = None
         self.plain = ""  # the text shown, for tests and logs
 
-    def show(self, url: str, scenario: str, status: RunStatus) -> None:
-        key = (url, scenario, status)
+    def show(self, url: str, scenario: str, status: RunStatus,
+             recording: str | None = None) -> None:
+        key = (url, scenario, status, recording)
         if key == self._last:
             return
         self._last = key
-        text = banner_text(url, scenario, status)
+        text = banner_text(url, scenario, status, recording)
         self.plain = text.plain
         self.update(text)
         self.remove_class(*SEVERITY_CLASSES)

@@ -1,33 +1,49 @@
-"""Link health for a wired robot (frames per second, errors, round-trip time,
-from ``Snapshot.health`` and the driver's link events); for a simulation the
-simulated time, the speed and the control ticks."""
+"""Link health for a wired robot (frames per second, round-trip times, errors,
+from ``Snapshot.health`` and the driver's LINK events); for a simulation the
+simulated time and the speed."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
+from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
 SPEED_NAMES = {"1x": "1×", "10x": "10×", "max": "max"}
-# Health keys worth a short name; anything else is shown as it comes.
-SHORT = {"frames_per_s": "fps", "rtt_ms": "rtt ms", "rtt_p99_ms": "rtt p99",
-         "crc_errors": "crc err", "retries": "retries", "lost": "lost", "late": "late"}
-ERROR_KEYS = ("crc_errors", "lost", "late", "errors", "timeouts")
+ERROR_KEYS = ("crc_errors", "malformed", "stray")
 
 
-def health_text(health: Mapping[str, float]) -> Text:
-    out = Text()
+def _figure(out: Text, label: str, value: float | None, unit: str = "",
+            bad: bool = False) -> None:
+    out.append(f"{label} ", "dim")
+    if value is None:
+        out.append("—")
+    else:
+        text = f"{value:.0f}" if value == int(value) or abs(value) >= 100 else f"{value:.2f}"
+        out.append(text + unit, "bold red" if bad else "")
+    out.append("  ")
+
+
+def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
+    """Two lines: frames per second and round-trip times; errors, lost and late
+    replies, retries (red when not zero)."""
     if not health:
-        return Text("no link figures yet", "dim")
-    for i, (key, value) in enumerate(sorted(health.items())):
-        if i:
-            out.append("  ")
-        bad = key in ERROR_KEYS and value > 0
-        out.append(f"{SHORT.get(key, key)} ", "dim")
-        out.append(f"{value:g}" if abs(value) >= 100 or value == int(value) else f"{value:.2f}",
-                   "bold red" if bad else "")
-    return out
+        return Text("no link figures yet  ", "dim"), Text()
+    rates = Text(no_wrap=True, overflow="ellipsis")
+    _figure(rates, "fps", health.get("frames_per_s"))
+    med = health.get("rtt_median_ms", health.get("rtt_ms"))
+    p99 = health.get("rtt_p99_ms")
+    rates.append("rtt/p99 ", "dim")
+    rates.append("—" if med is None else f"{med:.2f}")
+    rates.append("/" + ("—" if p99 is None else f"{p99:.2f}") + " ms  ")
+    faults = Text(no_wrap=True, overflow="ellipsis")
+    errors = sum(health.get(k, 0.0) for k in ERROR_KEYS)
+    for label, value in (("errors", errors), ("lost", health.get("lost", 0.0)),
+                         ("late", health.get("late", 0.0)),
+                         ("retries", health.get("retries", 0.0))):
+        _figure(faults, label, value, bad=value > 0)
+    return rates, faults
 
 
 class LinkPanel(Static):
@@ -40,23 +56,20 @@ class LinkPanel(Static):
         self._last: object = None
         self.border_title = "link"
 
-    def show(self, simulated: bool, time_s: float | None, ticks: int, speed: str,
-             health: Mapping[str, float], recording: str | None) -> None:
-        key = (simulated, None if time_s is None else round(time_s, 1), ticks // 5, speed,
-               tuple(sorted(health.items())), recording)
+    def show(self, simulated: bool, time_s: float | None, speed: str,
+             health: Mapping[str, float]) -> None:
+        key = (simulated, None if time_s is None else round(time_s, 1), speed,
+               tuple(sorted(health.items())))
         if key == self._last:
             return
         self._last = key
         if simulated:
             self.border_title = "simulation"
-            out = Text("t ", "dim")
+            out = Text("t ", "dim", no_wrap=True, overflow="ellipsis")
             out.append("—" if time_s is None else f"{time_s:7.1f} s")
             out.append("  speed ", "dim")
             out.append(SPEED_NAMES.get(speed, speed), "bold")
+            self.update(out)
         else:
             self.border_title = "link health"
-            out = health_text(health)
-        out.append("\n")
-        out.append("rec ", "dim")
-        out.append(recording if recording else "off", "bold red" if recording else "dim")
-        self.update(out)
+            self.update(Group(*health_text(health)))

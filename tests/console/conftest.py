@@ -40,8 +40,13 @@ class StillSim:
         }
 
 
+HEALTH = {"frames_per_s": 1480.5, "rtt_median_ms": 0.41, "rtt_p99_ms": 1.2, "crc_errors": 0.0,
+          "lost": 0.0, "late": 1.0, "retries": 2.0, "frames_tx": 9000.0}
+
+
 class StillRobot:
-    def __init__(self) -> None:
+    def __init__(self, health: dict[str, float] | None = None) -> None:
+        self.health = health or {}
         self.commands: list[dict[MotorId, float]] = []
         self.stops = 0
 
@@ -52,7 +57,7 @@ class StillRobot:
                   (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL)}
         motors[MotorId.MTF] = MotorState(LIFT / 0.002, 10.0)
         motors[MotorId.MTB] = MotorState(0.0, 0.0)
-        return Snapshot(12.34, sensors, motors)
+        return Snapshot(12.34, sensors, motors, self.health)
 
     def command(self, speeds: Speeds) -> None:
         self.commands.append(dict(speeds))
@@ -80,7 +85,7 @@ class StillClock:
 
 def still_open(simulated: bool = True) -> Callable[..., RobotSession]:
     def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
-        return RobotSession(StillRobot(), StillClock(), url, simulated,
+        return RobotSession(StillRobot(None if simulated else HEALTH), StillClock(), url, simulated,
                             StillSim() if simulated else None)
     return open_fn
 

@@ -4,7 +4,9 @@ against the real simulated robot and the real run loop."""
 from __future__ import annotations
 
 import asyncio
+import json
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -13,7 +15,9 @@ from stairbot.console.modals import ConfirmScreen
 from textual import events
 from textual.widgets import Input
 
-from stairbot.hardware import MotorId, Speeds
+from stairbot.cli import main as cli_main
+from stairbot.errors import LinkLostError
+from stairbot.hardware import MotorId, Snapshot, Speeds
 from stairbot.robots import RobotSession, open_robot
 
 
@@ -82,9 +86,19 @@ async def ready(pilot: Any) -> None:
     await until(pilot, lambda: "READY" in banner(pilot.app), "the robot is ready")
 
 
-def test_a_full_run_started_from_the_keyboard_reaches_the_end() -> None:
+def _comparable(line: str) -> dict[str, Any]:
+    event = json.loads(line)
+    for key in ("wall_time_s", "realtime_factor"):  # the wall clock's, not the run's
+        event["data"].pop(key, None)
+    return event
+
+
+def test_a_full_run_started_from_the_keyboard_reaches_the_end(tmp_path: Path) -> None:
+    """... and its event record is what `stairbot run --record` writes."""
+    record = tmp_path / "console.jsonl"
+
     async def go() -> None:
-        app = build_app(speed="max")
+        app = build_app(speed="max", record=str(record))
         async with app.run_test(size=(120, 40)) as pilot:
             await ready(pilot)
             at_start = app.picture.render().plain
@@ -108,7 +122,14 @@ def test_a_full_run_started_from_the_keyboard_reaches_the_end() -> None:
             assert f"run {result['outcome']}" in text
             assert f"climbed {result['steps_climbed']}" in text
             assert app.state.view().flow == "end"
+            assert "REC" in text
     asyncio.run(go())
+    headless = tmp_path / "run.jsonl"
+    assert cli_main(["run", "--quiet", "--record", str(headless)]) in (0, 1)
+    ours = [_comparable(x) for x in record.read_text().splitlines()]
+    theirs = [_comparable(x) for x in headless.read_text().splitlines()]
+    assert ours[-1]["kind"] == "end"
+    assert ours == theirs
 
 
 def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
@@ -267,4 +288,65 @@ def test_estop_key_works_over_a_text_prompt(still_app: Callable[..., StairbotCon
             await press(pilot, "escape")
             await press(pilot, "x")
             await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
+
+
+def test_a_lost_link_shows_as_a_banner_not_a_traceback(
+        still_app: Callable[..., StairbotConsole]) -> None:
+    async def go() -> None:
+        app = still_app()
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            robot = app.engine.session.robot  # type: ignore[union-attr]
+            reads = 0
+            still_read = robot.read
+
+            def failing_read() -> Snapshot:
+                nonlocal reads
+                reads += 1
+                if reads > 20:
+                    raise LinkLostError("motor board: no reply to 3 attempts")
+                return still_read()
+
+            robot.read = failing_read
+            await press(pilot, "s")
+            await until(pilot, lambda: "ENDED" in banner(app), "the run ends")
+            assert "no reply to 3 attempts" in banner(app)
+            assert "-error" in app.banner.classes
+            assert robot.stops > 0  # the runner stopped every motor
+    asyncio.run(go())
+
+
+def test_speed_reset_palette_and_resize() -> None:
+    async def go() -> None:
+        app = build_app(speed="1x")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            assert app.engine.clock is not None
+            for speed in ("10x", "max", "1x"):
+                await press(pilot, "f")
+                assert app.state.view().speed == speed
+            await press(pilot, "f")
+            await press(pilot, "s")
+            def sim_time() -> float:
+                snap = app.state.view().snapshot
+                return snap.time_s if snap is not None else 0.0
+
+            await until(pilot, lambda: sim_time() > 3.0, "3 s of simulated time")
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+            await press(pilot, "r")  # back to the scenario's start
+            await until(pilot, lambda: sim_time() == 0.0, "the reset")
+            titles = {c.title for c in app.get_system_commands(app.screen)}
+            for title in ("EMERGENCY STOP", "Clear emergency stop", "Start full run",
+                          "Calibrate only", "Pause / resume", "Reset the simulated scenario",
+                          "Choose robot URL", "Choose scenario", "Simulation speed",
+                          "Record events"):
+                assert title in titles
+            for size in ((120, 40), (80, 24), (100, 30)):
+                await pilot.resize_terminal(*size)
+                await pilot.pause(0.2)
+                lines = app.picture.render().plain.splitlines()
+                assert len(lines) == app.picture.size.height
+                assert "steps 0|0|0" in lines[-1]
     asyncio.run(go())
