@@ -31,10 +31,12 @@ SetLiftSpeeds whose Ack is collected on the next call.  Link health goes into
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
+import threading
 import time
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import Any, Concatenate, ParamSpec, TypeVar
 from urllib.parse import parse_qsl, urlencode
 
 import serial
@@ -107,6 +109,23 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     return FdChannel(fd, owner=ser)
 
 
+P = ParamSpec("P")
+R = TypeVar("R")
+
+
+def _locked(method: Callable[Concatenate[SerialRobot, P], R]
+            ) -> Callable[Concatenate[SerialRobot, P], R]:
+    """Run a SerialRobot method under the robot's lock: the keepalive thread
+    and the control loop (or a console) share one link."""
+
+    @functools.wraps(method)
+    def wrapper(self: SerialRobot, *args: P.args, **kwargs: P.kwargs) -> R:
+        with self._lock:
+            return method(self, *args, **kwargs)
+
+    return wrapper
+
+
 class LockstepClock:
     """The host's clock against lockstep fake boards: ``advance(dt)`` asks the
     motor board to step the world to the new time and waits until it has."""
@@ -152,7 +171,18 @@ class SerialRobot:
         # simulated time: X times the wall time the host has to feed it.
         scale = 1.0 if lockstep else time_scale
         self.board_watchdog_ms = min(65535, round(watchdog_ms * scale))
+        self._lock = threading.RLock()
         self._handshake()
+        # A robot opened and left idle (a console before its run starts) must
+        # not trip the boards' watchdogs: a daemon thread sends Heartbeats to
+        # any board the host has not addressed for a quarter of the timeout.
+        # Lockstep boards count simulated time, which stands still meanwhile.
+        self._stop = threading.Event()
+        self._keepalive: threading.Thread | None = None
+        if watchdog_ms and not lockstep:
+            self._keepalive = threading.Thread(target=self._keep_alive, daemon=True,
+                                               name="serial robot keepalive")
+            self._keepalive.start()
 
     # -- setting up ------------------------------------------------------------
     def _handshake(self) -> None:
@@ -209,6 +239,7 @@ class SerialRobot:
         return float(self.clock.now()) if self.clock is not None else 0.0
 
     # -- the Robot protocol ----------------------------------------------------
+    @_locked
     def read(self) -> Snapshot:
         """One ReadAll to each board.  Raises LinkLostError (no reply, or a
         board's watchdog tripped), RobotFellError (fake boards: the simulated
@@ -228,6 +259,7 @@ class SerialRobot:
         self._maybe_event(health)
         return Snapshot(self._now(), sensors, motors, health)
 
+    @_locked
     def command(self, speeds: Mapping[MotorId, float]) -> None:
         """Send every motor's speed in one frame; its Ack is checked later."""
         self._reap()
@@ -239,6 +271,7 @@ class SerialRobot:
         self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
                                             send=not self.lockstep))
 
+    @_locked
     def flush(self) -> None:
         """Wait for the Acks of every command still in flight (LinkLostError
         if one never comes)."""
@@ -247,19 +280,23 @@ class SerialRobot:
             self._wait(pending)
         self._reap()
 
+    @_locked
     def stop_all(self) -> None:
         """Stop every motor (lifts hold); never raises."""
         with contextlib.suppress(Exception):
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
 
+    @_locked
     def estop(self) -> None:
         """Latch the emergency stop on both boards."""
         self._wait([self._request(b, [m.EStop()]) for b in m.Board])
 
+    @_locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
         """Clear latches (e-stop, watchdog, faults) on both boards."""
         self._wait([self._request(b, [m.Clear(mask)]) for b in m.Board])
 
+    @_locked
     def step_to(self, time_us: int) -> None:
         """Lockstep: the world advances to ``time_us``.  With PIPELINED_STEP
         the StepDone is awaited by the next read() (the boards handle frames
@@ -280,6 +317,7 @@ class SerialRobot:
         if not reply.messages or not isinstance(reply.messages[0], m.StepDone):
             raise HardwareError(f"the motor board refused StepTo: {reply.messages}")
 
+    @_locked
     def heartbeat(self) -> None:
         """Feed the watchdog of a board that was sent nothing for a quarter of
         its timeout (the control loop's own frames normally do this)."""
@@ -290,6 +328,7 @@ class SerialRobot:
             if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:
                 self._commands.append(self._request(board, [m.Heartbeat()]))
 
+    @_locked
     def diagnostics(self) -> dict[str, object]:
         out: dict[str, object] = {"url": self.url, "lockstep": self.lockstep,
                                   "link": self.health(),
@@ -305,7 +344,26 @@ class SerialRobot:
                                offset_m=truth.offset_mm / 1000)
         return out
 
+    def _keep_alive(self) -> None:
+        period = self.watchdog_ms / 4000
+        while not self._stop.wait(period):
+            try:
+                with self._lock:
+                    if self._closed:
+                        return
+                    self.heartbeat()
+                    self._reap()
+            except Exception:  # noqa: BLE001 - link trouble shows on the next read()
+                continue
+
     def close(self) -> None:
+        self._stop.set()
+        if self._keepalive is not None and self._keepalive is not threading.current_thread():
+            self._keepalive.join(1.0)
+        self._close()
+
+    @_locked
+    def _close(self) -> None:
         if self._closed:
             return
         self.stop_all()
