@@ -22,33 +22,25 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
                       the host's wall clock runs at the same rate
 
-The driver implements the Robot protocol: ``read()`` is one ReadAll to each
-board (both in flight at once), ``command()`` one frame of SetWheelSpeeds +
-SetLiftSpeeds whose Ack is collected on the next call.  Link health goes into
-``Snapshot.health``, ``diagnostics()`` and LINK events (``attach_sink``).
+The board logic -- Robot protocol, handshake, keepalive, link health, lost
+links -- is ``board_robot.BoardRobot``; this module adds the serial port and
+the ``Link`` that frames messages for it.
 """
 
 from __future__ import annotations
 
-import contextlib
-import functools
 import io
-import threading
 import time
-from collections.abc import Callable, Mapping
-from typing import Any, Concatenate, ParamSpec, TypeVar
+from typing import Any
 from urllib.parse import parse_qsl, urlencode
 
 import serial
-from stairbot.drivers import messages as m
-from stairbot.drivers import units as u
-from stairbot.drivers.link import FdChannel, Link, Pending, PortChannel
+from stairbot.drivers.board_robot import BoardRobot, LockstepClock
+from stairbot.drivers.link import FdChannel, Link, PortChannel
 
 from stairbot.clock import WallClock
 from stairbot.config import RobotConfig
-from stairbot.errors import HardwareError, LinkLostError, RobotFellError, RobotUrlError
-from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.scenario import Scenario
 
@@ -57,7 +49,6 @@ DEFAULTS: dict[str, float] = {
     "lockstep": 0, "time_scale": 1.0,
 }
 _INTS = {"baud", "retries", "lost", "watchdog", "lockstep"}
-EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
 
 
 def parse_serial_url(url: str) -> tuple[str, dict[str, float]]:
@@ -109,364 +100,8 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     return FdChannel(fd, owner=ser)
 
 
-P = ParamSpec("P")
-R = TypeVar("R")
-
-
-def _locked(method: Callable[Concatenate[SerialRobot, P], R]
-            ) -> Callable[Concatenate[SerialRobot, P], R]:
-    """Run a SerialRobot method under the robot's lock: the keepalive thread
-    and the control loop (or a console) share one link."""
-
-    @functools.wraps(method)
-    def wrapper(self: SerialRobot, *args: P.args, **kwargs: P.kwargs) -> R:
-        with self._lock:
-            return method(self, *args, **kwargs)
-
-    return wrapper
-
-
-class LockstepClock:
-    """The host's clock against lockstep fake boards: ``advance(dt)`` asks the
-    motor board to step the world to the new time and waits until it has."""
-
-    def __init__(self, robot: SerialRobot) -> None:
-        self._robot = robot
-        self._us = 0
-
-    def now(self) -> float:
-        return self._us / 1e6
-
-    def advance(self, dt: float) -> None:
-        self._us += round(dt * 1e6)
-        self._robot.step_to(self._us)
-
-
-class SerialRobot:
-    """Both boards over one Link (see the module docstring)."""
-
-    PIPELINED_STEP = True
-
-    def __init__(self, link: Link, url: str, watchdog_ms: int = 250,
-                 lockstep: bool = False, sink: EventSink = discard,
-                 time_scale: float = 1.0) -> None:
-        self.link = link
-        self.url = url
-        self.lockstep = lockstep
-        self.sink = sink
-        self.clock: Any = None  # set by open_serial_robot
-        self.idents: dict[int, m.Ident] = {}
-        self.status: dict[int, m.Status] = {}
-        self.refused = 0
-        self._commands: list[Pending] = []
-        self._step: Pending | None = None
-        self._rate_mark = (time.monotonic(), 0)
-        self._fps = 0.0
-        self._reported: dict[str, float] = {}
-        self._last_event = float("-inf")
-        self._closed = False
-        self._last_tx: dict[int, float] = {}
-        self.watchdog_ms = watchdog_ms  # in wall-clock ms
-        # Fake boards paced at X times real time count the watchdog in their
-        # simulated time: X times the wall time the host has to feed it.
-        scale = 1.0 if lockstep else time_scale
-        self.board_watchdog_ms = min(65535, round(watchdog_ms * scale))
-        self._lock = threading.RLock()
-        self._handshake()
-        # A robot opened and left idle (a console before its run starts) must
-        # not trip the boards' watchdogs: a daemon thread sends Heartbeats to
-        # any board the host has not addressed for a quarter of the timeout.
-        # Lockstep boards count simulated time, which stands still meanwhile.
-        self._stop = threading.Event()
-        self._keepalive: threading.Thread | None = None
-        if watchdog_ms and not lockstep:
-            self._keepalive = threading.Thread(target=self._keep_alive, daemon=True,
-                                               name="serial robot keepalive")
-            self._keepalive.start()
-
-    # -- setting up ------------------------------------------------------------
-    def _handshake(self) -> None:
-        for board in m.Board:
-            name = board.name.lower()
-            try:
-                reply = self.link.exchange(board, [m.Identify(), m.GetStatus()])
-            except LinkLostError:
-                raise RobotUrlError(self.url, None, f"no {name} board answered on the port "
-                                    f"({self.link.retries + 1} tries of "
-                                    f"{self.link.timeout_s * 1e3:.0f} ms)") from None
-            ident, status = (reply.messages + (None, None))[:2]
-            if not isinstance(ident, m.Ident) or not isinstance(status, m.Status):
-                raise RobotUrlError(self.url, None, f"the {name} board gave an unexpected "
-                                    f"answer to Identify: {reply.messages}")
-            if ident.protocol_major != m.PROTOCOL_MAJOR:
-                raise RobotUrlError(self.url, None, f"the {name} board speaks protocol "
-                                    f"{ident.protocol_major}.{ident.protocol_minor}; "
-                                    f"this host speaks {m.PROTOCOL_MAJOR}.x")
-            board_lockstep = bool(status.flags & m.StatusFlag.LOCKSTEP)
-            if board_lockstep != self.lockstep:
-                hint = ("add ?lockstep=1 to the URL" if board_lockstep
-                        else "start the fake boards with --lockstep")
-                state = "run" if board_lockstep else "do not run"
-                raise RobotUrlError(self.url, "lockstep",
-                                    f"the boards {state} in lockstep; {hint}")
-            self.idents[board] = ident
-            # Opening the robot is the explicit clear of a watchdog latch left by
-            # an earlier session; an emergency stop stays latched.  Setting up is
-            # the one place where a command frame is sent again after a timeout.
-            for attempt in range(self.link.retries + 1):
-                try:
-                    reply = self.link.exchange(board, [m.SetWatchdog(self.board_watchdog_ms),
-                                                       m.Clear(m.ClearMask.WATCHDOG)])
-                    break
-                except LinkLostError:
-                    if attempt == self.link.retries:
-                        raise RobotUrlError(self.url, None, f"the {name} board did not "
-                                            "answer SetWatchdog") from None
-            status = reply.messages[-1]
-            if isinstance(status, m.Status):
-                self.status[board] = status
-            self._last_tx[board] = time.monotonic()
-
-    @property
-    def simulated(self) -> bool:
-        return any(s.flags & m.StatusFlag.SIMULATED for s in self.status.values())
-
-    def attach_sink(self, sink: EventSink) -> None:
-        """Send LINK events to ``sink`` from now on."""
-        self.sink = sink
-
-    def _now(self) -> float:
-        return float(self.clock.now()) if self.clock is not None else 0.0
-
-    # -- the Robot protocol ----------------------------------------------------
-    @_locked
-    def read(self) -> Snapshot:
-        """One ReadAll to each board.  Raises LinkLostError (no reply, or a
-        board's watchdog tripped), RobotFellError (fake boards: the simulated
-        robot fell) or HardwareError (e-stop latched on a board, bad reply)."""
-        self._reap()
-        pm = self.link.request(m.Board.MOTOR, [m.ReadAll()], send=False)
-        ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
-        step, self._step = self._step, None
-        if step is None:
-            fm, fs = self._wait([pm, ps])
-        else:  # the boards stepped the world before they answered ReadAll
-            done, fm, fs = self._wait([step, pm, ps])
-            self._check_step(done)
-        motors = self._motors(fm.messages)
-        sensors = self._sensors(fs.messages)
-        health = self.health()
-        self._maybe_event(health)
-        return Snapshot(self._now(), sensors, motors, health)
-
-    @_locked
-    def command(self, speeds: Mapping[MotorId, float]) -> None:
-        """Send every motor's speed in one frame; its Ack is checked later."""
-        self._reap()
-        if self.link.lost_streak >= self.link.max_lost:
-            self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
-        wheels, lifts = u.speeds_to_wire(speeds)
-        # In lockstep the StepTo that follows every command carries it out in
-        # the same write.
-        self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
-                                            send=not self.lockstep))
-
-    @_locked
-    def flush(self) -> None:
-        """Wait for the Acks of every command still in flight (LinkLostError
-        if one never comes)."""
-        pending = [p for p in self._commands if not p.done]
-        if pending:
-            self._wait(pending)
-        self._reap()
-
-    @_locked
-    def stop_all(self) -> None:
-        """Stop every motor (lifts hold); never raises."""
-        with contextlib.suppress(Exception):
-            self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
-
-    @_locked
-    def estop(self) -> None:
-        """Latch the emergency stop on both boards."""
-        self._wait([self._request(b, [m.EStop()]) for b in m.Board])
-
-    @_locked
-    def clear(self, mask: int = m.ClearMask.ALL) -> None:
-        """Clear latches (e-stop, watchdog, faults) on both boards."""
-        self._wait([self._request(b, [m.Clear(mask)]) for b in m.Board])
-
-    @_locked
-    def step_to(self, time_us: int) -> None:
-        """Lockstep: the world advances to ``time_us``.  With PIPELINED_STEP
-        the StepDone is awaited by the next read() (the boards handle frames
-        in order, so that read sees the stepped world): one round trip per
-        tick instead of two.  Otherwise waits here."""
-        if self._step is not None:
-            self._check_step(self._wait([self._step])[0])
-        # Pipelined, the StepTo waits in the output buffer with the speeds
-        # before it, and the next read's requests carry all of them in one
-        # write: a pty write costs a context switch, the dearest part of a tick.
-        self._step = self._request(m.Board.MOTOR, [m.StepTo(time_us)],
-                                   send=not self.PIPELINED_STEP)
-        if not self.PIPELINED_STEP:
-            step, self._step = self._step, None
-            self._check_step(self._wait([step])[0])
-
-    def _check_step(self, reply: Any) -> None:
-        if not reply.messages or not isinstance(reply.messages[0], m.StepDone):
-            raise HardwareError(f"the motor board refused StepTo: {reply.messages}")
-
-    @_locked
-    def heartbeat(self) -> None:
-        """Feed the watchdog of a board that was sent nothing for a quarter of
-        its timeout (the control loop's own frames normally do this)."""
-        if not self.watchdog_ms:
-            return
-        now = time.monotonic()
-        for board in m.Board:
-            if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:
-                self._commands.append(self._request(board, [m.Heartbeat()]))
-
-    @_locked
-    def diagnostics(self) -> dict[str, object]:
-        out: dict[str, object] = {"url": self.url, "lockstep": self.lockstep,
-                                  "link": self.health(),
-                                  "boards": {m.Board(b).name.lower(): vars_of(i)
-                                             for b, i in self.idents.items()}}
-        if self.simulated and not self._closed:
-            with contextlib.suppress(Exception):
-                (reply,) = self._wait([self._request(m.Board.MOTOR, [m.GetTruth()])])
-                truth = reply.messages[0]
-                if isinstance(truth, m.Truth):
-                    out.update(fell=bool(truth.flags & 1),
-                               max_pitch_deg=truth.max_pitch_cdeg / 100,
-                               offset_m=truth.offset_mm / 1000)
-        return out
-
-    def _keep_alive(self) -> None:
-        period = self.watchdog_ms / 4000
-        while not self._stop.wait(period):
-            try:
-                with self._lock:
-                    if self._closed:
-                        return
-                    self.heartbeat()
-                    self._reap()
-            except Exception:  # noqa: BLE001 - link trouble shows on the next read()
-                continue
-
-    def close(self) -> None:
-        self._stop.set()
-        if self._keepalive is not None and self._keepalive is not threading.current_thread():
-            self._keepalive.join(1.0)
-        self._close()
-
-    @_locked
-    def _close(self) -> None:
-        if self._closed:
-            return
-        self.stop_all()
-        self._closed = True
-        self.link.close()
-
-    def health(self) -> dict[str, float]:
-        """The link's counters, RTT figures, ``rtt_ms`` (the latest round
-        trip) and ``frames_per_s`` (frames both ways, over the last second or
-        so of wall time)."""
-        stats = self.link.stats
-        h = stats.as_dict()
-        h["refused"] = float(self.refused)
-        h["rtt_ms"] = round(stats.rtt_s[-1] * 1e3, 3) if stats.rtt_s else 0.0
-        now, frames = time.monotonic(), stats.frames_tx + stats.frames_rx
-        t0, f0 = self._rate_mark
-        if now - t0 >= 1.0:
-            self._fps = (frames - f0) / (now - t0)
-            self._rate_mark = (now, frames)
-        h["frames_per_s"] = round(self._fps, 1)
-        return h
-
-    # -- internals ---------------------------------------------------------------
-    def _request(self, board: int, msgs: list[m.Message], send: bool = True) -> Pending:
-        self._last_tx[board] = time.monotonic()
-        return self.link.request(board, msgs, send=send)
-
-    def _wait(self, pendings: list[Pending]) -> list[Any]:
-        try:
-            return self.link.wait(pendings)
-        except LinkLostError as exc:
-            self._lost(str(exc))
-            raise  # unreachable: _lost raises
-
-    def _lost(self, reason: str) -> None:
-        self.sink(Event(self._now(), EventKind.LINK, f"link lost: {reason}", None,
-                        self.health()))
-        raise LinkLostError(f"{self.url}: {reason}")
-
-    def _reap(self) -> None:
-        self.link.poll()
-        still = []
-        for p in self._commands:
-            if p.reply is not None:
-                for msg in p.reply.messages:
-                    if isinstance(msg, m.Ack) and msg.result != m.AckResult.OK:
-                        self.refused += 1
-            elif not p.failed:
-                still.append(p)
-        self._commands = still
-
-    def _check_status(self, board: m.Board, status: m.Status) -> None:
-        self.status[board] = status
-        name = board.name.lower()
-        if status.flags & m.StatusFlag.WATCHDOG:
-            what = ": its motors are stopped until cleared" if board == m.Board.MOTOR else ""
-            self._lost(f"the {name} board's watchdog tripped (nothing from the host for "
-                       f"{status.watchdog_ms} ms){what}")
-        if status.fault == m.MotorFault.SIMULATION:
-            truth = self.diagnostics()
-            if truth.get("fell"):
-                raise RobotFellError("the simulated robot fell (reported by the fake boards)")
-            raise HardwareError(f"the {name} board's simulated world failed")
-        if status.flags & m.StatusFlag.ESTOP:
-            raise HardwareError(f"the {name} board has its emergency stop latched")
-
-    def _motors(self, msgs: tuple[Any, ...]) -> dict[MotorId, MotorState]:
-        if not msgs or not isinstance(msgs[0], m.Status):
-            raise HardwareError(f"the motor board answered ReadAll with {msgs!r}")
-        self._check_status(m.Board.MOTOR, msgs[0])
-        out = {m.MOTOR_CHANNELS[t.channel]: u.state_from_wire(t) for t in msgs[1:]
-               if isinstance(t, m.MotorTelemetry) and t.channel < len(m.MOTOR_CHANNELS)}
-        if len(out) != len(m.MOTOR_CHANNELS):
-            raise HardwareError(f"the motor board's ReadAll reply lacks motors: {msgs!r}")
-        return out
-
-    def _sensors(self, msgs: tuple[Any, ...]) -> dict[SensorId, SensorReading]:
-        if not msgs or not isinstance(msgs[0], m.Status):
-            raise HardwareError(f"the sensor board answered ReadAll with {msgs!r}")
-        self._check_status(m.Board.SENSOR, msgs[0])
-        out = {m.SENSOR_CHANNELS[t.channel]: u.reading_from_wire(t) for t in msgs[1:]
-               if isinstance(t, m.SensorTelemetry) and t.channel < len(m.SENSOR_CHANNELS)}
-        if len(out) != len(m.SENSOR_CHANNELS):
-            raise HardwareError(f"the sensor board's ReadAll reply lacks sensors: {msgs!r}")
-        return out
-
-    def _maybe_event(self, health: dict[str, float]) -> None:
-        keys = ("retries", "timeouts", "lost", "late", "stray", "crc_errors", "malformed",
-                "refused")
-        changed = {k: health[k] - self._reported.get(k, 0.0) for k in keys
-                   if health[k] != self._reported.get(k, 0.0)}
-        now = self._now()
-        if changed and now - self._last_event >= EVENT_EVERY_S:
-            self._last_event = now
-            self._reported = dict(health)
-            what = ", ".join(f"+{v:g} {k}" for k, v in changed.items())
-            self.sink(Event(now, EventKind.LINK, f"link: {what} (rtt median "
-                            f"{health['rtt_median_ms']:.2f} ms)", None, dict(health)))
-
-
-def vars_of(ident: m.Ident) -> dict[str, int]:
-    return {"protocol": ident.protocol_major * 256 + ident.protocol_minor,
-            "firmware": ident.firmware, "serial": ident.serial, "channels": ident.channels}
+class SerialRobot(BoardRobot):
+    """Both boards over one serial Link."""
 
 
 def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
@@ -492,3 +127,7 @@ def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
                           sleep=lambda s: time.sleep(s / scale))
     robot.clock = clock
     return RobotSession(robot=robot, clock=clock, url=url, simulated=robot.simulated, sim=None)
+
+
+__all__ = ["DEFAULTS", "LockstepClock", "SerialRobot", "open_channel", "open_serial_robot",
+           "parse_serial_url"]
