@@ -20,6 +20,7 @@ import importlib.util
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -77,7 +78,8 @@ def measure(robot: object, cycles: int, acked: bool) -> tuple[float, list[float]
 
 def bench_serial(cycles: int) -> None:
     proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial"],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                            cwd=tempfile.gettempdir())
     try:
         assert proc.stdout is not None
         url = proc.stdout.readline().strip()
@@ -113,7 +115,8 @@ def bench_lockstep(ticks: int) -> None:
     simulated run over the wire."""
     proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial",
                              "--lockstep"], stdout=subprocess.PIPE,
-                            stderr=subprocess.DEVNULL, text=True)
+                            stderr=subprocess.DEVNULL, text=True,
+                            cwd=tempfile.gettempdir())
     try:
         assert proc.stdout is not None
         url = proc.stdout.readline().strip()

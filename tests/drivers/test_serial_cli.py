@@ -5,13 +5,15 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import tempfile
 
 import pytest
 
 
 def stairbot(*args: str) -> subprocess.CompletedProcess[str]:
+    # cwd elsewhere: the installed package runs, not the source tree
     return subprocess.run([sys.executable, "-m", "stairbot", *args], capture_output=True,
-                          text=True, timeout=60)
+                          text=True, timeout=60, cwd=tempfile.gettempdir())
 
 
 @pytest.mark.parametrize("url, says", [

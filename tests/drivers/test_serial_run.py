@@ -7,6 +7,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -19,10 +20,11 @@ SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "
 
 
 @pytest.fixture
-def fake_boards_url() -> Iterator[str]:
+def fake_boards_url(tmp_path: Path) -> Iterator[str]:
+    # cwd elsewhere: the installed package runs, not the source tree
     proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial",
                              "--lockstep"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
+                            text=True, cwd=tmp_path)
     assert proc.stdout is not None
     url = proc.stdout.readline().strip()
     try:
