@@ -232,7 +232,17 @@ class StairbotConsole(App[None]):
         if not self.engine.running:
             self.notify("no run is going on")
         elif self.state.view().status.paused:
-            self.engine.resume()
+            if self.engine.simulated:
+                self.engine.resume()
+            else:
+                def answered(yes: bool | None) -> None:
+                    if yes:
+                        self.engine.resume()
+                        self.refresh_view()
+
+                self.push_screen(ConfirmScreen(
+                    f"Resume motion on the WIRED robot {self.url}?\n"
+                    "The motors will move. Space stops every motor."), answered)
         else:
             self.engine.pause()
         self.refresh_view()

@@ -18,6 +18,7 @@ KIND_STYLES = {
     EventKind.ERROR: "bold red",
     EventKind.LINK: "dim",
     EventKind.END: "bold",
+    EventKind.SUMMARY: "bold",
 }
 
 
@@ -26,7 +27,7 @@ def event_text(event: Event) -> Text:
     line = Text(f"{event.time_s:8.2f} s ", "dim")
     line.append(f"{event.kind.value:<7} ", KIND_STYLES.get(event.kind, ""))
     line.append(event.message, KIND_STYLES.get(event.kind, "") if event.kind in (
-        EventKind.ERROR, EventKind.WARNING, EventKind.END) else "")
+        EventKind.ERROR, EventKind.WARNING, EventKind.END, EventKind.SUMMARY) else "")
     return line
 
 

@@ -1,0 +1,174 @@
+"""The robot and clock as the console hands them to the run loop: every call
+under one lock, what was read and sent copied into the live state, a latched
+emergency stop that turns every command into a stop, pacing to a chosen
+simulation speed; and the event recorder (JSON lines).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import IO
+
+from stairbot.console.scene import SceneView
+from stairbot.console.state import LiveState
+
+from stairbot.errors import InputError
+from stairbot.events import Event
+from stairbot.hardware import Clock, MotorId, Robot, Snapshot, Speeds
+
+SCENE_PERIOD_S = 0.04  # wall seconds between pictures taken from the simulation
+ZERO: dict[MotorId, float] = {m: 0.0 for m in MotorId}
+
+
+class WatchedRobot:
+    """A Robot that passes every call on under a lock, tells the live state what
+    it read and sent, and obeys a latched emergency stop: while it is set every
+    command becomes a stop of every motor."""
+
+    def __init__(self, inner: Robot, state: LiveState, lock: threading.RLock,
+                 scene: Callable[[], SceneView | None] | None = None,
+                 wall: Callable[[], float] = time.monotonic) -> None:
+        self.inner = inner
+        self._state = state
+        self._lock = lock
+        self._scene = scene
+        self._wall = wall
+        self._last_scene = -1.0
+        self._estop = threading.Event()
+        self.estop_tick: int | None = None  # the tick count when the stop reached the robot
+        self.ticks = 0
+
+    @property
+    def estopped(self) -> bool:
+        return self._estop.is_set()
+
+    def read(self) -> Snapshot:
+        with self._lock:
+            snap = self.inner.read()
+            self.ticks += 1
+            self._state.on_read(snap)
+            self._maybe_scene()
+        return snap
+
+    def _maybe_scene(self, force: bool = False) -> None:
+        now = self._wall()
+        if self._scene is None or (not force and now - self._last_scene < SCENE_PERIOD_S):
+            return
+        self._last_scene = now
+        try:
+            scene = self._scene()
+        except Exception as exc:  # noqa: BLE001 - a picture must never stop the robot
+            self._scene = None
+            self._state.set_status(message=f"no picture: {exc}", severity="warning")
+            return
+        if scene is not None:
+            self._state.on_scene(scene)
+
+    def refresh_scene(self) -> None:
+        """Take a picture now (under the lock)."""
+        with self._lock:
+            self._maybe_scene(force=True)
+
+    def command(self, speeds: Speeds) -> None:
+        with self._lock:
+            if self._estop.is_set():
+                self.inner.stop_all()
+                self._state.on_command(dict(ZERO))
+            else:
+                self.inner.command(speeds)
+                self._state.on_command(dict(speeds))
+
+    def stop_all(self) -> None:
+        with self._lock:
+            self.inner.stop_all()
+            self._state.on_command(dict(ZERO))
+
+    def estop(self) -> None:
+        """Latch the stop and stop every motor now.  Safe from any thread: the
+        flag alone makes the run thread's next command a stop, so even if the
+        lock is busy for a moment no further motion is commanded."""
+        self._estop.set()
+        if self._lock.acquire(timeout=0.5):
+            try:
+                self.inner.stop_all()
+                self.estop_tick = self.ticks
+                self._state.on_command(dict(ZERO))
+            finally:
+                self._lock.release()
+
+    def clear_estop(self) -> None:
+        self._estop.clear()
+        self.estop_tick = None
+
+    def diagnostics(self) -> dict[str, object]:
+        with self._lock:
+            return self.inner.diagnostics()
+
+    def close(self) -> None:
+        with self._lock:
+            self.inner.close()
+
+
+class PacedClock:
+    """The session's clock, advanced under the robot lock and, for a simulation,
+    paced to ``scale`` simulated seconds per wall second (None: as fast as it goes)."""
+
+    def __init__(self, inner: Clock, lock: threading.RLock,
+                 wall: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        self.inner = inner
+        self._lock = lock
+        self._wall = wall
+        self._sleep = sleep
+        self._scale: float | None = None
+        self._anchor: tuple[float, float] | None = None
+
+    def set_scale(self, scale: float | None) -> None:
+        self._scale = scale
+        self._anchor = None
+
+    def now(self) -> float:
+        with self._lock:
+            return self.inner.now()
+
+    def advance(self, dt: float) -> None:
+        with self._lock:
+            self.inner.advance(dt)
+            sim_now = self.inner.now()
+        scale = self._scale
+        if scale is None:
+            return
+        wall_now = self._wall()
+        if self._anchor is None:
+            self._anchor = (sim_now, wall_now)
+            return
+        due = self._anchor[1] + (sim_now - self._anchor[0]) / scale
+        if due - wall_now > 0:
+            self._sleep(due - wall_now)
+        elif wall_now - due > 0.5:  # fell behind (a slow machine): do not race to catch up
+            self._anchor = (sim_now, wall_now)
+
+
+class Recorder:
+    """Writes events as JSON lines (the format of ``stairbot run --record``)."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        try:
+            self._file: IO[str] = Path(path).open("w", encoding="utf-8")  # noqa: SIM115 - closed by close()
+        except OSError as exc:
+            raise InputError(path, None, f"cannot write: {exc.strerror or exc}") from None
+        self._lock = threading.Lock()
+
+    def write(self, event: Event) -> None:
+        with self._lock:
+            if not self._file.closed:
+                self._file.write(event.to_json() + "\n")
+                self._file.flush()
+
+    def close(self) -> None:
+        with self._lock:
+            self._file.close()
