@@ -140,13 +140,13 @@ class StairbotConsole(App[None]):
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
             per_turn = self.engine.config.motors.lift_travel_per_turn
             lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
-        note = "" if v.simulated or v.scene is not None else \
+        note = "" if not v.wired or v.scene is not None else \
             "no pose from a wired robot"
         picture.show(v.scene, v.stairs, lifts, note)
         self.sensors.show(snap)
         self.motors.show(snap, v.commands)
         self.phase.show(v.phase, v.flow, v.context)
-        self.link.show(v.simulated, snap.time_s if snap else None, v.speed, v.health)
+        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health)
         if v.events:
             log = self.log_panel
             log.add(v.events)
@@ -256,8 +256,8 @@ class StairbotConsole(App[None]):
     def action_reset(self) -> None:
         if self.engine.running:
             self.notify("stop the run first (x)", severity="warning")
-        elif self.engine.session is not None and not self.engine.simulated:
-            self.notify("reset is for a simulated robot", severity="warning")
+        elif self.engine.session is not None and not self.engine.in_process:
+            self.notify("reset is for the in-process simulation (sim://)", severity="warning")
         else:
             self.log_panel.reset_log()
             self.open_robot(self.url, self.scenario)
@@ -287,6 +287,10 @@ class StairbotConsole(App[None]):
                                    self.scenario or "", "default"), chosen)
 
     def action_speed(self) -> None:
+        if self.engine.session is not None and not self.engine.in_process:
+            self.notify("a robot on a wire keeps its own time (fake boards: --time-scale)",
+                        severity="warning")
+            return
         current = self.state.view().speed
         nxt = SPEED_ORDER[(SPEED_ORDER.index(current) + 1) % len(SPEED_ORDER)]
         self.engine.set_speed(nxt)

@@ -106,7 +106,13 @@ class ConsoleEngine:
 
     @property
     def simulated(self) -> bool:
+        """No real hardware moves (sim://, or fake boards on a wire)."""
         return self.session is not None and self.session.simulated
+
+    @property
+    def in_process(self) -> bool:
+        """The simulation runs here (sim://): the console draws it and sets its speed."""
+        return self.session is not None and self.session.sim is not None
 
     def open(self, url: str, scenario_path: str | None) -> None:
         """Open the robot at ``url`` on the scenario (None: the default stairs),
@@ -129,9 +135,9 @@ class ConsoleEngine:
             attach(self._sink)
         self.robot = WatchedRobot(session.robot, self.state, self._lock, scene_fn, self._wall)
         self.clock = PacedClock(session.clock, self._lock, self._wall, self._sleep)
-        self.clock.set_scale(SPEEDS[self._speed] if session.simulated else None)
+        self.clock.set_scale(SPEEDS[self._speed] if sim is not None else None)
         stairs = stairs_from_scenario(scenario, self.config.LENGTH_OF_A_ROBOT)
-        self.state.set_robot(url, scenario.name, session.simulated, stairs)
+        self.state.set_robot(url, scenario.name, session.simulated, stairs, wired=sim is None)
         try:
             self.robot.read()  # first readings and picture, before any motion
         except StairbotError as exc:
@@ -261,7 +267,7 @@ class ConsoleEngine:
 
     def set_speed(self, speed: str) -> None:
         self._speed = speed
-        if self.clock is not None and self.simulated:
+        if self.clock is not None and self.in_process:
             self.clock.set_scale(SPEEDS[speed])
         self.state.set_speed(speed)
 

@@ -38,6 +38,7 @@ class StateView:
     url: str
     scenario: str
     simulated: bool
+    wired: bool  # no in-process world to draw: a driver on a serial link or CAN bus
     status: RunStatus
     snapshot: Snapshot | None
     commands: dict[MotorId, float]
@@ -63,6 +64,7 @@ class LiveState:
         self._url = url
         self._scenario = scenario
         self._simulated = simulated
+        self._wired = False
         self._status = RunStatus()
         self._snapshot: Snapshot | None = None
         self._commands: dict[MotorId, float] = {}
@@ -84,10 +86,11 @@ class LiveState:
         self._version += 1
 
     def set_robot(self, url: str, scenario: str, simulated: bool,
-                  stairs: tuple[tuple[float, float], ...] = ()) -> None:
+                  stairs: tuple[tuple[float, float], ...] = (), wired: bool = False) -> None:
         """A new robot was opened: forget the previous one's readings."""
         with self._lock:
             self._url, self._scenario, self._simulated = url, scenario, simulated
+            self._wired = wired
             self._snapshot, self._commands, self._ticks = None, {}, 0
             self._phase, self._flow, self._context = "—", "idle", {}
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
@@ -162,6 +165,7 @@ class LiveState:
                 url=self._url,
                 scenario=self._scenario,
                 simulated=self._simulated,
+                wired=self._wired,
                 status=self._status,
                 snapshot=self._snapshot,
                 commands=dict(self._commands),

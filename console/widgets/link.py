@@ -56,14 +56,15 @@ class LinkPanel(Static):
         self._last: object = None
         self.border_title = "link"
 
-    def show(self, simulated: bool, time_s: float | None, speed: str,
+    def show(self, in_process: bool, time_s: float | None, speed: str,
              health: Mapping[str, float]) -> None:
-        key = (simulated, None if time_s is None else round(time_s, 1), speed,
+        """``in_process``: the simulation runs in the console (no link to show)."""
+        key = (in_process, None if time_s is None else round(time_s, 1), speed,
                tuple(sorted(health.items())))
         if key == self._last:
             return
         self._last = key
-        if simulated:
+        if in_process:
             self.border_title = "simulation"
             out = Text("t ", "dim", no_wrap=True, overflow="ellipsis")
             out.append("—" if time_s is None else f"{time_s:7.1f} s")
