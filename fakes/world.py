@@ -20,6 +20,11 @@ import math
 from dataclasses import dataclass
 
 import pymunk
+
+try:  # the C functions behind pymunk's Body properties, without the Python wrapper
+    from pymunk._chipmunk import lib as _cp
+except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
+    _cp = None
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
 
 from stairbot.config import RobotConfig
@@ -38,7 +43,7 @@ STAIRS_ONLY = pymunk.ShapeFilter(mask=CAT_STAIRS)
 class WorldParams:
     """Physics and instability settings (not part of the robot config)."""
 
-    dt: float = 1.0 / 200.0
+    dt: float = 1.0 / 600.0  # 12 physics steps per 20 ms control tick
     iterations: int = 10
     stairs_friction: float = 1.0  # combined by product with the wheels' 0.9
     wheel_friction: float = 0.9  # rubber on wood
@@ -158,6 +163,12 @@ class World:
         self._bias = [-1.0, -1.0]
         self._moving = [False, False]
         self._pose_at = -1
+        self._ptrs: list[object] | None = None
+        self._wptrs: list[tuple[object, object]] | None = None
+        if _cp is not None and all(hasattr(b, "_body") for b in self.space.bodies):
+            self._ptrs = [b._body for b in self.segments]
+            self._wptrs = [(b._body, w[1]._body)
+                           for b, w in zip(self.segments, self.wheels, strict=True)]
         self._px, self._py, self._pa = [0.0] * 3, [0.0] * 3, [0.0] * 3
         self._fetch()
         self._check_y, self._check_t = list(self._py), 0.0
@@ -181,9 +192,15 @@ class World:
         if self._pose_at == self._steps_done:
             return
         px, py, pa = self._px, self._py, self._pa
-        for i, body in enumerate(self.segments):
-            pos = body.position
-            px[i], py[i], pa[i] = pos.x, pos.y, body.angle
+        if self._ptrs is not None:
+            get_pos, get_angle = _cp.cpBodyGetPosition, _cp.cpBodyGetAngle
+            for i, ptr in enumerate(self._ptrs):
+                pos = get_pos(ptr)
+                px[i], py[i], pa[i] = pos.x, pos.y, get_angle(ptr)
+        else:
+            for i, body in enumerate(self.segments):
+                pos = body.position
+                px[i], py[i], pa[i] = pos.x, pos.y, body.angle
         self._pose_at = self._steps_done
 
     def lift_offset(self, lift: int) -> float:
@@ -206,10 +223,18 @@ class World:
         """(turns, turns/s) of a segment's front wheel relative to the segment
         (+ = forward): what the wheel motor's encoder reports."""
         self._fetch()
-        body = self.segments[segment]
-        wheel = self.wheels[segment][1]
-        rel = wheel.angle - self._pa[segment] - self._wheel_zero[segment]
-        return -rel / TWO_PI, (body.angular_velocity - wheel.angular_velocity) / TWO_PI
+        if self._wptrs is not None:
+            bp, wp = self._wptrs[segment]
+            wheel_angle = _cp.cpBodyGetAngle(wp)
+            w_body = _cp.cpBodyGetAngularVelocity(bp)
+            w_wheel = _cp.cpBodyGetAngularVelocity(wp)
+        else:
+            wheel = self.wheels[segment][1]
+            wheel_angle = wheel.angle
+            w_body = self.segments[segment].angular_velocity
+            w_wheel = wheel.angular_velocity
+        rel = wheel_angle - self._pa[segment] - self._wheel_zero[segment]
+        return -rel / TWO_PI, (w_body - w_wheel) / TWO_PI
 
     def pitch_deg(self, segment: int = 1) -> float:
         """Nose-up pitch of a segment in degrees."""
