@@ -350,3 +350,19 @@ def test_speed_reset_palette_and_resize() -> None:
                 assert len(lines) == app.picture.size.height
                 assert "steps 0|0|0" in lines[-1]
     asyncio.run(go())
+
+
+def test_calibrate_only_from_the_command_palette() -> None:
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            (command,) = [c for c in app.get_system_commands(app.screen)
+                          if c.title == "Calibrate only"]
+            await command.callback()  # what the palette runs when the line is chosen
+            await until(pilot, lambda: "ENDED" in banner(app), "the calibration ends")
+            result = app.state.view().result
+            assert result is not None and result["steps_climbed"] == 0
+            assert result["ascent_end"] is None
+            assert f"run {result['outcome']}" in banner(app)
+    asyncio.run(go())

@@ -56,3 +56,30 @@ def test_scene_accepts_mappings() -> None:
            "wheels": [{"x": 0.5, "y": 0.1, "r": 0.02}]}
     view = scene_from_sim(raw)
     assert view.wheels == ((0.5, 0.1, 0.02),)
+
+
+def test_sensor_pairs_agree_differ_or_cannot_compare() -> None:
+    from stairbot.console.widgets.sensors import pair_text
+
+    from stairbot.hardware import SensorReading, SensorStatus
+
+    ok, near = SensorReading(0.500), SensorReading(0.503)
+    far = SensorReading(0.520)
+    out = SensorReading(1.3, SensorStatus.OUT_OF_RANGE)
+    assert "agree" in pair_text("front", ok, near, 0.005).plain
+    assert "DIFFER" in pair_text("front", ok, far, 0.005).plain
+    assert "both out of range" in pair_text("front", out, out, 0.005).plain
+    assert "cannot compare" in pair_text("front", ok, SensorReading(0, SensorStatus.ERROR),
+                                         0.005).plain
+
+
+def test_motor_direction_glyphs() -> None:
+    from stairbot.console.widgets.motors import direction
+
+    from stairbot.hardware import MotorId
+
+    assert direction(MotorId.MWF, 1.0)[0] == "▶"
+    assert direction(MotorId.MWL, -1.0)[0] == "◀"
+    assert direction(MotorId.MTF, 10.0)[0] == "▲"
+    assert direction(MotorId.MTB, -10.0)[0] == "▼"
+    assert direction(MotorId.MTB, 0.0)[0] == "■"
