@@ -190,11 +190,16 @@ class SerialBoardServer:
             timeout = 0.05
             if not lockstep:
                 due = sim0 + (time.monotonic() - wall0) * self.time_scale
-                while self.world.now() + self.step_s <= due:
+                if self.world.now() + self.step_s <= due:
+                    # One step at a time, looking at the line between steps: a
+                    # server that fell behind answers the host before it catches up.
                     self.world.advance(self.step_s)
                     for board in self.boards.values():
                         board.poll()
-                timeout = min(timeout, (self.world.now() + self.step_s - due) / self.time_scale)
+                    timeout = 0.0
+                else:
+                    timeout = min(timeout, (self.world.now() + self.step_s - due)
+                                  / self.time_scale)
             if self._late:
                 timeout = min(timeout, max(0.0, min(t for t, _ in self._late) - time.monotonic()))
             ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout))
