@@ -1,1 +1,36 @@
-"""stairbot.fakes: the simulated robot (pymunk world, sensor and motor models)."""
+"""stairbot.fakes: the simulated robot (pymunk world, sensor and motor models).
+
+The robot URL ``sim://`` opens :func:`stairbot.fakes.sim.open_sim_robot`.
+
+Modules:
+
+* :mod:`~stairbot.fakes.stairs` -- the stairs as one side-view polyline (floor,
+  risers and treads, a landing or a wall at the top) and ray casts against it;
+* :mod:`~stairbot.fakes.world` -- the pymunk side view: x forward, y up,
+  gravity -9.81 m/s^2; three box segments with two driven wheels each, two
+  lead-screw lifts, friction, and the instability checks (pitch beyond the
+  limit, a segment falling, every wheel off every support);
+* :mod:`~stairbot.fakes.plan` -- the top view: yaw, lateral position, side
+  walls and the corner geometry the front beams see;
+* :mod:`~stairbot.fakes.sensors` -- the distance sensor model (range limits,
+  resolution, seeded Gaussian noise, scenario faults);
+* :mod:`~stairbot.fakes.sim` -- :class:`SimRobot` (the Robot protocol),
+  :class:`SimClock` (the Clock protocol: advancing it steps the physics,
+  optionally paced to the wall clock) and the ``sim://`` factory.
+
+What is modelled and what is not:
+
+* the side view carries all the mechanics; the robot drives along its own axis
+  in it.  Yaw only enters through the top view: the front beams' geometry and
+  the lateral drift of forward motion.  A robot driving at a slant to the
+  risers climbs as if square (calibration squares it up first);
+* segment 2's right and left wheels share one side-view wheel pair running at
+  their mean; their difference turns the robot about segment 2's centre, and
+  only while segments 1 and 3 are lifted clear of the ground;
+* side walls bound the beams, not the robot's body;
+* lifts are stiff lead screws: they move at the commanded speed up to their
+  force limit, hold when stopped, and never coast;
+* the same config, scenario (seed) and command sequence give the same run,
+  bit for bit: a fixed physics step, no wall-clock input, one noise stream per
+  sensor, one sample per physics state.
+"""
