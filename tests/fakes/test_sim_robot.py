@@ -4,6 +4,9 @@ sensors in the world, determinism, instability, the sim:// URL and the clock."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import pytest
 from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
@@ -247,3 +250,31 @@ def test_clock_paces_only_when_asked() -> None:
     assert sum(slept) == pytest.approx(0.1)
     session = open_sim_robot("sim://", CFG, load_scenario(), RobotOptions(realtime=True))
     assert isinstance(session.clock, SimClock) and session.clock.time_scale == 1.0
+
+
+_RUN_IN_CHILD = """
+import hashlib
+from stairbot.config import load_config
+from stairbot.scenario import parse_scenario
+from stairbot.fakes.sim import SimClock, SimRobot
+from stairbot.hardware import MotorId as M
+r = SimRobot(load_config(), parse_scenario("[sensors]\\nnoise = 0.003\\n", "<child>"))
+c = SimClock(r)
+h = hashlib.sha256()
+for i in range(150):
+    s = r.read()
+    h.update(repr((s.time_s, sorted(s.sensors.items()), sorted(s.motors.items()))).encode())
+    r.command({M.MWF: 1.0, M.MWB: 1.0, M.MWR: 1.0, M.MWL: 0.8, M.MTF: 10.0 if i < 60 else 0.0})
+    c.advance(0.02)
+print(h.hexdigest())
+"""
+
+
+def test_runs_are_identical_across_processes() -> None:
+    digests = set()
+    for hash_seed in ("1", "2"):
+        env = dict(os.environ, PYTHONHASHSEED=hash_seed)
+        out = subprocess.run([sys.executable, "-c", _RUN_IN_CHILD], env=env, check=True,
+                             capture_output=True, text=True)
+        digests.add(out.stdout.strip())
+    assert len(digests) == 1
