@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from stairbot.console.modals import AskScreen, ConfirmScreen
+from stairbot.console.reckon import dead_reckon
 from stairbot.console.runner_thread import SPEEDS, ConsoleEngine
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
@@ -140,9 +141,15 @@ class StairbotConsole(App[None]):
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
             per_turn = self.engine.config.motors.lift_travel_per_turn
             lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
-        note = "" if not v.wired or v.scene is not None else \
-            "no pose from a wired robot"
-        picture.show(v.scene, v.stairs, lifts, note)
+        scene, note = v.scene, ""
+        if v.wired and scene is None:
+            scenario = self.engine.scenario
+            if snap is not None and v.stairs and scenario is not None:
+                scene = dead_reckon(snap, v.stairs, self.engine.config, scenario.start.distance)
+                note = "dead-reckoned (wired robot)"
+            else:
+                note = "no pose from a wired robot"
+        picture.show(scene, v.stairs, lifts, note)
         self.sensors.show(snap)
         self.motors.show(snap, v.commands)
         self.phase.show(v.phase, v.flow, v.context)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from stairbot.console.canvas import BrailleCanvas
 from stairbot.console.scene import SceneView, scene_from_sim, stairs_from_scenario
 
@@ -83,3 +85,36 @@ def test_motor_direction_glyphs() -> None:
     assert direction(MotorId.MTF, 10.0)[0] == "▲"
     assert direction(MotorId.MTB, -10.0)[0] == "▼"
     assert direction(MotorId.MTB, 0.0)[0] == "■"
+
+
+def test_dead_reckoning_follows_the_simulated_climb() -> None:
+    """The picture of a robot on a wire, from its counters alone, stays within
+    5 cm (wheel slip adds up) and 2 cm in height of the simulation's truth
+    over calibration and the first two steps."""
+    from stairbot.console.reckon import dead_reckon
+
+    from stairbot.robots import open_robot
+    from stairbot.runner import RunControl, run
+
+    cfg, sc = load_config(), load_scenario()
+    session = open_robot("sim://", cfg, sc)
+    control = RunControl()
+    worst = [0.0, 0.0]
+
+    def on_tick(_ctl: object, snap: Any) -> None:
+        if round(snap.time_s / cfg.algorithm.tick) % 25:
+            return
+        truth = scene_from_sim(session.sim.scene())  # type: ignore[union-attr]
+        est = dead_reckon(snap, truth.stairs, cfg, sc.start.distance)
+        for a, b in zip(truth.segments, est.segments, strict=True):
+            worst[0] = max(worst[0], abs(_mean(a, 0) - _mean(b, 0)))
+            worst[1] = max(worst[1], abs(_mean(a, 1) - _mean(b, 1)))
+        if snap.time_s > 80.0:
+            control.request_stop("enough")
+
+    run(session, cfg, control=control, on_tick=on_tick)
+    assert worst[0] < 0.05 and worst[1] < 0.02, worst
+
+
+def _mean(points: Any, axis: int) -> float:
+    return sum(p[axis] for p in points) / len(points)
