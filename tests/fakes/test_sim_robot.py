@@ -278,3 +278,15 @@ def test_runs_are_identical_across_processes() -> None:
                              capture_output=True, text=True)
         digests.add(out.stdout.strip())
     assert len(digests) == 1
+
+
+def test_a_segment_dropping_fast_is_a_fall() -> None:
+    r, c = robot()
+    for body in r.world.space.bodies:
+        body.position = (body.position.x, body.position.y + 0.3)
+    with pytest.raises(RobotFellError, match="falling"):
+        for _ in range(25):
+            c.advance(TICK)
+            r.read()
+    r.stop_all()
+    assert "falling" in str(r.diagnostics()["fall_reason"])
