@@ -36,7 +36,6 @@ _PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's 
 CAT_STAIRS = 0b01
 CAT_ROBOT = 0b10
 ROBOT_GROUP = 1
-STAIRS_ONLY = pymunk.ShapeFilter(mask=CAT_STAIRS)
 
 
 @dataclass(frozen=True)
@@ -211,14 +210,6 @@ class World:
         return (-math.sin(a) * (self._px[e] - self._px[1])
                 + math.cos(a) * (self._py[e] - self._py[1]))
 
-    def wheel_turns(self, segment: int) -> float:
-        """Turns of a segment's front wheel relative to the segment (+ = forward)."""
-        return self.wheel_state(segment)[0]
-
-    def wheel_speed(self, segment: int) -> float:
-        """Measured turns/s of a segment's front wheel relative to the segment."""
-        return self.wheel_state(segment)[1]
-
     def wheel_state(self, segment: int) -> tuple[float, float]:
         """(turns, turns/s) of a segment's front wheel relative to the segment
         (+ = forward): what the wheel motor's encoder reports."""
@@ -372,14 +363,6 @@ class World:
             ) -> tuple[float, float] | None:
         """First point of the stairs' surface on the segment start -> end, or None."""
         return self.profile.ray(start[0], start[1], end[0], end[1])
-
-    def ray_pymunk(self, start: tuple[float, float], end: tuple[float, float]
-                   ) -> tuple[float, float] | None:
-        """The same through pymunk's segment query (slower; for checking :meth:`ray`)."""
-        hit = self.space.segment_query_first(start, end, 0.0, STAIRS_ONLY)
-        if hit is None:
-            return None
-        return (float(hit.point.x), float(hit.point.y))
 
     def clear_of_ground(self, segment: int, clearance: float) -> bool:
         """True when nothing of the stairs lies within ``clearance`` under the
