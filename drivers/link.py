@@ -167,6 +167,7 @@ class Pending:
     attempts: int = 1
     reply: Frame | None = None
     failed: bool = False
+    order: int = -1  # commands only: their place in the sending order
 
     @property
     def done(self) -> bool:
@@ -195,6 +196,9 @@ class Link:
         self._seq = 0
         self._out = bytearray()
         self.lost_streak = 0
+        self._commands_sent = 0
+        self._last_answered = -1  # order of the latest-sent command that was answered
+        self._failed: deque[int] = deque(maxlen=256)  # orders of unanswered commands
         self.stats = LinkStats()
 
     # -- sending ---------------------------------------------------------------
@@ -215,6 +219,9 @@ class Link:
         now = self._now()
         p = Pending(board, seq, wire, all(m.IDEMPOTENT for m in messages), now,
                     now + self.timeout_s)
+        if not p.idempotent:
+            p.order = self._commands_sent
+            self._commands_sent += 1
         self._pending[(board, seq)] = p
         self._send(wire, send)
         return p
@@ -259,8 +266,9 @@ class Link:
             self.stats.add_rtt(self._now() - p.sent_at)
             p.reply = frame
             del self._pending[key]
-            if not p.idempotent:
-                self.lost_streak = 0
+            if not p.idempotent and p.order > self._last_answered:
+                self._last_answered = p.order
+                self._count_streak()
         self.stats.crc_errors = rs.crc_errors
         self.stats.malformed = rs.malformed + rs.overruns
 
@@ -281,7 +289,13 @@ class Link:
             del self._pending[key]
             self._expired.append(key)
             if not p.idempotent:
-                self.lost_streak += 1
+                self._failed.append(p.order)
+                self._count_streak()
+
+    def _count_streak(self) -> None:
+        # "In a row" goes by sending order, not by when a timeout noticed the
+        # loss: commands that failed after the latest one that was answered.
+        self.lost_streak = sum(1 for o in self._failed if o > self._last_answered)
 
     def poll(self) -> None:
         """Take in whatever has arrived, without waiting; expire old requests.

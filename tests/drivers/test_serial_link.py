@@ -185,3 +185,22 @@ def test_corrupted_reply_counts_a_crc_error_and_the_retry_succeeds() -> None:
     link.exchange(1, [m.GetStatus()])
     assert link.stats.crc_errors + link.stats.malformed == 1
     assert link.stats.retries == 1
+
+
+def test_losses_count_in_sending_order_not_in_the_order_timeouts_notice_them() -> None:
+    # every other command is lost; their timeouts all fire together, later
+    sent = [0]
+
+    def respond(frame: Frame) -> bytes | None:
+        sent[0] += 1
+        return None if sent[0] % 2 else answer(frame, m.Ack(0x21, 0))
+
+    link, ch = make_link(respond, max_lost=2)
+    for _ in range(8):
+        link.request(1, [m.SetLiftSpeeds(0, 0)])
+        ch.t += 0.001
+        link.poll()
+    ch.t += 0.1
+    link.poll()
+    assert link.stats.lost == 4
+    assert link.lost_streak == 0  # the last command sent was answered
