@@ -113,13 +113,13 @@ class SimRobot:
             return self._snap
         t = w.time
         sfr, sfl = self._front_truth()
-        back = self._back_truth()
+        sbr, sbl = self._back_truth()
         sensors = self.sensors
         snap = Snapshot(time_s=t, sensors={
             SensorId.SFR: sensors[SensorId.SFR].measure(sfr, t),
             SensorId.SFL: sensors[SensorId.SFL].measure(sfl, t),
-            SensorId.SBR: sensors[SensorId.SBR].measure(back, t),
-            SensorId.SBL: sensors[SensorId.SBL].measure(back, t),
+            SensorId.SBR: sensors[SensorId.SBR].measure(sbr, t),
+            SensorId.SBL: sensors[SensorId.SBL].measure(sbl, t),
         }, motors=self._motor_states(), health={})
         self._snap, self._snap_at = snap, w.steps_done
         return snap
@@ -248,14 +248,28 @@ class SimRobot:
         return (front_distance(forward, -lat, hit_dx, slant),
                 front_distance(forward, lat, hit_dx, slant))
 
-    def _back_truth(self) -> float | None:
-        """True distance seen by SBR/SBL straight down from segment 3."""
+    def _back_truth(self) -> tuple[float | None, float | None]:
+        """True distances seen by SBR and SBL, looking down from segment 3.  Turned
+        by a yaw, the two stand at different x (over a nosing they may disagree)."""
         w = self.world
         lx, ly, reach = self._back_mount
         x3, y3, a3 = w.pose(2)
         c, s = math.cos(a3), math.sin(a3)
         mx, my = x3 + c * lx - s * ly, y3 + s * lx + c * ly
-        hit = w.ray((mx, my), (mx + s * reach, my - c * reach))
+        yaw = self.plan.yaw
+        if yaw == 0.0:
+            d = self._down(mx, my, c, s, reach)
+            return d, d
+        # top view: the mount sits `behind` along the robot and +-lateral across it
+        x2 = w.pose(1)[0]
+        behind = mx - x2
+        shift = behind * (math.cos(yaw) - 1.0)
+        lat = self.config.sensors.back_lateral * math.sin(yaw)
+        return (self._down(mx + shift + lat, my, c, s, reach),
+                self._down(mx + shift - lat, my, c, s, reach))
+
+    def _down(self, mx: float, my: float, c: float, s: float, reach: float) -> float | None:
+        hit = self.world.ray((mx, my), (mx + s * reach, my - c * reach))
         if hit is None:
             return None
         return math.hypot(hit[0] - mx, hit[1] - my)

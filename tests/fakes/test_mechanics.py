@@ -5,6 +5,7 @@ counters, as the controller will."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import pytest
@@ -179,3 +180,21 @@ def test_backing_off_the_top_edge_with_lifts_level_falls() -> None:
     assert diag["fell"] is True
     assert isinstance(diag["fall_reason"], str) and diag["fall_reason"]
     drv.robot.stop_all()  # never raises, even after a fall
+
+
+def test_turned_over_a_nosing_the_back_sensors_disagree() -> None:
+    drv = OpenLoop(load_config(), load_scenario())
+    drv.ascend_one_step()  # the rear of segment 3 ends over riser 1's nosing
+    w, s = drv.robot.world, drv.cfg.sensors
+    rear = min(p[0] for p in w.segment_corners(2))
+    mount_x = rear + s.back_from_rear
+    # turn (in the top view) just enough that SBL's spot crosses the nosing's edge
+    drv.robot.plan.yaw = math.asin(min(1.0, (abs(mount_x) + 0.01) / s.back_lateral))
+    if mount_x < 0:
+        drv.robot.plan.yaw = -drv.robot.plan.yaw  # from the floor side onto the tread
+    drv.clock.advance(drv.tick)
+    snap = drv.snap().sensors
+    readings = sorted((snap[SensorId.SBR].distance_m, snap[SensorId.SBL].distance_m))
+    rise = drv.robot.scenario.steps[0].rise
+    assert readings[0] == pytest.approx(drv.cfg.BACK_CLEARANCE, abs=0.003)
+    assert readings[1] == pytest.approx(drv.cfg.BACK_CLEARANCE + rise, abs=0.005)
