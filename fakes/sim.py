@@ -125,12 +125,15 @@ class SimRobot:
         return snap
 
     def command(self, speeds: Speeds) -> None:
-        """Set every motor's speed in turns/s (clamped to the motor's limit)."""
+        """Set every motor's speed in turns/s (clamped to the motor's limit; a
+        speed that is not a finite number stops that motor)."""
         new = dict(self._zero)
         limits = self._limits
         for motor, value in speeds.items():
             limit = limits[motor]
             v = float(value)
+            if v != v or v in (math.inf, -math.inf):
+                v = 0.0
             new[motor] = limit if v > limit else (-limit if v < -limit else v)
         self._apply(new)
 

@@ -290,3 +290,11 @@ def test_a_segment_dropping_fast_is_a_fall() -> None:
             r.read()
     r.stop_all()
     assert "falling" in str(r.diagnostics()["fall_reason"])
+
+
+def test_a_speed_that_is_not_a_number_stops_the_motor() -> None:
+    r, c = robot()
+    hold(r, c, {F: math.nan, B: math.inf, R: 1.0, L: 1.0}, 0.2)
+    snap = r.read()
+    assert r.world.lift_speed == [0.0, 0.0]
+    assert math.isfinite(snap.turns(F)) and not r.world.fell
