@@ -53,7 +53,7 @@ class Scene:
 
     time_s: float
     stairs: tuple[Point, ...]  # the stairs' surface as one polyline
-    segments: tuple[tuple[Point, ...], ...]  # segments 1, 2, 3: four corners each
+    segments: tuple[tuple[Point, ...], ...]  # segments 1, 2, 3: each a closed outline
     wheels: tuple[Point, ...]  # wheel centres: segment 1 rear, front, segment 2 ...
     wheel_radius: float
     yaw_deg: float
