@@ -15,7 +15,10 @@ their difference turns the robot about segment 2's centre at
 (vR - vL) / track_width, but only while segments 1 and 3 are both lifted clear
 of the ground (otherwise their wheels scrub and it does not turn).  Turn
 counters come from the simulated wheels' rotation relative to their segment and
-from the lifts' actual offsets (encoders), never from the commands.
+from the lifts' actual offsets (encoders), not from the commands; the one
+exception is the differential part of MWR/MWL, which the side view cannot roll:
+it integrates the commanded difference (the wheels spin whether or not the
+robot turns).
 """
 
 from __future__ import annotations
