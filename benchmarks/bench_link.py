@@ -24,12 +24,11 @@ import tempfile
 import time
 from pathlib import Path
 
+from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.serial_robot import open_serial_robot
 from stairbot.drivers.serial_wire import Frame, encode_frame
-
-from stairbot.config import load_config
 from stairbot.hardware import MotorId
 from stairbot.robots import RobotOptions
 from stairbot.scenario import load_scenario

@@ -27,14 +27,14 @@ import time
 from collections.abc import Callable
 
 import can
+
+from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_can_robot
 from stairbot.drivers.can_wire import frame_bits, wire
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
-
-from stairbot.config import load_config
 from stairbot.hardware import MotorId
 from stairbot.robots import RobotOptions
 from stairbot.scenario import load_scenario

@@ -13,6 +13,14 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
+from textual import events, work
+from textual.app import App, ComposeResult, SystemCommand
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.screen import Screen
+from textual.widgets import Footer
+
+from stairbot.config import RobotConfig, load_config
 from stairbot.console.modals import AskScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
 from stairbot.console.runner_thread import SPEEDS, ConsoleEngine
@@ -25,14 +33,6 @@ from stairbot.console.widgets.motors import MotorPanel
 from stairbot.console.widgets.phase import PhasePanel
 from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
-from textual import events, work
-from textual.app import App, ComposeResult, SystemCommand
-from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
-from textual.screen import Screen
-from textual.widgets import Footer
-
-from stairbot.config import RobotConfig, load_config
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 

@@ -12,9 +12,8 @@ import argparse
 from collections.abc import Sequence
 from urllib.parse import urlsplit
 
-from stairbot.console.runner_thread import SPEEDS
-
 from stairbot.config import load_config
+from stairbot.console.runner_thread import SPEEDS
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.robots import known_schemes
 from stairbot.scenario import load_scenario

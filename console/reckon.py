@@ -16,9 +16,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from stairbot.console.scene import Point, SceneView
-
 from stairbot.config import RobotConfig
+from stairbot.console.scene import Point, SceneView
 from stairbot.hardware import WHEEL_MOTORS, MotorId, Snapshot
 
 

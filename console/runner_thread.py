@@ -15,11 +15,10 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from stairbot.config import RobotConfig
 from stairbot.console.scene import SceneView, scene_from_sim, stairs_from_scenario
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, Recorder, WatchedRobot
-
-from stairbot.config import RobotConfig
 from stairbot.errors import InputError, StairbotError
 from stairbot.events import Event, EventKind
 from stairbot.robots import RobotOptions, RobotSession

@@ -12,7 +12,6 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from stairbot.console.scene import SceneView
-
 from stairbot.events import Event
 from stairbot.hardware import MotorId, Snapshot
 

@@ -14,7 +14,6 @@ from typing import IO
 
 from stairbot.console.scene import SceneView
 from stairbot.console.state import LiveState
-
 from stairbot.errors import InputError
 from stairbot.events import Event
 from stairbot.hardware import Clock, MotorId, Robot, Snapshot, Speeds

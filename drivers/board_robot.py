@@ -23,7 +23,6 @@ from typing import Any, Concatenate, ParamSpec, TypeVar
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.link import Link, Pending
-
 from stairbot.errors import HardwareError, LinkLostError, RobotFellError, RobotUrlError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot

@@ -26,11 +26,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import can
+
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_wire import BROADCAST, CanWire, frame_bits, wire
 from stairbot.drivers.link import LinkStats
 from stairbot.drivers.serial_wire import Frame
-
 from stairbot.errors import LinkLostError
 
 _CHANNELS = {int(m.Board.MOTOR): (len(m.MOTOR_CHANNELS), m.MotorTelemetry),

@@ -51,12 +51,12 @@ from urllib.parse import parse_qsl, unquote
 
 import can
 import can.util
-from stairbot.drivers import messages as m
-from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.serial_robot import LockstepClock, SerialRobot
 
 from stairbot.clock import WallClock
 from stairbot.config import RobotConfig
+from stairbot.drivers import messages as m
+from stairbot.drivers.can_link import CanLink
+from stairbot.drivers.serial_robot import LockstepClock, SerialRobot
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.scenario import Scenario

@@ -27,6 +27,7 @@ from typing import Any
 
 import can
 import cantools
+
 from stairbot.drivers import messages as m
 
 DBC_NAME = "stairbot.dbc"

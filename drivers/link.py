@@ -31,7 +31,6 @@ from typing import Any, Protocol
 
 from stairbot.drivers.messages import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
-
 from stairbot.errors import LinkLostError
 
 

@@ -35,11 +35,11 @@ from typing import Any
 from urllib.parse import parse_qsl, urlencode
 
 import serial
-from stairbot.drivers.board_robot import BoardRobot, LockstepClock
-from stairbot.drivers.link import FdChannel, Link, PortChannel
 
 from stairbot.clock import WallClock
 from stairbot.config import RobotConfig
+from stairbot.drivers.board_robot import BoardRobot, LockstepClock
+from stairbot.drivers.link import FdChannel, Link, PortChannel
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.scenario import Scenario

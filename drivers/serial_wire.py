@@ -25,6 +25,7 @@ import binascii
 from dataclasses import dataclass
 
 from cobs import cobs
+
 from stairbot.drivers.messages import MAX_PAYLOAD, MESSAGES, CodecError, Message, decode, encode
 
 FROM_BOARD = 0x80

@@ -20,7 +20,6 @@ from stairbot.drivers.messages import (
     SetLiftSpeeds,
     SetWheelSpeeds,
 )
-
 from stairbot.hardware import MotorId, MotorState, SensorReading, SensorStatus
 
 

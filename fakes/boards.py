@@ -20,7 +20,6 @@ from collections.abc import Sequence
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.serial_wire import RawMessage
-
 from stairbot.errors import HardwareError
 from stairbot.hardware import Clock, MotorId, Robot, Snapshot
 

@@ -17,11 +17,10 @@ import signal
 import sys
 from importlib import import_module
 
+from stairbot.config import RobotConfig, load_config
 from stairbot.fakes.boards import BoardWorld, make_boards
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
-
-from stairbot.config import RobotConfig, load_config
 from stairbot.scenario import Scenario, load_scenario
 
 

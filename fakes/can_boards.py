@@ -31,14 +31,14 @@ import time
 from dataclasses import dataclass
 
 import can
+
+from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
+from stairbot.errors import RobotUrlError
 from stairbot.fakes.boards import Board, BoardWorld, make_boards
 from stairbot.fakes.serial_boards import WireFaults
-
-from stairbot.config import load_config
-from stairbot.errors import RobotUrlError
 from stairbot.scenario import load_scenario
 
 

@@ -29,12 +29,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from urllib.parse import urlsplit
 
+from stairbot.config import RobotConfig
+from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensors import RangeSensor
 from stairbot.fakes.world import World, WorldParams
-
-from stairbot.config import RobotConfig
-from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.hardware import (
     LIFT_MOTORS,
     MotorId,

@@ -25,9 +25,8 @@ try:  # the C functions behind pymunk's Body properties, without the Python wrap
     from pymunk._chipmunk import lib as _cp
 except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
     _cp = None
-from stairbot.fakes.stairs import StairsProfile, stairs_outline
-
 from stairbot.config import RobotConfig
+from stairbot.fakes.stairs import StairsProfile, stairs_outline
 from stairbot.scenario import Scenario
 
 TWO_PI = 2.0 * math.pi

@@ -4,8 +4,9 @@ know now (an emergency stop, a lost link, how the run ended)."""
 from __future__ import annotations
 
 from rich.text import Text
-from stairbot.console.state import RunStatus
 from textual.widgets import Static
+
+from stairbot.console.state import RunStatus
 
 SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
 

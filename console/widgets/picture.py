@@ -4,9 +4,10 @@ braille dots so the picture gets twice the columns and four times the rows."""
 from __future__ import annotations
 
 from rich.text import Text
+from textual.widget import Widget
+
 from stairbot.console.canvas import BrailleCanvas
 from stairbot.console.scene import Point, SceneView
-from textual.widget import Widget
 
 SEGMENT_STYLES = ("bold bright_cyan", "bold yellow", "bold magenta")
 STAIRS_STYLE = "grey70"

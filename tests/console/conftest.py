@@ -5,8 +5,9 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import pytest
-from stairbot.console.app import StairbotConsole
 from still_robot import make_still_app
+
+from stairbot.console.app import StairbotConsole
 
 
 @pytest.fixture

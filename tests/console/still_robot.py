@@ -7,10 +7,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.scene import stairs_from_scenario
-
-from stairbot.config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot, Speeds
 from stairbot.robots import RobotSession

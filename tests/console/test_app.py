@@ -10,12 +10,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from stairbot.console.app import StairbotConsole, build_app
-from stairbot.console.modals import ConfirmScreen
 from textual import events
 from textual.widgets import Input
 
 from stairbot.cli import main as cli_main
+from stairbot.console.app import StairbotConsole, build_app
+from stairbot.console.modals import ConfirmScreen
 from stairbot.errors import LinkLostError
 from stairbot.hardware import MotorId, Snapshot, Speeds
 from stairbot.robots import RobotSession, open_robot

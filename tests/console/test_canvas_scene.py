@@ -4,10 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
+from stairbot.config import load_config
 from stairbot.console.canvas import BrailleCanvas
 from stairbot.console.scene import SceneView, scene_from_sim, stairs_from_scenario
-
-from stairbot.config import load_config
 from stairbot.scenario import load_scenario
 
 
@@ -41,7 +40,6 @@ def test_scenario_stairs_outline() -> None:
 
 def test_scene_from_the_simulation_shows_the_robot_before_the_stairs() -> None:
     from stairbot.fakes.sim import open_sim_robot
-
     from stairbot.robots import RobotOptions
 
     session = open_sim_robot("sim://", load_config(), load_scenario(), RobotOptions())
@@ -62,7 +60,6 @@ def test_scene_accepts_mappings() -> None:
 
 def test_sensor_pairs_agree_differ_or_cannot_compare() -> None:
     from stairbot.console.widgets.sensors import pair_text
-
     from stairbot.hardware import SensorReading, SensorStatus
 
     ok, near = SensorReading(0.500), SensorReading(0.503)
@@ -77,7 +74,6 @@ def test_sensor_pairs_agree_differ_or_cannot_compare() -> None:
 
 def test_motor_direction_glyphs() -> None:
     from stairbot.console.widgets.motors import direction
-
     from stairbot.hardware import MotorId
 
     assert direction(MotorId.MWF, 1.0)[0] == "▶"
@@ -92,7 +88,6 @@ def test_dead_reckoning_follows_the_simulated_climb() -> None:
     5 cm (wheel slip adds up) and 2 cm in height of the simulation's truth
     over calibration and the first two steps."""
     from stairbot.console.reckon import dead_reckon
-
     from stairbot.robots import open_robot
     from stairbot.runner import RunControl, run
 

@@ -8,10 +8,10 @@ from types import SimpleNamespace
 from typing import Any
 
 import pytest
-from stairbot.console.runner_thread import ConsoleEngine, describe_result
-from stairbot.console.state import LiveState
 
 from stairbot.config import load_config
+from stairbot.console.runner_thread import ConsoleEngine, describe_result
+from stairbot.console.state import LiveState
 from stairbot.errors import InputError
 from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
 

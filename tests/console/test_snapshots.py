@@ -7,8 +7,9 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
-from stairbot.console.app import StairbotConsole
 from still_robot import show_climbing
+
+from stairbot.console.app import StairbotConsole
 
 
 async def climbing(pilot: Any) -> None:

@@ -13,18 +13,18 @@ from dataclasses import dataclass
 
 import can
 import pytest
+
+from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import CanRobot, open_can_robot, parse_can_url, resolve_bus_config
 from stairbot.drivers.serial_robot import LockstepClock
+from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.events import Event
 from stairbot.fakes.boards import Board, BoardWorld, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.serial_boards import WireFaults
-
-from stairbot.config import load_config
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
-from stairbot.events import Event
 from stairbot.hardware import MotorId
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.scenario import load_scenario

@@ -15,15 +15,15 @@ from pathlib import Path
 
 import can
 import pytest
+
+from stairbot.config import load_config
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import CanRobot
 from stairbot.drivers.serial_robot import LockstepClock
+from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
-
-from stairbot.config import load_config
-from stairbot.events import Event, EventKind
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunResult, run
 from stairbot.scenario import Scenario, load_scenario

@@ -16,14 +16,14 @@ import cantools
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
+from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_wire import CanWire, frame_bits, load_dbc, wire
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
-
-from stairbot.config import load_config
 from stairbot.scenario import load_scenario
 
 VECTORS: list[dict[str, Any]] = json.loads(

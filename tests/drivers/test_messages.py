@@ -9,9 +9,9 @@ import struct
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
-
 from stairbot.hardware import MotorId, SensorStatus
 
 RANGES = {"B": (0, 255), "H": (0, 65535), "h": (-32768, 32767), "I": (0, 2**32 - 1),

@@ -7,10 +7,10 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import pytest
+
 from stairbot.drivers import messages as m
 from stairbot.drivers.link import Link
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
-
 from stairbot.errors import LinkLostError
 
 Responder = Callable[[Frame], bytes | None]

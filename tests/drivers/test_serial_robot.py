@@ -14,15 +14,15 @@ from pathlib import Path
 import pytest
 import serial
 import serial.rfc2217
+
+from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_robot import SerialRobot, parse_serial_url
+from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import BoardWorld, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
-
-from stairbot.config import RobotConfig, load_config
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
-from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, SensorId
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import run

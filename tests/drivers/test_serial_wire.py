@@ -12,6 +12,7 @@ import pytest
 from crc import Calculator, Crc16
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import (
     MAX_FRAME,

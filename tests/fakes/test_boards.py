@@ -6,11 +6,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import pytest
+
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import RawMessage
-from stairbot.fakes.boards import BoardWorld, MotorBoard, SensorBoard, make_boards
-
 from stairbot.errors import RobotFellError
+from stairbot.fakes.boards import BoardWorld, MotorBoard, SensorBoard, make_boards
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 

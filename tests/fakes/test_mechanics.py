@@ -9,10 +9,10 @@ import math
 from collections.abc import Callable
 
 import pytest
-from stairbot.fakes.sim import SimClock, SimRobot
 
 from stairbot.config import RobotConfig, load_config
 from stairbot.errors import RobotFellError
+from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import MotorId, SensorId, Snapshot
 from stairbot.scenario import Scenario, load_scenario
 

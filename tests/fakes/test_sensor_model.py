@@ -6,10 +6,10 @@ import math
 import random
 
 import pytest
+
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensors import RangeSensor
 from stairbot.fakes.stairs import StairsProfile
-
 from stairbot.hardware import SensorId, SensorStatus
 from stairbot.scenario import Fault
 

@@ -11,12 +11,13 @@ import pytest
 from cobs import cobs
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_boards import StubClock, StubRobot
+
 from stairbot.drivers import messages as m
 from stairbot.drivers.link import FdChannel, Link
 from stairbot.drivers.serial_wire import Frame, FrameReader, crc16, encode_frame
 from stairbot.fakes.boards import BoardWorld, make_boards
 from stairbot.fakes.serial_boards import SerialBoardServer
-from test_boards import StubClock, StubRobot
 
 
 @pytest.fixture

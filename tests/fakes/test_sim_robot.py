@@ -9,10 +9,10 @@ import subprocess
 import sys
 
 import pytest
-from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
 
 from stairbot.config import load_config
 from stairbot.errors import RobotFellError, RobotUrlError
+from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
 from stairbot.hardware import Clock, MotorId, Robot, SensorId, SensorStatus, Snapshot
 from stairbot.robots import RobotOptions
 from stairbot.scenario import Scenario, load_scenario, parse_scenario
