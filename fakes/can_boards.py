@@ -23,7 +23,6 @@ error frame), duplicated, late, and a board that goes silent.
 from __future__ import annotations
 
 import contextlib
-import random
 import signal
 import sys
 import threading
@@ -38,7 +37,7 @@ from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
 from stairbot.errors import RobotUrlError
 from stairbot.fakes.boards import Board, BoardWorld, make_boards
-from stairbot.fakes.serial_boards import WireFaults
+from stairbot.fakes.serial_boards import FaultDice, WireFaults
 from stairbot.scenario import load_scenario
 
 
@@ -67,21 +66,16 @@ class CanBoardServer:
         self.step_s = step_s
         self.codec = codec or wire()
         self.stats = CanServerStats()
-        self._rng = random.Random(self.faults.seed)
+        self._dice = FaultDice(self.faults, self.stats)
         self._late: list[tuple[float, can.Message]] = []
         self._stop = threading.Event()
 
     # -- faults ------------------------------------------------------------------
     def _chance(self, p: float) -> bool:
-        if p and self._rng.random() < p:
-            self.stats.injected += 1
-            return True
-        return False
+        return self._dice.chance(p)
 
     def _silent(self, board: int) -> bool:
-        f = self.faults
-        return (f.silent_after_s is not None and self.world.now() >= f.silent_after_s
-                and f.silent_board in (None, board))
+        return self._dice.silent(board, self.world.now())
 
     # -- frames --------------------------------------------------------------------
     def _send(self, frame: can.Message) -> None:

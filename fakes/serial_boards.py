@@ -24,6 +24,7 @@ import threading
 import time
 import tty
 from dataclasses import dataclass
+from typing import Protocol
 
 from stairbot.drivers.messages import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
@@ -48,6 +49,33 @@ class WireFaults:
     def any(self) -> bool:
         return bool(self.drop or self.corrupt or self.duplicate or self.late
                     or self.silent_after_s is not None)
+
+
+class _Counts(Protocol):
+    injected: int
+
+
+class FaultDice:
+    """Draws one server's wire faults from its seeded stream and counts each
+    injected fault in ``stats.injected``; shared by the serial and CAN servers."""
+
+    def __init__(self, faults: WireFaults, stats: _Counts) -> None:
+        self.faults = faults
+        self.stats = stats
+        self.rng = random.Random(faults.seed)
+
+    def chance(self, p: float) -> bool:
+        """True with probability ``p`` (and then counted as injected)."""
+        if p and self.rng.random() < p:
+            self.stats.injected += 1
+            return True
+        return False
+
+    def silent(self, board: int, now_s: float) -> bool:
+        """Whether ``board`` has gone silent at board time ``now_s``."""
+        f = self.faults
+        return (f.silent_after_s is not None and now_s >= f.silent_after_s
+                and f.silent_board in (None, board))
 
 
 @dataclass
@@ -76,7 +104,8 @@ class SerialBoardServer:
         self.time_scale = time_scale
         self.step_s = step_s
         self.stats = ServerStats()
-        self._rng = random.Random(self.faults.seed)
+        self._dice = FaultDice(self.faults, self.stats)
+        self._rng = self._dice.rng
         self._reader = FrameReader()
         self._last: dict[int, tuple[Frame, bytes]] = {}
         self._late: list[tuple[float, bytes]] = []
@@ -86,15 +115,10 @@ class SerialBoardServer:
 
     # -- faults ------------------------------------------------------------------
     def _chance(self, p: float) -> bool:
-        if p and self._rng.random() < p:
-            self.stats.injected += 1
-            return True
-        return False
+        return self._dice.chance(p)
 
     def _silent(self, board: int) -> bool:
-        f = self.faults
-        return (f.silent_after_s is not None and self.world.now() >= f.silent_after_s
-                and f.silent_board in (None, board))
+        return self._dice.silent(board, self.world.now())
 
     def _corrupt(self, wire: bytes) -> bytes:
         i = self._rng.randrange(len(wire) - 1)  # never the delimiter
