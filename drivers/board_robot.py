@@ -20,12 +20,14 @@ import time
 from collections.abc import Callable, Mapping
 from typing import Any, Concatenate, ParamSpec, TypeVar
 
+from stairbot.clock import WallClock
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.link import Link, Pending
 from stairbot.errors import HardwareError, LinkLostError, RobotFellError, RobotUrlError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.robots import RobotSession
 
 EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
 
@@ -76,7 +78,7 @@ class BoardRobot:
         self.url = url
         self.lockstep = lockstep
         self.sink = sink
-        self.clock: Any = None  # set by open_serial_robot
+        self.clock: Any = None  # set by board_session
         self.idents: dict[int, m.Ident] = {}
         self.status: dict[int, m.Status] = {}
         self.refused = 0
@@ -384,6 +386,19 @@ class BoardRobot:
             what = ", ".join(f"+{v:g} {k}" for k, v in changed.items())
             self.sink(Event(now, EventKind.LINK, f"link: {what} (rtt median "
                             f"{health['rtt_median_ms']:.2f} ms)", None, dict(health)))
+
+
+def board_session(robot: BoardRobot, url: str, time_scale: float) -> RobotSession:
+    """The session of an opened board robot: its lockstep clock, or the wall
+    clock (sped up by ``time_scale`` when the fake boards run faster)."""
+    clock: LockstepClock | WallClock
+    if robot.lockstep:
+        clock = LockstepClock(robot)
+    else:
+        clock = WallClock(monotonic=lambda: time.monotonic() * time_scale,
+                          sleep=lambda s: time.sleep(s / time_scale))
+    robot.clock = clock
+    return RobotSession(robot=robot, clock=clock, url=url, simulated=robot.simulated, sim=None)
 
 
 def vars_of(ident: m.Ident) -> dict[str, int]:

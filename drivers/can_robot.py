@@ -44,7 +44,6 @@ Examples::
 from __future__ import annotations
 
 import ipaddress
-import time
 from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qsl, unquote
@@ -52,11 +51,11 @@ from urllib.parse import parse_qsl, unquote
 import can
 import can.util
 
-from stairbot.clock import WallClock
 from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
+from stairbot.drivers.board_robot import board_session
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.serial_robot import LockstepClock, SerialRobot
+from stairbot.drivers.serial_robot import SerialRobot
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.scenario import Scenario
@@ -230,11 +229,4 @@ def open_can_robot(url: str, config: RobotConfig, scenario: Scenario,
     except BaseException:
         link.close()
         raise
-    clock: Any
-    if robot.lockstep:
-        clock = LockstepClock(robot)
-    else:
-        clock = WallClock(monotonic=lambda: time.monotonic() * scale,
-                          sleep=lambda s: time.sleep(s / scale))
-    robot.clock = clock
-    return RobotSession(robot=robot, clock=clock, url=url, simulated=robot.simulated, sim=None)
+    return board_session(robot, url, scale)

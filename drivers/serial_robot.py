@@ -30,15 +30,12 @@ the ``Link`` that frames messages for it.
 from __future__ import annotations
 
 import io
-import time
-from typing import Any
 from urllib.parse import parse_qsl, urlencode
 
 import serial
 
-from stairbot.clock import WallClock
 from stairbot.config import RobotConfig
-from stairbot.drivers.board_robot import BoardRobot, LockstepClock
+from stairbot.drivers.board_robot import BoardRobot, LockstepClock, board_session
 from stairbot.drivers.link import FdChannel, Link, PortChannel
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
@@ -119,14 +116,7 @@ def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
     except BaseException:
         link.close()
         raise
-    clock: Any
-    if robot.lockstep:
-        clock = LockstepClock(robot)
-    else:
-        clock = WallClock(monotonic=lambda: time.monotonic() * scale,
-                          sleep=lambda s: time.sleep(s / scale))
-    robot.clock = clock
-    return RobotSession(robot=robot, clock=clock, url=url, simulated=robot.simulated, sim=None)
+    return board_session(robot, url, scale)
 
 
 __all__ = ["DEFAULTS", "LockstepClock", "SerialRobot", "open_channel", "open_serial_robot",
