@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import tomllib
 from typing import Any, TypeVar
@@ -32,12 +33,47 @@ def load_toml(text: str, source: str, error: type[InputError]) -> dict[str, Any]
 
 def convert(raw: dict[str, Any], kind: type[T], source: str, error: type[InputError]) -> T:
     """Convert parsed TOML to the struct ``kind``.  Raises ``error`` whose message
-    names ``source``, the dotted field and what the field allows."""
+    names ``source``, the dotted field and what the field allows.  TOML's
+    ``inf`` and ``nan`` are refused wherever a number goes."""
     try:
-        return msgspec.convert(raw, kind, strict=True)
+        out = msgspec.convert(raw, kind, strict=True)
     except msgspec.ValidationError as exc:
         field, problem = explain(str(exc), raw, kind)
         raise error(source, field, problem) from None
+    bad = _non_finite(raw, [])
+    if bad is not None:
+        value, tokens = bad
+        raise error(source, _dotted(tokens) or None,
+                    f"{_shown(value)} is not allowed; allowed: "
+                    f"{describe(_type_at(kind, tokens))}, finite")
+    return out
+
+
+def _non_finite(raw: Any, tokens: list[str | int]) -> tuple[float, list[str | int]] | None:
+    """The first inf or nan in parsed TOML, with where it is."""
+    if isinstance(raw, float):
+        return None if math.isfinite(raw) else (raw, tokens)
+    items = raw.items() if isinstance(raw, dict) else (
+        enumerate(raw) if isinstance(raw, list) else ())
+    for key, value in items:
+        found = _non_finite(value, [*tokens, key])
+        if found is not None:
+            return found
+    return None
+
+
+def _shown(value: Any) -> str:
+    """A value as the TOML file spells it (true, inf, 'text'), or its kind for a
+    table or a list."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if value != value else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "a list"
+    return repr(value)
 
 
 def _tokens(path: str) -> list[str | int]:
@@ -131,5 +167,4 @@ def explain(message: str, raw: dict[str, Any], kind: Any) -> tuple[str | None, s
         return _dotted(full), f"required but missing; allowed: {describe(_type_at(kind, full))}"
     field = _dotted(tokens) or None
     value = _value_at(raw, tokens)
-    shown = f"{value!r}" if not isinstance(value, dict | list) else type(value).__name__
-    return field, f"{shown} is not allowed; allowed: {describe(_type_at(kind, tokens))}"
+    return field, f"{_shown(value)} is not allowed; allowed: {describe(_type_at(kind, tokens))}"

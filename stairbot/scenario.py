@@ -41,8 +41,12 @@ class Stairs(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     side_wall: Literal["none", "left", "right", "both"] = "none"
 
 
+MAX_START_DISTANCE = 20.0
+"""Farthest start before the first riser, m (the simulated floor runs 30 m back)."""
+
+
 class Start(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    distance: Pos = 0.5
+    distance: Annotated[float, msgspec.Meta(gt=0, le=MAX_START_DISTANCE)] = 0.5
     yaw_deg: Annotated[float, msgspec.Meta(ge=-80, le=80)] = 0.0
     lateral: float = 0.0
 

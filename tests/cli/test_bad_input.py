@@ -47,6 +47,33 @@ CASES = [
      "--config", ["robot_neg.toml", "geometry.wheel_radius", "> 0"]),
     ("robot_key.toml", ROBOT.replace("[masses]\n", "[masses]\nbattery = 2\n"), "--config",
      ["robot_key.toml", "masses.battery", "unknown key"]),
+    ("robot_section.toml", ROBOT + "\n[battery]\nvolts = 12\n", "--config",
+     ["robot_section.toml", "battery", "unknown key", "geometry, masses, motors"]),
+    ("robot_inf.toml", ROBOT.replace("lift_travel = 0.21", "lift_travel = inf"), "--config",
+     ["robot_inf.toml", "motors.lift_travel", "inf is not allowed", "> 0, finite"]),
+    ("robot_bool.toml", ROBOT.replace("max_steps = 10", "max_steps = true"), "--config",
+     ["robot_bool.toml", "algorithm.max_steps", "true is not allowed", "a whole number"]),
+    ("robot_empty.toml", "", "--config",
+     ["robot_empty.toml", "geometry", "required but missing"]),
+    ("empty_steps.toml", "[stairs]\nsteps = [{rise = 0.17}]\n", "--scenario",
+     ["empty_steps.toml", "stairs.steps[0].tread", "required but missing", "> 0"]),
+    ("fault_sensor.toml", "[[faults]]\nat = 1.0\nsensor = 'SXX'\nkind = 'error'\n",
+     "--scenario", ["fault_sensor.toml", "faults[0].sensor", "'SFR'", "'SBL'"]),
+    ("fault_key.toml", "[[faults]]\nat = 1.0\nsensor = 'SFL'\nkind = 'error'\nwhen = 2\n",
+     "--scenario", ["fault_key.toml", "faults[0].when", "unknown key", "duration"]),
+    ("fault_nan.toml",
+     "[[faults]]\nat = 1.0\nsensor = 'SFL'\nkind = 'offset'\noffset = nan\n",
+     "--scenario", ["fault_nan.toml", "faults[0].offset", "nan is not allowed", "finite"]),
+    ("lateral_inf.toml", "[start]\nlateral = -inf\n", "--scenario",
+     ["lateral_inf.toml", "start.lateral", "-inf is not allowed"]),
+    ("yaw.toml", "[start]\nyaw_deg = 95.0\n", "--scenario",
+     ["yaw.toml", "start.yaw_deg", "95.0", ">= -80 and <= 80"]),
+    ("far.toml", "[start]\ndistance = 50.0\n", "--scenario",
+     ["far.toml", "start.distance", "<= 20"]),
+    ("expect.toml", "[expect]\noutcome = 'great'\n", "--scenario",
+     ["expect.toml", "expect.outcome", "'great'", "'completed'"]),
+    ("top_key.toml", "colour = 'red'\n", "--scenario",
+     ["top_key.toml", "colour", "unknown key", "stairs, start, sensors"]),
 ]
 
 
@@ -139,3 +166,17 @@ def test_the_installed_script_prints_no_traceback_for_bad_input(tmp_path: Path) 
     line = one_error_line(proc.stderr)
     assert "faults[0].sensor" in line and "'SFQ'" in line and "'SFL'" in line
     assert proc.stdout == ""
+
+
+@pytest.mark.parametrize("option", ["--scenario", "--config"])
+def test_a_binary_file_or_a_directory_exits_2(tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str],
+                                              option: str) -> None:
+    binary = tmp_path / "blob.toml"
+    binary.write_bytes(b"\x7fELF\x02\x01\x01\x00\xff\xfe\x00\x00")
+    assert main(["run", option, str(binary)]) == 2
+    assert "blob.toml: not a UTF-8 text file" in one_error_line(capsys.readouterr().err)
+    folder = tmp_path / "folder.toml"
+    folder.mkdir()
+    assert main(["run", option, str(folder)]) == 2
+    assert "folder.toml: cannot read" in one_error_line(capsys.readouterr().err)
