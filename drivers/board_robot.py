@@ -34,15 +34,15 @@ EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
 
 P = ParamSpec("P")
 R = TypeVar("R")
+S = TypeVar("S", bound="BoardRobot")
 
 
-def _locked(method: Callable[Concatenate[BoardRobot, P], R]
-            ) -> Callable[Concatenate[BoardRobot, P], R]:
+def locked(method: Callable[Concatenate[S, P], R]) -> Callable[Concatenate[S, P], R]:
     """Run a BoardRobot method under the robot's lock: the keepalive thread
     and the control loop (or a console) share one link."""
 
     @functools.wraps(method)
-    def wrapper(self: BoardRobot, *args: P.args, **kwargs: P.kwargs) -> R:
+    def wrapper(self: S, *args: P.args, **kwargs: P.kwargs) -> R:
         with self._lock:
             return method(self, *args, **kwargs)
 
@@ -70,6 +70,7 @@ class BoardRobot:
     see the module docstring."""
 
     PIPELINED_STEP = True
+    WIRE = "link"  # what the boards hang on, for messages: "serial port", "CAN bus"
 
     def __init__(self, link: Link, url: str, watchdog_ms: int = 250,
                  lockstep: bool = False, sink: EventSink = discard,
@@ -105,7 +106,7 @@ class BoardRobot:
         self._keepalive: threading.Thread | None = None
         if watchdog_ms and not lockstep:
             self._keepalive = threading.Thread(target=self._keep_alive, daemon=True,
-                                               name="serial robot keepalive")
+                                               name=f"{self.WIRE} robot keepalive")
             self._keepalive.start()
 
     # -- setting up ------------------------------------------------------------
@@ -115,8 +116,8 @@ class BoardRobot:
             try:
                 reply = self.link.exchange(board, [m.Identify(), m.GetStatus()])
             except LinkLostError:
-                raise RobotUrlError(self.url, None, f"no {name} board answered on the port "
-                                    f"({self.link.retries + 1} tries of "
+                raise RobotUrlError(self.url, None, f"no {name} board answered on the "
+                                    f"{self.WIRE} ({self.link.retries + 1} tries of "
                                     f"{self.link.timeout_s * 1e3:.0f} ms)") from None
             ident, status = (reply.messages + (None, None))[:2]
             if not isinstance(ident, m.Ident) or not isinstance(status, m.Status):
@@ -163,7 +164,7 @@ class BoardRobot:
         return float(self.clock.now()) if self.clock is not None else 0.0
 
     # -- the Robot protocol ----------------------------------------------------
-    @_locked
+    @locked
     def read(self) -> Snapshot:
         """One ReadAll to each board.  Raises LinkLostError (no reply, or a
         board's watchdog tripped), RobotFellError (fake boards: the simulated
@@ -183,7 +184,7 @@ class BoardRobot:
         self._maybe_event(health)
         return Snapshot(self._now(), sensors, motors, health)
 
-    @_locked
+    @locked
     def command(self, speeds: Mapping[MotorId, float]) -> None:
         """Send every motor's speed in one frame; its Ack is checked later."""
         self._reap()
@@ -195,7 +196,7 @@ class BoardRobot:
         self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
                                             send=not self.lockstep))
 
-    @_locked
+    @locked
     def flush(self) -> None:
         """Wait for the Acks of every command still in flight (LinkLostError
         if one never comes)."""
@@ -204,23 +205,23 @@ class BoardRobot:
             self._wait(pending)
         self._reap()
 
-    @_locked
+    @locked
     def stop_all(self) -> None:
         """Stop every motor (lifts hold); never raises."""
         with contextlib.suppress(Exception):
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
 
-    @_locked
+    @locked
     def estop(self) -> None:
         """Latch the emergency stop on both boards."""
         self._wait([self._request(b, [m.EStop()]) for b in m.Board])
 
-    @_locked
+    @locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
         """Clear latches (e-stop, watchdog, faults) on both boards."""
         self._wait([self._request(b, [m.Clear(mask)]) for b in m.Board])
 
-    @_locked
+    @locked
     def step_to(self, time_us: int) -> None:
         """Lockstep: the world advances to ``time_us``.  With PIPELINED_STEP
         the StepDone is awaited by the next read() (the boards handle frames
@@ -241,7 +242,7 @@ class BoardRobot:
         if not reply.messages or not isinstance(reply.messages[0], m.StepDone):
             raise HardwareError(f"the motor board refused StepTo: {reply.messages}")
 
-    @_locked
+    @locked
     def heartbeat(self) -> None:
         """Feed the watchdog of a board that was sent nothing for a quarter of
         its timeout (the control loop's own frames normally do this)."""
@@ -252,7 +253,7 @@ class BoardRobot:
             if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:
                 self._commands.append(self._request(board, [m.Heartbeat()]))
 
-    @_locked
+    @locked
     def diagnostics(self) -> dict[str, object]:
         out: dict[str, object] = {"url": self.url, "lockstep": self.lockstep,
                                   "link": self.health(),
@@ -286,7 +287,7 @@ class BoardRobot:
             self._keepalive.join(1.0)
         self._close()
 
-    @_locked
+    @locked
     def _close(self) -> None:
         if self._closed:
             return
@@ -322,10 +323,18 @@ class BoardRobot:
             self._lost(str(exc))
             raise  # unreachable: _lost raises
 
-    def _lost(self, reason: str) -> None:
+    def _lost(self, reason: str, boards_stopped: bool = False) -> None:
+        """Report the lost link (a LINK event) and raise LinkLostError saying
+        what became of the motors."""
         self.sink(Event(self._now(), EventKind.LINK, f"link lost: {reason}", None,
                         self.health()))
-        raise LinkLostError(f"{self.url}: {reason}")
+        if boards_stopped:
+            after = ""
+        elif self.watchdog_ms:
+            after = f"; the boards' watchdogs stop every motor within {self.watchdog_ms} ms"
+        else:
+            after = "; the boards' watchdogs are off (watchdog=0): motors may still run"
+        raise LinkLostError(f"{self.url}: link lost: {reason}{after}")
 
     def _reap(self) -> None:
         self.link.poll()
@@ -345,7 +354,8 @@ class BoardRobot:
         if status.flags & m.StatusFlag.WATCHDOG:
             what = ": its motors are stopped until cleared" if board == m.Board.MOTOR else ""
             self._lost(f"the {name} board's watchdog tripped (nothing from the host for "
-                       f"{status.watchdog_ms} ms){what}")
+                       f"{status.watchdog_ms} ms){what}",
+                       boards_stopped=board == m.Board.MOTOR)
         if status.fault == m.MotorFault.SIMULATION:
             truth = self.diagnostics()
             if truth.get("fell"):

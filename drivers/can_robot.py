@@ -53,9 +53,8 @@ import can.util
 
 from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import board_session
+from stairbot.drivers.board_robot import BoardRobot, board_session, locked
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.serial_robot import SerialRobot
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.scenario import Scenario
@@ -191,21 +190,26 @@ def open_bus(spec: CanUrl) -> can.BusABC:
         raise RobotUrlError(spec.url, None, f"cannot open CAN bus {where}: {detail}") from exc
 
 
-class CanRobot(SerialRobot):
+class CanRobot(BoardRobot):
     """Both boards on one CAN bus.  The board logic -- handshake, ReadAll to
     each board, speeds in SetWheelSpeeds + SetLiftSpeeds with their Acks
     checked on the next call, watchdog and e-stop handling, link health into
-    ``Snapshot.health`` and LINK events, LinkLostError -- is the serial
-    driver's; only the link differs.  An emergency stop is one broadcast frame
-    with the bus's highest-priority id."""
+    ``Snapshot.health`` and LINK events, LinkLostError -- is
+    ``board_robot.BoardRobot``'s, as for the serial driver; only the link
+    differs.  An emergency stop is one broadcast frame with the bus's
+    highest-priority id."""
 
+    WIRE = "CAN bus"
     link: CanLink  # type: ignore[assignment]
 
+    @locked
     def estop(self) -> None:
         """Latch the emergency stop on both boards with one EStop_All frame
-        (id 0x00F) and wait for both boards' Status."""
+        (id 0x00F) and wait for both boards' Status.  Under the robot's lock,
+        like every other robot method: the keepalive thread shares the link."""
         self._wait(self.link.broadcast(m.EStop()))  # type: ignore[arg-type]
 
+    @locked
     def diagnostics(self) -> dict[str, object]:
         out = super().diagnostics()
         bus = self.link.bus

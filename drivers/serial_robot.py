@@ -100,6 +100,8 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
 class SerialRobot(BoardRobot):
     """Both boards over one serial Link."""
 
+    WIRE = "serial port"
+
 
 def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
                       options: RobotOptions) -> RobotSession:

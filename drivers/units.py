@@ -7,6 +7,7 @@ nearest; values beyond a wire type's range are clamped, never wrapped.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 from stairbot.drivers.messages import (
@@ -28,7 +29,11 @@ def _clamp(value: int, low: int, high: int) -> int:
 
 
 def speed_to_wire(tps: float) -> int:
-    """turns/s -> milli-turns/s (nearest, clamped to int16)."""
+    """turns/s -> milli-turns/s (nearest, clamped to int16).  A speed that is
+    not a finite number is sent as 0 (stop; a lift holds), as ``sim://`` does,
+    rather than raising out of the control loop or running a motor flat out."""
+    if not math.isfinite(tps):
+        return 0
     return _clamp(round(tps * 1000.0), -INT16_MAX, INT16_MAX)
 
 

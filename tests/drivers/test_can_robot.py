@@ -120,7 +120,7 @@ def test_a_bus_that_cannot_open_is_one_line_and_no_boards_is_one_line() -> None:
     config, scenario = load_config(), load_scenario()
     with pytest.raises(RobotUrlError, match="cannot open CAN bus slcan//dev/nonexistent"):
         open_robot("can://slcan//dev/nonexistent", config, scenario, RobotOptions())
-    with pytest.raises(RobotUrlError, match="no motor board answered"):
+    with pytest.raises(RobotUrlError, match="no motor board answered on the CAN bus"):
         open_robot(f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0", config,
                    scenario, RobotOptions())
 
@@ -187,6 +187,22 @@ def test_emergency_stop_is_one_broadcast_frame_and_latches(rig: Rig) -> None:
     rig.robot.command(FORWARD)
     rig.robot.flush()
     assert rig.world.speeds()[MotorId.MWF] == 1.0
+
+
+def test_the_emergency_stop_runs_under_the_robots_lock(
+        rig: Rig, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The keepalive thread shares the link: EStop_All goes out under the lock."""
+    link = rig.robot.link
+    held: list[bool] = []
+    broadcast = link.broadcast
+
+    def spy(msg: m.Message) -> list:  # type: ignore[type-arg]
+        held.append(rig.robot._lock._is_owned())  # type: ignore[attr-defined]
+        return broadcast(msg)
+
+    monkeypatch.setattr(link, "broadcast", spy)
+    rig.robot.estop()
+    assert held == [True]
 
 
 def test_a_silent_board_means_link_lost_and_a_link_event() -> None:

@@ -90,6 +90,13 @@ def test_speeds_to_wire_sends_zero_for_motors_left_out() -> None:
     assert lifts == m.SetLiftSpeeds(0, 10000)
 
 
+def test_a_speed_that_is_not_a_number_is_sent_as_stop() -> None:
+    wheels, lifts = u.speeds_to_wire({MotorId.MWF: float("nan"), MotorId.MWB: float("inf"),
+                                      MotorId.MWR: 0.5, MotorId.MTF: float("-inf")})
+    assert wheels == m.SetWheelSpeeds(0, 0, 500, 0)
+    assert lifts == m.SetLiftSpeeds(0, 0)
+
+
 def test_only_queries_and_step_to_are_idempotent() -> None:
     idempotent = {c.__name__ for c in m.MESSAGES.values() if c.IDEMPOTENT}
     assert idempotent == {"Identify", "Heartbeat", "GetStatus", "ReadAll", "GetMotor",

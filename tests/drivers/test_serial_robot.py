@@ -350,7 +350,7 @@ def test_url_options() -> None:
 
 @pytest.mark.parametrize("url, problem", [
     ("serial:///dev/no-such-port", "cannot open port /dev/no-such-port"),
-    ("serial://loop://?timeout=0.01&retries=0", "no motor board answered"),
+    ("serial://loop://?timeout=0.01&retries=0", "no motor board answered on the serial port"),
     ("serial://", "expected serial://PORT"),
 ])
 def test_a_port_that_cannot_be_used_is_one_clear_line(url: str, problem: str) -> None:
