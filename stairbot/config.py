@@ -173,7 +173,16 @@ class RobotConfig:
     @property
     def max_step_rise_m(self) -> float:
         """Highest rise the ascent accepts: the sensors must see over it before MTF
-        has made MAX_OF_VERTICAL_TURNS - number_of_vertical_turns turns."""
+        has made MAX_OF_VERTICAL_TURNS - number_of_vertical_turns turns, so the
+        beam (front_height above the wheels) may rise at most lift_travel -
+        front_height - drive_clearance: the rise is at most lift_travel -
+        drive_clearance.
+
+        This is the limit of a rigid robot with a level beam.  A real one loses
+        a little to the nose-down pitch that the cantilevered segment 1 puts on
+        the wheels of segment 2: the beam must still clear the tread
+        LENGTH_OF_A_ROBOT + SAFE_LENGTH ahead.  The simulated robot loses under
+        1 mm (docs/algorithm.md, ascent 3)."""
         lift_at_sight = self.motors.lift_travel - (
             self.sensors.front_height + self.algorithm.drive_clearance
         )

@@ -86,3 +86,51 @@ def test_default_stairs_up_and_back_at_a_yaw_and_seed(yaw: float, seed: int) -> 
         "completed", "top_reached", 5, 5), r.to_dict()
     assert not r.fell
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+
+
+EDGE = """
+[stairs]
+count = 2
+rise = {rise:.4f}
+tread = 0.28
+[sensors]
+noise = 0.001
+seed = {seed}
+"""
+
+
+@pytest.mark.parametrize("seed", [1, 4])
+def test_max_step_rise_m_is_where_the_simulated_robot_stops_climbing(seed: int) -> None:
+    # The figure is the rule's limit for a rigid robot with a level beam (see
+    # docs/algorithm.md, ascent 3); the simulated robot, whose wheels give a little
+    # under the cantilevered segment 1, reaches it to within 1 mm.
+    limit = CONFIG.max_step_rise_m
+    under, _ = run_sim(parse_scenario(EDGE.format(rise=limit - 0.002, seed=seed), "under"))
+    assert (under.outcome, under.ascent_end, under.steps_climbed, under.steps_descended) == (
+        "completed", "top_reached", 2, 2), under.to_dict()
+    over, _ = run_sim(parse_scenario(EDGE.format(rise=limit + 0.002, seed=seed), "over"))
+    assert (over.outcome, over.ascent_end, over.steps_climbed) == (
+        "completed", "obstacle", 0), over.to_dict()
+    assert not under.fell and not over.fell
+
+
+TREAD_EDGE = """
+[stairs]
+count = 2
+rise = 0.17
+tread = {tread:.4f}
+[sensors]
+noise = 0.0
+"""
+
+
+def test_min_tread_m_is_where_the_simulated_robot_stops_entering() -> None:
+    # Without noise the edge is exact; with noise a single reading pair decides,
+    # so a tread a noise deviation or two shorter is sometimes entered.
+    limit = CONFIG.min_tread_m
+    over, _ = run_sim(parse_scenario(TREAD_EDGE.format(tread=limit + 0.002), "over"))
+    assert (over.outcome, over.ascent_end, over.steps_climbed, over.steps_descended) == (
+        "completed", "top_reached", 2, 2), over.to_dict()
+    under, _ = run_sim(parse_scenario(TREAD_EDGE.format(tread=limit - 0.002), "under"))
+    assert (under.outcome, under.ascent_end, under.steps_climbed) == (
+        "completed", "obstacle", 0), under.to_dict()
