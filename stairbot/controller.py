@@ -11,6 +11,7 @@ told as an event.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -19,7 +20,15 @@ from stairbot.config import RobotConfig
 from stairbot.context import Context
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.handler import Handler, PhaseIO, where
-from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, LIFT_MOTORS, MotorId, SensorId, Snapshot
+from stairbot.hardware import (
+    BACK_SENSORS,
+    FRONT_SENSORS,
+    LIFT_MOTORS,
+    MotorId,
+    SensorId,
+    SensorStatus,
+    Snapshot,
+)
 from stairbot.phases import BY_VALUE, Mode, Phase
 from stairbot.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
 
@@ -169,7 +178,15 @@ class Controller:
         for motor, state in snap.motors.items():
             if state.fault:
                 return f"motor fault: {motor} reports {state.fault!r} in {phase.label}"
-        errors = motion.sensor_errors(snap, _needed_sensors(phase, self._ctx))
+            if not math.isfinite(state.turns):
+                return f"motor fault: {motor} counts {state.turns} turns in {phase.label}"
+        needed = _needed_sensors(phase, self._ctx)
+        for sensor in needed:
+            # an ERROR reading's distance means nothing; any other must be a number
+            reading = snap.sensors[sensor]
+            if reading.status is not SensorStatus.ERROR and not math.isfinite(reading.distance_m):
+                return f"sensor error: {sensor} reads {reading.distance_m} m in {phase.label}"
+        errors = motion.sensor_errors(snap, needed)
         if errors:
             names = ", ".join(str(s) for s in errors)
             return f"sensor error: {names} report{'s' if len(errors) == 1 else ''} an error " \
@@ -187,7 +204,8 @@ class Controller:
         out = _zeros()
         for motor, v in speeds.items():
             vmax = self._vmax[motor]
-            v = max(-vmax, min(vmax, v))
+            # min/max pass a NaN through as a full-speed limit: it stops instead
+            v = max(-vmax, min(vmax, v)) if math.isfinite(v) else 0.0
             if motor in LIFT_MOTORS:
                 turns = snap.turns(motor)
                 if (v > 0 and turns >= stroke) or (v < 0 and turns <= -stroke):

@@ -3,13 +3,15 @@ stops safely, says why, and never moves again once it has ended."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
 from stairbot.config import load_config
 from stairbot.controller import PHASE_TIMEOUT_S, Controller
 from stairbot.events import Event, EventKind
-from stairbot.hardware import MotorId, SensorId
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.phases import Phase
 
 CFG = load_config()
@@ -220,3 +222,29 @@ def test_a_turn_that_never_squares_up_ends_with_an_error() -> None:
     run(ctrl, robot)
     assert ctrl.result.outcome == "error"
     assert "turned 90°" in str(ctrl.result.error)
+
+
+def test_a_reading_or_a_counter_that_is_not_a_number_ends_with_an_error() -> None:
+    for broken in ("reading", "counter"):
+        ctrl, robot, _ = start()
+        run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+        snap = robot.read()
+        if broken == "reading":
+            sensors = {**snap.sensors, SensorId.SFL: SensorReading(math.nan)}
+            snap = Snapshot(snap.time_s, sensors, snap.motors)
+        else:
+            motors = {**snap.motors, MotorId.MWF: MotorState(math.inf)}
+            snap = Snapshot(snap.time_s, snap.sensors, motors)
+        assert ctrl.tick(snap) == dict.fromkeys(MotorId, 0.0)
+        assert ctrl.result.outcome == "error"
+        assert ("SFL" if broken == "reading" else "MWF") in str(ctrl.result.error)
+        finish_and_check_zero(ctrl, robot)
+
+
+def test_a_speed_that_is_not_a_number_is_commanded_as_zero() -> None:
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+    limited = ctrl._limit({MotorId.MWF: math.nan, MotorId.MWB: -math.inf, MotorId.MTF: 99.0},
+                          robot.read())
+    assert limited[MotorId.MWF] == 0.0 and limited[MotorId.MWB] == 0.0
+    assert limited[MotorId.MTF] == CFG.motors.lift_speed
