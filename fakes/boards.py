@@ -15,7 +15,8 @@ A transport (``serial_boards``, the CAN fake) feeds each valid host frame to
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Iterable, Sequence
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
@@ -103,6 +104,43 @@ class BoardWorld:
             max(-(2**31) + 1, min(2**31 - 1, round(float(offset) * 1000))) if isinstance(
                 offset, int | float) else 0,
         )
+
+
+class Pacer:
+    """Keeps a world that is not in lockstep up with the wall clock times
+    ``time_scale``, one ``step_s`` step per :meth:`step`, so that a server
+    looks at its line between steps: one that fell behind answers the host
+    before it catches up.  Shared by the serial and the CAN server."""
+
+    MAX_WAIT_S = 0.05  # the longest a server waits on its line before looking again
+
+    def __init__(self, world: BoardWorld, boards: Iterable[Board], time_scale: float = 1.0,
+                 step_s: float = 0.005, monotonic: Callable[[], float] = time.monotonic
+                 ) -> None:
+        self.world = world
+        self.boards = list(boards)
+        self.time_scale = time_scale
+        self.step_s = step_s
+        self._monotonic = monotonic
+        self._start: tuple[float, float] | None = None  # (wall, world) at the first step
+
+    def step(self) -> float:
+        """Advance the world one step if it is due (and let every board check
+        its watchdog and Moves); the seconds the server may then wait on its
+        line: 0 after a step, until the next step is due otherwise, and
+        MAX_WAIT_S in lockstep (only StepTo advances the world)."""
+        if self.world.lockstep:
+            return self.MAX_WAIT_S
+        if self._start is None:
+            self._start = (self._monotonic(), self.world.now())
+        wall0, world0 = self._start
+        due = world0 + (self._monotonic() - wall0) * self.time_scale
+        if self.world.now() + self.step_s <= due:
+            self.world.advance(self.step_s)
+            for board in self.boards:
+                board.poll()
+            return 0.0
+        return min(self.MAX_WAIT_S, (self.world.now() + self.step_s - due) / self.time_scale)
 
 
 class Board:
@@ -204,18 +242,7 @@ class Board:
             if msg.mask & m.ClearMask.FAULTS:
                 self.fault = m.MotorFault.NONE
             return [self.status()]
-        if isinstance(msg, m.StepTo):
-            if not self.world.lockstep:
-                return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
-            done = self.world.step_to(msg.time_us)
-            self.after_step()
-            return [m.StepDone(done & 0xFFFFFFFF)]
-        if isinstance(msg, m.GetTruth):
-            return [self.world.truth()]
         return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
-
-    def after_step(self) -> None:
-        self.poll()
 
 
 class MotorBoard(Board):
@@ -293,6 +320,14 @@ class MotorBoard(Board):
             return self._motion(msg, {msg.channel: sp(msg.speed_mtps)})
         if isinstance(msg, m.Move):
             return self._move(msg)
+        if isinstance(msg, m.StepTo):  # the simulation's messages go to the motor board
+            if not self.world.lockstep:
+                return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
+            done = self.world.step_to(msg.time_us)
+            self.after_step()
+            return [m.StepDone(done & 0xFFFFFFFF)]
+        if isinstance(msg, m.GetTruth):
+            return [self.world.truth()]
         if isinstance(msg, m.Stop | m.Brake):
             if msg.mask & ~m.ALL_MOTORS_MASK:
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]
@@ -304,6 +339,12 @@ class MotorBoard(Board):
                         self.modes[ch] = m.MotorMode.BRAKE
             return [m.Ack(msg.TYPE, m.AckResult.OK)]
         return super().answer(msg)
+
+    def after_step(self) -> None:
+        """The world moved on: check both boards' watchdogs and the Moves."""
+        self.poll()
+        if self.peer is not None:
+            self.peer.poll()
 
     def _move(self, msg: m.Move) -> list[m.Message]:
         if msg.channel >= self.CHANNELS:
@@ -323,11 +364,6 @@ class MotorBoard(Board):
         if msg.turns_mt == 0:
             self._set({msg.channel: 0.0})
         return [m.Ack(msg.TYPE, m.AckResult.OK)]
-
-    def after_step(self) -> None:
-        self.poll()
-        if self.peer is not None:
-            self.peer.poll()
 
 
 class SensorBoard(Board):

@@ -36,7 +36,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
 from stairbot.errors import RobotUrlError
-from stairbot.fakes.boards import Board, BoardWorld, make_boards
+from stairbot.fakes.boards import Board, BoardWorld, Pacer, make_boards
 from stairbot.fakes.serial_boards import FaultDice, WireFaults
 from stairbot.scenario import load_scenario
 
@@ -151,19 +151,12 @@ class CanBoardServer:
 
     def serve(self) -> None:
         """Serve until :meth:`stop`.  In real time the world advances in
-        ``step_s`` steps to keep up with the wall clock times ``time_scale``;
-        in lockstep only StepTo advances it."""
-        lockstep = self.world.lockstep
-        wall0, sim0 = time.monotonic(), self.world.now()
+        ``step_s`` steps to keep up with the wall clock times ``time_scale``
+        (a :class:`Pacer`: the bus is looked at between steps, as on the serial
+        server); in lockstep only StepTo advances it."""
+        pacer = Pacer(self.world, self.boards.values(), self.time_scale, self.step_s)
         while not self._stop.is_set():
-            timeout = 0.05
-            if not lockstep:
-                due = sim0 + (time.monotonic() - wall0) * self.time_scale
-                while self.world.now() + self.step_s <= due:
-                    self.world.advance(self.step_s)
-                    for board in self.boards.values():
-                        board.poll()
-                timeout = min(timeout, (self.world.now() + self.step_s - due) / self.time_scale)
+            timeout = pacer.step()
             if self._late:
                 timeout = min(timeout, max(0.0, min(t for t, _ in self._late) - time.monotonic()))
             frame = self.bus.recv(timeout=max(0.0, timeout))

@@ -28,7 +28,7 @@ from typing import Protocol
 
 from stairbot.drivers.messages import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
-from stairbot.fakes.boards import Board, BoardWorld
+from stairbot.fakes.boards import Board, BoardWorld, Pacer
 
 
 @dataclass(frozen=True)
@@ -207,23 +207,10 @@ class SerialBoardServer:
     def serve(self) -> None:
         """Serve until :meth:`stop` (or the fd closes).  In real time the world
         advances in ``step_s`` steps to keep up with the wall clock times
-        ``time_scale``; in lockstep only StepTo advances it."""
-        lockstep = self.world.lockstep
-        wall0, sim0 = time.monotonic(), self.world.now()
+        ``time_scale`` (a :class:`Pacer`); in lockstep only StepTo advances it."""
+        pacer = Pacer(self.world, self.boards.values(), self.time_scale, self.step_s)
         while not self._stop.is_set():
-            timeout = 0.05
-            if not lockstep:
-                due = sim0 + (time.monotonic() - wall0) * self.time_scale
-                if self.world.now() + self.step_s <= due:
-                    # One step at a time, looking at the line between steps: a
-                    # server that fell behind answers the host before it catches up.
-                    self.world.advance(self.step_s)
-                    for board in self.boards.values():
-                        board.poll()
-                    timeout = 0.0
-                else:
-                    timeout = min(timeout, (self.world.now() + self.step_s - due)
-                                  / self.time_scale)
+            timeout = pacer.step()
             if self._late:
                 timeout = min(timeout, max(0.0, min(t for t, _ in self._late) - time.monotonic()))
             ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout))

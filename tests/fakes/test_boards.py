@@ -10,7 +10,7 @@ import pytest
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import RawMessage
 from stairbot.errors import RobotFellError
-from stairbot.fakes.boards import BoardWorld, MotorBoard, SensorBoard, make_boards
+from stairbot.fakes.boards import BoardWorld, MotorBoard, Pacer, SensorBoard, make_boards
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 
@@ -176,7 +176,11 @@ def test_refusals_and_unknown_messages(rig: tuple) -> None:
 
 
 def test_step_to_is_idempotent_and_lockstep_only(rig: tuple) -> None:
-    robot, world, motor, _ = rig
+    robot, world, motor, sensor = rig
+    # the simulation's messages are the motor board's (docs/protocol.md, section 2)
+    assert sensor.handle([m.StepTo(20_000)]) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([m.GetTruth()]) == [m.Ack(0x7D, m.AckResult.NOT_SUPPORTED)]
+    assert robot.t == 0.0
     assert motor.handle([m.StepTo(20_000)]) == [m.StepDone(20_000)]
     assert motor.handle([m.StepTo(20_000)]) == [m.StepDone(20_000)]
     assert motor.handle([m.StepTo(10_000)]) == [m.StepDone(20_000)]
@@ -201,3 +205,23 @@ def test_a_failed_world_is_a_latched_simulation_fault(rig: tuple) -> None:
     assert status.fault == m.MotorFault.SIMULATION and status.flags & m.StatusFlag.FAULT
     truth = motor.handle([m.GetTruth()])[0]
     assert truth == m.Truth(1, 325, 12)
+
+
+def test_the_pacer_keeps_the_world_up_with_the_wall_clock_one_step_at_a_time(
+        rig: tuple) -> None:
+    robot, world, motor, _ = rig
+    wall = [100.0]
+    pacer = Pacer(world, [motor], time_scale=10.0, step_s=0.005, monotonic=lambda: wall[0])
+    world.lockstep = True
+    assert pacer.step() == Pacer.MAX_WAIT_S and robot.t == 0.0  # lockstep: StepTo only
+    world.lockstep = False
+    assert pacer.step() == pytest.approx(0.0005)  # the first step is due 0.5 ms from now
+    wall[0] += 0.00201  # 20.1 ms of world time are due: four steps, one per call
+    waits = [pacer.step() for _ in range(5)]
+    assert waits[:4] == [0.0] * 4 and waits[4] > 0.0
+    assert robot.t == pytest.approx(0.02)
+    motor.handle([m.SetWatchdog(10)])
+    wall[0] += 0.002
+    while pacer.step() == 0.0:
+        pass
+    assert motor.watchdog_tripped  # the boards are polled between steps
