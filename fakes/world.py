@@ -273,7 +273,7 @@ class World:
             step(dt)
         self._steps_done += n
         self.time = self._steps_done * dt
-        self._check(n * dt)
+        self._check()
 
     def _set_lifts(self, seconds: float) -> None:
         """Aim each moving lift's pin at where the screw will be in ``seconds``; the
@@ -316,7 +316,7 @@ class World:
                 return True
         return False
 
-    def _check(self, elapsed: float) -> None:
+    def _check(self) -> None:
         """Track the pitch; detect a pitch beyond the limit, a segment falling (by
         its height change since the last check) and every wheel off every support."""
         if self.fell:

@@ -145,7 +145,7 @@ def describe(t: mi.Type | None) -> str:
     if isinstance(t, mi.BoolType):
         return "true or false"
     if isinstance(t, mi.ListType):
-        return "a list of " + describe(t.item_type)
+        return "a list, each " + describe(t.item_type)
     if isinstance(t, mi.StructType):
         return "a table with keys " + ", ".join(f.encode_name for f in t.fields)
     return "see the schema"
