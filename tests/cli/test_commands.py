@@ -57,6 +57,28 @@ def test_config_show_text_has_every_section_and_the_derived_values(
                for line in derived.splitlines())
 
 
+SEED_CONSTANTS = (
+    "SAFE_DISTANCE_IN_FRONT_OF_STEP", "SAFE_LENGTH", "MAX_OF_VERTICAL_TURNS",
+    "NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE", "NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH",
+    "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE", "NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE",
+    "LENGTH_OF_A_ROBOT", "LENGTH_OF_FIRST_MODULE", "LENGTH_OF_SECOND_MODULE",
+    "LENGTH_OF_THIRD_MODULE", "LENGTH_OF_INFINITY", "BACK_CLEARANCE",
+)
+
+
+def test_config_show_prints_every_seed_constant_under_its_seed_name(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    # the constant table of ../shared/ALGORITHM.md, each with a value on its own line
+    assert main(["config", "show"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    for name in SEED_CONSTANTS:
+        assert any(line.split("=")[0].strip() == name and "=" in line for line in lines), name
+    assert main(["config", "show", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    flat = {k for section in data.values() if isinstance(section, dict) for k in section}
+    assert set(SEED_CONSTANTS) <= flat
+
+
 def test_config_show_json_is_the_resolved_config(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["config", "show", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
