@@ -90,6 +90,7 @@ class BoardRobot:
         self._reported: dict[str, float] = {}
         self._last_event = float("-inf")
         self._closed = False
+        self._link_lost = False
         self._last_tx: dict[int, float] = {}
         self.watchdog_ms = watchdog_ms  # in wall-clock ms
         # Fake boards paced at X times real time count the watchdog in their
@@ -178,6 +179,7 @@ class BoardRobot:
         else:  # the boards stepped the world before they answered ReadAll
             done, fm, fs = self._wait([step, pm, ps])
             self._check_step(done)
+        self._link_lost = False  # both boards answered: any earlier loss is over
         motors = self._motors(fm.messages)
         sensors = self._sensors(fs.messages)
         health = self.health()
@@ -324,10 +326,13 @@ class BoardRobot:
             raise  # unreachable: _lost raises
 
     def _lost(self, reason: str, boards_stopped: bool = False) -> None:
-        """Report the lost link (a LINK event) and raise LinkLostError saying
-        what became of the motors."""
-        self.sink(Event(self._now(), EventKind.LINK, f"link lost: {reason}", None,
-                        self.health()))
+        """Report the lost link (a LINK event, the first time only: the stop,
+        truth and close that follow a loss would each report it again) and
+        raise LinkLostError saying what became of the motors."""
+        if not self._link_lost:
+            self._link_lost = True
+            self.sink(Event(self._now(), EventKind.LINK, f"link lost: {reason}", None,
+                            self.health()))
         if boards_stopped:
             after = ""
         elif self.watchdog_ms:
