@@ -119,11 +119,6 @@ def turn_yaw_rad(cfg: RobotConfig, wheel_turns: float) -> float:
     return wheel_turns * cfg.wheel_circumference / (cfg.geometry.track_width / 2.0)
 
 
-def yaw_turns(cfg: RobotConfig, yaw_rad: float) -> float:
-    """MWR turns that make ``yaw_rad`` of yaw (inverse of :func:`turn_yaw_rad`)."""
-    return yaw_rad * (cfg.geometry.track_width / 2.0) / cfg.wheel_circumference
-
-
 def lift_to(cfg: RobotConfig, snap: Snapshot, motor: MotorId, target: float) -> float | None:
     """Speed that moves lift ``motor`` towards the absolute counter ``target``,
     or None when it is there."""
