@@ -3,8 +3,10 @@ build it the same way).
 
 The run goes on a worker thread (the runner's loop); the screen redraws ten
 times a second from a copy of the live state, however fast or slow the control
-loop ticks.  The emergency stop is a priority binding: it works on every
-screen, even over a text prompt.
+loop ticks.  The emergency stop key is taken in ``on_event`` before any
+screen or widget sees it, so it works on every screen, even over a text
+prompt (which therefore cannot take a space: one key that always stops beats
+a second key to remember when it matters); the binding shows it in the footer.
 """
 
 from __future__ import annotations
@@ -61,20 +63,22 @@ class StairbotConsole(App[None]):
 
     CSS_PATH = "console.tcss"
     TITLE = "stairbot console"
+    # In footer order, most needed first: at 80 columns the footer shows the
+    # first eight (the e-stop to the robot URL); ctrl+p lists them all.
     BINDINGS = [
         Binding(ESTOP_KEY, "estop", "E-STOP", priority=True),
         Binding("c", "clear_estop", "clear"),
         Binding("s", "start('full')", "start"),
         Binding("p", "pause", "pause"),
-        Binding("f", "speed", "speed"),
+        Binding("x", "stop_run", "stop"),
         Binding("k", "start('calibrate')", "calib"),
-        Binding("r", "reset", "reset"),
+        Binding("q", "quit", "quit"),
         Binding("u", "choose_robot", "robot"),
         Binding("o", "choose_scenario", "scenario"),
+        Binding("f", "speed", "speed"),
+        Binding("r", "reset", "reset"),
         Binding("w", "record", "rec"),
-        Binding("x", "stop_run", "stop"),
         Binding("z", "zoom", "zoom"),
-        Binding("q", "quit", "quit"),
     ]
 
     def __init__(self, engine: ConsoleEngine, url: str, scenario: str | None,
@@ -162,22 +166,25 @@ class StairbotConsole(App[None]):
     # -- workers -------------------------------------------------------------------
     @work(thread=True, group="robot", exclusive=True, exit_on_error=False)
     def open_robot(self, url: str, scenario: str | None) -> None:
-        """Open a robot off the UI thread; on bad input say so and keep the old one."""
+        """Open a robot off the UI thread; on bad input say so and reopen the
+        previous robot (if opening the new one closed it)."""
         previous = (self.url, self.scenario) if self.engine.session is not None else None
         try:
             self.engine.open(url, scenario)
-        except (StairbotError, OSError) as exc:
-            self._tell(f"cannot open {url}: {exc}", "error")
-            self.state.set_status(robot="fault", severity="error",
-                                  message=f"cannot open {url}: {exc}")
+        except Exception as exc:  # noqa: BLE001 - any failure is a message, not a traceback
+            message = f"cannot open {url}: {_why(exc)}"
+            self._tell(message, "error")
             if previous is not None and self.engine.session is None and previous != (url,
                                                                                        scenario):
                 try:
                     self.engine.open(*previous)
-                    self.state.set_status(message=f"kept {previous[0]}: {url} failed: {exc}",
-                                          severity="error")
-                except (StairbotError, OSError):
-                    pass
+                    message = f"kept {previous[0]}: {message}"
+                except Exception as again:  # noqa: BLE001
+                    message += f"; {previous[0]} did not reopen either: {_why(again)}"
+            if self.engine.session is None:
+                self.state.set_status(robot="fault", severity="error", message=message)
+            else:  # the robot open before is still (or again) the one in use
+                self.state.set_status(severity="error", message=message)
             return
         self.url, self.scenario = url, scenario
 
@@ -220,39 +227,39 @@ class StairbotConsole(App[None]):
         if self.engine.session is None:
             self.notify("no robot open: choose one with u", severity="error")
             return
-        if self.engine.simulated:
-            self.run_program(mode)
-            return
-        what = "calibration" if mode == "calibrate" else "the full run"
-
-        def answered(yes: bool | None) -> None:
-            if yes:
-                self.run_program(mode)
-            else:
-                self.notify("not started")
-
-        self.push_screen(ConfirmScreen(
-            f"Start {what} on the WIRED robot {self.engine.session.url}?\n"
-            "The motors will move. Space stops every motor."), answered)
+        what = "Start calibration" if mode == "calibrate" else "Start the full run"
+        self._after_consent(what, lambda: self.run_program(mode))
 
     def action_pause(self) -> None:
         if not self.engine.running:
             self.notify("no run is going on")
         elif self.state.view().status.paused:
-            if self.engine.simulated:
-                self.engine.resume()
-            else:
-                def answered(yes: bool | None) -> None:
-                    if yes:
-                        self.engine.resume()
-                        self.refresh_view()
-
-                self.push_screen(ConfirmScreen(
-                    f"Resume motion on the WIRED robot {self.url}?\n"
-                    "The motors will move. Space stops every motor."), answered)
+            self._after_consent("Resume motion", self.engine.resume)
         else:
             self.engine.pause()
         self.refresh_view()
+
+    def _after_consent(self, what: str, go: Callable[[], object]) -> None:
+        """Do ``go`` now for the in-process simulation; for a robot on a wire ask
+        first.  Fake boards are asked about too: that they are simulated is only
+        their own word (a status flag), which is no ground for moving unasked."""
+        session = self.engine.session
+        if session is None or self.engine.in_process:
+            go()
+            return
+        boards = ("Boards on a wire that report a simulated world (fake boards)."
+                  if session.simulated else "REAL boards on a wire.")
+
+        def answered(yes: bool | None) -> None:
+            if yes:
+                go()
+                self.refresh_view()
+            else:
+                self.notify("nothing moved")
+
+        self.push_screen(ConfirmScreen(
+            f"{what} on {session.url}?\n{boards}\n"
+            "The motors will move. Space stops every motor."), answered)
 
     def action_stop_run(self) -> None:
         if self.engine.running:
@@ -340,6 +347,14 @@ class StairbotConsole(App[None]):
 
     def on_unmount(self) -> None:
         self.engine.shutdown()
+
+
+def _why(exc: Exception) -> str:
+    """An error as the operator reads it: our own errors say it all; anything
+    else is named by its type."""
+    if isinstance(exc, StairbotError | OSError):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
 
 
 def build_app(config: RobotConfig | str | Path | None = None, *, url: str = "sim://",

@@ -1,5 +1,6 @@
 """Small modal screens: a yes/no question and a one-line text prompt.  The
-emergency stop key stays live over them (it is a priority binding of the app)."""
+emergency stop key (space) stays live over them: the app takes it before any
+screen or widget sees it, so a prompt cannot take a space (and says so)."""
 
 from __future__ import annotations
 
@@ -56,6 +57,8 @@ class AskScreen(ModalScreen[str | None]):
             yield Input(value=self.value, placeholder=self.placeholder, id="answer")
             if self.hint:
                 yield Label(self.hint, classes="hint")
+            yield Label("space is the EMERGENCY STOP here too: this field takes no spaces",
+                        classes="hint")
 
     def on_mount(self) -> None:
         self.query_one(Input).focus()

@@ -56,12 +56,12 @@ def describe_result(result: dict[str, Any]) -> tuple[str, str]:
     """One line saying how a run ended, and its severity (good/warning/error)."""
     outcome = result.get("outcome", "?")
     parts = [f"run {outcome}"]
+    if result.get("error"):  # first: on a narrow screen the end of the line is cut
+        parts.append(str(result["error"]))
     if result.get("ascent_end"):
         parts.append(str(result["ascent_end"]).replace("_", " "))
     parts.append(f"climbed {result.get('steps_climbed', 0)}, "
                  f"descended {result.get('steps_descended', 0)}")
-    if result.get("error"):
-        parts.append(str(result["error"]))
     severity = {"completed": "good", "stopped": "warning"}.get(str(outcome), "error")
     return " · ".join(parts), severity
 
@@ -90,6 +90,7 @@ class ConsoleEngine:
         self._running = threading.Event()
         self._speed = "max"
         self._last_phase: object = None
+        self._controller: Any = None  # the run's controller, as the last tick saw it
         self._last_ctx = -1.0
 
     # -- robot -----------------------------------------------------------------
@@ -102,11 +103,6 @@ class ConsoleEngine:
     @property
     def running(self) -> bool:
         return self._running.is_set()
-
-    @property
-    def simulated(self) -> bool:
-        """No real hardware moves (sim://, or fake boards on a wire)."""
-        return self.session is not None and self.session.simulated
 
     @property
     def in_process(self) -> bool:
@@ -174,6 +170,7 @@ class ConsoleEngine:
         self.state.on_result({})
         self.state.set_status(robot="running", paused=False, severity="info",
                               message="calibrating only" if mode == "calibrate" else "full run")
+        self._controller = None
         try:
             self.control = self._control_fn()
             result = self._run_fn(session, self.config, self._sink, mode, self.control,
@@ -186,6 +183,8 @@ class ConsoleEngine:
             return None
         finally:
             self._running.clear()
+        if self._controller is not None:  # a stop or a fault ends the run between ticks
+            self._on_tick(self._controller, None, final=True)
         out: dict[str, Any] = result.to_dict() if hasattr(result, "to_dict") else dict(result)
         self.robot.refresh_scene()
         self.state.on_result(out)
@@ -200,16 +199,17 @@ class ConsoleEngine:
         if self.recorder is not None:
             self.recorder.write(event)
 
-    def _on_tick(self, ctl: Any, snap: Any) -> None:
+    def _on_tick(self, ctl: Any, snap: Any, final: bool = False) -> None:
+        self._controller = ctl
         try:
-            self._copy_phase(ctl)
+            self._copy_phase(ctl, final)
         except Exception:  # noqa: BLE001 - watching must never stop the run
             self.state.on_phase("(phase not readable)", "", None)
 
-    def _copy_phase(self, ctl: Any) -> None:
+    def _copy_phase(self, ctl: Any, force: bool = False) -> None:
         phase = getattr(ctl, "phase", None)
         now = self._wall()
-        if phase is self._last_phase and now - self._last_ctx < PHASE_PERIOD_S:
+        if not force and phase is self._last_phase and now - self._last_ctx < PHASE_PERIOD_S:
             return
         self._last_phase, self._last_ctx = phase, now
         label = str(getattr(phase, "label", phase))

@@ -82,10 +82,14 @@ class StillClock:
         self.t += dt
 
 
-def still_open(simulated: bool = True) -> Callable[..., RobotSession]:
+def still_open(simulated: bool = True, wired: bool | None = None) -> Callable[..., RobotSession]:
+    """``wired`` (default: not ``simulated``): no in-process world, link health;
+    wired and simulated are fake boards."""
+    on_wire = not simulated if wired is None else wired
+
     def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
-        return RobotSession(StillRobot(None if simulated else HEALTH), StillClock(), url, simulated,
-                            StillSim() if simulated else None)
+        return RobotSession(StillRobot(HEALTH if on_wire else None), StillClock(), url, simulated,
+                            None if on_wire else StillSim())
     return open_fn
 
 
@@ -108,6 +112,7 @@ def show_climbing(app: StairbotConsole) -> None:
         app.state.on_event(e)
 
 
-def make_still_app(simulated: bool = True, **kw: Any) -> StairbotConsole:
+def make_still_app(simulated: bool = True, wired: bool | None = None,
+                   **kw: Any) -> StairbotConsole:
     """The console on a still robot (``simulated=False``: a wired one)."""
-    return build_app(load_config(), open_fn=still_open(simulated), **kw)
+    return build_app(load_config(), open_fn=still_open(simulated, wired), **kw)

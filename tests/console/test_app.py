@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from still_robot import still_open
 from textual import events
 from textual.widgets import Input
 
@@ -249,9 +250,12 @@ def test_invalid_robot_or_scenario_gives_a_message(key: str, value: str, expect:
     asyncio.run(go())
 
 
-def test_starting_a_wired_robot_asks_first(still_app: Callable[..., StairbotConsole]) -> None:
+@pytest.mark.parametrize("boards_say_simulated", [False, True], ids=["real", "fake boards"])
+def test_starting_a_wired_robot_asks_first(still_app: Callable[..., StairbotConsole],
+                                           boards_say_simulated: bool) -> None:
+    """Fake boards are asked about too: their flag is only their own word."""
     async def go() -> None:
-        app = still_app(simulated=False, url="serial://loop://")
+        app = still_app(simulated=boards_say_simulated, wired=True, url="serial://loop://")
         async with app.run_test(size=(80, 24)) as pilot:
             await ready(pilot)
             robot = app.engine.session.robot  # type: ignore[union-attr]
@@ -314,6 +318,37 @@ def test_a_lost_link_shows_as_a_banner_not_a_traceback(
             assert "no reply to 3 attempts" in banner(app)
             assert "-error" in app.banner.classes
             assert robot.stops > 0  # the runner stopped every motor
+            await pilot.pause(0.2)
+            # The run ended between two ticks: the phase panel still shows the end.
+            view = app.state.view()
+            assert view.flow == "end" and view.phase.startswith("end")
+    asyncio.run(go())
+
+
+def test_a_robot_that_fails_to_reopen_is_named_in_the_banner() -> None:
+    """A bad URL closes the robot that was open; when that one cannot be opened
+    again either, the banner says so (not a stale "connecting")."""
+    opened: list[str] = []
+
+    def open_once(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
+        opened.append(url)
+        if len(opened) > 1:
+            raise LinkLostError(f"{url}: no reply")
+        return still_open(simulated=False)(url, config, scenario, options)
+
+    async def go() -> None:
+        app = build_app(url="serial://first", open_fn=open_once)
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, "u")
+            await until(pilot, lambda: bool(app.screen.query(Input)), "the prompt")
+            app.screen.query_one(Input).value = "serial://second"
+            await press(pilot, "enter")
+            await until(pilot, lambda: "did not reopen" in banner(app), "the message")
+            text = banner(app)
+            assert "FAULT" in text and "serial://second: no reply" in text
+            assert opened == ["serial://first", "serial://second", "serial://first"]
+            assert app.engine.session is None
     asyncio.run(go())
 
 

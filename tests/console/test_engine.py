@@ -142,3 +142,61 @@ def test_describe_result() -> None:
                                       "steps_climbed": 5, "steps_descended": 5})
     assert line == "run completed · top reached · climbed 5, descended 5"
     assert severity == "good"
+
+
+class HeldLoop(DriveLoop):
+    """The DriveLoop, held between two ticks (after its 50th) until released."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.held = threading.Event()
+        self.release = threading.Event()
+
+    def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: Any,
+                 on_tick: Any) -> dict[str, Any]:
+        robot, clock = session.robot, session.clock
+        while control.stop_reason is None:
+            self.snaps.append(robot.read())
+            robot.command(FORWARD)
+            clock.advance(config.algorithm.tick)
+            if len(self.snaps) == 50:
+                self.held.set()
+                self.release.wait()
+        robot.stop_all()
+        return {"outcome": "stopped"}
+
+
+def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> None:
+    """The operator's stop reaches the robot from the key handler's thread, at
+    once: it does not wait for the run loop to come round (here it never does)."""
+    calls: list[str] = []
+
+    class Spy:
+        def __init__(self, inner: Any) -> None:
+            self.inner = inner
+
+        def __getattr__(self, name: str) -> Any:
+            calls.append(name)
+            return getattr(self.inner, name)
+
+    def spy_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
+        from stairbot.robots import RobotSession, open_robot
+
+        s = open_robot(url, config, scenario, options)
+        return RobotSession(Spy(s.robot), s.clock, s.url, s.simulated, s.sim)
+
+    loop = HeldLoop()
+    engine = ConsoleEngine(LiveState(), load_config(), open_fn=spy_open, run_fn=loop,
+                           control_fn=Control)
+    engine.open("sim://", None)
+    worker = threading.Thread(target=engine.run, args=("full",))
+    worker.start()
+    try:
+        wait_for(loop.held.is_set, "the loop held between two ticks")
+        before = len(calls)
+        engine.estop()
+        assert calls[before:] == ["stop_all"]
+    finally:
+        engine.stop()
+        loop.release.set()
+        worker.join()
