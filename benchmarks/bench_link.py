@@ -54,12 +54,16 @@ def percentile(values: list[float], q: float) -> float:
     return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
-def measure(robot: object, cycles: int, acked: bool) -> tuple[float, list[float]]:
+def measure(robot: object, cycles: int, acked: bool, warmup: int = 200
+            ) -> tuple[float, list[float]]:
+    """Cycles per second and each cycle's latency (s) over ``cycles`` cycles,
+    after ``warmup`` cycles; with ``acked`` each cycle also waits for its Acks.
+    Shared with bench_link_can.py."""
     speeds = {mid: 0.0 for mid in MotorId}
     lat: list[float] = []
     read, command = robot.read, robot.command  # type: ignore[attr-defined]
     flush = robot.flush  # type: ignore[attr-defined]
-    for _ in range(200):
+    for _ in range(warmup):
         read()
         command(speeds)
     flush()

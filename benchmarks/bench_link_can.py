@@ -23,8 +23,8 @@ import statistics
 import subprocess
 import sys
 import threading
-import time
 from collections.abc import Callable
+from pathlib import Path
 
 import can
 
@@ -35,12 +35,17 @@ from stairbot.drivers.can_wire import frame_bits, wire
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
-from stairbot.hardware import MotorId
 from stairbot.robots import RobotOptions
 from stairbot.scenario import load_scenario
 
+# The cycle and its statistics are the serial benchmark's (this file's folder
+# is on the path whether it runs alone or from bench_link.py).
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_link import measure, percentile  # noqa: E402
+
 BITRATE = 1_000_000
 LOAD_LIMIT = 0.20
+WARMUP = 100  # cycles before the measured ones
 
 
 def cycle_frames() -> list[tuple[str, int, int]]:
@@ -61,31 +66,6 @@ def cycle_frames() -> list[tuple[str, int, int]]:
     return [(name, size, n) for name, (size, n) in counts.items()]
 
 
-def percentile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
-
-
-def measure(robot: object, cycles: int, acked: bool) -> tuple[float, list[float]]:
-    speeds = {mid: 0.0 for mid in MotorId}
-    read, command = robot.read, robot.command  # type: ignore[attr-defined]
-    flush = robot.flush  # type: ignore[attr-defined]
-    for _ in range(100):
-        read()
-        command(speeds)
-    flush()
-    lat: list[float] = []
-    t0 = time.perf_counter()
-    for _ in range(cycles):
-        c0 = time.perf_counter()
-        read()
-        command(speeds)
-        if acked:
-            flush()
-        lat.append(time.perf_counter() - c0)
-    return cycles / (time.perf_counter() - t0), lat
-
-
 def report(label: str, url: str, cycles: int) -> None:
     session = open_can_robot(url, load_config(), load_scenario(), RobotOptions())
     robot = session.robot
@@ -93,9 +73,9 @@ def report(label: str, url: str, cycles: int) -> None:
     for acked, name in ((False, "pipelined (Acks checked next cycle)"),
                         (True, "each Ack awaited in its cycle")):
         before = robot.health()  # type: ignore[attr-defined]
-        rate, lat = measure(robot, cycles, acked)
+        rate, lat = measure(robot, cycles, acked, WARMUP)
         after = robot.health()  # type: ignore[attr-defined]
-        bits = sum(after[k] - before[k] for k in ("bits_tx", "bits_rx")) / (cycles + 100)
+        bits = sum(after[k] - before[k] for k in ("bits_tx", "bits_rx")) / (cycles + WARMUP)
         print(f"  {name:38s} {rate:8.0f} cycles/s   latency median "
               f"{statistics.median(lat) * 1e3:.3f} ms  p99 {percentile(lat, 0.99) * 1e3:.3f} ms"
               f"  max {max(lat) * 1e3:.3f} ms   ({bits:.0f} bus bits a cycle, counted)")
