@@ -34,7 +34,21 @@ from stairbot.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError,
 
 PHASE_TIMEOUT_S = 60.0
 """A phase (other than the standing rule's wait) that lasts longer than this,
-in controller time, ends the program with an error: something is stuck."""
+in controller time, ends the program with an error: something is stuck.  A
+robot with slow motors gets longer: :func:`phase_timeout_s`."""
+
+
+def phase_timeout_s(config: RobotConfig) -> float:
+    """How long one phase may last: twice the longest motion a phase makes at
+    the config's speeds (a lift over its whole stroke, a drive of
+    LENGTH_OF_INFINITY, a calibration turn of its largest yaw), and at least
+    PHASE_TIMEOUT_S."""
+    m = config.motors
+    lift_s = 2 * config.MAX_OF_VERTICAL_TURNS / m.lift_speed
+    drive_s = config.wheel_turns(config.LENGTH_OF_INFINITY) / m.wheel_speed
+    turn = calibration.MAX_TURN_YAW_RAD * config.geometry.track_width / 2
+    turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
+    return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
 
 OUTCOMES = ("completed", "stopped", "error")
 
@@ -82,6 +96,7 @@ class Controller:
         m = config.motors
         self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
         self._stroke = config.MAX_OF_VERTICAL_TURNS
+        self._timeout = phase_timeout_s(config)
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -193,8 +208,8 @@ class Controller:
                    f"in {phase.label}"
         started = self._ctx.phase_started_s
         if phase is not Phase.PAUSED and started is not None \
-                and snap.time_s - started > PHASE_TIMEOUT_S:
-            return f"phase timeout: {phase.label} took longer than {PHASE_TIMEOUT_S:g} s"
+                and snap.time_s - started > self._timeout:
+            return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
         return None
 
     def _limit(self, speeds: dict[MotorId, float], snap: Snapshot) -> dict[MotorId, float]:

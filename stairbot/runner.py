@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from stairbot.config import RobotConfig
-from stairbot.controller import Controller
+from stairbot.controller import Controller, phase_timeout_s
 from stairbot.errors import HardwareError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import MotorId
@@ -115,7 +115,7 @@ def run(
     control: RunControl | None = None,
     *,
     controller: Controller | None = None,
-    max_sim_time_s: float = 3600.0,
+    max_sim_time_s: float | None = None,
     wall: Callable[[], float] = time.perf_counter,
     on_tick: Callable[[Controller, Any], None] | None = None,
 ) -> RunResult:
@@ -124,9 +124,14 @@ def run(
     Never raises for a robot failure: a HardwareError ends the run with outcome
     "error" (or "fell" for a RobotFellError) after every motor is stopped.
     ``on_tick(controller, snapshot)`` is called after each tick (for a console).
+    A run longer than ``max_sim_time_s`` of robot time ends with an error (by
+    default an hour, or 60 phase timeouts for a robot whose slow motors make
+    that longer).
     """
     robot, clock = session.robot, session.clock
     ctl = controller or Controller(config, sink, mode)
+    if max_sim_time_s is None:
+        max_sim_time_s = max(3600.0, 60 * phase_timeout_s(config))
     attach = getattr(robot, "attach_sink", None)
     if callable(attach):  # wired robots report link health as LINK events
         attach(sink)

@@ -4,17 +4,19 @@ stops safely, says why, and never moves again once it has ended."""
 from __future__ import annotations
 
 import math
+from importlib import resources
 
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
-from stairbot.config import load_config
-from stairbot.controller import PHASE_TIMEOUT_S, Controller
+from stairbot.config import load_config, parse_config
+from stairbot.controller import PHASE_TIMEOUT_S, Controller, phase_timeout_s
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.phases import Phase
 
 CFG = load_config()
+DEFAULT_ROBOT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
 STEPS = [(0.17, 0.28)] * 2
 WAIT = CFG.algorithm.standing_wait
 TICK = CFG.algorithm.tick
@@ -212,6 +214,17 @@ def test_a_phase_that_never_ends_times_out() -> None:
         robot.advance(TICK)
     assert "phase timeout" in str(ctrl.result.error)
     assert robot.t - entered == pytest.approx(PHASE_TIMEOUT_S, abs=2 * TICK)
+
+
+def test_a_robot_with_slow_lifts_gets_a_longer_phase_timeout() -> None:
+    # 2 mm/s lifts take 86 s to lift segment 1 for a step: longer than 60 s
+    slow = parse_config(DEFAULT_ROBOT.replace("lift_speed = 10.0", "lift_speed = 1.0"), "slow")
+    assert phase_timeout_s(CFG) == PHASE_TIMEOUT_S
+    assert phase_timeout_s(slow) == pytest.approx(2 * 2 * slow.MAX_OF_VERTICAL_TURNS / 1.0)
+    ctrl = Controller(slow)
+    run(ctrl, KinematicRobot(slow, steps=[(0.17, 0.28)]), max_time=3000.0)
+    assert (ctrl.result.outcome, ctrl.result.steps_climbed, ctrl.result.steps_descended) == (
+        "completed", 1, 1), ctrl.result
 
 
 def test_a_turn_that_never_squares_up_ends_with_an_error() -> None:
