@@ -17,7 +17,7 @@ import contextlib
 import functools
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Concatenate, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
@@ -35,6 +35,9 @@ EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
 P = ParamSpec("P")
 R = TypeVar("R")
 S = TypeVar("S", bound="BoardRobot")
+T = TypeVar("T", m.MotorTelemetry, m.SensorTelemetry)
+K = TypeVar("K", MotorId, SensorId)
+V = TypeVar("V", MotorState, SensorReading)
 
 
 def locked(method: Callable[Concatenate[S, P], R]) -> Callable[Concatenate[S, P], R]:
@@ -180,8 +183,10 @@ class BoardRobot:
             done, fm, fs = self._wait([step, pm, ps])
             self._check_step(done)
         self._link_lost = False  # both boards answered: any earlier loss is over
-        motors = self._motors(fm.messages)
-        sensors = self._sensors(fs.messages)
+        motors = self._read_all(m.Board.MOTOR, fm.messages, m.MotorTelemetry,
+                                m.MOTOR_CHANNELS, u.state_from_wire)
+        sensors = self._read_all(m.Board.SENSOR, fs.messages, m.SensorTelemetry,
+                                 m.SENSOR_CHANNELS, u.reading_from_wire)
         health = self.health()
         self._maybe_event(health)
         return Snapshot(self._now(), sensors, motors, health)
@@ -369,24 +374,19 @@ class BoardRobot:
         if status.flags & m.StatusFlag.ESTOP:
             raise HardwareError(f"the {name} board has its emergency stop latched")
 
-    def _motors(self, msgs: tuple[Any, ...]) -> dict[MotorId, MotorState]:
+    def _read_all(self, board: m.Board, msgs: tuple[Any, ...], kind: type[T],
+                  ids: Sequence[K], convert: Callable[[T], V]) -> dict[K, V]:
+        """A ReadAll reply -- Status, then one ``kind`` telemetry per channel --
+        as ``{ids[channel]: convert(telemetry)}``, after checking the Status.
+        HardwareError when the reply is not that."""
+        name = board.name.lower()
         if not msgs or not isinstance(msgs[0], m.Status):
-            raise HardwareError(f"the motor board answered ReadAll with {msgs!r}")
-        self._check_status(m.Board.MOTOR, msgs[0])
-        out = {m.MOTOR_CHANNELS[t.channel]: u.state_from_wire(t) for t in msgs[1:]
-               if isinstance(t, m.MotorTelemetry) and t.channel < len(m.MOTOR_CHANNELS)}
-        if len(out) != len(m.MOTOR_CHANNELS):
-            raise HardwareError(f"the motor board's ReadAll reply lacks motors: {msgs!r}")
-        return out
-
-    def _sensors(self, msgs: tuple[Any, ...]) -> dict[SensorId, SensorReading]:
-        if not msgs or not isinstance(msgs[0], m.Status):
-            raise HardwareError(f"the sensor board answered ReadAll with {msgs!r}")
-        self._check_status(m.Board.SENSOR, msgs[0])
-        out = {m.SENSOR_CHANNELS[t.channel]: u.reading_from_wire(t) for t in msgs[1:]
-               if isinstance(t, m.SensorTelemetry) and t.channel < len(m.SENSOR_CHANNELS)}
-        if len(out) != len(m.SENSOR_CHANNELS):
-            raise HardwareError(f"the sensor board's ReadAll reply lacks sensors: {msgs!r}")
+            raise HardwareError(f"the {name} board answered ReadAll with {msgs!r}")
+        self._check_status(board, msgs[0])
+        out = {ids[t.channel]: convert(t) for t in msgs[1:]
+               if isinstance(t, kind) and t.channel < len(ids)}
+        if len(out) != len(ids):
+            raise HardwareError(f"the {name} board's ReadAll reply lacks channels: {msgs!r}")
         return out
 
     def _maybe_event(self, health: dict[str, float]) -> None:

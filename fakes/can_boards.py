@@ -50,6 +50,7 @@ class CanServerStats:
     ignored: int = 0  # frames from boards (our own echo included)
     stray: int = 0  # host frames for a board not served here
     injected: int = 0  # faults injected
+    send_errors: int = 0  # replies the bus refused to send
 
 
 class CanBoardServer:
@@ -69,6 +70,7 @@ class CanBoardServer:
         self._dice = FaultDice(self.faults, self.stats)
         self._late: list[tuple[float, can.Message]] = []
         self._stop = threading.Event()
+        self.last_send_error: str | None = None
 
     # -- faults ------------------------------------------------------------------
     def _chance(self, p: float) -> bool:
@@ -89,16 +91,25 @@ class CanBoardServer:
             self._late.append((time.monotonic() + f.late_s, frame))
             return
         for _ in range(2 if self._chance(f.duplicate) else 1):
-            self.bus.send(frame)
-            self.stats.frames_tx += 1
+            self._put(frame)
+
+    def _put(self, frame: can.Message) -> None:
+        """Send one frame; a bus that refuses it (buffer full, interface
+        down) costs that frame, counted, never the server."""
+        try:
+            self.bus.send(frame, timeout=0.05)
+        except (can.CanError, OSError) as exc:
+            self.stats.send_errors += 1
+            self.last_send_error = str(exc)
+            return
+        self.stats.frames_tx += 1
 
     def _flush_late(self) -> None:
         now = time.monotonic()
         due = [fr for t, fr in self._late if t <= now]
         self._late = [(t, fr) for t, fr in self._late if t > now]
         for frame in due:
-            self.bus.send(frame)
-            self.stats.frames_tx += 1
+            self._put(frame)
 
     def receive(self, frame: can.Message) -> None:
         """Handle one frame from the bus."""
@@ -208,7 +219,8 @@ def main(argv: list[str]) -> int:
         bus.shutdown()
         s = server.stats
         print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.error_frames} "
-              f"error frames, {s.malformed} malformed, {s.injected} faults injected",
+              f"error frames, {s.malformed} malformed, {s.injected} faults injected, "
+              f"{s.send_errors} replies the bus refused",
               file=sys.stderr)
     return 0
 

@@ -308,3 +308,24 @@ def test_faster_than_real_time_without_lockstep() -> None:
         server.stop()
         thread.join(5)
         server.bus.shutdown()
+
+
+def test_a_bus_that_refuses_the_boards_replies_costs_frames_not_the_server() -> None:
+    world = make_world(load_config(), load_scenario(), True)
+    bus = can.Bus(interface="virtual", channel=f"refuse-{next(_names)}")
+    server = CanBoardServer(bus, world, make_boards(world))
+    identify = can.Message(arbitration_id=0x0EF, data=b"", is_extended_id=False)
+    bus.shutdown()  # every send now raises CanOperationError
+    server.receive(identify)  # both boards answer: two replies refused
+    assert (server.stats.frames_rx, server.stats.send_errors, server.stats.frames_tx) == (2, 2, 0)
+
+
+def test_a_read_all_reply_without_every_channel_is_a_hardware_error(rig: Rig) -> None:
+    status = m.Status(0x40, 0, 250, 0)
+    tel = tuple(m.MotorTelemetry(c, 1, 0, 1000, 5) for c in range(5))  # MTB missing
+    with pytest.raises(HardwareError, match="motor board's ReadAll reply lacks channels"):
+        rig.robot._read_all(m.Board.MOTOR, (status, *tel), m.MotorTelemetry,
+                            m.MOTOR_CHANNELS, lambda t: t)  # type: ignore[arg-type,return-value]
+    with pytest.raises(HardwareError, match="sensor board answered ReadAll with"):
+        rig.robot._read_all(m.Board.SENSOR, tel, m.SensorTelemetry, m.SENSOR_CHANNELS,
+                            lambda t: t)  # type: ignore[arg-type,return-value]
