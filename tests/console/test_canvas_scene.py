@@ -59,17 +59,21 @@ def test_scene_accepts_mappings() -> None:
 
 
 def test_sensor_pairs_agree_differ_or_cannot_compare() -> None:
-    from stairbot.console.widgets.sensors import pair_text
+    from stairbot.console.widgets.sensors import pair_verdict
     from stairbot.hardware import SensorReading, SensorStatus
+
+    def verdict(a: SensorReading, b: SensorReading) -> str:
+        top, bottom = pair_verdict(a, b, 0.005)
+        return f"{top.plain} {bottom.plain}"
 
     ok, near = SensorReading(0.500), SensorReading(0.503)
     far = SensorReading(0.520)
     out = SensorReading(1.3, SensorStatus.OUT_OF_RANGE)
-    assert "agree" in pair_text("front", ok, near, 0.005).plain
-    assert "DIFFER" in pair_text("front", ok, far, 0.005).plain
-    assert "both out of range" in pair_text("front", out, out, 0.005).plain
-    assert "cannot compare" in pair_text("front", ok, SensorReading(0, SensorStatus.ERROR),
-                                         0.005).plain
+    assert verdict(ok, near) == "agree Δ 3 mm"
+    assert verdict(ok, far) == "DIFFER Δ 20 mm"
+    assert verdict(ok, SensorReading(0.9)) == "DIFFER Δ>99 mm"
+    assert verdict(out, out) == "both out of range"
+    assert verdict(ok, SensorReading(0, SensorStatus.ERROR)) == "cannot compare"
 
 
 def test_motor_direction_glyphs() -> None:
