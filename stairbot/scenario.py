@@ -133,6 +133,10 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
         if fault.kind == "offset" and fault.offset == 0.0:
             raise ScenarioError(source, f"faults[{fi}].offset",
                                 "an offset fault needs a non-zero offset in metres")
+        if fault.kind == "error" and fault.offset != 0.0:
+            raise ScenarioError(source, f"faults[{fi}].offset",
+                                "only an 'offset' fault takes an offset; an 'error' fault "
+                                "makes the sensor report ERROR (leave offset out)")
     half = st.width / 2
     if abs(data.start.lateral) >= half:
         raise ScenarioError(source, "start.lateral",
