@@ -57,8 +57,7 @@ class AskScreen(ModalScreen[str | None]):
             yield Input(value=self.value, placeholder=self.placeholder, id="answer")
             if self.hint:
                 yield Label(self.hint, classes="hint")
-            yield Label("space is the EMERGENCY STOP here too: this field takes no spaces",
-                        classes="hint")
+            yield Label("space is the EMERGENCY STOP even here: no spaces", classes="hint")
 
     def on_mount(self) -> None:
         self.query_one(Input).focus()

@@ -48,6 +48,11 @@ class SpyRobot:
     def close(self) -> None:
         self.inner.close()
 
+    def motion(self, since: int) -> list[dict[MotorId, float]]:
+        """The commands from call ``since`` on that asked some motor to turn."""
+        return [c[1] for c in self.calls[since:]
+                if c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())]
+
 
 def spied_open(spies: list[SpyRobot]) -> Callable[..., RobotSession]:
     def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
@@ -142,13 +147,12 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             await ready(pilot)
             await press(pilot, "s")
             spy = spies[-1]
-            await until(pilot, lambda: any(
-                c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())
-                for c in spy.calls[-5:]), "the robot moves")
+            await until(pilot, lambda: bool(spy.motion(len(spy.calls) - 5)), "the robot moves")
             await press(pilot, "space")
             n_stop = len(spy.calls)
-            # The key handler itself stopped every motor: the last call that
-            # reached the robot when the key returned is stop_all.
+            # Every motor was stopped by the time the key was handled (that the
+            # key handler stops the robot itself, not waiting for the loop's
+            # next tick, is test_engine's ..._without_waiting_for_the_next_tick).
             assert ("stop_all", None) in spy.calls[n_stop - 2:n_stop]
             assert app.state.view().status.estopped
             sim = app.engine.session.sim  # type: ignore[union-attr]
@@ -167,9 +171,7 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             await until(pilot, lambda: reads_since_stop() > 100, "100 ticks after the stop")
             scene1, snap1 = truth()
             # No motion command reached the robot after the stop ...
-            moving = [c for c in spy.calls[n_stop:] if c[0] == "command"
-                      and c[1] and any(v != 0 for v in c[1].values())]
-            assert moving == []
+            assert spy.motion(n_stop) == []
             # ... no motor turns, and the robot stays where it is (within 1 mm).
             for m in MotorId:
                 assert snap1.motors[m].speed_tps == pytest.approx(0.0, abs=0.02)
@@ -186,9 +188,7 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             assert not app.state.view().status.estopped
             await press(pilot, "p")  # resume
             n_resume = len(spy.calls)
-            await until(pilot, lambda: any(
-                c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())
-                for c in spy.calls[n_resume:]), "motion after clear + resume")
+            await until(pilot, lambda: bool(spy.motion(n_resume)), "motion after clear + resume")
             await press(pilot, "x")
             await until(pilot, lambda: not app.engine.running, "the run stops")
     asyncio.run(go())
@@ -215,9 +215,7 @@ def test_pause_and_resume() -> None:
             await press(pilot, "p")
             assert "PAUSED" not in banner(app)
             n_resume = len(spy.calls)
-            await until(pilot, lambda: any(
-                c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())
-                for c in spy.calls[n_resume:]), "motion after resume")
+            await until(pilot, lambda: bool(spy.motion(n_resume)), "motion after resume")
             assert app.state.view().snapshot.time_s > t_paused  # type: ignore[union-attr]
             await press(pilot, "x")
             await until(pilot, lambda: not app.engine.running, "the run stops")
