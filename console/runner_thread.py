@@ -230,10 +230,14 @@ class ConsoleEngine:
         self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
 
     def clear_estop(self) -> bool:
-        """Clear the latched stop; motion resumes only with :meth:`resume`."""
-        if self.robot is None or not self.robot.estopped:
+        """Clear the latched stop; motion resumes only with :meth:`resume`.
+        False when no stop was set (on the robot, or, with no robot open, on the
+        banner)."""
+        latched = self.robot is not None and self.robot.estopped
+        if not latched and not self.state.view().status.estopped:
             return False
-        self.robot.clear_estop()
+        if self.robot is not None:
+            self.robot.clear_estop()
         if self.control is not None:
             self.control.clear_estop()
         msg = "emergency stop cleared; p resumes the run" if self.running else \

@@ -129,6 +129,15 @@ def test_a_run_cannot_start_until_the_estop_is_cleared(
     assert not engine.state.view().status.estopped
 
 
+def test_an_estop_with_no_robot_open_can_be_cleared() -> None:
+    engine = ConsoleEngine(LiveState(), load_config())
+    assert not engine.clear_estop()
+    engine.estop()
+    assert engine.state.view().status.estopped
+    assert engine.clear_estop()
+    assert not engine.state.view().status.estopped
+
+
 def test_bad_scenario_and_url_raise_input_errors() -> None:
     engine = ConsoleEngine(LiveState(), load_config())
     with pytest.raises(InputError, match="cannot read"):
