@@ -74,7 +74,9 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     equal_tolerance: Pos
     standing_wait: Pos
     max_steps: Annotated[int, msgspec.Meta(ge=1, le=20)]
-    tick: Annotated[float, msgspec.Meta(gt=0, le=0.5)]
+    # at most 1 kHz: what a host drives over a serial link or a CAN bus (and the
+    # simulation's physics step, 1/600 s, must fit in a tick for time to move)
+    tick: Annotated[float, msgspec.Meta(ge=0.001, le=0.5)]
 
 
 class ConfigFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

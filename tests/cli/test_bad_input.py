@@ -53,6 +53,8 @@ CASES = [
      ["robot_inf.toml", "motors.lift_travel", "inf is not allowed", "> 0, finite"]),
     ("robot_bool.toml", ROBOT.replace("max_steps = 10", "max_steps = true"), "--config",
      ["robot_bool.toml", "algorithm.max_steps", "true is not allowed", "a whole number"]),
+    ("robot_tick.toml", ROBOT.replace("tick = 0.02", "tick = 0.0005"), "--config",
+     ["robot_tick.toml", "algorithm.tick", "0.0005", ">= 0.001 and <= 0.5"]),
     ("robot_empty.toml", "", "--config",
      ["robot_empty.toml", "geometry", "required but missing"]),
     ("empty_steps.toml", "[stairs]\nsteps = [{rise = 0.17}]\n", "--scenario",
