@@ -148,13 +148,14 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             await press(pilot, "s")
             spy = spies[-1]
             await until(pilot, lambda: bool(spy.motion(len(spy.calls) - 5)), "the robot moves")
+            n_key = len(spy.calls)
             await press(pilot, "space")
-            n_stop = len(spy.calls)
-            # Every motor was stopped by the time the key was handled (that the
-            # key handler stops the robot itself, not waiting for the loop's
-            # next tick, is test_engine's ..._without_waiting_for_the_next_tick).
-            assert ("stop_all", None) in spy.calls[n_stop - 2:n_stop]
-            assert app.state.view().status.estopped
+            await until(pilot, lambda: app.state.view().status.estopped, "the stop")
+            # From the first stop after the key on, nothing moves (that the key
+            # handler stops the robot itself, not waiting for the loop's next
+            # tick, is test_engine's ..._without_waiting_for_the_next_tick).
+            n_stop = next(i for i in range(n_key, len(spy.calls))
+                          if spy.calls[i][0] == "stop_all")
             sim = app.engine.session.sim  # type: ignore[union-attr]
 
             def reads_since_stop() -> int:
@@ -182,10 +183,10 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             assert "E-STOP" in banner(app)
             # Resume is refused until the stop is cleared.
             await press(pilot, "p")
+            await until(pilot, lambda: "clear the emergency stop" in banner(app), "refused")
             assert app.state.view().status.estopped
-            assert "clear the emergency stop" in banner(app)
             await press(pilot, "c")
-            assert not app.state.view().status.estopped
+            await until(pilot, lambda: not app.state.view().status.estopped, "cleared")
             await press(pilot, "p")  # resume
             n_resume = len(spy.calls)
             await until(pilot, lambda: bool(spy.motion(n_resume)), "motion after clear + resume")
@@ -205,7 +206,7 @@ def test_pause_and_resume() -> None:
             spy = spies[-1]
             await until(pilot, lambda: len(spy.calls) > 100, "100 calls")
             await press(pilot, "p")
-            assert "PAUSED" in banner(app)
+            await until(pilot, lambda: "PAUSED" in banner(app), "paused")
             n_pause = len(spy.calls)
             await until(pilot, lambda: len(spy.calls) > n_pause + 60, "ticks while paused")
             # From the tick after the pause on, every command is all zeros.
@@ -213,7 +214,7 @@ def test_pause_and_resume() -> None:
             assert cmds and all(not any(v != 0 for v in (c or {}).values()) for c in cmds)
             t_paused = app.state.view().snapshot.time_s  # type: ignore[union-attr]
             await press(pilot, "p")
-            assert "PAUSED" not in banner(app)
+            await until(pilot, lambda: "PAUSED" not in banner(app), "resumed")
             n_resume = len(spy.calls)
             await until(pilot, lambda: bool(spy.motion(n_resume)), "motion after resume")
             assert app.state.view().snapshot.time_s > t_paused  # type: ignore[union-attr]
@@ -284,7 +285,7 @@ def test_estop_key_works_over_a_text_prompt(still_app: Callable[..., StairbotCon
             robot = app.engine.session.robot  # type: ignore[union-attr]
             stops = robot.stops
             await press(pilot, "space")
-            assert app.state.view().status.estopped
+            await until(pilot, lambda: app.state.view().status.estopped, "the stop")
             assert robot.stops > stops
             assert " " not in app.screen.query_one(Input).value
             await press(pilot, "escape")
@@ -358,7 +359,7 @@ def test_speed_reset_palette_and_resize() -> None:
             assert app.engine.clock is not None
             for speed in ("10x", "max", "1x"):
                 await press(pilot, "f")
-                assert app.state.view().speed == speed
+                await until(pilot, lambda s=speed: app.state.view().speed == s, speed)
             await press(pilot, "f")
             await press(pilot, "s")
             def sim_time() -> float:
