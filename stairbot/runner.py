@@ -17,7 +17,7 @@ from typing import Any
 
 from stairbot.config import RobotConfig
 from stairbot.controller import Controller, phase_timeout_s
-from stairbot.errors import HardwareError, RobotFellError
+from stairbot.errors import HardwareError, LinkLostError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import MotorId
 from stairbot.phases import Mode
@@ -157,6 +157,8 @@ def run(
     except RobotFellError as exc:
         fell = True
         ctl.abort(f"robot fell: {exc}", "error")
+    except LinkLostError as exc:  # the driver's message already says "link lost" and why
+        ctl.abort(str(exc), "error")
     except HardwareError as exc:
         ctl.abort(f"hardware failure: {exc}", "error")
     finally:
