@@ -29,7 +29,7 @@ import can
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_wire import BROADCAST, CanWire, frame_bits, wire
-from stairbot.drivers.link import LinkStats
+from stairbot.drivers.link import LinkStats, Request
 from stairbot.drivers.serial_wire import Frame
 from stairbot.errors import LinkLostError
 
@@ -64,24 +64,12 @@ class CanStats(LinkStats):
 
 
 @dataclass(eq=False)
-class CanPending:
+class CanPending(Request):
     """A request in flight: its messages and the replies still to come."""
 
-    board: int
-    seq: int
-    messages: tuple[m.Message, ...]
-    idempotent: bool
-    sent_at: float
-    deadline: float
-    attempts: int = 1
-    reply: Frame | None = None
-    failed: bool = False
+    messages: tuple[m.Message, ...] = ()
     got: list[m.Message] = field(default_factory=list)
     todo: deque[tuple[int, int, type[m.Message]]] = field(default_factory=deque)
-
-    @property
-    def done(self) -> bool:
-        return self.reply is not None or self.failed
 
     def expect(self) -> None:
         """(Re)start waiting for every reply."""
@@ -142,8 +130,8 @@ class CanLink:
         out once, as a broadcast frame (board 15)."""
         self._seq = (self._seq + 1) & 0xFFFF
         now = self._now()
-        p = CanPending(board, self._seq, tuple(messages), all(x.IDEMPOTENT for x in messages),
-                       now, now + self.timeout_s)
+        p = CanPending(board, self._seq, all(x.IDEMPOTENT for x in messages),
+                       now, now + self.timeout_s, messages=tuple(messages))
         p.expect()
         self._pending.setdefault(board, deque()).append(p)
         self._held.append(p)

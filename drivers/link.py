@@ -153,24 +153,30 @@ class LinkStats:
         return out
 
 
-@dataclass
-class Pending:
-    """A request in flight."""
+@dataclass(eq=False)
+class Request:
+    """What every request in flight keeps, whatever the wire (serial or CAN)."""
 
     board: int
     seq: int
-    wire: bytes
     idempotent: bool
     sent_at: float
     deadline: float
     attempts: int = 1
     reply: Frame | None = None
     failed: bool = False
-    order: int = -1  # commands only: their place in the sending order
 
     @property
     def done(self) -> bool:
         return self.reply is not None or self.failed
+
+
+@dataclass
+class Pending(Request):
+    """A request in flight on a serial link: the frame as sent, for a resend."""
+
+    wire: bytes = b""
+    order: int = -1  # commands only: their place in the sending order
 
 
 class Link:
@@ -216,8 +222,8 @@ class Link:
         seq = self._next_seq(board)
         wire = encode_frame(Frame(board, seq, tuple(messages)))
         now = self._now()
-        p = Pending(board, seq, wire, all(m.IDEMPOTENT for m in messages), now,
-                    now + self.timeout_s)
+        p = Pending(board, seq, all(m.IDEMPOTENT for m in messages), now,
+                    now + self.timeout_s, wire=wire)
         if not p.idempotent:
             p.order = self._commands_sent
             self._commands_sent += 1
