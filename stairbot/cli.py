@@ -231,7 +231,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     """``stairbot run``: open the robot, run the program, summarise, judge."""
     config, scenario = _load_inputs(args)
     # Imported here: the runner pulls in the controller, which `config show` needs not.
-    from stairbot.phases import Mode
+    from stairbot.algorithm.phases import Mode
     from stairbot.robots import RobotOptions, open_robot
     from stairbot.runner import RunControl, run
 

@@ -15,12 +15,12 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from stairbot.algorithm.controller import Controller, phase_timeout_s
+from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
-from stairbot.controller import Controller, phase_timeout_s
 from stairbot.errors import HardwareError, LinkLostError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import MotorId
-from stairbot.phases import Mode
 from stairbot.robots import RobotSession
 
 ZERO_SPEEDS: dict[MotorId, float] = {m: 0.0 for m in MotorId}

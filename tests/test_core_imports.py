@@ -1,5 +1,6 @@
-"""The core (every module of the ``stairbot`` package itself, not its drivers,
-fakes and console subpackages) imports nothing of textual, pymunk, serial or can."""
+"""The package lists each module once (no module reachable under two names),
+and the core (every module but the drivers, fakes and console subpackages)
+imports nothing of textual, pymunk, serial or can."""
 
 from __future__ import annotations
 
@@ -23,17 +24,30 @@ print(json.dumps(bad))
 """
 
 
+def all_modules() -> list[str]:
+    return [m.name for m in pkgutil.walk_packages(stairbot.__path__, "stairbot.")]
+
+
 def core_modules() -> list[str]:
     return sorted(
-        f"stairbot.{m.name}" for m in pkgutil.iter_modules(stairbot.__path__)
-        if m.name not in SUBPACKAGES and m.name != "__main__"
+        name for name in all_modules()
+        if name.split(".")[1] not in SUBPACKAGES and name != "stairbot.__main__"
     )
+
+
+def test_every_module_is_listed_once() -> None:
+    names = all_modules()
+    assert len(names) == len(set(names))
+    assert not any(name.startswith("stairbot.stairbot") for name in names)
+    for expected in ("stairbot.algorithm.controller", "stairbot.drivers.serial_robot",
+                     "stairbot.fakes.sim", "stairbot.console.app"):
+        assert expected in names
 
 
 def test_the_core_modules_are_found() -> None:
     names = core_modules()
     for expected in ("stairbot.config", "stairbot.scenario", "stairbot.hardware",
-                     "stairbot.events", "stairbot.cli"):
+                     "stairbot.events", "stairbot.cli", "stairbot.algorithm.controller"):
         assert expected in names
 
 

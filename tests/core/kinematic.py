@@ -16,8 +16,8 @@ import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from stairbot.algorithm.controller import Controller
 from stairbot.config import RobotConfig
-from stairbot.controller import Controller
 from stairbot.hardware import (
     LIFT_MOTORS,
     MotorId,

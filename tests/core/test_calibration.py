@@ -8,11 +8,11 @@ import math
 import pytest
 from kinematic import KinematicRobot, run
 
+from stairbot.algorithm.controller import Controller
+from stairbot.algorithm.phases import Mode, Phase
 from stairbot.config import load_config
-from stairbot.controller import Controller
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, SensorId
-from stairbot.phases import Mode, Phase
 
 CFG = load_config()
 CLEARANCE = CFG.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE

@@ -8,11 +8,11 @@ import json
 import pytest
 from kinematic import KinematicRobot, run
 
+from stairbot.algorithm.context import TAB_SIZE, Context
+from stairbot.algorithm.controller import Controller
+from stairbot.algorithm.phases import Phase
 from stairbot.config import load_config
-from stairbot.context import TAB_SIZE, Context
-from stairbot.controller import Controller
 from stairbot.errors import InputError
-from stairbot.phases import Phase
 
 CFG = load_config()
 

@@ -9,11 +9,11 @@ from importlib import resources
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
+from stairbot.algorithm.controller import PHASE_TIMEOUT_S, Controller, phase_timeout_s
+from stairbot.algorithm.phases import Phase
 from stairbot.config import load_config, parse_config
-from stairbot.controller import PHASE_TIMEOUT_S, Controller, phase_timeout_s
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.phases import Phase
 
 CFG = load_config()
 DEFAULT_ROBOT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")

@@ -6,11 +6,11 @@ from __future__ import annotations
 import pytest
 from kinematic import KinematicRobot, run
 
+from stairbot.algorithm.controller import Controller
+from stairbot.algorithm.phases import Mode, Phase
 from stairbot.config import load_config
-from stairbot.controller import Controller
 from stairbot.events import Event, EventKind
 from stairbot.hardware import LIFT_MOTORS, MotorId
-from stairbot.phases import Mode, Phase
 
 CFG = load_config()
 STEP = (0.17, 0.28)

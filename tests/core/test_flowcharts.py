@@ -1,6 +1,6 @@
 """docs/algorithm.md draws the calibration, ascent and descent flowcharts from
 the controller's transition table: this fails when the drawing and the code
-disagree (regenerate with ``python -m stairbot.transitions``)."""
+disagree (regenerate with ``python -m stairbot.algorithm.transitions``)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.phases import FLOWS
-from stairbot.transitions import TRANSITIONS, mermaid
+from stairbot.algorithm.phases import FLOWS
+from stairbot.algorithm.transitions import TRANSITIONS, mermaid
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "algorithm.md"
-FIX = "the flowcharts in docs/algorithm.md are stale: paste `python -m stairbot.transitions`"
+FIX = ("the flowcharts in docs/algorithm.md are stale: paste "
+       "`python -m stairbot.algorithm.transitions`")
 
 
 def drawn(flow: str) -> str:

@@ -6,11 +6,9 @@ import re
 
 import pytest
 
-from stairbot.config import load_config
-from stairbot.controller import HANDLERS, Controller
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.phases import FLOWS, Phase
-from stairbot.transitions import (
+from stairbot.algorithm.controller import HANDLERS, Controller
+from stairbot.algorithm.phases import FLOWS, Phase
+from stairbot.algorithm.transitions import (
     BACK_PAIR_PHASES,
     STANDING_ARMED,
     TRANSITIONS,
@@ -18,6 +16,8 @@ from stairbot.transitions import (
     allowed,
     mermaid,
 )
+from stairbot.config import load_config
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config()
 

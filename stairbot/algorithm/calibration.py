@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import math
 
-from stairbot import motion
-from stairbot.handler import Handler, PhaseIO, Speeds, lift, where
+from stairbot.algorithm import motion
+from stairbot.algorithm.handler import Handler, PhaseIO, Speeds, lift, where
+from stairbot.algorithm.phases import Mode, Phase
 from stairbot.hardware import MotorId
-from stairbot.phases import Mode, Phase
 
 PROBE_YAW_RAD = math.radians(10.0)
 """Case 3: the probe turn stops after this much yaw if the readings have not

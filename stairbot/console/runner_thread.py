@@ -39,7 +39,7 @@ def _default_open(url: str, config: RobotConfig, scenario: Scenario,
 
 def _default_run(session: RobotSession, config: RobotConfig, sink: Callable[[Event], None],
                  mode: str, control: Any, on_tick: Callable[[Any, Any], None]) -> Any:
-    from stairbot.phases import Mode
+    from stairbot.algorithm.phases import Mode
     from stairbot.runner import run
 
     return run(session, config, sink, Mode.CALIBRATE_ONLY if mode == "calibrate" else Mode.FULL,

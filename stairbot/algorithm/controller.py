@@ -5,7 +5,7 @@ and returns a speed for all six motors.  Faults are checked before the
 phase's own logic (a motor fault, a sensor error on a sensor the phase needs,
 a phase that takes too long), then the standing rule, then the phase's
 handler.  The clock is ``Snapshot.time_s`` alone; nothing here sleeps.  Every
-phase change is checked against :data:`~stairbot.transitions.TRANSITIONS` and
+phase change is checked against :data:`~stairbot.algorithm.transitions.TRANSITIONS` and
 told as an event.
 """
 
@@ -15,11 +15,13 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from stairbot import ascent, calibration, descent, motion, standing
+from stairbot.algorithm import ascent, calibration, descent, motion, standing
+from stairbot.algorithm.context import Context
+from stairbot.algorithm.handler import Handler, PhaseIO, where
+from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.algorithm.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
 from stairbot.config import RobotConfig
-from stairbot.context import Context
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.handler import Handler, PhaseIO, where
 from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
@@ -29,8 +31,6 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.phases import BY_VALUE, Mode, Phase
-from stairbot.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
 
 PHASE_TIMEOUT_S = 60.0
 """A phase (other than the standing rule's wait) that lasts longer than this,

@@ -2,7 +2,7 @@
 condition that makes it.  The single source of truth: the controller refuses
 any change not listed here, the standing rule is armed exactly in the phases
 that list :attr:`Phase.PAUSED`, and the flowcharts in docs/algorithm.md are
-drawn from it (``python -m stairbot.transitions``).
+drawn from it (``python -m stairbot.algorithm.transitions``).
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from stairbot.phases import FLOWS, Phase
+from stairbot.algorithm.phases import FLOWS, Phase
 
 P = Phase
 

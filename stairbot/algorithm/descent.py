@@ -11,10 +11,10 @@ counts.
 
 from __future__ import annotations
 
-from stairbot import motion
-from stairbot.handler import Handler, PhaseIO, Speeds, lift, reading_drive, turns_drive
+from stairbot.algorithm import motion
+from stairbot.algorithm.handler import Handler, PhaseIO, Speeds, lift, reading_drive, turns_drive
+from stairbot.algorithm.phases import Phase
 from stairbot.hardware import BACK_SENSORS, MotorId
-from stairbot.phases import Phase
 
 
 def _tab(io: PhaseIO) -> float | None:

@@ -15,13 +15,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from stairbot import motion
+from stairbot.algorithm import motion
+from stairbot.algorithm.context import Context
+from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.algorithm.transitions import TRANSITIONS
 from stairbot.config import RobotConfig
-from stairbot.context import Context
 from stairbot.events import EventKind
 from stairbot.hardware import MotorId, Snapshot
-from stairbot.phases import BY_VALUE, Mode, Phase
-from stairbot.transitions import TRANSITIONS
 
 Speeds = dict[MotorId, float]
 

@@ -1,4 +1,4 @@
-"""Ascent steps 2–9 (step 1 is calibration: :mod:`stairbot.calibration`).
+"""Ascent steps 2–9 (step 1 is calibration: :mod:`stairbot.algorithm.calibration`).
 
 h below is number_of_turns_for_step_height.  Ascent 3 lifts segment 1 until
 the front sensors see over the step, then number_of_vertical_turns more; h is
@@ -9,10 +9,10 @@ reading when the distance is measurable and by turns when it is not.
 
 from __future__ import annotations
 
-from stairbot import motion
-from stairbot.handler import Handler, PhaseIO, Speeds, lift, reading_drive
+from stairbot.algorithm import motion
+from stairbot.algorithm.handler import Handler, PhaseIO, Speeds, lift, reading_drive
+from stairbot.algorithm.phases import Phase
 from stairbot.hardware import MotorId
-from stairbot.phases import Phase
 
 
 def _approach(io: PhaseIO) -> Speeds:

@@ -6,18 +6,18 @@ Armed in the phases whose table entry lists :attr:`Phase.PAUSED` (where both
 sensors of the pair look at the same flat surface), watching SBR/SBL in
 descent 2 and SFR/SFL elsewhere.  A disagreement only counts when both sensors
 give a usable distance, and both the difference and its smoothed value
-(:data:`~stairbot.motion.DIFF_SMOOTHING`) must exceed equal_tolerance for
+(:data:`~stairbot.algorithm.motion.DIFF_SMOOTHING`) must exceed equal_tolerance for
 DEBOUNCE_TICKS ticks in a row: neither a short spike nor sensor noise stops
 the robot.
 """
 
 from __future__ import annotations
 
-from stairbot import motion
-from stairbot.handler import Handler, PhaseIO, Speeds
+from stairbot.algorithm import motion
+from stairbot.algorithm.handler import Handler, PhaseIO, Speeds
+from stairbot.algorithm.phases import Phase
+from stairbot.algorithm.transitions import BACK_PAIR_PHASES, STANDING_ARMED
 from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, SensorId
-from stairbot.phases import Phase
-from stairbot.transitions import BACK_PAIR_PHASES, STANDING_ARMED
 
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after

@@ -41,7 +41,7 @@ class Context:
 
     # -- where the program stands ---------------------------------------------------
     phase: str = "cal_check"
-    """Value of the present :class:`~stairbot.phases.Phase`."""
+    """Value of the present :class:`~stairbot.algorithm.phases.Phase`."""
     purpose: str = "start"
     """What the calibration phases are doing: "start", "ascent" or "descent"."""
     calibration_case: str | None = None
