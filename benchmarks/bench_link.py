@@ -31,7 +31,6 @@ from stairbot.drivers.serial_robot import open_serial_robot
 from stairbot.drivers.serial_wire import Frame, encode_frame
 from stairbot.hardware import MotorId
 from stairbot.robots import RobotOptions
-from stairbot.scenario import load_scenario
 
 BAUD = 1_000_000
 BITS_PER_BYTE = 10  # 8N1
@@ -86,7 +85,7 @@ def bench_serial(cycles: int) -> None:
     try:
         assert proc.stdout is not None
         url = proc.stdout.readline().strip()
-        session = open_serial_robot(url, load_config(), load_scenario(), RobotOptions())
+        session = open_serial_robot(url, load_config(), RobotOptions())
         robot = session.robot
         tx, rx = cycle_bytes()
         print(f"serial over a pseudo-terminal ({url}), fake boards in real time, "
@@ -124,7 +123,7 @@ def bench_lockstep(ticks: int) -> None:
         assert proc.stdout is not None
         url = proc.stdout.readline().strip()
         config = load_config()
-        session = open_serial_robot(url, config, load_scenario(), RobotOptions())
+        session = open_serial_robot(url, config, RobotOptions())
         robot, clock, tick = session.robot, session.clock, config.algorithm.tick
         speeds = {MotorId.MWF: 0.5, MotorId.MWB: 0.5, MotorId.MWR: 0.5, MotorId.MWL: 0.5}
         t0 = time.perf_counter()

@@ -67,7 +67,7 @@ def cycle_frames() -> list[tuple[str, int, int]]:
 
 
 def report(label: str, url: str, cycles: int) -> None:
-    session = open_can_robot(url, load_config(), load_scenario(), RobotOptions())
+    session = open_can_robot(url, load_config(), RobotOptions())
     robot = session.robot
     print(f"{label} ({url}), fake boards in real time, {cycles} cycles")
     for acked, name in ((False, "pipelined (Acks checked next cycle)"),

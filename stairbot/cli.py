@@ -20,6 +20,7 @@ import signal
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
+from dataclasses import replace
 from importlib import import_module
 from types import FrameType
 from typing import IO, Any, TextIO
@@ -246,7 +247,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                 print(event.line(), file=progress, flush=True)
 
         try:
-            session = open_robot(args.robot, config, scenario, options)
+            session = open_robot(args.robot, config, replace(options, world=scenario))
         except HardwareError as exc:
             print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
             return EXIT_MISMATCH

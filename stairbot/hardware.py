@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Protocol, runtime_checkable
 
+from stairbot.events import EventSink
+
 
 class SensorId(StrEnum):
     SFR = "SFR"  # segment 1, front right, looking forward
@@ -90,7 +92,11 @@ Speeds = Mapping[MotorId, float]
 
 @runtime_checkable
 class Robot(Protocol):
-    """A robot the controller can drive: the simulation, or boards on a wire."""
+    """A robot the controller can drive: the simulation, or boards on a wire.
+
+    Every robot (sim://, serial://, can://, a third party's) implements all of
+    it; tests/test_robot_conformance.py holds them to it.  Optional abilities
+    are the small protocols below, checked with ``isinstance``."""
 
     def read(self) -> Snapshot:
         """Read every sensor and motor.  Raises HardwareError (LinkLostError,
@@ -98,19 +104,66 @@ class Robot(Protocol):
         ...
 
     def command(self, speeds: Speeds) -> None:
-        """Set every motor's speed (turns/s); motors left out get 0."""
+        """Set every motor's speed (turns/s); motors left out get 0.  While the
+        e-stop is latched every motor stays stopped whatever is asked."""
         ...
 
     def stop_all(self) -> None:
-        """Stop every motor at once; lifts hold.  Never raises."""
+        """Stop every motor at once; lifts hold.  Not latched.  Never raises."""
+        ...
+
+    def estop(self) -> None:
+        """Emergency stop: every motor stops at once, the lifts hold, and the
+        stop is latched (``command`` moves nothing) until :meth:`clear`.
+        Never raises."""
+        ...
+
+    def clear(self) -> None:
+        """Clear the e-stop latch (and any latch the boards hold).  Moves
+        nothing by itself: motion needs a new ``command``."""
+        ...
+
+    @property
+    def estopped(self) -> bool:
+        """True while the e-stop is latched (as far as the host knows)."""
         ...
 
     def diagnostics(self) -> dict[str, object]:
-        """Extra facts for the summary and the console (sim truth, link health)."""
+        """Extra facts for the summary and the console (link health)."""
         ...
 
     def close(self) -> None:
         """Stop every motor and release the robot."""
+        ...
+
+
+@dataclass(frozen=True, slots=True)
+class Truth:
+    """What only a simulation knows of itself: for summaries, sweeps and the
+    console's picture, never for the controller."""
+
+    fell: bool
+    fall_reason: str | None
+    pitch_deg: float | None
+    max_pitch_deg: float | None
+    offset_m: float | None
+    """Distance from the start pose."""
+
+
+@runtime_checkable
+class HasTruth(Protocol):
+    """A simulated robot (sim://, or fake boards in lockstep) that can tell the
+    truth about itself."""
+
+    def truth(self) -> Truth:
+        ...
+
+
+@runtime_checkable
+class ReportsEvents(Protocol):
+    """A robot that tells its own events (a wired robot's link health)."""
+
+    def attach_sink(self, sink: EventSink) -> None:
         ...
 
 

@@ -7,7 +7,9 @@ URL schemes (each handler documents its own grammar in its module header):
 * ``can://INTERFACE/CHANNEL?...`` boards on a CAN bus, any python-can interface
 
 Third parties add schemes with an entry point in the ``stairbot.robots`` group,
-whose value is a factory ``f(url, config, scenario, options) -> RobotSession``.
+whose value is a factory ``f(url, config, options) -> RobotSession``.  A driver
+takes a URL and a config; only a simulated robot reads ``options.world`` (the
+stairs and start pose it simulates).
 """
 
 from __future__ import annotations
@@ -27,10 +29,13 @@ from stairbot.scenario import Scenario
 @dataclass(frozen=True)
 class RobotOptions:
     """How to run: ``realtime`` paces a simulation to the wall clock;
-    ``time_scale`` (sim seconds per wall second) paces it faster or slower."""
+    ``time_scale`` (sim seconds per wall second) paces it faster or slower;
+    ``world`` is the scenario a simulated robot (``sim://``) is placed in —
+    drivers for real boards never read it."""
 
     realtime: bool = False
     time_scale: float | None = None
+    world: Scenario | None = None
 
 
 @dataclass
@@ -47,7 +52,7 @@ class RobotSession:
         self.robot.close()
 
 
-RobotFactory = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
+RobotFactory = Callable[[str, RobotConfig, RobotOptions], RobotSession]
 
 # Built-in schemes, imported lazily so the core never imports pymunk/serial/can.
 _BUILTIN: dict[str, str] = {
@@ -80,11 +85,11 @@ def _load(target: str, url: str) -> RobotFactory:
 def open_robot(
     url: str,
     config: RobotConfig,
-    scenario: Scenario,
     options: RobotOptions | None = None,
 ) -> RobotSession:
     """Open the robot named by ``url``.  Raises RobotUrlError for an unknown
-    scheme or a robot that cannot be opened (the handler says why)."""
+    scheme or a malformed URL, HardwareError for a robot that cannot be
+    reached (the handler says why)."""
     scheme = urlsplit(url).scheme if "://" in url else ""
     schemes = known_schemes()
     if scheme not in schemes:
@@ -92,4 +97,4 @@ def open_robot(
         what = f"unknown scheme {scheme!r}" if scheme else "not a robot URL"
         raise RobotUrlError(url, None, f"{what}; allowed: {allowed}")
     factory = _load(schemes[scheme], url)
-    return factory(url, config, scenario, options or RobotOptions())
+    return factory(url, config, options or RobotOptions())

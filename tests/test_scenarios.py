@@ -18,7 +18,7 @@ CONFIG = load_config()
 
 def run_sim(scenario: Scenario) -> tuple[RunResult, list[Event]]:
     events: list[Event] = []
-    session = open_robot("sim://", CONFIG, scenario, RobotOptions())
+    session = open_robot("sim://", CONFIG, RobotOptions(world=scenario))
     try:
         return run(session, CONFIG, sink=events.append), events
     finally:

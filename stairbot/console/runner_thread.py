@@ -13,6 +13,7 @@ import contextlib
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 from stairbot.config import RobotConfig
@@ -34,7 +35,7 @@ def _default_open(url: str, config: RobotConfig, scenario: Scenario,
                   options: RobotOptions) -> RobotSession:
     from stairbot.robots import open_robot
 
-    return open_robot(url, config, scenario, options)
+    return open_robot(url, config, replace(options, world=scenario))
 
 
 def _default_run(session: RobotSession, config: RobotConfig, sink: Callable[[Event], None],

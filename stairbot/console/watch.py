@@ -102,6 +102,11 @@ class WatchedRobot:
         self._estop.clear()
         self.estop_tick = None
 
+    def clear(self) -> None:
+        with self._lock:
+            self.inner.clear()
+        self.clear_estop()
+
     def diagnostics(self) -> dict[str, object]:
         with self._lock:
             return self.inner.diagnostics()

@@ -93,6 +93,7 @@ class BoardRobot:
         self._reported: dict[str, float] = {}
         self._last_event = float("-inf")
         self._closed = False
+        self._estopped = False
         self._link_lost = False
         self._last_tx: dict[int, float] = {}
         self.watchdog_ms = watchdog_ms  # in wall-clock ms
@@ -221,12 +222,20 @@ class BoardRobot:
     @locked
     def estop(self) -> None:
         """Latch the emergency stop on both boards."""
+        self._estopped = True
         self._wait([self._request(b, [m.EStop()]) for b in m.Board])
 
     @locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
         """Clear latches (e-stop, watchdog, faults) on both boards."""
         self._wait([self._request(b, [m.Clear(mask)]) for b in m.Board])
+        if mask & m.ClearMask.ESTOP:
+            self._estopped = False
+
+    @property
+    def estopped(self) -> bool:
+        """True from estop() until a clear() of the e-stop latch."""
+        return self._estopped
 
     @locked
     def step_to(self, time_us: int) -> None:

@@ -57,7 +57,6 @@ from stairbot.drivers.board_robot import BoardRobot, board_session, locked
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
-from stairbot.scenario import Scenario
 
 OPTION_DEFAULTS: dict[str, float] = {
     "timeout": 0.1, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
@@ -217,8 +216,7 @@ class CanRobot(BoardRobot):
         return out
 
 
-def open_can_robot(url: str, config: RobotConfig, scenario: Scenario,
-                   options: RobotOptions) -> RobotSession:
+def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
     """Open ``can://INTERFACE/CHANNEL?...``.  RobotUrlError (one line) when the
     URL is malformed, the bus cannot open or no board answers."""
     spec = parse_can_url(url)

@@ -39,7 +39,6 @@ from stairbot.drivers.board_robot import BoardRobot, LockstepClock, board_sessio
 from stairbot.drivers.link import FdChannel, Link, PortChannel
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
-from stairbot.scenario import Scenario
 
 DEFAULTS: dict[str, float] = {
     "baud": 1_000_000, "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250,
@@ -103,8 +102,7 @@ class SerialRobot(BoardRobot):
     WIRE = "serial port"
 
 
-def open_serial_robot(url: str, config: RobotConfig, scenario: Scenario,
-                      options: RobotOptions) -> RobotSession:
+def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
     """Open ``serial://PORT?...``.  RobotUrlError (one line) when the URL is
     malformed, the port cannot open or no board answers."""
     port, opts = parse_serial_url(url)

@@ -43,7 +43,7 @@ from stairbot.hardware import (
     Speeds,
 )
 from stairbot.robots import RobotOptions, RobotSession
-from stairbot.scenario import Scenario
+from stairbot.scenario import Scenario, load_scenario
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
 Point = tuple[float, float]
@@ -102,6 +102,7 @@ class SimRobot:
         self._back_mount = (-self.world.lengths[2] / 2 + s.back_from_rear,
                             s.back_height - r, s.back_max_range * 1.05)
         self.closed = False
+        self._estopped = False
 
     # -- the Robot protocol ------------------------------------------------------
     def read(self) -> Snapshot:
@@ -130,6 +131,9 @@ class SimRobot:
         """Set every motor's speed in turns/s (clamped to the motor's limit; a
         speed that is not a finite number stops that motor)."""
         new = dict(self._zero)
+        if self._estopped:
+            self._apply(new)
+            return
         limits = self._limits
         for motor, value in speeds.items():
             limit = limits[motor]
@@ -142,6 +146,19 @@ class SimRobot:
     def stop_all(self) -> None:
         """Stop every motor at once; the lifts hold."""
         self._apply(dict.fromkeys(MotorId, 0.0))
+
+    def estop(self) -> None:
+        """Stop every motor and latch: commands move nothing until clear()."""
+        self._estopped = True
+        self.stop_all()
+
+    def clear(self) -> None:
+        """Clear the e-stop latch; nothing moves until the next command."""
+        self._estopped = False
+
+    @property
+    def estopped(self) -> bool:
+        return self._estopped
 
     def diagnostics(self) -> dict[str, object]:
         """Simulation truth for summaries and the console."""
@@ -318,15 +335,15 @@ class SimClock:
         self._sim0 = self.robot.world.time
 
 
-def open_sim_robot(url: str, config: RobotConfig, scenario: Scenario,
-                   options: RobotOptions) -> RobotSession:
-    """Open ``sim://``: a fresh simulated robot at the scenario's start pose.
-    Raises RobotUrlError for anything but ``sim://``."""
+def open_sim_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
+    """Open ``sim://``: a fresh simulated robot at the start pose of
+    ``options.world`` (the default scenario if none).  Raises RobotUrlError
+    for anything but ``sim://``."""
     parts = urlsplit(url)
     if parts.scheme != "sim" or parts.netloc or parts.path or parts.query or parts.fragment:
         raise RobotUrlError(url, None, "the simulated robot takes no host, path or "
                             "options; allowed: sim://")
-    robot = SimRobot(config, scenario)
+    robot = SimRobot(config, options.world or load_scenario())
     scale = options.time_scale
     if scale is None and options.realtime:
         scale = 1.0

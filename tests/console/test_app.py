@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import json
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -56,7 +57,7 @@ class SpyRobot:
 
 def spied_open(spies: list[SpyRobot]) -> Callable[..., RobotSession]:
     def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
-        session = open_robot(url, config, scenario, options)
+        session = open_robot(url, config, replace(options, world=scenario))
         spy = SpyRobot(session.robot)
         spies.append(spy)
         return RobotSession(spy, session.clock, session.url, session.simulated, session.sim)

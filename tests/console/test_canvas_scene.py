@@ -42,7 +42,7 @@ def test_scene_from_the_simulation_shows_the_robot_before_the_stairs() -> None:
     from stairbot.fakes.sim import open_sim_robot
     from stairbot.robots import RobotOptions
 
-    session = open_sim_robot("sim://", load_config(), load_scenario(), RobotOptions())
+    session = open_sim_robot("sim://", load_config(), RobotOptions(world=load_scenario()))
     view = scene_from_sim(session.sim.scene())  # type: ignore[union-attr]
     assert len(view.segments) == 3
     assert view.segment_steps() == [0, 0, 0]
@@ -96,7 +96,9 @@ def test_dead_reckoning_follows_the_simulated_climb() -> None:
     from stairbot.runner import RunControl, run
 
     cfg, sc = load_config(), load_scenario()
-    session = open_robot("sim://", cfg, sc)
+    from stairbot.robots import RobotOptions
+
+    session = open_robot("sim://", cfg, RobotOptions(world=sc))
     control = RunControl()
     worst = [0.0, 0.0]
 

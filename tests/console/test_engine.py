@@ -4,6 +4,7 @@ pause, and bad input, against the real simulated robot."""
 from __future__ import annotations
 
 import threading
+from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any
 
@@ -191,7 +192,7 @@ def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> Non
     def spy_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
         from stairbot.robots import RobotSession, open_robot
 
-        s = open_robot(url, config, scenario, options)
+        s = open_robot(url, config, replace(options, world=scenario))
         return RobotSession(Spy(s.robot), s.clock, s.url, s.simulated, s.sim)
 
     loop = HeldLoop()

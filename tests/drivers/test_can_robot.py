@@ -117,12 +117,11 @@ def test_no_interface_anywhere_is_one_clear_line(monkeypatch: pytest.MonkeyPatch
 
 
 def test_a_bus_that_cannot_open_is_one_line_and_no_boards_is_one_line() -> None:
-    config, scenario = load_config(), load_scenario()
+    config = load_config()
     with pytest.raises(RobotUrlError, match="cannot open CAN bus slcan//dev/nonexistent"):
-        open_robot("can://slcan//dev/nonexistent", config, scenario, RobotOptions())
+        open_robot("can://slcan//dev/nonexistent", config)
     with pytest.raises(RobotUrlError, match="no motor board answered on the CAN bus"):
-        open_robot(f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0", config,
-                   scenario, RobotOptions())
+        open_robot(f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0", config)
 
 
 @pytest.mark.skipif(not os.path.exists("/sys/class/net/vcan0"),
@@ -251,7 +250,7 @@ def test_threaded_server_on_a_virtual_bus_via_open_robot() -> None:
     thread.start()
     try:
         session = open_can_robot(f"can://virtual/{channel}?lockstep=1&timeout=1",
-                                 load_config(), load_scenario(), RobotOptions())
+                                 load_config(), RobotOptions())
         assert session.simulated
         for _ in range(10):
             session.robot.read()
@@ -291,7 +290,7 @@ def test_faster_than_real_time_without_lockstep() -> None:
     thread.start()
     try:
         session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1",
-                                 load_config(), load_scenario(), RobotOptions())
+                                 load_config(), RobotOptions())
         first = session.robot.read()
         for _ in range(25):
             session.robot.read()

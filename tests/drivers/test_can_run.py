@@ -71,8 +71,8 @@ def run_recorded(session: RobotSession) -> tuple[RunResult, list[Event]]:
 
 @pytest.fixture(scope="module")
 def sim_run(scenario_file: Path) -> tuple[RunResult, list[Event]]:
-    return run_recorded(open_robot("sim://", load_config(), load_scenario(scenario_file),
-                                   RobotOptions()))
+    return run_recorded(open_robot("sim://", load_config(),
+                                   RobotOptions(world=load_scenario(scenario_file))))
 
 
 def assert_same_end(wire: RunResult, wire_events: list[Event],
@@ -138,8 +138,7 @@ def fake_boards_url(scenario_file: Path) -> Iterator[str]:
 def test_full_ascent_and_descent_over_udp_multicast_ends_as_sim_does(
         fake_boards_url: str, scenario_file: Path,
         sim_run: tuple[RunResult, list[Event]]) -> None:
-    session = open_robot(fake_boards_url + "&timeout=2", load_config(),
-                         load_scenario(scenario_file), RobotOptions())
+    session = open_robot(fake_boards_url + "&timeout=2", load_config())
     try:
         wire, events = run_recorded(session)
         health = session.robot.diagnostics()["link"]

@@ -24,7 +24,7 @@ from stairbot.fakes.boards import BoardWorld, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId, SensorId
-from stairbot.robots import RobotOptions, RobotSession, open_robot
+from stairbot.robots import RobotSession, open_robot
 from stairbot.runner import run
 from stairbot.scenario import Scenario, load_scenario
 
@@ -39,7 +39,7 @@ class Fake:
     server: SerialBoardServer
 
     def open(self, query: str = "lockstep=1&timeout=0.5") -> RobotSession:
-        return open_robot(f"serial://{self.path}?{query}", CONFIG, SCENARIO, RobotOptions())
+        return open_robot(f"serial://{self.path}?{query}", CONFIG)
 
 
 def serve(faults: WireFaults | None = None) -> Iterator[Fake]:
@@ -126,8 +126,7 @@ def test_an_idle_robot_keeps_the_watchdogs_fed() -> None:
     server = SerialBoardServer(pty.master, world, make_boards(world))
     thread = threading.Thread(target=server.serve, daemon=True)
     thread.start()
-    session = open_robot(f"serial://{pty.path}?watchdog=400&timeout=0.5", CONFIG, SCENARIO,
-                         RobotOptions())
+    session = open_robot(f"serial://{pty.path}?watchdog=400&timeout=0.5", CONFIG)
     try:
         time.sleep(1.2)  # three watchdog periods with nothing from the control loop
         session.robot.read()  # no watchdog trip
@@ -241,7 +240,7 @@ def test_any_pyserial_url_works_as_the_port_socket() -> None:
     thread = threading.Thread(target=accept, daemon=True)
     thread.start()
     session = open_robot(f"serial://socket://127.0.0.1:{port}?lockstep=1&timeout=0.5",
-                         CONFIG, SCENARIO, RobotOptions())
+                         CONFIG)
     try:
         assert session.robot.read().sensors[SensorId.SFL].ok
         session.robot.command({MotorId.MWB: 1.0})
@@ -312,7 +311,7 @@ class _Rfc2217Bridge:
 def test_any_pyserial_url_works_as_the_port_rfc2217(fake: Fake) -> None:
     bridge = _Rfc2217Bridge(fake.path)
     session = open_robot(f"serial://rfc2217://127.0.0.1:{bridge.port}?baud=115200&lockstep=1&timeout=1",
-                         CONFIG, SCENARIO, RobotOptions())
+                         CONFIG)
     try:
         session.robot.command({MotorId.MTB: -10.0})
         session.clock.advance(0.1)
@@ -325,7 +324,7 @@ def test_any_pyserial_url_works_as_the_port_rfc2217(fake: Fake) -> None:
 def test_spy_wrapper_sees_the_traffic(fake: Fake, tmp_path: Path) -> None:
     dump = tmp_path / "spy.txt"
     session = open_robot(f"serial://spy://{fake.path}?file={dump}&lockstep=1&timeout=0.5",
-                         CONFIG, SCENARIO, RobotOptions())
+                         CONFIG)
     session.robot.read()
     session.close()
     text = dump.read_text()
@@ -358,5 +357,5 @@ def test_url_options() -> None:
 ])
 def test_a_port_that_cannot_be_used_is_one_clear_line(url: str, problem: str) -> None:
     with pytest.raises(RobotUrlError) as info:
-        open_robot(url, CONFIG, SCENARIO, RobotOptions())
+        open_robot(url, CONFIG)
     assert problem in str(info.value) and "\n" not in str(info.value)

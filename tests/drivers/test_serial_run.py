@@ -39,8 +39,8 @@ def fake_boards_url(tmp_path: Path) -> Iterator[str]:
 
 def test_full_ascent_and_descent_over_a_pty_ends_as_sim_does(fake_boards_url: str) -> None:
     config, scenario = load_config(), load_scenario()
-    sim = run(open_robot("sim://", config, scenario, RobotOptions()), config)
-    session = open_robot(fake_boards_url + "&timeout=2", config, scenario, RobotOptions())
+    sim = run(open_robot("sim://", config, RobotOptions(world=scenario)), config)
+    session = open_robot(fake_boards_url + "&timeout=2", config)
     try:
         wire: RunResult = run(session, config)
         health = session.robot.diagnostics()["link"]

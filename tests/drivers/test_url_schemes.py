@@ -16,9 +16,9 @@ TOY_MODULE = '''
 from stairbot.fakes.sim import open_sim_robot
 
 
-def open_toy(url, config, scenario, options):
+def open_toy(url, config, options):
     """A third party's robot: here the simulation, under its own scheme."""
-    session = open_sim_robot("sim://", config, scenario, options)
+    session = open_sim_robot("sim://", config, options)
     session.url = url
     return session
 '''

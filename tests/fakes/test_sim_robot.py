@@ -15,7 +15,7 @@ from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
 from stairbot.hardware import Clock, MotorId, Robot, SensorId, SensorStatus, Snapshot
 from stairbot.robots import RobotOptions
-from stairbot.scenario import Scenario, load_scenario, parse_scenario
+from stairbot.scenario import Scenario, parse_scenario
 
 CFG = load_config()
 TICK = CFG.algorithm.tick
@@ -224,13 +224,13 @@ def test_diagnostics_and_scene_describe_the_pose() -> None:
 
 
 def test_open_sim_robot_accepts_only_sim_url() -> None:
-    session = open_sim_robot("sim://", CFG, load_scenario(), RobotOptions())
+    session = open_sim_robot("sim://", CFG, RobotOptions())
     assert session.simulated and isinstance(session.sim, SimRobot)
     assert session.robot is session.sim
     session.close()
     for bad in ("sim://host", "sim:///path", "sim://?x=1", "serial://x"):
         with pytest.raises(RobotUrlError):
-            open_sim_robot(bad, CFG, load_scenario(), RobotOptions())
+            open_sim_robot(bad, CFG, RobotOptions())
 
 
 def test_clock_paces_only_when_asked() -> None:
@@ -248,7 +248,7 @@ def test_clock_paces_only_when_asked() -> None:
     paced = SimClock(r, 2.0, monotonic=lambda: wall[0], sleep=sleep)
     paced.advance(0.2)
     assert sum(slept) == pytest.approx(0.1)
-    session = open_sim_robot("sim://", CFG, load_scenario(), RobotOptions(realtime=True))
+    session = open_sim_robot("sim://", CFG, RobotOptions(realtime=True))
     assert isinstance(session.clock, SimClock) and session.clock.time_scale == 1.0
 
 
