@@ -47,6 +47,14 @@ def phases_visited(events: list[Event]) -> set[str]:
     return {str(e.data.get("phase")) for e in events if e.kind is EventKind.PHASE}
 
 
+def assert_one_phase_entry_a_tick(events: list[Event]) -> None:
+    """The controller enters at most one phase a tick: no two PHASE events
+    share a time."""
+    times = [e.time_s for e in events if e.kind is EventKind.PHASE]
+    twice = sorted({t for t in times if times.count(t) > 1})
+    assert not twice, f"more than one phase entered at t = {twice}"
+
+
 @pytest.mark.parametrize("name", shipped())
 def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
     scenario = load_scenario(name)
@@ -57,6 +65,7 @@ def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
     visited = phases_visited(events)
     assert must <= visited, f"{name} never entered {must - visited}"
     assert not (must_not & visited), f"{name} entered {must_not & visited}"
+    assert_one_phase_entry_a_tick(events)
 
 
 def test_every_calibration_case_and_error_situation_has_a_scenario() -> None:

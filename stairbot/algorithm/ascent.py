@@ -10,173 +10,258 @@ reading when the distance is measurable and by turns when it is not.
 from __future__ import annotations
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.handler import Handler, PhaseIO, Speeds, lift, reading_drive
+from stairbot.algorithm.moves import lift, reading_drive
+from stairbot.algorithm.phase import (
+    FAULT,
+    PhaseDef,
+    Step,
+    Tick,
+    fail,
+    go,
+    stay,
+)
 from stairbot.algorithm.phases import Phase
+from stairbot.algorithm.work import Work
 from stairbot.hardware import MotorId
 
+P = Phase
+FLOW = "ascent"
 
-def _approach(io: PhaseIO) -> Speeds:
-    cfg, ctx = io.cfg, io.ctx
-    sfr, sfl = motion.pair(io.snap)
+
+# -- ascent 2: approach --------------------------------------------------------------------
+def _approach(t: Tick, _w: Work) -> Step:
+    cfg, ctx = t.cfg, t.ctx
+    sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) or motion.far(sfl, cfg):
-        io.fail(f"riser lost during the approach (step {ctx.number_of_steps + 1}): "
-                f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead")
-        return {}
-    reading = motion.mean_distance(io.snap)
+        return fail(f"riser lost during the approach (step {ctx.number_of_steps + 1}): "
+                    f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead")
+    reading = motion.mean_distance(t.snap)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
-    here = motion.wheel_position(io.snap)
     if reading <= safe:
-        # From SAFE_DISTANCE_IN_FRONT_OF_STEP on, NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
-        # more.  A robot that starts nearer (after ascent 9) drives only the rest.
-        ctx.target_wheel = (here + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
-                            - cfg.wheel_turns(safe - reading))
-        io.go(Phase.ASCENT_APPROACH_TURNS)
-        return {}
+        return go(P.ASCENT_APPROACH_TURNS)
     remaining = cfg.wheel_turns(reading - safe) + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
-    return motion.drive(cfg, 1, remaining)
+    return stay(motion.drive(cfg, 1, remaining))
 
 
-def _approach_turns(io: PhaseIO) -> Speeds:
-    assert io.ctx.target_wheel is not None  # set by ascent 2's first part
-    remaining = io.ctx.target_wheel - motion.wheel_position(io.snap)
+APPROACH = PhaseDef(
+    P.ASCENT_APPROACH, "ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", FLOW, _approach,
+    watches="front",
+    to={P.ASCENT_APPROACH_TURNS: "reads SAFE_DISTANCE_IN_FRONT_OF_STEP",
+        P.ERROR: "riser lost (nothing ahead); " + FAULT})
+
+
+def _approach_turns_enter(t: Tick, w: Work) -> None:
+    # From SAFE_DISTANCE_IN_FRONT_OF_STEP on, NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+    # more.  A robot that starts nearer (after ascent 9) drives only the rest.
+    cfg = t.cfg
+    gap = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP - motion.mean_distance(t.snap)
+    w.target_wheel = w.entry_wheel + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH \
+        - cfg.wheel_turns(gap)
+
+
+def _approach_turns(t: Tick, w: Work) -> Step:
+    assert w.target_wheel is not None  # set on entry
+    remaining = w.target_wheel - motion.wheel_position(t.snap)
     if remaining <= motion.WHEEL_DONE:
-        io.go(Phase.ASCENT_LIFT_FIRST)
-        return {}
-    return motion.drive(io.cfg, 1, remaining)
+        return go(P.ASCENT_LIFT_FIRST)
+    return stay(motion.drive(t.cfg, 1, remaining))
 
 
-def _lift_first_enter(io: PhaseIO) -> None:
-    ctx, cfg = io.ctx, io.cfg
-    ctx.return_mtf = ctx.entry_mtf
-    ctx.target_mtf = ctx.entry_mtf + cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
-    ctx.target_mtb = None
+APPROACH_TURNS = PhaseDef(
+    P.ASCENT_APPROACH_TURNS, "ascent 2 — approach: NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH more",
+    FLOW, _approach_turns, enter=_approach_turns_enter, watches="front",
+    to={P.ASCENT_LIFT_FIRST: "turns made", P.ERROR: FAULT})
 
 
-def _lift_first(io: PhaseIO) -> Speeds:
-    ctx, cfg = io.ctx, io.cfg
+# -- ascent 3: lift segment 1 -------------------------------------------------------------
+def _lift_first_enter(t: Tick, w: Work) -> None:
+    ctx, cfg = t.ctx, t.cfg
+    ctx.return_mtf = w.entry_mtf
+    w.target_mtf = w.entry_mtf + cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
+
+
+def _lift_first(t: Tick, w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
     sight = cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
-    readings = motion.pair(io.snap)
+    readings = motion.pair(t.snap)
     if all(motion.far(r, cfg) or (r.ok and r.distance_m >= sight) for r in readings):
-        io.info(f"segment 1 sees over step {ctx.number_of_steps + 1}: SFR/SFL read "
-                f"{readings[0].distance_m:.3f}/{readings[1].distance_m:.3f} m "
-                f"(≥ {sight:.3f} m) after {io.snap.turns(MotorId.MTF) - ctx.return_mtf:.1f} "
-                "MTF turns")
-        io.go(Phase.ASCENT_LIFT_FIRST_MORE)
-        return {}
-    assert ctx.target_mtf is not None
-    speed = motion.lift_to(cfg, io.snap, MotorId.MTF, ctx.target_mtf)
+        t.say(f"segment 1 sees over step {ctx.number_of_steps + 1}: SFR/SFL read "
+              f"{readings[0].distance_m:.3f}/{readings[1].distance_m:.3f} m "
+              f"(≥ {sight:.3f} m) after {t.snap.turns(MotorId.MTF) - ctx.return_mtf:.1f} "
+              "MTF turns")
+        return go(P.ASCENT_LIFT_FIRST_MORE)
+    assert w.target_mtf is not None
+    speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
         ctx.ascent_end = "obstacle"
         allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
-        io.info(f"step {ctx.number_of_steps + 1} too high or its tread too short: no reading "
-                f"≥ {sight:.3f} m within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
-                ascent_end="obstacle")
-        io.go(Phase.ASCENT_LOWER_OBSTACLE)
-        return {}
-    return {MotorId.MTF: speed}
+        t.say(f"step {ctx.number_of_steps + 1} too high or its tread too short: no reading "
+              f"≥ {sight:.3f} m within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
+              ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE)
+    return stay({MotorId.MTF: speed})
 
 
-def _lifted_first(io: PhaseIO) -> None:
-    ctx = io.ctx
-    ctx.number_of_turns_for_step_height = io.snap.turns(MotorId.MTF) - ctx.return_mtf
-    io.info(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
-            f"(step {ctx.number_of_steps + 1})",
-            number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
-    io.go(Phase.ASCENT_DRIVE_FIRST)
+LIFT_FIRST = PhaseDef(
+    P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, enter=_lift_first_enter,
+    to={P.ASCENT_LIFT_FIRST_MORE: "reads ≥ LENGTH_OF_A_ROBOT + SAFE_LENGTH",
+        P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
+                                 "step too high or tread too short",
+        P.ERROR: FAULT})
 
 
-def _lowered_obstacle(io: PhaseIO) -> None:
-    io.go(Phase.DESCENT_BACK_OFF if io.ctx.number_of_steps > 0 else Phase.DESCENT_FINISH)
+def _lifted_first(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    ctx.number_of_turns_for_step_height = t.snap.turns(MotorId.MTF) - ctx.return_mtf
+    t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
+          f"(step {ctx.number_of_steps + 1})",
+          number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
+    return go(P.ASCENT_DRIVE_FIRST)
 
 
-def _first_target(io: PhaseIO) -> float | None:
-    ctx, cfg = io.ctx, io.cfg
-    if motion.measurable(io.snap, cfg):
-        ctx.length_of_next_step = motion.mean_distance(io.snap)
-        io.info(f"length_of_next_step = {ctx.length_of_next_step:.3f} m",
-                length_of_next_step=ctx.length_of_next_step)
+_more_enter, _more_step = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_vertical_turns},
+                               _lifted_first)
+LIFT_FIRST_MORE = PhaseDef(
+    P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
+    _more_step, enter=_more_enter,
+    to={P.ASCENT_DRIVE_FIRST: "turns made: number_of_turns_for_step_height stored",
+        P.ERROR: FAULT})
+
+
+def _lowered_obstacle(t: Tick, _w: Work) -> Step:
+    return go(P.DESCENT_BACK_OFF if t.ctx.number_of_steps > 0 else P.DESCENT_FINISH)
+
+
+_obstacle_enter, _obstacle_step = lift(
+    lambda t, w: {MotorId.MTF: t.ctx.return_mtf - w.entry_mtf}, _lowered_obstacle)
+LOWER_OBSTACLE = PhaseDef(
+    P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
+    enter=_obstacle_enter,
+    to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
+        P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
+
+
+# -- ascent 4-7: segment by segment onto the step -------------------------------------------
+def _first_target(t: Tick) -> float | None:
+    ctx, cfg = t.ctx, t.cfg
+    if motion.measurable(t.snap, cfg):
+        ctx.length_of_next_step = motion.mean_distance(t.snap)
+        t.say(f"length_of_next_step = {ctx.length_of_next_step:.3f} m",
+              length_of_next_step=ctx.length_of_next_step)
         return ctx.length_of_next_step - cfg.LENGTH_OF_FIRST_MODULE
     ctx.length_of_next_step = None
-    io.info("length_of_next_step not measurable (nothing ahead within LENGTH_OF_INFINITY): "
-            "driving NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE turns",
-            length_of_next_step=None)
+    t.say("length_of_next_step not measurable (nothing ahead within LENGTH_OF_INFINITY): "
+          "driving NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE turns", length_of_next_step=None)
     return None
 
 
-def _second_target(io: PhaseIO) -> float | None:
-    length = io.ctx.length_of_next_step
+def _second_target(t: Tick) -> float | None:
+    length = t.ctx.length_of_next_step
     if length is None:
         return None
-    return length - io.cfg.LENGTH_OF_FIRST_MODULE - io.cfg.LENGTH_OF_SECOND_MODULE
+    return length - t.cfg.LENGTH_OF_FIRST_MODULE - t.cfg.LENGTH_OF_SECOND_MODULE
 
 
-def _third_target(io: PhaseIO) -> float | None:
-    length = io.ctx.length_of_next_step
-    return None if length is None else length - io.cfg.LENGTH_OF_A_ROBOT
+def _third_target(t: Tick) -> float | None:
+    length = t.ctx.length_of_next_step
+    return None if length is None else length - t.cfg.LENGTH_OF_A_ROBOT
 
 
-def _h(io: PhaseIO) -> float:
-    return io.ctx.number_of_turns_for_step_height
+def _h(t: Tick) -> float:
+    return t.ctx.number_of_turns_for_step_height
 
 
-def _lifted_third(io: PhaseIO) -> None:
-    ctx, cfg = io.ctx, io.cfg
+_drive1 = reading_drive(1, _first_target,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
+                        lambda _t, _w: go(P.ASCENT_LIFT_SECOND))
+DRIVE_FIRST = PhaseDef(
+    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, _drive1[1],
+    enter=_drive1[0], watches="front",
+    to={P.ASCENT_LIFT_SECOND: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE "
+                              "(or turns made)",
+        P.ERROR: FAULT})
+
+_lift2 = lift(lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)},
+              lambda _t, _w: go(P.ASCENT_DRIVE_SECOND))
+LIFT_SECOND = PhaseDef(
+    P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW, _lift2[1], enter=_lift2[0],
+    watches="front", to={P.ASCENT_DRIVE_SECOND: "turns made", P.ERROR: FAULT})
+
+_drive2 = reading_drive(1, _second_target,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
+                        lambda _t, _w: go(P.ASCENT_LIFT_THIRD))
+DRIVE_SECOND = PhaseDef(
+    P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, _drive2[1],
+    enter=_drive2[0], watches="front",
+    to={P.ASCENT_LIFT_THIRD: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE − "
+                             "LENGTH_OF_SECOND_MODULE (or turns made)",
+        P.ERROR: FAULT})
+
+
+def _lifted_third(t: Tick, _w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps
-    if motion.measurable(io.snap, cfg):
-        ctx.tab_length_to_edge[i] = motion.mean_distance(io.snap)
-        io.info(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m",
-                index=i, tab_length_to_edge=ctx.tab_length_to_edge[i])
+    if motion.measurable(t.snap, cfg):
+        ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
+        t.say(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m",
+              index=i, tab_length_to_edge=ctx.tab_length_to_edge[i])
     else:
         ctx.tab_length_to_edge[i] = None
-        io.info(f"tab_length_to_edge[{i}] not measurable (nothing ahead): the descent of this "
-                "step drives by turns", index=i, tab_length_to_edge=None)
+        t.say(f"tab_length_to_edge[{i}] not measurable (nothing ahead): the descent of this "
+              "step drives by turns", index=i, tab_length_to_edge=None)
     ctx.number_of_steps += 1
-    io.info(f"number_of_steps = {ctx.number_of_steps}", number_of_steps=ctx.number_of_steps)
-    io.go(Phase.ASCENT_CHECK)
+    t.say(f"number_of_steps = {ctx.number_of_steps}", number_of_steps=ctx.number_of_steps)
+    return go(P.ASCENT_CHECK)
 
 
-def _check(io: PhaseIO) -> Speeds:
-    ctx, cfg = io.ctx, io.cfg
-    sfr, sfl = motion.pair(io.snap)
+_lift3 = lift(lambda t, _w: {MotorId.MTB: _h(t)}, _lifted_third)
+LIFT_THIRD = PhaseDef(
+    P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], enter=_lift3[0],
+    watches="front",
+    to={P.ASCENT_CHECK: "turns made; tab_length_to_edge[i] stored, number_of_steps + 1",
+        P.ERROR: FAULT})
+
+
+# -- ascent 8-9: the top, or the next step ------------------------------------------------------
+def _check(t: Tick, _w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         ctx.ascent_end = "top_reached"
-        io.info(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
-                "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
-        io.go(Phase.DESCENT_LOWER_THIRD)
-    elif ctx.number_of_steps >= cfg.algorithm.max_steps:
+        t.say(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
+              "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
+        return go(P.DESCENT_LOWER_THIRD)
+    if ctx.number_of_steps >= cfg.algorithm.max_steps:
         ctx.ascent_end = "step_limit"
-        io.info(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
-                "the descent begins", ascent_end="step_limit")
-        io.go(Phase.DESCENT_LOWER_THIRD)
-    else:
-        io.go(Phase.ASCENT_DRIVE_THIRD)
-    return {}
+        t.say(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
+              "the descent begins", ascent_end="step_limit")
+        return go(P.DESCENT_LOWER_THIRD)
+    return go(P.ASCENT_DRIVE_THIRD)
 
 
-def _driven_third(io: PhaseIO) -> None:
-    io.ctx.purpose = "ascent"
-    io.go(Phase.CAL_CHECK)
+CHECK = PhaseDef(
+    P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, watches="front",
+    to={P.DESCENT_LOWER_THIRD: "reads ≥ LENGTH_OF_INFINITY (top reached) "
+                               "or number_of_steps = max_steps",
+        P.ASCENT_DRIVE_THIRD: "otherwise",
+        P.ERROR: FAULT})
 
 
-HANDLERS: dict[Phase, Handler] = {
-    Phase.ASCENT_APPROACH: Handler(_approach),
-    Phase.ASCENT_APPROACH_TURNS: Handler(_approach_turns),
-    Phase.ASCENT_LIFT_FIRST: Handler(_lift_first, _lift_first_enter),
-    Phase.ASCENT_LIFT_FIRST_MORE: lift(lambda io: {MotorId.MTF: io.ctx.number_of_vertical_turns},
-                                       _lifted_first),
-    Phase.ASCENT_LOWER_OBSTACLE: lift(
-        lambda io: {MotorId.MTF: io.ctx.return_mtf - io.ctx.entry_mtf}, _lowered_obstacle),
-    Phase.ASCENT_DRIVE_FIRST: reading_drive(
-        1, _first_target, lambda io: io.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
-        lambda io: io.go(Phase.ASCENT_LIFT_SECOND)),
-    Phase.ASCENT_LIFT_SECOND: lift(lambda io: {MotorId.MTF: -_h(io), MotorId.MTB: -_h(io)},
-                                   lambda io: io.go(Phase.ASCENT_DRIVE_SECOND)),
-    Phase.ASCENT_DRIVE_SECOND: reading_drive(
-        1, _second_target, lambda io: io.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
-        lambda io: io.go(Phase.ASCENT_LIFT_THIRD)),
-    Phase.ASCENT_LIFT_THIRD: lift(lambda io: {MotorId.MTB: _h(io)}, _lifted_third),
-    Phase.ASCENT_CHECK: Handler(_check),
-    Phase.ASCENT_DRIVE_THIRD: reading_drive(
-        1, _third_target, lambda io: io.cfg.wheel_turns(io.cfg.LENGTH_OF_THIRD_MODULE),
-        _driven_third),
-}
+def _driven_third(t: Tick, _w: Work) -> Step:
+    t.ctx.purpose = "ascent"
+    return go(P.CAL_CHECK)
+
+
+_drive3 = reading_drive(1, _third_target,
+                        lambda t: t.cfg.wheel_turns(t.cfg.LENGTH_OF_THIRD_MODULE), _driven_third)
+DRIVE_THIRD = PhaseDef(
+    P.ASCENT_DRIVE_THIRD, "ascent 9 — drive segment 3 onto the step", FLOW, _drive3[1],
+    enter=_drive3[0], watches="front",
+    to={P.CAL_CHECK: "reads length_of_next_step − LENGTH_OF_A_ROBOT (or turns made): "
+                     "next step, ascent 1",
+        P.ERROR: FAULT})
+
+PHASES: tuple[PhaseDef, ...] = (
+    APPROACH, APPROACH_TURNS, LIFT_FIRST, LIFT_FIRST_MORE, LOWER_OBSTACLE, DRIVE_FIRST,
+    LIFT_SECOND, DRIVE_SECOND, LIFT_THIRD, CHECK, DRIVE_THIRD,
+)

@@ -13,9 +13,24 @@ from __future__ import annotations
 import math
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.handler import Handler, PhaseIO, Speeds, lift, where
+from stairbot.algorithm.moves import lift
+from stairbot.algorithm.phase import (
+    FAULT,
+    PhaseDef,
+    Step,
+    Tick,
+    end,
+    fail,
+    go,
+    stay,
+    where,
+)
 from stairbot.algorithm.phases import Mode, Phase
+from stairbot.algorithm.work import Work
 from stairbot.hardware import MotorId
+
+P = Phase
+FLOW = "calibration"
 
 PROBE_YAW_RAD = math.radians(10.0)
 """Case 3: the probe turn stops after this much yaw if the readings have not
@@ -26,160 +41,181 @@ TURN_SLOW_FLOOR = 0.25
 """The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
 
 
-def _readings(io: PhaseIO) -> tuple[float, float]:
-    sfr, sfl = motion.pair(io.snap)
+def _readings(t: Tick) -> tuple[float, float]:
+    sfr, sfl = motion.pair(t.snap)
     return sfr.distance_m, sfl.distance_m
 
 
-def _where(io: PhaseIO) -> str:
-    return where(io.ctx, io.phase)
+def _after_calibration(t: Tick) -> Step:
+    return go(P.DESCENT_BACK_TO_EDGE if t.ctx.purpose == "descent" else P.ASCENT_APPROACH)
 
 
-def _after_calibration(io: PhaseIO) -> None:
-    if io.ctx.purpose == "descent":
-        io.go(Phase.DESCENT_BACK_TO_EDGE)
-    else:
-        io.go(Phase.ASCENT_APPROACH)
-
-
-def _check(io: PhaseIO) -> Speeds:
-    cfg, ctx = io.cfg, io.ctx
-    sfr, sfl = motion.pair(io.snap)
+# -- check the readings --------------------------------------------------------------
+def _check(t: Tick, _w: Work) -> Step:
+    cfg, ctx = t.cfg, t.ctx
+    sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         if ctx.purpose != "start":
-            io.fail(f"nothing ahead at {_where(io)}: SFR {sfr.distance_m:.3f} m, "
-                    f"SFL {sfl.distance_m:.3f} m where a riser should be")
-            return {}
+            return fail(f"nothing ahead at {where(ctx, P.CAL_CHECK)}: SFR {sfr.distance_m:.3f} m, "
+                        f"SFL {sfl.distance_m:.3f} m where a riser should be")
         ctx.calibration_case = "1"
-        io.info("calibration case 1: nothing ahead (SFR and SFL read at least "
-                f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
-        io.end("stopped", "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
-        return {}
+        t.say("calibration case 1: nothing ahead (SFR and SFL read at least "
+              f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
+        return end("stopped", "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
     diff = sfl.distance_m - sfr.distance_m
     equal = abs(diff) <= cfg.algorithm.equal_tolerance
     if equal and ctx.purpose != "start":
         ctx.calibration_case = None
-        _after_calibration(io)
-        return {}
+        return _after_calibration(t)
     ctx.calibration_case = "3" if equal else "2"
-    io.info(f"calibration ({_where(io)}): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
-            + ("equal, case 3" if equal else "not equal, case 2"),
-            case=ctx.calibration_case, SFR=sfr.distance_m, SFL=sfl.distance_m)
-    io.go(Phase.CAL_LIFT)
-    return {}
+    t.say(f"calibration ({where(ctx, P.CAL_CHECK)}): SFR {sfr.distance_m:.3f} m, "
+          f"SFL {sfl.distance_m:.3f} m: " + ("equal, case 3" if equal else "not equal, case 2"),
+          case=ctx.calibration_case, SFR=sfr.distance_m, SFL=sfl.distance_m)
+    return go(P.CAL_LIFT)
 
 
-def _lift_enter_targets(io: PhaseIO) -> dict[MotorId, float]:
-    ctx, cfg = io.ctx, io.cfg
-    ctx.return_mtf, ctx.return_mtb = ctx.entry_mtf, ctx.entry_mtb
+CHECK = PhaseDef(
+    P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check,
+    to={
+        P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead)",
+        P.CAL_LIFT: "start: case 2 (SFR ≠ SFL) or case 3 (SFR = SFL); later: SFR ≠ SFL",
+        P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL",
+        P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL",
+        P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be",
+    })
+
+
+# -- lift segments 1 and 3 for clearance -----------------------------------------------
+def _lift_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
+    ctx, cfg = t.ctx, t.cfg
+    ctx.return_mtf, ctx.return_mtb = w.entry_mtf, w.entry_mtb
     up = cfg.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE
     limit = cfg.MAX_OF_VERTICAL_TURNS
-    return {MotorId.MTF: min(up, limit - ctx.entry_mtf),
-            MotorId.MTB: min(up, limit - ctx.entry_mtb)}
+    return {MotorId.MTF: min(up, limit - w.entry_mtf), MotorId.MTB: min(up, limit - w.entry_mtb)}
 
 
-def _lifted(io: PhaseIO) -> None:
-    io.ctx.turn_origin = io.snap.turns(MotorId.MWR)
-    io.go(Phase.CAL_TURN if io.ctx.calibration_case == "2" else Phase.CAL_PROBE)
+def _lifted(t: Tick, _w: Work) -> Step:
+    t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
+    return go(P.CAL_TURN if t.ctx.calibration_case == "2" else P.CAL_PROBE)
 
 
-def _turned_too_far(io: PhaseIO) -> bool:
-    made = abs(io.snap.turns(MotorId.MWR) - io.ctx.turn_origin)
-    if motion.turn_yaw_rad(io.cfg, made) <= MAX_TURN_YAW_RAD:
-        return False
-    io.fail(f"calibration ({_where(io)}) turned {math.degrees(MAX_TURN_YAW_RAD):.0f}° "
-            "without finding SFR = SFL")
-    return True
+_lift_enter, _lift_step = lift(_lift_deltas, _lifted)
+LIFT = PhaseDef(
+    P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
+    enter=_lift_enter,
+    to={P.CAL_TURN: "lifted; case 2", P.CAL_PROBE: "lifted; case 3", P.ERROR: FAULT})
 
 
-def _turn_enter(io: PhaseIO) -> None:
-    sfr, sfl = _readings(io)
+# -- turning ---------------------------------------------------------------------------
+def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
+    made = abs(t.snap.turns(MotorId.MWR) - t.ctx.turn_origin)
+    if motion.turn_yaw_rad(t.cfg, made) <= MAX_TURN_YAW_RAD:
+        return None
+    return fail(f"calibration ({where(t.ctx, phase)}) turned "
+                f"{math.degrees(MAX_TURN_YAW_RAD):.0f}° without finding SFR = SFL")
+
+
+def _turn_enter(t: Tick, w: Work) -> None:
+    sfr, sfl = _readings(t)
     # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
-    io.ctx.turn_direction = 1 if sfl < sfr else -1
-    io.ctx.turn_diff = sfl - sfr
+    w.turn_direction = 1 if sfl < sfr else -1
+    w.turn_diff = sfl - sfr
 
 
-def _turn(io: PhaseIO) -> Speeds:
-    ctx, cfg = io.ctx, io.cfg
-    sfr, sfl = _readings(io)
-    ctx.turn_diff = motion.smooth(ctx.turn_diff, sfl - sfr)
+def _turn(t: Tick, w: Work) -> Step:
+    cfg = t.cfg
+    sfr, sfl = _readings(t)
+    w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
     # Turning left closes SFL - SFR from below, turning right from above: stop
     # when the smoothed difference has reached zero.
-    remaining = -ctx.turn_direction * ctx.turn_diff
+    remaining = -w.turn_direction * w.turn_diff
     if remaining <= 0.0:
-        io.info(f"squared up: SFR {sfr:.3f} m, SFL {sfl:.3f} m", SFR=sfr, SFL=sfl)
-        io.go(Phase.CAL_LOWER)
-        return {}
-    if _turned_too_far(io):
-        return {}
+        t.say(f"squared up: SFR {sfr:.3f} m, SFL {sfl:.3f} m", SFR=sfr, SFL=sfl)
+        return go(P.CAL_LOWER)
+    too_far = _turned_too_far(t, P.CAL_TURN)
+    if too_far is not None:
+        return too_far
     slow = min(1.0, max(TURN_SLOW_FLOOR, remaining / (2 * cfg.algorithm.equal_tolerance)))
-    return motion.turn(ctx.turn_direction, cfg, slow)
+    return stay(motion.turn(w.turn_direction, cfg, slow))
 
 
-def _probe_enter(io: PhaseIO) -> None:
-    io.ctx.probe_sfr, io.ctx.probe_sfl = _readings(io)
+TURN = PhaseDef(
+    P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, enter=_turn_enter,
+    to={P.CAL_LOWER: "SFR = SFL", P.ERROR: "turned too far; " + FAULT})
 
 
-def _probe(io: PhaseIO) -> Speeds:
-    ctx, cfg = io.ctx, io.cfg
-    sfr, sfl = _readings(io)
-    d_sfr, d_sfl = sfr - ctx.probe_sfr, sfl - ctx.probe_sfl
+def _probe_enter(t: Tick, w: Work) -> None:
+    w.probe_sfr, w.probe_sfl = _readings(t)
+
+
+def _probe(t: Tick, w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    sfr, sfl = _readings(t)
+    d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
     tol = cfg.algorithm.equal_tolerance
-    made = abs(io.snap.turns(MotorId.MWR) - ctx.turn_origin)
+    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
     if abs(d_sfr) + abs(d_sfl) < 2 * tol and motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
-        return motion.turn(1, cfg)
+        return stay(motion.turn(1, cfg))
     corner = d_sfr > 0 and d_sfl < 0 and d_sfr - d_sfl >= tol
     ctx.calibration_case = "3B" if corner else "3A"
     data = {"case": ctx.calibration_case, "dSFR": d_sfr, "dSFL": d_sfl}
     if corner:
-        io.info(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
-                f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
-        ctx.probe_sfr = sfr
-        io.go(Phase.CAL_CORNER)
-    else:
-        io.info(f"calibration case 3A: square to the riser (turning left, SFR changed "
-                f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
-        io.go(Phase.CAL_TURN)
-    return {}
+        t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
+              f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
+        return go(P.CAL_CORNER)
+    t.say(f"calibration case 3A: square to the riser (turning left, SFR changed "
+          f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
+    return go(P.CAL_TURN)
 
 
-def _corner(io: PhaseIO) -> Speeds:
-    ctx = io.ctx
-    sfr, _sfl = _readings(io)
-    ctx.probe_sfr = max(ctx.probe_sfr, sfr)  # the largest SFR seen while turning
-    if sfr < ctx.probe_sfr - io.cfg.algorithm.equal_tolerance:
-        io.info(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
-        io.go(Phase.CAL_TURN)
-        return {}
-    if _turned_too_far(io):
-        return {}
-    return motion.turn(1, io.cfg)
+PROBE = PhaseDef(
+    P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe,
+    enter=_probe_enter,
+    to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
+        P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
 
 
-def _lower_targets(io: PhaseIO) -> dict[MotorId, float]:
-    ctx = io.ctx
-    return {MotorId.MTF: ctx.return_mtf - ctx.entry_mtf,
-            MotorId.MTB: ctx.return_mtb - ctx.entry_mtb}
+def _corner(t: Tick, w: Work) -> Step:
+    sfr, _sfl = _readings(t)
+    w.probe_sfr = max(w.probe_sfr, sfr)  # the largest SFR seen while turning
+    if sfr < w.probe_sfr - t.cfg.algorithm.equal_tolerance:
+        t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
+        return go(P.CAL_TURN)
+    too_far = _turned_too_far(t, P.CAL_CORNER)
+    if too_far is not None:
+        return too_far
+    return stay(motion.turn(1, t.cfg))
 
 
-def _lowered(io: PhaseIO) -> None:
-    ctx, cfg = io.ctx, io.cfg
+CORNER = PhaseDef(
+    P.CAL_CORNER, "calibration case 3B — turn left until both readings shrink", FLOW, _corner,
+    enter=_probe_enter,
+    to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
+
+
+# -- lower segments 1 and 3 --------------------------------------------------------------
+def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
+    ctx = t.ctx
+    return {MotorId.MTF: ctx.return_mtf - w.entry_mtf, MotorId.MTB: ctx.return_mtb - w.entry_mtb}
+
+
+def _lowered(t: Tick, _w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
     if ctx.purpose == "start":
-        if motion.measurable(io.snap, cfg):
-            ctx.start_reading = motion.mean_distance(io.snap)
-            io.info(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
-                    start_reading=ctx.start_reading)
-        if io.mode is Mode.CALIBRATE_ONLY:
-            io.end("completed", "calibrate-only: calibration done")
-            return
-    _after_calibration(io)
+        if motion.measurable(t.snap, cfg):
+            ctx.start_reading = motion.mean_distance(t.snap)
+            t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
+                  start_reading=ctx.start_reading)
+        if t.mode is Mode.CALIBRATE_ONLY:
+            return end("completed", "calibrate-only: calibration done")
+    return _after_calibration(t)
 
 
-HANDLERS: dict[Phase, Handler] = {
-    Phase.CAL_CHECK: Handler(_check),
-    Phase.CAL_LIFT: lift(_lift_enter_targets, _lifted),
-    Phase.CAL_TURN: Handler(_turn, _turn_enter),
-    Phase.CAL_PROBE: Handler(_probe, _probe_enter),
-    Phase.CAL_CORNER: Handler(_corner),
-    Phase.CAL_LOWER: lift(_lower_targets, _lowered),
-}
+_lower_enter, _lower_step = lift(_lower_deltas, _lowered)
+LOWER = PhaseDef(
+    P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, enter=_lower_enter,
+    to={P.ASCENT_APPROACH: "lowered (start or ascent 1)",
+        P.DESCENT_BACK_TO_EDGE: "lowered (descent 1)",
+        P.DONE: "lowered; calibrate-only mode", P.ERROR: FAULT})
+
+PHASES: tuple[PhaseDef, ...] = (CHECK, LIFT, PROBE, CORNER, TURN, LOWER)

@@ -1,5 +1,6 @@
-"""The controller's context: the seed's variables under their seed names, plus
-the bookkeeping the phases need to be restartable.
+"""The controller's context: the seed's variables under their seed names,
+where the program stands, and the present phase's own working state
+(:class:`~stairbot.algorithm.work.Work`).
 
 Everything a phase needs to carry on is here, and motion targets are absolute
 counter values (not "N more turns"), so a controller restored from
@@ -12,6 +13,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
+from stairbot.algorithm.work import Work
 from stairbot.errors import InputError
 
 TAB_SIZE = 20
@@ -66,30 +68,17 @@ class Context:
     standing_diff: float | None = None
     """The standing rule's smoothed difference of the watched pair (left − right)."""
 
-    # -- motion targets: absolute counter values ------------------------------------
-    target_wheel: float | None = None
-    """Target for the mean of the four wheel counters (drives)."""
-    target_reading: float | None = None
-    """Mean SFR/SFL reading a drive ends at (None: a drive by turns only)."""
-    target_mtf: float | None = None
-    target_mtb: float | None = None
-    entry_wheel: float = 0.0
-    entry_mtf: float = 0.0
-    entry_mtb: float = 0.0
-    """Counters when the present phase began."""
+    # -- bookkeeping that spans phases ---------------------------------------------
     return_mtf: float = 0.0
     return_mtb: float = 0.0
     """Lift counters to come back to: before the calibration lift, before ascent 3
     (and where descent 2 began lowering MTB)."""
-    turn_direction: int = 0
-    """Calibration turns: +1 left (counter-clockwise), -1 right."""
-    turn_diff: float = 0.0
-    """Calibration turns: SFL − SFR, smoothed over a few ticks."""
     turn_origin: float = 0.0
     """MWR counter when calibration began turning: bounds the total turn."""
-    probe_sfr: float = 0.0
-    probe_sfl: float = 0.0
-    """SFR/SFL when the case-3 probe turn began (or, in case 3B, the largest SFR)."""
+
+    # -- the present phase's own working state ----------------------------------------
+    work: Work = field(default_factory=Work)
+    """Made afresh when a phase is entered; no other phase reads it."""
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON-serialisable) that :meth:`from_dict` restores."""
@@ -118,14 +107,29 @@ class Context:
                 raise InputError(source, "tab_length_to_edge",
                                  f"must be a list of {TAB_SIZE} numbers or nulls")
             kwargs["tab_length_to_edge"] = [None if v is None else float(v) for v in tab]
+        work = kwargs.get("work")
+        if work is not None:
+            kwargs["work"] = _work_from(work, source)
         ctx = cls(**kwargs)
         for name, f in known.items():
             value = getattr(ctx, name)
-            if name == "tab_length_to_edge":
+            if name in ("tab_length_to_edge", "work"):
                 continue
             if not _type_ok(value, str(f.type)):
                 raise InputError(source, name, f"{value!r} is not of type {f.type}")
         return ctx
+
+
+def _work_from(data: object, source: str) -> Work:
+    if not isinstance(data, dict):
+        raise InputError(source, "work", "must be a table of the phase's working state")
+    known = {f.name: f for f in fields(Work)}
+    for key, value in data.items():
+        if key not in known:
+            raise InputError(source, f"work.{key}", "unknown key; allowed: " + ", ".join(known))
+        if not _type_ok(value, str(known[key].type)):
+            raise InputError(source, f"work.{key}", f"{value!r} is not of type {known[key].type}")
+    return Work(**data)
 
 
 def _type_ok(value: object, annotation: str) -> bool:

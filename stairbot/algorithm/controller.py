@@ -3,10 +3,12 @@
 Each :meth:`Controller.tick` takes one :class:`~stairbot.hardware.Snapshot`
 and returns a speed for all six motors.  Faults are checked before the
 phase's own logic (a motor fault, a sensor error on a sensor the phase needs,
-a phase that takes too long), then the standing rule, then the phase's
-handler.  The clock is ``Snapshot.time_s`` alone; nothing here sleeps.  Every
-phase change is checked against :data:`~stairbot.algorithm.transitions.TRANSITIONS` and
-told as an event.
+a phase that takes too long), then the standing rule, then the phase's step.
+Whichever decides returns a :class:`~stairbot.algorithm.phase.Step`; if it
+names a next phase, :meth:`Controller._apply` enters it — the one place a
+phase is entered, at most once a tick — after checking the change against
+:data:`~stairbot.algorithm.transitions.TRANSITIONS`, and tells it as an event.
+The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 """
 
 from __future__ import annotations
@@ -15,11 +17,12 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from stairbot.algorithm import ascent, calibration, descent, motion, standing
+from stairbot.algorithm import calibration, motion, standing
 from stairbot.algorithm.context import Context
-from stairbot.algorithm.handler import Handler, PhaseIO, where
+from stairbot.algorithm.phase import Step, Tick, fail, where
 from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.algorithm.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
+from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
@@ -30,6 +33,7 @@ from stairbot.hardware import (
     SensorId,
     SensorStatus,
     Snapshot,
+    Speeds,
 )
 
 PHASE_TIMEOUT_S = 60.0
@@ -51,10 +55,6 @@ def phase_timeout_s(config: RobotConfig) -> float:
     return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
 
 OUTCOMES = ("completed", "stopped", "error")
-
-HANDLERS: dict[Phase, Handler] = {
-    **calibration.HANDLERS, **ascent.HANDLERS, **descent.HANDLERS, **standing.HANDLERS,
-}
 
 
 @dataclass(frozen=True)
@@ -161,7 +161,8 @@ class Controller:
     # -- the tick ---------------------------------------------------------------------
     def tick(self, snap: Snapshot) -> dict[MotorId, float]:
         """Advance the program by one snapshot; returns a speed (turns/s) for
-        every motor.  After the end, and while held, every speed is 0."""
+        every motor.  After the end, and while held, every speed is 0.  The
+        first tick enters the program's first phase and moves nothing."""
         self._time = snap.time_s
         if self.finished:
             return _zeros()
@@ -172,21 +173,25 @@ class Controller:
         if self._held_since is not None:
             self._shift_timers(snap.time_s - self._held_since)
             self._held_since = None
-        io = PhaseIO(snap, self.config, self._ctx, self.mode, self)
         if not self._started:
             self._started = True
             self._enter(self.phase, "program start", snap)
+            return _zeros()
         fault = self._fault(snap)
         if fault is not None:
-            self.fail(fault, snap)
+            self._apply(fail(fault), snap)
             return _zeros()
-        if standing.watch(io):
+        ctx = self._ctx
+        record = self.phase.record
+        t = Tick(snap, self.config, ctx, self.mode, self._say)
+        step = standing.watch(t, record)
+        if step is None:
+            assert record.step is not None  # only DONE and ERROR have none
+            step = record.step(t, ctx.work)
+        if step.next is not None:
+            self._apply(step, snap)
             return _zeros()
-        phase = self.phase
-        speeds = HANDLERS[phase].step(io)
-        if self.phase is not phase or self.phase is Phase.PAUSED:
-            return _zeros()
-        return self._limit(speeds, snap)
+        return self._limit(step.speeds, snap)
 
     def _fault(self, snap: Snapshot) -> str | None:
         phase = self.phase
@@ -212,7 +217,7 @@ class Controller:
             return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
         return None
 
-    def _limit(self, speeds: dict[MotorId, float], snap: Snapshot) -> dict[MotorId, float]:
+    def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
         """Every motor gets a speed within its maximum; a lift at the end of its
         stroke is not driven further."""
         stroke = self._stroke
@@ -228,67 +233,59 @@ class Controller:
             out[motor] = v
         return out
 
-    # -- phase changes (the Machine the handlers reach) -------------------------------------
-    def transition(self, phase: Phase, why: str, snap: Snapshot) -> None:
-        """Enter ``phase``; raises TransitionError when the table does not allow it."""
-        if not allowed(self.phase, phase):
-            raise TransitionError(f"{self.phase.value} -> {phase.value} is not in the "
-                                  "transition table")
-        self._enter(phase, why, snap)
+    # -- phase changes: the one place a phase is entered ----------------------------------
+    def _apply(self, step: Step, snap: Snapshot) -> None:
+        """Enter ``step.next``; raises TransitionError when the table does not
+        allow the change (a bug in a phase)."""
+        nxt, src, ctx = step.next, self.phase, self._ctx
+        assert nxt is not None
+        if not allowed(src, nxt):
+            raise TransitionError(f"{src.value} -> {nxt.value} is not in the transition table")
+        if nxt is Phase.ERROR:
+            self._finish(Phase.ERROR, "error", step.reason or "error", snap.time_s)
+        elif nxt is Phase.DONE:
+            self._finish(Phase.DONE, step.outcome or "completed", step.reason or "done",
+                         snap.time_s)
+        elif nxt is Phase.PAUSED:
+            ctx.resume_phase = src.value
+            ctx.pause_started_s = snap.time_s
+            ctx.pauses += 1
+            self._emit(EventKind.PAUSE, step.reason or "paused", snap.time_s,
+                       {"resume_phase": ctx.resume_phase})
+            self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
+        elif src is Phase.PAUSED:
+            assert ctx.pause_started_s is not None
+            if ctx.phase_started_s is not None:
+                ctx.phase_started_s += snap.time_s - ctx.pause_started_s
+            ctx.resume_phase = ctx.pause_started_s = None
+            self._emit(EventKind.RESUME, step.reason or "resumed", snap.time_s,
+                       {"phase": nxt.value})
+            self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
+        else:
+            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap)
 
-    def fail(self, reason: str, snap: Snapshot) -> None:
-        """End the program with an error (a transition the table allows)."""
-        if self.finished:
-            return
-        if not allowed(self.phase, Phase.ERROR):
-            raise TransitionError(f"{self.phase.value} -> error is not in the transition table")
-        self._finish(Phase.ERROR, "error", reason, snap.time_s)
-
-    def end(self, outcome: str, reason: str, snap: Snapshot) -> None:
-        """End the program with ``outcome`` (a transition to DONE the table allows)."""
-        if not allowed(self.phase, Phase.DONE):
-            raise TransitionError(f"{self.phase.value} -> done is not in the transition table")
-        self._finish(Phase.DONE, outcome, reason, snap.time_s)
-
-    def pause(self, reason: str, snap: Snapshot) -> None:
-        self._emit(EventKind.PAUSE, reason, snap.time_s, {"resume_phase": self._ctx.resume_phase})
-        self.transition(Phase.PAUSED, TRANSITIONS[self.phase][Phase.PAUSED], snap)
-
-    def resume(self, reason: str, snap: Snapshot) -> None:
-        ctx = self._ctx
-        assert ctx.resume_phase is not None and ctx.pause_started_s is not None
-        target = Phase(ctx.resume_phase)
-        if not allowed(Phase.PAUSED, target):
-            raise TransitionError(f"paused -> {target.value} is not in the transition table")
-        if ctx.phase_started_s is not None:
-            ctx.phase_started_s += snap.time_s - ctx.pause_started_s
-        ctx.resume_phase = ctx.pause_started_s = None
-        self._emit(EventKind.RESUME, reason, snap.time_s, {"phase": target.value})
-        self._enter(target, TRANSITIONS[Phase.PAUSED][target], snap, fresh=False)
-
-    def emit(self, kind: EventKind, message: str, snap: Snapshot,
-             data: dict[str, Any] | None = None) -> None:
-        self._emit(kind, message, snap.time_s, data or {})
-
-    # -- inside ---------------------------------------------------------------------------
     def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True) -> None:
+        """Make ``phase`` the present one.  ``fresh``: a new start of the phase
+        (its timer, its work, its entry action); not fresh: the standing rule's
+        wait, or the phase it resumes."""
         ctx = self._ctx
         previous = ctx.phase
         ctx.phase = phase.value
         ctx.disagree_ticks = 0
         ctx.standing_diff = None
-        if fresh and phase is not Phase.PAUSED:
+        if fresh:
             ctx.phase_started_s = snap.time_s
-            ctx.entry_wheel = motion.wheel_position(snap)
-            ctx.entry_mtf = snap.turns(MotorId.MTF)
-            ctx.entry_mtb = snap.turns(MotorId.MTB)
+            ctx.work = Work.at_entry(snap)
         note = where(ctx, phase)
         where_text = f" ({note})" if note else ""
-        self._emit(EventKind.PHASE, f"{phase.label}{where_text}" + ("" if fresh else " (resumed)"),
-                   snap.time_s, {"phase": phase.value, "flow": phase.flow, "from": previous,
-                                 "why": why})
-        if fresh and phase in HANDLERS:
-            HANDLERS[phase].enter(PhaseIO(snap, self.config, ctx, self.mode, self))
+        resumed = "" if fresh or phase is Phase.PAUSED else " (resumed)"
+        self._emit(EventKind.PHASE, f"{phase.label}{where_text}{resumed}", snap.time_s,
+                   {"phase": phase.value, "flow": phase.flow, "from": previous, "why": why})
+        if fresh:
+            phase.record.enter(Tick(snap, self.config, ctx, self.mode, self._say), ctx.work)
+
+    def _say(self, message: str, **data: Any) -> None:
+        self._emit(EventKind.INFO, message, self._time, data)
 
     def _finish(self, phase: Phase, outcome: str, reason: str, time_s: float) -> None:
         ctx = self._ctx

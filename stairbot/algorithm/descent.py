@@ -12,120 +12,183 @@ counts.
 from __future__ import annotations
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.handler import Handler, PhaseIO, Speeds, lift, reading_drive, turns_drive
+from stairbot.algorithm.moves import checked_first, lift, reading_drive, turns_drive
+from stairbot.algorithm.phase import (
+    FAULT,
+    PhaseDef,
+    Step,
+    Tick,
+    end,
+    fail,
+    go,
+    stay,
+)
 from stairbot.algorithm.phases import Phase
+from stairbot.algorithm.work import Work
 from stairbot.hardware import BACK_SENSORS, MotorId
 
-
-def _tab(io: PhaseIO) -> float | None:
-    return io.ctx.tab_length_to_edge[io.descent_index]
-
-
-def _backed_off(io: PhaseIO) -> None:
-    io.ctx.purpose = "descent"
-    io.go(Phase.CAL_CHECK)
+P = Phase
+FLOW = "descent"
 
 
-def _edge_target(io: PhaseIO) -> float | None:
-    tab = _tab(io)
-    if tab is None:
-        io.fail(f"descent 1: tab_length_to_edge[{io.descent_index}] was not measured; "
-                "the edge of the step cannot be found")
-    return tab
+def _tab(t: Tick) -> float | None:
+    return t.ctx.tab_length_to_edge[t.descent_index]
 
 
-def _edge_fallback(io: PhaseIO) -> float:
+def _h(t: Tick) -> float:
+    return t.ctx.number_of_turns_for_step_height
+
+
+# -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
+def _backed_off(t: Tick, _w: Work) -> Step:
+    t.ctx.purpose = "descent"
+    return go(P.CAL_CHECK)
+
+
+_back_off = turns_drive(-1, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, _backed_off)
+BACK_OFF = PhaseDef(
+    P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW, _back_off[1],
+    enter=_back_off[0], watches="front",
+    to={P.CAL_CHECK: "turns made: calibrate (case 2)", P.ERROR: FAULT})
+
+
+def _edge_known(t: Tick, _w: Work) -> Step | None:
+    if _tab(t) is None:
+        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured; "
+                    "the edge of the step cannot be found")
+    return None
+
+
+def _edge_fallback(t: Tick) -> float:
     # Descent 1 backed off to SAFE_DISTANCE_IN_FRONT_OF_STEP before calibrating.
-    tab = _tab(io) or io.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
-    return io.cfg.wheel_turns(max(0.0, tab - io.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
+    tab = _tab(t) or t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
+    return t.cfg.wheel_turns(max(0.0, tab - t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
 
 
-def _lower_third_enter(io: PhaseIO) -> None:
-    ctx, cfg = io.ctx, io.cfg
-    ctx.return_mtb = ctx.entry_mtb
-    ctx.target_mtb = -cfg.MAX_OF_VERTICAL_TURNS
-    ctx.target_mtf = None
-    reading = motion.mean_distance(io.snap, back=True)
+_to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD))
+BACK_TO_EDGE = PhaseDef(
+    P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
+    checked_first(_edge_known, _to_edge[1]), enter=_to_edge[0], watches="front",
+    to={P.DESCENT_LOWER_THIRD: "reads tab_length_to_edge[i]",
+        P.ERROR: "tab_length_to_edge[i] unknown; " + FAULT})
+
+
+# -- descent 2: lower segment 3 until the back sensors find the step below ------------------------
+def _lower_third_enter(t: Tick, w: Work) -> None:
+    t.ctx.return_mtb = w.entry_mtb
+    w.target_mtb = -t.cfg.MAX_OF_VERTICAL_TURNS
+
+
+def _over_an_edge(t: Tick, _w: Work) -> Step | None:
+    cfg = t.cfg
+    reading = motion.mean_distance(t.snap, back=True)
     if reading <= cfg.BACK_CLEARANCE + cfg.sensors.resolution / 2:
-        io.fail(f"floor not found: SBR/SBL read {reading:.3f} m, at or below BACK_CLEARANCE "
-                f"({cfg.BACK_CLEARANCE} m), before segment 3 was lowered (step "
-                f"{io.descent_index + 1}): segment 3 is not over an edge")
+        return fail(f"floor not found: SBR/SBL read {reading:.3f} m, at or below BACK_CLEARANCE "
+                    f"({cfg.BACK_CLEARANCE} m), before segment 3 was lowered (step "
+                    f"{t.descent_index + 1}): segment 3 is not over an edge")
+    return None
 
 
-def _lower_third(io: PhaseIO) -> Speeds:
-    ctx, cfg = io.ctx, io.cfg
-    reading = motion.mean_distance(io.snap, back=True)
+def _lower_third(t: Tick, w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    reading = motion.mean_distance(t.snap, back=True)
     to_go = reading - cfg.BACK_CLEARANCE
     if to_go <= cfg.sensors.resolution / 2:
-        ctx.number_of_turns_for_step_height = ctx.return_mtb - io.snap.turns(MotorId.MTB)
-        io.info(f"segment 3 on the step below: number_of_turns_for_step_height = "
-                f"{ctx.number_of_turns_for_step_height:.2f} (step {io.descent_index + 1})",
-                number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
-        io.go(Phase.DESCENT_DRIVE_SECOND)
-        return {}
-    assert ctx.target_mtb is not None
-    limit = motion.lift_to(cfg, io.snap, MotorId.MTB, ctx.target_mtb)
+        ctx.number_of_turns_for_step_height = ctx.return_mtb - t.snap.turns(MotorId.MTB)
+        t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
+              f"{ctx.number_of_turns_for_step_height:.2f} (step {t.descent_index + 1})",
+              number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
+        return go(P.DESCENT_DRIVE_SECOND)
+    assert w.target_mtb is not None
+    limit = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
     if limit is None:
-        io.fail(f"floor not found when descending step {io.descent_index + 1}: MTB reached "
-                f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL still "
-                f"read {reading:.3f} m")
-        return {}
-    backs = [io.snap.sensors[s] for s in BACK_SENSORS]
+        return fail(f"floor not found when descending step {t.descent_index + 1}: MTB reached "
+                    f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL "
+                    f"still read {reading:.3f} m")
+    backs = [t.snap.sensors[s] for s in BACK_SENSORS]
     if all(r.ok for r in backs):
         speed = motion.approach(cfg.motors.lift_speed, cfg.lift_turns(to_go),
                                 motion.LIFT_SLOW_ZONE, cfg.algorithm.tick)
-        return {MotorId.MTB: -min(speed, abs(limit))}
-    return {MotorId.MTB: limit}  # out of range far: nothing below yet, keep lowering
+        return stay({MotorId.MTB: -min(speed, abs(limit))})
+    return stay({MotorId.MTB: limit})  # out of range far: nothing below yet, keep lowering
 
 
-def _second_target(io: PhaseIO) -> float | None:
-    tab = _tab(io)
-    return None if tab is None else io.cfg.LENGTH_OF_SECOND_MODULE + tab
+LOWER_THIRD = PhaseDef(
+    P.DESCENT_LOWER_THIRD, "descent 2 — lower segment 3", FLOW,
+    checked_first(_over_an_edge, _lower_third), enter=_lower_third_enter, watches="back",
+    to={P.DESCENT_DRIVE_SECOND: "SBR/SBL read BACK_CLEARANCE: "
+                                "number_of_turns_for_step_height stored",
+        P.ERROR: "reads ≤ BACK_CLEARANCE at the start, or floor not found "
+                 "within MAX_OF_VERTICAL_TURNS; " + FAULT})
 
 
-def _first_target(io: PhaseIO) -> float | None:
-    tab = _tab(io)
+# -- descent 3-6: segment by segment off the step ----------------------------------------------
+def _second_target(t: Tick) -> float | None:
+    tab = _tab(t)
+    return None if tab is None else t.cfg.LENGTH_OF_SECOND_MODULE + tab
+
+
+def _first_target(t: Tick) -> float | None:
+    tab = _tab(t)
     if tab is None:
         return None
-    return io.cfg.LENGTH_OF_FIRST_MODULE + io.cfg.LENGTH_OF_SECOND_MODULE + tab
+    return t.cfg.LENGTH_OF_FIRST_MODULE + t.cfg.LENGTH_OF_SECOND_MODULE + tab
 
 
-def _h(io: PhaseIO) -> float:
-    return io.ctx.number_of_turns_for_step_height
+_drive2 = reading_drive(-1, _second_target,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
+                        lambda _t, _w: go(P.DESCENT_LOWER_SECOND))
+DRIVE_SECOND = PhaseDef(
+    P.DESCENT_DRIVE_SECOND, "descent 3 — drive segment 2 off the step", FLOW, _drive2[1],
+    enter=_drive2[0], watches="front",
+    to={P.DESCENT_LOWER_SECOND: "reads LENGTH_OF_SECOND_MODULE + tab_length_to_edge[i] "
+                                "(or turns made)",
+        P.ERROR: FAULT})
+
+_lower2 = lift(lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)},
+               lambda _t, _w: go(P.DESCENT_DRIVE_FIRST))
+LOWER_SECOND = PhaseDef(
+    P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW, _lower2[1], enter=_lower2[0],
+    watches="front", to={P.DESCENT_DRIVE_FIRST: "turns made", P.ERROR: FAULT})
+
+_drive1 = reading_drive(-1, _first_target,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
+                        lambda _t, _w: go(P.DESCENT_LOWER_FIRST))
+DRIVE_FIRST = PhaseDef(
+    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, _drive1[1],
+    enter=_drive1[0], watches="front",
+    to={P.DESCENT_LOWER_FIRST: "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
+                               "tab_length_to_edge[i] (or turns made)",
+        P.ERROR: FAULT})
 
 
-def _lowered_first(io: PhaseIO) -> None:
-    ctx = io.ctx
+def _lowered_first(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
     ctx.steps_descended += 1
-    io.info(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
-            f"({ctx.steps_descended} of {ctx.number_of_steps})",
-            steps_descended=ctx.steps_descended)
+    t.say(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
+          f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
     if ctx.steps_descended < ctx.number_of_steps:
-        io.go(Phase.DESCENT_BACK_OFF)
-    else:
-        io.go(Phase.DESCENT_FINISH)
+        return go(P.DESCENT_BACK_OFF)
+    return go(P.DESCENT_FINISH)
 
 
-def _finish_target(io: PhaseIO) -> float | None:
-    return io.ctx.start_reading
+_lower1 = lift(lambda t, _w: {MotorId.MTF: -_h(t)}, _lowered_first)
+LOWER_FIRST = PhaseDef(
+    P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], enter=_lower1[0],
+    to={P.DESCENT_BACK_OFF: "turns made; steps remain",
+        P.DESCENT_FINISH: "turns made; all number_of_steps descended", P.ERROR: FAULT})
 
 
-HANDLERS: dict[Phase, Handler] = {
-    Phase.DESCENT_BACK_OFF: turns_drive(
-        -1, lambda io: io.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, _backed_off),
-    Phase.DESCENT_BACK_TO_EDGE: reading_drive(
-        -1, _edge_target, _edge_fallback, lambda io: io.go(Phase.DESCENT_LOWER_THIRD)),
-    Phase.DESCENT_LOWER_THIRD: Handler(_lower_third, _lower_third_enter),
-    Phase.DESCENT_DRIVE_SECOND: reading_drive(
-        -1, _second_target, lambda io: io.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
-        lambda io: io.go(Phase.DESCENT_LOWER_SECOND)),
-    Phase.DESCENT_LOWER_SECOND: lift(lambda io: {MotorId.MTF: _h(io), MotorId.MTB: _h(io)},
-                                     lambda io: io.go(Phase.DESCENT_DRIVE_FIRST)),
-    Phase.DESCENT_DRIVE_FIRST: reading_drive(
-        -1, _first_target, lambda io: io.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
-        lambda io: io.go(Phase.DESCENT_LOWER_FIRST)),
-    Phase.DESCENT_LOWER_FIRST: lift(lambda io: {MotorId.MTF: -_h(io)}, _lowered_first),
-    Phase.DESCENT_FINISH: reading_drive(
-        -1, _finish_target, lambda io: io.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
-        lambda io: io.end("completed", "back at the start position")),
-}
+# -- descent 7: back to the start ----------------------------------------------------------------
+_finish = reading_drive(-1, lambda t: t.ctx.start_reading,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
+                        lambda _t, _w: end("completed", "back at the start position"))
+FINISH = PhaseDef(
+    P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW, _finish[1],
+    enter=_finish[0], watches="front",
+    to={P.DONE: "reads the start reading (or turns made)", P.ERROR: FAULT})
+
+PHASES: tuple[PhaseDef, ...] = (
+    BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST, LOWER_FIRST,
+    FINISH,
+)

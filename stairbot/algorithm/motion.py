@@ -1,4 +1,4 @@
-"""Readings and motions shared by the phase handlers.
+"""Readings and motions shared by the phases.
 
 What the sensors say (measurable, nothing ahead, the pair's mean) and how a
 motion approaches its target: full speed far away, slowing in proportion to
@@ -18,6 +18,7 @@ from stairbot.hardware import (
     SensorReading,
     SensorStatus,
     Snapshot,
+    Speeds,
 )
 
 SLOW_FLOOR = 0.15
@@ -35,9 +36,6 @@ DIFF_SMOOTHING = 0.3
 averages the sensors' noise over a few ticks (calibration turns, standing rule)."""
 TURN_SPEED = 0.15
 """Calibration turning speed of MWR/MWL, turns/s: slow, so noise cannot stop it early."""
-
-Speeds = dict[MotorId, float]
-
 
 def wheel_position(snap: Snapshot) -> float:
     """The drive's odometer: the mean of the four wheel counters, turns."""
@@ -132,7 +130,7 @@ def lift_to(cfg: RobotConfig, snap: Snapshot, motor: MotorId, target: float) -> 
 def lifts_to(cfg: RobotConfig, snap: Snapshot, targets: dict[MotorId, float]) -> Speeds | None:
     """Speeds that bring every lift in ``targets`` to its counter at once, or None
     when all are there."""
-    out: Speeds = {}
+    out: dict[MotorId, float] = {}
     for motor, target in targets.items():
         v = lift_to(cfg, snap, motor, target)
         if v is not None:

@@ -1,9 +1,12 @@
 """The controller's phases: one for every step and sub-step of the seed.
 
-Each :class:`Phase` carries the label the seed would use for it (shown to the
-operator, e.g. "ascent 3 — lift segment 1") and the flow it belongs to:
-``"calibration"``, ``"ascent"``, ``"descent"``, or ``"end"`` for the phases that
-stand outside the three flowcharts (the standing rule's wait, done, error).
+A :class:`Phase` is the phase's identity (its ``value`` is the stable name in
+logs and JSON); everything else about it is its record
+(:class:`~stairbot.algorithm.phase.PhaseDef`, in the module of its flow): the
+label the seed would use for it (shown to the operator, e.g. "ascent 3 — lift
+segment 1"), the flow it belongs to (``"calibration"``, ``"ascent"``,
+``"descent"``, or ``"end"`` for the standing rule's wait, done, error), its
+entry action, its step and its transitions.
 The calibration phases serve three purposes (the start of the program, ascent
 step 1 on later steps, descent step 1); the context says which.
 """
@@ -11,6 +14,10 @@ step 1 on later steps, descent step 1); the context says which.
 from __future__ import annotations
 
 from enum import Enum
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from stairbot.algorithm.phase import PhaseDef
 
 
 class Mode(Enum):
@@ -53,14 +60,19 @@ class Phase(Enum):
     ERROR = "error"
 
     @property
+    def record(self) -> PhaseDef:
+        """The phase's record: seed name, flow, entry action, step, transitions."""
+        return _records()[self]
+
+    @property
     def label(self) -> str:
         """The phase as the seed names it, e.g. "ascent 3 — lift segment 1"."""
-        return _LABELS[self][0]
+        return _records()[self].label
 
     @property
     def flow(self) -> str:
         """"calibration", "ascent", "descent" or "end"."""
-        return _LABELS[self][1]
+        return _records()[self].flow
 
     @property
     def terminal(self) -> bool:
@@ -71,38 +83,18 @@ class Phase(Enum):
         return self.label
 
 
-_LABELS: dict[Phase, tuple[str, str]] = {
-    Phase.CAL_CHECK: ("calibration — check the readings (case 1?)", "calibration"),
-    Phase.CAL_LIFT: ("calibration — lift segments 1 and 3 for clearance", "calibration"),
-    Phase.CAL_TURN: ("calibration case 2 — turn until SFR = SFL", "calibration"),
-    Phase.CAL_PROBE: ("calibration case 3 — probe turn left (A or B?)", "calibration"),
-    Phase.CAL_CORNER: ("calibration case 3B — turn left until both readings shrink", "calibration"),
-    Phase.CAL_LOWER: ("calibration — lower segments 1 and 3", "calibration"),
-    Phase.ASCENT_APPROACH: ("ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", "ascent"),
-    Phase.ASCENT_APPROACH_TURNS: (
-        "ascent 2 — approach: NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH more", "ascent"),
-    Phase.ASCENT_LIFT_FIRST: ("ascent 3 — lift segment 1", "ascent"),
-    Phase.ASCENT_LIFT_FIRST_MORE: (
-        "ascent 3 — lift segment 1: number_of_vertical_turns more", "ascent"),
-    Phase.ASCENT_LOWER_OBSTACLE: ("ascent 3 — step too high: lower segment 1", "ascent"),
-    Phase.ASCENT_DRIVE_FIRST: ("ascent 4 — drive segment 1 onto the step", "ascent"),
-    Phase.ASCENT_LIFT_SECOND: ("ascent 5 — lift segment 2", "ascent"),
-    Phase.ASCENT_DRIVE_SECOND: ("ascent 6 — drive segment 2 onto the step", "ascent"),
-    Phase.ASCENT_LIFT_THIRD: ("ascent 7 — lift segment 3", "ascent"),
-    Phase.ASCENT_CHECK: ("ascent 8 — check the distance (top?)", "ascent"),
-    Phase.ASCENT_DRIVE_THIRD: ("ascent 9 — drive segment 3 onto the step", "ascent"),
-    Phase.DESCENT_BACK_OFF: ("descent 1 — back off to a safe position", "descent"),
-    Phase.DESCENT_BACK_TO_EDGE: ("descent 1 — back up to the edge", "descent"),
-    Phase.DESCENT_LOWER_THIRD: ("descent 2 — lower segment 3", "descent"),
-    Phase.DESCENT_DRIVE_SECOND: ("descent 3 — drive segment 2 off the step", "descent"),
-    Phase.DESCENT_LOWER_SECOND: ("descent 4 — lower segment 2", "descent"),
-    Phase.DESCENT_DRIVE_FIRST: ("descent 5 — drive segment 1 off the step", "descent"),
-    Phase.DESCENT_LOWER_FIRST: ("descent 6 — lower segment 1", "descent"),
-    Phase.DESCENT_FINISH: ("descent 7 — finish: back off to the start position", "descent"),
-    Phase.PAUSED: ("standing rule — readings disagree: stopped, waiting", "end"),
-    Phase.DONE: ("end — program finished", "end"),
-    Phase.ERROR: ("end — program ended with an error", "end"),
-}
+_RECORDS: dict[Phase, PhaseDef] = {}
+
+
+def _records() -> dict[Phase, PhaseDef]:
+    # The records live with their flows (calibration.py, ascent.py...), which
+    # import this module: they are gathered on first use.
+    if not _RECORDS:
+        from stairbot.algorithm.table import PHASES
+
+        _RECORDS.update(PHASES)
+    return _RECORDS
+
 
 BY_VALUE: dict[str, Phase] = {p.value: p for p in Phase}
 """Phase by its value (faster than ``Phase(value)`` in the control tick)."""

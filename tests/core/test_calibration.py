@@ -19,6 +19,9 @@ CLEARANCE = CFG.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE
 SQUARE = math.radians(0.6)  # what a smoothed 1 mm difference over 0.1 m allows
 
 
+TURNED: dict[int, int] = {}  # id(controller) -> the squaring turn's direction
+
+
 def calibrate(**kw: object) -> tuple[Controller, KinematicRobot, list[Event], list[Phase]]:
     events: list[Event] = []
     ctrl = Controller(CFG, events.append, Mode.CALIBRATE_ONLY)
@@ -29,6 +32,8 @@ def calibrate(**kw: object) -> tuple[Controller, KinematicRobot, list[Event], li
     def watch(c: Controller) -> bool:
         if not seen or seen[-1] is not c.phase:
             seen.append(c.phase)
+        if c.phase is Phase.CAL_TURN:  # the turn phase's own work, while it lasts
+            TURNED[id(c)] = c.context.work.turn_direction
         if c.phase in (Phase.CAL_TURN, Phase.CAL_PROBE, Phase.CAL_CORNER):
             # turning happens only with both end segments lifted for clearance
             turning.append(min(robot.counters[MotorId.MTF], robot.counters[MotorId.MTB]))
@@ -46,15 +51,26 @@ def first_turn(events: list[Event]) -> str:
     return next(e.message for e in events if e.kind is EventKind.INFO and "case" in e.message)
 
 
-@pytest.mark.parametrize("yaw", [15.0, 3.0, -3.0, -15.0])
+@pytest.mark.parametrize("yaw", [15.0, -15.0])
 def test_case_2_turns_towards_the_nearer_side_until_square(yaw: float) -> None:
     ctrl, robot, events, seen = calibrate(yaw_deg=yaw, noise=0.001)
     assert ctrl.context.calibration_case == "2"
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_TURN, Phase.CAL_LOWER]
     # turned left (+) for SFL < SFR, i.e. when yawed right (-), and vice versa
-    assert ctrl.context.turn_direction == (1 if yaw < 0 else -1)
+    assert TURNED[id(ctrl)] == (1 if yaw < 0 else -1)
     assert abs(robot.yaw) < SQUARE
     assert "not equal, case 2" in first_turn(events)
+
+
+@pytest.mark.parametrize("seed", range(1, 7))
+@pytest.mark.parametrize("yaw", [3.0, -3.0])
+def test_a_small_yaw_squares_up_as_case_2_or_3a(yaw: float, seed: int) -> None:
+    """At 3° the pair's difference (about 6 mm) is within two noise sigmas of
+    equal_tolerance (5 mm): one reading may call it equal (case 3, whose probe
+    finds 3A) or not (case 2).  Either way the robot ends square."""
+    ctrl, robot, _events, _seen = calibrate(yaw_deg=yaw, noise=0.001, seed=seed)
+    assert ctrl.context.calibration_case in ("2", "3A")
+    assert abs(robot.yaw) < SQUARE
 
 
 def test_case_3a_probes_left_then_turns_back_square() -> None:
@@ -62,7 +78,7 @@ def test_case_3a_probes_left_then_turns_back_square() -> None:
     assert ctrl.context.calibration_case == "3A"
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_TURN,
                     Phase.CAL_LOWER]
-    assert ctrl.context.turn_direction == -1  # back right
+    assert TURNED[id(ctrl)] == -1  # back right
     assert abs(robot.yaw) < SQUARE
     assert any("case 3A" in e.message for e in events)
 
@@ -95,6 +111,8 @@ def test_case_3b_a_corner_turns_left_until_both_shrink_then_squares_up() -> None
     def watch(c: Controller) -> bool:
         if not seen or seen[-1] is not c.phase:
             seen.append(c.phase)
+        if c.phase is Phase.CAL_TURN:  # the turn phase's own work, while it lasts
+            TURNED[id(c)] = c.context.work.turn_direction
         return False
 
     run(ctrl, robot, until=watch)

@@ -11,6 +11,7 @@ from kinematic import KinematicRobot, run
 from stairbot.algorithm.context import TAB_SIZE, Context
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Phase
+from stairbot.algorithm.work import Work
 from stairbot.config import load_config
 from stairbot.errors import InputError
 
@@ -28,7 +29,7 @@ def test_a_new_context_holds_the_seeds_variables() -> None:
 
 def test_round_trip_through_json() -> None:
     ctx = Context(length_of_next_step=0.29, number_of_steps=3, phase="ascent_lift_third",
-                  ascent_end="top_reached", target_mtf=12.5, pauses=2)
+                  ascent_end="top_reached", work=Work(target_mtf=12.5, checked=True), pauses=2)
     ctx.tab_length_to_edge[0] = 0.14
     data = json.loads(json.dumps(ctx.to_dict()))
     assert Context.from_dict(data) == ctx
@@ -43,6 +44,10 @@ def test_from_dict_names_a_bad_key_or_value() -> None:
         Context.from_dict({"number_of_steps": True})
     with pytest.raises(InputError, match="tab_length_to_edge: must be a list of 20"):
         Context.from_dict({"tab_length_to_edge": [0.1]})
+    with pytest.raises(InputError, match="work.colour: unknown key"):
+        Context.from_dict({"work": {"colour": "red"}})
+    with pytest.raises(InputError, match="work.target_mtf"):
+        Context.from_dict({"work": {"target_mtf": "high"}})
 
 
 def test_a_restored_controller_continues_like_the_original() -> None:

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 import pytest
 
-from stairbot.algorithm.controller import HANDLERS, Controller
-from stairbot.algorithm.phases import FLOWS, Phase
+from stairbot.algorithm import phases
+from stairbot.algorithm.context import Context
+from stairbot.algorithm.controller import Controller
+from stairbot.algorithm.phase import Step, Tick, go
+from stairbot.algorithm.phases import FLOWS, Mode, Phase
 from stairbot.algorithm.transitions import (
     BACK_PAIR_PHASES,
     STANDING_ARMED,
@@ -16,6 +20,7 @@ from stairbot.algorithm.transitions import (
     allowed,
     mermaid,
 )
+from stairbot.algorithm.work import Work
 from stairbot.config import load_config
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 
@@ -47,15 +52,35 @@ def test_seed_steps_each_have_a_phase() -> None:
         assert any(case in label for label in labels), case
 
 
-def test_the_table_covers_every_phase_and_every_active_phase_has_a_handler() -> None:
+def test_the_table_covers_every_phase_and_every_active_phase_has_a_step() -> None:
     assert set(TRANSITIONS) == set(Phase)
     for phase in Phase:
+        assert phase.record.phase is phase
         if phase.terminal:
             assert TRANSITIONS[phase] == {}
-            assert phase not in HANDLERS
+            assert phase.record.step is None
         else:
-            assert phase in HANDLERS, phase
+            assert phase.record.step is not None, phase
             assert Phase.ERROR in TRANSITIONS[phase], phase  # faults end anywhere
+
+
+def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
+    """A phase's step is a function of (context, readings): it says what comes
+    next; only the controller makes it so."""
+    ctx = Context(phase=Phase.CAL_CHECK.value)
+    said: list[str] = []
+    sensors = {SensorId.SFR: SensorReading(0.50), SensorId.SFL: SensorReading(0.60),
+               SensorId.SBR: SensorReading(0.04), SensorId.SBL: SensorReading(0.04)}
+    snap = Snapshot(0.0, sensors, {m: MotorState(0.0) for m in MotorId})
+    tick = Tick(snap, CFG, ctx, Mode.FULL, lambda message, **_: said.append(message))
+    record = Phase.CAL_CHECK.record
+    assert record.step is not None
+    step = record.step(tick, Work.at_entry(snap))
+    assert isinstance(step, Step)
+    assert step.next is Phase.CAL_LIFT and not step.speeds
+    assert ctx.phase == Phase.CAL_CHECK.value  # not entered by the step
+    assert ctx.calibration_case == "2" and said  # the seed's variables and a message
+    assert Phase.CAL_LIFT in TRANSITIONS[Phase.CAL_CHECK]
 
 
 def test_every_phase_is_reachable_from_the_start() -> None:
@@ -79,17 +104,18 @@ def test_standing_rule_is_armed_where_the_table_says_and_not_while_turning_or_ri
         assert allowed(Phase.PAUSED, phase)
 
 
-def test_a_transition_outside_the_table_raises() -> None:
+@pytest.mark.parametrize("bad", [go(Phase.DESCENT_FINISH), Step(next=Phase.DONE)])
+def test_a_step_that_returns_a_change_outside_the_table_raises(
+        monkeypatch: pytest.MonkeyPatch, bad: Step) -> None:
     ctrl = Controller(CFG)
-    snap = snapshot()
-    ctrl.tick(snap)
+    ctrl.tick(snapshot(0.0))  # enters calibration
+    ctrl.tick(snapshot(0.02))  # case 3: lift
     assert ctrl.phase is Phase.CAL_LIFT
-    with pytest.raises(TransitionError, match="cal_lift -> descent_finish"):
-        ctrl.transition(Phase.DESCENT_FINISH, "no such edge", snap)
-    with pytest.raises(TransitionError):
-        ctrl.end("completed", "not from here", snap)
-    ctrl.transition(Phase.CAL_PROBE, "allowed", snap)
-    assert ctrl.phase is Phase.CAL_PROBE
+    rogue = replace(Phase.CAL_LIFT.record, step=lambda _t, _w: bad)
+    monkeypatch.setitem(phases._records(), Phase.CAL_LIFT, rogue)
+    with pytest.raises(TransitionError, match="cal_lift -> "):
+        ctrl.tick(snapshot(0.04))
+    assert ctrl.phase is Phase.CAL_LIFT
 
 
 def test_mermaid_draws_every_edge_of_its_flow() -> None:

@@ -1,0 +1,96 @@
+"""The shapes of phase several steps of the seed share: a drive that ends at a
+reading (with the seed's turn-count fallback), and lifts to counter targets.
+
+Each builder returns the (enter, step) pair of a :class:`PhaseDef`; ``done``
+chooses the :class:`Step` that ends the phase (usually ``go(next)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from stairbot.algorithm import motion
+from stairbot.algorithm.phase import Step, Tick, stay
+from stairbot.algorithm.work import Work
+from stairbot.hardware import MotorId
+
+Enter = Callable[[Tick, Work], None]
+StepFn = Callable[[Tick, Work], Step]
+Done = Callable[[Tick, Work], Step]
+
+
+def reading_drive(
+    direction: int,
+    target: Callable[[Tick], float | None],
+    fallback_turns: Callable[[Tick], float],
+    done: Done,
+) -> tuple[Enter, StepFn]:
+    """A drive (``direction`` +1 forward, -1 back) that ends when the mean
+    SFR/SFL reading reaches ``target(t)`` metres.
+
+    While the front sensors are measurable the target is re-expressed as an
+    absolute wheel-counter target every tick (dead reckoning from the latest
+    reading); while they are not, the drive carries on to the last such
+    target — or, if they never were, to ``fallback_turns(t)`` turns from the
+    phase's start (the seed's "not measurable" fallback).  A ``target`` of
+    None means a drive by turns only.
+    """
+
+    def enter(t: Tick, w: Work) -> None:
+        w.target_reading = target(t)
+        w.target_wheel = w.entry_wheel + direction * fallback_turns(t)
+
+    def step(t: Tick, w: Work) -> Step:
+        cfg = t.cfg
+        here = motion.wheel_position(t.snap)
+        if w.target_reading is not None and motion.measurable(t.snap, cfg):
+            remaining_m = direction * (motion.mean_distance(t.snap) - w.target_reading)
+            w.target_wheel = here + direction * cfg.wheel_turns(remaining_m)
+        assert w.target_wheel is not None  # set on entry
+        remaining = direction * (w.target_wheel - here)
+        if remaining <= motion.WHEEL_DONE:
+            return done(t, w)
+        return stay(motion.drive(cfg, direction, remaining))
+
+    return enter, step
+
+
+def turns_drive(direction: int, turns: Callable[[Tick], float],
+                done: Done) -> tuple[Enter, StepFn]:
+    """A drive of ``turns(t)`` wheel turns (``direction`` +1 forward, -1 back)."""
+    return reading_drive(direction, lambda _t: None, turns, done)
+
+
+def lift(deltas: Callable[[Tick, Work], dict[MotorId, float]],
+         done: Done) -> tuple[Enter, StepFn]:
+    """Lifts to absolute counters, all at once: ``deltas(t, w)`` on entry gives
+    them relative to the entry counters, as {MTF: delta, MTB: delta}."""
+
+    def enter(t: Tick, w: Work) -> None:
+        d = deltas(t, w)
+        w.target_mtf = w.entry_mtf + d[MotorId.MTF] if MotorId.MTF in d else None
+        w.target_mtb = w.entry_mtb + d[MotorId.MTB] if MotorId.MTB in d else None
+
+    def step(t: Tick, w: Work) -> Step:
+        speeds = motion.lifts_to(t.cfg, t.snap, w.lift_targets())
+        if speeds is None:
+            return done(t, w)
+        return stay(speeds)
+
+    return enter, step
+
+
+def checked_first(check: Callable[[Tick, Work], Step | None], step: StepFn) -> StepFn:
+    """``step``, with ``check`` run once before its first tick: a phase whose
+    entry condition does not hold ends there (``check`` returns that Step)
+    before anything moves."""
+
+    def first(t: Tick, w: Work) -> Step:
+        if not w.checked:
+            w.checked = True
+            stop = check(t, w)
+            if stop is not None:
+                return stop
+        return step(t, w)
+
+    return first

@@ -1,0 +1,19 @@
+"""Every phase's record, gathered from the modules of the flows."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import MappingProxyType
+
+from stairbot.algorithm import ascent, calibration, descent, standing
+from stairbot.algorithm.phase import PhaseDef
+from stairbot.algorithm.phases import Phase
+
+PHASES: Mapping[Phase, PhaseDef] = MappingProxyType(
+    {d.phase: d for d in (*calibration.PHASES, *ascent.PHASES, *descent.PHASES, *standing.PHASES)}
+)
+"""phase -> its record, for every Phase."""
+
+missing = set(Phase) - set(PHASES)
+if missing:  # pragma: no cover - caught by the import in every test
+    raise RuntimeError(f"phases without a record: {sorted(p.value for p in missing)}")

@@ -1,0 +1,51 @@
+"""A phase's private working state (:class:`Work`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from stairbot.algorithm import motion
+from stairbot.hardware import MotorId, Snapshot
+
+
+@dataclass
+class Work:
+    """A phase's private working state: made afresh each time a phase is
+    entered (not when the standing rule resumes it), seen by no other phase.
+    Motion targets are absolute counter values, so a phase restored from a
+    saved context carries on exactly."""
+
+    entry_wheel: float = 0.0
+    entry_mtf: float = 0.0
+    entry_mtb: float = 0.0
+    """Counters when the phase began."""
+    target_wheel: float | None = None
+    """Target for the mean of the four wheel counters (drives)."""
+    target_reading: float | None = None
+    """Mean SFR/SFL reading a drive ends at (None: a drive by turns only)."""
+    target_mtf: float | None = None
+    target_mtb: float | None = None
+    turn_direction: int = 0
+    """Calibration turns: +1 left (counter-clockwise), -1 right."""
+    turn_diff: float = 0.0
+    """Calibration turns: SFL − SFR, smoothed over a few ticks."""
+    probe_sfr: float = 0.0
+    probe_sfl: float = 0.0
+    """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""
+    checked: bool = False
+    """The phase's entry condition has been checked (on its first step)."""
+
+    @classmethod
+    def at_entry(cls, snap: Snapshot) -> Work:
+        """Fresh work for a phase entered at ``snap``."""
+        return cls(entry_wheel=motion.wheel_position(snap), entry_mtf=snap.turns(MotorId.MTF),
+                   entry_mtb=snap.turns(MotorId.MTB))
+
+    def lift_targets(self) -> dict[MotorId, float]:
+        """The lift targets that are set."""
+        out: dict[MotorId, float] = {}
+        if self.target_mtf is not None:
+            out[MotorId.MTF] = self.target_mtf
+        if self.target_mtb is not None:
+            out[MotorId.MTB] = self.target_mtb
+        return out
