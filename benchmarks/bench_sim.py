@@ -36,7 +36,7 @@ from stairbot.scenario import Scenario, load_scenario
 def full_run(config: RobotConfig, scenario: Scenario) -> tuple[RunResult, float]:
     """One whole run of the program on ``sim://``, as fast as possible; returns
     the result and the CPU time the run took."""
-    session = open_robot("sim://", config, scenario, RobotOptions())
+    session = open_robot("sim://", config, RobotOptions(world=scenario))
     try:
         cpu0 = time.process_time()
         result = run(session, config)
@@ -48,7 +48,7 @@ def full_run(config: RobotConfig, scenario: Scenario) -> tuple[RunResult, float]
 def bare_run(config: RobotConfig, scenario: Scenario, sim_time_s: float) -> tuple[float, float]:
     """Step a fresh world of the same scenario for ``sim_time_s`` in control-tick
     chunks with nothing but physics; returns the wall time and CPU time taken."""
-    session = open_robot("sim://", config, scenario, RobotOptions())
+    session = open_robot("sim://", config, RobotOptions(world=scenario))
     robot: Any = session.sim  # stairbot.fakes.sim.SimRobot
     robot.command({m: config.motors.wheel_speed for m in
                    (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL)})
