@@ -191,10 +191,18 @@ class RobotConfig:
         return lift_at_sight + self.sensors.front_height
 
     @property
+    def min_step_rise_m(self) -> float:
+        """Lowest rise it climbs: once the front sensors see over a riser,
+        segment 1 rises number_of_vertical_turns more before the tread is
+        measured, and must not see past the next riser meanwhile (with 10 mm
+        to spare).  Lower steps are refused."""
+        return self.sensors.front_height + self.algorithm.drive_clearance + 0.01
+
+    @property
     def min_tread_m(self) -> float:
-        """Shortest tread it enters: after the approach the sensors stand approach_gap
-        before the riser and must then read at least LENGTH_OF_A_ROBOT + SAFE_LENGTH."""
-        return self.LENGTH_OF_A_ROBOT + self.SAFE_LENGTH - self.algorithm.approach_gap
+        """Shortest tread it enters: LENGTH_OF_A_ROBOT + SAFE_LENGTH, measured at
+        the first sight over the riser as the reading less the approach's gap."""
+        return self.LENGTH_OF_A_ROBOT + self.SAFE_LENGTH
 
     @property
     def wheel_speed_m_s(self) -> float:
@@ -224,6 +232,7 @@ class RobotConfig:
             "lift_speed_m_s": self.lift_speed_m_s,
             "max_step_rise_m": self.max_step_rise_m,
             "min_tread_m": self.min_tread_m,
+            "min_step_rise_m": self.min_step_rise_m,
         }
 
     def to_dict(self) -> dict[str, Any]:

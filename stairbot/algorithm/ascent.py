@@ -27,6 +27,11 @@ from stairbot.hardware import MotorId
 P = Phase
 FLOW = "ascent"
 
+SIGHT_JUMP_M = 0.05
+"""Ascent 3: the front sensors see over the riser when both read at least this
+much past it (or nothing ahead).  No tread is this short, and it is ten
+times the sensors' noise: a noisy reading of the riser never passes for it."""
+
 
 # -- ascent 2: approach --------------------------------------------------------------------
 def _approach(t: Tick, _w: Work) -> Step:
@@ -54,15 +59,21 @@ def _approach_turns_enter(t: Tick, w: Work) -> None:
     # From SAFE_DISTANCE_IN_FRONT_OF_STEP on, NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
     # more.  A robot that starts nearer (after ascent 9) drives only the rest.
     cfg = t.cfg
-    gap = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP - motion.mean_distance(t.snap)
+    w.start_reading = motion.mean_distance(t.snap)
+    nearer = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP - w.start_reading
     w.target_wheel = w.entry_wheel + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH \
-        - cfg.wheel_turns(gap)
+        - cfg.wheel_turns(nearer)
 
 
 def _approach_turns(t: Tick, w: Work) -> Step:
-    assert w.target_wheel is not None  # set on entry
-    remaining = w.target_wheel - motion.wheel_position(t.snap)
+    assert w.target_wheel is not None and w.start_reading is not None  # set on entry
+    here = motion.wheel_position(t.snap)
+    remaining = w.target_wheel - here
     if remaining <= motion.WHEEL_DONE:
+        # The sensors read "too near" from here on: the gap is dead reckoned.
+        driven = (here - w.entry_wheel) * t.cfg.wheel_circumference
+        t.ctx.riser_gap = max(0.0, w.start_reading - driven)
+        t.say(f"at the riser: {t.ctx.riser_gap:.3f} m from it", riser_gap=t.ctx.riser_gap)
         return go(P.ASCENT_LIFT_FIRST)
     return stay(motion.drive(t.cfg, 1, remaining))
 
@@ -80,23 +91,46 @@ def _lift_first_enter(t: Tick, w: Work) -> None:
     w.target_mtf = w.entry_mtf + cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
 
 
+def _gap(t: Tick) -> float:
+    gap = t.ctx.riser_gap
+    return t.cfg.algorithm.approach_gap if gap is None else gap
+
+
+def tread_seen(t: Tick) -> float | None:
+    """The tread past the riser, once both front sensors see over it: the
+    nearer reading less the gap to the riser; +inf for nothing ahead; None
+    while either still sees the riser."""
+    gap, cfg = _gap(t), t.cfg
+    readings = motion.pair(t.snap)
+    if not all(motion.far(r, cfg) or (r.ok and r.distance_m >= gap + SIGHT_JUMP_M)
+               for r in readings):
+        return None
+    near = [r.distance_m for r in readings if not motion.far(r, cfg)]
+    return min(near) - gap if near else float("inf")
+
+
 def _lift_first(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
-    sight = cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
-    readings = motion.pair(t.snap)
-    if all(motion.far(r, cfg) or (r.ok and r.distance_m >= sight) for r in readings):
-        t.say(f"segment 1 sees over step {ctx.number_of_steps + 1}: SFR/SFL read "
-              f"{readings[0].distance_m:.3f}/{readings[1].distance_m:.3f} m "
-              f"(≥ {sight:.3f} m) after {t.snap.turns(MotorId.MTF) - ctx.return_mtf:.1f} "
-              "MTF turns")
-        return go(P.ASCENT_LIFT_FIRST_MORE)
+    if tread_seen(t) is not None:
+        sfr, sfl = (r.distance_m for r in motion.pair(t.snap))
+        lifted = t.snap.turns(MotorId.MTF) - ctx.return_mtf
+        rise = lifted * cfg.motors.lift_travel_per_turn + cfg.sensors.front_height
+        t.say(f"segment 1 sees over step {ctx.number_of_steps + 1} after {lifted:.1f} MTF turns "
+              f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m", rise=rise)
+        if rise >= cfg.min_step_rise_m:
+            return go(P.ASCENT_LIFT_FIRST_MORE)
+        ctx.ascent_end = "obstacle"
+        t.say(f"step {ctx.number_of_steps + 1} is too low to climb: rise about {rise:.3f} m < "
+              f"{cfg.min_step_rise_m:.3f} m (lifting on, the sensors could see past the next "
+              "riser); the ascent ends (obstacle)", ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE, "rise lower than the robot measures")
     assert w.target_mtf is not None
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
         ctx.ascent_end = "obstacle"
         allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
-        t.say(f"step {ctx.number_of_steps + 1} too high or its tread too short: no reading "
-              f"≥ {sight:.3f} m within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
+        t.say(f"step {ctx.number_of_steps + 1} too high: the front sensors did not see over "
+              f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
               ascent_end="obstacle")
         return go(P.ASCENT_LOWER_OBSTACLE)
     return stay({MotorId.MTF: speed})
@@ -104,14 +138,28 @@ def _lift_first(t: Tick, w: Work) -> Step:
 
 LIFT_FIRST = PhaseDef(
     P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, enter=_lift_first_enter,
-    to={P.ASCENT_LIFT_FIRST_MORE: "reads ≥ LENGTH_OF_A_ROBOT + SAFE_LENGTH",
+    to={P.ASCENT_LIFT_FIRST_MORE: "sees over the riser (reads ≥ gap + SIGHT_JUMP_M)",
         P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
-                                 "step too high or tread too short",
+                                 "step too high; or sees over a rise < min_step_rise_m",
         P.ERROR: FAULT})
 
 
 def _lifted_first(t: Tick, _w: Work) -> Step:
-    ctx = t.ctx
+    ctx, cfg = t.ctx, t.cfg
+    need = cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
+    # Measured now, clear of the edge: at the first sight over it the beam
+    # still grazes the step's own tread and reads short.
+    tread = tread_seen(t)
+    ahead = "nothing ahead" if tread is None or tread == float("inf") \
+        else f"tread {tread:.3f} m"
+    t.say(f"step {ctx.number_of_steps + 1}: {ahead} (the reading less {_gap(t):.3f} m to the "
+          "riser)", tread=None if tread is None or tread == float("inf") else tread)
+    if tread is not None and tread < need:
+        ctx.ascent_end = "obstacle"
+        t.say(f"the tread of step {ctx.number_of_steps + 1} is too short: {tread:.3f} m < "
+              f"LENGTH_OF_A_ROBOT + SAFE_LENGTH = {need:.3f} m; the ascent ends (obstacle)",
+              ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than LENGTH_OF_A_ROBOT + SAFE_LENGTH")
     ctx.number_of_turns_for_step_height = t.snap.turns(MotorId.MTF) - ctx.return_mtf
     t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
           f"(step {ctx.number_of_steps + 1})",
@@ -124,7 +172,10 @@ _more_enter, _more_step = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_verti
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
     _more_step, enter=_more_enter,
-    to={P.ASCENT_DRIVE_FIRST: "turns made: number_of_turns_for_step_height stored",
+    to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
+                              "number_of_turns_for_step_height stored",
+        P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
+                                 "tread too short",
         P.ERROR: FAULT})
 
 

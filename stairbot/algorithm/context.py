@@ -75,6 +75,10 @@ class Context:
     (and where descent 2 began lowering MTB)."""
     turn_origin: float = 0.0
     """MWR counter when calibration began turning: bounds the total turn."""
+    riser_gap: float | None = None
+    """How far the front sensors stand from the riser when ascent 3 begins:
+    the approach's last reading less what it drove after it (the sensors read
+    "too near" there).  The tread is what they see past the riser less this."""
 
     # -- the present phase's own working state ----------------------------------------
     work: Work = field(default_factory=Work)

@@ -32,6 +32,8 @@ class Work:
     probe_sfr: float = 0.0
     probe_sfl: float = 0.0
     """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""
+    start_reading: float | None = None
+    """A reading the phase measures from (the approach's last, the sight-over)."""
     checked: bool = False
     """The phase's entry condition has been checked (on its first step)."""
 

@@ -51,7 +51,7 @@ def test_config_show_text_has_every_section_and_the_derived_values(
     derived = out[out.index("[derived]"):]
     assert any(line.startswith("max_step_rise_m") and "0.202" in line
                for line in derived.splitlines())
-    assert any(line.startswith("min_tread_m") and "0.255" in line
+    assert any(line.startswith("min_tread_m") and "0.26" in line
                for line in derived.splitlines())
     assert any(line.startswith("MAX_OF_VERTICAL_TURNS") and "105" in line and "turns" in line
                for line in derived.splitlines())
@@ -83,7 +83,7 @@ def test_config_show_json_is_the_resolved_config(capsys: pytest.CaptureFixture[s
     assert main(["config", "show", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["derived"]["max_step_rise_m"] == pytest.approx(0.202)
-    assert data["derived"]["min_tread_m"] == pytest.approx(0.255)
+    assert data["derived"]["min_tread_m"] == pytest.approx(0.26)
     assert data["geometry"]["LENGTH_OF_A_ROBOT"] == pytest.approx(0.225)
     assert data["algorithm"]["max_steps"] == 10
 

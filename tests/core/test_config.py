@@ -55,7 +55,7 @@ def test_to_dict_has_every_section_and_the_derived_values() -> None:
     d = load_config().to_dict()
     assert set(d) >= {"geometry", "masses", "motors", "sensors", "algorithm", "derived", "source"}
     assert d["derived"]["max_step_rise_m"] == pytest.approx(0.202)
-    assert d["derived"]["min_tread_m"] == pytest.approx(0.255)
+    assert d["derived"]["min_tread_m"] == pytest.approx(0.26)
     assert d["geometry"]["LENGTH_OF_A_ROBOT"] == 0.225
 
 
