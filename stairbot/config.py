@@ -62,6 +62,9 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     back_min_range: NonNeg
     back_max_range: Pos
     resolution: NonNeg
+    noise: NonNeg = 0.005
+    """Stated sigma of a distance reading (the datasheet's): perception derives
+    its tolerances from it."""
 
 
 class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

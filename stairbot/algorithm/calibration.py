@@ -16,6 +16,7 @@ from stairbot.algorithm import motion
 from stairbot.algorithm.moves import lift
 from stairbot.algorithm.phase import (
     FAULT,
+    NO_MOTION,
     PhaseDef,
     Step,
     Tick,
@@ -28,6 +29,7 @@ from stairbot.algorithm.phase import (
 from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
 from stairbot.hardware import MotorId
+from stairbot.perception import still_tolerance
 
 P = Phase
 FLOW = "calibration"
@@ -35,9 +37,12 @@ FLOW = "calibration"
 PROBE_YAW_RAD = math.radians(10.0)
 """Case 3: the probe turn stops after this much yaw if the readings have not
 changed by 2 × equal_tolerance before."""
+STILL_TICKS = 25
+"""Calibration's check averages the pair's difference over this many ticks
+(0.5 s at the 20 ms tick) before it decides between the cases."""
 MAX_TURN_YAW_RAD = math.radians(90.0)
 """A calibration that turns this far without SFR = SFL ends with an error."""
-TURN_SLOW_FLOOR = 0.25
+TURN_SLOW_FLOOR = 0.1
 """The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
 
 
@@ -51,9 +56,15 @@ def _after_calibration(t: Tick) -> Step:
 
 
 # -- check the readings --------------------------------------------------------------
-def _check(t: Tick, _w: Work) -> Step:
+def _check(t: Tick, w: Work) -> Step:
     cfg, ctx = t.cfg, t.ctx
     sfr, sfl = motion.pair(t.snap)
+    # Standing still, the pair is averaged over STILL_TICKS before it is
+    # called equal or not: one noisy reading must not choose the case.
+    if w.diff_n < STILL_TICKS:
+        w.diff_sum += sfl.distance_m - sfr.distance_m
+        w.diff_n += 1
+        return stay(NO_MOTION)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         if ctx.purpose != "start":
             return fail(f"nothing ahead at {where(ctx, P.CAL_CHECK)}: SFR {sfr.distance_m:.3f} m, "
@@ -62,8 +73,8 @@ def _check(t: Tick, _w: Work) -> Step:
         t.say("calibration case 1: nothing ahead (SFR and SFL read at least "
               f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
         return end("stopped", "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
-    diff = sfl.distance_m - sfr.distance_m
-    equal = abs(diff) <= cfg.algorithm.equal_tolerance
+    diff = w.diff_sum / w.diff_n
+    equal = abs(diff) <= still_tolerance(cfg, w.diff_n)
     if equal and ctx.purpose != "start":
         ctx.calibration_case = None
         return _after_calibration(t)
@@ -125,13 +136,30 @@ def _turn_enter(t: Tick, w: Work) -> None:
 def _turn(t: Tick, w: Work) -> Step:
     cfg = t.cfg
     sfr, sfl = _readings(t)
+    if w.checked:  # stopped at SFR = SFL: measuring standing still
+        w.diff_sum += sfl - sfr
+        w.diff_n += 1
+        if w.diff_n < STILL_TICKS:
+            return stay(NO_MOTION)
+        diff = w.diff_sum / w.diff_n
+        if abs(diff) <= still_tolerance(cfg, w.diff_n):
+            t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {w.diff_n} readings "
+                  f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
+                  diff=diff)
+            return go(P.CAL_LOWER)
+        # Not square yet: turn on, slowly, the way the difference says.
+        w.checked, w.diff_sum, w.diff_n = False, 0.0, 0
+        w.turn_direction = 1 if diff > 0 else -1
+        w.turn_diff = diff
     w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
     # Turning left closes SFL - SFR from below, turning right from above: stop
-    # when the smoothed difference has reached zero.
+    # when the smoothed difference has reached zero (or, with readings that
+    # no longer change, has decayed to a twentieth of their resolution), then
+    # check it standing still.
     remaining = -w.turn_direction * w.turn_diff
-    if remaining <= 0.0:
-        t.say(f"squared up: SFR {sfr:.3f} m, SFL {sfl:.3f} m", SFR=sfr, SFL=sfl)
-        return go(P.CAL_LOWER)
+    if remaining <= cfg.sensors.resolution / 20:
+        w.checked = True
+        return stay(NO_MOTION)
     too_far = _turned_too_far(t, P.CAL_TURN)
     if too_far is not None:
         return too_far

@@ -35,6 +35,7 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
 )
+from stairbot.perception import Perception
 
 PHASE_TIMEOUT_S = 60.0
 """A phase (other than the standing rule's wait) that lasts longer than this,
@@ -97,6 +98,7 @@ class Controller:
         self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
         self._stroke = config.MAX_OF_VERTICAL_TURNS
         self._timeout = phase_timeout_s(config)
+        self._perception = Perception(config)
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -166,6 +168,7 @@ class Controller:
         self._time = snap.time_s
         if self.finished:
             return _zeros()
+        snap = self._perception.see(snap)
         if self._held is not None:
             if self._held_since is None:
                 self._held_since = snap.time_s

@@ -5,10 +5,11 @@ resume exactly where it stopped if they agree, end with an error if not.
 Armed in the phases whose record names a pair in ``watches`` (where both
 sensors of the pair look at the same flat surface): SBR/SBL in descent 2,
 SFR/SFL elsewhere.  A disagreement only counts when both sensors give a
-usable distance, and both the difference and its smoothed value
-(:data:`~stairbot.algorithm.motion.DIFF_SMOOTHING`) must exceed
-equal_tolerance for DEBOUNCE_TICKS ticks in a row: neither a short spike nor
-sensor noise stops the robot.
+usable distance, and both the (filtered) difference and its smoothed value
+(:data:`~stairbot.algorithm.motion.DIFF_SMOOTHING`) must exceed their
+tolerances (equal_tolerance, or more for sensors whose stated noise needs
+it: :func:`~stairbot.perception.pair_tolerance`) for DEBOUNCE_TICKS ticks in
+a row: neither a short spike nor sensor noise stops the robot.
 
 :func:`watch` runs before an armed phase's step and returns the pause; the
 PAUSED phase's step returns the resume (to the phase it stopped in) or the
@@ -21,6 +22,7 @@ from stairbot.algorithm import motion
 from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
+from stairbot.perception import pair_tolerance
 
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after
@@ -45,8 +47,9 @@ def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
         ctx.standing_diff = None
         return False
     ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
-    tol = t.cfg.algorithm.equal_tolerance
-    return abs(ctx.standing_diff) > tol and (not raw_too or abs(diff) > tol)
+    smoothed_tol = pair_tolerance(t.cfg, motion.DIFF_SMOOTHING)
+    return abs(ctx.standing_diff) > smoothed_tol and \
+        (not raw_too or abs(diff) > pair_tolerance(t.cfg))
 
 
 def watch(t: Tick, phase: PhaseDef) -> Step | None:

@@ -34,6 +34,9 @@ class Work:
     """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
+    diff_sum: float = 0.0
+    diff_n: int = 0
+    """A pair difference summed over ticks standing still, and how many."""
     checked: bool = False
     """The phase's entry condition has been checked (on its first step)."""
 

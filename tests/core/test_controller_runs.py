@@ -81,9 +81,10 @@ def test_measurements_are_told_and_stored(default_run) -> None:  # type: ignore[
     assert any(m.startswith("tab_length_to_edge[4] not measurable") for m in told)
     heights = [e.data["number_of_turns_for_step_height"] for e in events
                if "number_of_turns_for_step_height" in e.data]
-    # ascent: the beam (0.03 m) sees over 0.17 m after 70 turns, + 19 more;
-    # descent: segment 3 down by the rise
-    assert heights[:5] == pytest.approx([89.0] * 5, abs=0.3)
+    # ascent: the beam (0.03 m) sees over 0.17 m after 70 turns, + 19 more
+    # (the median filter sees it two ticks late: 0.4 turns); descent: segment 3
+    # down by the rise
+    assert heights[:5] == pytest.approx([89.0] * 5, abs=0.5)
     assert heights[5:] == pytest.approx([85.0] * 5, abs=0.3)
 
 
@@ -135,7 +136,7 @@ def test_a_step_it_cannot_climb_ends_the_ascent_and_goes_back(step: tuple[float,
     robot = KinematicRobot(CFG, steps=[step] * 2)
     ctrl = Controller(CFG)
     run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_LOWER_OBSTACLE)
-    assert robot.counters[MotorId.MTF] == pytest.approx(mtf, abs=0.3)
+    assert robot.counters[MotorId.MTF] == pytest.approx(mtf, abs=0.5)
     run(ctrl, robot)
     r = ctrl.result
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == \

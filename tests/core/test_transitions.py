@@ -8,6 +8,7 @@ from dataclasses import replace
 import pytest
 
 from stairbot.algorithm import phases
+from stairbot.algorithm.calibration import STILL_TICKS
 from stairbot.algorithm.context import Context
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phase import Step, Tick, go
@@ -75,9 +76,12 @@ def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
     tick = Tick(snap, CFG, ctx, Mode.FULL, lambda message, **_: said.append(message))
     record = Phase.CAL_CHECK.record
     assert record.step is not None
-    step = record.step(tick, Work.at_entry(snap))
-    assert isinstance(step, Step)
-    assert step.next is Phase.CAL_LIFT and not step.speeds
+    work = Work.at_entry(snap)
+    steps = [record.step(tick, work) for _ in range(STILL_TICKS + 1)]
+    assert all(isinstance(s, Step) and not s.speeds for s in steps)
+    assert [s.next for s in steps[:-1]] == [None] * STILL_TICKS  # averaging, standing still
+    step = steps[-1]
+    assert step.next is Phase.CAL_LIFT
     assert ctx.phase == Phase.CAL_CHECK.value  # not entered by the step
     assert ctx.calibration_case == "2" and said  # the seed's variables and a message
     assert Phase.CAL_LIFT in TRANSITIONS[Phase.CAL_CHECK]
@@ -108,13 +112,15 @@ def test_standing_rule_is_armed_where_the_table_says_and_not_while_turning_or_ri
 def test_a_step_that_returns_a_change_outside_the_table_raises(
         monkeypatch: pytest.MonkeyPatch, bad: Step) -> None:
     ctrl = Controller(CFG)
-    ctrl.tick(snapshot(0.0))  # enters calibration
-    ctrl.tick(snapshot(0.02))  # case 3: lift
-    assert ctrl.phase is Phase.CAL_LIFT
+    n = 0
+    while ctrl.phase is not Phase.CAL_LIFT:  # enters calibration, case 3: lift
+        ctrl.tick(snapshot(n * CFG.algorithm.tick))
+        n += 1
+        assert n < 100
     rogue = replace(Phase.CAL_LIFT.record, step=lambda _t, _w: bad)
     monkeypatch.setitem(phases._records(), Phase.CAL_LIFT, rogue)
     with pytest.raises(TransitionError, match="cal_lift -> "):
-        ctrl.tick(snapshot(0.04))
+        ctrl.tick(snapshot(n * CFG.algorithm.tick))
     assert ctrl.phase is Phase.CAL_LIFT
 
 
