@@ -234,12 +234,12 @@ class ConsoleEngine:
         """Stop every motor now and latch it until :meth:`clear_estop`: the
         robot's own ``estop()``, from this thread at once (the run loop, told
         too, holds the program and does not repeat it)."""
-        if self.robot is not None:
-            self.robot.estop()
-        if self.control is not None and self.running:
-            self.control.estop()
         self.state.set_status(estopped=True, paused=self.running, severity="error",
                               message="EMERGENCY STOP — every motor stopped; c clears it")
+        if self.robot is not None:
+            self.robot.estop()  # (a robot that fails to confirm it says so in the banner)
+        if self.control is not None and self.running:
+            self.control.estop()
         self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
 
     def clear_estop(self) -> bool:

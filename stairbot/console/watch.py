@@ -6,6 +6,7 @@ simulation speed; and the event recorder (JSON lines).
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
 from collections.abc import Callable
@@ -95,12 +96,25 @@ class WatchedRobot:
         if self._lock.acquire(timeout=0.5):
             try:
                 if not self._estop_sent:
-                    self._estop_sent = True
-                    self.inner.estop()
-                    self.estop_tick = self.ticks
-                    self._state.on_command(dict(ZERO_SPEEDS))
+                    self._send_estop()
             finally:
                 self._lock.release()
+
+    def _send_estop(self) -> None:
+        # estop() never raises by the protocol; a robot that breaks it (a
+        # lost link) must not take the console down with it: stop what can
+        # be stopped, say so, and let the next press try the robot again.
+        try:
+            self.inner.estop()
+        except Exception as exc:  # noqa: BLE001 - the key must always work
+            with contextlib.suppress(Exception):
+                self.inner.stop_all()
+            self._state.set_status(severity="error", message=f"EMERGENCY STOP: the robot "
+                                   f"did not confirm its e-stop: {exc}")
+        else:
+            self._estop_sent = True
+        self.estop_tick = self.ticks
+        self._state.on_command(dict(ZERO_SPEEDS))
 
     def clear(self) -> None:
         """Clear the robot's latch, then this one.  Raises what the robot's

@@ -195,3 +195,32 @@ def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> Non
         engine.stop()
         loop.release.set()
         worker.join()
+
+
+def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
+    """estop() never raises by the protocol; a driver that breaks it (a lost
+    link) still gets every later command turned into a stop, and the banner
+    says the robot did not confirm."""
+    from stairbot.errors import LinkLostError
+
+    def broken_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
+        from stairbot.robots import RobotSession, open_robot
+
+        s = open_robot(url, config, replace(options, world=scenario))
+
+        def estop() -> None:
+            raise LinkLostError("motor board: no reply to EStop")
+
+        s.robot.estop = estop  # type: ignore[method-assign]
+        return RobotSession(s.robot, s.clock, s.url, s.simulated, s.sim)
+
+    engine = ConsoleEngine(LiveState(), load_config(), open_fn=broken_open)
+    engine.open("sim://", None)
+    assert engine.robot is not None
+    engine.robot.command(FORWARD)
+    engine.estop()  # does not raise
+    status = engine.state.view().status
+    assert status.estopped and "did not confirm its e-stop" in status.message
+    assert engine.robot.estopped
+    engine.robot.command(FORWARD)  # turned into a stop
+    assert engine.state.view().commands == dict.fromkeys(MotorId, 0.0)
