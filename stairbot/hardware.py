@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
+from types import MappingProxyType
 from typing import Protocol, runtime_checkable
 
 from stairbot.events import EventSink
@@ -89,6 +90,9 @@ class Snapshot:
 Speeds = Mapping[MotorId, float]
 """Motor speed commands in turns/s; a motor left out is commanded to 0."""
 
+ZERO_SPEEDS: Speeds = MappingProxyType(dict.fromkeys(MotorId, 0.0))
+"""Every motor at 0 (lifts hold), read-only: share it, never copy it."""
+
 
 @runtime_checkable
 class Robot(Protocol):
@@ -115,7 +119,8 @@ class Robot(Protocol):
     def estop(self) -> None:
         """Emergency stop: every motor stops at once, the lifts hold, and the
         stop is latched (``command`` moves nothing) until :meth:`clear`.
-        Never raises."""
+        ``read`` still works while latched (the operator watches the sensors).
+        Never raises, not even on a lost link or after ``close``."""
         ...
 
     def clear(self) -> None:
@@ -133,7 +138,7 @@ class Robot(Protocol):
         ...
 
     def close(self) -> None:
-        """Stop every motor and release the robot."""
+        """Stop every motor and release the robot.  Closing twice is harmless."""
         ...
 
 
@@ -156,6 +161,35 @@ class HasTruth(Protocol):
     truth about itself."""
 
     def truth(self) -> Truth:
+        ...
+
+
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class Scene:
+    """A simulation's side view, for the console's picture: world metres, x
+    forward (towards the stairs), y up, riser 1 at x = 0."""
+
+    time_s: float
+    stairs: tuple[Point, ...]
+    """The stairs' surface as one polyline."""
+    segments: tuple[tuple[Point, ...], ...]
+    """Segments 1, 2, 3 (front to back), each a closed outline."""
+    wheels: tuple[Point, ...]
+    """Wheel centres, segment 1's first."""
+    wheel_radius: float
+    yaw_deg: float
+    lateral_m: float
+    fell: bool
+
+
+@runtime_checkable
+class HasScene(Protocol):
+    """A simulation that can draw itself (sim://): the console's picture."""
+
+    def scene(self) -> Scene:
         ...
 
 

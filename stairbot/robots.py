@@ -22,7 +22,7 @@ from urllib.parse import urlsplit
 
 from stairbot.config import RobotConfig
 from stairbot.errors import RobotUrlError
-from stairbot.hardware import Clock, Robot
+from stairbot.hardware import Clock, HasScene, Robot
 from stairbot.scenario import Scenario
 
 
@@ -40,13 +40,15 @@ class RobotOptions:
 
 @dataclass
 class RobotSession:
-    """An opened robot with the clock that goes with it."""
+    """An opened robot with the clock that goes with it.  ``sim`` is the
+    in-process simulation the console can draw (sim://); None for a robot on
+    a wire, fake boards included (their world runs in another process)."""
 
     robot: Robot
     clock: Clock
     url: str
     simulated: bool
-    sim: object | None = None  # the simulation object, for pictures and truth
+    sim: HasScene | None = None
 
     def close(self) -> None:
         self.robot.close()

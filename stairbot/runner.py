@@ -9,35 +9,41 @@ controls (stop, pause, emergency stop) come in through a thread-safe
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, Literal
 
 from stairbot.algorithm.controller import Controller, phase_timeout_s
 from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
 from stairbot.errors import HardwareError, LinkLostError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import MotorId
+from stairbot.hardware import HasTruth, ReportsEvents, Robot, Snapshot, Truth
 from stairbot.robots import RobotSession
 
-ZERO_SPEEDS: dict[MotorId, float] = {m: 0.0 for m in MotorId}
+Latch = Literal["estop", "clear"]
 
 
 class RunControl:
     """Operator requests to a running loop; every method is thread-safe.
 
-    The emergency stop is latched: the loop commands zero speeds from the next
-    command on and the controller is held until :meth:`clear_estop` *and*
-    :meth:`resume` (clearing alone never restarts motion)."""
+    The emergency stop is latched: each press of :meth:`estop` becomes one
+    ``robot.estop()`` on the run thread at the top of the next tick (the
+    robot's own latch then keeps every motor stopped) and holds the
+    controller.  :meth:`clear_estop` becomes one ``robot.clear()`` there, in
+    the order the two were pressed; clearing alone never restarts motion --
+    that takes :meth:`resume` as well."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._stop_reason: str | None = None
         self._estopped = False
         self._paused = False
+        self._latches: deque[Latch] = deque()
 
     def request_stop(self, reason: str = "stopped by the operator") -> None:
         with self._lock:
@@ -47,10 +53,12 @@ class RunControl:
         with self._lock:
             self._estopped = True
             self._paused = True
+            self._latches.append("estop")
 
     def clear_estop(self) -> None:
         with self._lock:
             self._estopped = False
+            self._latches.append("clear")
 
     def pause(self) -> None:
         with self._lock:
@@ -60,6 +68,14 @@ class RunControl:
         with self._lock:
             if not self._estopped:
                 self._paused = False
+
+    def take_latches(self) -> list[Latch]:
+        """The e-stops and clears pressed since the last call, oldest first
+        (the run thread carries them out)."""
+        with self._lock:
+            out = list(self._latches)
+            self._latches.clear()
+            return out
 
     @property
     def estopped(self) -> bool:
@@ -103,10 +119,6 @@ class RunResult:
         return out
 
 
-def _float_or_none(value: object) -> float | None:
-    return float(value) if isinstance(value, int | float) else None
-
-
 def run(
     session: RobotSession,
     config: RobotConfig,
@@ -117,7 +129,7 @@ def run(
     controller: Controller | None = None,
     max_sim_time_s: float | None = None,
     wall: Callable[[], float] = time.perf_counter,
-    on_tick: Callable[[Controller, Any], None] | None = None,
+    on_tick: Callable[[Controller, Snapshot], None] | None = None,
 ) -> RunResult:
     """Run the program on ``session`` until the controller finishes.
 
@@ -126,15 +138,15 @@ def run(
     ``on_tick(controller, snapshot)`` is called after each tick (for a console).
     A run longer than ``max_sim_time_s`` of robot time ends with an error (by
     default an hour, or 60 phase timeouts for a robot whose slow motors make
-    that longer).
+    that longer).  Fell, pitch and offset in the result come from the robot's
+    ``truth()`` (HasTruth; None for a robot without it).
     """
     robot, clock = session.robot, session.clock
     ctl = controller or Controller(config, sink, mode)
     if max_sim_time_s is None:
         max_sim_time_s = max(3600.0, 60 * phase_timeout_s(config))
-    attach = getattr(robot, "attach_sink", None)
-    if callable(attach):  # wired robots report link health as LINK events
-        attach(sink)
+    if isinstance(robot, ReportsEvents):  # wired robots report link health as LINK events
+        robot.attach_sink(sink)
     tick = config.algorithm.tick
     t0, wall0 = clock.now(), wall()
     fell = False
@@ -146,9 +158,11 @@ def run(
                     break
             snap = robot.read()
             speeds = ctl.tick(snap)
-            if control is not None and control.estopped:
-                speeds = ZERO_SPEEDS
-            robot.command(speeds)
+            # An e-stop pressed during this tick is carried out now rather
+            # than after one more command; while latched nothing is sent (the
+            # robot's latch holds every motor, and boards would refuse it).
+            if control is None or not _latch(control, robot):
+                robot.command(speeds)
             if on_tick is not None:
                 on_tick(ctl, snap)
             clock.advance(tick)
@@ -162,12 +176,15 @@ def run(
     except HardwareError as exc:
         ctl.abort(f"hardware failure: {exc}", "error")
     finally:
+        if control is not None:  # presses the loop did not come round to
+            with contextlib.suppress(HardwareError):  # a clear on a lost link
+                _latch(control, robot)
         robot.stop_all()
     wall_time = wall() - wall0
     sim_time = clock.now() - t0
-    diag = robot.diagnostics()
+    truth = _truth(robot)
     res = ctl.result
-    fell = fell or bool(diag.get("fell", False))
+    fell = fell or (truth is not None and truth.fell)
     result = RunResult(
         outcome="fell" if fell else res.outcome,
         ascent_end=res.ascent_end,
@@ -176,8 +193,8 @@ def run(
         pauses=res.pauses,
         error=res.error,
         fell=fell,
-        max_pitch_deg=_float_or_none(diag.get("max_pitch_deg")),
-        final_offset_m=_float_or_none(diag.get("offset_m")),
+        max_pitch_deg=truth.max_pitch_deg if truth is not None else None,
+        final_offset_m=truth.offset_m if truth is not None else None,
         sim_time_s=sim_time,
         wall_time_s=wall_time,
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
@@ -186,14 +203,35 @@ def run(
     return result
 
 
-def _apply(control: RunControl, ctl: Controller, robot: Any) -> None:
+def _truth(robot: Robot) -> Truth | None:
+    """The robot's truth if it has one it can tell now (a lost link cannot)."""
+    if not isinstance(robot, HasTruth):
+        return None
+    try:
+        return robot.truth()
+    except HardwareError:
+        return None
+
+
+def _latch(control: RunControl, robot: Robot) -> bool:
+    """Carry out the e-stops and clears pressed since the last call, in order;
+    whether the e-stop is latched now."""
+    for latch in control.take_latches():
+        if latch == "estop":
+            robot.estop()
+        else:
+            robot.clear()
+    return control.estopped
+
+
+def _apply(control: RunControl, ctl: Controller, robot: Robot) -> None:
     reason = control.stop_reason
     if reason is not None:
+        _latch(control, robot)
         robot.stop_all()
         ctl.abort(reason, "stopped")
         return
-    if control.estopped:
-        robot.stop_all()
+    if _latch(control, robot):
         if not ctl.held:
             ctl.hold("emergency stop")
     elif control.paused:

@@ -11,9 +11,9 @@ a second key to remember when it matters); the binding shows it in the footer.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Awaitable, Callable, Iterable
 from pathlib import Path
-from typing import Any
+from typing import Unpack
 
 from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
@@ -25,7 +25,7 @@ from textual.widgets import Footer
 from stairbot.config import RobotConfig, load_config
 from stairbot.console.modals import AskScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
-from stairbot.console.runner_thread import SPEEDS, ConsoleEngine
+from stairbot.console.runner_thread import SPEEDS, ConsoleEngine, EngineHooks
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
@@ -192,7 +192,7 @@ class StairbotConsole(App[None]):
     def run_program(self, mode: str) -> None:
         result = self.engine.run(mode)
         if result is not None:
-            self._tell(f"run {result.get('outcome')}", "information")
+            self._tell(f"run {result.outcome}", "information")
 
     def _tell(self, message: str, severity: str) -> None:
         self.call_from_thread(self.notify, message, severity=severity,
@@ -340,7 +340,7 @@ class StairbotConsole(App[None]):
         for action, title, help_text in COMMANDS:
             yield SystemCommand(title, help_text, self._runner(action))
 
-    def _runner(self, action: str) -> Callable[[], Any]:
+    def _runner(self, action: str) -> Callable[[], Awaitable[None]]:
         async def go() -> None:
             await self.run_action(action)
         return go
@@ -359,7 +359,7 @@ def _why(exc: Exception) -> str:
 
 def build_app(config: RobotConfig | str | Path | None = None, *, url: str = "sim://",
               scenario: str | None = None, record: str | None = None, speed: str = "1x",
-              **engine_hooks: Any) -> StairbotConsole:
+              **engine_hooks: Unpack[EngineHooks]) -> StairbotConsole:
     """Build the console.  ``config`` is a RobotConfig, a file, or None for the
     shipped robot (raises ConfigError for a bad file).  ``engine_hooks``
     (open_fn, run_fn, control_fn, wall, sleep) replace the engine's defaults."""

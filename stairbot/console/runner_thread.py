@@ -3,8 +3,9 @@ worker thread, and the operator's controls reaching it safely.
 
 The run thread owns the robot; the UI thread only ever calls
 :meth:`ConsoleEngine.estop`, :meth:`pause` and friends, which set flags (and,
-for the emergency stop, stop every motor directly, under the same lock the run
-thread holds for each robot call, so the two never talk to the robot at once).
+for the emergency stop, call the robot's own ``estop()`` directly, under the
+same lock the run thread holds for each robot call, so the two never talk to
+the robot at once).
 """
 
 from __future__ import annotations
@@ -14,21 +15,41 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
+from typing import TypedDict
 
+from stairbot.algorithm.controller import Controller
 from stairbot.config import RobotConfig
-from stairbot.console.scene import SceneView, scene_from_sim, stairs_from_scenario
+from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
-from stairbot.console.watch import PacedClock, Recorder, WatchedRobot
+from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
 from stairbot.errors import InputError, StairbotError
-from stairbot.events import Event, EventKind
+from stairbot.events import Event, EventKind, EventSink
+from stairbot.hardware import HasScene, ReportsEvents, Snapshot
 from stairbot.robots import RobotOptions, RobotSession
+from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
 
 SPEEDS: dict[str, float | None] = {"1x": 1.0, "10x": 10.0, "max": None}
 """Simulation speeds the operator can pick: sim seconds per wall second."""
 
 PHASE_PERIOD_S = 0.2  # wall seconds between copies of the controller's context
+
+OnTick = Callable[[Controller, Snapshot], None]
+OpenFn = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
+RunFn = Callable[[RobotSession, RobotConfig, EventSink, str, RunControl, OnTick], RunResult]
+"""(session, config, sink, mode, control, on_tick) -> result: the run loop,
+``mode`` "full" or "calibrate"."""
+
+
+class EngineHooks(TypedDict, total=False):
+    """What a test (or another front end) may put in place of the engine's
+    defaults: how robots open, the run loop, its controls, the wall clock."""
+
+    open_fn: OpenFn
+    run_fn: RunFn
+    control_fn: Callable[[], RunControl]
+    wall: Callable[[], float]
+    sleep: Callable[[float], None]
 
 
 def _default_open(url: str, config: RobotConfig, scenario: Scenario,
@@ -38,8 +59,8 @@ def _default_open(url: str, config: RobotConfig, scenario: Scenario,
     return open_robot(url, config, replace(options, world=scenario))
 
 
-def _default_run(session: RobotSession, config: RobotConfig, sink: Callable[[Event], None],
-                 mode: str, control: Any, on_tick: Callable[[Any, Any], None]) -> Any:
+def _default_run(session: RobotSession, config: RobotConfig, sink: EventSink,
+                 mode: str, control: RunControl, on_tick: OnTick) -> RunResult:
     from stairbot.algorithm.phases import Mode
     from stairbot.runner import run
 
@@ -47,23 +68,15 @@ def _default_run(session: RobotSession, config: RobotConfig, sink: Callable[[Eve
                control, on_tick=on_tick)
 
 
-def _default_control() -> Any:
-    from stairbot.runner import RunControl
-
-    return RunControl()
-
-
-def describe_result(result: dict[str, Any]) -> tuple[str, str]:
+def describe_result(result: RunResult) -> tuple[str, str]:
     """One line saying how a run ended, and its severity (good/warning/error)."""
-    outcome = result.get("outcome", "?")
-    parts = [f"run {outcome}"]
-    if result.get("error"):  # first: on a narrow screen the end of the line is cut
-        parts.append(str(result["error"]))
-    if result.get("ascent_end"):
-        parts.append(str(result["ascent_end"]).replace("_", " "))
-    parts.append(f"climbed {result.get('steps_climbed', 0)}, "
-                 f"descended {result.get('steps_descended', 0)}")
-    severity = {"completed": "good", "stopped": "warning"}.get(str(outcome), "error")
+    parts = [f"run {result.outcome}"]
+    if result.error:  # first: on a narrow screen the end of the line is cut
+        parts.append(result.error)
+    if result.ascent_end:
+        parts.append(result.ascent_end.replace("_", " "))
+    parts.append(f"climbed {result.steps_climbed}, descended {result.steps_descended}")
+    severity = {"completed": "good", "stopped": "warning"}.get(result.outcome, "error")
     return " · ".join(parts), severity
 
 
@@ -72,9 +85,9 @@ class ConsoleEngine:
     the operator's controls from the UI thread."""
 
     def __init__(self, state: LiveState, config: RobotConfig, *,
-                 open_fn: Callable[..., RobotSession] = _default_open,
-                 run_fn: Callable[..., Any] = _default_run,
-                 control_fn: Callable[[], Any] = _default_control,
+                 open_fn: OpenFn = _default_open,
+                 run_fn: RunFn = _default_run,
+                 control_fn: Callable[[], RunControl] = RunControl,
                  wall: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
         self.state = state
@@ -86,12 +99,12 @@ class ConsoleEngine:
         self.robot: WatchedRobot | None = None
         self.clock: PacedClock | None = None
         self.scenario: Scenario | None = None
-        self.control: Any = None
+        self.control: RunControl | None = None
         self.recorder: Recorder | None = None
         self._running = threading.Event()
         self._speed = "max"
         self._last_phase: object = None
-        self._controller: Any = None  # the run's controller, as the last tick saw it
+        self._controller: Controller | None = None  # the run's, as the last tick saw it
         self._last_ctx = -1.0
 
     # -- robot -----------------------------------------------------------------
@@ -122,14 +135,13 @@ class ConsoleEngine:
         session = self._open_fn(url, self.config, scenario, RobotOptions())
         self.session, self.scenario = session, scenario
         sim = session.sim
-        scene_fn = None
-        if session.simulated and sim is not None and hasattr(sim, "scene"):
-            def scene_fn() -> SceneView | None:
-                return scene_from_sim(sim.scene())
-        attach = getattr(session.robot, "attach_sink", None)
-        if callable(attach):  # a driver's LINK events go to the log and the record
-            attach(self._sink)
-        self.robot = WatchedRobot(session.robot, self.state, self._lock, scene_fn, self._wall)
+        scene_fn: Callable[[], SceneView] | None = None
+        if isinstance(sim, HasScene):
+            def scene_fn() -> SceneView:
+                return scene_view(sim.scene())
+        if isinstance(session.robot, ReportsEvents):  # LINK events: the log and the record
+            session.robot.attach_sink(self._sink)
+        self.robot = watch(session.robot, self.state, self._lock, scene_fn, self._wall)
         self.clock = PacedClock(session.clock, self._lock, self._wall, self._sleep)
         self.clock.set_scale(SPEEDS[self._speed] if sim is not None else None)
         stairs = stairs_from_scenario(scenario, self.config.LENGTH_OF_A_ROBOT)
@@ -152,9 +164,9 @@ class ConsoleEngine:
         self.session = self.robot = self.clock = None
 
     # -- the run (worker thread) -----------------------------------------------
-    def run(self, mode: str = "full") -> dict[str, Any] | None:
-        """Run the program until it ends; returns the result as a dict, or None
-        when it could not run.  Never raises: failures end up in the live state."""
+    def run(self, mode: str = "full") -> RunResult | None:
+        """Run the program until it ends; returns its result, or None when it
+        could not run.  Never raises: failures end up in the live state."""
         if self.session is None or self.robot is None or self.clock is None:
             self.state.set_status(message="no robot open: choose a robot first (u)",
                                   severity="warning")
@@ -168,13 +180,13 @@ class ConsoleEngine:
         self._running.set()
         session = RobotSession(self.robot, self.clock, self.session.url,
                                self.session.simulated, self.session.sim)
-        self.state.on_result({})
+        self.state.on_result(None)
         self.state.set_status(robot="running", paused=False, severity="info",
                               message="calibrating only" if mode == "calibrate" else "full run")
         self._controller = None
         try:
-            self.control = self._control_fn()
-            result = self._run_fn(session, self.config, self._sink, mode, self.control,
+            self.control = control = self._control_fn()
+            result = self._run_fn(session, self.config, self._sink, mode, control,
                                   self._on_tick)
         except Exception as exc:  # noqa: BLE001 - a fault shows as a banner, not a traceback
             with contextlib.suppress(Exception):
@@ -185,62 +197,68 @@ class ConsoleEngine:
         finally:
             self._running.clear()
         if self._controller is not None:  # a stop or a fault ends the run between ticks
-            self._on_tick(self._controller, None, final=True)
-        out: dict[str, Any] = result.to_dict() if hasattr(result, "to_dict") else dict(result)
+            self._watch_phase(self._controller, final=True)
         self.robot.refresh_scene()
-        self.state.on_result(out)
-        line, severity = describe_result(out)
+        self.state.on_result(result)
+        line, severity = describe_result(result)
         if self.robot.estopped:
             line += " · EMERGENCY STOP still set: c clears it"
         self.state.set_status(robot="ended", paused=False, message=line, severity=severity)
-        return out
+        return result
 
     def _sink(self, event: Event) -> None:
         self.state.on_event(event)
         if self.recorder is not None:
             self.recorder.write(event)
 
-    def _on_tick(self, ctl: Any, snap: Any, final: bool = False) -> None:
+    def _on_tick(self, ctl: Controller, snap: Snapshot) -> None:
         self._controller = ctl
+        self._watch_phase(ctl)
+
+    def _watch_phase(self, ctl: Controller, final: bool = False) -> None:
         try:
             self._copy_phase(ctl, final)
         except Exception:  # noqa: BLE001 - watching must never stop the run
             self.state.on_phase("(phase not readable)", "", None)
 
-    def _copy_phase(self, ctl: Any, force: bool = False) -> None:
-        phase = getattr(ctl, "phase", None)
+    def _copy_phase(self, ctl: Controller, force: bool = False) -> None:
+        phase = ctl.phase
         now = self._wall()
         if not force and phase is self._last_phase and now - self._last_ctx < PHASE_PERIOD_S:
             return
         self._last_phase, self._last_ctx = phase, now
-        label = str(getattr(phase, "label", phase))
-        flow = str(getattr(phase, "flow", ""))
-        context = getattr(ctl, "context", None)
-        ctx = context.to_dict() if context is not None and hasattr(context, "to_dict") else None
-        self.state.on_phase(label, flow, ctx)
+        self.state.on_phase(phase.label, ctl.flow, ctl.context.to_dict())
 
     # -- operator controls (UI thread) -------------------------------------------
     def estop(self) -> None:
-        """Stop every motor now and latch it until :meth:`clear_estop`."""
-        if self.control is not None and self.running:
-            self.control.estop()
-        if self.robot is not None:
-            self.robot.estop()
+        """Stop every motor now and latch it until :meth:`clear_estop`: the
+        robot's own ``estop()``, from this thread at once (the run loop, told
+        too, holds the program and does not repeat it)."""
         self.state.set_status(estopped=True, paused=self.running, severity="error",
                               message="EMERGENCY STOP — every motor stopped; c clears it")
+        if self.robot is not None:
+            self.robot.estop()  # (a robot that fails to confirm it says so in the banner)
+        if self.control is not None and self.running:
+            self.control.estop()
         self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
 
     def clear_estop(self) -> bool:
-        """Clear the latched stop; motion resumes only with :meth:`resume`.
-        False when no stop was set (on the robot, or, with no robot open, on the
-        banner)."""
+        """Clear the latched stop (the robot's ``clear()``: on the run thread
+        during a run); motion resumes only with :meth:`resume`.  False when no
+        stop was set (on the robot, or, with no robot open, on the banner).
+        A robot that cannot be cleared (a lost link) stays latched and says why."""
         latched = self.robot is not None and self.robot.estopped
         if not latched and not self.state.view().status.estopped:
             return False
-        if self.robot is not None:
-            self.robot.clear_estop()
-        if self.control is not None:
-            self.control.clear_estop()
+        if self.control is not None and self.running:
+            self.control.clear_estop()  # the run thread calls the robot's clear()
+        elif self.robot is not None:
+            try:
+                self.robot.clear()
+            except StairbotError as exc:
+                self.state.set_status(severity="error", message=f"the emergency stop "
+                                      f"could not be cleared: {exc}")
+                return True
         msg = "emergency stop cleared; p resumes the run" if self.running else \
             "emergency stop cleared"
         self.state.set_status(estopped=False, severity="warning", message=msg)
@@ -257,7 +275,7 @@ class ConsoleEngine:
         """Resume a paused run; refused while the emergency stop is set."""
         if self.control is None or not self.running:
             return False
-        if self.robot is not None and self.robot.estopped:
+        if self.control.estopped:
             self.state.set_status(message="clear the emergency stop (c) before resuming",
                                   severity="error")
             return False

@@ -1,20 +1,17 @@
 """What the picture draws: the stairs outline and the robot's segments and
 wheels in world coordinates (metres, x forward towards the stairs, y up).
 
-:func:`scene_from_sim` reads whatever the simulation's ``scene()`` returns;
-:func:`stairs_from_scenario` draws the stairs of a scenario for a wired robot,
-whose pose the console cannot see.
+:func:`scene_view` draws the simulation's :class:`~stairbot.hardware.Scene`
+(its ``scene()``, HasScene); :func:`stairs_from_scenario` draws the stairs of
+a scenario for a wired robot, whose pose the console cannot see.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
+from stairbot.hardware import Point, Scene
 from stairbot.scenario import Scenario
-
-Point = tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -82,66 +79,13 @@ def stairs_from_scenario(scenario: Scenario, robot_length: float) -> tuple[Point
     return tuple(pts)
 
 
-def _point(value: Any) -> Point:
-    if isinstance(value, Mapping):
-        return (float(value["x"]), float(value["y"]))
-    x, y = value[0], value[1]
-    return (float(x), float(y))
-
-
-def _points(values: Iterable[Any]) -> tuple[Point, ...]:
-    return tuple(_point(v) for v in values)
-
-
-def _get(obj: Any, *names: str) -> Any:
-    for name in names:
-        if isinstance(obj, Mapping) and name in obj:
-            return obj[name]
-        if hasattr(obj, name):
-            return getattr(obj, name)
-    return None
-
-
-def _segment_polygon(seg: Any) -> tuple[Point, ...]:
-    if isinstance(seg, Sequence) and seg and not isinstance(seg, str | bytes):
-        first = seg[0]
-        if isinstance(first, Sequence | Mapping):
-            return _points(seg)
-    corners = _get(seg, "corners", "polygon", "points", "outline", "vertices")
-    if corners is not None:
-        return _points(corners)
-    raise ValueError(f"cannot read a segment from {type(seg).__name__}")
-
-
-def _wheel(w: Any, default_radius: float) -> tuple[float, float, float]:
-    if isinstance(w, Sequence) and not isinstance(w, str | bytes):
-        if len(w) >= 3:
-            return (float(w[0]), float(w[1]), float(w[2]))
-        return (float(w[0]), float(w[1]), default_radius)
-    centre = _get(w, "centre", "center", "position", "pos")
-    radius = _get(w, "radius", "r")
-    if centre is not None:
-        cx, cy = _point(centre)
-    else:
-        cx, cy = float(_get(w, "x")), float(_get(w, "y"))
-    return (cx, cy, float(radius) if radius is not None else default_radius)
-
-
-def scene_from_sim(raw: Any) -> SceneView:
-    """Adapt the simulation's ``scene()`` (a mapping or an object with
-    ``stairs``, ``segments`` and ``wheels``) to a :class:`SceneView`.
-    Raises ValueError when it cannot be read."""
-    stairs = _get(raw, "stairs", "stairs_outline", "outline")
-    segments = _get(raw, "segments", "bodies")
-    wheels = _get(raw, "wheels")
-    if stairs is None or segments is None:
-        raise ValueError("the simulation's scene has no stairs or segments")
-    time_s = _get(raw, "time_s", "time")
-    radius = _get(raw, "wheel_radius")
-    r = float(radius) if isinstance(radius, int | float) else 0.016
+def scene_view(scene: Scene) -> SceneView:
+    """The picture of a simulation's scene: its outlines as they are, each
+    wheel with the scene's wheel radius."""
+    r = scene.wheel_radius
     return SceneView(
-        stairs=_points(stairs),
-        segments=tuple(_segment_polygon(s) for s in segments),
-        wheels=tuple(_wheel(w, r) for w in (wheels or ())),
-        time_s=float(time_s) if isinstance(time_s, int | float) else None,
+        stairs=scene.stairs,
+        segments=scene.segments,
+        wheels=tuple((x, y, r) for x, y in scene.wheels),
+        time_s=scene.time_s,
     )

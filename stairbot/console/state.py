@@ -14,6 +14,7 @@ from typing import Any
 from stairbot.console.scene import SceneView
 from stairbot.events import Event
 from stairbot.hardware import MotorId, Snapshot
+from stairbot.runner import RunResult
 
 LOG_LENGTH = 1000
 
@@ -48,7 +49,7 @@ class StateView:
     scene: SceneView | None
     stairs: tuple[tuple[float, float], ...]
     health: dict[str, float]
-    result: dict[str, Any] | None
+    result: RunResult | None
     speed: str
     recording: str | None
     events: tuple[tuple[int, Event], ...] = field(default=())
@@ -74,7 +75,7 @@ class LiveState:
         self._scene: SceneView | None = None
         self._stairs: tuple[tuple[float, float], ...] = ()
         self._health: dict[str, float] = {}
-        self._result: dict[str, Any] | None = None
+        self._result: RunResult | None = None
         self._speed = "max"
         self._recording: str | None = None
         self._events: deque[tuple[int, Event]] = deque(maxlen=LOG_LENGTH)
@@ -95,9 +96,20 @@ class LiveState:
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
             self._bump()
 
-    def set_status(self, **changes: Any) -> None:
+    def set_status(self, *, robot: str | None = None, estopped: bool | None = None,
+                   paused: bool | None = None, message: str | None = None,
+                   severity: str | None = None) -> None:
+        """Change the fields given (None: left as it is)."""
         with self._lock:
-            self._status = replace(self._status, **changes)
+            st = self._status
+            self._status = replace(
+                st,
+                robot=st.robot if robot is None else robot,
+                estopped=st.estopped if estopped is None else estopped,
+                paused=st.paused if paused is None else paused,
+                message=st.message if message is None else message,
+                severity=st.severity if severity is None else severity,
+            )
             self._bump()
 
     def on_read(self, snap: Snapshot) -> None:
@@ -135,7 +147,7 @@ class LiveState:
                 )
             self._bump()
 
-    def on_result(self, result: dict[str, Any]) -> None:
+    def on_result(self, result: RunResult | None) -> None:
         with self._lock:
             self._result = result
             self._bump()

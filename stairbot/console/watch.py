@@ -6,20 +6,20 @@ simulation speed; and the event recorder (JSON lines).
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import IO
+from typing import IO, Protocol
 
 from stairbot.console.scene import SceneView
 from stairbot.console.state import LiveState
 from stairbot.errors import InputError
 from stairbot.events import Event
-from stairbot.hardware import Clock, MotorId, Robot, Snapshot, Speeds
+from stairbot.hardware import ZERO_SPEEDS, Clock, HasTruth, Robot, Snapshot, Speeds, Truth
 
 SCENE_PERIOD_S = 0.04  # wall seconds between pictures taken from the simulation
-ZERO: dict[MotorId, float] = {m: 0.0 for m in MotorId}
 
 
 class WatchedRobot:
@@ -28,7 +28,7 @@ class WatchedRobot:
     command becomes a stop of every motor."""
 
     def __init__(self, inner: Robot, state: LiveState, lock: threading.RLock,
-                 scene: Callable[[], SceneView | None] | None = None,
+                 scene: Callable[[], SceneView] | None = None,
                  wall: Callable[[], float] = time.monotonic) -> None:
         self.inner = inner
         self._state = state
@@ -37,6 +37,7 @@ class WatchedRobot:
         self._wall = wall
         self._last_scene = -1.0
         self._estop = threading.Event()
+        self._estop_sent = False  # the inner robot's estop() was called for this latch
         self.estop_tick: int | None = None  # the tick count when the stop reached the robot
         self.ticks = 0
 
@@ -63,8 +64,7 @@ class WatchedRobot:
             self._scene = None
             self._state.set_status(message=f"no picture: {exc}", severity="warning")
             return
-        if scene is not None:
-            self._state.on_scene(scene)
+        self._state.on_scene(scene)
 
     def refresh_scene(self) -> None:
         """Take a picture now (under the lock)."""
@@ -75,7 +75,7 @@ class WatchedRobot:
         with self._lock:
             if self._estop.is_set():
                 self.inner.stop_all()
-                self._state.on_command(dict(ZERO))
+                self._state.on_command(dict(ZERO_SPEEDS))
             else:
                 self.inner.command(speeds)
                 self._state.on_command(dict(speeds))
@@ -83,29 +83,47 @@ class WatchedRobot:
     def stop_all(self) -> None:
         with self._lock:
             self.inner.stop_all()
-            self._state.on_command(dict(ZERO))
+            self._state.on_command(dict(ZERO_SPEEDS))
 
     def estop(self) -> None:
-        """Latch the stop and stop every motor now.  Safe from any thread: the
-        flag alone makes the run thread's next command a stop, so even if the
-        lock is busy for a moment no further motion is commanded."""
+        """Latch the stop and call the robot's own ``estop()``, once per latch
+        (the run loop passing the same press on does not repeat it).  Safe from
+        any thread: the flag alone makes the run thread's next command a stop,
+        so even if the lock is busy for a moment no further motion is
+        commanded, and the run thread's own call then reaches the robot.
+        Never raises."""
         self._estop.set()
         if self._lock.acquire(timeout=0.5):
             try:
-                self.inner.stop_all()
-                self.estop_tick = self.ticks
-                self._state.on_command(dict(ZERO))
+                if not self._estop_sent:
+                    self._send_estop()
             finally:
                 self._lock.release()
 
-    def clear_estop(self) -> None:
-        self._estop.clear()
-        self.estop_tick = None
+    def _send_estop(self) -> None:
+        # estop() never raises by the protocol; a robot that breaks it (a
+        # lost link) must not take the console down with it: stop what can
+        # be stopped, say so, and let the next press try the robot again.
+        try:
+            self.inner.estop()
+        except Exception as exc:  # noqa: BLE001 - the key must always work
+            with contextlib.suppress(Exception):
+                self.inner.stop_all()
+            self._state.set_status(severity="error", message=f"EMERGENCY STOP: the robot "
+                                   f"did not confirm its e-stop: {exc}")
+        else:
+            self._estop_sent = True
+        self.estop_tick = self.ticks
+        self._state.on_command(dict(ZERO_SPEEDS))
 
     def clear(self) -> None:
+        """Clear the robot's latch, then this one.  Raises what the robot's
+        ``clear()`` raises (a lost link); the stop then stays latched."""
         with self._lock:
             self.inner.clear()
-        self.clear_estop()
+            self._estop_sent = False
+            self._estop.clear()
+            self.estop_tick = None
 
     def diagnostics(self) -> dict[str, object]:
         with self._lock:
@@ -114,6 +132,28 @@ class WatchedRobot:
     def close(self) -> None:
         with self._lock:
             self.inner.close()
+
+
+class _TruthRobot(Robot, HasTruth, Protocol):
+    """A robot that knows its truth."""
+
+
+class WatchedTruthRobot(WatchedRobot):
+    """A WatchedRobot around a robot that knows its truth (HasTruth)."""
+
+    inner: _TruthRobot
+
+    def truth(self) -> Truth:
+        with self._lock:
+            return self.inner.truth()
+
+
+def watch(inner: Robot, state: LiveState, lock: threading.RLock,
+          scene: Callable[[], SceneView] | None = None,
+          wall: Callable[[], float] = time.monotonic) -> WatchedRobot:
+    """The robot watched, with the capabilities it has (truth passes through)."""
+    cls = WatchedTruthRobot if isinstance(inner, HasTruth) else WatchedRobot
+    return cls(inner, state, lock, scene, wall)
 
 
 class PacedClock:

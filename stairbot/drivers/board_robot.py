@@ -26,7 +26,7 @@ from stairbot.drivers import units as u
 from stairbot.drivers.link import Link, Pending
 from stairbot.errors import HardwareError, LinkLostError, RobotFellError, RobotUrlError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot, Truth
 from stairbot.robots import RobotSession
 
 EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
@@ -277,13 +277,26 @@ class BoardRobot:
                                              for b, i in self.idents.items()}}
         if self.simulated and not self._closed:
             with contextlib.suppress(Exception):
-                (reply,) = self._wait([self._request(m.Board.MOTOR, [m.GetTruth()])])
-                truth = reply.messages[0]
-                if isinstance(truth, m.Truth):
-                    out.update(fell=bool(truth.flags & 1),
-                               max_pitch_deg=truth.max_pitch_cdeg / 100,
-                               offset_m=truth.offset_mm / 1000)
+                truth = self.truth()
+                out.update(fell=truth.fell, max_pitch_deg=truth.max_pitch_deg,
+                           offset_m=truth.offset_m)
         return out
+
+    @locked
+    def truth(self) -> Truth:
+        """What fake boards know of their simulated world (GetTruth): fell,
+        the most it pitched, the offset from the start (no pitch now, no fall
+        reason: the wire does not carry them).  HardwareError for boards that
+        are not simulated, a closed robot or a lost link."""
+        if not self.simulated or self._closed:
+            raise HardwareError(f"{self.url}: only fake boards tell the truth of a "
+                                "simulated world")
+        (reply,) = self._wait([self._request(m.Board.MOTOR, [m.GetTruth()])])
+        truth = reply.messages[0] if reply.messages else None
+        if not isinstance(truth, m.Truth):
+            raise HardwareError(f"the motor board answered GetTruth with {reply.messages}")
+        return Truth(fell=bool(truth.flags & 1), fall_reason=None, pitch_deg=None,
+                     max_pitch_deg=truth.max_pitch_cdeg / 100, offset_m=truth.offset_mm / 1000)
 
     def _keep_alive(self) -> None:
         period = self.watchdog_ms / 4000

@@ -22,7 +22,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.serial_wire import RawMessage
 from stairbot.errors import HardwareError
-from stairbot.hardware import Clock, MotorId, Robot, Snapshot
+from stairbot.hardware import Clock, HasTruth, MotorId, Robot, Snapshot
 
 FIRMWARE_VERSION = 0x0100
 DEFAULT_WATCHDOG_MS = 250
@@ -92,17 +92,17 @@ class BoardWorld:
             self._time_us = round(self.clock.now() * 1e6)
 
     def truth(self) -> m.Truth:
-        diag = self.robot.diagnostics()
-        fell = bool(diag.get("fell", False)) or (
-            self.failure is not None and "fell" in self.failure.lower())
-        pitch = diag.get("max_pitch_deg", 0.0)
-        offset = diag.get("offset_m", 0.0)
+        """GetTruth's answer: the world's own truth (a robot without it, such
+        as a test's stub, reports zeros), and a fall the world failed on."""
+        fell, pitch, offset = False, 0.0, 0.0
+        if isinstance(self.robot, HasTruth):
+            t = self.robot.truth()
+            fell, pitch, offset = t.fell, t.max_pitch_deg or 0.0, t.offset_m or 0.0
+        fell = fell or (self.failure is not None and "fell" in self.failure.lower())
         return m.Truth(
             1 if fell else 0,
-            max(-32767, min(32767, round(float(pitch) * 100))) if isinstance(
-                pitch, int | float) else 0,
-            max(-(2**31) + 1, min(2**31 - 1, round(float(offset) * 1000))) if isinstance(
-                offset, int | float) else 0,
+            max(-32767, min(32767, round(pitch * 100))),
+            max(-(2**31) + 1, min(2**31 - 1, round(offset * 1000))),
         )
 
 

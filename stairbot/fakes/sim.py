@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from urllib.parse import urlsplit
 
 from stairbot.config import RobotConfig
@@ -36,35 +35,24 @@ from stairbot.fakes.sensors import RangeSensor
 from stairbot.fakes.world import World, WorldParams
 from stairbot.hardware import (
     LIFT_MOTORS,
+    ZERO_SPEEDS,
     MotorId,
     MotorState,
+    Scene,
     SensorId,
     Snapshot,
     Speeds,
+    Truth,
 )
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.scenario import Scenario, load_scenario
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
-Point = tuple[float, float]
-
-
-@dataclass(frozen=True)
-class Scene:
-    """What the console draws, in world metres (x forward, y up; riser 1 at x=0)."""
-
-    time_s: float
-    stairs: tuple[Point, ...]  # the stairs' surface as one polyline
-    segments: tuple[tuple[Point, ...], ...]  # segments 1, 2, 3: each a closed outline
-    wheels: tuple[Point, ...]  # wheel centres: segment 1 rear, front, segment 2 ...
-    wheel_radius: float
-    yaw_deg: float
-    lateral_m: float
-    fell: bool
 
 
 class SimRobot:
-    """The simulated robot (see the module docstring)."""
+    """The simulated robot (see the module docstring): a Robot, with the
+    capabilities HasTruth (``truth()``) and HasScene (``scene()``)."""
 
     def __init__(self, config: RobotConfig, scenario: Scenario,
                  params: WorldParams | None = None) -> None:
@@ -84,11 +72,10 @@ class SimRobot:
                 (SensorId.SBL, s.back_min_range, s.back_max_range),
             )
         }
-        self._zero: dict[MotorId, float] = dict.fromkeys(MotorId, 0.0)
         m = config.motors
         self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
                         for mid in MotorId}
-        self._speeds = dict(self._zero)
+        self._speeds = dict(ZERO_SPEEDS)
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
         self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
         self._lift_turns = [0.0, 0.0]
@@ -129,8 +116,9 @@ class SimRobot:
 
     def command(self, speeds: Speeds) -> None:
         """Set every motor's speed in turns/s (clamped to the motor's limit; a
-        speed that is not a finite number stops that motor)."""
-        new = dict(self._zero)
+        speed that is not a finite number stops that motor).  While the e-stop
+        is latched every motor stays stopped."""
+        new = dict(ZERO_SPEEDS)
         if self._estopped:
             self._apply(new)
             return
@@ -144,11 +132,13 @@ class SimRobot:
         self._apply(new)
 
     def stop_all(self) -> None:
-        """Stop every motor at once; the lifts hold."""
-        self._apply(dict.fromkeys(MotorId, 0.0))
+        """Stop every motor at once; the lifts hold.  Never raises (not even
+        after a fall or close)."""
+        self._apply(dict(ZERO_SPEEDS))
 
     def estop(self) -> None:
-        """Stop every motor and latch: commands move nothing until clear()."""
+        """Stop every motor and latch: commands move nothing until clear().
+        Reading goes on.  Never raises."""
         self._estopped = True
         self.stop_all()
 
@@ -161,15 +151,11 @@ class SimRobot:
         return self._estopped
 
     def diagnostics(self) -> dict[str, object]:
-        """Simulation truth for summaries and the console."""
+        """The simulation's pose, for a person reading it (a run's fell, pitch
+        and offset come from :meth:`truth`)."""
         w = self.world
         return {
             "sim_time_s": w.time,
-            "pitch_deg": w.pitch_deg(),
-            "max_pitch_deg": w.max_pitch_deg,
-            "offset_m": self.offset_m(),
-            "fell": w.fell,
-            "fall_reason": w.fall_reason,
             "yaw_deg": math.degrees(self.plan.yaw),
             "lateral_m": self.plan.y,
             "x_m": w.centre_x(),
@@ -178,9 +164,32 @@ class SimRobot:
         }
 
     def close(self) -> None:
-        """Stop every motor; the robot stays where it is."""
+        """Stop every motor; the robot stays where it is.  Closing again is
+        harmless."""
         self.stop_all()
         self.closed = True
+
+    # -- capabilities: HasTruth, HasScene -------------------------------------------
+    def truth(self) -> Truth:
+        """Whether the robot fell (and why), its pitch now and the most it
+        pitched, and how far segment 2 is from where it started."""
+        w = self.world
+        return Truth(fell=w.fell, fall_reason=w.fall_reason, pitch_deg=w.pitch_deg(),
+                     max_pitch_deg=w.max_pitch_deg, offset_m=self.offset_m())
+
+    def scene(self) -> Scene:
+        """The stairs and the robot's pose, for drawing."""
+        w = self.world
+        return Scene(
+            time_s=w.time,
+            stairs=tuple(w.outline),
+            segments=tuple(tuple(w.segment_corners(i)) for i in range(3)),
+            wheels=tuple((float(b.position.x), float(b.position.y)) for b in w.all_wheels),
+            wheel_radius=w.radius,
+            yaw_deg=math.degrees(self.plan.yaw),
+            lateral_m=self.plan.y,
+            fell=w.fell,
+        )
 
     # -- simulation ----------------------------------------------------------------
     def advance(self, dt: float) -> None:
@@ -212,20 +221,6 @@ class SimRobot:
         """Top-view distance of segment 2's centre from where it started."""
         return math.hypot(self.world.centre_x() - self.world.start_x,
                           self.plan.y - self._start_y)
-
-    def scene(self) -> Scene:
-        """The stairs and the robot's pose, for drawing."""
-        w = self.world
-        return Scene(
-            time_s=w.time,
-            stairs=tuple(w.outline),
-            segments=tuple(tuple(w.segment_corners(i)) for i in range(3)),
-            wheels=tuple((float(b.position.x), float(b.position.y)) for b in w.all_wheels),
-            wheel_radius=w.radius,
-            yaw_deg=math.degrees(self.plan.yaw),
-            lateral_m=self.plan.y,
-            fell=w.fell,
-        )
 
     # -- internals -------------------------------------------------------------------
     def _apply(self, speeds: dict[MotorId, float]) -> None:

@@ -11,32 +11,41 @@ from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.scene import stairs_from_scenario
 from stairbot.events import Event, EventKind
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot, Speeds
+from stairbot.hardware import (
+    MotorId,
+    MotorState,
+    Point,
+    Scene,
+    SensorId,
+    SensorReading,
+    Snapshot,
+    Speeds,
+)
 from stairbot.robots import RobotSession
 from stairbot.scenario import load_scenario
 
 LIFT = 0.19  # segment 1 raised this far above segment 2, m
 
 
-def _box(x0: float, x1: float, y0: float, y1: float) -> list[tuple[float, float]]:
-    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+def _box(x0: float, x1: float, y0: float, y1: float) -> tuple[Point, ...]:
+    return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
 
 
 class StillSim:
-    """Just enough of stairbot.fakes.sim.SimRobot for the picture."""
+    """Just enough of stairbot.fakes.sim.SimRobot for the picture (HasScene)."""
 
-    def scene(self) -> dict[str, Any]:
+    def scene(self) -> Scene:
         stairs = stairs_from_scenario(load_scenario(), 0.225)
         b, t = 0.016, 0.061
-        return {
-            "time_s": 12.34,
-            "stairs": stairs,
-            "segments": [_box(-0.085, -0.01, b + LIFT, t + LIFT), _box(-0.16, -0.085, b, t),
-                         _box(-0.235, -0.16, b, t)],
-            "wheels": [(-0.0665, LIFT), (-0.0285, LIFT), (-0.1415, b), (-0.1035, b),
-                       (-0.2165, b), (-0.1785, b)],
-            "wheel_radius": 0.016,
-        }
+        return Scene(
+            time_s=12.34,
+            stairs=stairs,
+            segments=(_box(-0.085, -0.01, b + LIFT, t + LIFT), _box(-0.16, -0.085, b, t),
+                      _box(-0.235, -0.16, b, t)),
+            wheels=((-0.0665, LIFT), (-0.0285, LIFT), (-0.1415, b), (-0.1035, b),
+                    (-0.2165, b), (-0.1785, b)),
+            wheel_radius=0.016, yaw_deg=0.0, lateral_m=0.0, fell=False,
+        )
 
 
 HEALTH = {"frames_per_s": 1480.5, "rtt_median_ms": 0.41, "rtt_p99_ms": 1.2, "crc_errors": 0.0,
@@ -48,6 +57,7 @@ class StillRobot:
         self.health = health or {}
         self.commands: list[dict[MotorId, float]] = []
         self.stops = 0
+        self.estopped = False
 
     def read(self) -> Snapshot:
         sensors = {SensorId.SFR: SensorReading(0.265), SensorId.SFL: SensorReading(0.262),
@@ -63,6 +73,13 @@ class StillRobot:
 
     def stop_all(self) -> None:
         self.stops += 1
+
+    def estop(self) -> None:
+        self.stops += 1
+        self.estopped = True
+
+    def clear(self) -> None:
+        self.estopped = False
 
     def diagnostics(self) -> dict[str, object]:
         return {}

@@ -43,6 +43,18 @@ class SpyRobot:
         self.calls.append(("stop_all", None))
         self.inner.stop_all()
 
+    def estop(self) -> None:
+        self.calls.append(("estop", None))
+        self.inner.estop()
+
+    def clear(self) -> None:
+        self.calls.append(("clear", None))
+        self.inner.clear()
+
+    @property
+    def estopped(self) -> bool:
+        return bool(self.inner.estopped)
+
     def diagnostics(self) -> dict[str, object]:
         return self.inner.diagnostics()
 
@@ -123,11 +135,11 @@ def test_a_full_run_started_from_the_keyboard_reaches_the_end(tmp_path: Path) ->
             await app.workers.wait_for_complete()
             await pilot.pause(0.2)
             result = app.state.view().result
-            assert result and result["outcome"] in ("completed", "stopped", "error", "fell")
+            assert result and result.outcome in ("completed", "stopped", "error", "fell")
             text = banner(app)
             assert "ENDED" in text
-            assert f"run {result['outcome']}" in text
-            assert f"climbed {result['steps_climbed']}" in text
+            assert f"run {result.outcome}" in text
+            assert f"climbed {result.steps_climbed}" in text
             assert app.state.view().flow == "end"
             assert "REC" in text
     asyncio.run(go())
@@ -152,11 +164,13 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             n_key = len(spy.calls)
             await press(pilot, "space")
             await until(pilot, lambda: app.state.view().status.estopped, "the stop")
-            # From the first stop after the key on, nothing moves (that the key
-            # handler stops the robot itself, not waiting for the loop's next
-            # tick, is test_engine's ..._without_waiting_for_the_next_tick).
+            # The key reaches the robot's own estop(), once; from then on
+            # nothing moves (that the key handler stops the robot itself, not
+            # waiting for the loop's next tick, is test_engine's
+            # ..._without_waiting_for_the_next_tick).
             n_stop = next(i for i in range(n_key, len(spy.calls))
-                          if spy.calls[i][0] == "stop_all")
+                          if spy.calls[i][0] == "estop")
+            assert spy.inner.estopped
             sim = app.engine.session.sim  # type: ignore[union-attr]
 
             def reads_since_stop() -> int:
@@ -188,6 +202,10 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             assert app.state.view().status.estopped
             await press(pilot, "c")
             await until(pilot, lambda: not app.state.view().status.estopped, "cleared")
+            await until(pilot, lambda: not spy.inner.estopped, "the robot's clear()")
+            assert [c[0] for c in spy.calls[n_stop:]].count("estop") == 1
+            assert [c[0] for c in spy.calls[n_stop:]].count("clear") == 1
+            assert spy.motion(n_stop) == []  # clearing alone moves nothing
             await press(pilot, "p")  # resume
             n_resume = len(spy.calls)
             await until(pilot, lambda: bool(spy.motion(n_resume)), "motion after clear + resume")
@@ -397,7 +415,7 @@ def test_calibrate_only_from_the_command_palette() -> None:
             await command.callback()  # what the palette runs when the line is chosen
             await until(pilot, lambda: "ENDED" in banner(app), "the calibration ends")
             result = app.state.view().result
-            assert result is not None and result["steps_climbed"] == 0
-            assert result["ascent_end"] is None
-            assert f"run {result['outcome']}" in banner(app)
+            assert result is not None and result.steps_climbed == 0
+            assert result.ascent_end is None
+            assert f"run {result.outcome}" in banner(app)
     asyncio.run(go())

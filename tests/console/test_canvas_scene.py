@@ -6,7 +6,8 @@ from typing import Any
 
 from stairbot.config import load_config
 from stairbot.console.canvas import BrailleCanvas
-from stairbot.console.scene import SceneView, scene_from_sim, stairs_from_scenario
+from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
+from stairbot.hardware import Scene
 from stairbot.scenario import load_scenario
 
 
@@ -43,7 +44,7 @@ def test_scene_from_the_simulation_shows_the_robot_before_the_stairs() -> None:
     from stairbot.robots import RobotOptions
 
     session = open_sim_robot("sim://", load_config(), RobotOptions(world=load_scenario()))
-    view = scene_from_sim(session.sim.scene())  # type: ignore[union-attr]
+    view = scene_view(session.sim.scene())  # type: ignore[union-attr]
     assert len(view.segments) == 3
     assert view.segment_steps() == [0, 0, 0]
     front = max(p[0] for p in view.segments[0])
@@ -51,11 +52,13 @@ def test_scene_from_the_simulation_shows_the_robot_before_the_stairs() -> None:
     assert len(view.wheels) == 6
 
 
-def test_scene_accepts_mappings() -> None:
-    raw = {"stairs": [(0, 0), (1, 0)], "segments": [{"corners": [(0, 0), (1, 0), (1, 1)]}],
-           "wheels": [{"x": 0.5, "y": 0.1, "r": 0.02}]}
-    view = scene_from_sim(raw)
-    assert view.wheels == ((0.5, 0.1, 0.02),)
+def test_the_picture_is_the_scene_with_its_wheel_radius() -> None:
+    scene = Scene(time_s=1.5, stairs=((0.0, 0.0), (1.0, 0.0)),
+                  segments=(((0.0, 0.0), (1.0, 0.0), (1.0, 1.0)),), wheels=((0.5, 0.1),),
+                  wheel_radius=0.02, yaw_deg=0.0, lateral_m=0.0, fell=False)
+    view = scene_view(scene)
+    assert view.stairs == scene.stairs and view.segments == scene.segments
+    assert view.wheels == ((0.5, 0.1, 0.02),) and view.time_s == 1.5
 
 
 def test_sensor_pairs_agree_differ_or_cannot_compare() -> None:
@@ -105,7 +108,7 @@ def test_dead_reckoning_follows_the_simulated_climb() -> None:
     def on_tick(_ctl: object, snap: Any) -> None:
         if round(snap.time_s / cfg.algorithm.tick) % 25:
             return
-        truth = scene_from_sim(session.sim.scene())  # type: ignore[union-attr]
+        truth = scene_view(session.sim.scene())  # type: ignore[union-attr]
         est = dead_reckon(snap, truth.stairs, cfg, sc.start.distance)
         for a, b in zip(truth.segments, est.segments, strict=True):
             worst[0] = max(worst[0], abs(_mean(a, 0) - _mean(b, 0)))

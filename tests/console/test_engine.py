@@ -15,44 +15,30 @@ from stairbot.console.runner_thread import ConsoleEngine, describe_result
 from stairbot.console.state import LiveState
 from stairbot.errors import InputError
 from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
+from stairbot.runner import RunControl, RunResult
 
 FORWARD = {m: 1.0 for m in WHEEL_MOTORS}
 
 
-class Control:
-    """The RunControl contract (stairbot.runner), for the stand-in loop."""
-
-    def __init__(self) -> None:
-        self.stop_reason: str | None = None
-        self.estopped = self.paused = False
-
-    def request_stop(self, reason: str = "stopped") -> None:
-        self.stop_reason = reason
-
-    def estop(self) -> None:
-        self.estopped = self.paused = True
-
-    def clear_estop(self) -> None:
-        self.estopped = False
-
-    def pause(self) -> None:
-        self.paused = True
-
-    def resume(self) -> None:
-        self.paused = self.estopped
+def stopped(steps_climbed: int = 0, ascent_end: str | None = None) -> RunResult:
+    """How a stand-in loop ends."""
+    return RunResult(outcome="stopped", ascent_end=ascent_end, steps_climbed=steps_climbed,
+                     steps_descended=0, pauses=0, error=None, fell=False, max_pitch_deg=None,
+                     final_offset_m=None, sim_time_s=0.0, wall_time_s=0.0, realtime_factor=None)
 
 
 class DriveLoop:
     """Stands in for runner.run: the same read/command/advance loop with a
     controller that only drives forward, and that IGNORES the e-stop and pause
-    (so the test proves the console's own gate stops the robot)."""
+    (so the test proves the console's own gate stops the robot): it never
+    carries out the RunControl's e-stops and clears."""
 
     def __init__(self) -> None:
         self.snaps: list[Snapshot] = []
         self.started = threading.Event()
 
-    def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: Any,
-                 on_tick: Any) -> dict[str, Any]:
+    def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: RunControl,
+                 on_tick: Any) -> RunResult:
         robot, clock = session.robot, session.clock
         while control.stop_reason is None and len(self.snaps) < 20000:
             snap = robot.read()
@@ -62,8 +48,7 @@ class DriveLoop:
             clock.advance(config.algorithm.tick)
             self.started.set()
         robot.stop_all()
-        return {"outcome": "stopped", "ascent_end": None, "steps_climbed": 0,
-                "steps_descended": 0, "error": None}
+        return stopped()
 
 
 def wait_for(cond: Any, what: str) -> None:
@@ -80,7 +65,7 @@ def wait_for(cond: Any, what: str) -> None:
 @pytest.fixture
 def engine_and_loop() -> tuple[ConsoleEngine, DriveLoop]:
     loop = DriveLoop()
-    engine = ConsoleEngine(LiveState(), load_config(), run_fn=loop, control_fn=Control)
+    engine = ConsoleEngine(LiveState(), load_config(), run_fn=loop, control_fn=RunControl)
     engine.open("sim://", None)
     return engine, loop
 
@@ -148,8 +133,8 @@ def test_bad_scenario_and_url_raise_input_errors() -> None:
 
 
 def test_describe_result() -> None:
-    line, severity = describe_result({"outcome": "completed", "ascent_end": "top_reached",
-                                      "steps_climbed": 5, "steps_descended": 5})
+    done = replace(stopped(5, "top_reached"), outcome="completed", steps_descended=5)
+    line, severity = describe_result(done)
     assert line == "run completed · top reached · climbed 5, descended 5"
     assert severity == "good"
 
@@ -162,8 +147,8 @@ class HeldLoop(DriveLoop):
         self.held = threading.Event()
         self.release = threading.Event()
 
-    def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: Any,
-                 on_tick: Any) -> dict[str, Any]:
+    def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: RunControl,
+                 on_tick: Any) -> RunResult:
         robot, clock = session.robot, session.clock
         while control.stop_reason is None:
             self.snaps.append(robot.read())
@@ -173,7 +158,7 @@ class HeldLoop(DriveLoop):
                 self.held.set()
                 self.release.wait()
         robot.stop_all()
-        return {"outcome": "stopped"}
+        return stopped()
 
 
 def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> None:
@@ -197,7 +182,7 @@ def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> Non
 
     loop = HeldLoop()
     engine = ConsoleEngine(LiveState(), load_config(), open_fn=spy_open, run_fn=loop,
-                           control_fn=Control)
+                           control_fn=RunControl)
     engine.open("sim://", None)
     worker = threading.Thread(target=engine.run, args=("full",))
     worker.start()
@@ -205,8 +190,37 @@ def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> Non
         wait_for(loop.held.is_set, "the loop held between two ticks")
         before = len(calls)
         engine.estop()
-        assert calls[before:] == ["stop_all"]
+        assert calls[before:] == ["estop"]
     finally:
         engine.stop()
         loop.release.set()
         worker.join()
+
+
+def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
+    """estop() never raises by the protocol; a driver that breaks it (a lost
+    link) still gets every later command turned into a stop, and the banner
+    says the robot did not confirm."""
+    from stairbot.errors import LinkLostError
+
+    def broken_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
+        from stairbot.robots import RobotSession, open_robot
+
+        s = open_robot(url, config, replace(options, world=scenario))
+
+        def estop() -> None:
+            raise LinkLostError("motor board: no reply to EStop")
+
+        s.robot.estop = estop  # type: ignore[method-assign]
+        return RobotSession(s.robot, s.clock, s.url, s.simulated, s.sim)
+
+    engine = ConsoleEngine(LiveState(), load_config(), open_fn=broken_open)
+    engine.open("sim://", None)
+    assert engine.robot is not None
+    engine.robot.command(FORWARD)
+    engine.estop()  # does not raise
+    status = engine.state.view().status
+    assert status.estopped and "did not confirm its e-stop" in status.message
+    assert engine.robot.estopped
+    engine.robot.command(FORWARD)  # turned into a stop
+    assert engine.state.view().commands == dict.fromkeys(MotorId, 0.0)

@@ -11,7 +11,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import RawMessage
 from stairbot.errors import RobotFellError
 from stairbot.fakes.boards import BoardWorld, MotorBoard, Pacer, SensorBoard, make_boards
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot, Truth
 
 
 class StubRobot:
@@ -40,7 +40,10 @@ class StubRobot:
         self.speeds = {mid: 0.0 for mid in MotorId}
 
     def diagnostics(self) -> dict[str, object]:
-        return {"fell": self.fail, "max_pitch_deg": 3.25, "offset_m": 0.012}
+        return {}
+
+    def truth(self) -> Truth:
+        return Truth(self.fail, "stub" if self.fail else None, 1.0, 3.25, 0.012)
 
     def close(self) -> None:
         pass

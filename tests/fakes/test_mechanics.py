@@ -141,9 +141,10 @@ def test_one_step_up_puts_all_three_segments_on_the_tread(
         climbed: tuple[OpenLoop, dict[str, float]]) -> None:
     drv, figures = climbed
     step = drv.robot.scenario.steps[0]
-    diag = drv.robot.diagnostics()
-    assert diag["fell"] is False
-    assert float(diag["max_pitch_deg"]) < 6.0  # ~3 deg expected while tipping onto segment 1
+    truth = drv.robot.truth()
+    assert truth.fell is False
+    assert truth.max_pitch_deg is not None
+    assert truth.max_pitch_deg < 6.0  # ~3 deg expected while tipping onto segment 1
     rise_turns = drv.cfg.lift_turns(step.rise)
     assert rise_turns < figures["h"] < rise_turns + drv.cfg.lift_turns(0.015)
     for rear, front, bottom in drv.segment_spans():
@@ -151,7 +152,7 @@ def test_one_step_up_puts_all_three_segments_on_the_tread(
         assert rear > -0.015  # the rear may overhang the nosing by the approach gap only
         assert bottom == pytest.approx(step.rise, abs=0.003)
     # the whole robot stands level on the tread
-    assert abs(float(diag["pitch_deg"])) < 1.0
+    assert truth.pitch_deg is not None and abs(truth.pitch_deg) < 1.0
 
 
 def test_one_step_down_returns_to_the_floor(
@@ -160,9 +161,9 @@ def test_one_step_down_returns_to_the_floor(
     h = drv.descend_one_step(figures["tab"])
     step = drv.robot.scenario.steps[0]
     assert h == pytest.approx(drv.cfg.lift_turns(step.rise), abs=drv.cfg.lift_turns(0.004))
-    diag = drv.robot.diagnostics()
-    assert diag["fell"] is False
-    assert float(diag["max_pitch_deg"]) < 6.0
+    truth = drv.robot.truth()
+    assert truth.fell is False
+    assert truth.max_pitch_deg is not None and truth.max_pitch_deg < 6.0
     for _rear, front, bottom in drv.segment_spans():
         assert front < 0.0  # before riser 1
         assert bottom == pytest.approx(0.0, abs=0.003)
@@ -176,9 +177,9 @@ def test_backing_off_the_top_edge_with_lifts_level_falls() -> None:
     back = {F: -1.0, B: -1.0, R: -1.0, L: -1.0}
     with pytest.raises(RobotFellError):
         drv.run_until(back, lambda: drv.snap() is None, limit_s=10.0)
-    diag = drv.robot.diagnostics()
-    assert diag["fell"] is True
-    assert isinstance(diag["fall_reason"], str) and diag["fall_reason"]
+    truth = drv.robot.truth()
+    assert truth.fell is True
+    assert isinstance(truth.fall_reason, str) and truth.fall_reason
     drv.robot.stop_all()  # never raises, even after a fall
 
 

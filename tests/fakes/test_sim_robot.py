@@ -13,7 +13,16 @@ import pytest
 from stairbot.config import load_config
 from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
-from stairbot.hardware import Clock, MotorId, Robot, SensorId, SensorStatus, Snapshot
+from stairbot.hardware import (
+    Clock,
+    HasScene,
+    HasTruth,
+    MotorId,
+    Robot,
+    SensorId,
+    SensorStatus,
+    Snapshot,
+)
 from stairbot.robots import RobotOptions
 from stairbot.scenario import Scenario, parse_scenario
 
@@ -42,6 +51,7 @@ def hold(r: SimRobot, c: SimClock, speeds: dict[MotorId, float], seconds: float)
 def test_implements_the_protocols() -> None:
     r, c = robot()
     assert isinstance(r, Robot) and isinstance(c, Clock)
+    assert isinstance(r, HasTruth) and isinstance(r, HasScene)
 
 
 def test_wheel_counters_follow_the_distance_travelled() -> None:
@@ -57,7 +67,7 @@ def test_wheel_counters_follow_the_distance_travelled() -> None:
     for m in (F, B, R, L):
         turns = after.turns(m) - before.turns(m)
         assert turns == pytest.approx(CFG.wheel_turns(travelled), rel=0.02)
-    assert float(r.diagnostics()["offset_m"]) == pytest.approx(travelled, abs=1e-4)
+    assert r.truth().offset_m == pytest.approx(travelled, abs=1e-4)
 
 
 def test_backwards_counts_down() -> None:
@@ -206,14 +216,18 @@ def test_every_wheel_off_every_support_is_a_fall() -> None:
         for _ in range(50):
             c.advance(TICK)
             r.read()
-    assert r.diagnostics()["fell"] is True
+    assert r.truth().fell is True
 
 
-def test_diagnostics_and_scene_describe_the_pose() -> None:
+def test_truth_diagnostics_and_scene_describe_the_pose() -> None:
     r, c = robot()
     c.advance(0.1)
+    t = r.truth()
+    assert not t.fell and t.fall_reason is None and t.offset_m is not None
+    assert t.pitch_deg is not None and t.max_pitch_deg is not None
+    assert abs(t.pitch_deg) <= t.max_pitch_deg < 1.0
     d = r.diagnostics()
-    for key in ("sim_time_s", "pitch_deg", "max_pitch_deg", "offset_m", "fell", "fall_reason"):
+    for key in ("sim_time_s", "yaw_deg", "lateral_m", "x_m", "lift_front_m", "lift_back_m"):
         assert key in d
     scene = r.scene()
     assert scene.stairs[1] == (0.0, 0.0)
@@ -289,7 +303,7 @@ def test_a_segment_dropping_fast_is_a_fall() -> None:
             c.advance(TICK)
             r.read()
     r.stop_all()
-    assert "falling" in str(r.diagnostics()["fall_reason"])
+    assert "falling" in str(r.truth().fall_reason)
 
 
 def test_a_speed_that_is_not_a_number_stops_the_motor() -> None:
