@@ -180,7 +180,10 @@ def _probe(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     sfr, sfl = _readings(t)
     d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
-    tol = cfg.algorithm.equal_tolerance
+    # Half a resolution step off the readings' grid: whole-millimetre readings
+    # that sum to the threshold exactly must not be decided by float rounding
+    # (the simulation's and the wire's last bits differ).
+    tol = cfg.algorithm.equal_tolerance + cfg.sensors.resolution / 4
     made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
     if abs(d_sfr) + abs(d_sfl) < 2 * tol and motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
         return stay(motion.turn(1, cfg))

@@ -11,7 +11,7 @@ from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
-FLOWS = ("calibration", "ascent", "descent")
+from stairbot.algorithm.phases import FLOWS
 
 
 def flow_text(flow: str) -> Text:
