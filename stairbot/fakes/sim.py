@@ -79,6 +79,11 @@ class SimRobot:
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
         self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
         self._lift_turns = [0.0, 0.0]
+        # Wheel encoders count the wheels' travel along the robot's heading; the
+        # side view moves only its projection on the flight's axis (see _apply).
+        self._wheel_seen = [self.world.wheel_state(i)[0] for i in range(3)]
+        self._wheel_turns = [0.0, 0.0, 0.0]
+        self._wheel_tps = [0.0, 0.0, 0.0]
         self._lift_tps = [0.0, 0.0]  # measured over the last advance
         self._snap: Snapshot | None = None
         self._snap_at = -1
@@ -205,6 +210,13 @@ class SimRobot:
         if elapsed <= 0.0:
             return
         self.plan.move(w.centre_x() - x0)
+        along = self._along()
+        for i in range(3):
+            seen = w.wheel_state(i)[0]
+            turned = (seen - self._wheel_seen[i]) / along
+            self._wheel_seen[i] = seen
+            self._wheel_turns[i] += turned
+            self._wheel_tps[i] = turned / elapsed
         self._diff_speed = diff
         if diff != 0.0:
             self._diff_turns += diff * elapsed
@@ -226,21 +238,30 @@ class SimRobot:
     def _apply(self, speeds: dict[MotorId, float]) -> None:
         self._speeds = speeds
         w = self.world
-        w.set_wheel_speed(0, speeds[MotorId.MWF])
-        w.set_wheel_speed(1, (speeds[MotorId.MWR] + speeds[MotorId.MWL]) / 2.0)
-        w.set_wheel_speed(2, speeds[MotorId.MWB])
+        # The side view is the flight's axis: a robot yawed by psi driving at v
+        # closes on the risers at v cos(psi) and drifts sideways at v sin(psi)
+        # (Plan.move), never faster than its wheels.
+        along = self._along()
+        w.set_wheel_speed(0, speeds[MotorId.MWF] * along)
+        w.set_wheel_speed(1, (speeds[MotorId.MWR] + speeds[MotorId.MWL]) / 2.0 * along)
+        w.set_wheel_speed(2, speeds[MotorId.MWB] * along)
         per_turn = self.config.motors.lift_travel_per_turn
         w.set_lift_speed(0, speeds[MotorId.MTF] * per_turn)
         w.set_lift_speed(1, speeds[MotorId.MTB] * per_turn)
 
+    def _along(self) -> float:
+        """cos(yaw): the share of the robot's travel along the flight's axis."""
+        return max(0.05, math.cos(self.plan.yaw))
+
     def _motor_states(self) -> dict[MotorId, MotorState]:
         w = self.world
         per_turn = self.config.motors.lift_travel_per_turn
-        mean, mean_speed = w.wheel_state(1)
+        turns, tps = self._wheel_turns, self._wheel_tps
+        mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
         return {
-            MotorId.MWF: MotorState(*w.wheel_state(0)),
-            MotorId.MWB: MotorState(*w.wheel_state(2)),
+            MotorId.MWF: MotorState(turns[0], tps[0]),
+            MotorId.MWB: MotorState(turns[2], tps[2]),
             MotorId.MWR: MotorState(mean + d, mean_speed + ds),
             MotorId.MWL: MotorState(mean - d, mean_speed - ds),
             MotorId.MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),

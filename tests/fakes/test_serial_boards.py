@@ -44,7 +44,8 @@ def drain(fd: int) -> bytes:
         out += chunk
 
 
-@settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=200, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.binary(max_size=600))
 def test_arbitrary_bytes_never_crash_the_server(server: tuple, data: bytes) -> None:
     srv, r = server
@@ -67,7 +68,8 @@ bodies = st.lists(st.tuples(st.integers(0, 255), st.binary(max_size=8)), min_siz
                   max_size=6)
 
 
-@settings(max_examples=300, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=300, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.integers(0, 15), st.integers(0, 255), bodies)
 def test_arbitrary_messages_in_valid_frames_never_crash_a_board(
         server: tuple, board: int, seq: int, msgs: list[tuple[int, bytes]]) -> None:
