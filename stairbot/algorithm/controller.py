@@ -36,6 +36,7 @@ from stairbot.hardware import (
     Speeds,
 )
 from stairbot.perception import Perception
+from stairbot.supervisor import Supervisor
 
 PHASE_TIMEOUT_S = 60.0
 """A phase (other than the standing rule's wait) that lasts longer than this,
@@ -99,6 +100,7 @@ class Controller:
         self._stroke = config.MAX_OF_VERTICAL_TURNS
         self._timeout = phase_timeout_s(config)
         self._perception = Perception(config)
+        self._supervisor = Supervisor(config)
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -172,6 +174,7 @@ class Controller:
         if self._held is not None:
             if self._held_since is None:
                 self._held_since = snap.time_s
+            self._supervisor.commanded({})
             return _zeros()
         if self._held_since is not None:
             self._shift_timers(snap.time_s - self._held_since)
@@ -180,7 +183,7 @@ class Controller:
             self._started = True
             self._enter(self.phase, "program start", snap)
             return _zeros()
-        fault = self._fault(snap)
+        fault = self._fault(snap) or self._supervisor.check(snap)
         if fault is not None:
             self._apply(fail(fault), snap)
             return _zeros()
@@ -193,8 +196,11 @@ class Controller:
             step = record.step(t, ctx.work)
         if step.next is not None:
             self._apply(step, snap)
-            return _zeros()
-        return self._limit(step.speeds, snap)
+            speeds = _zeros()
+        else:
+            speeds = self._limit(step.speeds, snap)
+        self._supervisor.commanded(speeds)
+        return speeds
 
     def _fault(self, snap: Snapshot) -> str | None:
         phase = self.phase

@@ -52,6 +52,7 @@ class KinematicRobot:
     faults: list[Fault] = field(default_factory=list)
     back_offset: float = 0.0  # added to SBR/SBL: a floor further down than it is
     motor_faults: dict[MotorId, str] = field(default_factory=dict)
+    jammed: set[MotorId] = field(default_factory=set)  # commanded, but do not turn
     front_override: Callable[[KinematicRobot], tuple[float, float]] | None = None
 
     def __post_init__(self) -> None:
@@ -162,7 +163,7 @@ class KinematicRobot:
 
     def advance(self, dt: float) -> None:
         cfg = self.cfg
-        sp = self.speeds
+        sp = {m: 0.0 if m in self.jammed else v for m, v in self.speeds.items()}
         limit = cfg.MAX_OF_VERTICAL_TURNS
         for m in MotorId:
             self.counters[m] += sp[m] * dt

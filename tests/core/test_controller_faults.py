@@ -84,6 +84,26 @@ def test_a_motor_fault_ends_with_an_error_naming_the_motor() -> None:
     finish_and_check_zero(ctrl, robot)
 
 
+@pytest.mark.parametrize(("motors", "phase"), [
+    ((MotorId.MWR, MotorId.MWL), Phase.ASCENT_APPROACH),  # against something unseen
+    ((MotorId.MWF,), Phase.ASCENT_APPROACH),
+    ((MotorId.MTF,), Phase.ASCENT_LIFT_FIRST),
+    ((MotorId.MTB,), Phase.ASCENT_LIFT_THIRD),
+])
+def test_a_motor_commanded_that_does_not_turn_is_a_stall_and_everything_stops(
+        motors: tuple[MotorId, ...], phase: Phase) -> None:
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is phase)
+    robot.jammed.update(motors)
+    motor = motors[0]
+    jammed_at = robot.t
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "stall" in str(ctrl.result.error) and str(motor) in str(ctrl.result.error)
+    assert robot.t - jammed_at < 3.0  # noticed within a few seconds, not at the phase timeout
+    finish_and_check_zero(ctrl, robot)
+
+
 def test_floor_not_found_when_descending() -> None:
     # the back sensors see a floor 0.5 m further down than it is: MTB runs out of stroke
     ctrl, robot, _ = start(back_offset=0.5)
@@ -211,9 +231,8 @@ def test_a_phase_that_never_ends_times_out() -> None:
     ctrl, robot, _ = start()
     run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
     entered = robot.t
-    while not ctrl.finished:  # the robot ignores every command
-        ctrl.tick(robot.read())
-        robot.advance(TICK)
+    robot.front_override = lambda r: (0.6, 0.6)  # wheels turn, the riser never nears
+    run(ctrl, robot)
     assert "phase timeout" in str(ctrl.result.error)
     assert robot.t - entered == pytest.approx(PHASE_TIMEOUT_S, abs=2 * TICK)
 

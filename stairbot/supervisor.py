@@ -1,0 +1,75 @@
+"""The safety supervisor: checks the robot every tick, whatever the phase logic
+believes, and names what is wrong.
+
+Today it watches for a stalled motor: one commanded to turn that does not
+(a wheel against an obstacle, a jammed lift, a dead encoder).  Grinding on
+helps nothing and may break something: the program ends with an error and
+every motor stops, lifts holding.
+
+Pure Python, on the controller's clock (the snapshots' times).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from stairbot.config import RobotConfig
+from stairbot.hardware import LIFT_MOTORS, MotorId, Snapshot, Speeds
+
+STALL_S = 1.0
+"""A motor that makes less than STALL_SHARE of its commanded motion for this
+long, in controller time, has stalled."""
+STALL_SHARE = 0.2
+"""What share of the commanded motion counts as moving."""
+MIN_COMMAND = 0.2
+"""Commands below this share of the motor's top speed are not watched (a
+motor creeping to its target may rightly barely move)."""
+
+
+@dataclass
+class _Watch:
+    since_s: float
+    start_turns: float
+    expected: float = 0.0
+    """Turns the commands since ``since_s`` asked for (signed)."""
+
+
+class Supervisor:
+    """One per controller: :meth:`check` each snapshot, then
+    :meth:`commanded` with the speeds sent for it."""
+
+    def __init__(self, cfg: RobotConfig) -> None:
+        m = cfg.motors
+        self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
+        self._watch: dict[MotorId, _Watch] = {}
+        self._sent: Speeds = {}
+        self._prev: Snapshot | None = None
+
+    def commanded(self, speeds: Speeds) -> None:
+        """The speeds sent after the last snapshot checked (they act until the next)."""
+        self._sent = speeds
+
+    def check(self, snap: Snapshot) -> str | None:
+        """A reason to stop the robot now, or None."""
+        prev, self._prev = self._prev, snap
+        if prev is None:
+            return None
+        dt = snap.time_s - prev.time_s
+        for motor in MotorId:
+            v = self._sent.get(motor, 0.0)
+            if dt <= 0.0 or abs(v) < MIN_COMMAND * self._vmax[motor]:
+                self._watch.pop(motor, None)
+                continue
+            w = self._watch.get(motor)
+            if w is None or (w.expected > 0) != (v > 0):
+                w = self._watch[motor] = _Watch(prev.time_s, prev.turns(motor))
+            w.expected += v * dt
+            if snap.time_s - w.since_s < STALL_S:
+                continue
+            moved = snap.turns(motor) - w.start_turns
+            if moved * (1 if v > 0 else -1) < STALL_SHARE * abs(w.expected):
+                return (f"motor stall: {motor} was commanded {w.expected:+.2f} turns over "
+                        f"{snap.time_s - w.since_s:.1f} s and made {moved:+.2f}: stopped "
+                        "instead of grinding")
+            del self._watch[motor]  # it moves: watch the next stretch afresh
+        return None
