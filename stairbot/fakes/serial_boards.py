@@ -28,7 +28,8 @@ from typing import Protocol
 
 from stairbot.drivers.messages import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
-from stairbot.fakes.boards import Board, BoardWorld, Pacer
+from stairbot.fakes.board_world import BoardWorld, Pacer
+from stairbot.fakes.boards import Board
 
 
 @dataclass(frozen=True)
@@ -240,3 +241,4 @@ class PtyPair:
         for fd in (self.master, self.slave):
             with contextlib.suppress(OSError):
                 os.close(fd)
+

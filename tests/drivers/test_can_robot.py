@@ -21,7 +21,8 @@ from stairbot.drivers.can_robot import CanRobot, open_can_robot, parse_can_url, 
 from stairbot.drivers.serial_robot import LockstepClock
 from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
 from stairbot.events import Event
-from stairbot.fakes.boards import Board, BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.serial_boards import WireFaults

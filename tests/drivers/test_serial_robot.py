@@ -20,7 +20,8 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.serial_robot import SerialRobot, parse_serial_url
 from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
 from stairbot.events import Event, EventKind
-from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId, SensorId

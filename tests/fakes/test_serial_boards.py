@@ -16,7 +16,8 @@ from test_boards import StubClock, StubRobot
 from stairbot.drivers import messages as m
 from stairbot.drivers.link import FdChannel, Link
 from stairbot.drivers.serial_wire import Frame, FrameReader, crc16, encode_frame
-from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import SerialBoardServer
 
 
