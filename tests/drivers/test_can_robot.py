@@ -17,16 +17,16 @@ import pytest
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.can_robot import CanRobot, open_can_robot, parse_can_url, resolve_bus_config
-from stairbot.drivers.serial_robot import LockstepClock
+from stairbot.drivers.can_robot import open_can_robot, parse_can_url, resolve_bus_config
 from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
 from stairbot.events import Event
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
+from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import WireFaults
-from stairbot.hardware import MotorId
+from stairbot.hardware import Clock, HasTruth, MotorId
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.scenario import load_scenario
 
@@ -36,8 +36,8 @@ FORWARD = {MotorId.MWF: 1.0, MotorId.MWB: 1.0, MotorId.MWR: 1.0, MotorId.MWL: 1.
 
 @dataclass
 class Rig:
-    robot: CanRobot
-    clock: LockstepClock
+    robot: LockstepRobot
+    clock: Clock
     server: CanBoardServer
     world: BoardWorld
     boards: dict[int, Board]
@@ -56,10 +56,8 @@ def make_rig(faults: WireFaults | None = None, timeout: float = 0.05) -> Rig:
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world, boards, faults)
     link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), server),
                    timeout_s=timeout, retries=1)
-    robot = CanRobot(link, f"can://virtual/{channel}?lockstep=1", lockstep=True)  # type: ignore[arg-type]
-    clock = LockstepClock(robot)
-    robot.clock = clock
-    return Rig(robot, clock, server, world, boards)
+    robot = LockstepRobot(link, f"can://virtual/{channel}?lockstep=1")
+    return Rig(robot, robot.clock, server, world, boards)
 
 
 @pytest.fixture
@@ -258,7 +256,10 @@ def test_threaded_server_on_a_virtual_bus_via_open_robot() -> None:
             session.robot.command(FORWARD)
             session.clock.advance(0.02)
         diag = session.robot.diagnostics()
-        assert diag["fell"] is False and "bus" in diag
+        assert "bus" in diag and diag["wire"] == "CAN bus"
+        assert isinstance(session.robot, HasTruth)  # fake boards in lockstep
+        truth = session.robot.truth()
+        assert truth.fell is False and truth.offset_m is not None and truth.offset_m > 0
         session.close()
     finally:
         server.stop()
@@ -292,6 +293,7 @@ def test_faster_than_real_time_without_lockstep() -> None:
     try:
         session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1",
                                  load_config(), RobotOptions())
+        assert not isinstance(session.robot, HasTruth)  # a board robot, as a real one
         first = session.robot.read()
         for _ in range(25):
             session.robot.read()

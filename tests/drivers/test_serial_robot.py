@@ -17,14 +17,16 @@ import serial.rfc2217
 
 from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.serial_robot import SerialRobot, parse_serial_url
+from stairbot.drivers.board_robot import BoardRobot
+from stairbot.drivers.serial_robot import parse_serial_url
 from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
 from stairbot.events import Event, EventKind
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
-from stairbot.hardware import MotorId, SensorId
+from stairbot.hardware import HasTruth, MotorId, SensorId
 from stairbot.robots import RobotSession, open_robot
 from stairbot.runner import run
 from stairbot.scenario import Scenario, load_scenario
@@ -62,8 +64,8 @@ def fake() -> Iterator[Fake]:
     yield from serve()
 
 
-def robot_of(session: RobotSession) -> SerialRobot:
-    assert isinstance(session.robot, SerialRobot)
+def robot_of(session: RobotSession) -> BoardRobot:
+    assert isinstance(session.robot, BoardRobot)
     return session.robot
 
 
@@ -86,7 +88,10 @@ def test_read_command_and_lockstep_clock(fake: Fake) -> None:
         assert snap.health["frames_rx"] == snap.health["frames_tx"] > 50
         assert snap.health["lost"] == 0 and snap.health["rtt_median_ms"] > 0
         diag = session.robot.diagnostics()
-        assert diag["fell"] is False and diag["boards"]["motor"]["channels"] == 6
+        assert diag["boards"]["motor"]["channels"] == 6 and diag["wire"] == "serial port"
+        assert isinstance(session.robot, LockstepRobot) and isinstance(session.robot, HasTruth)
+        truth = session.robot.truth()
+        assert truth.fell is False and truth.max_pitch_deg is not None
     finally:
         session.close()
     assert fake.world.speeds()[MotorId.MTF] == 0.0  # close stops every motor
