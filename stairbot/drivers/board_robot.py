@@ -157,8 +157,9 @@ class BoardRobot:
     @locked
     def read(self) -> Snapshot:
         """One ReadAll to each board.  Raises LinkLostError (no reply, or a
-        board's watchdog tripped) or HardwareError (e-stop latched on a board,
-        a failed world behind fake boards, a bad reply)."""
+        board's watchdog tripped) or HardwareError (an e-stop a board latched
+        on its own, a failed world behind fake boards, a bad reply).  While
+        this host's own e-stop is latched, reading goes on."""
         self._reap()
         pm = self.link.request(m.Board.MOTOR, [m.ReadAll()], send=False)
         ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
@@ -178,11 +179,12 @@ class BoardRobot:
 
     @locked
     def command(self, speeds: Mapping[MotorId, float]) -> None:
-        """Send every motor's speed in one frame; its Ack is checked later."""
+        """Send every motor's speed in one frame; its Ack is checked later.
+        While the e-stop is latched every speed sent is 0."""
         self._reap()
         if self.link.lost_streak >= self.link.max_lost:
             self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
-        wheels, lifts = u.speeds_to_wire(speeds)
+        wheels, lifts = u.speeds_to_wire({} if self._estopped else speeds)
         self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
                                             send=not self.HOLD_COMMANDS))
 
@@ -198,15 +200,23 @@ class BoardRobot:
     @locked
     def stop_all(self) -> None:
         """Stop every motor (lifts hold); never raises."""
+        if self._closed:
+            return
         with contextlib.suppress(Exception):
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
 
     @locked
     def estop(self) -> None:
-        """Latch the emergency stop on both boards: one EStop each (one
-        broadcast frame on CAN), whose Status is awaited."""
+        """Latch the emergency stop: here at once (``command`` sends only
+        zeros from now on), and on both boards with one EStop each (one
+        broadcast frame on CAN) whose Status is awaited.  Never raises: a board
+        that does not confirm is a LINK event ("link lost"), and its watchdog
+        stops its motors."""
         self._estopped = True
-        self._wait(self.link.broadcast(m.EStop()))
+        if self._closed:
+            return
+        with contextlib.suppress(Exception):  # the Robot protocol: estop never raises
+            self._wait(self.link.broadcast(m.EStop()))
 
     @locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
@@ -324,8 +334,9 @@ class BoardRobot:
                        boards_stopped=board == m.Board.MOTOR)
         if status.fault == m.MotorFault.SIMULATION:
             self._world_failed(board)
-        if status.flags & m.StatusFlag.ESTOP:
-            raise HardwareError(f"the {name} board has its emergency stop latched")
+        if status.flags & m.StatusFlag.ESTOP and not self._estopped:
+            raise HardwareError(f"the {name} board has its emergency stop latched "
+                                "(not by this host: the board's own input?)")
 
     def _world_failed(self, board: m.Board) -> None:
         """Fake boards say the simulated world behind them failed (a fall)."""

@@ -174,17 +174,48 @@ def test_emergency_stop_is_one_broadcast_frame_and_latches(rig: Rig) -> None:
     tx = rig.robot.link.stats.frames_tx
     rig.robot.estop()
     assert rig.robot.link.stats.frames_tx == tx + 1  # EStop_All, id 0x00F
+    assert rig.robot.estopped
     assert rig.world.speeds() == {mid: 0.0 for mid in MotorId}
-    with pytest.raises(HardwareError, match="emergency stop latched"):
-        rig.robot.read()
+    assert all(b.estop for b in rig.boards.values())  # latched on both boards
+    snap = rig.robot.read()  # this host's own latch: reading goes on
+    assert snap.motors[MotorId.MTF].fault == "estop"
     rig.robot.command(FORWARD)
     rig.robot.flush()
-    assert rig.world.speeds()[MotorId.MWF] == 0.0  # refused
+    assert rig.world.speeds()[MotorId.MWF] == 0.0  # zeros sent, and refused
     rig.robot.clear(m.ClearMask.ESTOP)
+    assert not rig.robot.estopped and not any(b.estop for b in rig.boards.values())
     rig.robot.read()
     rig.robot.command(FORWARD)
     rig.robot.flush()
     assert rig.world.speeds()[MotorId.MWF] == 1.0
+
+
+def test_an_emergency_stop_a_board_latched_on_its_own_stops_the_reads(rig: Rig) -> None:
+    rig.tick(FORWARD)
+    rig.boards[m.Board.SENSOR].estop = True  # the board's own input, not this host
+    with pytest.raises(HardwareError, match="sensor board has its emergency stop latched"):
+        rig.robot.read()
+
+
+def test_estop_never_raises_and_latches_on_a_silent_bus() -> None:
+    # from 0.05 s of board time on the boards hear the host but never answer
+    rig = make_rig(WireFaults(silent_after_s=0.05), timeout=0.01)
+    try:
+        rig.tick(FORWARD)
+        rig.clock.advance(0.04)  # the StepTo goes out with the EStop: silent from then on
+        events: list[Event] = []
+        rig.robot.attach_sink(events.append)
+        rig.robot.estop()
+        assert rig.robot.estopped
+        assert all(b.estop for b in rig.boards.values())  # they heard it
+        assert any("link lost" in e.message for e in events)
+        rig.robot.close()
+        rig.robot.estop()  # closed: still no exception, still latched
+        rig.robot.stop_all()
+        assert rig.robot.estopped
+    finally:
+        rig.robot.close()
+        rig.server.bus.shutdown()
 
 
 def test_the_emergency_stop_runs_under_the_robots_lock(

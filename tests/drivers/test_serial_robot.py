@@ -102,15 +102,38 @@ def test_estop_latches_on_the_boards_until_cleared(fake: Fake) -> None:
     robot = robot_of(session)
     robot.command({MotorId.MWF: 1.0})
     robot.estop()
-    assert fake.world.speeds()[MotorId.MWF] == 0.0
-    with pytest.raises(HardwareError, match="emergency stop latched"):
-        robot.read()
+    assert robot.estopped and fake.world.speeds()[MotorId.MWF] == 0.0
+    assert robot.read().motors[MotorId.MWF].fault == "estop"  # reading goes on
     robot.command({MotorId.MWF: 1.0})
     robot.flush()
     assert robot.refused == 2 and fake.world.speeds()[MotorId.MWF] == 0.0
     robot.clear(m.ClearMask.ESTOP)
+    assert not robot.estopped
     robot.read()
     session.close()
+
+
+def test_an_emergency_stop_latched_by_a_board_itself_stops_the_reads(fake: Fake) -> None:
+    session = fake.open()
+    fake.server.boards[m.Board.MOTOR].estop = True  # its own input, not this host
+    with pytest.raises(HardwareError, match="motor board has its emergency stop latched"):
+        session.robot.read()
+    session.close()
+
+
+def test_estop_never_raises_when_the_boards_fall_silent() -> None:
+    for fake in serve(WireFaults(silent_after_s=0.05)):  # they hear, but never answer
+        session = fake.open("lockstep=1&timeout=0.05&retries=0")
+        events: list[Event] = []
+        robot_of(session).attach_sink(events.append)
+        session.clock.advance(0.1)  # the StepTo goes out with the EStops: silent from then on
+        session.robot.estop()
+        assert session.robot.estopped
+        assert any("link lost" in e.message for e in events)
+        assert all(b.estop for b in fake.server.boards.values())  # they did hear it
+        session.close()
+        session.robot.estop()  # closed: no exception either
+        assert session.robot.estopped
 
 
 def test_heartbeat_feeds_boards_the_host_has_not_addressed_lately(fake: Fake) -> None:
