@@ -7,7 +7,8 @@ one SetWheelSpeeds + SetLiftSpeeds whose Ack is collected on the next call,
 the handshake identifies the boards and sets their watchdogs, a keepalive
 thread feeds them while the robot stands idle, and link health goes into
 ``Snapshot.health``, ``diagnostics()`` and LINK events (``attach_sink``).  A
-lost link raises LinkLostError.
+lost link raises LinkLostError; a board that never answers while opening,
+NoBoardError.
 
 Fake boards in lockstep are a simulation, not a robot on a wire: their clock,
 StepTo, truth and falls are ``stairbot.fakes.lockstep``'s, which
@@ -28,7 +29,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.health import HealthReport
 from stairbot.drivers.link import BoardLink, Reply, Request
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import Clock, MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.robots import RobotSession
@@ -108,14 +109,14 @@ class BoardRobot:
             try:
                 reply = link.exchange(board, [m.Identify(), m.GetStatus()])
             except LinkLostError:
-                raise RobotUrlError(self.url, None, f"no {name} board answered on the "
-                                    f"{link.wire} ({tries})") from None
+                raise NoBoardError(self.url, name, f"no {name} board answered on the "
+                                   f"{link.wire} ({tries})") from None
             ident, status = (reply.messages + (None, None))[:2]
             if not isinstance(ident, m.Ident) or not isinstance(status, m.Status):
-                raise RobotUrlError(self.url, None, f"the {name} board gave an unexpected "
+                raise HardwareError(f"{self.url}: the {name} board gave an unexpected "
                                     f"answer to Identify: {reply.messages}")
             if ident.protocol_major != m.PROTOCOL_MAJOR:
-                raise RobotUrlError(self.url, None, f"the {name} board speaks protocol "
+                raise HardwareError(f"{self.url}: the {name} board speaks protocol "
                                     f"{ident.protocol_major}.{ident.protocol_minor}; "
                                     f"this host speaks {m.PROTOCOL_MAJOR}.x")
             board_lockstep = bool(status.flags & m.StatusFlag.LOCKSTEP)
@@ -136,9 +137,9 @@ class BoardRobot:
                     break
                 except LinkLostError:
                     if attempt == link.retries:
-                        raise RobotUrlError(self.url, None, f"the {name} board did not "
-                                            f"answer SetWatchdog on the {link.wire} "
-                                            f"({tries})") from None
+                        raise NoBoardError(self.url, name, f"the {name} board did not "
+                                           f"answer SetWatchdog on the {link.wire} "
+                                           f"({tries})") from None
             status = reply.messages[-1]
             if isinstance(status, m.Status):
                 self.status[board] = status

@@ -193,7 +193,8 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     """Open ``can://INTERFACE/CHANNEL?...``: both boards on one bus, driven by
     ``board_robot.BoardRobot`` over a :class:`CanLink` (an emergency stop is
     one broadcast frame with the bus's highest-priority id).  RobotUrlError
-    (one line) when the URL is malformed, the bus cannot open or no board
+    (one line) when the URL is malformed or the bus cannot open; NoBoardError
+    (a HardwareError, one line naming the board and the URL) when no board
     answers."""
     spec = parse_can_url(url)
     opts = spec.options

@@ -99,7 +99,8 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
 
 def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
     """Open ``serial://PORT?...``.  RobotUrlError (one line) when the URL is
-    malformed, the port cannot open or no board answers."""
+    malformed or the port cannot open; NoBoardError (a HardwareError, one
+    line naming the board and the URL) when no board answers."""
     port, opts = parse_serial_url(url)
     channel = open_channel(port, int(opts["baud"]), url)
     link = SerialLink(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),

@@ -18,7 +18,7 @@ from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import open_can_robot, parse_can_url, resolve_bus_config
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, make_boards
@@ -119,8 +119,12 @@ def test_a_bus_that_cannot_open_is_one_line_and_no_boards_is_one_line() -> None:
     config = load_config()
     with pytest.raises(RobotUrlError, match="cannot open CAN bus slcan//dev/nonexistent"):
         open_robot("can://slcan//dev/nonexistent", config)
-    with pytest.raises(RobotUrlError, match="no motor board answered on the CAN bus"):
-        open_robot(f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0", config)
+    url = f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0"
+    with pytest.raises(NoBoardError) as info:  # the URL was fine: a hardware error
+        open_robot(url, config)
+    assert str(info.value) == (f"{url}: no motor board answered on the CAN bus "
+                               "(1 try of 10 ms)")
+    assert (info.value.board, info.value.url) == ("motor", url)
 
 
 @pytest.mark.skipif(not os.path.exists("/sys/class/net/vcan0"),

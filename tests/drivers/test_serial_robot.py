@@ -19,7 +19,7 @@ from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_robot import parse_serial_url
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event, EventKind
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
@@ -381,10 +381,18 @@ def test_url_options() -> None:
 
 @pytest.mark.parametrize("url, problem", [
     ("serial:///dev/no-such-port", "cannot open port /dev/no-such-port"),
-    ("serial://loop://?timeout=0.01&retries=0", "no motor board answered on the serial port"),
     ("serial://", "expected serial://PORT"),
 ])
 def test_a_port_that_cannot_be_used_is_one_clear_line(url: str, problem: str) -> None:
     with pytest.raises(RobotUrlError) as info:
         open_robot(url, CONFIG)
     assert problem in str(info.value) and "\n" not in str(info.value)
+
+
+def test_no_board_answering_is_a_hardware_error_naming_board_and_url() -> None:
+    url = "serial://loop://?timeout=0.01&retries=1"
+    with pytest.raises(NoBoardError) as info:
+        open_robot(url, CONFIG)
+    assert str(info.value) == (f"{url}: no motor board answered on the serial port "
+                               "(2 tries of 10 ms)")
+    assert (info.value.board, info.value.url) == ("motor", url)
