@@ -17,7 +17,7 @@ import pytest
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.can_robot import open_can_robot, parse_can_url, resolve_bus_config
+from stairbot.drivers.can_robot import open_bus, open_can_robot, parse_can_url, resolve_bus_config
 from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event
 from stairbot.fakes.board_world import BoardWorld
@@ -130,10 +130,20 @@ def test_a_bus_that_cannot_open_is_one_line_and_no_boards_is_one_line() -> None:
 @pytest.mark.skipif(not os.path.exists("/sys/class/net/vcan0"),
                     reason="no kernel CAN support on this machine")
 def test_socketcan_vcan0_opens() -> None:  # pragma: no cover - needs a kernel CAN device
+    """The URL opens a socketcan bus on vcan0, and that bus carries frames:
+    one sent on it reaches a second bus on the same device."""
+    from can.interfaces.socketcan import SocketcanBus
+
     s = parse_can_url("can://socketcan/vcan0")
-    from stairbot.drivers.can_robot import open_bus
-    bus = open_bus(s)
-    bus.shutdown()
+    bus, other = open_bus(s), open_bus(s)
+    try:
+        assert isinstance(bus, SocketcanBus) and bus.channel == "vcan0"
+        bus.send(can.Message(arbitration_id=0x0EF, data=b"", is_extended_id=False))
+        heard = other.recv(timeout=5.0)
+        assert heard is not None and heard.arbitration_id == 0x0EF  # Identify_All
+    finally:
+        bus.shutdown()
+        other.shutdown()
 
 
 # -- the boards over the wire ----------------------------------------------------------
