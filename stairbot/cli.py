@@ -27,7 +27,7 @@ from typing import IO, Any, TextIO
 
 from stairbot import __version__
 from stairbot.config import RobotConfig, load_config
-from stairbot.errors import HardwareError, InputError
+from stairbot.errors import HardwareError, InputError, NoBoardError
 from stairbot.events import Event, EventKind
 from stairbot.scenario import (
     Scenario,
@@ -248,6 +248,9 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         try:
             session = open_robot(args.robot, config, replace(options, world=scenario))
+        except NoBoardError as exc:  # the URL was fine; the message names board and URL
+            print(f"{PROG}: error: {exc}", file=sys.stderr)
+            return EXIT_MISMATCH
         except HardwareError as exc:
             print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
             return EXIT_MISMATCH

@@ -43,3 +43,14 @@ class LinkLostError(HardwareError):
 
 class RobotFellError(HardwareError):
     """The simulated world detected instability: pitch beyond the limit, a fall."""
+
+
+class NoBoardError(HardwareError):
+    """A board never answered on a link that opened: the URL was fine, the
+    board is off, unplugged, on another port or bus, or not running.  The
+    message is one line naming the board and the URL."""
+
+    def __init__(self, url: str, board: str, problem: str) -> None:
+        self.url = url
+        self.board = board
+        super().__init__(f"{url}: {problem}")

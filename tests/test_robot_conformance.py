@@ -23,7 +23,6 @@ import can
 import pytest
 
 from stairbot.config import RobotConfig, load_config
-from stairbot.errors import HardwareError, LinkLostError
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
@@ -153,24 +152,9 @@ def open_can() -> Iterator[Rig]:
 
 OPENERS = {"sim": open_sim, "serial": open_serial, "can": open_can}
 
-# (test name, robot) -> why the driver does not pass it yet.
-_CAN_FLAG = ("CanRobot.estop (drivers/can_robot.py) overrides BoardRobot.estop and never "
-             "sets _estopped, so `estopped` stays False after an e-stop")
-_RAISES = ("BoardRobot.estop / CanRobot.estop wait for the boards' Status with no "
-           "suppression: LinkLostError on a dead link, and after close() (closed port / "
-           "closed bus)")
-_READ = ("BoardRobot.read raises HardwareError('the motor board has its emergency stop "
-         "latched') for a latch the host set itself (_check_status, drivers/board_robot.py)")
-NOT_YET: dict[tuple[str, str], tuple[str, type[BaseException]]] = {
-    ("test_estopped_is_true_from_estop_until_clear", "can"): (_CAN_FLAG, AssertionError),
-    ("test_estop_twice_then_one_clear", "can"): (_CAN_FLAG, AssertionError),
-    ("test_read_goes_on_while_latched", "serial"): (_READ, HardwareError),
-    ("test_read_goes_on_while_latched", "can"): (_READ, HardwareError),
-    ("test_estop_and_stop_all_never_raise_after_close", "serial"): (_RAISES, LinkLostError),
-    ("test_estop_and_stop_all_never_raise_after_close", "can"): (_RAISES, LinkLostError),
-    ("test_estop_never_raises_on_a_dead_link", "serial"): (_RAISES, LinkLostError),
-    ("test_estop_never_raises_on_a_dead_link", "can"): (_RAISES, LinkLostError),
-}
+# (test name, robot) -> (why the driver does not pass it yet, what it raises).
+# Empty: every shipped robot passes every test.
+NOT_YET: dict[tuple[str, str], tuple[str, type[BaseException]]] = {}
 
 
 @pytest.fixture(params=ROBOTS)

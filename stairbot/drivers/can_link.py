@@ -1,15 +1,16 @@
-"""Requests and replies over a python-can bus, with the serial link's interface.
+"""The link protocol over a python-can bus.
 
-:class:`CanLink` offers what :class:`stairbot.drivers.link.Link` offers the
-robot driver (``request``, ``wait``, ``poll``, ``exchange``, ``stats``,
-``lost_streak``), so the same board logic drives both wires.  CAN frames carry
-no sequence number (a message fills the 8 bytes), so replies are matched to
-requests by what each message is answered with (docs/protocol.md, "CAN"):
+:class:`CanLink` is a :class:`~stairbot.drivers.link.RequestLink`, as the
+serial link is: retries, expiry and the health counters are shared.  What is
+CAN's own: each message is one frame, and frames carry no sequence number (a
+message fills the 8 bytes), so replies are matched to requests by what each
+message is answered with (docs/protocol.md, "CAN"):
 
-* Identify -> Ident; Heartbeat, GetStatus, SetWatchdog, EStop, Clear -> Status;
-  ReadAll -> Status + one telemetry frame per channel; GetMotor/GetSensor ->
-  one telemetry frame; StepTo -> StepDone; GetTruth -> Truth; commands -> Ack.
-  An Ack naming the message's type answers any of them (a refusal).
+* the reply a message declares (``ANSWER``: Identify -> Ident; Heartbeat,
+  GetStatus, SetWatchdog, EStop, Clear -> Status; GetMotor/GetSensor -> one
+  telemetry frame; commands -> Ack); ReadAll -> Status + one telemetry frame
+  per channel.  An Ack naming the message's type answers any of them (a
+  refusal).
 * A board sends its replies in order, and a CAN bus keeps the order of one
   sender's frames, so a board's replies fill its oldest waiting request first.
 * A request waits ``timeout_s``; only idempotent ones are re-sent (up to
@@ -22,35 +23,26 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import can
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_wire import BROADCAST, CanWire, frame_bits, wire
-from stairbot.drivers.link import LinkStats, Request
-from stairbot.drivers.serial_wire import Frame
+from stairbot.drivers.link import LinkStats, Request, RequestLink
 from stairbot.errors import LinkLostError
 
 _CHANNELS = {int(m.Board.MOTOR): (len(m.MOTOR_CHANNELS), m.MotorTelemetry),
              int(m.Board.SENSOR): (len(m.SENSOR_CHANNELS), m.SensorTelemetry)}
-_STATUS_ANSWERED = (m.Heartbeat, m.GetStatus, m.SetWatchdog, m.EStop, m.Clear)
-_SINGLE: dict[type[m.Message], type[m.Message]] = {
-    m.Identify: m.Ident, m.StepTo: m.StepDone, m.GetTruth: m.Truth,
-    m.GetMotor: m.MotorTelemetry, m.GetSensor: m.SensorTelemetry,
-}
 
 
 def expected_replies(board: int, msg: m.Message) -> list[type[m.Message]]:
     """The reply messages, in order, a board sends for ``msg`` when it obeys."""
-    if isinstance(msg, _STATUS_ANSWERED):
-        return [m.Status]
     if isinstance(msg, m.ReadAll):
         count, kind = _CHANNELS.get(board, (0, m.MotorTelemetry))
         return [m.Status] + [kind] * count
-    reply = _SINGLE.get(type(msg))
-    return [reply] if reply is not None else [m.Ack]
+    return [m.MESSAGES.get(msg.ANSWER, m.Ack)]
 
 
 @dataclass
@@ -64,10 +56,9 @@ class CanStats(LinkStats):
 
 
 @dataclass(eq=False)
-class CanPending(Request):
-    """A request in flight: its messages and the replies still to come."""
+class CanRequest(Request):
+    """A request on the bus: the replies that came and those still to come."""
 
-    messages: tuple[m.Message, ...] = ()
     got: list[m.Message] = field(default_factory=list)
     todo: deque[tuple[int, int, type[m.Message]]] = field(default_factory=deque)
 
@@ -100,44 +91,41 @@ class CanPending(Request):
         """Replies still to come."""
         return len(self.todo)
 
+    def progress(self) -> str:
+        return f"; {len(self.got)} of {len(self.got) + self.owed} replies came"
 
-class CanLink:
+
+class CanLink(RequestLink[CanRequest]):
     """Requests and replies for both boards on one python-can bus."""
+
+    wire = "CAN bus"
+    stats: CanStats
 
     def __init__(self, bus: can.BusABC, timeout_s: float = 0.1, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
                  codec: CanWire | None = None) -> None:
+        super().__init__(CanStats(), timeout_s, retries, max_lost, now)
         self.bus = bus
-        self.timeout_s = timeout_s
-        self.retries = retries
-        self.max_lost = max_lost
         self.codec = codec or wire()
-        self._now = now
-        self._pending: dict[int, deque[CanPending]] = {}
         self._owed: dict[int, int] = {}  # replies still due to requests given up
-        self._seq = 0
-        self._held: list[CanPending] = []
-        self.lost_streak = 0
-        self.stats = CanStats()
+        self._held: list[CanRequest] = []
 
     # -- sending ---------------------------------------------------------------
-    def request(self, board: int, messages: Sequence[m.Message], send: bool = True
-                ) -> CanPending:
-        """Send ``messages`` to ``board``, one frame each; the replies are
-        collected by :meth:`wait` or :meth:`poll`.  With ``send=False`` the
-        frames wait for :meth:`flush` (or the next request that sends), as on
-        the serial link; then one message asked of every board in a row goes
-        out once, as a broadcast frame (board 15)."""
-        self._seq = (self._seq + 1) & 0xFFFF
-        now = self._now()
-        p = CanPending(board, self._seq, all(x.IDEMPOTENT for x in messages),
-                       now, now + self.timeout_s, messages=tuple(messages))
-        p.expect()
-        self._pending.setdefault(board, deque()).append(p)
-        self._held.append(p)
+    def _new(self, board: int, messages: tuple[m.Message, ...], idempotent: bool,
+             now: float) -> CanRequest:
+        req = CanRequest(board, messages, idempotent, now, now + self.timeout_s)
+        req.expect()
+        return req
+
+    def _transmit(self, req: CanRequest, send: bool) -> None:
+        self._held.append(req)
         if send:
             self.flush()
-        return p
+
+    def _resend(self, req: CanRequest) -> None:
+        self._owed[req.board] = self._owed.get(req.board, 0) + req.owed
+        req.expect()
+        self._send(req)
 
     def flush(self) -> None:
         """Send every held request, in order; a single message held for every
@@ -156,20 +144,12 @@ class CanLink:
                 self._send(p)
                 i += 1
 
-    def _send(self, p: CanPending) -> None:
+    def _send(self, p: CanRequest) -> None:
         for msg in p.messages:
             self.send(p.board, msg)
 
-    def broadcast(self, msg: m.Message) -> list[CanPending]:
-        """Send ``msg`` once to every board (one frame to board 15) and wait
-        for each board's replies as for a request of its own."""
-        self.flush()
-        out = [self.request(board, [msg], send=False) for board in _CHANNELS]
-        self.flush()
-        return out
-
     def send(self, board: int, msg: m.Message) -> None:
-        """One frame, no reply expected (e.g. a broadcast EStop)."""
+        """One frame, no reply expected."""
         frame = self.codec.to_can(board, msg)
         try:
             self.bus.send(frame, timeout=self.timeout_s)
@@ -211,10 +191,10 @@ class CanLink:
         self._match(board, msg)
 
     def _match(self, board: int, msg: m.Message) -> None:
-        for p in self._pending.get(board, ()):
+        for p in self.in_flight(board):
             if p.offer(msg):
                 if not p.todo:
-                    self._complete(p)
+                    self._complete(p, tuple(p.got), frames=len(p.got))
                 return
         if self._owed.get(board, 0) > 0:
             self._owed[board] -= 1
@@ -222,71 +202,12 @@ class CanLink:
         else:
             self.stats.stray += 1
 
-    def _complete(self, p: CanPending) -> None:
-        self.stats.frames_rx += len(p.got)
-        self.stats.add_rtt(self._now() - p.sent_at)
-        p.reply = Frame(p.board, p.seq & 0xFF, tuple(p.got), from_board=True)
-        self._pending[p.board].remove(p)
-        if not p.idempotent:
-            self.lost_streak = 0
+    def _given_up(self, req: CanRequest) -> None:
+        self._owed[req.board] = min(64, self._owed.get(req.board, 0) + req.owed)
 
-    def _expire(self) -> None:
-        now = self._now()
-        for board, queue in self._pending.items():
-            for p in list(queue):
-                if now < p.deadline:
-                    continue
-                self.stats.timeouts += 1
-                owed = p.owed
-                if p.idempotent and p.attempts <= self.retries:
-                    p.attempts += 1
-                    self.stats.retries += 1
-                    self._owed[board] = self._owed.get(board, 0) + owed
-                    p.sent_at, p.deadline = now, now + self.timeout_s
-                    p.expect()
-                    self._send(p)
-                    continue
-                p.failed = True
-                self.stats.lost += 1
-                self._owed[board] = min(64, self._owed.get(board, 0) + owed)
-                queue.remove(p)
-                if not p.idempotent:
-                    self.lost_streak += 1
-
-    def poll(self) -> None:
-        """Take in whatever has arrived, without waiting; expire old requests."""
-        self.flush()
-        while self._receive(0.0):
-            pass
-        self._expire()
-
-    def wait(self, pendings: Sequence[CanPending]) -> list[Frame]:
-        """The replies of ``pendings``, in order.  Re-sends idempotent requests
-        that time out; raises LinkLostError when one gets no complete reply
-        after its retries, or ``max_lost`` commands in a row went unanswered."""
-        self.flush()
-        while True:
-            while self._receive(0.0):  # what has arrived counts before any timeout
-                pass
-            self._expire()
-            failed = [p for p in pendings if p.failed]
-            if failed:
-                p = failed[0]
-                names = "+".join(type(x).__name__ for x in p.messages)
-                raise LinkLostError(
-                    f"board {p.board} did not answer {names} ({p.attempts} attempt(s) of "
-                    f"{self.timeout_s * 1e3:.0f} ms; {len(p.got)} of {len(p.got) + p.owed} "
-                    "replies came)")
-            if self.lost_streak >= self.max_lost:
-                raise LinkLostError(f"{self.lost_streak} commands in a row went unanswered")
-            waiting = [p for p in pendings if p.reply is None]
-            if not waiting:
-                return [p.reply for p in pendings if p.reply is not None]
-            self._receive(min(p.deadline for p in waiting) - self._now())
-
-    def exchange(self, board: int, messages: Sequence[m.Message]) -> Frame:
-        """Send one request and wait for its reply."""
-        return self.wait([self.request(board, messages)])[0]
+    def describe(self) -> dict[str, object]:
+        return {"wire": self.wire, "bus": {"interface": type(self.bus).__name__,
+                                           "channel": str(self.bus.channel_info)}}
 
     def close(self) -> None:
         self.bus.shutdown()

@@ -23,6 +23,7 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
                       default 250 (0 = off); time-scaled fake boards get X times it
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
+                      (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
                       the host's wall clock runs at the same rate
   - any other ``key=value`` is passed to ``can.Bus`` as a keyword, its value
@@ -52,8 +53,7 @@ import can
 import can.util
 
 from stairbot.config import RobotConfig
-from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import BoardRobot, board_session, locked
+from stairbot.drivers.board_robot import open_board_session
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
@@ -189,46 +189,18 @@ def open_bus(spec: CanUrl) -> can.BusABC:
         raise RobotUrlError(spec.url, None, f"cannot open CAN bus {where}: {detail}") from exc
 
 
-class CanRobot(BoardRobot):
-    """Both boards on one CAN bus.  The board logic -- handshake, ReadAll to
-    each board, speeds in SetWheelSpeeds + SetLiftSpeeds with their Acks
-    checked on the next call, watchdog and e-stop handling, link health into
-    ``Snapshot.health`` and LINK events, LinkLostError -- is
-    ``board_robot.BoardRobot``'s, as for the serial driver; only the link
-    differs.  An emergency stop is one broadcast frame with the bus's
-    highest-priority id."""
-
-    WIRE = "CAN bus"
-    link: CanLink  # type: ignore[assignment]
-
-    @locked
-    def estop(self) -> None:
-        """Latch the emergency stop on both boards with one EStop_All frame
-        (id 0x00F) and wait for both boards' Status.  Under the robot's lock,
-        like every other robot method: the keepalive thread shares the link."""
-        self._wait(self.link.broadcast(m.EStop()))  # type: ignore[arg-type]
-
-    @locked
-    def diagnostics(self) -> dict[str, object]:
-        out = super().diagnostics()
-        bus = self.link.bus
-        out["bus"] = {"interface": type(bus).__name__, "channel": str(bus.channel_info)}
-        return out
-
-
 def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
-    """Open ``can://INTERFACE/CHANNEL?...``.  RobotUrlError (one line) when the
-    URL is malformed, the bus cannot open or no board answers."""
+    """Open ``can://INTERFACE/CHANNEL?...``: both boards on one bus, driven by
+    ``board_robot.BoardRobot`` over a :class:`CanLink` (an emergency stop is
+    one broadcast frame with the bus's highest-priority id).  RobotUrlError
+    (one line) when the URL is malformed or the bus cannot open; NoBoardError
+    (a HardwareError, one line naming the board and the URL) when no board
+    answers."""
     spec = parse_can_url(url)
     opts = spec.options
     bus = open_bus(spec)
     link = CanLink(bus, timeout_s=opts["timeout"], retries=int(opts["retries"]),
                    max_lost=int(opts["lost"]))
-    scale = options.time_scale or opts["time_scale"]
-    try:
-        robot = CanRobot(link, url, int(opts["watchdog"]),  # type: ignore[arg-type]
-                         bool(opts["lockstep"]), time_scale=scale)
-    except BaseException:
-        link.close()
-        raise
-    return board_session(robot, url, scale)
+    return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
+                              lockstep=bool(opts["lockstep"]),
+                              time_scale=options.time_scale or opts["time_scale"])

@@ -1,110 +1,78 @@
-"""The request/response engine over a byte stream, and its health counters.
+"""The link protocol both wires share: requests to a board, their replies,
+retries, expiry and the health counters.
 
-The host numbers every frame it sends (``seq``, mod 256); a board answers each
-request frame with exactly one reply frame carrying the same ``seq``.  Several
-requests may be in flight at once (one per board per control cycle), so a
-cycle costs one round trip, not one per board.
+:class:`BoardLink` is what :class:`~stairbot.drivers.board_robot.BoardRobot`
+needs of a wire.  :class:`RequestLink` implements it once -- matching replies
+to requests, retrying, expiring, counting -- and a wire subclasses it with
+what only that wire knows: how a request is encoded and sent, how bytes or
+frames come in and which request a reply belongs to (the serial link by the
+frame's sequence number, ``serial_link.py``; the CAN link by what each
+message is answered with, ``can_link.py``).
 
 Rules (docs/protocol.md, "Requests and replies"):
 
-* A request waits at most ``timeout_s`` for its reply.
+* A request waits at most ``timeout_s`` for its whole reply.
 * Only requests made entirely of idempotent messages (queries, StepTo) are
-  re-sent, byte for byte with the same ``seq``, up to ``retries`` times.
-  Commands are never re-sent: the next control cycle sends fresh ones.
-* A reply to a request that already timed out is counted ``late``; a reply
-  matching nothing (a duplicate, an echo) is counted ``stray``.
-* :meth:`Link.wait` raises LinkLostError when a waited-for request got no
-  reply after its retries; commands that go unanswered ``max_lost`` times in
-  a row also mean the link is lost.
+  sent again, up to ``retries`` times.  Commands are never sent again: the
+  next control cycle sends fresh ones.
+* A reply to a request given up is counted ``late``; a reply matching
+  nothing (a duplicate, an echo) is counted ``stray``.
+* :meth:`RequestLink.wait` raises LinkLostError when a waited-for request got
+  no reply after its retries; ``max_lost`` commands in a row (in the order
+  they were sent) that went unanswered also mean the link is lost.
 """
 
 from __future__ import annotations
 
-import os
-import select
 import statistics
 import time
+from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Generic, Protocol, TypeVar
 
-from stairbot.drivers.messages import Message
-from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
+from stairbot.drivers.codes import Board
+from stairbot.drivers.records import Message, RawMessage
 from stairbot.errors import LinkLostError
 
 
-class ByteChannel(Protocol):
-    def write(self, data: bytes) -> None: ...
+@dataclass(frozen=True, slots=True)
+class Reply:
+    """A board's whole answer to one request, whatever the wire: the board
+    and its messages in the order it sent them."""
 
-    def read_some(self, timeout_s: float) -> bytes:
-        """Whatever bytes arrive within ``timeout_s`` (maybe none)."""
-        ...
-
-    def close(self) -> None: ...
-
-
-class FdChannel:
-    """A channel on a POSIX file descriptor (a tty, a pty): select + os.read,
-    which avoids reconfiguring the port for every read timeout."""
-
-    def __init__(self, fd: int, owner: Any = None) -> None:
-        self.fd = fd
-        self._owner = owner  # the pyserial port that owns the fd, closed with us
-
-    def write(self, data: bytes) -> None:
-        view = memoryview(data)
-        while view:
-            try:
-                n = os.write(self.fd, view)
-            except BlockingIOError:
-                select.select([], [self.fd], [], 0.1)
-                continue
-            view = view[n:]
-
-    def read_some(self, timeout_s: float) -> bytes:
-        ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout_s))
-        if not ready:
-            return b""
-        try:
-            return os.read(self.fd, 4096)
-        except (BlockingIOError, InterruptedError):
-            return b""
-
-    def close(self) -> None:
-        if self._owner is not None:
-            self._owner.close()
-        else:
-            os.close(self.fd)
+    board: int
+    messages: tuple[Message | RawMessage, ...]
 
 
-class PortChannel:
-    """A channel on any pyserial port (socket://, rfc2217://, loop://...):
-    reads poll with a short fixed port timeout."""
+@dataclass(eq=False)
+class Request:
+    """A request in flight, whatever the wire.  ``order`` numbers commands
+    (non-idempotent requests) in sending order; -1 for queries."""
 
-    POLL_S = 0.002
+    board: int
+    messages: tuple[Message, ...]
+    idempotent: bool
+    sent_at: float
+    deadline: float
+    order: int = -1
+    attempts: int = 1
+    reply: Reply | None = None
+    failed: bool = False
 
-    def __init__(self, port: Any) -> None:
-        self.port = port
-        port.timeout = self.POLL_S
+    @property
+    def done(self) -> bool:
+        return self.reply is not None or self.failed
 
-    def write(self, data: bytes) -> None:
-        self.port.write(data)
-
-    def read_some(self, timeout_s: float) -> bytes:
-        deadline = time.perf_counter() + timeout_s
-        while True:
-            data: bytes = self.port.read(max(1, self.port.in_waiting))
-            if data or time.perf_counter() >= deadline:
-                return data
-
-    def close(self) -> None:
-        self.port.close()
+    def progress(self) -> str:
+        """What a wire adds to "did not answer" (the CAN link: replies that came)."""
+        return ""
 
 
 @dataclass
 class LinkStats:
-    """What the driver counts.  ``rtt_s`` keeps the latest round-trip times."""
+    """What a link counts.  ``rtt_s`` keeps the latest round-trip times."""
 
     frames_tx: int = 0
     frames_rx: int = 0
@@ -153,188 +121,212 @@ class LinkStats:
         return out
 
 
-@dataclass(eq=False)
-class Request:
-    """What every request in flight keeps, whatever the wire (serial or CAN)."""
-
-    board: int
-    seq: int
-    idempotent: bool
-    sent_at: float
-    deadline: float
-    attempts: int = 1
-    reply: Frame | None = None
-    failed: bool = False
+class BoardLink(Protocol):
+    """Requests and replies to both boards over one wire (a serial port, a
+    CAN bus).  Every method raises LinkLostError when the wire fails."""
 
     @property
-    def done(self) -> bool:
-        return self.reply is not None or self.failed
+    def wire(self) -> str:
+        """What the boards hang on, for messages: "serial port", "CAN bus"."""
+        ...
+
+    @property
+    def timeout_s(self) -> float: ...
+
+    @property
+    def retries(self) -> int: ...
+
+    @property
+    def max_lost(self) -> int: ...
+
+    @property
+    def lost_streak(self) -> int:
+        """Commands unanswered in a row, in sending order."""
+        ...
+
+    @property
+    def stats(self) -> LinkStats: ...
+
+    def request(self, board: int, messages: Sequence[Message], send: bool = True) -> Request:
+        """Send ``messages`` to ``board`` as one request; with ``send=False``
+        it waits for :meth:`flush` or the next request that sends."""
+        ...
+
+    def broadcast(self, msg: Message) -> Sequence[Request]:
+        """Send ``msg`` to every board at once, one request per board."""
+        ...
+
+    def flush(self) -> None:
+        """Send every request held back."""
+        ...
+
+    def poll(self) -> None:
+        """Take in whatever has arrived and expire old requests; never waits."""
+        ...
+
+    def wait(self, requests: Sequence[Request]) -> list[Reply]:
+        """The replies of ``requests``, in order (LinkLostError: see the rules)."""
+        ...
+
+    def exchange(self, board: int, messages: Sequence[Message]) -> Reply:
+        """Send one request and wait for its reply."""
+        ...
+
+    def describe(self) -> dict[str, object]:
+        """What the wire is, for diagnostics."""
+        ...
+
+    def close(self) -> None: ...
 
 
-@dataclass
-class Pending(Request):
-    """A request in flight on a serial link: the frame as sent, for a resend."""
-
-    wire: bytes = b""
-    order: int = -1  # commands only: their place in the sending order
+R = TypeVar("R", bound=Request)
 
 
-class Link:
-    """Requests and replies over one byte channel (both boards share it)."""
+class RequestLink(ABC, Generic[R]):
+    """The one implementation of matching, retry, expiry and health counting;
+    a wire subclasses it (see the module docstring)."""
 
-    def __init__(
-        self,
-        channel: ByteChannel,
-        timeout_s: float = 0.05,
-        retries: int = 2,
-        max_lost: int = 3,
-        now: Callable[[], float] = time.perf_counter,
-    ) -> None:
-        self.channel = channel
+    wire = "link"
+
+    def __init__(self, stats: LinkStats, timeout_s: float, retries: int, max_lost: int,
+                 now: Callable[[], float] = time.perf_counter) -> None:
+        self.stats = stats
         self.timeout_s = timeout_s
         self.retries = retries
         self.max_lost = max_lost
         self._now = now
-        self._reader = FrameReader()
-        self._pending: dict[tuple[int, int], Pending] = {}
-        self._expired: deque[tuple[int, int]] = deque(maxlen=64)
-        self._seq = 0
-        self._out = bytearray()
-        self.lost_streak = 0
+        self._in_flight: dict[int, list[R]] = {}  # per board, in sending order
         self._commands_sent = 0
         self._last_answered = -1  # order of the latest-sent command that was answered
         self._failed: deque[int] = deque(maxlen=256)  # orders of unanswered commands
-        self.stats = LinkStats()
+        self.lost_streak = 0
 
-    # -- sending ---------------------------------------------------------------
-    def _next_seq(self, board: int) -> int:
-        for _ in range(256):
-            self._seq = (self._seq + 1) & 0xFF
-            if (board, self._seq) not in self._pending:
-                return self._seq
-        raise LinkLostError("256 requests in flight: the boards do not answer")
+    # -- what a wire provides ----------------------------------------------------
+    @abstractmethod
+    def _new(self, board: int, messages: tuple[Message, ...], idempotent: bool,
+             now: float) -> R:
+        """The wire's record of a new request (its sequence number, its bytes)."""
 
-    def request(self, board: int, messages: Sequence[Message], send: bool = True) -> Pending:
-        """Send one request frame to ``board``; its reply is collected by
-        :meth:`wait` or :meth:`poll`.  With ``send=False`` the frame waits in
-        the output buffer for :meth:`flush` (or the next request that sends),
-        so that several frames go out in one write."""
-        seq = self._next_seq(board)
-        wire = encode_frame(Frame(board, seq, tuple(messages)))
-        now = self._now()
-        p = Pending(board, seq, all(m.IDEMPOTENT for m in messages), now,
-                    now + self.timeout_s, wire=wire)
-        if not p.idempotent:
-            p.order = self._commands_sent
+    @abstractmethod
+    def _transmit(self, req: R, send: bool) -> None:
+        """Put ``req`` on the wire, or hold it back for :meth:`flush`."""
+
+    @abstractmethod
+    def _resend(self, req: R) -> None:
+        """Send ``req`` again after a timeout (an idempotent request)."""
+
+    @abstractmethod
+    def _receive(self, timeout_s: float) -> bool:
+        """Take in what arrives within ``timeout_s``, handing each complete
+        reply to :meth:`_complete`; False when nothing came."""
+
+    def _given_up(self, req: R) -> None:
+        """``req`` failed: remember what a late reply to it would look like."""
+
+    @abstractmethod
+    def flush(self) -> None: ...
+
+    @abstractmethod
+    def describe(self) -> dict[str, object]: ...
+
+    @abstractmethod
+    def close(self) -> None: ...
+
+    # -- requests --------------------------------------------------------------
+    def request(self, board: int, messages: Sequence[Message], send: bool = True) -> R:
+        """Send ``messages`` to ``board`` as one request; its reply is collected
+        by :meth:`wait` or :meth:`poll`.  With ``send=False`` the request waits
+        for :meth:`flush` (or the next request that sends), so that several go
+        out together."""
+        msgs = tuple(messages)
+        req = self._new(board, msgs, all(x.IDEMPOTENT for x in msgs), self._now())
+        if not req.idempotent:
+            req.order = self._commands_sent
             self._commands_sent += 1
-        self._pending[(board, seq)] = p
-        self._send(wire, send)
-        return p
+        self._in_flight.setdefault(board, []).append(req)
+        self._transmit(req, send)
+        return req
 
-    def _send(self, wire: bytes, flush: bool = True) -> None:
-        self._out += wire
-        self.stats.frames_tx += 1
-        self.stats.bytes_tx += len(wire)
-        if flush:
-            self.flush()
+    def broadcast(self, msg: Message) -> list[R]:
+        """``msg`` to every board, sent together (on CAN as one frame to board 15)."""
+        out = [self.request(board, [msg], send=False) for board in Board]
+        self.flush()
+        return out
 
-    def flush(self) -> None:
-        """Write every frame still in the output buffer (one write)."""
-        if not self._out:
-            return
-        data, self._out = bytes(self._out), bytearray()
-        try:
-            self.channel.write(data)
-        except OSError as exc:
-            raise LinkLostError(f"cannot write to the port: {exc}") from exc
+    def in_flight(self, board: int) -> list[R]:
+        """The requests to ``board`` still waiting for their reply, oldest first."""
+        return self._in_flight.get(board, [])
 
-    # -- receiving -------------------------------------------------------------
-    def _receive(self, timeout_s: float) -> None:
-        try:
-            data = self.channel.read_some(timeout_s)
-        except OSError as exc:
-            raise LinkLostError(f"cannot read from the port: {exc}") from exc
-        if not data:
-            return
-        self.stats.bytes_rx += len(data)
-        rs = self._reader.stats
-        for frame in self._reader.feed(data):
-            key = (frame.board, frame.seq)
-            p = self._pending.get(key) if frame.from_board else None
-            if p is None:
-                if key in self._expired:
-                    self.stats.late += 1
-                else:
-                    self.stats.stray += 1
-                continue
-            self.stats.frames_rx += 1
-            self.stats.add_rtt(self._now() - p.sent_at)
-            p.reply = frame
-            del self._pending[key]
-            if not p.idempotent and p.order > self._last_answered:
-                self._last_answered = p.order
-                self._count_streak()
-        self.stats.crc_errors = rs.crc_errors
-        self.stats.malformed = rs.malformed + rs.overruns
+    def _complete(self, req: R, messages: tuple[Message | RawMessage, ...],
+                  frames: int = 1) -> None:
+        """``req`` has its whole reply, ``frames`` frames of it."""
+        self.stats.frames_rx += frames
+        self.stats.add_rtt(self._now() - req.sent_at)
+        req.reply = Reply(req.board, messages)
+        self._in_flight[req.board].remove(req)
+        if not req.idempotent and req.order > self._last_answered:
+            self._last_answered = req.order
+            self._count_streak()
 
     def _expire(self) -> None:
         now = self._now()
-        for key, p in list(self._pending.items()):
-            if now < p.deadline:
-                continue
-            self.stats.timeouts += 1
-            if p.idempotent and p.attempts <= self.retries:
-                p.attempts += 1
-                self.stats.retries += 1
-                p.sent_at, p.deadline = now, now + self.timeout_s
-                self._send(p.wire)
-                continue
-            p.failed = True
-            self.stats.lost += 1
-            del self._pending[key]
-            self._expired.append(key)
-            if not p.idempotent:
-                self._failed.append(p.order)
-                self._count_streak()
+        for queue in self._in_flight.values():
+            for req in list(queue):
+                if now < req.deadline:
+                    continue
+                self.stats.timeouts += 1
+                if req.idempotent and req.attempts <= self.retries:
+                    req.attempts += 1
+                    self.stats.retries += 1
+                    req.sent_at, req.deadline = now, now + self.timeout_s
+                    self._resend(req)
+                    continue
+                req.failed = True
+                self.stats.lost += 1
+                queue.remove(req)
+                self._given_up(req)
+                if not req.idempotent:
+                    self._failed.append(req.order)
+                    self._count_streak()
 
     def _count_streak(self) -> None:
         # "In a row" goes by sending order, not by when a timeout noticed the
         # loss: commands that failed after the latest one that was answered.
         self.lost_streak = sum(1 for o in self._failed if o > self._last_answered)
 
+    def _drain(self) -> None:
+        while self._receive(0.0):
+            pass
+
     def poll(self) -> None:
         """Take in whatever has arrived, without waiting; expire old requests.
-        Frames held back with ``send=False`` stay held."""
-        self._receive(0.0)
+        Requests held back with ``send=False`` stay held."""
+        self._drain()
         self._expire()
 
-    def wait(self, pendings: Sequence[Pending]) -> list[Frame]:
-        """The replies of ``pendings``, in order.  Re-sends idempotent requests
-        that time out; raises LinkLostError when one gets no reply at all, or
-        when ``max_lost`` commands in a row went unanswered."""
+    def wait(self, requests: Sequence[Request]) -> list[Reply]:
+        """The replies of ``requests``, in order.  Sends idempotent requests
+        that time out again; raises LinkLostError when one gets no reply at
+        all, or when ``max_lost`` commands in a row went unanswered."""
         self.flush()
         while True:
             # Take in what has already arrived before judging deadlines: a host
             # descheduled past a timeout must not call a waiting reply late.
-            self._receive(0.0)
+            self._drain()
             self._expire()
-            failed = [p for p in pendings if p.failed]
-            if failed:
-                p = failed[0]
-                raise LinkLostError(
-                    f"board {p.board} did not answer (seq {p.seq}, {p.attempts} attempt(s) "
-                    f"of {self.timeout_s * 1e3:.0f} ms)")
+            for req in requests:
+                if req.failed:
+                    names = "+".join(type(x).__name__ for x in req.messages)
+                    raise LinkLostError(
+                        f"board {req.board} did not answer {names} ({req.attempts} "
+                        f"attempt(s) of {self.timeout_s * 1e3:.0f} ms{req.progress()})")
             if self.lost_streak >= self.max_lost:
                 raise LinkLostError(f"{self.lost_streak} commands in a row went unanswered")
-            waiting = [p for p in pendings if p.reply is None]
+            waiting = [req for req in requests if req.reply is None]
             if not waiting:
-                return [p.reply for p in pendings if p.reply is not None]
-            timeout = min(p.deadline for p in waiting) - self._now()
-            self._receive(max(0.0, timeout))
+                return [req.reply for req in requests if req.reply is not None]
+            self._receive(max(0.0, min(req.deadline for req in waiting) - self._now()))
 
-    def exchange(self, board: int, messages: Sequence[Message]) -> Frame:
+    def exchange(self, board: int, messages: Sequence[Message]) -> Reply:
         """Send one request and wait for its reply."""
         return self.wait([self.request(board, messages)])[0]
-
-    def close(self) -> None:
-        self.channel.close()

@@ -19,12 +19,13 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
                       default 250 (0 = off)
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
+                      (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
                       the host's wall clock runs at the same rate
 
 The board logic -- Robot protocol, handshake, keepalive, link health, lost
 links -- is ``board_robot.BoardRobot``; this module adds the serial port and
-the ``Link`` that frames messages for it.
+the ``SerialLink`` (``serial_link.py``) that frames messages for it.
 """
 
 from __future__ import annotations
@@ -35,8 +36,8 @@ from urllib.parse import parse_qsl, urlencode
 import serial
 
 from stairbot.config import RobotConfig
-from stairbot.drivers.board_robot import BoardRobot, LockstepClock, board_session
-from stairbot.drivers.link import FdChannel, Link, PortChannel
+from stairbot.drivers.board_robot import open_board_session
+from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 
@@ -96,28 +97,17 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     return FdChannel(fd, owner=ser)
 
 
-class SerialRobot(BoardRobot):
-    """Both boards over one serial Link."""
-
-    WIRE = "serial port"
-
-
 def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
     """Open ``serial://PORT?...``.  RobotUrlError (one line) when the URL is
-    malformed, the port cannot open or no board answers."""
+    malformed or the port cannot open; NoBoardError (a HardwareError, one
+    line naming the board and the URL) when no board answers."""
     port, opts = parse_serial_url(url)
     channel = open_channel(port, int(opts["baud"]), url)
-    link = Link(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                max_lost=int(opts["lost"]))
-    try:
-        scale = options.time_scale or opts["time_scale"]
-        robot = SerialRobot(link, url, int(opts["watchdog"]), bool(opts["lockstep"]),
-                            time_scale=scale)
-    except BaseException:
-        link.close()
-        raise
-    return board_session(robot, url, scale)
+    link = SerialLink(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
+                      max_lost=int(opts["lost"]))
+    return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
+                              lockstep=bool(opts["lockstep"]),
+                              time_scale=options.time_scale or opts["time_scale"])
 
 
-__all__ = ["DEFAULTS", "LockstepClock", "SerialRobot", "open_channel", "open_serial_robot",
-           "parse_serial_url"]
+__all__ = ["DEFAULTS", "open_channel", "open_serial_robot", "parse_serial_url"]

@@ -26,7 +26,15 @@ from dataclasses import dataclass
 
 from cobs import cobs
 
-from stairbot.drivers.messages import MAX_PAYLOAD, MESSAGES, CodecError, Message, decode, encode
+from stairbot.drivers.messages import (
+    MAX_PAYLOAD,
+    MESSAGES,
+    CodecError,
+    Message,
+    RawMessage,
+    decode,
+    encode,
+)
 
 FROM_BOARD = 0x80
 MAX_FRAME = 254  # stuffed bytes between delimiters; longer runs are dropped as garbage
@@ -35,15 +43,6 @@ MIN_BODY = 4  # addr, seq, crc
 
 class CrcError(CodecError):
     """A frame whose CRC does not match."""
-
-
-@dataclass(frozen=True, slots=True)
-class RawMessage:
-    """A message of a type this side does not know (kept so a board can
-    answer it with Ack(UNKNOWN_TYPE))."""
-
-    type_code: int
-    payload: bytes
 
 
 @dataclass(frozen=True, slots=True)

@@ -4,9 +4,9 @@
 ``stairbot.drivers.messages`` as docs/protocol.md says a real board must:
 per-board watchdog (no valid host frame for ``watchdog_ms`` -> every motor
 stops, lifts hold, a fault latches until an explicit Clear), latched emergency
-stop, fault latch, Move by turns.  Both are backed by one :class:`BoardWorld`:
-any Robot and Clock -- in practice the simulation's SimRobot and SimClock, so
-the fake boards drive the same physics as ``sim://``.
+stop, fault latch, Move by turns; the motor board also answers the
+simulation's StepTo and GetTruth.  Both are backed by one
+:class:`~stairbot.fakes.board_world.BoardWorld` (``board_world.py``).
 
 A transport (``serial_boards``, the CAN fake) feeds each valid host frame to
 ``board.handle(messages)`` and sends back what it returns; it calls
@@ -15,132 +15,14 @@ A transport (``serial_boards``, the CAN fake) feeds each valid host frame to
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Sequence
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
-from stairbot.drivers.serial_wire import RawMessage
-from stairbot.errors import HardwareError
-from stairbot.hardware import Clock, HasTruth, MotorId, Robot, Snapshot
+from stairbot.fakes.board_world import BoardWorld
 
 FIRMWARE_VERSION = 0x0100
 DEFAULT_WATCHDOG_MS = 250
-
-
-class BoardWorld:
-    """The robot behind both boards, read at most once per instant (so the
-    sensor noise draws are the same as a ``sim://`` run's), and its clock.
-
-    In lockstep the world advances only on :meth:`step_to`; otherwise the
-    server calls :meth:`advance` as wall time passes."""
-
-    def __init__(self, robot: Robot, clock: Clock, lockstep: bool = False) -> None:
-        self.robot = robot
-        self.clock = clock
-        self.lockstep = lockstep
-        self.failure: str | None = None
-        self._snap: Snapshot | None = None
-        self._snap_time = -1.0
-        self._time_us = round(clock.now() * 1e6)
-        self._speeds: dict[MotorId, float] = {mid: 0.0 for mid in m.MOTOR_CHANNELS}
-
-    def now(self) -> float:
-        return self.clock.now()
-
-    def snapshot(self) -> Snapshot | None:
-        """The robot now, or None once the world has failed (see ``failure``)."""
-        if self.failure is not None:
-            return self._snap
-        t = self.clock.now()
-        if self._snap is None or t != self._snap_time:
-            try:
-                self._snap = self.robot.read()
-            except HardwareError as exc:
-                self._fail(str(exc))
-                return self._snap
-            self._snap_time = t
-        return self._snap
-
-    def _fail(self, reason: str) -> None:
-        self.failure = reason
-        self.robot.stop_all()
-
-    def set_speeds(self, speeds: dict[MotorId, float]) -> None:
-        self._speeds.update(speeds)
-        if self.failure is None:
-            self.robot.command(dict(self._speeds))
-
-    def speeds(self) -> dict[MotorId, float]:
-        return dict(self._speeds)
-
-    def step_to(self, time_us: int) -> int:
-        """Advance to ``time_us`` (no-op if already there or past); the time now."""
-        if time_us > self._time_us and self.failure is None:
-            self.advance((time_us - self._time_us) / 1e6)
-            self._time_us = time_us
-        return self._time_us
-
-    def advance(self, seconds: float) -> None:
-        if self.failure is not None:
-            return
-        try:
-            self.clock.advance(seconds)
-        except HardwareError as exc:
-            self._fail(str(exc))
-        if not self.lockstep:
-            self._time_us = round(self.clock.now() * 1e6)
-
-    def truth(self) -> m.Truth:
-        """GetTruth's answer: the world's own truth (a robot without it, such
-        as a test's stub, reports zeros), and a fall the world failed on."""
-        fell, pitch, offset = False, 0.0, 0.0
-        if isinstance(self.robot, HasTruth):
-            t = self.robot.truth()
-            fell, pitch, offset = t.fell, t.max_pitch_deg or 0.0, t.offset_m or 0.0
-        fell = fell or (self.failure is not None and "fell" in self.failure.lower())
-        return m.Truth(
-            1 if fell else 0,
-            max(-32767, min(32767, round(pitch * 100))),
-            max(-(2**31) + 1, min(2**31 - 1, round(offset * 1000))),
-        )
-
-
-class Pacer:
-    """Keeps a world that is not in lockstep up with the wall clock times
-    ``time_scale``, one ``step_s`` step per :meth:`step`, so that a server
-    looks at its line between steps: one that fell behind answers the host
-    before it catches up.  Shared by the serial and the CAN server."""
-
-    MAX_WAIT_S = 0.05  # the longest a server waits on its line before looking again
-
-    def __init__(self, world: BoardWorld, boards: Iterable[Board], time_scale: float = 1.0,
-                 step_s: float = 0.005, monotonic: Callable[[], float] = time.monotonic
-                 ) -> None:
-        self.world = world
-        self.boards = list(boards)
-        self.time_scale = time_scale
-        self.step_s = step_s
-        self._monotonic = monotonic
-        self._start: tuple[float, float] | None = None  # (wall, world) at the first step
-
-    def step(self) -> float:
-        """Advance the world one step if it is due (and let every board check
-        its watchdog and Moves); the seconds the server may then wait on its
-        line: 0 after a step, until the next step is due otherwise, and
-        MAX_WAIT_S in lockstep (only StepTo advances the world)."""
-        if self.world.lockstep:
-            return self.MAX_WAIT_S
-        if self._start is None:
-            self._start = (self._monotonic(), self.world.now())
-        wall0, world0 = self._start
-        due = world0 + (self._monotonic() - wall0) * self.time_scale
-        if self.world.now() + self.step_s <= due:
-            self.world.advance(self.step_s)
-            for board in self.boards:
-                board.poll()
-            return 0.0
-        return min(self.MAX_WAIT_S, (self.world.now() + self.step_s - due) / self.time_scale)
 
 
 class Board:
@@ -206,14 +88,14 @@ class Board:
         """Stop every motor this board drives (nothing on the sensor board)."""
 
     # -- messages --------------------------------------------------------------
-    def handle(self, msgs: Sequence[m.Message | RawMessage]) -> list[m.Message]:
+    def handle(self, msgs: Sequence[m.Message | m.RawMessage]) -> list[m.Message]:
         """The replies to one valid host frame, in order; feeds the watchdog."""
         self.poll()  # a frame that comes too late does not un-trip the watchdog
         self._last_feed = self.world.now()
         self.handled += 1
         out: list[m.Message] = []
         for msg in msgs:
-            if isinstance(msg, RawMessage):
+            if isinstance(msg, m.RawMessage):
                 out.append(m.Ack(msg.type_code, m.AckResult.UNKNOWN_TYPE))
             elif msg.REPLY:
                 out.append(m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED))

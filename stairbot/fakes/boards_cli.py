@@ -18,7 +18,8 @@ import sys
 from importlib import import_module
 
 from stairbot.config import RobotConfig, load_config
-from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.scenario import Scenario, load_scenario

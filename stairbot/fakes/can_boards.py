@@ -36,7 +36,8 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
 from stairbot.errors import RobotUrlError
-from stairbot.fakes.boards import Board, BoardWorld, Pacer, make_boards
+from stairbot.fakes.board_world import BoardWorld, Pacer
+from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.serial_boards import FaultDice, WireFaults
 from stairbot.scenario import load_scenario
 

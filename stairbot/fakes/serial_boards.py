@@ -28,7 +28,8 @@ from typing import Protocol
 
 from stairbot.drivers.messages import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
-from stairbot.fakes.boards import Board, BoardWorld, Pacer
+from stairbot.fakes.board_world import BoardWorld, Pacer
+from stairbot.fakes.boards import Board
 
 
 @dataclass(frozen=True)
@@ -240,3 +241,31 @@ class PtyPair:
         for fd in (self.master, self.slave):
             with contextlib.suppress(OSError):
                 os.close(fd)
+
+
+class InlineChannel:
+    """A host's byte channel with the fake boards served in the same thread:
+    every read first lets the server handle what the host wrote.  ``fd`` is
+    the host's end of a socket pair whose other end the server holds (a
+    socket pair, unlike a pty, hands bytes across at once).  No thread and no
+    pacing: the world moves only when its owner advances it -- for tests that
+    drive the boards' clock and the host's together.  Closing it closes ``fd``."""
+
+    def __init__(self, fd: int, server: SerialBoardServer) -> None:
+        self.fd = fd
+        self.server = server
+
+    def write(self, data: bytes) -> None:
+        os.write(self.fd, data)
+
+    def read_some(self, timeout_s: float) -> bytes:
+        while select.select([self.server.fd], [], [], 0.0)[0]:
+            data = os.read(self.server.fd, 4096)
+            if not data:
+                break
+            self.server.receive(data)
+        ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout_s))
+        return os.read(self.fd, 4096) if ready else b""
+
+    def close(self) -> None:
+        os.close(self.fd)

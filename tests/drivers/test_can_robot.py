@@ -17,15 +17,16 @@ import pytest
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.can_robot import CanRobot, open_can_robot, parse_can_url, resolve_bus_config
-from stairbot.drivers.serial_robot import LockstepClock
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.drivers.can_robot import open_bus, open_can_robot, parse_can_url, resolve_bus_config
+from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event
-from stairbot.fakes.boards import Board, BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
+from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import WireFaults
-from stairbot.hardware import MotorId
+from stairbot.hardware import Clock, HasTruth, MotorId
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.scenario import load_scenario
 
@@ -35,8 +36,8 @@ FORWARD = {MotorId.MWF: 1.0, MotorId.MWB: 1.0, MotorId.MWR: 1.0, MotorId.MWL: 1.
 
 @dataclass
 class Rig:
-    robot: CanRobot
-    clock: LockstepClock
+    robot: LockstepRobot
+    clock: Clock
     server: CanBoardServer
     world: BoardWorld
     boards: dict[int, Board]
@@ -55,10 +56,8 @@ def make_rig(faults: WireFaults | None = None, timeout: float = 0.05) -> Rig:
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world, boards, faults)
     link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), server),
                    timeout_s=timeout, retries=1)
-    robot = CanRobot(link, f"can://virtual/{channel}?lockstep=1", lockstep=True)  # type: ignore[arg-type]
-    clock = LockstepClock(robot)
-    robot.clock = clock
-    return Rig(robot, clock, server, world, boards)
+    robot = LockstepRobot(link, f"can://virtual/{channel}?lockstep=1")
+    return Rig(robot, robot.clock, server, world, boards)
 
 
 @pytest.fixture
@@ -120,17 +119,31 @@ def test_a_bus_that_cannot_open_is_one_line_and_no_boards_is_one_line() -> None:
     config = load_config()
     with pytest.raises(RobotUrlError, match="cannot open CAN bus slcan//dev/nonexistent"):
         open_robot("can://slcan//dev/nonexistent", config)
-    with pytest.raises(RobotUrlError, match="no motor board answered on the CAN bus"):
-        open_robot(f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0", config)
+    url = f"can://virtual/empty-{next(_names)}?timeout=0.01&retries=0"
+    with pytest.raises(NoBoardError) as info:  # the URL was fine: a hardware error
+        open_robot(url, config)
+    assert str(info.value) == (f"{url}: no motor board answered on the CAN bus "
+                               "(1 try of 10 ms)")
+    assert (info.value.board, info.value.url) == ("motor", url)
 
 
 @pytest.mark.skipif(not os.path.exists("/sys/class/net/vcan0"),
                     reason="no kernel CAN support on this machine")
 def test_socketcan_vcan0_opens() -> None:  # pragma: no cover - needs a kernel CAN device
+    """The URL opens a socketcan bus on vcan0, and that bus carries frames:
+    one sent on it reaches a second bus on the same device."""
+    from can.interfaces.socketcan import SocketcanBus
+
     s = parse_can_url("can://socketcan/vcan0")
-    from stairbot.drivers.can_robot import open_bus
-    bus = open_bus(s)
-    bus.shutdown()
+    bus, other = open_bus(s), open_bus(s)
+    try:
+        assert isinstance(bus, SocketcanBus) and bus.channel == "vcan0"
+        bus.send(can.Message(arbitration_id=0x0EF, data=b"", is_extended_id=False))
+        heard = other.recv(timeout=5.0)
+        assert heard is not None and heard.arbitration_id == 0x0EF  # Identify_All
+    finally:
+        bus.shutdown()
+        other.shutdown()
 
 
 # -- the boards over the wire ----------------------------------------------------------
@@ -175,17 +188,48 @@ def test_emergency_stop_is_one_broadcast_frame_and_latches(rig: Rig) -> None:
     tx = rig.robot.link.stats.frames_tx
     rig.robot.estop()
     assert rig.robot.link.stats.frames_tx == tx + 1  # EStop_All, id 0x00F
+    assert rig.robot.estopped
     assert rig.world.speeds() == {mid: 0.0 for mid in MotorId}
-    with pytest.raises(HardwareError, match="emergency stop latched"):
-        rig.robot.read()
+    assert all(b.estop for b in rig.boards.values())  # latched on both boards
+    snap = rig.robot.read()  # this host's own latch: reading goes on
+    assert snap.motors[MotorId.MTF].fault == "estop"
     rig.robot.command(FORWARD)
     rig.robot.flush()
-    assert rig.world.speeds()[MotorId.MWF] == 0.0  # refused
+    assert rig.world.speeds()[MotorId.MWF] == 0.0  # zeros sent, and refused
     rig.robot.clear(m.ClearMask.ESTOP)
+    assert not rig.robot.estopped and not any(b.estop for b in rig.boards.values())
     rig.robot.read()
     rig.robot.command(FORWARD)
     rig.robot.flush()
     assert rig.world.speeds()[MotorId.MWF] == 1.0
+
+
+def test_an_emergency_stop_a_board_latched_on_its_own_stops_the_reads(rig: Rig) -> None:
+    rig.tick(FORWARD)
+    rig.boards[m.Board.SENSOR].estop = True  # the board's own input, not this host
+    with pytest.raises(HardwareError, match="sensor board has its emergency stop latched"):
+        rig.robot.read()
+
+
+def test_estop_never_raises_and_latches_on_a_silent_bus() -> None:
+    # from 0.05 s of board time on the boards hear the host but never answer
+    rig = make_rig(WireFaults(silent_after_s=0.05), timeout=0.01)
+    try:
+        rig.tick(FORWARD)
+        rig.clock.advance(0.04)  # the StepTo goes out with the EStop: silent from then on
+        events: list[Event] = []
+        rig.robot.attach_sink(events.append)
+        rig.robot.estop()
+        assert rig.robot.estopped
+        assert all(b.estop for b in rig.boards.values())  # they heard it
+        assert any("link lost" in e.message for e in events)
+        rig.robot.close()
+        rig.robot.estop()  # closed: still no exception, still latched
+        rig.robot.stop_all()
+        assert rig.robot.estopped
+    finally:
+        rig.robot.close()
+        rig.server.bus.shutdown()
 
 
 def test_the_emergency_stop_runs_under_the_robots_lock(
@@ -257,7 +301,10 @@ def test_threaded_server_on_a_virtual_bus_via_open_robot() -> None:
             session.robot.command(FORWARD)
             session.clock.advance(0.02)
         diag = session.robot.diagnostics()
-        assert diag["fell"] is False and "bus" in diag
+        assert "bus" in diag and diag["wire"] == "CAN bus"
+        assert isinstance(session.robot, HasTruth)  # fake boards in lockstep
+        truth = session.robot.truth()
+        assert truth.fell is False and truth.offset_m is not None and truth.offset_m > 0
         session.close()
     finally:
         server.stop()
@@ -291,6 +338,7 @@ def test_faster_than_real_time_without_lockstep() -> None:
     try:
         session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1",
                                  load_config(), RobotOptions())
+        assert not isinstance(session.robot, HasTruth)  # a board robot, as a real one
         first = session.robot.read()
         for _ in range(25):
             session.robot.read()

@@ -20,12 +20,11 @@ import pytest
 
 from stairbot.config import load_config
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.can_robot import CanRobot
-from stairbot.drivers.serial_robot import LockstepClock
 from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
+from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunResult, run
 from stairbot.scenario import Scenario, load_scenario
@@ -95,10 +94,8 @@ def inline_session(scenario: Scenario, channel: str) -> tuple[RobotSession, CanB
                             make_boards(world))
     link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), server),
                    timeout_s=2.0)
-    robot = CanRobot(link, f"can://virtual/{channel}?lockstep=1", lockstep=True)  # type: ignore[arg-type]
-    clock = LockstepClock(robot)
-    robot.clock = clock
-    return RobotSession(robot, clock, f"can://virtual/{channel}", robot.simulated), server
+    robot = LockstepRobot(link, f"can://virtual/{channel}?lockstep=1")
+    return RobotSession(robot, robot.clock, f"can://virtual/{channel}", robot.simulated), server
 
 
 def test_full_ascent_and_descent_over_virtual_can_ends_as_sim_does(

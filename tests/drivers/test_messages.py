@@ -101,3 +101,14 @@ def test_only_queries_and_step_to_are_idempotent() -> None:
     idempotent = {c.__name__ for c in m.MESSAGES.values() if c.IDEMPOTENT}
     assert idempotent == {"Identify", "Heartbeat", "GetStatus", "ReadAll", "GetMotor",
                           "GetSensor", "StepTo", "GetTruth"}
+
+
+def test_every_host_message_declares_a_reply_a_board_sends() -> None:
+    for cls in m.MESSAGES.values():
+        if not cls.REPLY:
+            answer = m.MESSAGES[cls.ANSWER]
+            assert answer.REPLY, cls.__name__
+    assert m.MESSAGES[m.StepTo.ANSWER] is m.StepDone
+    assert m.MESSAGES[m.GetTruth.ANSWER] is m.Truth
+    assert m.MESSAGES[m.ReadAll.ANSWER] is m.Status  # then the telemetry
+    assert m.MESSAGES[m.SetWheelSpeeds.ANSWER] is m.Ack

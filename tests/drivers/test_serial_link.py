@@ -9,7 +9,7 @@ from collections.abc import Callable
 import pytest
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.link import Link
+from stairbot.drivers.serial_link import SerialLink
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
 from stairbot.errors import LinkLostError
 
@@ -60,16 +60,16 @@ def status_reply(frame: Frame) -> bytes:
     return answer(frame, m.Status(0, 0, 250, 0))
 
 
-def make_link(respond: Responder, delay: float = 0.001, **kw: int) -> tuple[Link,
-                                                                          ScriptedChannel]:
+def make_link(respond: Responder, delay: float = 0.001, **kw: int) -> tuple[
+        SerialLink, ScriptedChannel]:
     ch = ScriptedChannel(respond, delay)
-    return Link(ch, timeout_s=0.05, now=ch.now, **kw), ch
+    return SerialLink(ch, timeout_s=0.05, now=ch.now, **kw), ch
 
 
 def test_exchange_and_rtt() -> None:
     link, ch = make_link(status_reply, delay=0.002)
     reply = link.exchange(1, [m.GetStatus()])
-    assert reply.from_board and reply.messages == (m.Status(0, 0, 250, 0),)
+    assert reply.board == 1 and reply.messages == (m.Status(0, 0, 250, 0),)
     assert link.stats.frames_tx == link.stats.frames_rx == 1
     assert link.stats.rtt_median_ms() == pytest.approx(2.0)
 

@@ -17,13 +17,16 @@ import serial.rfc2217
 
 from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.serial_robot import SerialRobot, parse_serial_url
-from stairbot.errors import HardwareError, LinkLostError, RobotUrlError
+from stairbot.drivers.board_robot import BoardRobot
+from stairbot.drivers.serial_robot import parse_serial_url
+from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event, EventKind
-from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
-from stairbot.hardware import MotorId, SensorId
+from stairbot.hardware import HasTruth, MotorId, SensorId
 from stairbot.robots import RobotSession, open_robot
 from stairbot.runner import run
 from stairbot.scenario import Scenario, load_scenario
@@ -61,8 +64,8 @@ def fake() -> Iterator[Fake]:
     yield from serve()
 
 
-def robot_of(session: RobotSession) -> SerialRobot:
-    assert isinstance(session.robot, SerialRobot)
+def robot_of(session: RobotSession) -> BoardRobot:
+    assert isinstance(session.robot, BoardRobot)
     return session.robot
 
 
@@ -85,7 +88,10 @@ def test_read_command_and_lockstep_clock(fake: Fake) -> None:
         assert snap.health["frames_rx"] == snap.health["frames_tx"] > 50
         assert snap.health["lost"] == 0 and snap.health["rtt_median_ms"] > 0
         diag = session.robot.diagnostics()
-        assert diag["fell"] is False and diag["boards"]["motor"]["channels"] == 6
+        assert diag["boards"]["motor"]["channels"] == 6 and diag["wire"] == "serial port"
+        assert isinstance(session.robot, LockstepRobot) and isinstance(session.robot, HasTruth)
+        truth = session.robot.truth()
+        assert truth.fell is False and truth.max_pitch_deg is not None
     finally:
         session.close()
     assert fake.world.speeds()[MotorId.MTF] == 0.0  # close stops every motor
@@ -96,15 +102,38 @@ def test_estop_latches_on_the_boards_until_cleared(fake: Fake) -> None:
     robot = robot_of(session)
     robot.command({MotorId.MWF: 1.0})
     robot.estop()
-    assert fake.world.speeds()[MotorId.MWF] == 0.0
-    with pytest.raises(HardwareError, match="emergency stop latched"):
-        robot.read()
+    assert robot.estopped and fake.world.speeds()[MotorId.MWF] == 0.0
+    assert robot.read().motors[MotorId.MWF].fault == "estop"  # reading goes on
     robot.command({MotorId.MWF: 1.0})
     robot.flush()
     assert robot.refused == 2 and fake.world.speeds()[MotorId.MWF] == 0.0
     robot.clear(m.ClearMask.ESTOP)
+    assert not robot.estopped
     robot.read()
     session.close()
+
+
+def test_an_emergency_stop_latched_by_a_board_itself_stops_the_reads(fake: Fake) -> None:
+    session = fake.open()
+    fake.server.boards[m.Board.MOTOR].estop = True  # its own input, not this host
+    with pytest.raises(HardwareError, match="motor board has its emergency stop latched"):
+        session.robot.read()
+    session.close()
+
+
+def test_estop_never_raises_when_the_boards_fall_silent() -> None:
+    for fake in serve(WireFaults(silent_after_s=0.05)):  # they hear, but never answer
+        session = fake.open("lockstep=1&timeout=0.05&retries=0")
+        events: list[Event] = []
+        robot_of(session).attach_sink(events.append)
+        session.clock.advance(0.1)  # the StepTo goes out with the EStops: silent from then on
+        session.robot.estop()
+        assert session.robot.estopped
+        assert any("link lost" in e.message for e in events)
+        assert all(b.estop for b in fake.server.boards.values())  # they did hear it
+        session.close()
+        session.robot.estop()  # closed: no exception either
+        assert session.robot.estopped
 
 
 def test_heartbeat_feeds_boards_the_host_has_not_addressed_lately(fake: Fake) -> None:
@@ -118,24 +147,6 @@ def test_heartbeat_feeds_boards_the_host_has_not_addressed_lately(fake: Fake) ->
     robot.flush()
     assert robot.link.stats.frames_tx == before + 2
     session.close()
-
-
-def test_an_idle_robot_keeps_the_watchdogs_fed() -> None:
-    world = make_world(CONFIG, SCENARIO, lockstep=False)  # boards in real time
-    pty = PtyPair()
-    server = SerialBoardServer(pty.master, world, make_boards(world))
-    thread = threading.Thread(target=server.serve, daemon=True)
-    thread.start()
-    session = open_robot(f"serial://{pty.path}?watchdog=400&timeout=0.5", CONFIG)
-    try:
-        time.sleep(1.2)  # three watchdog periods with nothing from the control loop
-        session.robot.read()  # no watchdog trip
-        assert robot_of(session).link.stats.frames_tx >= 8  # the keepalive's Heartbeats
-    finally:
-        session.close()
-        server.stop()
-        thread.join(5)
-        pty.close()
 
 
 def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake: Fake) -> None:
@@ -352,10 +363,18 @@ def test_url_options() -> None:
 
 @pytest.mark.parametrize("url, problem", [
     ("serial:///dev/no-such-port", "cannot open port /dev/no-such-port"),
-    ("serial://loop://?timeout=0.01&retries=0", "no motor board answered on the serial port"),
     ("serial://", "expected serial://PORT"),
 ])
 def test_a_port_that_cannot_be_used_is_one_clear_line(url: str, problem: str) -> None:
     with pytest.raises(RobotUrlError) as info:
         open_robot(url, CONFIG)
     assert problem in str(info.value) and "\n" not in str(info.value)
+
+
+def test_no_board_answering_is_a_hardware_error_naming_board_and_url() -> None:
+    url = "serial://loop://?timeout=0.01&retries=1"
+    with pytest.raises(NoBoardError) as info:
+        open_robot(url, CONFIG)
+    assert str(info.value) == (f"{url}: no motor board answered on the serial port "
+                               "(2 tries of 10 ms)")
+    assert (info.value.board, info.value.url) == ("motor", url)

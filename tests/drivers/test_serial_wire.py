@@ -115,7 +115,7 @@ def test_frame_round_trip(board: int, seq: int, from_board: bool, msgs: list[m.M
     assert FrameReader().feed(wire) == [frame]
 
 
-@settings(max_examples=300)
+@settings(max_examples=300, deadline=None)
 @given(st.binary(max_size=400))
 def test_arbitrary_bytes_never_crash_the_decoders(data: bytes) -> None:
     with contextlib.suppress(CodecError):

@@ -8,9 +8,10 @@ from collections.abc import Mapping
 import pytest
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.serial_wire import RawMessage
+from stairbot.drivers.messages import RawMessage
 from stairbot.errors import RobotFellError
-from stairbot.fakes.boards import BoardWorld, MotorBoard, Pacer, SensorBoard, make_boards
+from stairbot.fakes.board_world import BoardWorld, Pacer
+from stairbot.fakes.boards import MotorBoard, SensorBoard, make_boards
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot, Truth
 
 

@@ -14,9 +14,10 @@ from hypothesis import strategies as st
 from test_boards import StubClock, StubRobot
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.link import FdChannel, Link
+from stairbot.drivers.serial_link import FdChannel, SerialLink
 from stairbot.drivers.serial_wire import Frame, FrameReader, crc16, encode_frame
-from stairbot.fakes.boards import BoardWorld, make_boards
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import SerialBoardServer
 
 
@@ -101,7 +102,7 @@ def test_a_repeated_frame_is_answered_again_but_executed_once(server: tuple) -> 
 def test_arbitrary_bytes_from_the_boards_never_crash_the_host(data: bytes) -> None:
     r, w = os.pipe()
     try:
-        link = Link(FdChannel(r), timeout_s=0.001)
+        link = SerialLink(FdChannel(r), timeout_s=0.001)
         os.write(w, data + b"\x00")
         link.poll()
         s = link.stats

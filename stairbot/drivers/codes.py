@@ -1,0 +1,90 @@
+"""The numbers and codes of the boards' protocol (docs/protocol.md, sections
+1 and 2, "Codes"): the protocol version, board addresses, channel order, and
+the code tables the messages carry.  Pure data: no message, no wire.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum, IntFlag
+
+from stairbot.hardware import MotorId, SensorId
+
+PROTOCOL_MAJOR = 1
+PROTOCOL_MINOR = 0
+MAX_PAYLOAD = 8
+INT16_MAX = 32767
+INT32_MAX = 2**31 - 1
+
+
+class Board(IntEnum):
+    """Board addresses (4 bits).  0 is reserved; 15 is the broadcast address."""
+
+    MOTOR = 1
+    SENSOR = 2
+
+
+BROADCAST = 0x0F
+
+# Channel numbers: the index of a motor or sensor on its board.
+MOTOR_CHANNELS: tuple[MotorId, ...] = (
+    MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL, MotorId.MTF, MotorId.MTB,
+)
+SENSOR_CHANNELS: tuple[SensorId, ...] = (SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL)
+LIFT_CHANNELS: frozenset[int] = frozenset({4, 5})
+ALL_MOTORS_MASK = 0x3F
+
+
+class MotorMode(IntEnum):
+    """What a motor is doing (4 bits in MotorTelemetry)."""
+
+    IDLE = 0  # speed 0: a wheel coasts to rest, a lift holds
+    RUN = 1  # running at a commanded speed
+    MOVE = 2  # moving a commanded number of turns
+    BRAKE = 3  # wheel actively braked; a lift holds
+    HOLD = 4  # stopped by e-stop, watchdog or fault; a lift holds
+
+
+class MotorFault(IntEnum):
+    NONE = 0
+    ESTOP = 1  # emergency stop latched
+    WATCHDOG = 2  # the board's watchdog tripped
+    OVERCURRENT = 3
+    STALL = 4
+    ENCODER = 5
+    LIMIT = 6  # a lift at the end of its stroke refused to go further
+    DRIVER = 7  # motor driver chip fault
+    SIMULATION = 8  # fake boards only: the simulated world failed (a fall); see Truth
+
+
+class SensorCode(IntEnum):
+    OK = 0
+    OUT_OF_RANGE = 1
+    ERROR = 2
+
+
+class StatusFlag(IntFlag):
+    """Board status bits (Status.flags)."""
+
+    ESTOP = 0x01  # emergency stop latched
+    WATCHDOG = 0x02  # watchdog tripped and latched
+    FAULT = 0x04  # some motor or sensor fault latched
+    SIMULATED = 0x40  # a fake board (simulation), not hardware
+    LOCKSTEP = 0x80  # a fake board whose physics advances only on StepTo
+
+
+class ClearMask(IntFlag):
+    ESTOP = 0x01
+    WATCHDOG = 0x02
+    FAULTS = 0x04
+    ALL = 0x07
+
+
+class AckResult(IntEnum):
+    OK = 0
+    ESTOP = 1  # refused: emergency stop latched
+    WATCHDOG = 2  # refused: watchdog fault latched
+    BAD_CHANNEL = 3
+    BAD_VALUE = 4
+    UNKNOWN_TYPE = 5
+    BAD_LENGTH = 6
+    NOT_SUPPORTED = 7  # e.g. StepTo on a real board
