@@ -47,7 +47,21 @@ def phases_visited(events: list[Event]) -> set[str]:
     return {str(e.data.get("phase")) for e in events if e.kind is EventKind.PHASE}
 
 
-@pytest.mark.parametrize("name", shipped())
+# Shipped scenarios that fail today, kept at the [expect] they must have.  Strict:
+# the moment one passes, the xfail fails, and its mark must go.
+KNOWN_FAILING = {
+    "low_short": "issue 10: 0.10 m rises with 0.22 m treads must be refused; the robot falls",
+    "very_low": "issue 10: 0.08 m rises with 0.24 m treads must be refused; the robot "
+                "climbs one and stops on the stairs",
+}
+
+
+def _shipped_params() -> list[object]:
+    return [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=KNOWN_FAILING[n]))
+            if n in KNOWN_FAILING else n for n in shipped()]
+
+
+@pytest.mark.parametrize("name", _shipped_params())
 def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
     scenario = load_scenario(name)
     result, events = run_sim(scenario)
