@@ -141,14 +141,16 @@ def terminal(grid: Grid) -> Text:
         e = grid.bx.edges
         hit = xlim and e and e[j] <= xlim[1] < e[j + 1]
         out.append(" ▲ " if hit else "   ")
-    out.append("\n" + " " * (lw + 1))
-    out.append("  ".join(lab for lab in grid.bx.labels[::3]) if len(grid.bx.labels) > 12 else
-               "".join(f"{lab[-3:]:^3}" for lab in grid.bx.labels))
-    out.append(f"   {grid.x}" + (f"  (▲ {xlim[0]} {xlim[1]:.3f})" if xlim else "") + "\n")
-    out.append(" " * (lw + 1))
+    out.append("\n")
+    labels = [lab[:8] for lab in grid.bx.labels]
+    for k in range(max((len(lab) for lab in labels), default=0)):  # column labels, vertical
+        out.append(" " * (lw + 1) + "".join(f" {lab[k] if k < len(lab) else ' '} "
+                                            for lab in labels) + "\n")
+    out.append(" " * (lw + 1) + f"{grid.x}" + (f"  (▲ {xlim[0]} {xlim[1]:.3f})" if xlim else "")
+               + "\n")
     for v in VERDICTS:
         out.append(f" {LETTERS[v]} ", style=f"bold white on {COLOURS[v]}")
-        out.append(f" {v}  ")
+        out.append(f" {v} ")
     out.append("\n")
     return out
 

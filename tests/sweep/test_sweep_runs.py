@@ -139,8 +139,8 @@ def test_stop_halfway_then_resume_loses_no_case_and_runs_none_twice(how: str,
         proc.wait(timeout=60)
         with (out / "cases.jsonl").open("a", encoding="utf-8") as f:
             f.write('{"case": 13, "verd')  # as if killed mid-write
-    else:
-        os.kill(proc.pid, signal.SIGINT)
+    else:  # as a terminal's Ctrl-C does: to the whole group, the pool's workers too
+        os.killpg(proc.pid, signal.SIGINT)
         assert proc.wait(timeout=120) == 130, proc.stderr.read() if proc.stderr else ""
     first = {r["case"] for r in lines_complete(out)}
     assert 5 <= len(first) < 14
