@@ -5,9 +5,11 @@ and the parallel efficiency (rate with N workers / (N x rate with 1)).
 The 100 cases are short (one 0.17 m step, a landing, a fresh noise seed per
 case) so the whole benchmark takes a few minutes on 2 cores.  Each executor
 first runs one warm-up case per worker (not counted), so the figures are the
-steady rate, not the pool's start-up.  With --repeat N each figure is the
-median of N runs.  The load average before and after is printed: other work
-on the machine lowers the 2-worker figures first.
+steady rate, not the pool's start-up.  "CPU s/case" is the workers' own CPU
+time per case: equal for 1 and 2 workers means the sweep adds no work when
+it runs in parallel, and a lower efficiency is the cores being shared.  With
+--repeat N each figure is the median of N runs.  The load average before and
+after is printed: other work on the machine lowers the 2-worker figures first.
 
 A script that prints figures, not a test: it asserts nothing.  Usage:
 
@@ -41,8 +43,9 @@ cases = {n}
 """
 
 
-def rate(cases: list[Case], jobs: int, dask: str | None) -> float:
-    """Cases per minute of ``cases`` on a fresh executor with ``jobs`` workers."""
+def rate(cases: list[Case], jobs: int, dask: str | None) -> tuple[float, float]:
+    """Cases per minute of ``cases`` on a fresh executor with ``jobs`` workers,
+    and the workers' mean CPU seconds per case."""
     spec = parse_spec(SPEC.format(n=len(cases)), "bench.toml")
     with tempfile.TemporaryDirectory() as tmp, open_executor(jobs, dask) as (ex, _label):
         wait([ex.submit(run_case, cases[k % len(cases)]) for k in range(jobs)])  # warm up
@@ -51,7 +54,8 @@ def rate(cases: list[Case], jobs: int, dask: str | None) -> float:
         out = run_cases(cases, store, ex, lambda _r: None, jobs)
         wall = time.perf_counter() - t0
         store.close()
-    return out.ran / wall * 60.0
+    cpu = statistics.fmean(r["cpu_s"] for r in out.records)
+    return out.ran / wall * 60.0, cpu
 
 
 def main() -> None:
@@ -70,14 +74,17 @@ def main() -> None:
             executors.append(("Dask LocalCluster", "local"))
         except ImportError:
             print("Dask: not installed (pip install 'stairbot[dask]'), skipped")
-    print(f"{'executor':<20} {'workers':>7} {'cases/min':>10} {'efficiency':>11}")
+    print(f"{'executor':<20} {'workers':>7} {'cases/min':>10} {'efficiency':>11} "
+          f"{'CPU s/case':>11}")
     for name, dask in executors:
         one = 0.0
         for jobs in (1, 2):
-            r = statistics.median(rate(cases, jobs, dask) for _ in range(args.repeat))
+            runs = sorted(rate(cases, jobs, dask) for _ in range(args.repeat))
+            r, cpu = runs[len(runs) // 2]
             one = one or r
             eff = r / (jobs * one)
-            print(f"{name:<20} {jobs:>7} {r:>10.1f} {100 * eff:>10.0f} %", flush=True)
+            print(f"{name:<20} {jobs:>7} {r:>10.1f} {100 * eff:>10.0f} % {cpu:>11.3f}",
+                  flush=True)
     print(f"load after {os.getloadavg()[0]:.2f}")
 
 

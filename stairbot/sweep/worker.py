@@ -47,7 +47,7 @@ def _left_moving(session: Any, config: Any) -> list[str]:
 
 def run_case(case: Case) -> dict[str, Any]:
     """Run ``case`` on ``sim://`` and judge it.  Returns the JSONL record."""
-    wall0 = time.perf_counter()
+    wall0, cpu0 = time.perf_counter(), time.process_time()
     record: dict[str, Any] = {"case": case.index, "axes": case.axes, "facts": case.facts}
     try:
         from stairbot.config import load_config, parse_config
@@ -71,4 +71,5 @@ def run_case(case: Case) -> dict[str, Any]:
         record.update(verdict="error", why=f"{type(exc).__name__}: {exc}",
                       traceback=traceback.format_exc(), result=None)
     record["wall_s"] = round(time.perf_counter() - wall0, 3)
+    record["cpu_s"] = round(time.process_time() - cpu0, 3)
     return record
