@@ -5,14 +5,17 @@ worker per core, ``-j N``).  With ``--dask ADDRESS`` (a running scheduler) or
 ``--dask local`` (a LocalCluster on this machine) the very same loop runs on
 ``Client.get_executor()``, a ``concurrent.futures.Executor`` too.
 
-At most two cases per worker are in flight, so Ctrl-C stops quickly: no new
-case starts, the running ones finish and are written, then the loop returns.
+Cases run in a shuffled order (seeded by the spec hash), so a sweep stopped
+early has covered its whole grid thinly rather than its first rows.  At most
+two cases per worker are in flight, so Ctrl-C stops quickly: no new case
+starts, the running ones finish and are written, then the loop returns.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import random
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
@@ -93,7 +96,11 @@ def run_cases(cases: list[Case], store: ResultStore, executor: Executor,
     are written."""
     out = Outcome()
     t0 = time.perf_counter()
-    todo = iter([c for c in cases if c.index not in store.done])
+    # A seeded shuffle: a sweep stopped early has run a uniform sample of its
+    # cases, not the first rows of its grid (the order never changes a result).
+    order = [c for c in cases if c.index not in store.done]
+    random.Random(store.spec.hash).shuffle(order)
+    todo = iter(order)
     pending: dict[Future[dict[str, Any]], Case] = {}
     limit = max(1, 2 * jobs)
 
