@@ -46,6 +46,9 @@ EXTERNAL: dict[str, tuple[str, str]] = {
                 "the operator console: a terminal UI that watches and commands the robot"),
     "fake-boards": ("stairbot.fakes.boards_cli:main",
                     "serve simulated motor and sensor boards on a pseudo-terminal or CAN bus"),
+    "sweep": ("stairbot.sweep.cli:main",
+              "run many generated cases and judge each (stairbot sweep SPEC.toml; "
+              "docs/envelope.md)"),
 }
 
 ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N, "

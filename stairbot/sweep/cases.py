@@ -1,0 +1,213 @@
+"""Cases: a case index becomes a scenario TOML (and a robot config TOML when
+the spec overrides the robot), built and validated by the same loaders that
+``stairbot run --scenario/--config`` use, so what a sweep runs is what a person
+reproduces from the files it writes.
+
+:func:`check_spec` builds every case before any runs: a value the loaders
+refuse (and the edges of every distribution) stops the sweep with a SpecError
+naming the axis.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass, field
+from functools import cache
+from importlib import resources
+from typing import Any
+
+from stairbot._schema import _tokens
+from stairbot.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
+from stairbot.errors import ConfigError, ScenarioError
+from stairbot.scenario import DEFAULT_COUNT, DEFAULT_RISE, DEFAULT_TREAD, Scenario, parse_scenario
+from stairbot.sweep import tomlw
+from stairbot.sweep.spec import VIRTUAL, Axis, Rules, Spec, SpecError, case_rng
+
+DIGITS = 6  # drawn values are rounded to a micrometre (or a micro-degree) before use
+
+
+@dataclass(frozen=True)
+class Case:
+    """One case, ready to run: its index, its axis values, the documents, and
+    the facts the verdict needs (limits, zone, steps expected)."""
+
+    index: int
+    axes: dict[str, Any]
+    scenario_text: str
+    config_text: str | None  # None: the reference robot
+    facts: dict[str, Any] = field(default_factory=dict)
+
+
+@cache
+def _default_config_text() -> str:
+    return resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
+
+
+@cache
+def _parsed_config(text: str | None) -> RobotConfig:
+    return parse_config(text or _default_config_text(), "<config>")
+
+
+def _set(doc: dict[str, Any], path: str, value: Any) -> None:
+    tokens = _tokens("." + path)
+    node: Any = doc
+    for tok, nxt in zip(tokens, tokens[1:], strict=False):
+        if isinstance(tok, int):
+            if not isinstance(node, list) or tok >= len(node):
+                have = len(node) if isinstance(node, list) else 0
+                raise IndexError(f"the base has {have} such entries")
+            node = node[tok]
+        else:
+            node = node.setdefault(tok, [] if isinstance(nxt, int) else {})
+    last = tokens[-1]
+    if isinstance(last, int):
+        if not isinstance(node, list) or last >= len(node):
+            raise IndexError(f"the base has {len(node) if isinstance(node, list) else 0} entries")
+        node[last] = value
+    else:
+        node[last] = value
+
+
+def _round(value: Any) -> Any:
+    return round(value, DIGITS) if isinstance(value, float) else value
+
+
+def _jitter(spec: Spec, index: int, stairs: dict[str, Any], values: dict[str, Any]) -> None:
+    """Per-step variation: replace count/rise/tread by explicit steps, each step's
+    rise and tread moved by a uniform draw of at most the jitter."""
+    rj = float(values.get("stairs.rise_jitter", 0.0) or 0.0)
+    tj = float(values.get("stairs.tread_jitter", 0.0) or 0.0)
+    if rj == 0.0 and tj == 0.0:
+        return
+    if "steps" in stairs:
+        steps = [dict(s) for s in stairs.pop("steps")]
+    else:
+        count = stairs.pop("count", DEFAULT_COUNT)
+        rise, tread = stairs.pop("rise", DEFAULT_RISE), stairs.pop("tread", DEFAULT_TREAD)
+        steps = [{"rise": rise, "tread": tread} for _ in range(count)]
+    rng = case_rng(spec.seed, index, "stairs.jitter")
+    for s in steps:
+        s["rise"] = round(float(s["rise"]) + rng.uniform(-rj, rj), DIGITS)
+        s["tread"] = round(float(s["tread"]) + rng.uniform(-tj, tj), DIGITS)
+    stairs.pop("count", None)
+    stairs.pop("rise", None)
+    stairs.pop("tread", None)
+    stairs["steps"] = steps
+
+
+def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, float, float]:
+    """("inside" | "band" | "outside", max rise, min tread) of the steps the robot
+    attempts (the first max_steps) against its limits (rises between
+    min_step_rise_m and max_step_rise_m, treads of min_tread_m or more), give
+    or take the margins.
+    A tread counts where the robot must fit on it: every tread it climbs onto,
+    but not the last one under a landing, which runs on into the landing."""
+    steps = scenario.steps[:config.algorithm.max_steps]
+    if not steps:
+        return "inside", 0.0, math.inf
+    max_rise = max(s.rise for s in steps)
+    min_rise = min(s.rise for s in steps)
+    last = len(scenario.steps) - 1
+    treads = [s.tread for i, s in enumerate(steps) if not (i == last and scenario.top == "landing")]
+    min_tread = min(treads, default=math.inf)
+    lr, lo, lt = config.max_step_rise_m, config.min_step_rise_m, config.min_tread_m
+    rm, tm = rules.rise_margin_m, rules.tread_margin_m
+    if max_rise > lr + rm or min_rise < lo - rm or min_tread < lt - tm:
+        return "outside", max_rise, min_tread
+    if max_rise <= lr - rm and min_rise >= lo + rm and min_tread >= lt + tm:
+        return "inside", max_rise, min_tread
+    return "band", max_rise, min_tread
+
+
+def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) -> Case:
+    """Case ``index`` (with one axis forced to a value, to check a distribution's
+    edges).  Raises SpecError when the loaders refuse what the axes make."""
+    values = {p: _round(v) for p, v in spec.axis_values(index).items()}
+    if override is not None:
+        values[override[0]] = _round(override[1])
+    scen = copy.deepcopy(_base(spec.scenario_text))
+    scen.pop("expect", None)
+    has_config = spec.config_text is not None or any(p.startswith("config.") for p in values)
+    cfg = copy.deepcopy(_base(spec.config_text or _default_config_text())) if has_config else None
+    for path, value in values.items():
+        if path in VIRTUAL:
+            continue
+        target, sub = (cfg, path.removeprefix("config.")) if path.startswith("config.") else (
+            scen, path)
+        assert target is not None
+        if path in ("stairs.count", "stairs.rise", "stairs.tread"):
+            scen.setdefault("stairs", {}).pop("steps", None)
+        if path == "stairs.steps":
+            for k in ("count", "rise", "tread"):
+                scen.setdefault("stairs", {}).pop(k, None)
+        try:
+            _set(target, sub, value)
+        except IndexError as exc:
+            raise SpecError(spec.source, f"axes.{path}", str(exc)) from None
+    _jitter(spec, index, scen.setdefault("stairs", {}), values)
+    scen["name"] = f"{spec.name}-{index:06d}"
+    scen["description"] = f"case {index} of sweep {spec.name} ({spec.hash[:12]})"
+    scenario_text = tomlw.dumps(scen)
+    config_text = None if cfg is None else tomlw.dumps(cfg)
+    where = f"case {index}" + (f" ({override[0]} = {override[1]!r})" if override else "")
+    try:
+        scenario = parse_scenario(scenario_text, "<case>")
+    except ScenarioError as exc:
+        raise _blame(spec, exc.field, "", exc.problem, where, values) from None
+    try:
+        config = _parsed_config(config_text)
+    except ConfigError as exc:
+        raise _blame(spec, exc.field, "config.", exc.problem, where, values) from None
+    z, max_rise, min_tread = zone(scenario, config, spec.rules)
+    facts = {
+        "zone": z, "count": len(scenario.steps), "max_rise_m": max_rise,
+        "min_tread_m": min_tread if math.isfinite(min_tread) else None,
+        "limit_rise_m": round(config.max_step_rise_m, DIGITS),
+        "limit_tread_m": round(config.min_tread_m, DIGITS),
+        "expected_steps": min(len(scenario.steps), config.algorithm.max_steps),
+        "faults": len(scenario.faults), "home_m": spec.rules.home_m,
+    }
+    return Case(index, values, scenario_text, config_text, facts)
+
+
+@cache
+def _base_cached(text: str) -> dict[str, Any]:
+    return tomllib.loads(text)
+
+
+def _base(text: str) -> dict[str, Any]:
+    return _base_cached(text)
+
+
+def _blame(spec: Spec, field_: str | None, prefix: str, problem: str, where: str,
+           values: dict[str, Any]) -> SpecError:
+    """Name the axis that made the loaders refuse a case (or the base file)."""
+    full = f"{prefix}{field_}" if field_ else None
+    axis = next((p for p in values if full is not None and (
+        p == full or full.startswith(p + ".") or full.startswith(p + "["))), None)
+    if axis is None and full is not None and full.startswith("stairs.steps"):
+        axis = next((p for p in values if p.startswith("stairs.")), None)
+    if axis is None:
+        axis = next((p for p in values if p.startswith(prefix or "@")), None) if prefix else None
+    name = f"axes.{axis}" if axis else ("sweep.config" if prefix else "sweep.scenario")
+    what = "robot config" if prefix else "scenario"
+    return SpecError(spec.source, name, f"{where}: the {what} refuses it: "
+                     f"{full or 'the document'}: {problem}")
+
+
+def check_spec(spec: Spec) -> list[Case]:
+    """Every case of the spec, built and validated, after the edges of each
+    distribution are checked.  Raises SpecError (nothing has run)."""
+    if spec.total == 0:
+        raise SpecError(spec.source, "axes", "the axes give no cases")
+    for axis in spec.axes:
+        if axis.sampled:
+            _check_edges(spec, axis)
+    return [build_case(spec, i) for i in range(spec.total)]
+
+
+def _check_edges(spec: Spec, axis: Axis) -> None:
+    for value in axis.extremes():
+        build_case(spec, 0, (axis.path, value))

@@ -1,0 +1,165 @@
+"""``stairbot sweep``: run a sweep spec, or redraw the report of a results folder.
+
+::
+
+    stairbot sweep SPEC.toml [-j N | --dask ADDRESS|local] [--out DIR] [--resume]
+    stairbot sweep check SPEC.toml
+    stairbot sweep report RESULTS [--x AXIS --y AXIS] [--png FILE]
+
+Exit codes: 0 no case unsafe, stranded, wrong or error; 1 some are (the counts
+are on the last line); 2 a bad spec, folder or option (one line, nothing ran);
+130 stopped by Ctrl-C (what finished is kept: rerun with --resume).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from rich.console import Console
+
+from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
+from stairbot.sweep.spec import SpecError
+from stairbot.sweep.verdict import passing
+
+EXIT_OK, EXIT_FAILURES, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise SpecError(self.prog, None, message)
+
+
+def _jobs(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed: 1 or more")
+    return n
+
+
+def _plot_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--x", metavar="AXIS", help="heat map x axis (default: the spec's [report])")
+    p.add_argument("--y", metavar="AXIS", help="heat map y axis")
+    p.add_argument("--png", metavar="FILE", type=Path,
+                   help="where to write the PNG heat map (default: RESULTS/heatmap.png; "
+                        "needs stairbot[plot])")
+    p.add_argument("--no-png", action="store_true", help="draw the heat map in the terminal only")
+
+
+def run_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="stairbot sweep", formatter_class=argparse.RawDescriptionHelpFormatter,
+                description=__doc__, epilog="The spec format and the verdict rules: "
+                "docs/envelope.md.  Shipped specs: sweeps/*.toml.")
+    p.add_argument("spec", metavar="SPEC.toml", help="the sweep spec")
+    p.add_argument("-j", "--jobs", type=_jobs, help="worker processes (default: one per core)")
+    p.add_argument("--dask", metavar="ADDRESS|local",
+                   help="run on a Dask scheduler (tcp://HOST:8786), or 'local' for a "
+                        "LocalCluster of -j workers (needs stairbot[dask])")
+    p.add_argument("--out", metavar="DIR", type=Path,
+                   help="results folder (default: ./sweep-NAME-HASH8)")
+    p.add_argument("--resume", action="store_true",
+                   help="keep the cases already in the results folder, run the rest")
+    p.add_argument("--limit", metavar="N", type=_jobs, help="run only the first N cases")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress, no tables")
+    _plot_options(p)
+    return p
+
+
+def main(argv: Sequence[str]) -> int:
+    """Entry point of ``stairbot sweep`` (argv after the word ``sweep``)."""
+    argv = list(argv)
+    if argv[:1] == ["report"]:
+        return cmd_report(argv[1:])
+    if argv[:1] == ["check"]:
+        return cmd_check(argv[1:])
+    return cmd_sweep(argv)
+
+
+def cmd_check(argv: list[str]) -> int:
+    p = _Parser(prog="stairbot sweep check",
+                description="Validate a spec: build and check every case, run none.")
+    p.add_argument("spec", metavar="SPEC.toml")
+    args = p.parse_args(argv)
+    from stairbot.sweep.cases import check_spec
+    from stairbot.sweep.spec import load_spec
+
+    spec = load_spec(args.spec)
+    cases = check_spec(spec)
+    zones = counts_of([{"verdict": c.facts["zone"]} for c in cases])
+    print(f"ok  {args.spec}: {len(cases)} case(s) ({spec.grid_size} grid point(s) x "
+          f"{spec.samples_per_point}); inside {zones['inside']}, band {zones['band']}, "
+          f"outside {zones['outside']}; hash {spec.hash[:12]}")
+    return EXIT_OK
+
+
+def cmd_sweep(argv: list[str]) -> int:
+    args = run_parser().parse_args(argv)
+    from stairbot.sweep.cases import check_spec
+    from stairbot.sweep.execute import default_jobs, open_executor, run_cases
+    from stairbot.sweep.spec import load_spec
+    from stairbot.sweep.store import ResultStore, meta_of
+
+    spec = load_spec(args.spec)
+    cases = check_spec(spec)  # a bad spec never starts work
+    if args.limit is not None:
+        cases = cases[:args.limit]
+    jobs = args.jobs or default_jobs()
+    folder = args.out or Path(f"sweep-{spec.name}-{spec.hash[:8]}")
+    store = ResultStore(folder, spec, args.resume)
+    console = Console()
+    try:
+        with open_executor(jobs, args.dask) as (executor, label):
+            view = ProgressView(len(cases), counts_of(store.records),
+                                f"{spec.name} on {label}", args.quiet)
+            try:
+                out = run_cases(cases, store, executor, view.update, jobs)
+            finally:
+                view.close()
+    finally:
+        store.close()
+    records = [r for r in store.records if r["case"] < len(cases)]
+    meta = meta_of(spec)
+    if not args.quiet:
+        print_summary(records, meta, console, spec.report.worst)
+        png = draw(records, meta, folder, console, args.x, args.y, args.png, not args.no_png)
+        if png is not None:
+            print(f"heat map: {png}")
+    failing = sum(1 for r in records if not passing(str(r["verdict"])))
+    rate = f"{out.ran / out.wall_s * 60:.0f} cases/min" if out.wall_s > 0 and out.ran else "-"
+    state = "interrupted; rerun with --resume" if out.interrupted else (
+        f"{failing} not passing" if failing else "all passing")
+    print(f"sweep {spec.name}: {len(records)}/{len(cases)} case(s) in {folder} "
+          f"({out.ran} run now in {out.wall_s:.1f} s, {rate}; {state}): "
+          f"{counts_line(counts_of(records))}", flush=True)
+    if out.interrupted:
+        return EXIT_INTERRUPTED
+    return EXIT_FAILURES if failing else EXIT_OK
+
+
+def cmd_report(argv: list[str]) -> int:
+    p = _Parser(prog="stairbot sweep report",
+                description="Redraw the verdict table, worst cases and heat maps "
+                            "from a results folder.")
+    p.add_argument("results", metavar="RESULTS", type=Path, help="a sweep results folder")
+    p.add_argument("--worst", metavar="N", type=int, help="how many worst cases to list")
+    _plot_options(p)
+    args = p.parse_args(argv)
+    from stairbot.sweep.store import read_meta, read_records
+
+    meta = read_meta(args.results)
+    records = list({r["case"]: r for r in read_records(args.results)}.values())
+    console = Console()
+    print_summary(records, meta, console,
+                  args.worst if args.worst is not None else int(meta["report"]["worst"]))
+    png = draw(records, meta, args.results, console, args.x, args.y, args.png, not args.no_png)
+    if png is not None:
+        print(f"heat map: {png}")
+    failing = sum(1 for r in records if not passing(str(r["verdict"])))
+    print(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
+          f"{counts_line(counts_of(records))}", file=sys.stdout)
+    return EXIT_FAILURES if failing else EXIT_OK

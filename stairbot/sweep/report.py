@@ -1,0 +1,169 @@
+"""What a person looks at: the progress line while a sweep runs, and at the end
+the verdict counts, the worst cases and the heat maps (``stairbot sweep
+report RESULTS`` redraws them from a results folder)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+from stairbot.sweep import heatmap
+from stairbot.sweep.verdict import SEVERITY, VERDICTS
+
+STYLE = {"climbed": "green", "refused": "blue", "stranded": "yellow", "wrong": "magenta",
+         "unsafe": "red", "error": "bold red"}
+
+
+def counts_of(records: list[dict[str, Any]]) -> Counter[str]:
+    return Counter(str(r.get("verdict")) for r in records)
+
+
+def counts_line(counts: Counter[str], markup: bool = False) -> str:
+    parts = []
+    for v in VERDICTS:
+        text = f"{v} {counts.get(v, 0)}"
+        parts.append(f"[{STYLE[v]}]{text}[/]" if markup and counts.get(v) else text)
+    return ", ".join(parts)
+
+
+class ProgressView:
+    """A progress bar with counts per verdict and an ETA on a terminal; plain
+    lines every 10 s (or 10 %) elsewhere, so CI logs stay short."""
+
+    def __init__(self, total: int, done: Counter[str], label: str, quiet: bool = False) -> None:
+        self.total, self.counts, self.quiet = total, Counter(done), quiet
+        self.err = Console(stderr=True)
+        self.live = sys.stderr.isatty() and not quiet
+        self.t0 = self.last = time.monotonic()
+        self.start_done = sum(done.values())
+        self.progress: Progress | None = None
+        if self.live:
+            self.progress = Progress(
+                TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                TextColumn("{task.fields[counts]}"), TimeElapsedColumn(), TextColumn("eta"),
+                TimeRemainingColumn(), console=self.err, transient=False)
+            self.task = self.progress.add_task(label, total=total,
+                                               completed=self.start_done,
+                                               counts=counts_line(self.counts, True))
+            self.progress.start()
+        elif not quiet:
+            print(f"{label}: {total} cases, {self.start_done} already done", file=sys.stderr,
+                  flush=True)
+
+    def update(self, record: dict[str, Any]) -> None:
+        self.counts[str(record.get("verdict"))] += 1
+        n = sum(self.counts.values())
+        if self.progress is not None:
+            self.progress.update(self.task, completed=n, counts=counts_line(self.counts, True))
+            return
+        now = time.monotonic()
+        if self.quiet or not (now - self.last >= 10 or n == self.total
+                              or n % max(1, self.total // 10) == 0):
+            return
+        self.last = now
+        ran = n - self.start_done
+        eta = (now - self.t0) / ran * (self.total - n) if ran else 0.0
+        print(f"[{n}/{self.total}] {counts_line(self.counts)}; eta {eta:.0f} s",
+              file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.progress is not None:
+            self.progress.stop()
+
+
+def _short(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, list):
+        return f"[{len(value)} item(s)]"
+    return str(value)
+
+
+def worst_cases(records: list[dict[str, Any]], n: int) -> list[dict[str, Any]]:
+    bad = [r for r in records if SEVERITY.get(str(r.get("verdict")), 0) > 0]
+    bad.sort(key=lambda r: (-SEVERITY[str(r["verdict"])],
+                            -((r.get("result") or {}).get("max_pitch_deg") or 0.0), r["case"]))
+    return bad[:n]
+
+
+def print_summary(records: list[dict[str, Any]], meta: dict[str, Any], console: Console,
+                  worst: int) -> None:
+    counts = counts_of(records)
+    table = Table(title=f"sweep {meta.get('name')}: {len(records)} of {meta.get('total')} "
+                        "case(s)", title_justify="left")
+    table.add_column("verdict")
+    table.add_column("cases", justify="right")
+    table.add_column("share", justify="right")
+    for v in VERDICTS:
+        k = counts.get(v, 0)
+        share = f"{100 * k / len(records):.1f} %" if records else "-"
+        table.add_row(f"[{STYLE[v]}]{v}[/]", str(k), share)
+    console.print(table)
+    bad = worst_cases(records, worst)
+    if not bad:
+        return
+    wt = Table(title=f"worst {len(bad)} case(s)", title_justify="left")
+    for col in ("case", "verdict", "axes", "why", "reproduce"):
+        wt.add_column(col, overflow="fold")
+    for r in bad:
+        axes = ", ".join(f"{k.split('.')[-1]}={_short(v)}" for k, v in r.get("axes", {}).items())
+        wt.add_row(str(r["case"]), f"[{STYLE[r['verdict']]}]{r['verdict']}[/]", axes,
+                   str(r.get("why", ""))[:90], str(r.get("reproduce", "")))
+    console.print(wt)
+
+
+def choose_axes(meta: dict[str, Any], x: str | None, y: str | None) -> tuple[str, str] | None:
+    """The heat map's axes: given, else the spec's [report], else the first two
+    numeric axes, else the stairs' min tread x max rise."""
+    rep = meta.get("report", {})
+    x = x or rep.get("x")
+    y = y or rep.get("y")
+    if x and y:
+        return x, y
+    paths = [a["path"] for a in meta.get("axes", []) if a["kind"] != "choice"]
+    if len(paths) >= 2:
+        return x or paths[1], y or paths[0]
+    return x or "min_tread_m", y or "max_rise_m"
+
+
+def draw(records: list[dict[str, Any]], meta: dict[str, Any], folder: Path, console: Console,
+         x: str | None = None, y: str | None = None, png: Path | None = None,
+         want_png: bool = True) -> Path | None:
+    """The terminal heat map, and the PNG (default RESULTS/heatmap.png) when
+    matplotlib is there; returns the PNG's path or None."""
+    axes = choose_axes(meta, x, y)
+    if axes is None or not records:
+        return None
+    rep = meta.get("report", {})
+    grid = heatmap.Grid.build(records, axes[0], axes[1], int(rep.get("bins", 12)))
+    console.print(heatmap.terminal(grid))
+    if not want_png:
+        return None
+    rules = meta.get("rules", {})
+    title = (f"sweep {meta.get('name')} ({meta.get('hash', '')[:12]}): {len(records)} cases; "
+             + counts_line(counts_of(records)))
+    from stairbot.sweep.execute import ExtraMissing
+
+    try:
+        return heatmap.png(grid, png or folder / "heatmap.png", title,
+                           (float(rules.get("rise_margin_m", 0.01)),
+                            float(rules.get("tread_margin_m", 0.01))))
+    except ExtraMissing as exc:
+        if png is not None:  # asked for by name: a missing extra is an error
+            raise
+        console.print(f"no PNG heat map: {exc.problem}")
+        return None

@@ -1,0 +1,353 @@
+"""The sweep spec: which axes to vary, how, and the verdict rules.
+
+A spec is a TOML file (docs/envelope.md)::
+
+    [sweep]
+    name = "limits"          # default: the file name
+    seed = 7                 # master seed of every sampled axis
+    cases = 4                # samples per grid point (with sampled axes)
+    scenario = "default"     # base scenario: a file (relative to the spec) or a shipped name
+    config = "robot.toml"    # base robot config (default: the reference robot)
+
+    [axes]                   # dotted paths into the scenario, or config.SECTION.KEY
+    "stairs.rise" = { range = [0.18, 0.22, 0.005] }   # grid: start, stop, step
+    "stairs.tread" = [0.26, 0.28]                     # grid: these values
+    "start.yaw_deg" = { uniform = [-20, 20] }         # sampled per case
+    "sensors.seed" = { randint = [1, 1000000] }
+
+    [verdict]                # all optional
+    rise_margin_m = 0.01
+    tread_margin_m = 0.01
+    home_m = 0.05
+
+    [report]
+    x = "stairs.tread"
+    y = "stairs.rise"
+
+Everything wrong with a spec raises :class:`SpecError` (exit 2, one line).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import random
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Any
+
+import msgspec
+import msgspec.inspect as mi
+
+from stairbot._schema import _tokens, _type_at, convert, load_toml
+from stairbot.config import ConfigFile
+from stairbot.errors import InputError
+from stairbot.scenario import ScenarioFile
+
+
+class SpecError(InputError):
+    """A sweep spec is malformed: the CLI exits 2 before any case runs."""
+
+
+GRID_KINDS = ("list", "range")
+SAMPLED_KINDS = ("uniform", "normal", "choice", "randint")
+DISTRIBUTIONS = ("range", *SAMPLED_KINDS)
+VIRTUAL = {
+    "stairs.rise_jitter": "each step's rise varies uniformly by up to this much, m",
+    "stairs.tread_jitter": "each step's tread varies uniformly by up to this much, m",
+}
+NORMAL_SIGMAS = 4.0  # a normal axis must be valid this many deviations either side
+
+
+class SweepTable(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    name: str | None = None
+    description: str = ""
+    seed: int = 1
+    cases: Annotated[int, msgspec.Meta(ge=1, le=1_000_000)] = 1
+    scenario: str | None = None
+    config: str | None = None
+
+
+class VerdictTable(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    rise_margin_m: Annotated[float, msgspec.Meta(ge=0)] = 0.01
+    tread_margin_m: Annotated[float, msgspec.Meta(ge=0)] = 0.01
+    home_m: Annotated[float, msgspec.Meta(gt=0)] = 0.05
+
+
+class ReportTable(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    x: str | None = None
+    y: str | None = None
+    worst: Annotated[int, msgspec.Meta(ge=0)] = 10
+    bins: Annotated[int, msgspec.Meta(ge=2, le=40)] = 12
+
+
+class SpecFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    sweep: SweepTable = msgspec.field(default_factory=SweepTable)
+    axes: dict[str, Any] = msgspec.field(default_factory=dict)
+    verdict: VerdictTable = msgspec.field(default_factory=VerdictTable)
+    report: ReportTable = msgspec.field(default_factory=ReportTable)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One axis: a grid (``list``/``range``: every value, a product with the other
+    grids) or a distribution drawn once per case."""
+
+    path: str
+    kind: str
+    values: tuple[Any, ...] = ()
+    params: tuple[float, ...] = ()
+
+    @property
+    def sampled(self) -> bool:
+        return self.kind in SAMPLED_KINDS
+
+    def draw(self, rng: random.Random) -> Any:
+        if self.kind == "uniform":
+            return rng.uniform(self.params[0], self.params[1])
+        if self.kind == "normal":
+            return rng.gauss(self.params[0], self.params[1])
+        if self.kind == "randint":
+            return rng.randint(int(self.params[0]), int(self.params[1]))
+        return self.values[rng.randrange(len(self.values))]
+
+    def extremes(self) -> list[Any]:
+        """The values a distribution can reach at its edges (checked up front)."""
+        if self.kind == "randint":
+            return [int(p) for p in self.params]
+        if self.kind == "uniform":
+            return list(self.params)
+        if self.kind == "normal":
+            mu, sd = self.params
+            return [mu - NORMAL_SIGMAS * sd, mu + NORMAL_SIGMAS * sd]
+        return list(self.values)
+
+    def describe(self) -> str:
+        if self.kind in ("list", "range", "choice"):
+            return f"{self.kind} of {len(self.values)}"
+        return f"{self.kind}({', '.join(f'{p:g}' for p in self.params)})"
+
+
+@dataclass(frozen=True)
+class Rules:
+    rise_margin_m: float = 0.01
+    tread_margin_m: float = 0.01
+    home_m: float = 0.05
+
+
+@dataclass(frozen=True)
+class Spec:
+    source: str
+    name: str
+    description: str
+    seed: int
+    samples: int
+    axes: tuple[Axis, ...]
+    rules: Rules
+    scenario_text: str
+    config_text: str | None
+    report: ReportTable
+    raw: dict[str, Any] = field(repr=False)
+
+    @property
+    def hash(self) -> str:
+        blob = json.dumps({"spec": self.raw, "scenario": self.scenario_text,
+                           "config": self.config_text}, sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()
+
+    @property
+    def grid_axes(self) -> tuple[Axis, ...]:
+        return tuple(a for a in self.axes if not a.sampled)
+
+    @property
+    def sampled_axes(self) -> tuple[Axis, ...]:
+        return tuple(a for a in self.axes if a.sampled)
+
+    @property
+    def grid_size(self) -> int:
+        return math.prod(len(a.values) for a in self.grid_axes)
+
+    @property
+    def samples_per_point(self) -> int:
+        return self.samples if self.sampled_axes else 1
+
+    @property
+    def total(self) -> int:
+        return self.grid_size * self.samples_per_point
+
+    def axis_values(self, index: int) -> dict[str, Any]:
+        """Every axis's value in case ``index``: the grid point is index //
+        samples (axes in spec order, the last varying fastest), each sampled
+        axis is drawn from its own generator seeded by (seed, index, path)."""
+        if not 0 <= index < self.total:
+            raise IndexError(f"case {index} is outside 0..{self.total - 1}")
+        point, _ = divmod(index, self.samples_per_point)
+        out: dict[str, Any] = {}
+        grid = self.grid_axes
+        sizes = [len(a.values) for a in grid]
+        for axis, size in zip(reversed(grid), reversed(sizes), strict=True):
+            point, k = divmod(point, size)
+            out[axis.path] = axis.values[k]
+        for axis in self.sampled_axes:
+            out[axis.path] = axis.draw(case_rng(self.seed, index, axis.path))
+        return {a.path: out[a.path] for a in self.axes}
+
+
+def case_rng(seed: int, index: int, what: str) -> random.Random:
+    """The generator for one draw: the same (seed, case, axis) gives the same value
+    on every machine and Python version (string seeds hash with SHA-512)."""
+    return random.Random(f"{seed}/{index}/{what}")
+
+
+# -- parsing ---------------------------------------------------------------------
+
+
+def _known_type(path: str) -> Any:
+    """The schema type at a dotted axis path, or None when there is no such field."""
+    if path in VIRTUAL:
+        return "virtual"
+    if path.startswith("config."):
+        return _type_at(ConfigFile, _tokens("." + path.removeprefix("config.")))
+    if path.split(".")[0].split("[")[0] in ("expect", "name", "description"):
+        return None
+    return _type_at(ScenarioFile, _tokens("." + path))
+
+
+def _allowed_paths() -> str:
+    paths = []
+    for name in ("stairs", "start", "sensors", "faults"):
+        sub = _type_at(ScenarioFile, [name])
+        if isinstance(sub, mi.StructType):
+            paths += [f"{name}.{g.encode_name}" for g in sub.fields]
+        else:
+            paths.append(name)
+    paths += list(VIRTUAL)
+    return ", ".join(paths) + ", faults[N].KEY, config.SECTION.KEY (see `stairbot config show`)"
+
+
+def _flatten(table: dict[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
+    out: list[tuple[str, Any]] = []
+    for key, value in table.items():
+        path = f"{prefix}.{key}" if prefix else key
+        is_dist = isinstance(value, dict) and (
+            bool(set(value) & set(DISTRIBUTIONS)) or _known_type(path) is not None)
+        if isinstance(value, dict) and not is_dist:
+            out += _flatten(value, path)
+        else:
+            out.append((path, value))
+    return out
+
+
+def _numbers(src: str, where: str, value: Any, count: int, what: str) -> list[float]:
+    ok = (isinstance(value, list) and len(value) == count
+          and all(isinstance(v, int | float) and not isinstance(v, bool)
+                  and math.isfinite(v) for v in value))
+    if not ok:
+        raise SpecError(src, where, f"{value!r} is not allowed; allowed: {what}")
+    return [float(v) for v in value]
+
+
+def parse_axis(src: str, path: str, value: Any) -> Axis:
+    """One ``[axes]`` entry.  Raises SpecError naming ``axes.PATH``."""
+    where = f"axes.{path}"
+    if _known_type(path) is None:
+        raise SpecError(src, where, f"unknown axis; allowed: {_allowed_paths()}")
+    if isinstance(value, list):
+        if not value:
+            raise SpecError(src, where, "an empty list gives no cases; allowed: one or more values")
+        return Axis(path, "list", tuple(value))
+    if not isinstance(value, dict):
+        return Axis(path, "list", (value,))
+    if len(value) != 1 or next(iter(value)) not in DISTRIBUTIONS:
+        raise SpecError(src, where, f"{value!r} is not an axis; allowed: a value, a list, or "
+                        "one of {range = [start, stop, step]}, {uniform = [low, high]}, "
+                        "{normal = [mean, sd]}, {choice = [...]}, {randint = [low, high]}")
+    kind, arg = next(iter(value.items()))
+    if kind == "range":
+        start, stop, step = _numbers(src, f"{where}.range", arg, 3,
+                                     "[start, stop, step] with step > 0 and stop >= start")
+        if step <= 0 or stop < start:
+            raise SpecError(src, f"{where}.range", f"{arg!r} is an empty range; allowed: "
+                            "[start, stop, step] with step > 0 and stop >= start")
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if n > 100_000:
+            raise SpecError(src, f"{where}.range", f"{n} values; allowed: at most 100000")
+        ints = all(isinstance(v, int) for v in arg)
+        vals = [int(start + k * step) if ints else round(start + k * step, 10) for k in range(n)]
+        return Axis(path, "range", tuple(vals))
+    if kind == "choice":
+        if not isinstance(arg, list) or not arg:
+            raise SpecError(src, f"{where}.choice", "allowed: a non-empty list of values")
+        return Axis(path, "choice", tuple(arg))
+    shape = "[mean, sd]" if kind == "normal" else "[low, high]"
+    lo, hi = _numbers(src, f"{where}.{kind}", arg, 2, shape)
+    if kind == "normal" and hi < 0:
+        raise SpecError(src, f"{where}.normal", f"sd {hi:g} is not allowed; allowed: sd >= 0")
+    if kind != "normal" and hi < lo:
+        raise SpecError(src, f"{where}.{kind}", f"{arg!r} is empty; allowed: [low, high] "
+                        "with high >= low")
+    if kind == "randint" and not all(isinstance(v, int) for v in arg):
+        raise SpecError(src, f"{where}.randint", f"{arg!r}: allowed: two whole numbers")
+    return Axis(path, kind, (), (lo, hi))
+
+
+def _base_text(spec_dir: Path, name: str | None, src: str, key: str, default: str,
+               folder: str | None) -> str:
+    if name is None:
+        return resources.files("stairbot").joinpath(default).read_text("utf-8")
+    p = spec_dir / name
+    if p.is_file():
+        return p.read_text("utf-8")
+    if folder is not None and "/" not in name and not name.endswith(".toml"):
+        entry = resources.files("stairbot").joinpath(folder, f"{name}.toml")
+        if entry.is_file():
+            return entry.read_text("utf-8")
+    raise SpecError(src, f"sweep.{key}", f"{name!r}: no such file (relative to the spec)"
+                    + (", nor a shipped scenario" if folder else ""))
+
+
+def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
+    """Parse a spec document; the cases themselves are checked by
+    :func:`stairbot.sweep.cases.check_spec`.  Raises SpecError."""
+    raw = load_toml(text, source, SpecError)
+    data = convert(raw, SpecFile, source, SpecError)
+    axes = [parse_axis(source, p, v) for p, v in _flatten(data.axes)]
+    seen = [a.path for a in axes]
+    for path in seen:
+        if seen.count(path) > 1:
+            raise SpecError(source, f"axes.{path}", "given twice; allowed: once")
+    for key in ("x", "y"):
+        wanted = getattr(data.report, key)
+        if wanted is not None and wanted not in seen and wanted not in DERIVED:
+            raise SpecError(source, f"report.{key}", f"{wanted!r} is not an axis of this spec; "
+                            f"allowed: {', '.join([*seen, *DERIVED])}")
+    spec_dir = spec_dir or Path(source).parent
+    s = data.sweep
+    scenario_text = _base_text(spec_dir, s.scenario, source, "scenario",
+                               "default_scenario.toml", "scenarios")
+    config_text = (None if s.config is None else
+                   _base_text(spec_dir, s.config, source, "config", "", None))
+    v = data.verdict
+    return Spec(source=source, name=s.name or Path(source).stem, description=s.description,
+                seed=s.seed, samples=s.cases, axes=tuple(axes),
+                rules=Rules(v.rise_margin_m, v.tread_margin_m, v.home_m),
+                scenario_text=scenario_text, config_text=config_text, report=data.report,
+                raw=raw)
+
+
+DERIVED = ("max_rise_m", "min_tread_m", "count")
+"""Values every case records beside its axes (usable as heat-map axes)."""
+
+
+def load_spec(path: str | Path) -> Spec:
+    """Load a spec file.  Raises SpecError (unreadable, not TOML, bad field)."""
+    p = Path(path)
+    try:
+        text = p.read_text("utf-8")
+    except OSError as exc:
+        raise SpecError(str(p), None, f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise SpecError(str(p), None, "not a UTF-8 text file") from None
+    return parse_spec(text, str(p), p.parent)

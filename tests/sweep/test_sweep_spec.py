@@ -1,0 +1,137 @@
+"""Sweep specs: parsing, case generation and the checks that stop a bad spec
+before any case runs (exit 2, one line naming the field and what is allowed)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+from stairbot.cli import main
+from stairbot.config import load_config
+from stairbot.scenario import parse_scenario
+from stairbot.sweep.cases import build_case, check_spec, zone
+from stairbot.sweep.spec import Rules, parse_spec
+
+GOOD = """
+[sweep]
+name = "t"
+seed = 3
+cases = 4
+[axes]
+"stairs.rise" = { range = [0.15, 0.17, 0.01] }
+"stairs.tread" = [0.26, 0.30]
+"start.yaw_deg" = { uniform = [-10, 10] }
+"sensors.seed" = { randint = [1, 1000] }
+"config.masses.second_module" = { normal = [1.3, 0.05] }
+"stairs.rise_jitter" = 0.004
+"""
+
+
+def test_grid_times_samples_and_every_case_reproducible_from_hash_and_index() -> None:
+    a, b = parse_spec(GOOD, "a.toml"), parse_spec(GOOD, "b.toml")
+    assert a.hash == b.hash and a.grid_size == 6 and a.total == 24
+    assert [c.scenario_text for c in check_spec(a)] == [c.scenario_text for c in check_spec(b)]
+    case = build_case(a, 17)
+    assert case == build_case(b, 17) and case.config_text is not None
+    # the grid point is index // cases, the last grid axis varying fastest
+    assert (case.axes["stairs.rise"], case.axes["stairs.tread"]) == (0.17, 0.26)
+    steps = parse_scenario(case.scenario_text, "x").steps
+    assert all(abs(s.rise - 0.17) <= 0.004 for s in steps) and len({s.rise for s in steps}) > 1
+    # another seed draws other values; the same seed the same, whatever the file name
+    other = parse_spec(GOOD.replace("seed = 3", "seed = 4"), "a.toml")
+    assert build_case(other, 17).axes["start.yaw_deg"] != case.axes["start.yaw_deg"]
+
+
+def test_last_tread_under_a_landing_does_not_count_but_under_a_wall_it_does() -> None:
+    cfg, rules = load_config(), Rules()
+    text = "[stairs]\ncount = {n}\nrise = 0.17\ntread = 0.22\ntop = '{top}'\n"
+    one = parse_scenario(text.format(n=1, top="landing"), "x")
+    assert zone(one, cfg, rules)[0] == "inside"
+    assert zone(parse_scenario(text.format(n=1, top="wall"), "x"), cfg, rules)[0] == "outside"
+    assert zone(parse_scenario(text.format(n=2, top="landing"), "x"), cfg, rules)[0] == "outside"
+    band = parse_scenario("[stairs]\ncount = 2\nrise = 0.20\ntread = 0.3\n", "x")
+    assert zone(band, cfg, rules)[0] == "band"
+
+
+BAD = {
+    "unknown axis": ('"stairs.colour" = ["red"]', "axes.stairs.colour", "unknown axis"),
+    "empty range": ('"stairs.rise" = { range = [0.2, 0.1, 0.01] }', "axes.stairs.rise.range",
+                    "empty range"),
+    "zero step": ('"stairs.rise" = { range = [0.1, 0.2, 0] }', "axes.stairs.rise.range",
+                  "empty range"),
+    "empty list": ('"stairs.rise" = []', "axes.stairs.rise", "empty list"),
+    "negative count": ('"stairs.count" = [-1]', "axes.stairs.count", ">= 0"),
+    "noise below 0": ('"sensors.noise" = { uniform = [-0.01, 0.01] }', "axes.sensors.noise",
+                      ">= 0"),
+    "config out of bounds": ('"config.masses.wheel" = { uniform = [-0.1, 0.1] }',
+                             "axes.config.masses.wheel", "robot config refuses"),
+    "config consistency": ('"config.algorithm.approach_gap" = { uniform = [0.0, 0.2] }',
+                           "axes.config.algorithm.approach_gap", "SAFE_DISTANCE"),
+    "normal reaches 0": ('"start.distance" = { normal = [0.2, 0.1] }', "axes.start.distance",
+                         "> 0"),
+    "unknown distribution": ('"stairs.rise" = { unifrom = [0.1, 0.2] }', "axes.stairs.rise",
+                             "not an axis"),
+    "fault index missing": ('"faults[0].at" = [1.0]', "axes.faults[0].at", "base has 0"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_axis_exits_2_with_one_line_before_any_work(
+        case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line, field, words = BAD[case]
+    spec = tmp_path / "bad.toml"
+    spec.write_text(f"[axes]\n{line}\n", encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["sweep", str(spec), "--out", str(out), "-j", "1"]) == 2
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(f"stairbot: error: {spec}: {field}: "), lines[0]
+    assert words in lines[0], lines[0]
+    assert not out.exists()  # nothing started
+
+
+@pytest.mark.parametrize(("text", "field"), [
+    ("[sweep]\ncases = -3\n", "sweep.cases"),
+    ("[sweep]\ncases = 0\n", "sweep.cases"),
+    ("[sweep]\nscenario = 'nope'\n", "sweep.scenario"),
+    ("[sweep]\nseed = 'x'\n", "sweep.seed"),
+    ("[report]\nx = 'stairs.rise'\n", "report.x"),
+    ("[verdict]\nhome_m = 0\n", "verdict.home_m"),
+    ("[axes\n", None),
+])
+def test_bad_spec_fields_exit_2_with_one_line(text: str, field: str | None, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "bad.toml"
+    spec.write_text(text, encoding="utf-8")
+    assert main(["sweep", "check", str(spec)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"stairbot: error: {spec}: "), err
+    if field:
+        assert f": {field}: " in err[0], err[0]
+
+
+def test_missing_dask_names_the_extra(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import fails
+    spec = tmp_path / "s.toml"
+    spec.write_text("[axes]\n\"stairs.count\" = 1\n", encoding="utf-8")
+    assert main(["sweep", str(spec), "--dask", "local", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["stairbot: error: --dask: needs the optional extra: "
+                   "pip install 'stairbot[dask]'"]
+
+
+def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
+    root = Path(__file__).parents[2] / "stairbot" / "sweeps"
+    sizes = {}
+    for path in sorted(root.glob("*.toml")):
+        spec = parse_spec(path.read_text("utf-8"), str(path), root)
+        sizes[spec.name] = len(check_spec(spec))
+    assert sizes["quick"] <= 60 and sizes["envelope"] >= 2000
+    assert {"quick", "envelope", "limits", "sensors"} <= set(sizes)
+    zones = {c.facts["zone"] for c in check_spec(
+        parse_spec((root / "quick.toml").read_text("utf-8"), "quick.toml", root))}
+    assert zones == {"inside", "band", "outside"}

@@ -1,0 +1,44 @@
+"""The verdict rules, one case each (docs/envelope.md)."""
+
+from __future__ import annotations
+
+import pytest
+
+from stairbot.sweep.cases import Case
+from stairbot.sweep.verdict import judge
+from stairbot.sweep.worker import run_case
+
+FACTS = {"zone": "inside", "expected_steps": 3, "faults": 0, "home_m": 0.05}
+
+
+def result(outcome: str = "completed", up: int = 3, down: int = 3, offset: float = 0.01,
+           fell: bool = False) -> dict[str, object]:
+    return {"outcome": outcome, "steps_climbed": up, "steps_descended": down,
+            "final_offset_m": offset, "fell": fell, "ascent_end": "top_reached",
+            "error": None}
+
+
+@pytest.mark.parametrize(("res", "zone", "faults", "moving", "want"), [
+    (result(), "inside", 0, (), "climbed"),
+    (result(), "band", 0, (), "climbed"),
+    (result(), "outside", 0, (), "wrong"),
+    (result(up=0, down=0), "outside", 0, (), "refused"),
+    (result(up=0, down=0), "band", 0, (), "refused"),
+    (result(up=0, down=0), "inside", 0, (), "wrong"),
+    (result(outcome="error", up=1, down=1), "inside", 1, (), "refused"),  # a fault may refuse
+    (result(outcome="error", up=1, down=1), "inside", 0, (), "wrong"),
+    (result(outcome="fell", fell=True, up=0, down=0, offset=0.5), "outside", 0, (), "unsafe"),
+    (result(), "inside", 0, ("MTF",), "unsafe"),
+    (result(outcome="error", up=2, down=0, offset=0.6), "inside", 0, (), "stranded"),
+    (result(up=3, down=3, offset=0.2), "inside", 0, (), "stranded"),
+])
+def test_judge(res: dict[str, object], zone: str, faults: int, moving: tuple[str, ...],
+               want: str) -> None:
+    verdict, why = judge(res, {**FACTS, "zone": zone, "faults": faults}, moving)
+    assert verdict == want, why
+
+
+def test_a_case_that_crashes_is_an_error_with_its_traceback() -> None:
+    rec = run_case(Case(7, {}, "[stairs]\ncount = -1\n", None, dict(FACTS)))
+    assert rec["case"] == 7 and rec["verdict"] == "error" and rec["result"] is None
+    assert "Traceback" in rec["traceback"] and "ScenarioError" in rec["why"]
