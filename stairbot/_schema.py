@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from pathlib import Path
 from typing import Any, TypeVar
 
 import msgspec
@@ -21,6 +22,17 @@ T = TypeVar("T")
 
 _PATH = re.compile(r"^(?P<problem>.*) - at `\$(?P<path>[^`]*)`$", re.S)
 _TOKEN = re.compile(r"\.([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]")
+
+
+def read_text(path: Path, error: type[InputError]) -> str:
+    """A file's text.  Raises ``error`` naming the file when it cannot be read
+    or is not UTF-8."""
+    try:
+        return path.read_text("utf-8")
+    except OSError as exc:
+        raise error(str(path), None, f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise error(str(path), None, "not a UTF-8 text file") from None
 
 
 def load_toml(text: str, source: str, error: type[InputError]) -> dict[str, Any]:

@@ -17,7 +17,7 @@ from typing import Annotated, Any
 
 import msgspec
 
-from stairbot._schema import convert, load_toml
+from stairbot._schema import convert, load_toml, read_text
 from stairbot.errors import ConfigError
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
@@ -317,10 +317,5 @@ def load_config(path: str | Path | None = None) -> RobotConfig:
         text = resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
         return parse_config(text, f"<default {DEFAULT_CONFIG_NAME}>")
     p = Path(path)
-    try:
-        text = p.read_text("utf-8")
-    except OSError as exc:
-        raise ConfigError(str(p), None, f"cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ConfigError(str(p), None, "not a UTF-8 text file") from None
+    text = read_text(p, ConfigError)
     return parse_config(text, str(p))

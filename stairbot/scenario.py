@@ -16,7 +16,7 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
-from stairbot._schema import convert, load_toml
+from stairbot._schema import convert, load_toml, read_text
 from stairbot.errors import ScenarioError
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
@@ -186,12 +186,7 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
                                 + ", ".join(names))
         entry = resources.files("stairbot").joinpath(SHIPPED_DIR, f"{path}.toml")
         return parse_scenario(entry.read_text("utf-8"), f"<scenario {path}>")
-    try:
-        text = p.read_text("utf-8")
-    except OSError as exc:
-        raise ScenarioError(str(p), None, f"cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ScenarioError(str(p), None, "not a UTF-8 text file") from None
+    text = read_text(p, ScenarioError)
     return parse_scenario(text, str(p))
 
 

@@ -102,11 +102,8 @@ def open_sim() -> Iterator[Rig]:
         session.close()
 
 
-def open_serial() -> Iterator[Rig]:
-    """Fake boards in lockstep on a pseudo-terminal, served on a thread."""
-    world = make_world(CONFIG, SCENARIO, lockstep=True)
-    pty = PtyPair()
-    server = SerialBoardServer(pty.master, world, make_boards(world))
+def _served(kind: str, server: SerialBoardServer | CanBoardServer, url: str) -> Iterator[Rig]:
+    """Serve fake boards on a thread and open ``url`` to them; stopped after."""
     thread = threading.Thread(target=server.serve, daemon=True)
     thread.start()
 
@@ -115,13 +112,23 @@ def open_serial() -> Iterator[Rig]:
         thread.join(5)
 
     try:
-        session = open_robot(f"serial://{pty.path}?lockstep=1&timeout=0.5", CONFIG)
+        session = open_robot(url, CONFIG)
         try:
-            yield Rig("serial", session, stop_boards)
+            yield Rig(kind, session, stop_boards)
         finally:
             session.close()
     finally:
         stop_boards()
+
+
+def open_serial() -> Iterator[Rig]:
+    """Fake boards in lockstep on a pseudo-terminal, served on a thread."""
+    world = make_world(CONFIG, SCENARIO, lockstep=True)
+    pty = PtyPair()
+    try:
+        yield from _served("serial", SerialBoardServer(pty.master, world, make_boards(world)),
+                           f"serial://{pty.path}?lockstep=1&timeout=0.5")
+    finally:
         pty.close()
 
 
@@ -132,21 +139,9 @@ def open_can() -> Iterator[Rig]:
     world = make_world(CONFIG, SCENARIO, lockstep=True)
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
                             make_boards(world))
-    thread = threading.Thread(target=server.serve, daemon=True)
-    thread.start()
-
-    def stop_boards() -> None:
-        server.stop()
-        thread.join(5)
-
     try:
-        session = open_robot(f"can://virtual/{channel}?lockstep=1&timeout=0.5", CONFIG)
-        try:
-            yield Rig("can", session, stop_boards)
-        finally:
-            session.close()
+        yield from _served("can", server, f"can://virtual/{channel}?lockstep=1&timeout=0.5")
     finally:
-        stop_boards()
         server.bus.shutdown()
 
 

@@ -10,7 +10,7 @@ reading when the distance is measurable and by turns when it is not.
 from __future__ import annotations
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.moves import lift, reading_drive
+from stairbot.algorithm.moves import drive_phase, lift, lift_phase, reading_drive
 from stairbot.algorithm.phase import (
     FAULT,
     PhaseDef,
@@ -222,31 +222,20 @@ def _h(t: Tick) -> float:
     return t.ctx.number_of_turns_for_step_height
 
 
-_drive1 = reading_drive(1, _first_target,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
-                        lambda _t, _w: go(P.ASCENT_LIFT_SECOND))
-DRIVE_FIRST = PhaseDef(
-    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, _drive1[1],
-    enter=_drive1[0], watches="front",
-    to={P.ASCENT_LIFT_SECOND: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE "
-                              "(or turns made)",
-        P.ERROR: FAULT})
+DRIVE_FIRST = drive_phase(
+    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, 1, _first_target,
+    lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, P.ASCENT_LIFT_SECOND,
+    "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns made)")
 
-_lift2 = lift(lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)},
-              lambda _t, _w: go(P.ASCENT_DRIVE_SECOND))
-LIFT_SECOND = PhaseDef(
-    P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW, _lift2[1], enter=_lift2[0],
-    watches="front", to={P.ASCENT_DRIVE_SECOND: "turns made", P.ERROR: FAULT})
+LIFT_SECOND = lift_phase(
+    P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
+    lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)}, P.ASCENT_DRIVE_SECOND)
 
-_drive2 = reading_drive(1, _second_target,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
-                        lambda _t, _w: go(P.ASCENT_LIFT_THIRD))
-DRIVE_SECOND = PhaseDef(
-    P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, _drive2[1],
-    enter=_drive2[0], watches="front",
-    to={P.ASCENT_LIFT_THIRD: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE − "
-                             "LENGTH_OF_SECOND_MODULE (or turns made)",
-        P.ERROR: FAULT})
+DRIVE_SECOND = drive_phase(
+    P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, 1, _second_target,
+    lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE, P.ASCENT_LIFT_THIRD,
+    "reads length_of_next_step − LENGTH_OF_FIRST_MODULE − LENGTH_OF_SECOND_MODULE "
+    "(or turns made)")
 
 
 def _lifted_third(t: Tick, _w: Work) -> Step:

@@ -12,7 +12,14 @@ counts.
 from __future__ import annotations
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.moves import checked_first, lift, reading_drive, turns_drive
+from stairbot.algorithm.moves import (
+    checked_first,
+    drive_phase,
+    lift,
+    lift_phase,
+    reading_drive,
+    turns_drive,
+)
 from stairbot.algorithm.phase import (
     FAULT,
     PhaseDef,
@@ -135,31 +142,21 @@ def _first_target(t: Tick) -> float | None:
     return t.cfg.LENGTH_OF_FIRST_MODULE + t.cfg.LENGTH_OF_SECOND_MODULE + tab
 
 
-_drive2 = reading_drive(-1, _second_target,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
-                        lambda _t, _w: go(P.DESCENT_LOWER_SECOND))
-DRIVE_SECOND = PhaseDef(
-    P.DESCENT_DRIVE_SECOND, "descent 3 — drive segment 2 off the step", FLOW, _drive2[1],
-    enter=_drive2[0], watches="front",
-    to={P.DESCENT_LOWER_SECOND: "reads LENGTH_OF_SECOND_MODULE + tab_length_to_edge[i] "
-                                "(or turns made)",
-        P.ERROR: FAULT})
+DRIVE_SECOND = drive_phase(
+    P.DESCENT_DRIVE_SECOND, "descent 3 — drive segment 2 off the step", FLOW, -1,
+    _second_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
+    P.DESCENT_LOWER_SECOND, "reads LENGTH_OF_SECOND_MODULE + tab_length_to_edge[i] "
+    "(or turns made)")
 
-_lower2 = lift(lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)},
-               lambda _t, _w: go(P.DESCENT_DRIVE_FIRST))
-LOWER_SECOND = PhaseDef(
-    P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW, _lower2[1], enter=_lower2[0],
-    watches="front", to={P.DESCENT_DRIVE_FIRST: "turns made", P.ERROR: FAULT})
+LOWER_SECOND = lift_phase(
+    P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW,
+    lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)}, P.DESCENT_DRIVE_FIRST)
 
-_drive1 = reading_drive(-1, _first_target,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
-                        lambda _t, _w: go(P.DESCENT_LOWER_FIRST))
-DRIVE_FIRST = PhaseDef(
-    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, _drive1[1],
-    enter=_drive1[0], watches="front",
-    to={P.DESCENT_LOWER_FIRST: "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
-                               "tab_length_to_edge[i] (or turns made)",
-        P.ERROR: FAULT})
+DRIVE_FIRST = drive_phase(
+    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, -1,
+    _first_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
+    P.DESCENT_LOWER_FIRST, "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
+    "tab_length_to_edge[i] (or turns made)")
 
 
 def _lowered_first(t: Tick, _w: Work) -> Step:

@@ -3,6 +3,9 @@ reading (with the seed's turn-count fallback), and lifts to counter targets.
 
 Each builder returns the (enter, step) pair of a :class:`PhaseDef`; ``done``
 chooses the :class:`Step` that ends the phase (usually ``go(next)``).
+:func:`drive_phase` and :func:`lift_phase` build the whole record of the
+plainest ones, which end by going on to one next phase (the ascent's and
+descent's mirrored drives and lifts of segments 1 and 2).
 """
 
 from __future__ import annotations
@@ -10,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.phase import Step, Tick, stay
+from stairbot.algorithm.phase import FAULT, Phase, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.work import Work
 from stairbot.hardware import MotorId
 
@@ -94,3 +97,22 @@ def checked_first(check: Callable[[Tick, Work], Step | None], step: StepFn) -> S
         return step(t, w)
 
     return first
+
+
+def drive_phase(phase: Phase, label: str, flow: str, direction: int,
+                target: Callable[[Tick], float | None],
+                fallback_turns: Callable[[Tick], float], then: Phase, reaches: str) -> PhaseDef:
+    """A :func:`reading_drive` phase that goes on to ``then`` when it ``reaches``
+    its target; the front pair is watched."""
+    enter, step = reading_drive(direction, target, fallback_turns, lambda _t, _w: go(then))
+    return PhaseDef(phase, label, flow, step, enter=enter, watches="front",
+                    to={then: reaches, Phase.ERROR: FAULT})
+
+
+def lift_phase(phase: Phase, label: str, flow: str,
+               deltas: Callable[[Tick, Work], dict[MotorId, float]], then: Phase) -> PhaseDef:
+    """A :func:`lift` phase that goes on to ``then`` when the turns are made;
+    the front pair is watched."""
+    enter, step = lift(deltas, lambda _t, _w: go(then))
+    return PhaseDef(phase, label, flow, step, enter=enter, watches="front",
+                    to={then: "turns made", Phase.ERROR: FAULT})

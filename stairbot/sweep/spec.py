@@ -41,7 +41,7 @@ from typing import Annotated, Any
 import msgspec
 import msgspec.inspect as mi
 
-from stairbot._schema import _tokens, _type_at, convert, load_toml
+from stairbot._schema import _tokens, _type_at, convert, load_toml, read_text
 from stairbot.config import ConfigFile
 from stairbot.errors import InputError
 from stairbot.scenario import ScenarioFile
@@ -299,7 +299,7 @@ def _base_text(spec_dir: Path, name: str | None, src: str, key: str, default: st
         return resources.files("stairbot").joinpath(default).read_text("utf-8")
     p = spec_dir / name
     if p.is_file():
-        return p.read_text("utf-8")
+        return read_text(p, SpecError)
     if folder is not None and "/" not in name and not name.endswith(".toml"):
         entry = resources.files("stairbot").joinpath(folder, f"{name}.toml")
         if entry.is_file():
@@ -344,10 +344,5 @@ DERIVED = ("max_rise_m", "min_tread_m", "count")
 def load_spec(path: str | Path) -> Spec:
     """Load a spec file.  Raises SpecError (unreadable, not TOML, bad field)."""
     p = Path(path)
-    try:
-        text = p.read_text("utf-8")
-    except OSError as exc:
-        raise SpecError(str(p), None, f"cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise SpecError(str(p), None, "not a UTF-8 text file") from None
+    text = read_text(p, SpecError)
     return parse_spec(text, str(p), p.parent)
