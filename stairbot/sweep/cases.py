@@ -97,11 +97,29 @@ def _jitter(spec: Spec, index: int, stairs: dict[str, Any], values: dict[str, An
     stairs["steps"] = steps
 
 
+SIGHT_MARGIN_M = 0.02
+"""The band either side of LENGTH_OF_INFINITY in which the start's nearer
+front beam may or may not see the first riser (the robot's pose as placed,
+the sensors' noise)."""
+
+
+def first_sight(scenario: Scenario, config: RobotConfig) -> float:
+    """The shorter of the two front beams, from the start pose to the first
+    riser (top view: the mounts ``front_lateral`` either side of the centre
+    line, the robot turned ``yaw_deg``).  The calibration's case 1 stops the
+    robot, rightly, when both read LENGTH_OF_INFINITY or more: stairs that
+    far are not in sight, whatever their steps."""
+    yaw = math.radians(scenario.start.yaw_deg)
+    lateral = config.sensors.front_lateral * abs(math.sin(yaw))
+    return (scenario.start.distance - lateral) / math.cos(yaw)
+
+
 def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, float, float]:
     """("inside" | "band" | "outside", max rise, min tread) of the steps the robot
     attempts (the first max_steps) against its limits (rises between
     min_step_rise_m and max_step_rise_m, treads of min_tread_m or more), give
-    or take the margins.
+    or take the margins; stairs out of sight at the start (see
+    :func:`first_sight`) are outside.
     A tread counts where the robot must fit on it: every tread it climbs onto,
     but not the last one under a landing, which runs on into the landing."""
     steps = scenario.steps[:config.algorithm.max_steps]
@@ -114,9 +132,13 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     min_tread = min(treads, default=math.inf)
     lr, lo, lt = config.max_step_rise_m, config.min_step_rise_m, config.min_tread_m
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
-    if max_rise > lr + rm or min_rise < lo - rm or min_tread < lt - tm:
+    sight = first_sight(scenario, config)
+    far = config.LENGTH_OF_INFINITY
+    if (max_rise > lr + rm or min_rise < lo - rm or min_tread < lt - tm
+            or sight > far + SIGHT_MARGIN_M):
         return "outside", max_rise, min_tread
-    if max_rise <= lr - rm and min_rise >= lo + rm and min_tread >= lt + tm:
+    if (max_rise <= lr - rm and min_rise >= lo + rm and min_tread >= lt + tm
+            and sight <= far - SIGHT_MARGIN_M):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread
 

@@ -3,10 +3,12 @@ published limits (``stairbot config show``) give one of six verdicts.
 
 Zones (margins from the spec's ``[verdict]``, default 10 mm):
 
-* inside:  max rise <= max_step_rise_m - margin, min rise >= min_step_rise_m + margin
-           and min tread >= min_tread_m + margin
-* outside: max rise >  max_step_rise_m + margin, min rise < min_step_rise_m - margin
-           or min tread <  min_tread_m - margin
+* inside:  max rise <= max_step_rise_m - margin, min rise >= min_step_rise_m + margin,
+           min tread >= min_tread_m + margin and the first riser in sight
+           (the nearer front beam <= LENGTH_OF_INFINITY - 20 mm)
+* outside: max rise >  max_step_rise_m + margin, min rise < min_step_rise_m - margin,
+           min tread <  min_tread_m - margin or the first riser out of sight
+           (both front beams > LENGTH_OF_INFINITY + 20 mm: calibration case 1)
 * band:    neither: climbing and refusing are both right
 
 Verdicts, first match wins:

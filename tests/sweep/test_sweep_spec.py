@@ -55,6 +55,21 @@ def test_last_tread_under_a_landing_does_not_count_but_under_a_wall_it_does() ->
     assert zone(band, cfg, rules)[0] == "band"
 
 
+@pytest.mark.parametrize(("distance", "yaw", "expected"), [
+    (0.5, 0.0, "inside"), (0.95, 0.0, "inside"), (0.99, 0.0, "band"), (1.05, 0.0, "outside"),
+    (0.99, 20.0, "outside"),  # both beams slant past LENGTH_OF_INFINITY (1.0 m)
+    (0.8, -20.0, "inside"),
+])
+def test_stairs_out_of_sight_at_the_start_are_outside(distance: float, yaw: float,
+                                                      expected: str) -> None:
+    """The seed's calibration case 1 stops a robot whose front beams both read
+    LENGTH_OF_INFINITY or more: such stairs must be refused, however easy."""
+    cfg, rules = load_config(), Rules()
+    scen = parse_scenario("[stairs]\ncount = 2\nrise = 0.15\ntread = 0.3\n"
+                          f"[start]\ndistance = {distance}\nyaw_deg = {yaw}\n", "x")
+    assert zone(scen, cfg, rules)[0] == expected
+
+
 BAD = {
     "unknown axis": ('"stairs.colour" = ["red"]', "axes.stairs.colour", "unknown axis"),
     "empty range": ('"stairs.rise" = { range = [0.2, 0.1, 0.01] }', "axes.stairs.rise.range",
