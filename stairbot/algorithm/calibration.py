@@ -28,6 +28,7 @@ from stairbot.algorithm.phase import (
 )
 from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
+from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
 from stairbot.perception import still_tolerance
 
@@ -42,6 +43,17 @@ STILL_TICKS = 25
 (0.5 s at the 20 ms tick) before it decides between the cases."""
 MAX_TURN_YAW_RAD = math.radians(90.0)
 """A calibration that turns this far without SFR = SFL ends with an error."""
+MAX_SQUARE_YAW_RAD = math.radians(30.0)
+"""The most the robot may stand askew of the riser at a calibration: two
+readings further apart than both beams on one riser turned this far
+(2 × front_lateral × tan 30°, 58 mm on the reference robot) cannot both see
+the riser -- the nearer one sees a side wall (case 2W)."""
+TURN_MARGIN_RAD = math.radians(12.0)
+"""The squaring turn may turn this much more than the readings at its start
+say it needs (noise, the mounts' offsets) before it ends with an error: it
+never turns on to square up to a side wall."""
+MAX_AWAY_YAW_RAD = math.radians(45.0)
+"""Case 2W turns away from the side wall at most this far."""
 TURN_SLOW_FLOOR = 0.1
 """The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
 
@@ -78,18 +90,30 @@ def _check(t: Tick, w: Work) -> Step:
     if equal and ctx.purpose != "start":
         ctx.calibration_case = None
         return _after_calibration(t)
-    ctx.calibration_case = "3" if equal else "2"
+    wall = not equal and abs(diff) > _one_riser(cfg)
+    ctx.calibration_case = "3" if equal else ("2W" if wall else "2")
+    said = ("equal, case 3" if equal else
+            "too far apart for one riser within "
+            f"{math.degrees(MAX_SQUARE_YAW_RAD):.0f}°: the nearer sees a side wall, case 2W"
+            if wall else "not equal, case 2")
     t.say(f"calibration ({where(ctx, P.CAL_CHECK)}): SFR {sfr.distance_m:.3f} m, "
-          f"SFL {sfl.distance_m:.3f} m: " + ("equal, case 3" if equal else "not equal, case 2"),
+          f"SFL {sfl.distance_m:.3f} m: {said}",
           case=ctx.calibration_case, SFR=sfr.distance_m, SFL=sfl.distance_m)
     return go(P.CAL_LIFT)
+
+
+def _one_riser(cfg: RobotConfig) -> float:
+    """The largest SFL − SFR (either sign) both beams on one riser can read,
+    the robot turned MAX_SQUARE_YAW_RAD from square to it."""
+    return 2 * cfg.sensors.front_lateral * math.tan(MAX_SQUARE_YAW_RAD)
 
 
 CHECK = PhaseDef(
     P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check,
     to={
         P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead)",
-        P.CAL_LIFT: "start: case 2 (SFR ≠ SFL) or case 3 (SFR = SFL); later: SFR ≠ SFL",
+        P.CAL_LIFT: "start: case 2 (SFR ≠ SFL), 2W (too far apart for one riser) or case 3 "
+                    "(SFR = SFL); later: SFR ≠ SFL",
         P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL",
         P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL",
         P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be",
@@ -107,14 +131,16 @@ def _lift_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
 
 def _lifted(t: Tick, _w: Work) -> Step:
     t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
-    return go(P.CAL_TURN if t.ctx.calibration_case == "2" else P.CAL_PROBE)
+    case = t.ctx.calibration_case
+    return go(P.CAL_TURN if case == "2" else P.CAL_AWAY if case == "2W" else P.CAL_PROBE)
 
 
 _lift_enter, _lift_step = lift(_lift_deltas, _lifted)
 LIFT = PhaseDef(
     P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
     enter=_lift_enter,
-    to={P.CAL_TURN: "lifted; case 2", P.CAL_PROBE: "lifted; case 3", P.ERROR: FAULT})
+    to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
+        P.CAL_PROBE: "lifted; case 3", P.ERROR: FAULT})
 
 
 # -- turning ---------------------------------------------------------------------------
@@ -131,6 +157,21 @@ def _turn_enter(t: Tick, w: Work) -> None:
     # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
     w.turn_direction = 1 if sfl < sfr else -1
     w.turn_diff = sfl - sfr
+    # Both beams on one riser, the difference says how far the robot is turned
+    # from square to it: the turn may make that and a margin, no more.
+    w.turn_from = t.snap.turns(MotorId.MWR)
+    lateral = max(t.cfg.sensors.front_lateral, 1e-6)
+    w.turn_limit_rad = math.atan(abs(sfl - sfr) / (2 * lateral)) + TURN_MARGIN_RAD
+
+
+def _turned_past_limit(t: Tick, w: Work) -> Step | None:
+    made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
+    if made <= w.turn_limit_rad:
+        return None
+    return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned {math.degrees(made):.0f}° "
+                f"without finding SFR = SFL, more than the "
+                f"{math.degrees(w.turn_limit_rad):.0f}° its first readings allow: "
+                "not squaring up to something other than the riser")
 
 
 def _turn(t: Tick, w: Work) -> Step:
@@ -160,7 +201,7 @@ def _turn(t: Tick, w: Work) -> Step:
     if remaining <= cfg.sensors.resolution / 20:
         w.checked = True
         return stay(NO_MOTION)
-    too_far = _turned_too_far(t, P.CAL_TURN)
+    too_far = _turned_too_far(t, P.CAL_TURN) or _turned_past_limit(t, w)
     if too_far is not None:
         return too_far
     slow = min(1.0, max(TURN_SLOW_FLOOR, remaining / (2 * cfg.algorithm.equal_tolerance)))
@@ -169,7 +210,8 @@ def _turn(t: Tick, w: Work) -> Step:
 
 TURN = PhaseDef(
     P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, enter=_turn_enter,
-    to={P.CAL_LOWER: "SFR = SFL", P.ERROR: "turned too far; " + FAULT})
+    to={P.CAL_LOWER: "SFR = SFL",
+        P.ERROR: "turned too far, or more than its first readings allow; " + FAULT})
 
 
 def _probe_enter(t: Tick, w: Work) -> None:
@@ -224,6 +266,50 @@ CORNER = PhaseDef(
     to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
 
 
+def _away_enter(t: Tick, w: Work) -> None:
+    sfr, sfl = _readings(t)
+    # The nearer beam sees a side wall: turn away from it (left when SFR is
+    # the nearer), the opposite of case 2's rule, until it sees the riser.
+    w.turn_direction = 1 if sfr < sfl else -1
+    w.turn_diff = sfl - sfr
+    w.turn_from = t.snap.turns(MotorId.MWR)
+
+
+def _away(t: Tick, w: Work) -> Step:
+    """Off the wall, the beam that saw it reads the riser: the pair flips
+    (the other sensor is now the nearer, the robot still askew the same way)
+    and the squaring turn goes on in the same direction.  Askew by less than
+    the pair can tell, it flips and flips back as the robot passes square."""
+    cfg = t.cfg
+    sfr, sfl = _readings(t)
+    first = w.turn_direction  # the sign of SFL − SFR at the start
+    w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
+    d = w.turn_diff
+    seen = not motion.far(motion.pair(t.snap)[0], cfg) and not motion.far(
+        motion.pair(t.snap)[1], cfg)
+    flipped = d * first < 0
+    w.checked = w.checked or flipped
+    off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance
+    passed_square = w.checked and not flipped and abs(d) <= _one_riser(cfg)
+    if seen and (off_wall or passed_square):
+        t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
+              "riser; squaring up", SFR=sfr, SFL=sfl)
+        return go(P.CAL_TURN)
+    made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
+    if made > MAX_AWAY_YAW_RAD:
+        return fail(f"calibration ({where(t.ctx, P.CAL_AWAY)}) turned "
+                    f"{math.degrees(MAX_AWAY_YAW_RAD):.0f}° away from the side wall and the "
+                    f"readings still do not fit one riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")
+    return stay(motion.turn(w.turn_direction, cfg))
+
+
+AWAY = PhaseDef(
+    P.CAL_AWAY, "calibration case 2W — turn away from the side wall until both see the riser",
+    FLOW, _away, enter=_away_enter,
+    to={P.CAL_TURN: "off the wall: the pair flipped (or flipped back, square)",
+        P.ERROR: "turned too far; " + FAULT})
+
+
 # -- lower segments 1 and 3 --------------------------------------------------------------
 def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
     ctx = t.ctx
@@ -249,4 +335,4 @@ LOWER = PhaseDef(
         P.DESCENT_BACK_TO_EDGE: "lowered (descent 1)",
         P.DONE: "lowered; calibrate-only mode", P.ERROR: FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (CHECK, LIFT, PROBE, CORNER, TURN, LOWER)
+PHASES: tuple[PhaseDef, ...] = (CHECK, LIFT, PROBE, CORNER, AWAY, TURN, LOWER)

@@ -35,6 +35,7 @@ class Phase(Enum):
     CAL_TURN = "cal_turn"
     CAL_PROBE = "cal_probe"
     CAL_CORNER = "cal_corner"
+    CAL_AWAY = "cal_away"
     CAL_LOWER = "cal_lower"
     ASCENT_APPROACH = "ascent_approach"
     ASCENT_APPROACH_TURNS = "ascent_approach_turns"

@@ -29,6 +29,10 @@ class Work:
     """Calibration turns: +1 left (counter-clockwise), -1 right."""
     turn_diff: float = 0.0
     """Calibration turns: SFL − SFR, smoothed over a few ticks."""
+    turn_from: float = 0.0
+    turn_limit_rad: float = 0.0
+    """The squaring turn: MWR's counter at its start, and the most it may turn
+    (what the readings at its start say, and a margin)."""
     probe_sfr: float = 0.0
     probe_sfl: float = 0.0
     """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""

@@ -255,7 +255,22 @@ def test_a_turn_that_never_squares_up_ends_with_an_error() -> None:
     ctrl, robot, _ = start(front_override=skewed)
     run(ctrl, robot)
     assert ctrl.result.outcome == "error"
-    assert "turned 90°" in str(ctrl.result.error)
+    # 5 cm apart at 0.1 m between the mounts: 26.6° askew, and the 12° margin
+    assert "more than the 39° its first readings allow" in str(ctrl.result.error)
+    assert 38.0 < -math.degrees(robot.yaw) < 40.0  # it stopped there, turned right
+
+
+def test_readings_too_far_apart_for_one_riser_turn_away_from_the_nearer() -> None:
+    """Case 2W: 10 cm apart cannot be one riser within 30°: the nearer (SFR)
+    sees a side wall; the robot turns away from it (left) -- never towards
+    it -- and ends with an error at 45° when the readings never change."""
+    ctrl, robot, events = start(front_override=lambda r: (0.5, 0.6))
+    run(ctrl, robot)
+    assert any(e.data.get("case") == "2W" for e in events)
+    assert ctrl.result.outcome == "error"
+    assert "away from the side wall" in str(ctrl.result.error)
+    assert 44.0 < math.degrees(robot.yaw) < 47.0  # turned left, as far as allowed
+    finish_and_check_zero(ctrl, robot)
 
 
 def test_a_reading_or_a_counter_that_is_not_a_number_ends_with_an_error() -> None:

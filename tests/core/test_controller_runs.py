@@ -54,7 +54,8 @@ def test_default_stairs_up_to_the_top_and_back_to_the_start(default_run) -> None
 def test_default_run_walks_every_phase_but_the_obstacle_and_corner(default_run) -> None:  # type: ignore[no-untyped-def]
     _, _, events, _ = default_run
     seen = set(phases(events))
-    not_expected = {Phase.ASCENT_LOWER_OBSTACLE, Phase.CAL_CORNER, Phase.PAUSED, Phase.ERROR}
+    not_expected = {Phase.ASCENT_LOWER_OBSTACLE, Phase.CAL_CORNER, Phase.CAL_AWAY,
+                    Phase.PAUSED, Phase.ERROR}
     assert seen == set(Phase) - not_expected
 
 

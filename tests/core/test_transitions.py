@@ -70,7 +70,7 @@ def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
     next; only the controller makes it so."""
     ctx = Context(phase=Phase.CAL_CHECK.value)
     said: list[str] = []
-    sensors = {SensorId.SFR: SensorReading(0.50), SensorId.SFL: SensorReading(0.60),
+    sensors = {SensorId.SFR: SensorReading(0.50), SensorId.SFL: SensorReading(0.53),
                SensorId.SBR: SensorReading(0.04), SensorId.SBL: SensorReading(0.04)}
     snap = Snapshot(0.0, sensors, {m: MotorState(0.0) for m in MotorId})
     tick = Tick(snap, CFG, ctx, Mode.FULL, lambda message, **_: said.append(message))
