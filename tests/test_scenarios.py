@@ -34,6 +34,7 @@ PATHS: dict[str, tuple[set[str], set[str]]] = {
     "calibration_case2_yaw_right": ({"cal_turn"}, {"cal_probe", "cal_corner"}),
     "calibration_case3a_square": ({"cal_probe", "cal_turn"}, {"cal_corner"}),
     "calibration_case3b_corner": ({"cal_probe", "cal_corner", "cal_turn"}, set()),
+    "side_wall_square": ({"cal_away", "cal_turn"}, {"cal_probe", "cal_corner"}),
     "wall_at_top": ({"ascent_lower_obstacle"}, set()),
     "step_too_high": ({"ascent_lower_obstacle"}, {"ascent_drive_first"}),
     "tread_too_short": ({"ascent_lower_obstacle"}, {"ascent_drive_first"}),
@@ -94,6 +95,30 @@ def test_default_stairs_up_and_back_at_a_yaw_and_seed(yaw: float, seed: int) -> 
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
         "completed", "top_reached", 5, 5), r.to_dict()
     assert not r.fell
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+
+
+NOISE5 = """
+[stairs]
+count = 3
+rise = 0.16
+tread = 0.29
+[start]
+distance = 0.45
+[sensors]
+noise = 0.005
+seed = {seed}
+"""
+
+
+@pytest.mark.parametrize("seed", range(1, 9))
+def test_five_millimetre_noise_climbs_with_at_most_one_pause(seed: int) -> None:
+    """Issue 10's noise repro: with 5 mm of noise, 4 of these 8 seeds ended in
+    standing-rule errors mid-step before perception filtered the readings."""
+    r, _ = run_sim(parse_scenario(NOISE5.format(seed=seed), f"noise5_seed{seed}"))
+    assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
+        "completed", "top_reached", 3, 3), r.to_dict()
+    assert r.pauses <= 1 and not r.fell, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
 
 
