@@ -16,7 +16,10 @@ is steadier when other work shares the machine).
 
 A script that prints figures, not a test: it asserts nothing.  Usage:
 
-    python benchmarks/bench_sim.py [--repeat N] [--scenario FILE|NAME]
+    python benchmarks/bench_sim.py [--repeat N] [--scenario FILE|NAME] [--config FILE]
+
+(``--config`` chooses the robot, e.g. one whose ``[sensors] front_model`` and
+``back_model`` name a realistic sensor preset.)
 """
 
 from __future__ import annotations
@@ -64,8 +67,9 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeat", type=int, default=3, help="runs of each kind (median shown)")
     p.add_argument("--scenario", default=None, help="scenario file or name (default stairs)")
+    p.add_argument("--config", default=None, help="robot config file (default: the shipped one)")
     args = p.parse_args()
-    config, scenario = load_config(), load_scenario(args.scenario)
+    config, scenario = load_config(args.config), load_scenario(args.scenario)
 
     full: list[float] = []
     bare: list[float] = []
@@ -81,6 +85,8 @@ def main() -> None:
         bare.append(sim / wall_b)
         bare_cpu.append(sim / cpu_b)
     assert result is not None
+    print(f"sensor models       front {config.sensors.front_model}, "
+          f"back {config.sensors.back_model}")
     print(f"scenario            {scenario.name}: outcome {result.outcome}, "
           f"{result.steps_climbed} up, {result.steps_descended} down, "
           f"{result.sim_time_s:.1f} s simulated; median of {args.repeat} run(s)")

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import msgspec
 
@@ -22,6 +22,9 @@ from stairbot.errors import ConfigError
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
 NonNeg = Annotated[float, msgspec.Meta(ge=0)]
+
+# The simulated sensors' models (stairbot.fakes.sensor_presets; the names must agree)
+SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"]
 
 
 class Geometry(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
@@ -65,6 +68,11 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     noise: NonNeg = 0.005
     """Stated sigma of a distance reading (the datasheet's): perception derives
     its tolerances from it."""
+    front_model: SensorModelName = "ideal"
+    """How the simulation models SFR/SFL (stairbot.fakes.sensor_presets); a real
+    robot ignores it."""
+    back_model: SensorModelName = "ideal"
+    """... and SBR/SBL."""
 
 
 class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

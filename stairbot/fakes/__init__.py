@@ -12,8 +12,13 @@ Modules:
   limit, a segment falling, every wheel off every support);
 * :mod:`~stairbot.fakes.plan` -- the top view: yaw, lateral position, side
   walls and the corner geometry the front beams see;
-* :mod:`~stairbot.fakes.sensors` -- the distance sensor model (range limits,
-  resolution, seeded Gaussian noise, scenario faults);
+* :mod:`~stairbot.fakes.sensors` -- the ideal distance sensor model (range
+  limits, resolution, seeded Gaussian noise, scenario faults);
+* :mod:`~stairbot.fakes.sensor_model`, :mod:`~stairbot.fakes.sensor_presets`,
+  :mod:`~stairbot.fakes.beams` -- realistic sensor models (a cone of rays,
+  timing, range-dependent noise, outliers, dropouts, weak signal, ultrasonic
+  incidence loss), their datasheet presets, and the cones' ray casts
+  (docs/sensors.md);
 * :mod:`~stairbot.fakes.sim` -- :class:`SimRobot` (the Robot protocol),
   :class:`SimClock` (the Clock protocol: advancing it steps the physics,
   optionally paced to the wall clock) and the ``sim://`` factory.

@@ -51,7 +51,15 @@ class Plan:
         (None: nothing); ``slant``: beam length per metre of x travelled in the
         side view (1 / cos(pitch)).  Valid for |yaw| < 90 degrees.
         """
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        hit = self.front_hit(forward, lateral, hit_dx, slant, self.yaw)
+        return None if hit is None else hit[0]
+
+    def front_hit(self, forward: float, lateral: float, hit_dx: float | None,
+                  slant: float, yaw: float) -> tuple[float, bool] | None:
+        """:meth:`front_distance` for a beam turned ``yaw`` (the robot's yaw plus
+        a ray's angle across a sensor's cone), and whether it meets a side wall
+        (True) or the stairs (False); None: nothing."""
+        c, s = math.cos(yaw), math.sin(yaw)
         # the side view puts the mount at `forward` straight ahead; in the top view it
         # sits forward*cos - lateral*sin ahead of the centre and y_m to the side
         y_m = self.y + forward * s + lateral * c
@@ -64,8 +72,8 @@ class Plan:
                     best = dx / c * slant
         wall = self._wall_distance(y_m, s)
         if wall is not None and (best is None or wall * slant < best):
-            best = wall * slant
-        return best
+            return wall * slant, True
+        return None if best is None else (best, False)
 
     def _wall_distance(self, y_m: float, s: float) -> float | None:
         half = self.width / 2

@@ -1,4 +1,7 @@
-"""The distance sensor model: range limits, resolution, seeded noise, faults.
+"""The ideal distance sensor model: range limits, resolution, seeded noise, faults.
+
+(The realistic models -- cone, timing, outliers, dropouts -- are in
+:mod:`stairbot.fakes.sensor_model`; its ``ideal`` preset reads exactly as this.)
 
 A true distance (or None: nothing to see) becomes a
 :class:`~stairbot.hardware.SensorReading` the way a small time-of-flight or
@@ -31,6 +34,19 @@ def sensor_rng(seed: int, sensor: SensorId) -> random.Random:
     return random.Random(f"stairbot-sensor:{seed}:{sensor.value}")
 
 
+def active_faults(faults: Iterable[Fault], t: float) -> tuple[float, bool]:
+    """The summed offset of the offset faults active at ``t``, and whether an
+    error fault is active."""
+    offset, error = 0.0, False
+    for f in faults:
+        if t >= f.at and (f.duration is None or t < f.at + f.duration):
+            if f.kind == "error":
+                error = True
+            else:
+                offset += f.offset
+    return offset, error
+
+
 class RangeSensor:
     """One distance sensor's model (see the module docstring)."""
 
@@ -49,22 +65,12 @@ class RangeSensor:
         self._error = SensorReading(0.0, SensorStatus.ERROR)
         self._by_step: dict[int, SensorReading] = {}
 
-    def _active(self, t: float) -> tuple[float, bool]:
-        offset, error = 0.0, False
-        for f in self.faults:
-            if t >= f.at and (f.duration is None or t < f.at + f.duration):
-                if f.kind == "error":
-                    error = True
-                else:
-                    offset += f.offset
-        return offset, error
-
     def measure(self, true_distance: float | None, t: float) -> SensorReading:
         """The reading at simulated time ``t`` of a target ``true_distance`` metres
         away (None: nothing in the beam)."""
         noise = self._gauss(0.0, self.noise) if self.noise > 0.0 else 0.0
         if self.faults:
-            offset, error = self._active(t)
+            offset, error = active_faults(self.faults, t)
             if error:
                 return self._error
         else:

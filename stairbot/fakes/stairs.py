@@ -68,24 +68,42 @@ class StairsProfile:
     def ray(self, x0: float, y0: float, x1: float, y1: float) -> Point | None:
         """The first point of the surface on the segment (x0, y0) -> (x1, y1), or
         None when it meets nothing."""
+        best, _ = self._first(x0, y0, x1, y1)
+        if best == math.inf:
+            return None
+        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best)
+
+    def ray_normal(self, x0: float, y0: float, x1: float, y1: float
+                   ) -> tuple[float, float, float, float] | None:
+        """Like :meth:`ray`, with the unit normal of the segment it meets:
+        (x, y, nx, ny), or None.  (At a rounded corner this is the normal of
+        the segment hit, not of the rounding.)"""
+        best, i = self._first(x0, y0, x1, y1)
+        if best == math.inf:
+            return None
+        ax, ay, bx, by = self.segments[i]
+        ex, ey = bx - ax, by - ay
+        length = math.hypot(ex, ey)
+        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, -ey / length, ex / length)
+
+    def _first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
+        """Ray parameter of the first surface met (inf: none) and its segment."""
         r = self.radius
         lo, hi = (x0, x1) if x0 <= x1 else (x1, x0)
         first = bisect_left(self._xmax, lo - r)
         last = bisect_right(self._xmin, hi + r)
         if first >= last:
-            return None
+            return math.inf, -1
         dx, dy = x1 - x0, y1 - y0
         idx = range(first, last) if dx >= 0 else range(last - 1, first - 1, -1)
-        best = math.inf
+        best, best_i = math.inf, -1
         for i in idx:
             t = self._hit(self.segments[i], x0, y0, dx, dy, r)
             if t < best:
-                best = t
+                best, best_i = t, i
             elif best < math.inf and dx != 0.0:
                 break  # x-monotonic: later segments lie further along the ray
-        if best == math.inf:
-            return None
-        return (x0 + dx * best, y0 + dy * best)
+        return best, best_i
 
     @staticmethod
     def _hit(seg: tuple[float, float, float, float], x0: float, y0: float,

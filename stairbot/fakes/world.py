@@ -363,6 +363,11 @@ class World:
         """First point of the stairs' surface on the segment start -> end, or None."""
         return self.profile.ray(start[0], start[1], end[0], end[1])
 
+    def ray_normal(self, start: tuple[float, float], end: tuple[float, float]
+                   ) -> tuple[float, float, float, float] | None:
+        """Like :meth:`ray`, with the unit normal of the surface met: (x, y, nx, ny)."""
+        return self.profile.ray_normal(start[0], start[1], end[0], end[1])
+
     def clear_of_ground(self, segment: int, clearance: float) -> bool:
         """True when nothing of the stairs lies within ``clearance`` under the
         segment's wheels."""

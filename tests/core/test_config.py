@@ -85,6 +85,10 @@ def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
         (with_change("algorithm", "LENGTH_OF_INFINITY", "2.0"), "algorithm.LENGTH_OF_INFINITY",
          "front_max_range"),
         (with_change("sensors", "front_min_range", "1.5"), "sensors.front_min_range", "below"),
+        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "lidar"\n'),
+         "sensors.front_model",
+         "'lidar' is not allowed; allowed: one of 'gp2y0a21', 'hcsr04', 'ideal', 'vl53l0x', "
+         "'vl53l1x'"),
     ],
 )
 def test_bad_configs_name_the_file_the_field_and_what_is_allowed(
@@ -96,6 +100,7 @@ def test_bad_configs_name_the_file_the_field_and_what_is_allowed(
     assert err.field == field
     assert words in str(err)
     assert str(err).startswith(f"robot.toml: {field}: ")
+    assert "\n" not in str(err)
 
 
 def test_not_toml_is_a_config_error() -> None:
