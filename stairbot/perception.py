@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from statistics import median
 
 from stairbot.config import RobotConfig
 from stairbot.hardware import (
@@ -92,16 +91,26 @@ def _agree(buf: deque[Sample], odometer: float | None) -> SensorReading:
     newest = buf[-1][0]
     if len(buf) == 1:
         return newest
-    counts: dict[SensorStatus, int] = {}
-    for r, _ in buf:
-        counts[r.status] = counts.get(r.status, 0) + 1
-    top = max(counts.values())
-    status = newest.status if counts[newest.status] == top else \
-        next(s for s, c in counts.items() if c == top)
+    status = newest.status
+    if not all(r.status is status for r, _ in buf):  # the common case needs no count
+        counts: dict[SensorStatus, int] = {}
+        for r, _ in buf:
+            counts[r.status] = counts.get(r.status, 0) + 1
+        top = max(counts.values())
+        if counts[status] != top:
+            status = next(s for s, c in counts.items() if c == top)
     if status is SensorStatus.OK and odometer is not None:
         values = [r.distance_m - (odometer - at) for r, at in buf if r.status is status]
     else:
         values = [r.distance_m for r, _ in buf if r.status is status]
     if status is SensorStatus.ERROR or not all(math.isfinite(v) for v in values):
         return SensorReading(newest.distance_m if newest.status is status else values[-1], status)
-    return SensorReading(median(values), status)
+    return SensorReading(_median(values), status)
+
+
+def _median(values: list[float]) -> float:
+    """statistics.median, without its generality (a hot path: every sensor, every tick)."""
+    s = sorted(values)
+    n = len(s)
+    half = n // 2
+    return s[half] if n % 2 else (s[half - 1] + s[half]) / 2
