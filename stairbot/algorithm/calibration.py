@@ -281,12 +281,12 @@ def _away(t: Tick, w: Work) -> Step:
     and the squaring turn goes on in the same direction.  Askew by less than
     the pair can tell, it flips and flips back as the robot passes square."""
     cfg = t.cfg
-    sfr, sfl = _readings(t)
+    r, l_ = motion.pair(t.snap)
+    sfr, sfl = r.distance_m, l_.distance_m
     first = w.turn_direction  # the sign of SFL − SFR at the start
     w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
     d = w.turn_diff
-    seen = not motion.far(motion.pair(t.snap)[0], cfg) and not motion.far(
-        motion.pair(t.snap)[1], cfg)
+    seen = not motion.far(r, cfg) and not motion.far(l_, cfg)
     flipped = d * first < 0
     w.checked = w.checked or flipped
     off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance

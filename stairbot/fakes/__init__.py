@@ -12,8 +12,8 @@ Modules:
   limit, a segment falling, every wheel off every support);
 * :mod:`~stairbot.fakes.plan` -- the top view: yaw, lateral position, side
   walls and the corner geometry the front beams see;
-* :mod:`~stairbot.fakes.sensors` -- the ideal distance sensor model (range
-  limits, resolution, seeded Gaussian noise, scenario faults);
+* :mod:`~stairbot.fakes.sensors` -- what every sensor shares: its seeded
+  noise generator and the scenario's faults;
 * :mod:`~stairbot.fakes.sensor_model`, :mod:`~stairbot.fakes.sensor_presets`,
   :mod:`~stairbot.fakes.beams` -- realistic sensor models (a cone of rays,
   timing, range-dependent noise, outliers, dropouts, weak signal, ultrasonic

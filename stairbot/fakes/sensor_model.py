@@ -33,7 +33,8 @@ What a reading goes through:
   resolution.
 
 With the ``ideal`` model (one ray, no timing, noise of the scenario, nothing
-else) this gives exactly the readings of :class:`~stairbot.fakes.sensors.RangeSensor`.
+else) this gives exactly the readings of the sensor stairbot had before the
+models (tests/fakes/reference_sensor.py keeps it as the test's oracle).
 """
 
 from __future__ import annotations

@@ -8,15 +8,16 @@ import random
 import pytest
 
 from stairbot.fakes.plan import Plan
-from stairbot.fakes.sensors import RangeSensor
+from stairbot.fakes.sensor_model import ModelSensor
+from stairbot.fakes.sensor_presets import IDEAL
 from stairbot.fakes.stairs import StairsProfile
 from stairbot.hardware import SensorId, SensorStatus
 from stairbot.scenario import Fault
 
 
 def sensor(noise: float = 0.0, seed: int = 1, faults: tuple[Fault, ...] = (),
-           sid: SensorId = SensorId.SFL) -> RangeSensor:
-    return RangeSensor(sid, 0.03, 1.3, 0.001, noise, seed, faults)
+           sid: SensorId = SensorId.SFL) -> ModelSensor:
+    return ModelSensor(sid, IDEAL, 0.03, 1.3, 0.001, noise, seed, faults)
 
 
 def test_readings_are_rounded_to_the_resolution() -> None:
