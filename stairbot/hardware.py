@@ -48,7 +48,8 @@ BACK_SENSORS: tuple[SensorId, ...] = (SensorId.SBR, SensorId.SBL)
 
 class SensorStatus(StrEnum):
     OK = "ok"
-    OUT_OF_RANGE = "out_of_range"  # no target within range (or closer than the minimum)
+    OUT_OF_RANGE = "out_of_range"  # no target within range, a return too weak to range, or
+    # a target closer than the minimum
     ERROR = "error"  # the sensor reports a fault; the distance means nothing
 
 
@@ -59,6 +60,11 @@ class SensorReading:
 
     distance_m: float
     status: SensorStatus = SensorStatus.OK
+    age_s: float = 0.0
+    """How long before the snapshot's time the sensor took this measurement
+    (the board's own count: a sensor repeats its last value between
+    measurements).  Perception does not use a reading older than its sensor
+    allows."""
 
     @property
     def ok(self) -> bool:
@@ -75,6 +81,20 @@ class MotorState:
 
 
 @dataclass(frozen=True, slots=True)
+class Imu:
+    """The sensor board's inertial unit (it rides in segment 2): attitude and
+    rates of segment 2.  Pitch is positive nose up (the front higher than the
+    back), roll positive right side down; rates in degrees per second."""
+
+    pitch_deg: float
+    roll_deg: float
+    pitch_rate_dps: float = 0.0
+    roll_rate_dps: float = 0.0
+    age_s: float = 0.0
+    """How long before the snapshot's time it was measured."""
+
+
+@dataclass(frozen=True, slots=True)
 class Snapshot:
     """Everything read from the robot at one control tick."""
 
@@ -82,6 +102,9 @@ class Snapshot:
     sensors: Mapping[SensorId, SensorReading]
     motors: Mapping[MotorId, MotorState]
     health: Mapping[str, float] = field(default_factory=dict)
+    imu: Imu | None = None
+    """None: the robot has no IMU (or it did not answer); the supervisor then
+    cannot watch the tilt and says so."""
 
     def turns(self, motor: MotorId) -> float:
         return self.motors[motor].turns

@@ -81,7 +81,7 @@ class Perception:
             buf = self._buffers[sid]
             buf.append((reading, odometer))
             sensors[sid] = _agree(buf, odometer if sid in FRONT_SENSORS else None)
-        return Snapshot(snap.time_s, sensors, snap.motors, snap.health)
+        return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
 
 def _agree(buf: deque[Sample], odometer: float | None) -> SensorReading:
