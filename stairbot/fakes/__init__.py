@@ -19,6 +19,10 @@ Modules:
   timing, range-dependent noise, outliers, dropouts, weak signal, ultrasonic
   incidence loss), their datasheet presets, and the cones' ray casts
   (docs/sensors.md);
+* :mod:`~stairbot.fakes.sim_sensors` -- the sensor board: the four distance
+  sensors through their models (each reading with its age) and the IMU in
+  segment 2 (pitch and pitch rate of its body; roll 0: a side view cannot
+  roll);
 * :mod:`~stairbot.fakes.sim` -- :class:`SimRobot` (the Robot protocol),
   :class:`SimClock` (the Clock protocol: advancing it steps the physics,
   optionally paced to the wall clock) and the ``sim://`` factory.

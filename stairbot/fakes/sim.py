@@ -5,9 +5,9 @@ robot from the config, pacing from RobotOptions).
 
 :class:`SimRobot` implements :class:`stairbot.hardware.Robot` on the pymunk side
 view (:mod:`stairbot.fakes.world`), the top view (:mod:`stairbot.fakes.plan`)
-and the sensor models (:mod:`stairbot.fakes.sensor_model`, one preset per
-sensor pair from the config's ``[sensors] front_model`` / ``back_model``; the
-cones' rays are cast by :mod:`stairbot.fakes.beams`).  :class:`SimClock`
+and the sensor board (:mod:`stairbot.fakes.sim_sensors`: the four distance
+sensors through their models, and the IMU in segment 2 -- pitch from the
+pymunk body, roll 0 because a side view cannot roll).  :class:`SimClock`
 implements :class:`stairbot.hardware.Clock`: advancing it steps the physics,
 and with pacing it is the only place in stairbot's simulation that sleeps.
 
@@ -32,10 +32,8 @@ from urllib.parse import urlsplit
 
 from stairbot.config import RobotConfig
 from stairbot.errors import RobotFellError, RobotUrlError
-from stairbot.fakes.beams import down_hits, front_hits, total_weight
 from stairbot.fakes.plan import Plan
-from stairbot.fakes.sensor_model import ModelSensor, combine
-from stairbot.fakes.sensor_presets import preset
+from stairbot.fakes.sim_sensors import SimSensors, imu
 from stairbot.fakes.world import World, WorldParams
 from stairbot.hardware import (
     LIFT_MOTORS,
@@ -43,8 +41,6 @@ from stairbot.hardware import (
     MotorId,
     MotorState,
     Scene,
-    SensorId,
-    SensorReading,
     Snapshot,
     Speeds,
     Truth,
@@ -67,19 +63,7 @@ class SimRobot:
         self.plan = Plan(scenario.width, scenario.side_wall, y=scenario.start.lateral,
                          yaw=math.radians(scenario.start.yaw_deg))
         self._start_y = self.plan.y
-        s, n = config.sensors, scenario.sensors
-        self.front_model, self.back_model = preset(s.front_model), preset(s.back_model)
-        self.sensors = {
-            sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults)
-            for sid, model, lo, hi in (
-                (SensorId.SFR, self.front_model, s.front_min_range, s.front_max_range),
-                (SensorId.SFL, self.front_model, s.front_min_range, s.front_max_range),
-                (SensorId.SBR, self.back_model, s.back_min_range, s.back_max_range),
-                (SensorId.SBL, self.back_model, s.back_min_range, s.back_max_range),
-            )
-        }
-        self._front_weight = total_weight(self.front_model.cone)
-        self._back_weight = total_weight(self.back_model.fan)
+        self.board = SimSensors(config, scenario, self.world, self.plan)
         m = config.motors
         self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
                         for mid in MotorId}
@@ -95,13 +79,6 @@ class SimRobot:
         self._lift_tps = [0.0, 0.0]  # measured over the last advance
         self._snap: Snapshot | None = None
         self._snap_at = -1
-        r = config.geometry.wheel_radius
-        # sensor mounts in their segment's frame (origin: centre of the axle line)
-        self._front_mount = (self.world.lengths[0] / 2, s.front_height - r,
-                             (self.front_model.max_range or s.front_max_range) * 1.05)
-        self._back_mount = (-self.world.lengths[2] / 2 + s.back_from_rear,
-                            s.back_height - r,
-                            (self.back_model.max_range or s.back_max_range) * 1.05)
         self.closed = False
         self._estopped = False
 
@@ -115,12 +92,8 @@ class SimRobot:
             raise RobotFellError(w.fall_reason or "unstable")
         if self._snap is not None and self._snap_at == w.steps_done:
             return self._snap
-        t = w.time
-        sfr, sfl = self._front_readings(t)
-        sbr, sbl = self._back_readings(t)
-        snap = Snapshot(time_s=t, sensors={
-            SensorId.SFR: sfr, SensorId.SFL: sfl, SensorId.SBR: sbr, SensorId.SBL: sbl,
-        }, motors=self._motor_states(), health={})
+        snap = Snapshot(time_s=w.time, sensors=self.board.read(w.time),
+                        motors=self._motor_states(), health={}, imu=imu(w))
         self._snap, self._snap_at = snap, w.steps_done
         return snap
 
@@ -272,99 +245,6 @@ class SimRobot:
             MotorId.MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
             MotorId.MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
         }
-
-    def _front_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
-        """What SFR and SFL report at ``t``: one ray each for a single-ray model,
-        else their cones, cast only when a measurement is due."""
-        right, left = self.sensors[SensorId.SFR], self.sensors[SensorId.SFL]
-        model = self.front_model
-        if model.single_ray:
-            sfr, sfl = self._front_truth()
-            return right.measure(sfr, t), left.measure(sfl, t)
-        if right.due(t) or left.due(t):
-            mx, my, a1, _c, _s, forward = self._front_origin()
-            lat = self.config.sensors.front_lateral
-            hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
-                              (-lat, lat), self._front_mount[2])
-            for sensor, seen in ((right, hits[0]), (left, hits[1])):
-                if sensor.due(t):
-                    sensor.sample(combine(model, seen, self._front_weight), t)
-        return right.reading(t), left.reading(t)
-
-    def _back_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
-        """What SBR and SBL report at ``t`` (see _front_readings)."""
-        right, left = self.sensors[SensorId.SBR], self.sensors[SensorId.SBL]
-        model = self.back_model
-        if model.single_ray:
-            sbr, sbl = self._back_truth()
-            return right.measure(sbr, t), left.measure(sbl, t)
-        if right.due(t) or left.due(t):
-            w = self.world
-            (xr, xl), my, a3, _c, _s, reach = self._back_origins()
-            seen_r = down_hits(w, model, (xr, my), a3, reach)
-            seen_l = seen_r if xl == xr else down_hits(w, model, (xl, my), a3, reach)
-            for sensor, seen in ((right, seen_r), (left, seen_l)):
-                if sensor.due(t):
-                    sensor.sample(combine(model, seen, self._back_weight), t)
-        return right.reading(t), left.reading(t)
-
-    def _front_origin(self) -> tuple[float, float, float, float, float, float]:
-        """The front mount in the side view (x, y), segment 1's angle, its cos
-        and sin, and the mount's distance ahead of segment 2's centre."""
-        w = self.world
-        lx, ly, _reach = self._front_mount
-        x1, y1, a1 = w.pose(0)
-        c, s = math.cos(a1), math.sin(a1)
-        mx, my = x1 + c * lx - s * ly, y1 + s * lx + c * ly
-        # the mount's distance ahead of segment 2's centre, along the robot
-        x2, y2, a2 = w.pose(1)
-        forward = math.cos(a2) * (mx - x2) + math.sin(a2) * (my - y2)
-        return mx, my, a1, c, s, forward
-
-    def _front_truth(self) -> tuple[float | None, float | None]:
-        """True distances seen by SFR and SFL (None: nothing within range)."""
-        w = self.world
-        reach = self._front_mount[2]
-        mx, my, _a1, c, s, forward = self._front_origin()
-        hit = w.ray((mx, my), (mx + c * reach, my + s * reach))
-        hit_dx = None if hit is None else hit[0] - mx
-        slant = 1.0 / max(c, 1e-6)
-        lat = self.config.sensors.front_lateral
-        front_distance = self.plan.front_distance
-        return (front_distance(forward, -lat, hit_dx, slant),
-                front_distance(forward, lat, hit_dx, slant))
-
-    def _back_truth(self) -> tuple[float | None, float | None]:
-        """True distances seen by SBR and SBL, looking down from segment 3.  Turned
-        by a yaw, the two stand at different x (over a nosing they may disagree)."""
-        (xr, xl), my, _a3, c, s, reach = self._back_origins()
-        d = self._down(xr, my, c, s, reach)
-        return d, (d if xl == xr else self._down(xl, my, c, s, reach))
-
-    def _back_origins(self) -> tuple[tuple[float, float], float, float, float, float, float]:
-        """The side-view x of SBR and SBL, their height, segment 3's angle, its
-        cos and sin, and the rays' reach.  Turned by a yaw, the two stand at
-        different x."""
-        w = self.world
-        lx, ly, reach = self._back_mount
-        x3, y3, a3 = w.pose(2)
-        c, s = math.cos(a3), math.sin(a3)
-        mx, my = x3 + c * lx - s * ly, y3 + s * lx + c * ly
-        yaw = self.plan.yaw
-        if yaw == 0.0:
-            return (mx, mx), my, a3, c, s, reach
-        # top view: the mount sits `behind` along the robot and +-lateral across it
-        x2 = w.pose(1)[0]
-        behind = mx - x2
-        shift = behind * (math.cos(yaw) - 1.0)
-        lat = self.config.sensors.back_lateral * math.sin(yaw)
-        return (mx + shift + lat, mx + shift - lat), my, a3, c, s, reach
-
-    def _down(self, mx: float, my: float, c: float, s: float, reach: float) -> float | None:
-        hit = self.world.ray((mx, my), (mx + s * reach, my - c * reach))
-        if hit is None:
-            return None
-        return math.hypot(hit[0] - mx, hit[1] - my)
 
 
 class SimClock:

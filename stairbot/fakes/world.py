@@ -231,6 +231,12 @@ class World:
         self._fetch()
         return math.degrees(self._pa[segment])
 
+    def pitch_rate_dps(self, segment: int = 1) -> float:
+        """Nose-up pitch rate of a segment in degrees per second."""
+        if self._ptrs is not None:
+            return math.degrees(_cp.cpBodyGetAngularVelocity(self._ptrs[segment]))
+        return math.degrees(self.segments[segment].angular_velocity)
+
     def pose(self, segment: int) -> tuple[float, float, float]:
         """(x, y, angle) of a segment's local origin: its centre on the axle line."""
         self._fetch()

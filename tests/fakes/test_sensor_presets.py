@@ -162,7 +162,12 @@ def test_a_preset_robot_reads_reproducibly_and_holds_between_updates() -> None:
         runs.append(seq)
     assert runs[0] == runs[1]
     fronts = [s[SensorId.SFR] for s in runs[0]]
-    assert fronts[0] == fronts[1] == fronts[2]  # 50 ms period, reads every 20 ms
+    # 50 ms period, reads every 20 ms: the value is held, and grows older
+    assert len({(r.distance_m, r.status) for r in fronts[:3]}) == 1
+    assert [r.age_s for r in fronts[:3]] == pytest.approx([0.0, 0.02, 0.04])
+    # the next measurement is due at 50 ms, taken at the read at 60 ms and
+    # published after its 50 ms latency: read at 120 ms, it is 60 ms old
+    assert [r.age_s for r in fronts[3:7]] == pytest.approx([0.06, 0.08, 0.10, 0.06])
     # 3 cm above the floor, the full 27-degree cone sees the floor ahead of the
     # riser 0.5 m away: the signal-weighted mix reads well short of it
     assert runs[0][0][SensorId.SFR].ok

@@ -1,0 +1,181 @@
+"""The simulated robot's sensor board: four distance sensors and the IMU.
+
+:class:`SimSensors` reads SFR/SFL (segment 1's front face, looking forward)
+and SBR/SBL (under segment 3, looking down) from the pymunk side view
+(:mod:`stairbot.fakes.world`) and the top view (:mod:`stairbot.fakes.plan`)
+through the sensor models (:mod:`stairbot.fakes.sensor_model`, one preset per
+pair from the config's ``[sensors] front_model`` / ``back_model``; the cones'
+rays are cast by :mod:`stairbot.fakes.beams`).  A reading's ``age_s`` is its
+model's: how long before the read the published measurement was taken (a
+model with a period or a latency); the ``ideal`` preset measures at every
+read, so its readings are 0 s old and shared, not copied.
+
+:func:`imu` is the board's inertial unit, which rides in segment 2: pitch
+and pitch rate of segment 2's pymunk body.  The simulation is a side view in
+two dimensions: nothing in it can roll, so roll and roll rate are 0 -- not a
+measurement, the model's limit.
+"""
+
+from __future__ import annotations
+
+import math
+
+from stairbot.config import RobotConfig
+from stairbot.fakes.beams import down_hits, front_hits, total_weight
+from stairbot.fakes.plan import Plan
+from stairbot.fakes.sensor_model import ModelSensor, combine
+from stairbot.fakes.sensor_presets import preset
+from stairbot.fakes.world import World
+from stairbot.hardware import Imu, SensorId, SensorReading
+from stairbot.scenario import Scenario
+
+IMU_SEGMENT = 1
+"""The IMU rides in segment 2 (index 1 in the world)."""
+
+
+def imu(world: World) -> Imu:
+    """What the sensor board's IMU reports now: segment 2's pitch (+ nose up)
+    and pitch rate; roll 0 (a side view cannot roll); measured now (age 0)."""
+    return Imu(world.pitch_deg(IMU_SEGMENT), 0.0, world.pitch_rate_dps(IMU_SEGMENT), 0.0)
+
+
+class SimSensors:
+    """SFR, SFL, SBR and SBL on the simulated robot (see the module docstring)."""
+
+    def __init__(self, config: RobotConfig, scenario: Scenario, world: World,
+                 plan: Plan) -> None:
+        self.config = config
+        self.world = world
+        self.plan = plan
+        s, n = config.sensors, scenario.sensors
+        self.front_model, self.back_model = preset(s.front_model), preset(s.back_model)
+        self.sensors = {
+            sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults)
+            for sid, model, lo, hi in (
+                (SensorId.SFR, self.front_model, s.front_min_range, s.front_max_range),
+                (SensorId.SFL, self.front_model, s.front_min_range, s.front_max_range),
+                (SensorId.SBR, self.back_model, s.back_min_range, s.back_max_range),
+                (SensorId.SBL, self.back_model, s.back_min_range, s.back_max_range),
+            )
+        }
+        # only a model with a period or a latency publishes readings older than now
+        self._front_timed = self.front_model.period_s > 0.0 or self.front_model.latency_s > 0.0
+        self._back_timed = self.back_model.period_s > 0.0 or self.back_model.latency_s > 0.0
+        self._front_weight = total_weight(self.front_model.cone)
+        self._back_weight = total_weight(self.back_model.fan)
+        r = config.geometry.wheel_radius
+        # sensor mounts in their segment's frame (origin: centre of the axle line)
+        self._front_mount = (world.lengths[0] / 2, s.front_height - r,
+                             (self.front_model.max_range or s.front_max_range) * 1.05)
+        self._back_mount = (-world.lengths[2] / 2 + s.back_from_rear,
+                            s.back_height - r,
+                            (self.back_model.max_range or s.back_max_range) * 1.05)
+
+    def read(self, t: float) -> dict[SensorId, SensorReading]:
+        """Every distance sensor's published reading at ``t``, with its age."""
+        sfr, sfl = self._front_readings(t)
+        sbr, sbl = self._back_readings(t)
+        if self._front_timed:
+            sfr, sfl = self._aged(SensorId.SFR, sfr, t), self._aged(SensorId.SFL, sfl, t)
+        if self._back_timed:
+            sbr, sbl = self._aged(SensorId.SBR, sbr, t), self._aged(SensorId.SBL, sbl, t)
+        return {SensorId.SFR: sfr, SensorId.SFL: sfl, SensorId.SBR: sbr, SensorId.SBL: sbl}
+
+    def _aged(self, sid: SensorId, reading: SensorReading, t: float) -> SensorReading:
+        age = self.sensors[sid].age(t)
+        if age == 0.0:
+            return reading
+        return SensorReading(reading.distance_m, reading.status, age)
+
+    def _front_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
+        """What SFR and SFL report at ``t``: one ray each for a single-ray model,
+        else their cones, cast only when a measurement is due."""
+        right, left = self.sensors[SensorId.SFR], self.sensors[SensorId.SFL]
+        model = self.front_model
+        if model.single_ray:
+            sfr, sfl = self._front_truth()
+            return right.measure(sfr, t), left.measure(sfl, t)
+        if right.due(t) or left.due(t):
+            mx, my, a1, _c, _s, forward = self._front_origin()
+            lat = self.config.sensors.front_lateral
+            hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
+                              (-lat, lat), self._front_mount[2])
+            for sensor, seen in ((right, hits[0]), (left, hits[1])):
+                if sensor.due(t):
+                    sensor.sample(combine(model, seen, self._front_weight), t)
+        return right.reading(t), left.reading(t)
+
+    def _back_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
+        """What SBR and SBL report at ``t`` (see _front_readings)."""
+        right, left = self.sensors[SensorId.SBR], self.sensors[SensorId.SBL]
+        model = self.back_model
+        if model.single_ray:
+            sbr, sbl = self._back_truth()
+            return right.measure(sbr, t), left.measure(sbl, t)
+        if right.due(t) or left.due(t):
+            w = self.world
+            (xr, xl), my, a3, _c, _s, reach = self._back_origins()
+            seen_r = down_hits(w, model, (xr, my), a3, reach)
+            seen_l = seen_r if xl == xr else down_hits(w, model, (xl, my), a3, reach)
+            for sensor, seen in ((right, seen_r), (left, seen_l)):
+                if sensor.due(t):
+                    sensor.sample(combine(model, seen, self._back_weight), t)
+        return right.reading(t), left.reading(t)
+
+    def _front_origin(self) -> tuple[float, float, float, float, float, float]:
+        """The front mount in the side view (x, y), segment 1's angle, its cos
+        and sin, and the mount's distance ahead of segment 2's centre."""
+        w = self.world
+        lx, ly, _reach = self._front_mount
+        x1, y1, a1 = w.pose(0)
+        c, s = math.cos(a1), math.sin(a1)
+        mx, my = x1 + c * lx - s * ly, y1 + s * lx + c * ly
+        # the mount's distance ahead of segment 2's centre, along the robot
+        x2, y2, a2 = w.pose(1)
+        forward = math.cos(a2) * (mx - x2) + math.sin(a2) * (my - y2)
+        return mx, my, a1, c, s, forward
+
+    def _front_truth(self) -> tuple[float | None, float | None]:
+        """True distances seen by SFR and SFL (None: nothing within range)."""
+        w = self.world
+        reach = self._front_mount[2]
+        mx, my, _a1, c, s, forward = self._front_origin()
+        hit = w.ray((mx, my), (mx + c * reach, my + s * reach))
+        hit_dx = None if hit is None else hit[0] - mx
+        slant = 1.0 / max(c, 1e-6)
+        lat = self.config.sensors.front_lateral
+        front_distance = self.plan.front_distance
+        return (front_distance(forward, -lat, hit_dx, slant),
+                front_distance(forward, lat, hit_dx, slant))
+
+    def _back_truth(self) -> tuple[float | None, float | None]:
+        """True distances seen by SBR and SBL, looking down from segment 3.  Turned
+        by a yaw, the two stand at different x (over a nosing they may disagree)."""
+        (xr, xl), my, _a3, c, s, reach = self._back_origins()
+        d = self._down(xr, my, c, s, reach)
+        return d, (d if xl == xr else self._down(xl, my, c, s, reach))
+
+    def _back_origins(self) -> tuple[tuple[float, float], float, float, float, float, float]:
+        """The side-view x of SBR and SBL, their height, segment 3's angle, its
+        cos and sin, and the rays' reach.  Turned by a yaw, the two stand at
+        different x."""
+        w = self.world
+        lx, ly, reach = self._back_mount
+        x3, y3, a3 = w.pose(2)
+        c, s = math.cos(a3), math.sin(a3)
+        mx, my = x3 + c * lx - s * ly, y3 + s * lx + c * ly
+        yaw = self.plan.yaw
+        if yaw == 0.0:
+            return (mx, mx), my, a3, c, s, reach
+        # top view: the mount sits `behind` along the robot and +-lateral across it
+        x2 = w.pose(1)[0]
+        behind = mx - x2
+        shift = behind * (math.cos(yaw) - 1.0)
+        lat = self.config.sensors.back_lateral * math.sin(yaw)
+        return (mx + shift + lat, mx + shift - lat), my, a3, c, s, reach
+
+    def _down(self, mx: float, my: float, c: float, s: float, reach: float) -> float | None:
+        hit = self.world.ray((mx, my), (mx + s * reach, my - c * reach))
+        if hit is None:
+            return None
+        return math.hypot(hit[0] - mx, hit[1] - my)
