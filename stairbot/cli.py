@@ -350,7 +350,7 @@ def cmd_config_show(args: argparse.Namespace) -> int:
         print(json.dumps(data, indent=2, sort_keys=True))
         return EXIT_OK
     print(f"# robot config from {data['source']}")
-    for section in ("geometry", "masses", "motors", "sensors", "algorithm"):
+    for section in ("geometry", "masses", "motors", "sensors", "algorithm", "safety"):
         print(f"\n[{section}]")
         for key, value in data[section].items():
             print(f"{key} = {value!r}")

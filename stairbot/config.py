@@ -90,12 +90,34 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     tick: Annotated[float, msgspec.Meta(ge=0.001, le=0.5)]
 
 
+class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    """What the supervisor watches every tick (stairbot.tilt) and the margin
+    the static-stability check keeps before every lift
+    (stairbot.algorithm.stability).  The defaults' reasons are in
+    default_robot.toml."""
+
+    imu: bool
+    """The sensor board has an IMU: without one in a snapshot (or with a stale
+    one) the robot stops.  False: tilt is not watched, and the run says so."""
+    max_pitch_deg: Annotated[float, msgspec.Meta(gt=0, le=30)]
+    max_roll_deg: Annotated[float, msgspec.Meta(gt=0, le=30)]
+    """Tilt beyond which every motor stops and the lifts hold (either sign)."""
+    max_rate_dps: Annotated[float, msgspec.Meta(gt=0, le=1000)]
+    """Pitch or roll rate beyond which every motor stops, degrees per second."""
+    imu_max_age_s: Annotated[float, msgspec.Meta(gt=0, le=1)]
+    """An IMU reading older than this counts as missing."""
+    stability_margin: NonNeg
+    """Metres the centre of mass must stay inside the wheels that carry the
+    robot while a lift moves."""
+
+
 class ConfigFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     geometry: Geometry
     masses: Masses
     motors: Motors
     sensors: Sensors
     algorithm: Algorithm
+    safety: Safety
 
 
 @dataclass(frozen=True)
@@ -108,6 +130,7 @@ class RobotConfig:
     motors: Motors
     sensors: Sensors
     algorithm: Algorithm
+    safety: Safety
 
     # -- seed constants that are lengths (metres) -------------------------------
     @property
@@ -250,7 +273,7 @@ class RobotConfig:
         """The resolved config as plain data: the file's sections plus ``derived``."""
         out: dict[str, Any] = {
             name: msgspec.to_builtins(getattr(self, name))
-            for name in ("geometry", "masses", "motors", "sensors", "algorithm")
+            for name in ("geometry", "masses", "motors", "sensors", "algorithm", "safety")
         }
         out["geometry"]["LENGTH_OF_A_ROBOT"] = round(self.LENGTH_OF_A_ROBOT, 6)
         out["derived"] = {k: round(v, 6) for k, v in self.derived().items()}
@@ -267,7 +290,7 @@ def parse_config(text: str, source: str) -> RobotConfig:
     raw = load_toml(text, source, ConfigError)
     data = convert(raw, ConfigFile, source, ConfigError)
     cfg = RobotConfig(source, data.geometry, data.masses, data.motors, data.sensors,
-                      data.algorithm)
+                      data.algorithm, data.safety)
     _check_consistency(cfg)
     return cfg
 
@@ -314,6 +337,13 @@ def _check_consistency(cfg: RobotConfig) -> None:
                           "must exceed sensors.front_height + algorithm.drive_clearance")
     if a.clearance_lift >= m.lift_travel:
         raise ConfigError(src, "algorithm.clearance_lift", "must be below motors.lift_travel")
+    half_base = g.LENGTH_OF_SECOND_MODULE / 2 - g.wheel_inset
+    if cfg.safety.stability_margin >= half_base:
+        raise ConfigError(
+            src, "safety.stability_margin",
+            f"{cfg.safety.stability_margin} m leaves no room: segment 2's wheels alone carry "
+            "the robot while segments 1 and 3 are lifted (calibration); allowed: 0 <= "
+            f"stability_margin < LENGTH_OF_SECOND_MODULE / 2 - wheel_inset = {half_base:.4f} m")
     if a.LENGTH_OF_INFINITY <= cfg.LENGTH_OF_A_ROBOT + a.SAFE_LENGTH:
         raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
                           "must exceed LENGTH_OF_A_ROBOT + SAFE_LENGTH")

@@ -45,7 +45,7 @@ def test_config_show_text_has_every_section_and_the_derived_values(
     assert main(["config", "show"]) == 0
     out = capsys.readouterr().out
     for section in ("[geometry]", "[masses]", "[motors]", "[sensors]", "[algorithm]",
-                    "[derived]"):
+                    "[safety]", "[derived]"):
         assert section in out
     assert "SAFE_DISTANCE_IN_FRONT_OF_STEP = 0.1" in out
     derived = out[out.index("[derived]"):]

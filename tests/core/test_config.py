@@ -53,7 +53,8 @@ def test_the_reference_robot_climbs_residential_stairs() -> None:
 
 def test_to_dict_has_every_section_and_the_derived_values() -> None:
     d = load_config().to_dict()
-    assert set(d) >= {"geometry", "masses", "motors", "sensors", "algorithm", "derived", "source"}
+    assert set(d) >= {"geometry", "masses", "motors", "sensors", "algorithm", "safety", "derived",
+                      "source"}
     assert d["derived"]["max_step_rise_m"] == pytest.approx(0.202)
     assert d["derived"]["min_tread_m"] == pytest.approx(0.26)
     assert d["geometry"]["LENGTH_OF_A_ROBOT"] == 0.225
@@ -85,6 +86,14 @@ def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
         (with_change("algorithm", "LENGTH_OF_INFINITY", "2.0"), "algorithm.LENGTH_OF_INFINITY",
          "front_max_range"),
         (with_change("sensors", "front_min_range", "1.5"), "sensors.front_min_range", "below"),
+        (with_change("safety", "max_pitch_deg", "40.0"), "safety.max_pitch_deg",
+         "40.0 is not allowed; allowed: a number > 0 and <= 30"),
+        (with_change("safety", "max_rate_dps", "0"), "safety.max_rate_dps", "> 0 and <= 1000"),
+        (with_change("safety", "imu", '"yes"'), "safety.imu", "allowed: true or false"),
+        (with_change("safety", "imu_max_age_s", None), "safety.imu_max_age_s", "required"),
+        (with_change("safety", "stability_margin", "0.02"), "safety.stability_margin",
+         "allowed: 0 <= stability_margin < LENGTH_OF_SECOND_MODULE / 2 - wheel_inset = 0.0190 m"),
+        (DEFAULT_TEXT[:DEFAULT_TEXT.index("[safety]")], "safety", "required but missing"),
         (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "lidar"\n'),
          "sensors.front_model",
          "'lidar' is not allowed; allowed: one of 'gp2y0a21', 'hcsr04', 'ideal', 'vl53l0x', "
