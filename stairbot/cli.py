@@ -320,6 +320,8 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
         f"  fell              {'yes' if d['fell'] else 'no'}"
         f" (max pitch {_fmt(d.get('max_pitch_deg'), ' deg', 1)})",
         f"  offset from start {_fmt(d.get('final_offset_m'), ' m')}",
+        "  tilt              " + ("watched (IMU)" if d.get("tilt_watched")
+                                  else "NOT watched: the robot config declares no IMU"),
         f"  time              {_fmt(d['sim_time_s'], ' s', 2)} robot time, "
         f"{_fmt(d['wall_time_s'], ' s', 2)} wall"
         + (f" (realtime x{rtf:.0f})" if isinstance(rtf, float | int) else ""),

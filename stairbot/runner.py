@@ -109,6 +109,8 @@ class RunResult:
     sim_time_s: float
     wall_time_s: float
     realtime_factor: float | None
+    tilt_watched: bool
+    """Whether the supervisor watched the tilt (the config declares an IMU)."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -198,6 +200,7 @@ def run(
         sim_time_s=sim_time,
         wall_time_s=wall_time,
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
+        tilt_watched=ctl.config.safety.imu,
     )
     sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
@@ -250,4 +253,6 @@ def _summary_line(r: RunResult) -> str:
         parts.append(f"{r.pauses} pause(s)")
     if r.error:
         parts.append(f"error: {r.error}")
+    if not r.tilt_watched:
+        parts.append("tilt not watched (no IMU in the robot config)")
     return "; ".join(parts)

@@ -1,10 +1,12 @@
 """The safety supervisor: checks the robot every tick, whatever the phase logic
 believes, and names what is wrong.
 
-Today it watches for a stalled motor: one commanded to turn that does not
-(a wheel against an obstacle, a jammed lift, a dead encoder).  Grinding on
-helps nothing and may break something: the program ends with an error and
-every motor stops, lifts holding.
+It watches the robot's tilt (:mod:`stairbot.tilt`: the IMU's pitch, roll and
+their rates against ``[safety]``, and an IMU that is declared but missing or
+stale), and a stalled motor: one commanded to turn that does not (a wheel
+against an obstacle, a jammed lift, a dead encoder).  Tipping on, or
+grinding on, helps nothing and may break something: the program ends with an
+error and every motor stops, lifts holding.
 
 Pure Python, on the controller's clock (the snapshots' times).
 """
@@ -15,6 +17,7 @@ from dataclasses import dataclass
 
 from stairbot.config import RobotConfig
 from stairbot.hardware import LIFT_MOTORS, MotorId, Snapshot, Speeds
+from stairbot.tilt import TiltWatch
 
 STALL_S = 1.0
 """A motor that makes less than STALL_SHARE of its commanded motion for this
@@ -44,13 +47,18 @@ class Supervisor:
         self._watch: dict[MotorId, _Watch] = {}
         self._sent: Speeds = {}
         self._prev: Snapshot | None = None
+        self.tilt = TiltWatch(cfg.safety)
 
     def commanded(self, speeds: Speeds) -> None:
         """The speeds sent after the last snapshot checked (they act until the next)."""
         self._sent = speeds
 
     def check(self, snap: Snapshot) -> str | None:
-        """A reason to stop the robot now, or None."""
+        """A reason to stop the robot now, or None: the tilt first (the robot
+        tipping is the most urgent), then a stall."""
+        return self.tilt.check(snap) or self._stall(snap)
+
+    def _stall(self, snap: Snapshot) -> str | None:
         prev, self._prev = self._prev, snap
         if prev is None:
             return None

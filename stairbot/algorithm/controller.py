@@ -182,6 +182,8 @@ class Controller:
         if not self._started:
             self._started = True
             self._enter(self.phase, "program start", snap)
+            tilt = self._supervisor.tilt
+            self._say(tilt.describe(), tilt_watched=tilt.watched)
             return _zeros()
         fault = self._fault(snap) or self._supervisor.check(snap)
         if fault is not None:

@@ -12,6 +12,7 @@ from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.scene import stairs_from_scenario
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
+    Imu,
     MotorId,
     MotorState,
     Point,
@@ -66,7 +67,7 @@ class StillRobot:
                   (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL)}
         motors[MotorId.MTF] = MotorState(LIFT / 0.002, 10.0)
         motors[MotorId.MTB] = MotorState(0.0, 0.0)
-        return Snapshot(12.34, sensors, motors, self.health)
+        return Snapshot(12.34, sensors, motors, self.health, imu=Imu(0.0, 0.0))  # level
 
     def command(self, speeds: Speeds) -> None:
         self.commands.append(dict(speeds))

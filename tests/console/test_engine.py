@@ -24,7 +24,8 @@ def stopped(steps_climbed: int = 0, ascent_end: str | None = None) -> RunResult:
     """How a stand-in loop ends."""
     return RunResult(outcome="stopped", ascent_end=ascent_end, steps_climbed=steps_climbed,
                      steps_descended=0, pauses=0, error=None, fell=False, max_pitch_deg=None,
-                     final_offset_m=None, sim_time_s=0.0, wall_time_s=0.0, realtime_factor=None)
+                     final_offset_m=None, sim_time_s=0.0, wall_time_s=0.0, realtime_factor=None,
+                     tilt_watched=True)
 
 
 class DriveLoop:

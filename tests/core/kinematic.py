@@ -20,6 +20,7 @@ from stairbot.algorithm.controller import Controller
 from stairbot.config import RobotConfig
 from stairbot.hardware import (
     LIFT_MOTORS,
+    Imu,
     MotorId,
     MotorState,
     SensorId,
@@ -54,6 +55,8 @@ class KinematicRobot:
     motor_faults: dict[MotorId, str] = field(default_factory=dict)
     jammed: set[MotorId] = field(default_factory=set)  # commanded, but do not turn
     front_override: Callable[[KinematicRobot], tuple[float, float]] | None = None
+    # the segments stand level (no physics): the IMU reads 0 unless a test says otherwise
+    imu: Imu | None = field(default_factory=lambda: Imu(0.0, 0.0))
 
     def __post_init__(self) -> None:
         g = self.cfg.geometry
@@ -156,7 +159,7 @@ class KinematicRobot:
         }
         motors = {m: MotorState(self.counters[m], self.speeds[m], self.motor_faults.get(m))
                   for m in MotorId}
-        return Snapshot(self.t, sensors, motors)
+        return Snapshot(self.t, sensors, motors, imu=self.imu)
 
     def command(self, speeds: dict[MotorId, float]) -> None:
         self.speeds = {m: float(speeds.get(m, 0.0)) for m in MotorId}

@@ -280,10 +280,10 @@ def test_a_reading_or_a_counter_that_is_not_a_number_ends_with_an_error() -> Non
         snap = robot.read()
         if broken == "reading":
             sensors = {**snap.sensors, SensorId.SFL: SensorReading(math.nan)}
-            snap = Snapshot(snap.time_s, sensors, snap.motors)
+            snap = Snapshot(snap.time_s, sensors, snap.motors, imu=snap.imu)
         else:
             motors = {**snap.motors, MotorId.MWF: MotorState(math.inf)}
-            snap = Snapshot(snap.time_s, snap.sensors, motors)
+            snap = Snapshot(snap.time_s, snap.sensors, motors, imu=snap.imu)
         assert ctrl.tick(snap) == dict.fromkeys(MotorId, 0.0)
         assert ctrl.result.outcome == "error"
         assert ("SFL" if broken == "reading" else "MWF") in str(ctrl.result.error)

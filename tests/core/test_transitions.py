@@ -23,7 +23,7 @@ from stairbot.algorithm.transitions import (
 )
 from stairbot.algorithm.work import Work
 from stairbot.config import load_config
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config()
 
@@ -31,7 +31,7 @@ CFG = load_config()
 def snapshot(t: float = 0.0, front: float = 0.5) -> Snapshot:
     sensors = {SensorId.SFR: SensorReading(front), SensorId.SFL: SensorReading(front),
                SensorId.SBR: SensorReading(0.04), SensorId.SBL: SensorReading(0.04)}
-    return Snapshot(t, sensors, {m: MotorState(0.0) for m in MotorId})
+    return Snapshot(t, sensors, {m: MotorState(0.0) for m in MotorId}, imu=Imu(0.0, 0.0))
 
 
 def test_every_phase_has_a_seed_label_and_a_flow() -> None:

@@ -1,6 +1,7 @@
 """The simulated sensor board: the IMU reports segment 2's pitch and pitch rate
 (roll 0: a side view cannot roll), and each distance reading carries its
-sensor model's age (0 and shared for the ideal preset)."""
+sensor model's age (0 and shared for the ideal preset).  The config's tilt
+limits stop the robot before the simulation counts a fall."""
 
 from __future__ import annotations
 
@@ -8,10 +9,12 @@ import math
 from dataclasses import replace
 
 import msgspec
+import msgspec.inspect as mi
 import pytest
 
-from stairbot.config import load_config
+from stairbot.config import Safety, load_config
 from stairbot.fakes.sim import SimClock, SimRobot
+from stairbot.fakes.world import WorldParams
 from stairbot.hardware import SensorId
 from stairbot.robots import RobotSession
 from stairbot.runner import run
@@ -83,3 +86,9 @@ def test_a_timed_model_tells_each_reading_its_age() -> None:
     # vl53l0x: a 30 ms period and 30 ms latency; hcsr04: 60 ms and 25 ms
     for sid, most in ((SensorId.SFR, 0.08), (SensorId.SBR, 0.1)):
         assert len(ages[sid]) > 2 and 0.0 < max(ages[sid]) <= most + 1e-9
+
+
+def test_every_allowed_tilt_limit_stops_before_the_simulation_counts_a_fall() -> None:
+    fields = {f.name: f.type for f in mi.type_info(Safety).fields}  # type: ignore[attr-defined]
+    most = fields["max_pitch_deg"].le
+    assert CFG.safety.max_pitch_deg < most < WorldParams().pitch_limit_deg

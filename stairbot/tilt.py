@@ -1,0 +1,77 @@
+"""The tilt watch: the supervisor's check of the IMU, every tick.
+
+The robot stops -- every motor, the lifts holding -- when segment 2's pitch
+or roll is beyond the config's limit (``[safety] max_pitch_deg``,
+``max_roll_deg``), or turning faster than ``max_rate_dps``: well before the
+robot tips over, and whatever the phase believes.  When in doubt it stops as
+well: a robot whose config declares an IMU (``[safety] imu = true``) and
+whose snapshot has none, or one older than ``imu_max_age_s``, or one that is
+not a number, cannot be watched.  A robot declared without an IMU is not
+watched at all, and :attr:`TiltWatch.watched` says so (the run tells it).
+
+Pure Python, on the controller's clock (the snapshots' times).
+"""
+
+from __future__ import annotations
+
+import math
+
+from stairbot.config import Safety
+from stairbot.hardware import Imu, Snapshot
+
+STOPPED = "every motor stopped, lifts holding"
+
+
+class TiltWatch:
+    """Checks each snapshot's IMU against ``[safety]``; one per supervisor."""
+
+    def __init__(self, safety: Safety) -> None:
+        self.safety = safety
+
+    @property
+    def watched(self) -> bool:
+        """Whether tilt is watched at all (the config declares an IMU)."""
+        return self.safety.imu
+
+    def describe(self) -> str:
+        """What is watched, in words, for the operator at the start of a run."""
+        s = self.safety
+        if not s.imu:
+            return "tilt not watched: the robot config declares no IMU ([safety] imu = false)"
+        return (f"tilt watched: the robot stops beyond pitch ±{s.max_pitch_deg:g}°, roll "
+                f"±{s.max_roll_deg:g}° or {s.max_rate_dps:g}°/s, or without an IMU reading "
+                f"newer than {s.imu_max_age_s:g} s")
+
+    def check(self, snap: Snapshot) -> str | None:
+        """A reason to stop the robot now, or None."""
+        s = self.safety
+        if not s.imu:
+            return None
+        imu = snap.imu
+        if imu is None:
+            return ("IMU missing: the robot config declares one ([safety] imu = true) but the "
+                    f"robot reports none, so tilt cannot be watched: {STOPPED}")
+        if not _finite(imu):
+            return (f"IMU error: it reports pitch {imu.pitch_deg}°, roll {imu.roll_deg}°, "
+                    f"rates {imu.pitch_rate_dps}/{imu.roll_rate_dps}°/s, age {imu.age_s} s: "
+                    f"{STOPPED}")
+        if imu.age_s > s.imu_max_age_s:
+            return (f"IMU stale: its reading is {imu.age_s:.3f} s old (limit "
+                    f"{s.imu_max_age_s:g} s), so tilt cannot be watched: {STOPPED}")
+        for name, value, limit, unit, sides in (
+            ("pitch", imu.pitch_deg, s.max_pitch_deg, "°", ("nose up", "nose down")),
+            ("roll", imu.roll_deg, s.max_roll_deg, "°", ("right side down", "left side down")),
+            ("pitch rate", imu.pitch_rate_dps, s.max_rate_dps, "°/s", ("nose up", "nose down")),
+            ("roll rate", imu.roll_rate_dps, s.max_rate_dps, "°/s",
+             ("right side down", "left side down")),
+        ):
+            if abs(value) > limit:
+                side = sides[0] if value > 0 else sides[1]
+                return (f"tilt: segment 2's {name} is {value:+.1f}{unit} ({side}), beyond the "
+                        f"limit ±{limit:g}{unit}: {STOPPED}")
+        return None
+
+
+def _finite(imu: Imu) -> bool:
+    return all(math.isfinite(v) for v in
+               (imu.pitch_deg, imu.roll_deg, imu.pitch_rate_dps, imu.roll_rate_dps, imu.age_s))
