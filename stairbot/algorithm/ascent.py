@@ -138,6 +138,7 @@ def _lift_first(t: Tick, w: Work) -> Step:
 
 LIFT_FIRST = PhaseDef(
     P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, enter=_lift_first_enter,
+    carried_by=(2, 3),
     to={P.ASCENT_LIFT_FIRST_MORE: "sees over the riser (reads ≥ gap + SIGHT_JUMP_M)",
         P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
                                  "step too high; or sees over a rise < min_step_rise_m",
@@ -171,7 +172,7 @@ _more_enter, _more_step = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_verti
                                _lifted_first)
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
-    _more_step, enter=_more_enter,
+    _more_step, enter=_more_enter, carried_by=(2, 3),
     to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
                               "number_of_turns_for_step_height stored",
         P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
@@ -187,7 +188,7 @@ _obstacle_enter, _obstacle_step = lift(
     lambda t, w: {MotorId.MTF: t.ctx.return_mtf - w.entry_mtf}, _lowered_obstacle)
 LOWER_OBSTACLE = PhaseDef(
     P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
-    enter=_obstacle_enter,
+    enter=_obstacle_enter, carried_by=(2, 3),
     to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
         P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
 
@@ -229,7 +230,7 @@ DRIVE_FIRST = drive_phase(
 
 LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
-    lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)}, P.ASCENT_DRIVE_SECOND)
+    lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)}, P.ASCENT_DRIVE_SECOND, (1, 3))
 
 DRIVE_SECOND = drive_phase(
     P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, 1, _second_target,
@@ -257,7 +258,7 @@ def _lifted_third(t: Tick, _w: Work) -> Step:
 _lift3 = lift(lambda t, _w: {MotorId.MTB: _h(t)}, _lifted_third)
 LIFT_THIRD = PhaseDef(
     P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], enter=_lift3[0],
-    watches="front",
+    watches="front", carried_by=(1, 2),
     to={P.ASCENT_CHECK: "turns made; tab_length_to_edge[i] stored, number_of_steps + 1",
         P.ERROR: FAULT})
 

@@ -138,7 +138,7 @@ def _lifted(t: Tick, _w: Work) -> Step:
 _lift_enter, _lift_step = lift(_lift_deltas, _lifted)
 LIFT = PhaseDef(
     P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
-    enter=_lift_enter,
+    enter=_lift_enter, carried_by=(2,),
     to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
         P.CAL_PROBE: "lifted; case 3", P.ERROR: FAULT})
 
@@ -331,6 +331,7 @@ def _lowered(t: Tick, _w: Work) -> Step:
 _lower_enter, _lower_step = lift(_lower_deltas, _lowered)
 LOWER = PhaseDef(
     P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, enter=_lower_enter,
+    carried_by=(2,),
     to={P.ASCENT_APPROACH: "lowered (start or ascent 1)",
         P.DESCENT_BACK_TO_EDGE: "lowered (descent 1)",
         P.DONE: "lowered; calibrate-only mode", P.ERROR: FAULT})

@@ -17,7 +17,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from stairbot.algorithm import calibration, motion, standing
+from stairbot.algorithm import calibration, motion, stability, standing
 from stairbot.algorithm.context import Context
 from stairbot.algorithm.phase import Step, Tick, fail, where
 from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
@@ -81,12 +81,17 @@ class Controller:
     ``context`` restores a saved run (:meth:`Context.to_dict`); the snapshots
     must then come from the same clock.  ``hold``/``release``/``abort`` are
     for the operator and must be called from the thread that ticks.
+    ``check_stability=False`` skips the static-stability check before the
+    lifts (:mod:`stairbot.algorithm.stability`): only for a test that shows
+    what the supervisor does without it.
     """
 
     def __init__(self, config: RobotConfig, sink: EventSink = discard,
-                 mode: Mode = Mode.FULL, context: Context | None = None) -> None:
+                 mode: Mode = Mode.FULL, context: Context | None = None, *,
+                 check_stability: bool = True) -> None:
         self.config = config
         self.mode = mode
+        self.check_stability = check_stability
         self._sink = sink
         if context is None:
             context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns)
@@ -193,6 +198,8 @@ class Controller:
         record = self.phase.record
         t = Tick(snap, self.config, ctx, self.mode, self._say)
         step = standing.watch(t, record)
+        if step is None and not ctx.work.balanced and self.check_stability:
+            step = stability.before_lift(t, record, ctx.work)
         if step is None:
             assert record.step is not None  # only DONE and ERROR have none
             step = record.step(t, ctx.work)

@@ -123,6 +123,7 @@ def _lower_third(t: Tick, w: Work) -> Step:
 LOWER_THIRD = PhaseDef(
     P.DESCENT_LOWER_THIRD, "descent 2 — lower segment 3", FLOW,
     checked_first(_over_an_edge, _lower_third), enter=_lower_third_enter, watches="back",
+    carried_by=(1, 2),
     to={P.DESCENT_DRIVE_SECOND: "SBR/SBL read BACK_CLEARANCE: "
                                 "number_of_turns_for_step_height stored",
         P.ERROR: "reads ≤ BACK_CLEARANCE at the start, or floor not found "
@@ -150,7 +151,7 @@ DRIVE_SECOND = drive_phase(
 
 LOWER_SECOND = lift_phase(
     P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW,
-    lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)}, P.DESCENT_DRIVE_FIRST)
+    lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)}, P.DESCENT_DRIVE_FIRST, (1, 3))
 
 DRIVE_FIRST = drive_phase(
     P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, -1,
@@ -172,6 +173,7 @@ def _lowered_first(t: Tick, _w: Work) -> Step:
 _lower1 = lift(lambda t, _w: {MotorId.MTF: -_h(t)}, _lowered_first)
 LOWER_FIRST = PhaseDef(
     P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], enter=_lower1[0],
+    carried_by=(2, 3),
     to={P.DESCENT_BACK_OFF: "turns made; steps remain",
         P.DESCENT_FINISH: "turns made; all number_of_steps descended", P.ERROR: FAULT})
 

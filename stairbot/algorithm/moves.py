@@ -110,9 +110,11 @@ def drive_phase(phase: Phase, label: str, flow: str, direction: int,
 
 
 def lift_phase(phase: Phase, label: str, flow: str,
-               deltas: Callable[[Tick, Work], dict[MotorId, float]], then: Phase) -> PhaseDef:
-    """A :func:`lift` phase that goes on to ``then`` when the turns are made;
-    the front pair is watched."""
+               deltas: Callable[[Tick, Work], dict[MotorId, float]], then: Phase,
+               carried_by: tuple[int, ...]) -> PhaseDef:
+    """A :func:`lift` phase that goes on to ``then`` when the turns are made,
+    the robot carried by the wheels of the segments ``carried_by``; the front
+    pair is watched."""
     enter, step = lift(deltas, lambda _t, _w: go(then))
     return PhaseDef(phase, label, flow, step, enter=enter, watches="front",
-                    to={then: "turns made", Phase.ERROR: FAULT})
+                    carried_by=carried_by, to={then: "turns made", Phase.ERROR: FAULT})

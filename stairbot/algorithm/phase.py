@@ -99,7 +99,11 @@ class PhaseDef:
 
     ``watches`` names the sensor pair the standing rule watches in this phase
     ("front" or "back"; None: not armed); an armed phase may be paused, and is
-    resumed from the pause, without saying so in ``to``."""
+    resumed from the pause, without saying so in ``to``.  ``carried_by``
+    names the segments (1, 2, 3) whose wheels carry the robot while the phase
+    moves its lifts: the static-stability check runs before its first step
+    (:mod:`stairbot.algorithm.stability`), and its error is added to the
+    edge to ERROR, also without saying so in ``to``; empty: no lift moves."""
 
     phase: Phase
     label: str
@@ -108,6 +112,7 @@ class PhaseDef:
     to: Mapping[Phase, str] = field(default_factory=dict)
     enter: Callable[[Tick, Work], None] = _no_entry
     watches: str | None = None
+    carried_by: tuple[int, ...] = ()
 
 
 def where(ctx: Context, phase: Phase) -> str:

@@ -12,6 +12,7 @@ from types import MappingProxyType
 
 from stairbot.algorithm.phase import BACK_DISAGREE, FRONT_DISAGREE
 from stairbot.algorithm.phases import FLOWS, Phase
+from stairbot.algorithm.stability import UNSTABLE_EDGE
 from stairbot.algorithm.table import PHASES
 
 P = Phase
@@ -23,11 +24,14 @@ class TransitionError(RuntimeError):
 
 def _table() -> dict[Phase, dict[Phase, str]]:
     """Every record's transitions; an armed phase also pauses (before its
-    error, as the flowcharts read), and the pause resumes into it."""
+    error, as the flowcharts read), and the pause resumes into it; a lift
+    phase's error names the stability check first."""
     table: dict[Phase, dict[Phase, str]] = {}
     resumes: dict[Phase, str] = {}
     for phase, record in PHASES.items():
         nexts = dict(record.to)
+        if record.carried_by:
+            nexts[P.ERROR] = f"{UNSTABLE_EDGE}; {nexts[P.ERROR]}"
         if record.watches is not None:
             error = nexts.pop(P.ERROR, None)
             nexts[P.PAUSED] = BACK_DISAGREE if record.watches == "back" else FRONT_DISAGREE

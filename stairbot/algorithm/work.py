@@ -43,6 +43,8 @@ class Work:
     """A pair difference summed over ticks standing still, and how many."""
     checked: bool = False
     """The phase's entry condition has been checked (on its first step)."""
+    balanced: bool = False
+    """The static-stability check has run (before a lift phase's first step)."""
 
     @classmethod
     def at_entry(cls, snap: Snapshot) -> Work:
