@@ -3,7 +3,10 @@
 Each :meth:`Controller.tick` takes one :class:`~stairbot.hardware.Snapshot`
 and returns a speed for all six motors.  Faults are checked before the
 phase's own logic (a motor fault, a sensor error on a sensor the phase needs,
-a phase that takes too long), then the standing rule, then the phase's step.
+a phase that takes too long, and the supervisor's tilt and stall), then the
+standing rule, then -- once, before a lift phase's first step -- the
+static-stability check (:mod:`~stairbot.algorithm.stability`), then the
+phase's step.
 Whichever decides returns a :class:`~stairbot.algorithm.phase.Step`; if it
 names a next phase, :meth:`Controller._apply` enters it — the one place a
 phase is entered, at most once a tick — after checking the change against
@@ -198,7 +201,8 @@ class Controller:
         record = self.phase.record
         t = Tick(snap, self.config, ctx, self.mode, self._say)
         step = standing.watch(t, record)
-        if step is None and not ctx.work.balanced and self.check_stability:
+        if step is None and record.carried_by and not ctx.work.balanced \
+                and self.check_stability:
             step = stability.before_lift(t, record, ctx.work)
         if step is None:
             assert record.step is not None  # only DONE and ERROR have none
