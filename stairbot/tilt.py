@@ -48,6 +48,11 @@ class TiltWatch:
         if not s.imu:
             return None
         imu = snap.imu
+        if imu is not None and abs(imu.pitch_deg) <= s.max_pitch_deg \
+                and abs(imu.roll_deg) <= s.max_roll_deg \
+                and abs(imu.pitch_rate_dps) <= s.max_rate_dps \
+                and abs(imu.roll_rate_dps) <= s.max_rate_dps and imu.age_s <= s.imu_max_age_s:
+            return None  # every tick of a normal run: nothing more to look at (NaN fails it)
         if imu is None:
             return ("IMU missing: the robot config declares one ([safety] imu = true) but the "
                     f"robot reports none, so tilt cannot be watched: {STOPPED}")
