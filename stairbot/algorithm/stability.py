@@ -14,9 +14,10 @@ the segments that carry the robot -- which the phase knows: lifting segment 1
 leaves segments 2 and 3 carrying it, lifting segment 2 segments 1 and 3,
 lifting segments 1 and 3 (calibration) segment 2 alone.
 
-The centre of mass and the axles both move in a straight line as a lift
-moves, so the check at the lift's start and at its target covers every
-position in between.
+The centre of mass and each axle move in a straight line as a lift moves,
+so the margin is least at the lift's start, at its target, or where two
+carrying axles pass each other (the outermost one changes, which only a
+steep pitch makes happen): :func:`worst` looks at each.
 
 Pure functions, and :func:`before_lift`, which the controller runs once
 before a lift phase's first step (docs/algorithm.md, "Safety").
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import combinations
 
 from stairbot.algorithm.phase import PhaseDef, Step, Tick, fail
 from stairbot.algorithm.work import Work
@@ -62,10 +64,8 @@ def balance(cfg: RobotConfig, carried_by: tuple[int, ...], mtf_turns: float,
     if not carried_by or not set(carried_by) <= {1, 2, 3}:
         raise ValueError(f"carried_by {carried_by!r}: name one or more of segments 1, 2, 3")
     g, m = cfg.geometry, cfg.masses
-    per_turn = cfg.motors.lift_travel_per_turn
-    lengths = (g.LENGTH_OF_FIRST_MODULE, g.LENGTH_OF_SECOND_MODULE, g.LENGTH_OF_THIRD_MODULE)
-    centres = ((lengths[0] + lengths[1]) / 2, 0.0, -(lengths[1] + lengths[2]) / 2)
-    heights = (mtf_turns * per_turn, 0.0, mtb_turns * per_turn)
+    _lengths, centres = _layout(cfg)
+    heights = _heights(cfg, (mtf_turns, mtb_turns))
     bodies = (m.first_module, m.second_module, m.third_module)
     wheels = 4 * m.wheel
     theta = math.radians(pitch_deg)
@@ -79,18 +79,54 @@ def balance(cfg: RobotConfig, carried_by: tuple[int, ...], mtf_turns: float,
         # the body's centre above its axles; the wheels' centre on them
         moment += body * horizontal(x, y + g.segment_height / 2) + wheels * horizontal(x, y)
         total += body + wheels
-    axles = [horizontal(centres[i - 1] + side * (lengths[i - 1] / 2 - g.wheel_inset),
-                        heights[i - 1])
-             for i in carried_by for side in (-1.0, 1.0)]
+    axles = _axles(cfg, carried_by, heights, c, s)
     return Balance(moment / total, min(axles), max(axles))
+
+
+Triple = tuple[float, float, float]
+
+
+def _layout(cfg: RobotConfig) -> tuple[Triple, Triple]:
+    """The segments' lengths, and their centres' x about segment 2's (front to back)."""
+    g = cfg.geometry
+    lengths = (g.LENGTH_OF_FIRST_MODULE, g.LENGTH_OF_SECOND_MODULE, g.LENGTH_OF_THIRD_MODULE)
+    return lengths, ((lengths[0] + lengths[1]) / 2, 0.0, -(lengths[1] + lengths[2]) / 2)
+
+
+def _heights(cfg: RobotConfig, counters: tuple[float, float]) -> Triple:
+    """Each segment's axles above segment 2's, from the (MTF, MTB) counters."""
+    per_turn = cfg.motors.lift_travel_per_turn
+    return counters[0] * per_turn, 0.0, counters[1] * per_turn
+
+
+def _axles(cfg: RobotConfig, carried_by: tuple[int, ...], heights: Triple,
+           c: float, s: float) -> list[float]:
+    """Horizontal positions of the carrying segments' axles (cos and sin of the pitch)."""
+    lengths, centres = _layout(cfg)
+    out = []
+    for i in carried_by:
+        half = lengths[i - 1] / 2 - cfg.geometry.wheel_inset
+        for x in (centres[i - 1] - half, centres[i - 1] + half):
+            out.append(x * c - heights[i - 1] * s)
+    return out
 
 
 def worst(cfg: RobotConfig, carried_by: tuple[int, ...], start: tuple[float, float],
           end: tuple[float, float], pitch_deg: float = 0.0) -> Balance:
-    """The less stable of the lift's two ends, (MTF, MTB) counters at ``start``
-    and ``end``: the worse of every position in between (see the module
-    docstring)."""
-    return min((balance(cfg, carried_by, *at, pitch_deg) for at in (start, end)),
+    """The least stable position of a lift from (MTF, MTB) counters ``start``
+    to ``end``: at one of its ends or where two carrying axles pass each
+    other (see the module docstring)."""
+    theta = math.radians(pitch_deg)
+    c, s = math.cos(theta), math.sin(theta)
+    a0 = _axles(cfg, carried_by, _heights(cfg, start), c, s)
+    a1 = _axles(cfg, carried_by, _heights(cfg, end), c, s)
+    where = {0.0, 1.0}
+    for i, j in combinations(range(len(a0)), 2):
+        d0, d1 = a0[i] - a0[j], a1[i] - a1[j]
+        if d0 * d1 < 0.0:
+            where.add(d0 / (d0 - d1))
+    return min((balance(cfg, carried_by, start[0] + f * (end[0] - start[0]),
+                        start[1] + f * (end[1] - start[1]), pitch_deg) for f in sorted(where)),
                key=lambda b: b.margin)
 
 

@@ -5,6 +5,7 @@ and the controller refusing a lift before anything moves."""
 from __future__ import annotations
 
 import math
+import random
 from dataclasses import replace
 
 import msgspec
@@ -127,3 +128,26 @@ def test_switched_off_the_check_lets_the_lift_go() -> None:
     ctrl, robot = Controller(cfg, check_stability=False), KinematicRobot(cfg)
     run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_PROBE)
     assert robot.counters[MotorId.MTF] > 0.0  # the kinematic robot does not topple
+
+
+def test_the_worst_position_of_a_lift_is_the_least_margin_along_it() -> None:
+    # any lift, any pitch, any support: worst() finds the least margin of the
+    # whole path, a kink where the outermost carrying axle changes included
+    rng = random.Random(5)
+    cfg = heavier_front(1.2)
+    stroke = cfg.MAX_OF_VERTICAL_TURNS
+    kinks = 0
+    for _ in range(300):
+        carried_by = rng.choice([(2,), (2, 3), (1, 3), (1, 2), (1, 2, 3)])
+        pitch = rng.uniform(-40.0, 40.0)
+        start = (rng.uniform(-stroke, stroke), rng.uniform(-stroke, stroke))
+        end = (rng.uniform(-stroke, stroke), rng.uniform(-stroke, stroke))
+        along = [balance(cfg, carried_by, start[0] + f * (end[0] - start[0]),
+                         start[1] + f * (end[1] - start[1]), pitch).margin
+                 for f in (k / 1000 for k in range(1001))]
+        found = worst(cfg, carried_by, start, end, pitch).margin
+        assert found <= min(along) + 1e-12
+        assert found == pytest.approx(min(along), abs=1e-4)
+        ends = min(along[0], along[-1])
+        kinks += min(along) < ends - 1e-4
+    assert kinks > 5  # the kinks are there, and found
