@@ -9,12 +9,17 @@ from importlib import resources
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
-from stairbot.algorithm.controller import PHASE_TIMEOUT_S, Controller, phase_timeout_s
+from stairbot.algorithm.controller import (
+    PHASE_TIMEOUT_S,
+    SENSOR_WAIT_S,
+    Controller,
+    phase_timeout_s,
+)
 from stairbot.algorithm.phases import Phase
 from stairbot.config import load_config, parse_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.perception import WINDOW
+from stairbot.perception import CONFIRM
 
 CFG = load_config()
 DEFAULT_ROBOT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
@@ -61,8 +66,41 @@ def test_a_sensor_error_mid_ascent_stops_everything() -> None:
     run(ctrl, robot)
     assert ctrl.result.outcome == "error"
     assert "sensor error: SFR" in str(ctrl.result.error)
-    # a sensor's error decides once most of the perception window reports it
-    assert 25.0 <= robot.t < 25.0 + (WINDOW // 2 + 2) * TICK
+    # CONFIRM errors in a row make it an error; the robot stands SENSOR_WAIT_S
+    # for it to come back, then ends
+    assert 25.0 + SENSOR_WAIT_S <= robot.t < 25.0 + SENSOR_WAIT_S + (CONFIRM + 2) * TICK
+    finish_and_check_zero(ctrl, robot)
+
+
+def test_a_passing_sensor_error_holds_the_robot_still_and_it_carries_on() -> None:
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFR, 25.0, 25.5, error=True)])
+    run(ctrl, robot, until=lambda c: bool(of(events, EventKind.PAUSE)))
+    held_in = ctrl.phase
+    sent = run(ctrl, robot, until=lambda c: bool(of(events, EventKind.RESUME)))
+    assert still(sent[:-1])  # every motor stopped, the lifts holding (the last tick resumed)
+    assert ctrl.phase is held_in
+    run(ctrl, robot)
+    r = ctrl.result
+    assert (r.outcome, r.pauses, r.steps_climbed, r.steps_descended) == ("completed", 1, 2, 2)
+    assert "SFR" in of(events, EventKind.PAUSE)[0].message
+
+
+def test_one_error_or_out_of_range_measurement_decides_nothing() -> None:
+    faults = [Fault(SensorId.SFR, 20.0 + i * 0.5, 20.0 + i * 0.5 + (CONFIRM - 1) * TICK,
+                    error=True) for i in range(20)]
+    ctrl, robot, _ = start(faults=faults)
+    run(ctrl, robot)
+    assert (ctrl.result.outcome, ctrl.result.pauses) == ("completed", 0)
+
+
+def test_a_frozen_sensor_is_stale_and_the_robot_stops_with_lifts_holding() -> None:
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 25.0, freeze=True)])
+    sent = run(ctrl, robot)
+    assert ctrl.result.outcome == "error"
+    assert "SFL stale" in str(ctrl.result.error)
+    pause = of(events, EventKind.PAUSE)[0]
+    assert 25.0 < pause.time_s < 25.0 + 0.2  # noticed within a few ticks
+    assert still(sent[-round(SENSOR_WAIT_S / TICK):])
     finish_and_check_zero(ctrl, robot)
 
 
