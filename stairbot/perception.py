@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Iterable
 from enum import IntEnum
 
 from stairbot.config import RobotConfig
@@ -113,28 +114,19 @@ def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
     return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
 
 
-def _kind(r: SensorReading, midpoint: float) -> Kind:
-    if r.status is SensorStatus.OK:
-        return Kind.OK
-    if r.status is SensorStatus.OUT_OF_RANGE:
-        return Kind.NEAR if r.distance_m < midpoint else Kind.FAR
-    return Kind.ERROR
-
-
 class _Track:
     """One sensor's recent measurements and the kind seen."""
 
-    __slots__ = ("front", "window", "max_age", "midpoint", "kinds", "keys", "newest",
-                 "taken_s", "kind", "run_kind", "run", "last_of_kind")
+    __slots__ = ("front", "max_age", "midpoint", "ok_keys", "newest", "taken_s", "kind",
+                 "run_kind", "run", "last_of_kind")
 
     def __init__(self, front: bool, window: int, max_age: float, midpoint: float) -> None:
         self.front = front
-        self.window = window
         self.max_age = max_age
         self.midpoint = midpoint
-        self.kinds: deque[Kind] = deque(maxlen=MAX_WINDOW)
-        self.keys: deque[float] = deque(maxlen=MAX_WINDOW)
-        """An OK measurement's distance, plus (front) the odometer when taken."""
+        self.ok_keys: deque[float] = deque(maxlen=window)
+        """The last OK measurements' distances, plus (front) the odometer when
+        each was taken; emptied when the kind seen leaves OK."""
         self.newest: SensorReading | None = None
         self.taken_s = -math.inf
         self.kind: Kind | None = None
@@ -166,15 +158,28 @@ class Perception:
         now = snap.time_s
         self._odometer.append((now, odometer))
         sensors: dict[SensorId, SensorReading] = {}
+        tracks = self._tracks
         for sid, reading in snap.sensors.items():
-            if reading.status is SensorStatus.OK and not math.isfinite(reading.distance_m):
-                sensors[sid] = reading  # not a measurement but a broken board: the controller ends
-                continue
-            track = self._tracks[sid]
-            taken = now - reading.age_s
-            if reading.age_s <= 0.0 or taken > track.taken_s + 1e-9:
-                self._measured(track, reading, taken,
-                               odometer if reading.age_s <= 0.0 else self._odometer_at(taken))
+            track = tracks[sid]
+            age = reading.age_s
+            if age <= 0.0:  # measured now (a sensor as fast as the tick)
+                if reading.status is SensorStatus.OK:
+                    d = reading.distance_m
+                    if d - d != 0.0:  # inf or NaN: not a measurement but a broken board
+                        sensors[sid] = reading
+                        continue
+                    if track.kind is Kind.OK and track.run_kind is Kind.OK:
+                        # the common case, kept short: another OK measurement
+                        track.newest, track.taken_s = reading, now
+                        track.run += 1
+                        keys = track.ok_keys
+                        keys.append(d + odometer if track.front else d)
+                        m = _median(keys)
+                        sensors[sid] = SensorReading(m - odometer if track.front else m)
+                        continue
+                self._measured(track, reading, now, odometer)
+            elif now - age > track.taken_s + 1e-9:
+                self._measured(track, reading, now - age, self._odometer_at(now - age))
             sensors[sid] = self._verdict(sid, track, now, odometer)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
@@ -185,16 +190,28 @@ class Perception:
     # -- per measurement ----------------------------------------------------------------
     def _measured(self, track: _Track, reading: SensorReading, taken: float,
                   odometer: float) -> None:
-        kind = _kind(reading, track.midpoint)
+        if reading.status is SensorStatus.OK:
+            if not math.isfinite(reading.distance_m):
+                reading = SensorReading(reading.distance_m, SensorStatus.ERROR, reading.age_s)
+                kind = Kind.ERROR
+            else:
+                kind = Kind.OK
+                d = reading.distance_m
+                track.ok_keys.append(d + odometer if track.front else d)
+        elif reading.status is SensorStatus.OUT_OF_RANGE:
+            kind = Kind.NEAR if reading.distance_m < track.midpoint else Kind.FAR
+        else:
+            kind = Kind.ERROR
         track.newest, track.taken_s = reading, taken
-        track.kinds.append(kind)
-        track.keys.append(reading.distance_m + odometer if track.front else reading.distance_m)
         track.last_of_kind[kind] = reading
         if kind is track.run_kind:
             track.run += 1
         else:
             track.run_kind, track.run = kind, 1
         if track.kind is None or (kind is not track.kind and track.run >= CONFIRM):
+            if track.kind is Kind.OK:
+                # a fresh median when it comes back
+                track.ok_keys.clear()
             track.kind = kind
 
     def _odometer_at(self, t: float) -> float:
@@ -219,10 +236,8 @@ class Perception:
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         kind = track.kind
         if kind is Kind.OK:
-            values = [k for kd, k in zip(track.kinds, track.keys, strict=True) if kd is Kind.OK]
-            if values:
-                values = values[-track.window:]
-                m = _median(values)
+            if track.ok_keys:
+                m = _median(track.ok_keys)
                 self._why.pop(sid, None)
                 return SensorReading(m - odometer if track.front else m, SensorStatus.OK, age)
             self._why[sid] = "no valid measurement among its last ones"
@@ -235,7 +250,7 @@ class Perception:
         return SensorReading(held.distance_m, SensorStatus.OUT_OF_RANGE, age)
 
 
-def _median(values: list[float]) -> float:
+def _median(values: Iterable[float]) -> float:
     """statistics.median, without its generality (a hot path: every sensor, every tick)."""
     s = sorted(values)
     n = len(s)

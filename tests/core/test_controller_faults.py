@@ -335,3 +335,23 @@ def test_a_speed_that_is_not_a_number_is_commanded_as_zero() -> None:
                           robot.read())
     assert limited[MotorId.MWF] == 0.0 and limited[MotorId.MWB] == 0.0
     assert limited[MotorId.MTF] == CFG.motors.lift_speed
+
+
+def _descent_3_travel(jump: float) -> tuple[float, list[Event]]:
+    ctrl, robot, events = start()
+    # step 1's (the top step's has no tab_length_to_edge: it goes by turns anyway)
+    run(ctrl, robot, until=lambda c: c.phase is Phase.DESCENT_DRIVE_SECOND
+        and c.context.steps_descended == 1)
+    at = robot.front_x
+    if jump:  # both beams slide onto something further away, at once
+        robot.faults += [Fault(s, robot.t + 0.2, robot.t + 30.0, offset=jump)
+                         for s in (SensorId.SFR, SensorId.SFL)]
+    run(ctrl, robot, until=lambda c: c.phase is not Phase.DESCENT_DRIVE_SECOND)
+    return at - robot.front_x, events
+
+
+def test_a_drive_whose_reading_jumps_goes_on_by_turns_not_by_the_new_reading() -> None:
+    clean, _ = _descent_3_travel(0.0)
+    jumped, events = _descent_3_travel(0.08)
+    assert jumped == pytest.approx(clean, abs=0.005)  # not cut short by 8 cm
+    assert any("jumped" in e.message for e in of(events, EventKind.INFO))
