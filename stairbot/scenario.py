@@ -54,6 +54,9 @@ class Start(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     noise: NonNeg = 0.001
     seed: int = 1
+    outliers: Annotated[float, msgspec.Meta(ge=0, le=0.5)] = 0.0
+    """Share of measurements replaced by a value anywhere within range (on top
+    of the sensor model's own rate, if it has one)."""
 
 
 class Fault(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

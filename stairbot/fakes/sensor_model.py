@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from functools import cached_property
 from typing import Literal
@@ -161,8 +161,10 @@ class ModelSensor:
 
     def __init__(self, sensor: SensorId, model: SensorModel, min_range: float,
                  max_range: float, resolution: float, noise: float, seed: int,
-                 faults: Iterable[Fault] = ()) -> None:
+                 faults: Iterable[Fault] = (), outliers: float = 0.0) -> None:
         self.sensor = sensor
+        if outliers > model.outlier_rate:  # the scenario's, on top of the model's
+            model = replace(model, outlier_rate=outliers)
         self.model = model
         # the config's range, within the sensor's own (RobotConfig.sensors.range)
         self.min_range = min_range if model.min_range is None else max(min_range, model.min_range)
