@@ -77,7 +77,7 @@ class BoardRobot:
             monotonic=lambda: monotonic() * time_scale, sleep=lambda s: time.sleep(s / time_scale))
         self.idents: dict[int, m.Ident] = {}
         self.status: dict[int, m.Status] = {}
-        self.imu = telemetry.ImuRead(None, "unknown")  # the IMU as last read
+        self.imu_read = telemetry.ImuRead(None, "unknown")  # the IMU as last read
         self.imu_rejected = 0  # replies whose IMU broke the protocol
         self.report = HealthReport(link.stats, monotonic)
         self._monotonic = monotonic
@@ -226,7 +226,7 @@ class BoardRobot:
         return {"url": self.url, **self.link.describe(), "link": self.health(),
                 "boards": {m.Board(b).name.lower(): vars_of(i)
                            for b, i in self.idents.items()},
-                "imu": {"state": self.imu.state, "problem": self.imu.problem,
+                "imu": {"state": self.imu_read.state, "problem": self.imu_read.problem,
                         "rejected": self.imu_rejected}}
 
     def _keep_alive(self) -> None:
@@ -336,14 +336,15 @@ class BoardRobot:
     def _read_imu(self, msgs: tuple[Any, ...], transit_s: float, now: float) -> Imu | None:
         """The IMU of the sensor board's ReadAll reply (None unless it is
         there, OK and valid).  A board that breaks the protocol is counted
-        (``imu_rejected``) and told once, as a WARNING, until it mends."""
+        (``imu_rejected``) and told once, as a WARNING, until it mends (a
+        value that changes every tick is one trouble, not one a tick)."""
         got = telemetry.imu_of(msgs, transit_s)
         if got.broken:
             self.imu_rejected += 1
-            if got.problem != self.imu.problem:
+            if got.state != self.imu_read.state:
                 self.sink(Event(now, EventKind.WARNING, f"sensor board IMU read as none: "
                                 f"{got.problem}", None, {"imu": got.state}))
-        self.imu = got
+        self.imu_read = got
         return got.imu
 
 
