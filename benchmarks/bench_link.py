@@ -43,7 +43,8 @@ def cycle_bytes() -> tuple[int, int]:
           Frame(1, 3, u.speeds_to_wire({}))]
     rx = [Frame(1, 1, (status, *(m.MotorTelemetry(c, 1, 0, 1000, 123456) for c in range(6))),
                 True),
-          Frame(2, 2, (status, *(m.SensorTelemetry(c, 0, 500, 7) for c in range(4))), True),
+          Frame(2, 2, (status, *(m.SensorTelemetry(c, 0, 500, 7, 12) for c in range(4)),
+                       *(m.ImuTelemetry(a, 0, -250, 15, 3) for a in m.IMU_AXES)), True),
           Frame(1, 3, (m.Ack(0x20, 0), m.Ack(0x21, 0)), True)]
     return sum(len(encode_frame(f)) for f in tx), sum(len(encode_frame(f)) for f in rx)
 

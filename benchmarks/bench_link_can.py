@@ -56,7 +56,8 @@ def cycle_frames() -> list[tuple[str, int, int]]:
             (1, m.SetLiftSpeeds(0, 0)),
             (1, m.Status(0, 0, 250, 0)), (2, m.Status(0, 0, 250, 0)),
             *((1, m.MotorTelemetry(c, 1, 0, 0, 0)) for c in range(6)),
-            *((2, m.SensorTelemetry(c, 0, 0, 0)) for c in range(4)),
+            *((2, m.SensorTelemetry(c, 0, 0, 0, 0)) for c in range(4)),
+            *((2, m.ImuTelemetry(a, 0, 0, 0, 0)) for a in m.IMU_AXES),
             (1, m.Ack(0x20, 0)), (1, m.Ack(0x21, 0))]
     counts: dict[str, list[int]] = {}
     for board, msg in sent:

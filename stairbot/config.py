@@ -19,11 +19,12 @@ import msgspec
 
 from stairbot._schema import convert, load_toml, read_text
 from stairbot.errors import ConfigError
+from stairbot.sensor_specs import SPECS, SensorSpec
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
 NonNeg = Annotated[float, msgspec.Meta(ge=0)]
 
-# The simulated sensors' models (stairbot.fakes.sensor_presets; the names must agree)
+# The kinds of distance sensor (stairbot.sensor_specs; the names must agree)
 SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"]
 
 
@@ -66,13 +67,38 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     back_max_range: Pos
     resolution: NonNeg
     noise: NonNeg = 0.005
-    """Stated sigma of a distance reading (the datasheet's): perception derives
-    its tolerances from it."""
+    """Stated sigma of a distance reading of the ``ideal`` model: perception
+    derives its tolerances from it.  A named model states its own
+    (stairbot.sensor_specs)."""
     front_model: SensorModelName = "ideal"
-    """How the simulation models SFR/SFL (stairbot.fakes.sensor_presets); a real
-    robot ignores it."""
+    """The kind of sensor SFR/SFL are (stairbot.sensor_specs): its timing and
+    noise set perception's staleness limit and tolerances, and the simulation
+    models it (stairbot.fakes.sensor_presets)."""
     back_model: SensorModelName = "ideal"
     """... and SBR/SBL."""
+    front_fov_deg: Annotated[float, msgspec.Meta(gt=0, le=90)] | None = None
+    """Full cone of SFR/SFL as mounted (a ToF's ROI narrows it); None: the model's."""
+    front_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
+    """Mounting tilt of SFR/SFL, degrees up."""
+    back_fov_deg: Annotated[float, msgspec.Meta(gt=0, le=90)] | None = None
+    back_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
+    """Mounting tilt of SBR/SBL, degrees towards the front."""
+
+    def spec(self, back: bool) -> SensorSpec:
+        """The datasheet of the front (or back) pair's kind of sensor."""
+        return SPECS[self.back_model if back else self.front_model]
+
+    def range(self, back: bool) -> tuple[float, float]:
+        """The pair's working range: the config's, within the sensor's own."""
+        spec = self.spec(back)
+        lo, hi = ((self.back_min_range, self.back_max_range) if back
+                  else (self.front_min_range, self.front_max_range))
+        return (lo if spec.min_range is None else max(lo, spec.min_range),
+                hi if spec.max_range is None else min(hi, spec.max_range))
+
+    def sigma(self, back: bool, distance_m: float) -> float:
+        """The stated sigma of one reading of the pair at ``distance_m``."""
+        return self.spec(back).sigma(distance_m, self.noise)
 
 
 class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
@@ -282,6 +308,8 @@ class RobotConfig:
 
 
 DEFAULT_CONFIG_NAME = "default_robot.toml"
+BACK_RANGE_MARGIN = 0.005
+"""The floor must read at least this far inside the back sensors' range."""
 
 
 def parse_config(text: str, source: str) -> RobotConfig:
@@ -316,12 +344,26 @@ def _check_consistency(cfg: RobotConfig) -> None:
         raise ConfigError(src, "sensors.front_min_range", "must be below front_max_range")
     if s.back_min_range >= s.back_max_range:
         raise ConfigError(src, "sensors.back_min_range", "must be below back_max_range")
-    if s.back_height < s.back_min_range:
+    back_lo = s.range(back=True)[0]
+    if s.back_height < back_lo + BACK_RANGE_MARGIN:
         raise ConfigError(src, "sensors.back_height",
-                          f"must be at least back_min_range ({s.back_min_range} m)")
-    if a.LENGTH_OF_INFINITY > s.front_max_range:
+                          f"{s.back_height} m, but SBR/SBL ({s.back_model}) read from "
+                          f"{back_lo} m: the floor would be out of range; allowed: at "
+                          f"least {back_lo + BACK_RANGE_MARGIN:.3f} m (mount them higher, "
+                          "or choose a back_model that reads nearer)")
+    front_hi = s.range(back=False)[1]
+    if a.LENGTH_OF_INFINITY > front_hi:
         raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
-                          f"must not exceed sensors.front_max_range ({s.front_max_range} m)")
+                          f"{a.LENGTH_OF_INFINITY} m, but SFR/SFL ({s.front_model}) read "
+                          f"at most {front_hi} m (sensors.front_max_range, within the "
+                          f"sensor's own range); allowed: at most {front_hi} m")
+    for back, fov in ((False, s.front_fov_deg), (True, s.back_fov_deg)):
+        full = s.spec(back).fov_deg
+        if fov is not None and full > 0 and fov > full:
+            pair = "back" if back else "front"
+            raise ConfigError(src, f"sensors.{pair}_fov_deg",
+                              f"{fov} degrees, wider than the {s.spec(back).name}'s "
+                              f"{full}-degree cone; allowed: up to {full} (an ROI narrows it)")
     if a.SAFE_DISTANCE_IN_FRONT_OF_STEP <= a.approach_gap:
         raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
                           f"must exceed approach_gap ({a.approach_gap} m)")

@@ -41,6 +41,12 @@ class LinkLostError(HardwareError):
     """The link to a board is lost: no valid reply within the allowed time."""
 
 
+class ProtocolVersionError(HardwareError):
+    """A board speaks another major version of the boards' protocol
+    (docs/protocol.md): its telemetry would be misread, so it is not opened.
+    The message names the URL, the board and both versions."""
+
+
 class RobotFellError(HardwareError):
     """The simulated world detected instability: pitch beyond the limit, a fall."""
 

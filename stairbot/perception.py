@@ -1,26 +1,41 @@
 """Perception: what the algorithm sees of the distance sensors.
 
 Every snapshot passes through :class:`Perception` before any phase sees it.
-Per sensor it keeps the last ``WINDOW`` readings and reports their median —
-which no single outlier moves — with the status most of them agree on: a
-reading the sensor gave once (a spike, a dropout, a lone "out of range")
-decides nothing.  The front sensors look along the drive: each of their
-older readings is carried forward by the distance the wheels have driven
-since, so the median of a moving robot is today's distance, not the one of
-two ticks ago.  Decisions that compare two sensors ("equal", the standing
-rule) use tolerances derived from the sensors' stated noise
-(``[sensors] noise`` in the robot config), not from a guess.
+Per sensor it works on *measurements*, not ticks: a sensor slower than the
+tick repeats its last value, and the board says how old it is
+(``SensorReading.age_s``), so a repeated value counts once.  Then:
 
-Pure Python, on the controller's clock (the snapshots' times), deterministic.
+* **kind**: each measurement is OK, NEAR (out of range, too near), FAR (out of
+  range, nothing within it) or ERROR.  The kind the algorithm sees changes
+  only when CONFIRM measurements in a row agree on the new one (hysteresis):
+  a dropout, a spike or a lone "out of range" decides nothing.
+* **distance**: the median of the last OK measurements over about WINDOW_S
+  (3 to 5 of them) -- no single outlier moves it.  The front sensors look
+  along the drive: each older measurement is carried forward by the distance
+  the wheels have driven since it was taken, so the median of a moving robot
+  is today's distance.
+* **staleness**: a sensor whose newest measurement is older than its
+  datasheet's latency plus STALE_PERIODS periods (a frozen sensor, a board
+  that stopped updating it) reads as ERROR: it is not used.
+  :meth:`Perception.why` says which.
+
+Decisions that compare two sensors ("equal", the standing rule) use
+tolerances derived from the sensors' stated noise at the distance measured
+(:mod:`stairbot.sensor_specs`, ``[sensors]`` in the robot config), not from a
+guess.  Pure Python, on the controller's clock (the snapshots' times),
+deterministic.
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Iterable
+from enum import IntEnum
 
 from stairbot.config import RobotConfig
 from stairbot.hardware import (
+    BACK_SENSORS,
     FRONT_SENSORS,
     WHEEL_MOTORS,
     SensorId,
@@ -29,86 +44,213 @@ from stairbot.hardware import (
     Snapshot,
 )
 
-WINDOW = 5
-"""Readings per sensor the median is taken over (100 ms at the 20 ms tick)."""
+WINDOW_S = 0.1
+"""The time a median spans (at least MIN_WINDOW, at most MAX_WINDOW measurements)."""
+MIN_WINDOW, MAX_WINDOW = 3, 5
+CONFIRM = 3
+"""Measurements in a row that must agree before the kind seen changes."""
+STALE_PERIODS = 3.0
+"""A measurement older than latency + this many periods (+ a tick) is stale."""
 SIGMAS = 4.0
 """A difference counts as real when it exceeds this many of its own sigmas."""
 MEDIAN_EFFICIENCY = 1.25
 """The median of n normal samples has about 1.25 times the sigma of their mean."""
+ODOMETER_HISTORY = 32
+"""Ticks of odometer kept to place an old measurement (0.64 s at 20 ms)."""
 
 
-def median_sigma(noise: float, n: int = WINDOW) -> float:
-    """Sigma of the median of ``n`` readings of a sensor with sigma ``noise``."""
-    return MEDIAN_EFFICIENCY * noise / math.sqrt(n)
+class Kind(IntEnum):
+    OK = 0
+    NEAR = 1
+    FAR = 2
+    ERROR = 3
 
 
-def still_tolerance(cfg: RobotConfig, samples: int) -> float:
-    """Like :func:`pair_tolerance`, for the mean of ``samples`` filtered
+def measurement_period(cfg: RobotConfig, back: bool) -> float:
+    """How often the pair gives a new measurement: its period, or every tick."""
+    return max(cfg.sensors.spec(back).period_s, cfg.algorithm.tick)
+
+
+def window(cfg: RobotConfig, back: bool) -> int:
+    """Measurements the pair's median spans."""
+    n = round(WINDOW_S / measurement_period(cfg, back))
+    return max(MIN_WINDOW, min(MAX_WINDOW, n))
+
+
+def max_age(cfg: RobotConfig, back: bool) -> float:
+    """The oldest a measurement of the pair may be and still be used."""
+    spec = cfg.sensors.spec(back)
+    return spec.latency_s + STALE_PERIODS * measurement_period(cfg, back) + cfg.algorithm.tick
+
+
+def median_sigma(cfg: RobotConfig, back: bool, distance_m: float) -> float:
+    """Sigma of the pair's filtered reading at ``distance_m``."""
+    n = window(cfg, back)
+    return MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m) / math.sqrt(n)
+
+
+def pair_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1.0,
+                   back: bool = False) -> float:
+    """How far two filtered readings of one surface ``distance_m`` away may
+    differ and still be "equal": equal_tolerance, or SIGMAS sigmas of their
+    difference if the sensors are noisier than that allows.  ``smoothing`` is
+    the weight of an exponential smoothing applied each tick on top (1.0:
+    none); it averages fewer independent values when the sensor is slower
+    than the tick."""
+    sigma_diff = math.sqrt(2.0) * median_sigma(cfg, back, distance_m)
+    repeats = measurement_period(cfg, back) / cfg.algorithm.tick
+    sigma_diff *= math.sqrt(min(1.0, repeats * smoothing / (2.0 - smoothing)))
+    return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
+
+
+def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
+                    back: bool = False) -> float:
+    """Like :func:`pair_tolerance`, for the mean of ``samples`` ticks' filtered
     differences taken standing still."""
-    sigma_diff = math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.noise / math.sqrt(samples)
+    repeats = measurement_period(cfg, back) / cfg.algorithm.tick
+    independent = max(1.0, samples / repeats)
+    sigma_diff = math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m) \
+        / math.sqrt(independent)
     return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
 
 
-def pair_tolerance(cfg: RobotConfig, smoothing: float = 1.0) -> float:
-    """How far two filtered readings of one surface may differ and still be
-    "equal": equal_tolerance, or SIGMAS sigmas of their difference if the
-    sensors are noisier than that allows.  ``smoothing`` is the weight of an
-    exponential smoothing applied on top (1.0: none)."""
-    sigma_diff = math.sqrt(2.0) * median_sigma(cfg.sensors.noise)
-    sigma_diff *= math.sqrt(smoothing / (2.0 - smoothing))
-    return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
+class _Track:
+    """One sensor's recent measurements and the kind seen."""
 
+    __slots__ = ("front", "max_age", "midpoint", "ok_keys", "newest", "taken_s", "kind",
+                 "run_kind", "run", "last_of_kind")
 
-Sample = tuple[SensorReading, float]
-"""A reading and the odometer (mean wheel counter, metres) when it was taken."""
+    def __init__(self, front: bool, window: int, max_age: float, midpoint: float) -> None:
+        self.front = front
+        self.max_age = max_age
+        self.midpoint = midpoint
+        self.ok_keys: deque[float] = deque(maxlen=window)
+        """The last OK measurements' distances, plus (front) the odometer when
+        each was taken; emptied when the kind seen leaves OK."""
+        self.newest: SensorReading | None = None
+        self.taken_s = -math.inf
+        self.kind: Kind | None = None
+        self.run_kind: Kind | None = None
+        self.run = 0
+        self.last_of_kind: dict[Kind, SensorReading] = {}
 
 
 class Perception:
     """Filters snapshots (see the module docstring).  One per controller."""
 
-    def __init__(self, cfg: RobotConfig, window: int = WINDOW) -> None:
-        self.window = window
-        self._metres_per_turn = cfg.wheel_circumference
-        self._buffers: dict[SensorId, deque[Sample]] = {
-            s: deque(maxlen=window) for s in SensorId}
+    def __init__(self, cfg: RobotConfig) -> None:
+        self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
+        self._tracks: dict[SensorId, _Track] = {}
+        for back, ids in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
+            lo, hi = cfg.sensors.range(back)
+            for sid in ids:
+                self._tracks[sid] = _Track(not back, window(cfg, back), max_age(cfg, back),
+                                           (lo + hi) / 2.0)
+        self._odometer: deque[tuple[float, float]] = deque(maxlen=ODOMETER_HISTORY)
+        self._why: dict[SensorId, str] = {}
 
     def see(self, snap: Snapshot) -> Snapshot:
         """The snapshot as the algorithm should see it."""
-        odometer = sum(snap.turns(m) for m in WHEEL_MOTORS) / len(WHEEL_MOTORS) \
+        turns = snap.motors
+        odometer = (turns[WHEEL_MOTORS[0]].turns + turns[WHEEL_MOTORS[1]].turns
+                    + turns[WHEEL_MOTORS[2]].turns + turns[WHEEL_MOTORS[3]].turns) \
             * self._metres_per_turn
+        now = snap.time_s
+        self._odometer.append((now, odometer))
         sensors: dict[SensorId, SensorReading] = {}
+        tracks = self._tracks
         for sid, reading in snap.sensors.items():
-            buf = self._buffers[sid]
-            buf.append((reading, odometer))
-            sensors[sid] = _agree(buf, odometer if sid in FRONT_SENSORS else None)
+            track = tracks[sid]
+            age = reading.age_s
+            if age <= 0.0:  # measured now (a sensor as fast as the tick)
+                if reading.status is SensorStatus.OK:
+                    d = reading.distance_m
+                    if d - d != 0.0:  # inf or NaN: not a measurement but a broken board
+                        sensors[sid] = reading
+                        continue
+                    if track.kind is Kind.OK and track.run_kind is Kind.OK:
+                        # the common case, kept short: another OK measurement
+                        track.newest, track.taken_s = reading, now
+                        track.run += 1
+                        keys = track.ok_keys
+                        keys.append(d + odometer if track.front else d)
+                        m = _median(keys)
+                        sensors[sid] = SensorReading(m - odometer if track.front else m)
+                        continue
+                self._measured(track, reading, now, odometer)
+            elif now - age > track.taken_s + 1e-9:
+                self._measured(track, reading, now - age, self._odometer_at(now - age))
+            sensors[sid] = self._verdict(sid, track, now, odometer)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
+    def why(self, sensor: SensorId) -> str | None:
+        """Why the sensor reads as ERROR now (stale, errors), or None."""
+        return self._why.get(sensor)
 
-def _agree(buf: deque[Sample], odometer: float | None) -> SensorReading:
-    """The window's verdict: the status most readings share (ties go to the
-    newest reading's), and the median distance of the readings with it —
-    each carried forward to ``odometer`` (a forward-looking sensor)."""
-    newest = buf[-1][0]
-    if len(buf) == 1:
-        return newest
-    status = newest.status
-    if not all(r.status is status for r, _ in buf):  # the common case needs no count
-        counts: dict[SensorStatus, int] = {}
-        for r, _ in buf:
-            counts[r.status] = counts.get(r.status, 0) + 1
-        top = max(counts.values())
-        if counts[status] != top:
-            status = next(s for s, c in counts.items() if c == top)
-    if status is SensorStatus.OK and odometer is not None:
-        values = [r.distance_m - (odometer - at) for r, at in buf if r.status is status]
-    else:
-        values = [r.distance_m for r, _ in buf if r.status is status]
-    if status is SensorStatus.ERROR or not all(math.isfinite(v) for v in values):
-        return SensorReading(newest.distance_m if newest.status is status else values[-1], status)
-    return SensorReading(_median(values), status)
+    # -- per measurement ----------------------------------------------------------------
+    def _measured(self, track: _Track, reading: SensorReading, taken: float,
+                  odometer: float) -> None:
+        if reading.status is SensorStatus.OK:
+            if not math.isfinite(reading.distance_m):
+                reading = SensorReading(reading.distance_m, SensorStatus.ERROR, reading.age_s)
+                kind = Kind.ERROR
+            else:
+                kind = Kind.OK
+                d = reading.distance_m
+                track.ok_keys.append(d + odometer if track.front else d)
+        elif reading.status is SensorStatus.OUT_OF_RANGE:
+            kind = Kind.NEAR if reading.distance_m < track.midpoint else Kind.FAR
+        else:
+            kind = Kind.ERROR
+        track.newest, track.taken_s = reading, taken
+        track.last_of_kind[kind] = reading
+        if kind is track.run_kind:
+            track.run += 1
+        else:
+            track.run_kind, track.run = kind, 1
+        if track.kind is None or (kind is not track.kind and track.run >= CONFIRM):
+            if track.kind is Kind.OK:
+                # a fresh median when it comes back
+                track.ok_keys.clear()
+            track.kind = kind
+
+    def _odometer_at(self, t: float) -> float:
+        """The odometer at time ``t`` (linear between ticks; the oldest kept if older)."""
+        later: tuple[float, float] | None = None
+        for at, odo in reversed(self._odometer):
+            if at <= t:
+                if later is None or later[0] == at:
+                    return odo
+                return odo + (later[1] - odo) * (t - at) / (later[0] - at)
+            later = (at, odo)
+        return self._odometer[0][1]
+
+    def _verdict(self, sid: SensorId, track: _Track, now: float, odometer: float
+                 ) -> SensorReading:
+        newest = track.newest
+        assert newest is not None and track.kind is not None
+        age = now - track.taken_s
+        if age > track.max_age:
+            self._why[sid] = (f"stale: its newest measurement is {age:.2f} s old "
+                              f"(at most {track.max_age:.2f} s)")
+            return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
+        kind = track.kind
+        if kind is Kind.OK:
+            if track.ok_keys:
+                m = _median(track.ok_keys)
+                self._why.pop(sid, None)
+                return SensorReading(m - odometer if track.front else m, SensorStatus.OK, age)
+            self._why[sid] = "no valid measurement among its last ones"
+            return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
+        if kind is Kind.ERROR:
+            self._why[sid] = f"{CONFIRM} measurements in a row report an error"
+            return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
+        self._why.pop(sid, None)
+        held = track.last_of_kind[kind]
+        return SensorReading(held.distance_m, SensorStatus.OUT_OF_RANGE, age)
 
 
-def _median(values: list[float]) -> float:
+def _median(values: Iterable[float]) -> float:
     """statistics.median, without its generality (a hot path: every sensor, every tick)."""
     s = sorted(values)
     n = len(s)

@@ -54,12 +54,15 @@ class Start(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     noise: NonNeg = 0.001
     seed: int = 1
+    outliers: Annotated[float, msgspec.Meta(ge=0, le=0.5)] = 0.0
+    """Share of measurements replaced by a value anywhere within range (on top
+    of the sensor model's own rate, if it has one)."""
 
 
 class Fault(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     at: NonNeg
     sensor: SensorName
-    kind: Literal["offset", "error"]
+    kind: Literal["offset", "error", "freeze"]
     offset: float = 0.0
     duration: Pos | None = None
 
@@ -133,10 +136,11 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
         if fault.kind == "offset" and fault.offset == 0.0:
             raise ScenarioError(source, f"faults[{fi}].offset",
                                 "an offset fault needs a non-zero offset in metres")
-        if fault.kind == "error" and fault.offset != 0.0:
+        if fault.kind != "offset" and fault.offset != 0.0:
             raise ScenarioError(source, f"faults[{fi}].offset",
-                                "only an 'offset' fault takes an offset; an 'error' fault "
-                                "makes the sensor report ERROR (leave offset out)")
+                                f"only an 'offset' fault takes an offset; an '{fault.kind}' "
+                                "fault makes the sensor report ERROR ('error') or stop "
+                                "measuring ('freeze'); leave offset out")
     half = st.width / 2
     if abs(data.start.lateral) >= half:
         raise ScenarioError(source, "start.lateral",

@@ -10,19 +10,26 @@ boards' own wire timeout only bounds how long a dead link is waited for.
 Tests a driver does not pass yet are marked ``xfail(strict=True)`` for that
 robot only, each saying why (see ``NOT_YET``): when the driver is fixed the
 test passes, strict xfail reports it, and the mark is removed.
+
+Each reading's age and the IMU are the simulation's: over a wire they must
+arrive as the simulated robot's own snapshot holds them, to the wire's
+resolution (docs/protocol.md) -- whatever the simulation reports, and also
+for ages and an IMU that move every tick (an ``Aged`` world).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
 import threading
-from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, replace
 
 import can
 import pytest
 
 from stairbot.config import RobotConfig, load_config
+from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
@@ -32,6 +39,7 @@ from stairbot.hardware import (
     WHEEL_MOTORS,
     HasScene,
     HasTruth,
+    Imu,
     MotorId,
     MotorState,
     ReportsEvents,
@@ -39,6 +47,7 @@ from stairbot.hardware import (
     SensorId,
     SensorReading,
     Snapshot,
+    Truth,
 )
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.scenario import Scenario, load_scenario
@@ -55,10 +64,13 @@ _channels = itertools.count()
 
 @dataclass
 class Rig:
-    """One opened robot and how to break its link (None: it has none)."""
+    """One opened robot, the simulated robot's own snapshot now (what the
+    boards serve, for a robot on a wire), and how to break its link (None:
+    it has none)."""
 
     kind: str
     session: RobotSession
+    own: Callable[[], Snapshot]
     break_link: Callable[[], None] | None = None
 
     @property
@@ -94,10 +106,40 @@ def wheels_moved(a: Snapshot, b: Snapshot) -> float:
     return max(abs(b.turns(m) - a.turns(m)) for m in WHEEL_MOTORS)
 
 
+class Aged:
+    """The simulated robot, its readings older and an IMU added, both moving
+    with time: what a simulation that models them would report (the boards
+    must carry it whatever the simulation itself fills in)."""
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+
+    def read(self) -> Snapshot:
+        snap = self.robot.read()
+        t = snap.time_s
+        sensors: Mapping[SensorId, SensorReading] = {
+            sid: replace(r, age_s=r.age_s + 0.0037 * (i + 1) + t % 0.05)
+            for i, (sid, r) in enumerate(snap.sensors.items())}
+        imu = Imu(pitch_deg=3.0 * math.sin(t) - 1.234, roll_deg=0.5 * math.cos(3 * t),
+                  pitch_rate_dps=171.9 * math.cos(t), roll_rate_dps=-86.0 * math.sin(3 * t),
+                  age_s=0.002 + t % 0.01)
+        return replace(snap, sensors=sensors, imu=imu)
+
+    def command(self, speeds: Mapping[MotorId, float]) -> None:
+        self.robot.command(speeds)
+
+    def stop_all(self) -> None:
+        self.robot.stop_all()
+
+    def truth(self) -> Truth:
+        assert isinstance(self.robot, HasTruth)
+        return self.robot.truth()
+
+
 def open_sim() -> Iterator[Rig]:
     session = open_robot("sim://", CONFIG, RobotOptions(world=SCENARIO))
     try:
-        yield Rig("sim", session)
+        yield Rig("sim", session, session.robot.read)  # reading again is its own snapshot
     finally:
         session.close()
 
@@ -111,19 +153,31 @@ def _served(kind: str, server: SerialBoardServer | CanBoardServer, url: str) -> 
         server.stop()
         thread.join(5)
 
+    def own() -> Snapshot:
+        snap = server.world.snapshot()  # the instant the boards served (lockstep)
+        assert snap is not None
+        return snap
+
     try:
         session = open_robot(url, CONFIG)
         try:
-            yield Rig(kind, session, stop_boards)
+            yield Rig(kind, session, own, stop_boards)
         finally:
             session.close()
     finally:
         stop_boards()
 
 
-def open_serial() -> Iterator[Rig]:
-    """Fake boards in lockstep on a pseudo-terminal, served on a thread."""
+def _world(aged: bool) -> BoardWorld:
     world = make_world(CONFIG, SCENARIO, lockstep=True)
+    if aged:
+        world.robot = Aged(world.robot)  # type: ignore[assignment]
+    return world
+
+
+def open_serial(aged: bool = False) -> Iterator[Rig]:
+    """Fake boards in lockstep on a pseudo-terminal, served on a thread."""
+    world = _world(aged)
     pty = PtyPair()
     try:
         yield from _served("serial", SerialBoardServer(pty.master, world, make_boards(world)),
@@ -132,11 +186,11 @@ def open_serial() -> Iterator[Rig]:
         pty.close()
 
 
-def open_can() -> Iterator[Rig]:
+def open_can(aged: bool = False) -> Iterator[Rig]:
     """Fake boards in lockstep on a fresh python-can virtual channel, served
     on a thread (one process: a virtual bus does not leave it)."""
     channel = f"conformance-{next(_channels)}"
-    world = make_world(CONFIG, SCENARIO, lockstep=True)
+    world = _world(aged)
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
                             make_boards(world))
     try:
@@ -302,3 +356,73 @@ def test_events_and_picture_as_each_robot_has_them(rig: Rig) -> None:
     assert isinstance(rig.session.sim, HasScene) is not wired
     if not wired:
         assert rig.session.sim is rig.robot
+
+
+# -- what the readings are worth: ages and the IMU ------------------------------------
+
+AGE_S, ANGLE_DEG, RATE_DPS = 0.001, 0.01, 0.1  # the wire's resolution (docs/protocol.md)
+AGE_MAX_S, ANGLE_MAX_DEG, RATE_MAX_DPS = 65.535, 180.0, 3276.7
+
+
+def near(got: float, want: float, resolution: float) -> bool:
+    """Equal to the wire's resolution (nearest rounding: half a step)."""
+    return abs(got - want) <= resolution / 2 + 1e-9
+
+
+def carried(imu: Imu | None) -> Imu | None:
+    """What protocol 2.0 carries of an IMU: nothing of one it cannot express
+    (a number that is not one, an angle beyond +-180: the board says ERROR);
+    rates and the age saturate."""
+    if imu is None:
+        return None
+    if not all(math.isfinite(x) for x in (imu.pitch_deg, imu.roll_deg, imu.pitch_rate_dps,
+                                           imu.roll_rate_dps)):
+        return None
+    if max(abs(imu.pitch_deg), abs(imu.roll_deg)) > ANGLE_MAX_DEG + ANGLE_DEG / 2:
+        return None
+    return replace(imu, pitch_rate_dps=max(-RATE_MAX_DPS, min(RATE_MAX_DPS, imu.pitch_rate_dps)),
+                   roll_rate_dps=max(-RATE_MAX_DPS, min(RATE_MAX_DPS, imu.roll_rate_dps)),
+                   age_s=min(AGE_MAX_S, imu.age_s))
+
+
+def assert_as_reported(got: Snapshot, own: Snapshot) -> None:
+    """``got`` (read through the robot) holds the ages and the IMU of ``own``
+    (the simulated robot's snapshot of the same instant)."""
+    for sid in SensorId:
+        want = min(AGE_MAX_S, own.sensors[sid].age_s)
+        assert near(got.sensors[sid].age_s, want, AGE_S), (sid, got.sensors[sid], want)
+    want_imu = carried(own.imu)
+    if want_imu is None:
+        assert got.imu is None
+        return
+    assert got.imu is not None, own.imu
+    for name, resolution in (("pitch_deg", ANGLE_DEG), ("roll_deg", ANGLE_DEG),
+                             ("pitch_rate_dps", RATE_DPS), ("roll_rate_dps", RATE_DPS),
+                             ("age_s", AGE_S)):
+        assert near(getattr(got.imu, name), getattr(want_imu, name), resolution), (
+            name, got.imu, want_imu)
+
+
+def test_ages_and_imu_arrive_as_the_simulation_reports_them(rig: Rig) -> None:
+    """Whatever ages and IMU the simulation fills in (none yet, or its own
+    model's), every robot reports them as the simulated robot's snapshot of
+    that instant holds them."""
+    for _ in range(3):
+        assert_as_reported(rig.robot.read(), rig.own())
+        rig.drive(FORWARD, 0.1)
+
+
+@pytest.fixture(params=("serial", "can"))
+def aged_rig(request: pytest.FixtureRequest) -> Iterator[Rig]:
+    opener = {"serial": open_serial, "can": open_can}[request.param]
+    yield from opener(aged=True)
+
+
+def test_ages_and_an_imu_that_move_each_tick_cross_the_wire(aged_rig: Rig) -> None:
+    """Over an Aged world: every tick's ages and IMU arrive as reported."""
+    for _ in range(10):
+        got = aged_rig.robot.read()
+        assert got.imu is not None
+        assert_as_reported(got, aged_rig.own())
+        aged_rig.robot.command(FORWARD)
+        aged_rig.session.clock.advance(TICK)

@@ -86,7 +86,7 @@ def _check(t: Tick, w: Work) -> Step:
               f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
         return end("stopped", "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
     diff = w.diff_sum / w.diff_n
-    equal = abs(diff) <= still_tolerance(cfg, w.diff_n)
+    equal = abs(diff) <= still_tolerance(cfg, w.diff_n, min(sfr.distance_m, sfl.distance_m))
     if equal and ctx.purpose != "start":
         ctx.calibration_case = None
         return _after_calibration(t)
@@ -183,7 +183,7 @@ def _turn(t: Tick, w: Work) -> Step:
         if w.diff_n < STILL_TICKS:
             return stay(NO_MOTION)
         diff = w.diff_sum / w.diff_n
-        if abs(diff) <= still_tolerance(cfg, w.diff_n):
+        if abs(diff) <= still_tolerance(cfg, w.diff_n, min(sfr, sfl)):
             t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {w.diff_n} readings "
                   f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
                   diff=diff)

@@ -2,8 +2,9 @@
 
 Each :meth:`Controller.tick` takes one :class:`~stairbot.hardware.Snapshot`
 and returns a speed for all six motors.  Faults are checked before the
-phase's own logic (a motor fault, a sensor error on a sensor the phase needs,
-a phase that takes too long, and the supervisor's tilt and stall), then the
+phase's own logic (a motor fault, a phase that takes too long, the
+supervisor's tilt and stall), then a sensor the phase needs that reads as
+ERROR (the robot stands and waits for it, up to SENSOR_WAIT_S), then the
 standing rule, then -- once, before a lift phase's first step -- the
 static-stability check (:mod:`~stairbot.algorithm.stability`), then the
 phase's step.
@@ -40,6 +41,11 @@ from stairbot.hardware import (
 )
 from stairbot.perception import Perception
 from stairbot.supervisor import Supervisor
+
+SENSOR_WAIT_S = 1.0
+"""How long the robot stands, lifts holding, for a sensor it needs that reads
+as ERROR (errors, or stale) to come back before the program ends with the
+error."""
 
 PHASE_TIMEOUT_S = 60.0
 """A phase (other than the standing rule's wait) that lasts longer than this,
@@ -109,6 +115,7 @@ class Controller:
         self._timeout = phase_timeout_s(config)
         self._perception = Perception(config)
         self._supervisor = Supervisor(config)
+        self._sensor_since: float | None = None
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -197,6 +204,9 @@ class Controller:
         if fault is not None:
             self._apply(fail(fault), snap)
             return _zeros()
+        if self._sensor_hold(snap):
+            self._supervisor.commanded({})
+            return _zeros()
         ctx = self._ctx
         record = self.phase.record
         t = Tick(snap, self.config, ctx, self.mode, self._say)
@@ -228,16 +238,41 @@ class Controller:
             reading = snap.sensors[sensor]
             if reading.status is not SensorStatus.ERROR and not math.isfinite(reading.distance_m):
                 return f"sensor error: {sensor} reads {reading.distance_m} m in {phase.label}"
-        errors = motion.sensor_errors(snap, needed)
-        if errors:
-            names = ", ".join(str(s) for s in errors)
-            return f"sensor error: {names} report{'s' if len(errors) == 1 else ''} an error " \
-                   f"in {phase.label}"
         started = self._ctx.phase_started_s
         if phase is not Phase.PAUSED and started is not None \
                 and snap.time_s - started > self._timeout:
             return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
         return None
+
+    def _sensor_hold(self, snap: Snapshot) -> bool:
+        """While a sensor the phase needs reads as ERROR (it reports errors, or
+        it is stale): every motor stops, the lifts hold, the timers stand, for
+        up to SENSOR_WAIT_S; then the program ends with the error.  True while
+        holding."""
+        ctx, phase = self._ctx, self.phase
+        errors = motion.sensor_errors(snap, _needed_sensors(phase, ctx))
+        if not errors:
+            if self._sensor_since is not None:
+                held = snap.time_s - self._sensor_since
+                self._shift_timers(held)
+                self._sensor_since = None
+                self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
+                           f"{phase.label}", snap.time_s, {"phase": phase.value})
+            return False
+        why = "; ".join(f"{s} {self._perception.why(s) or 'reports an error'}" for s in errors)
+        if self._sensor_since is None:
+            self._sensor_since = snap.time_s
+            ctx.pauses += 1
+            self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
+                       f"stopped, lifts holding, waiting up to {SENSOR_WAIT_S:g} s",
+                       snap.time_s, {"resume_phase": phase.value, "sensors": list(errors)})
+            return True
+        if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
+            return True
+        self._sensor_since = None
+        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"),
+                    snap)
+        return True
 
     def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
         """Every motor gets a speed within its maximum; a lift at the end of its

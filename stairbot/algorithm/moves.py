@@ -15,11 +15,25 @@ from collections.abc import Callable
 from stairbot.algorithm import motion
 from stairbot.algorithm.phase import FAULT, Phase, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.work import Work
+from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
+from stairbot.perception import median_sigma
 
 Enter = Callable[[Tick, Work], None]
 StepFn = Callable[[Tick, Work], Step]
 Done = Callable[[Tick, Work], Step]
+
+
+JUMP_M = 0.02
+"""A reading drive trusts its reading while it stays within this (or JUMP_SIGMAS
+of the filtered reading's sigma, if more) of what the wheels explain."""
+JUMP_SIGMAS = 6.0
+
+
+def jump_limit(cfg: RobotConfig, distance_m: float) -> float:
+    """How far a drive's reading may stray from its odometry and still be the
+    surface it started on."""
+    return max(JUMP_M, JUMP_SIGMAS * median_sigma(cfg, False, distance_m))
 
 
 def reading_drive(
@@ -46,9 +60,24 @@ def reading_drive(
     def step(t: Tick, w: Work) -> Step:
         cfg = t.cfg
         here = motion.wheel_position(t.snap)
-        if w.target_reading is not None and motion.measurable(t.snap, cfg):
-            remaining_m = direction * (motion.mean_distance(t.snap) - w.target_reading)
-            w.target_wheel = here + direction * cfg.wheel_turns(remaining_m)
+        if w.target_reading is not None and not w.reading_lost \
+                and motion.measurable(t.snap, cfg):
+            reading = motion.mean_distance(t.snap)
+            key = reading + here * cfg.wheel_circumference
+            if w.reading_key is None:
+                w.reading_key = key
+            jump = key - w.reading_key
+            if abs(jump) > jump_limit(cfg, reading):
+                # Not the surface the drive started on (the beams slid over an
+                # edge, or onto a side wall): the wheels carry on to the last
+                # target the readings gave.
+                w.reading_lost = True
+                t.say(f"SFR/SFL jumped {jump * 1000:+.0f} mm from what the wheels explain "
+                      f"(reading {reading:.3f} m): the rest of the drive goes by turns",
+                      jump=jump)
+            else:
+                remaining_m = direction * (reading - w.target_reading)
+                w.target_wheel = here + direction * cfg.wheel_turns(remaining_m)
         assert w.target_wheel is not None  # set on entry
         remaining = direction * (w.target_wheel - here)
         if remaining <= motion.WHEEL_DONE:

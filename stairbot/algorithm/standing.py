@@ -47,9 +47,10 @@ def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
         ctx.standing_diff = None
         return False
     ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
-    smoothed_tol = pair_tolerance(t.cfg, motion.DIFF_SMOOTHING)
+    near = min(r.distance_m for r in motion.pair(t.snap, back))
+    smoothed_tol = pair_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
     return abs(ctx.standing_diff) > smoothed_tol and \
-        (not raw_too or abs(diff) > pair_tolerance(t.cfg))
+        (not raw_too or abs(diff) > pair_tolerance(t.cfg, near, back=back))
 
 
 def watch(t: Tick, phase: PhaseDef) -> Step | None:

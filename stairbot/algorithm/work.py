@@ -36,6 +36,12 @@ class Work:
     probe_sfr: float = 0.0
     probe_sfl: float = 0.0
     """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""
+    reading_key: float | None = None
+    """A reading drive: the first mean SFR/SFL reading plus the odometer (m) --
+    constant while the sensors see the same surface."""
+    reading_lost: bool = False
+    """A reading drive: the reading jumped away from what the wheels explain;
+    the rest is driven by turns."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
     diff_sum: float = 0.0

@@ -2,7 +2,8 @@
 
 :class:`BoardRobot` implements the Robot protocol on a
 :class:`~stairbot.drivers.link.BoardLink` (the serial link, the CAN link):
-``read()`` is one ReadAll to each board (both in flight at once), ``command()``
+``read()`` is one ReadAll to each board (both in flight at once; the replies
+become the snapshot in ``telemetry.py``), ``command()``
 one SetWheelSpeeds + SetLiftSpeeds whose Ack is collected on the next call,
 the handshake identifies the boards and sets their watchdogs, a keepalive
 thread feeds them while the robot stands idle, and link health goes into
@@ -26,20 +27,20 @@ from typing import Any, Concatenate, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
 from stairbot.drivers import messages as m
+from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
+from stairbot.drivers.handshake import open_board
 from stairbot.drivers.health import HealthReport
 from stairbot.drivers.link import BoardLink, Reply, Request
-from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
+from stairbot.drivers.telemetry import K, T, V
+from stairbot.errors import HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import Clock, MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import Clock, Imu, MotorId, Snapshot
 from stairbot.robots import RobotSession
 
 P = ParamSpec("P")
 R = TypeVar("R")
 S = TypeVar("S", bound="BoardRobot")
-T = TypeVar("T", m.MotorTelemetry, m.SensorTelemetry)
-K = TypeVar("K", MotorId, SensorId)
-V = TypeVar("V", MotorState, SensorReading)
 
 
 def locked(method: Callable[Concatenate[S, P], R]) -> Callable[Concatenate[S, P], R]:
@@ -76,6 +77,8 @@ class BoardRobot:
             monotonic=lambda: monotonic() * time_scale, sleep=lambda s: time.sleep(s / time_scale))
         self.idents: dict[int, m.Ident] = {}
         self.status: dict[int, m.Status] = {}
+        self.imu_read = telemetry.ImuRead(None, "unknown")  # the IMU as last read
+        self.imu_rejected = 0  # replies whose IMU broke the protocol
         self.report = HealthReport(link.stats, monotonic)
         self._monotonic = monotonic
         self._commands: list[Request] = []
@@ -101,47 +104,11 @@ class BoardRobot:
 
     # -- setting up ------------------------------------------------------------
     def _handshake(self) -> None:
-        link = self.link
-        n = link.retries + 1
-        tries = f"{n} {'try' if n == 1 else 'tries'} of {link.timeout_s * 1e3:.0f} ms"
         for board in m.Board:
-            name = board.name.lower()
-            try:
-                reply = link.exchange(board, [m.Identify(), m.GetStatus()])
-            except LinkLostError:
-                raise NoBoardError(self.url, name, f"no {name} board answered on the "
-                                   f"{link.wire} ({tries})") from None
-            ident, status = (reply.messages + (None, None))[:2]
-            if not isinstance(ident, m.Ident) or not isinstance(status, m.Status):
-                raise HardwareError(f"{self.url}: the {name} board gave an unexpected "
-                                    f"answer to Identify: {reply.messages}")
-            if ident.protocol_major != m.PROTOCOL_MAJOR:
-                raise HardwareError(f"{self.url}: the {name} board speaks protocol "
-                                    f"{ident.protocol_major}.{ident.protocol_minor}; "
-                                    f"this host speaks {m.PROTOCOL_MAJOR}.x")
-            board_lockstep = bool(status.flags & m.StatusFlag.LOCKSTEP)
-            if board_lockstep != self.LOCKSTEP:
-                hint = ("add ?lockstep=1 to the URL" if board_lockstep
-                        else "start the fake boards with --lockstep")
-                state = "run" if board_lockstep else "do not run"
-                raise RobotUrlError(self.url, "lockstep",
-                                    f"the boards {state} in lockstep; {hint}")
-            self.idents[board] = ident
-            # Opening the robot is the explicit clear of a watchdog latch left by
-            # an earlier session; an emergency stop stays latched.  Setting up is
-            # the one place where a command frame is sent again after a timeout.
-            for attempt in range(link.retries + 1):
-                try:
-                    reply = link.exchange(board, [m.SetWatchdog(self.board_watchdog_ms),
-                                                  m.Clear(m.ClearMask.WATCHDOG)])
-                    break
-                except LinkLostError:
-                    if attempt == link.retries:
-                        raise NoBoardError(self.url, name, f"the {name} board did not "
-                                           f"answer SetWatchdog on the {link.wire} "
-                                           f"({tries})") from None
-            status = reply.messages[-1]
-            if isinstance(status, m.Status):
+            self.idents[board], status = open_board(
+                self.link, self.url, board, lockstep=self.LOCKSTEP,
+                watchdog_ms=self.board_watchdog_ms)
+            if status is not None:
                 self.status[board] = status
             self._last_tx[board] = self._monotonic()
 
@@ -160,19 +127,29 @@ class BoardRobot:
         """One ReadAll to each board.  Raises LinkLostError (no reply, or a
         board's watchdog tripped) or HardwareError (an e-stop a board latched
         on its own, a failed world behind fake boards, a bad reply).  While
-        this host's own e-stop is latched, reading goes on."""
+        this host's own e-stop is latched, reading goes on.
+
+        A reading's age is the board's plus the robot-clock time from sending
+        the ReadAll to the snapshot (the board answered within it): never
+        younger than the truth, exact when the clock stands still (lockstep).
+        An IMU whose values the protocol does not allow reads as None."""
         self._reap()
+        sent = self.clock.now()
         pm = self.link.request(m.Board.MOTOR, [m.ReadAll()], send=False)
         ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
         fm, fs = self._collect([pm, ps])
         self._link_lost = False  # both boards answered: any earlier loss is over
+        now = self.clock.now()
+        transit = max(0.0, now - sent)
         motors = self._read_all(m.Board.MOTOR, fm.messages, m.MotorTelemetry,
                                 m.MOTOR_CHANNELS, u.state_from_wire)
         sensors = self._read_all(m.Board.SENSOR, fs.messages, m.SensorTelemetry,
-                                 m.SENSOR_CHANNELS, u.reading_from_wire)
+                                 m.SENSOR_CHANNELS,
+                                 lambda t: u.reading_from_wire(t, transit))
+        imu = self._read_imu(fs.messages, transit, now)
         health = self.health()
-        self.report.maybe_event(health, self.clock.now(), self.sink)
-        return Snapshot(self.clock.now(), sensors, motors, health)
+        self.report.maybe_event(health, now, self.sink)
+        return Snapshot(now, sensors, motors, health, imu)
 
     def _collect(self, reads: list[Request]) -> list[Reply]:
         """The replies to a read's ReadAlls (fakes.lockstep adds its StepTo)."""
@@ -248,7 +225,9 @@ class BoardRobot:
         """The URL, the wire, link health and the boards' identities."""
         return {"url": self.url, **self.link.describe(), "link": self.health(),
                 "boards": {m.Board(b).name.lower(): vars_of(i)
-                           for b, i in self.idents.items()}}
+                           for b, i in self.idents.items()},
+                "imu": {"state": self.imu_read.state, "problem": self.imu_read.problem,
+                        "rejected": self.imu_rejected}}
 
     def _keep_alive(self) -> None:
         period = self.watchdog_ms / 4000
@@ -348,15 +327,25 @@ class BoardRobot:
         """A ReadAll reply -- Status, then one ``kind`` telemetry per channel --
         as ``{ids[channel]: convert(telemetry)}``, after checking the Status.
         HardwareError when the reply is not that."""
-        name = board.name.lower()
         if not msgs or not isinstance(msgs[0], m.Status):
-            raise HardwareError(f"the {name} board answered ReadAll with {msgs!r}")
+            raise HardwareError(f"the {board.name.lower()} board answered ReadAll with "
+                                f"{msgs!r}")
         self._check_status(board, msgs[0])
-        out = {ids[t.channel]: convert(t) for t in msgs[1:]
-               if isinstance(t, kind) and t.channel < len(ids)}
-        if len(out) != len(ids):
-            raise HardwareError(f"the {name} board's ReadAll reply lacks channels: {msgs!r}")
-        return out
+        return telemetry.channels(board, msgs[1:], kind, ids, convert)
+
+    def _read_imu(self, msgs: tuple[Any, ...], transit_s: float, now: float) -> Imu | None:
+        """The IMU of the sensor board's ReadAll reply (None unless it is
+        there, OK and valid).  A board that breaks the protocol is counted
+        (``imu_rejected``) and told once, as a WARNING, until it mends (a
+        value that changes every tick is one trouble, not one a tick)."""
+        got = telemetry.imu_of(msgs, transit_s)
+        if got.broken:
+            self.imu_rejected += 1
+            if got.state != self.imu_read.state:
+                self.sink(Event(now, EventKind.WARNING, f"sensor board IMU read as none: "
+                                f"{got.problem}", None, {"imu": got.state}))
+        self.imu_read = got
+        return got.imu
 
 
 def open_board_session(link: BoardLink, url: str, *, watchdog_ms: int, lockstep: bool,

@@ -7,10 +7,10 @@ message fills the 8 bytes), so replies are matched to requests by what each
 message is answered with (docs/protocol.md, "CAN"):
 
 * the reply a message declares (``ANSWER``: Identify -> Ident; Heartbeat,
-  GetStatus, SetWatchdog, EStop, Clear -> Status; GetMotor/GetSensor -> one
+  GetStatus, SetWatchdog, EStop, Clear -> Status; GetMotor/GetSensor/GetImu -> one
   telemetry frame; commands -> Ack); ReadAll -> Status + one telemetry frame
-  per channel.  An Ack naming the message's type answers any of them (a
-  refusal).
+  per channel and per IMU axis (``messages.READ_ALL_REPLY``).  An Ack naming
+  the message's type answers any of them (a refusal).
 * A board sends its replies in order, and a CAN bus keeps the order of one
   sender's frames, so a board's replies fill its oldest waiting request first.
 * A request waits ``timeout_s``; only idempotent ones are re-sent (up to
@@ -33,15 +33,11 @@ from stairbot.drivers.can_wire import BROADCAST, CanWire, frame_bits, wire
 from stairbot.drivers.link import LinkStats, Request, RequestLink
 from stairbot.errors import LinkLostError
 
-_CHANNELS = {int(m.Board.MOTOR): (len(m.MOTOR_CHANNELS), m.MotorTelemetry),
-             int(m.Board.SENSOR): (len(m.SENSOR_CHANNELS), m.SensorTelemetry)}
-
 
 def expected_replies(board: int, msg: m.Message) -> list[type[m.Message]]:
     """The reply messages, in order, a board sends for ``msg`` when it obeys."""
     if isinstance(msg, m.ReadAll):
-        count, kind = _CHANNELS.get(board, (0, m.MotorTelemetry))
-        return [m.Status] + [kind] * count
+        return list(m.READ_ALL_REPLY.get(board, (m.Status,)))
     return [m.MESSAGES.get(msg.ANSWER, m.Ack)]
 
 
@@ -131,7 +127,7 @@ class CanLink(RequestLink[CanRequest]):
         """Send every held request, in order; a single message held for every
         board in a row (ReadAll to both) becomes one broadcast frame."""
         held, self._held = self._held, []
-        everyone = set(_CHANNELS)
+        everyone = set(m.READ_ALL_REPLY)
         i = 0
         while i < len(held):
             p = held[i]

@@ -9,11 +9,17 @@ from enum import IntEnum, IntFlag
 
 from stairbot.hardware import MotorId, SensorId
 
-PROTOCOL_MAJOR = 1
+# 2.0: SensorTelemetry carries its reading's age (8 bytes, was 6); the sensor
+# board's IMU (ImuTelemetry, GetImu).  A host refuses a board of another major
+# version; Ident keeps its layout in every version so that it can tell.
+PROTOCOL_MAJOR = 2
 PROTOCOL_MINOR = 0
 MAX_PAYLOAD = 8
 INT16_MAX = 32767
+INT16_NONE = -32768  # never sent in an IMU field: a board's "no number" (NaN)
 INT32_MAX = 2**31 - 1
+AGE_MAX_MS = 65535  # a telemetry age saturates here: "this old or older"
+ANGLE_MAX_CDEG = 18000  # an IMU angle lies within +-180.00 degrees
 
 
 class Board(IntEnum):
@@ -60,6 +66,25 @@ class SensorCode(IntEnum):
     OK = 0
     OUT_OF_RANGE = 1
     ERROR = 2
+
+
+class ImuAxis(IntEnum):
+    """Which axis an ImuTelemetry is about (the sensor board's IMU "channels")."""
+
+    PITCH = 0  # positive nose up (the front higher than the back)
+    ROLL = 1  # positive right side down
+
+
+IMU_AXES: tuple[ImuAxis, ...] = (ImuAxis.PITCH, ImuAxis.ROLL)
+
+
+class ImuCode(IntEnum):
+    """ImuTelemetry.status.  Anything but OK (an unknown code too) means the
+    angle and rate carry nothing: the host reads no IMU."""
+
+    OK = 0
+    ABSENT = 1  # no IMU fitted on this board
+    ERROR = 2  # the IMU reports a fault, or has no valid measurement yet
 
 
 class StatusFlag(IntFlag):

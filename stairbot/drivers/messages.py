@@ -15,7 +15,8 @@ firmware author reads; this package is its executable twin:
   import messages as m``) and the codec.
 
 Units on the wire are integers: speeds in milli-turns/s (int16), turn counters
-in milli-turns (int32), distances in millimetres (uint16), times in ms or us.
+in milli-turns (int32), distances in millimetres (uint16), times and ages in ms
+or us, IMU angles in 0.01 degree and rates in 0.1 degree/s (int16).
 Everything is little-endian.  ``units.py`` converts to and from stairbot's
 units and types.
 
@@ -30,9 +31,13 @@ from __future__ import annotations
 import struct
 
 from stairbot.drivers.codes import (
+    AGE_MAX_MS,
     ALL_MOTORS_MASK,
+    ANGLE_MAX_CDEG,
     BROADCAST,
+    IMU_AXES,
     INT16_MAX,
+    INT16_NONE,
     INT32_MAX,
     LIFT_CHANNELS,
     MAX_PAYLOAD,
@@ -43,6 +48,8 @@ from stairbot.drivers.codes import (
     AckResult,
     Board,
     ClearMask,
+    ImuAxis,
+    ImuCode,
     MotorFault,
     MotorMode,
     SensorCode,
@@ -54,12 +61,14 @@ from stairbot.drivers.records import (
     Clear,
     CodecError,
     EStop,
+    GetImu,
     GetMotor,
     GetSensor,
     GetStatus,
     Heartbeat,
     Ident,
     Identify,
+    ImuTelemetry,
     Message,
     MotorTelemetry,
     Move,
@@ -72,6 +81,7 @@ from stairbot.drivers.records import (
     SetWheelSpeeds,
     Status,
     Stop,
+    TelemetryValueError,
 )
 from stairbot.drivers.sim_messages import GetTruth, StepDone, StepTo, Truth
 
@@ -79,12 +89,20 @@ MESSAGES: dict[int, type[Message]] = {
     cls.TYPE: cls
     for cls in (
         Identify, Heartbeat, GetStatus, SetWatchdog, EStop, Clear, ReadAll, GetMotor,
-        GetSensor, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, StepTo, GetTruth,
-        Ident, Status, MotorTelemetry, SensorTelemetry, Ack, StepDone, Truth,
+        GetSensor, GetImu, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, StepTo,
+        GetTruth, Ident, Status, MotorTelemetry, SensorTelemetry, ImuTelemetry, Ack, StepDone,
+        Truth,
     )
 }
 _STRUCTS: dict[int, struct.Struct] = {t: struct.Struct(c.FORMAT) for t, c in MESSAGES.items()}
 assert all(s.size <= MAX_PAYLOAD for s in _STRUCTS.values())
+
+# What a board obeying ReadAll sends, in order (docs/protocol.md, section 3).
+READ_ALL_REPLY: dict[int, tuple[type[Message], ...]] = {
+    int(Board.MOTOR): (Status, *(MotorTelemetry,) * len(MOTOR_CHANNELS)),
+    int(Board.SENSOR): (Status, *(SensorTelemetry,) * len(SENSOR_CHANNELS),
+                        *(ImuTelemetry,) * len(IMU_AXES)),
+}
 
 
 def payload_size(type_code: int) -> int:
@@ -117,12 +135,13 @@ def decode(type_code: int, payload: bytes) -> Message:
 
 
 __all__ = [
-    "ALL_MOTORS_MASK", "BROADCAST", "INT16_MAX", "INT32_MAX", "LIFT_CHANNELS", "MAX_PAYLOAD",
-    "MESSAGES", "MOTOR_CHANNELS", "PROTOCOL_MAJOR", "PROTOCOL_MINOR", "SENSOR_CHANNELS", "Ack",
-    "AckResult", "Board", "Brake", "Clear", "ClearMask", "CodecError", "EStop", "GetMotor",
-    "GetSensor", "GetStatus", "GetTruth", "Heartbeat", "Ident", "Identify", "Message",
-    "MotorFault", "MotorMode", "MotorTelemetry", "Move", "RawMessage", "ReadAll", "Run",
-    "SensorCode", "SensorTelemetry", "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds",
-    "Status", "StatusFlag", "StepDone", "StepTo", "Stop", "Truth", "decode", "encode",
-    "payload_size",
+    "AGE_MAX_MS", "ALL_MOTORS_MASK", "ANGLE_MAX_CDEG", "BROADCAST", "IMU_AXES", "INT16_MAX",
+    "INT16_NONE", "INT32_MAX", "LIFT_CHANNELS", "MAX_PAYLOAD", "MESSAGES", "MOTOR_CHANNELS",
+    "PROTOCOL_MAJOR", "PROTOCOL_MINOR", "READ_ALL_REPLY", "SENSOR_CHANNELS", "Ack",
+    "AckResult", "Board", "Brake", "Clear", "ClearMask", "CodecError", "EStop", "GetImu",
+    "GetMotor", "GetSensor", "GetStatus", "GetTruth", "Heartbeat", "Ident", "Identify",
+    "ImuAxis", "ImuCode", "ImuTelemetry", "Message", "MotorFault", "MotorMode",
+    "MotorTelemetry", "Move", "RawMessage", "ReadAll", "Run", "SensorCode", "SensorTelemetry",
+    "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds", "Status", "StatusFlag", "StepDone",
+    "StepTo", "Stop", "TelemetryValueError", "Truth", "decode", "encode", "payload_size",
 ]

@@ -21,12 +21,18 @@ from stairbot.errors import StairbotError
 
 # The type codes of the replies a host's message is answered with (ANSWER).
 IDENT, STATUS, ACK = 0x81, 0x82, 0xA0
-MOTOR_TELEMETRY, SENSOR_TELEMETRY = 0x90, 0x91
+MOTOR_TELEMETRY, SENSOR_TELEMETRY, IMU_TELEMETRY = 0x90, 0x91, 0x92
 
 
 class CodecError(StairbotError):
     """Bytes that are not a valid message or frame.  Drivers and boards count
     these and drop the frame; they never stop on one."""
+
+
+class TelemetryValueError(CodecError):
+    """A message that decodes but holds a value the protocol does not allow
+    (an IMU angle beyond +-180 degrees, the reserved -32768).  Its text names
+    the message, the field, the value and what is allowed."""
 
 
 M = TypeVar("M", bound="Message")
@@ -131,7 +137,8 @@ class Clear(Message):
 @dataclass(frozen=True, slots=True)
 class ReadAll(Message):
     """Ask for every channel at once.  Reply: Status, then one MotorTelemetry
-    per motor (motor board) or one SensorTelemetry per sensor (sensor board)."""
+    per motor (motor board), or one SensorTelemetry per sensor and one
+    ImuTelemetry per IMU axis (sensor board): ``messages.READ_ALL_REPLY``."""
 
     TYPE = 0x10
     ANSWER = STATUS
@@ -154,6 +161,17 @@ class GetSensor(Message):
     FORMAT = "<B"
     IDEMPOTENT = True
     channel: int
+
+
+@dataclass(frozen=True, slots=True)
+class GetImu(Message):
+    """Ask the sensor board for one axis (ImuAxis) of its IMU.  Reply: ImuTelemetry."""
+
+    TYPE = 0x13
+    ANSWER = IMU_TELEMETRY
+    FORMAT = "<B"
+    IDEMPOTENT = True
+    axis: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -275,16 +293,34 @@ class MotorTelemetry(Message):
 
 @dataclass(frozen=True, slots=True)
 class SensorTelemetry(Message):
-    """One sensor: channel, SensorCode, distance in mm, and a sample counter
-    that advances with every new measurement (wraps at 65536)."""
+    """One sensor: channel, SensorCode, distance in mm, a sample counter that
+    advances with every new measurement (wraps at 65536), and the reading's
+    age: ms from the measurement to this reply (saturating at AGE_MAX_MS)."""
 
     TYPE = 0x91
-    FORMAT = "<BBHH"
+    FORMAT = "<BBHHH"
     REPLY = True
     channel: int
     status: int
     distance_mm: int
     sample: int
+    age_ms: int
+
+
+@dataclass(frozen=True, slots=True)
+class ImuTelemetry(Message):
+    """One axis (ImuAxis) of the sensor board's IMU: ImuCode, the angle in
+    0.01 degree, the rate in 0.1 degree/s, and the measurement's age in ms
+    (saturating at AGE_MAX_MS).  Both axes of one reply come from one sample."""
+
+    TYPE = 0x92
+    FORMAT = "<BBhhH"
+    REPLY = True
+    axis: int
+    status: int
+    angle_cdeg: int
+    rate_ddps: int
+    age_ms: int
 
 
 @dataclass(frozen=True, slots=True)

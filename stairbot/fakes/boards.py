@@ -249,35 +249,56 @@ class MotorBoard(Board):
 
 
 class SensorBoard(Board):
-    """Four distance sensors, channels in ``messages.SENSOR_CHANNELS`` order."""
+    """Four distance sensors, channels in ``messages.SENSOR_CHANNELS`` order,
+    and the IMU (``messages.IMU_AXES``), as the world's snapshot holds them:
+    each reading's age and the IMU's (None: no IMU fitted, ABSENT) grow by the
+    time from the snapshot to the reply, as a real board's count would."""
 
     BOARD = m.Board.SENSOR
     CHANNELS = len(m.SENSOR_CHANNELS)
+    NEW_SAMPLE_S = 1e-6  # measurement times closer than this are one measurement
 
     def __init__(self, world: BoardWorld, serial: int = 2) -> None:
         super().__init__(world, serial)
-        self._sample = 0
-        self._sample_time: float | None = None
+        self._sample = [0] * self.CHANNELS
+        self._sample_time: list[float | None] = [None] * self.CHANNELS
+
+    def _since(self, snap_time: float) -> float:
+        """How long ago (board time) the snapshot was taken."""
+        return max(0.0, self.world.now() - snap_time)
 
     def telemetry(self, ch: int) -> m.SensorTelemetry:
         snap = self.world.snapshot()
         if snap is None:
-            return m.SensorTelemetry(ch, int(m.SensorCode.ERROR), 0, self._sample)
-        if snap.time_s != self._sample_time:
-            self._sample_time = snap.time_s
-            self._sample = (self._sample + 1) & 0xFFFF
+            return m.SensorTelemetry(ch, int(m.SensorCode.ERROR), 0, self._sample[ch],
+                                     m.AGE_MAX_MS)
         r = snap.sensors[m.SENSOR_CHANNELS[ch]]
-        return m.SensorTelemetry(ch, u.sensor_code(r.status), u.distance_to_wire(r.distance_m),
-                                 self._sample)
+        measured = snap.time_s - r.age_s  # a repeated value keeps its measurement time
+        last = self._sample_time[ch]
+        if last is None or not abs(measured - last) < self.NEW_SAMPLE_S:
+            self._sample_time[ch] = measured
+            self._sample[ch] = (self._sample[ch] + 1) & 0xFFFF
+        return u.reading_to_wire(ch, r, self._sample[ch], self._since(snap.time_s))
+
+    def imu_telemetry(self, axis: m.ImuAxis) -> m.ImuTelemetry:
+        snap = self.world.snapshot()
+        if snap is None:
+            return m.ImuTelemetry(int(axis), int(m.ImuCode.ERROR), 0, 0, m.AGE_MAX_MS)
+        return u.imu_to_wire(snap.imu, axis, self._since(snap.time_s))
 
     def answer(self, msg: m.Message) -> list[m.Message]:
-        if isinstance(msg, m.ReadAll):
-            tel = [self.telemetry(ch) for ch in range(self.CHANNELS)]  # reads the world first
+        if isinstance(msg, m.ReadAll):  # reads the world before the status
+            tel: list[m.Message] = [self.telemetry(ch) for ch in range(self.CHANNELS)]
+            tel += [self.imu_telemetry(axis) for axis in m.IMU_AXES]
             return [self.status(), *tel]
         if isinstance(msg, m.GetSensor):
             if msg.channel >= self.CHANNELS:
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]
             return [self.telemetry(msg.channel)]
+        if isinstance(msg, m.GetImu):
+            if msg.axis >= len(m.IMU_AXES):
+                return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]
+            return [self.imu_telemetry(m.IMU_AXES[msg.axis])]
         return super().answer(msg)
 
 

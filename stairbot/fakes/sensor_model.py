@@ -42,12 +42,12 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from functools import cached_property
 from typing import Literal
 
-from stairbot.fakes.sensors import active_faults, sensor_rng
+from stairbot.fakes.sensors import active_faults, frozen, sensor_rng
 from stairbot.hardware import SensorId, SensorReading, SensorStatus
 from stairbot.scenario import Fault
 
@@ -161,17 +161,21 @@ class ModelSensor:
 
     def __init__(self, sensor: SensorId, model: SensorModel, min_range: float,
                  max_range: float, resolution: float, noise: float, seed: int,
-                 faults: Iterable[Fault] = ()) -> None:
+                 faults: Iterable[Fault] = (), outliers: float = 0.0) -> None:
         self.sensor = sensor
+        if outliers > model.outlier_rate:  # the scenario's, on top of the model's
+            model = replace(model, outlier_rate=outliers)
         self.model = model
-        self.min_range = min_range if model.min_range is None else model.min_range
-        self.max_range = max_range if model.max_range is None else model.max_range
+        # the config's range, within the sensor's own (RobotConfig.sensors.range)
+        self.min_range = min_range if model.min_range is None else max(min_range, model.min_range)
+        self.max_range = max_range if model.max_range is None else min(max_range, model.max_range)
         self.resolution = resolution if model.resolution is None else model.resolution
         self.noise_a = noise if model.noise_a is None else model.noise_a
         self.noise_b = model.noise_b
         rng = sensor_rng(seed, sensor)
         self._gauss, self._uniform = rng.gauss, rng.random
         self.faults = tuple(f for f in faults if f.sensor == sensor.value)
+        self._freezes = tuple(f for f in self.faults if f.kind == "freeze")
         self._far = SensorReading(self.max_range, SensorStatus.OUT_OF_RANGE)
         self._near = SensorReading(self.min_range, SensorStatus.OUT_OF_RANGE)
         self._error = SensorReading(0.0, SensorStatus.ERROR)
@@ -183,8 +187,9 @@ class ModelSensor:
 
     # -- timing ---------------------------------------------------------------------
     def due(self, t: float) -> bool:
-        """Whether a measurement is to be taken at time ``t``."""
-        return t >= self._next
+        """Whether a measurement is to be taken at time ``t`` (never while a
+        freeze fault is active)."""
+        return t >= self._next and not (self._freezes and frozen(self._freezes, t))
 
     def sample(self, seen: tuple[float | None, Cause], t: float) -> None:
         """Take a measurement now of what the beam sees (a distance, or None and
@@ -223,7 +228,7 @@ class ModelSensor:
     def measure(self, true_distance: float | None, t: float) -> SensorReading:
         """One ray, square to its target: measure ``true_distance`` (None:
         nothing) if a measurement is due, and return the published reading."""
-        if t >= self._next:
+        if t >= self._next and not (self._freezes and frozen(self._freezes, t)):
             self.sample((true_distance, Cause.OK if true_distance is not None
                          else Cause.NOTHING), t)
         return self.reading(t)

@@ -4,7 +4,8 @@ generator, and the scenario's faults active at a time.
 The sensor itself is :class:`~stairbot.fakes.sensor_model.ModelSensor`; its
 ``ideal`` preset reads as the reference robot's sensors always have: scenario
 faults first (an ``offset`` fault adds its offset, an ``error`` fault makes the
-sensor report ERROR, each for ``at <= t < at + duration``), one Gaussian draw
+sensor report ERROR, a ``freeze`` fault stops it measuring -- its last reading
+repeats and grows old -- each for ``at <= t < at + duration``), one Gaussian draw
 per reading, OUT_OF_RANGE at the limits, otherwise OK rounded to the
 resolution.
 """
@@ -31,6 +32,13 @@ def active_faults(faults: Iterable[Fault], t: float) -> tuple[float, bool]:
         if t >= f.at and (f.duration is None or t < f.at + f.duration):
             if f.kind == "error":
                 error = True
-            else:
+            elif f.kind == "offset":
                 offset += f.offset
     return offset, error
+
+
+def frozen(faults: Iterable[Fault], t: float) -> bool:
+    """Whether a freeze fault is active at ``t``: the sensor takes no new
+    measurement (the board repeats the last one, and knows its age)."""
+    return any(f.kind == "freeze" and t >= f.at and (f.duration is None or t < f.at + f.duration)
+               for f in faults)

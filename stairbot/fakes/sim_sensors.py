@@ -24,7 +24,7 @@ from stairbot.config import RobotConfig
 from stairbot.fakes.beams import down_hits, front_hits, total_weight
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensor_model import ModelSensor, combine
-from stairbot.fakes.sensor_presets import preset
+from stairbot.fakes.sensor_presets import model_for
 from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.scenario import Scenario
@@ -48,7 +48,7 @@ class SimSensors:
         self.world = world
         self.plan = plan
         s, n = config.sensors, scenario.sensors
-        self.front_model, self.back_model = preset(s.front_model), preset(s.back_model)
+        self.front_model, self.back_model = model_for(s, back=False), model_for(s, back=True)
         self.sensors = {
             sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults)
             for sid, model, lo, hi in (

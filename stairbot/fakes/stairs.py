@@ -64,6 +64,17 @@ class StairsProfile:
         self.radius = radius
         self._xmin = [s[0] for s in self.segments]
         self._xmax = [s[2] for s in self.segments]
+        # per segment, what every cast needs: its start moved ``radius`` off the
+        # surface on either side, direction, normal and reach past the ends
+        self._geo: list[_Geo | None] = []
+        for ax, ay, bx, by in self.segments:
+            ex, ey = bx - ax, by - ay
+            length = math.hypot(ex, ey)
+            if length == 0.0:
+                self._geo.append(None)
+                continue
+            nx, ny = -ey / length, ex / length
+            self._geo.append((ax, ay, ex, ey, length * length, nx, ny, radius / length))
 
     def ray(self, x0: float, y0: float, x1: float, y1: float) -> Point | None:
         """The first point of the surface on the segment (x0, y0) -> (x1, y1), or
@@ -97,39 +108,40 @@ class StairsProfile:
         dx, dy = x1 - x0, y1 - y0
         idx = range(first, last) if dx >= 0 else range(last - 1, first - 1, -1)
         best, best_i = math.inf, -1
+        geo = self._geo
         for i in idx:
-            t = self._hit(self.segments[i], x0, y0, dx, dy, r)
+            g = geo[i]
+            t = math.inf if g is None else _hit(g, x0, y0, dx, dy, r)
             if t < best:
                 best, best_i = t, i
             elif best < math.inf and dx != 0.0:
                 break  # x-monotonic: later segments lie further along the ray
         return best, best_i
 
-    @staticmethod
-    def _hit(seg: tuple[float, float, float, float], x0: float, y0: float,
-             dx: float, dy: float, r: float) -> float:
-        """Ray parameter in [0, 1] where it crosses the segment's surface (the
-        segment moved ``r`` towards the ray's origin), or inf."""
-        ax, ay, bx, by = seg
-        ex, ey = bx - ax, by - ay
-        length = math.hypot(ex, ey)
-        if length == 0.0:
-            return math.inf
-        nx, ny = -ey / length, ex / length
-        side = (x0 - ax) * nx + (y0 - ay) * ny
-        if side < 0.0:
-            nx, ny, side = -nx, -ny, -side
-        if side < r:
-            along = ((x0 - ax) * ex + (y0 - ay) * ey) / (length * length)
-            # inside the surface: touching it; beside the segment's end: not this one
-            return 0.0 if -r / length <= along <= 1.0 + r / length else math.inf
-        ax, ay = ax + nx * r, ay + ny * r
-        denom = dx * ey - dy * ex
-        if denom == 0.0:
-            return math.inf
-        wx, wy = ax - x0, ay - y0
-        t = (wx * ey - wy * ex) / denom
-        u = (wx * dy - wy * dx) / denom
-        if 0.0 <= t <= 1.0 and -r / length <= u <= 1.0 + r / length:
-            return t
+
+_Geo = tuple[float, float, float, float, float, float, float, float]
+"""A segment: start (ax, ay), direction (ex, ey), length squared, unit normal
+(nx, ny), the surface's radius over the length."""
+
+
+def _hit(g: _Geo, x0: float, y0: float, dx: float, dy: float, r: float) -> float:
+    """Ray parameter in [0, 1] where it crosses the segment's surface (the
+    segment moved ``r`` towards the ray's origin), or inf."""
+    ax, ay, ex, ey, len2, nx, ny, r_len = g
+    side = (x0 - ax) * nx + (y0 - ay) * ny
+    if side < 0.0:
+        nx, ny, side = -nx, -ny, -side
+    if side < r:
+        along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
+        # inside the surface: touching it; beside the segment's end: not this one
+        return 0.0 if -r_len <= along <= 1.0 + r_len else math.inf
+    ax, ay = ax + nx * r, ay + ny * r
+    denom = dx * ey - dy * ex
+    if denom == 0.0:
         return math.inf
+    wx, wy = ax - x0, ay - y0
+    t = (wx * ey - wy * ex) / denom
+    if not 0.0 <= t <= 1.0:
+        return math.inf
+    u = (wx * dy - wy * dx) / denom
+    return t if -r_len <= u <= 1.0 + r_len else math.inf

@@ -39,6 +39,7 @@ class Fault:
     end: float = math.inf
     offset: float = 0.0
     error: bool = False
+    freeze: bool = False  # the board repeats the last measurement, and says how old it is
 
 
 @dataclass
@@ -66,6 +67,7 @@ class KinematicRobot:
         self.counters: dict[MotorId, float] = dict.fromkeys(MotorId, 0.0)
         self.speeds: dict[MotorId, float] = dict.fromkeys(MotorId, 0.0)
         self.rng = random.Random(self.seed)
+        self._taken: dict[SensorId, tuple[SensorReading, float]] = {}
         self.risers: list[tuple[float, float]] = []  # (x, height of the tread after it)
         x = height = 0.0
         for rise, tread in self.steps:
@@ -132,6 +134,9 @@ class KinematicRobot:
         offset = 0.0
         for f in self.faults:
             if f.sensor is sid and f.start <= self.t < f.end:
+                if f.freeze and sid in self._taken:
+                    last, at = self._taken[sid]
+                    return SensorReading(last.distance_m, last.status, self.t - at)
                 if f.error:
                     return SensorReading(lo, SensorStatus.ERROR)
                 offset += f.offset
@@ -147,15 +152,21 @@ class KinematicRobot:
             return SensorReading(hi, SensorStatus.OUT_OF_RANGE)
         return SensorReading(d)
 
+    def _fresh(self, sid: SensorId, d: float | None, lo: float, hi: float) -> SensorReading:
+        reading = self._measure(sid, d, lo, hi)
+        if reading.age_s == 0.0:
+            self._taken[sid] = (reading, self.t)
+        return reading
+
     def read(self) -> Snapshot:
         s = self.cfg.sensors
         sfr, sfl = self.true_front()
         back = self.true_back()
         sensors = {
-            SensorId.SFR: self._measure(SensorId.SFR, sfr, s.front_min_range, s.front_max_range),
-            SensorId.SFL: self._measure(SensorId.SFL, sfl, s.front_min_range, s.front_max_range),
-            SensorId.SBR: self._measure(SensorId.SBR, back, s.back_min_range, s.back_max_range),
-            SensorId.SBL: self._measure(SensorId.SBL, back, s.back_min_range, s.back_max_range),
+            SensorId.SFR: self._fresh(SensorId.SFR, sfr, s.front_min_range, s.front_max_range),
+            SensorId.SFL: self._fresh(SensorId.SFL, sfl, s.front_min_range, s.front_max_range),
+            SensorId.SBR: self._fresh(SensorId.SBR, back, s.back_min_range, s.back_max_range),
+            SensorId.SBL: self._fresh(SensorId.SBL, back, s.back_min_range, s.back_max_range),
         }
         motors = {m: MotorState(self.counters[m], self.speeds[m], self.motor_faults.get(m))
                   for m in MotorId}

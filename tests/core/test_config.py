@@ -98,6 +98,15 @@ def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
          "sensors.front_model",
          "'lidar' is not allowed; allowed: one of 'gp2y0a21', 'hcsr04', 'ideal', 'vl53l0x', "
          "'vl53l1x'"),
+        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nback_model = "gp2y0a21"\n'),
+         "sensors.back_height", "read from 0.1 m: the floor would be out of range"),
+        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "gp2y0a21"\n'),
+         "algorithm.LENGTH_OF_INFINITY", "(gp2y0a21) read at most 0.8 m"),
+        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "vl53l1x"\n'
+                              'front_fov_deg = 40\n'),
+         "sensors.front_fov_deg", "wider than the vl53l1x's 27.0-degree cone"),
+        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_tilt_deg = 60\n'),
+         "sensors.front_tilt_deg", "<= 45"),
     ],
 )
 def test_bad_configs_name_the_file_the_field_and_what_is_allowed(

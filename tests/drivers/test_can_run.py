@@ -98,9 +98,6 @@ def inline_session(scenario: Scenario, channel: str) -> tuple[RobotSession, CanB
     return RobotSession(robot, robot.clock, f"can://virtual/{channel}", robot.simulated), server
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the wire does not carry the IMU yet (the wire branch adds it): the default robot "
-    "declares one ([safety] imu = true), so a wired run stops with 'IMU missing'"))
 def test_full_ascent_and_descent_over_virtual_can_ends_as_sim_does(
         scenario_file: Path, sim_run: tuple[RunResult, list[Event]]) -> None:
     session, server = inline_session(load_scenario(scenario_file), "full-run")
@@ -135,9 +132,6 @@ def fake_boards_url(scenario_file: Path) -> Iterator[str]:
         assert "frames in" in err  # the fake reports its counters on SIGTERM
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the wire does not carry the IMU yet (the wire branch adds it): the default robot "
-    "declares one ([safety] imu = true), so a wired run stops with 'IMU missing'"))
 def test_full_ascent_and_descent_over_udp_multicast_ends_as_sim_does(
         fake_boards_url: str, scenario_file: Path,
         sim_run: tuple[RunResult, list[Event]]) -> None:

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
-from stairbot.hardware import MotorId, SensorStatus
+from stairbot.hardware import Imu, MotorId, SensorReading, SensorStatus
 
 RANGES = {"B": (0, 255), "H": (0, 65535), "h": (-32768, 32767), "I": (0, 2**32 - 1),
           "i": (-(2**31), 2**31 - 1)}
@@ -79,9 +79,57 @@ def test_units() -> None:
     assert u.distance_to_wire(-1.0) == 0 and u.distance_to_wire(100.0) == 65535
     state = u.state_from_wire(m.MotorTelemetry(4, 1, 2, -1500, 105000))
     assert (state.turns, state.speed_tps, state.fault) == (105.0, -1.5, "watchdog")
-    reading = u.reading_from_wire(m.SensorTelemetry(0, 1, 1300, 3))
+    reading = u.reading_from_wire(m.SensorTelemetry(0, 1, 1300, 3, 25))
     assert (reading.distance_m, reading.status) == (1.3, SensorStatus.OUT_OF_RANGE)
-    assert u.reading_from_wire(m.SensorTelemetry(0, 9, 0, 0)).status is SensorStatus.ERROR
+    assert reading.age_s == 0.025
+    assert u.reading_from_wire(m.SensorTelemetry(0, 9, 0, 0, 0)).status is SensorStatus.ERROR
+
+
+def test_ages_round_to_the_millisecond_and_saturate() -> None:
+    assert [u.age_to_wire(x) for x in (0.0, 0.0004, 0.0126, 1.5, 65.5349)] == [
+        0, 0, 13, 1500, 65535]
+    # "this old or older": too old, unknown (NaN) or endless all saturate; never negative
+    assert [u.age_to_wire(x) for x in (65.6, 1e9, float("inf"), float("nan"))] == [65535] * 4
+    assert u.age_to_wire(-0.5) == 0 and u.age_to_wire(float("-inf")) == 0
+    t = u.reading_to_wire(2, SensorReading(1.3, SensorStatus.OUT_OF_RANGE, 0.031), 7, 0.002)
+    assert t == m.SensorTelemetry(2, 1, 1300, 7, 33)  # the reply is 2 ms after the snapshot
+    assert u.reading_from_wire(t, transit_s=0.004).age_s == pytest.approx(0.037)
+    assert u.reading_to_wire(0, SensorReading(float("nan")), 1) == m.SensorTelemetry(
+        0, m.SensorCode.ERROR, 0, 1, 0)
+
+
+def test_the_imu_round_trips_to_the_wires_resolution() -> None:
+    imu = Imu(5.234, -0.756, 1.52, -0.24, 0.0031)
+    pitch, roll = (u.imu_to_wire(imu, axis, since_s=0.001) for axis in m.IMU_AXES)
+    assert (pitch, roll) == (m.ImuTelemetry(0, 0, 523, 15, 4), m.ImuTelemetry(1, 0, -76, -2, 4))
+    got = u.imu_from_wire(pitch, roll, transit_s=0.0005)
+    assert got is not None and got.age_s == pytest.approx(0.0045)
+    assert (got.pitch_deg, got.roll_deg, got.pitch_rate_dps, got.roll_rate_dps) == (
+        5.23, -0.76, 1.5, -0.2)
+    assert u.imu_to_wire(None, m.ImuAxis.ROLL) == m.ImuTelemetry(1, m.ImuCode.ABSENT, 0, 0, 0)
+    # the older axis's age is the IMU's
+    assert u.imu_from_wire(pitch, m.ImuTelemetry(1, 0, 0, 0, 9)) == Imu(5.23, 0.0, 1.5, 0.0, 0.009)
+
+
+@pytest.mark.parametrize("status", [m.ImuCode.ABSENT, m.ImuCode.ERROR, 3, 255])
+def test_an_imu_axis_that_is_not_ok_means_no_imu(status: int) -> None:
+    ok = m.ImuTelemetry(0, m.ImuCode.OK, 100, 10, 1)
+    other = m.ImuTelemetry(1, status, 20000, -32768, 1)  # its numbers mean nothing
+    assert u.imu_from_wire(ok, other) is None
+    assert u.imu_from_wire(m.ImuTelemetry(0, status, 0, 0, 0), ok) is None
+
+
+@pytest.mark.parametrize(("angle", "rate", "match"), [
+    (18001, 0, r"\(pitch\) angle_cdeg = 18001: allowed -18000..18000"),
+    (-32768, 0, r"\(pitch\) angle_cdeg = -32768"),
+    (0, -32768, r"\(pitch\) rate_ddps = -32768: allowed -32767..32767"),
+])
+def test_an_ok_imu_value_the_protocol_forbids_is_a_typed_error(
+        angle: int, rate: int, match: str) -> None:
+    ok = m.ImuTelemetry(1, m.ImuCode.OK, 0, 0, 0)
+    with pytest.raises(m.TelemetryValueError, match=match):
+        u.imu_from_wire(m.ImuTelemetry(0, m.ImuCode.OK, angle, rate, 0), ok)
+    assert issubclass(m.TelemetryValueError, m.CodecError)
 
 
 def test_speeds_to_wire_sends_zero_for_motors_left_out() -> None:
@@ -100,7 +148,7 @@ def test_a_speed_that_is_not_a_number_is_sent_as_stop() -> None:
 def test_only_queries_and_step_to_are_idempotent() -> None:
     idempotent = {c.__name__ for c in m.MESSAGES.values() if c.IDEMPOTENT}
     assert idempotent == {"Identify", "Heartbeat", "GetStatus", "ReadAll", "GetMotor",
-                          "GetSensor", "StepTo", "GetTruth"}
+                          "GetSensor", "GetImu", "StepTo", "GetTruth"}
 
 
 def test_every_host_message_declares_a_reply_a_board_sends() -> None:

@@ -164,9 +164,6 @@ def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake:
     again.close()
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the wire does not carry the IMU yet (the wire branch adds it): the default robot "
-    "declares one ([safety] imu = true), so a wired run stops with 'IMU missing'"))
 def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
     for fake in serve(WireFaults(silent_board=1, silent_after_s=0.2)):
         session = fake.open("lockstep=1&timeout=0.1&retries=1")

@@ -37,9 +37,6 @@ def fake_boards_url(tmp_path: Path) -> Iterator[str]:
         assert "frames in" in err  # the fake reports its own counters on SIGTERM
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the wire does not carry the IMU yet (the wire branch adds it): the default robot "
-    "declares one ([safety] imu = true), so a wired run stops with 'IMU missing'"))
 def test_full_ascent_and_descent_over_a_pty_ends_as_sim_does(fake_boards_url: str) -> None:
     config, scenario = load_config(), load_scenario()
     sim = run(open_robot("sim://", config, RobotOptions(world=scenario)), config)

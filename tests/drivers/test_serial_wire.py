@@ -101,7 +101,8 @@ def test_overrun_is_dropped_and_the_reader_resyncs() -> None:
 messages_st = st.sampled_from([
     m.ReadAll(), m.Identify(), m.GetStatus(), m.Heartbeat(7), m.Stop(0x3F),
     m.SetWheelSpeeds(1000, -1000, 0, 5), m.SetLiftSpeeds(10000, -10000),
-    m.MotorTelemetry(3, 1, 0, -250, -123456), m.SensorTelemetry(2, 1, 1300, 65535),
+    m.MotorTelemetry(3, 1, 0, -250, -123456), m.SensorTelemetry(2, 1, 1300, 65535, 65535),
+    m.ImuTelemetry(1, 0, -18000, -32767, 7), m.GetImu(0),
     m.Status(0xC0, 0, 250, 2**32 - 1), m.Ack(0x20, 1), m.StepTo(20000), m.Move(5, -19000, 10000),
 ])
 

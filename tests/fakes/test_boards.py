@@ -12,11 +12,20 @@ from stairbot.drivers.messages import RawMessage
 from stairbot.errors import RobotFellError
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import MotorBoard, SensorBoard, make_boards
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot, Truth
+from stairbot.hardware import (
+    Imu,
+    MotorId,
+    MotorState,
+    SensorId,
+    SensorReading,
+    Snapshot,
+    Truth,
+)
 
 
 class StubRobot:
-    """Turns integrate the commanded speeds; ``fail`` makes read() raise."""
+    """Turns integrate the commanded speeds; ``fail`` makes read() raise;
+    ``ages`` (per sensor) and ``imu`` are what the snapshot reports."""
 
     def __init__(self) -> None:
         self.t = 0.0
@@ -25,13 +34,17 @@ class StubRobot:
         self.reads = 0
         self.commands = 0
         self.fail = False
+        self.ages = {sid: 0.0 for sid in SensorId}
+        self.imu: Imu | None = None
 
     def read(self) -> Snapshot:
         if self.fail:
             raise RobotFellError("pitch beyond 35 degrees")
         self.reads += 1
-        return Snapshot(self.t, {s: SensorReading(0.5 + i / 10) for i, s in enumerate(SensorId)},
-                        {k: MotorState(v, self.speeds[k]) for k, v in self.turns.items()})
+        return Snapshot(self.t, {s: SensorReading(0.5 + i / 10, age_s=self.ages[s])
+                                 for i, s in enumerate(SensorId)},
+                        {k: MotorState(v, self.speeds[k]) for k, v in self.turns.items()},
+                        imu=self.imu)
 
     def command(self, speeds: Mapping[MotorId, float]) -> None:
         self.commands += 1
@@ -87,7 +100,11 @@ def test_identify_and_read_all(rig: tuple) -> None:
     replies = sensor.handle([m.ReadAll()])
     assert isinstance(replies[0], m.Status)
     assert replies[0].flags & m.StatusFlag.SIMULATED and replies[0].flags & m.StatusFlag.LOCKSTEP
-    assert [r.distance_mm for r in replies[1:]] == [500, 600, 700, 800]
+    assert tuple(type(r) for r in replies) == m.READ_ALL_REPLY[m.Board.SENSOR]
+    assert [r.distance_mm for r in replies[1:5]] == [500, 600, 700, 800]
+    assert [r.age_ms for r in replies[1:5]] == [0, 0, 0, 0]
+    assert replies[5:] == [m.ImuTelemetry(0, m.ImuCode.ABSENT, 0, 0, 0),  # no IMU fitted
+                           m.ImuTelemetry(1, m.ImuCode.ABSENT, 0, 0, 0)]
     motor.handle([m.ReadAll()])
     assert robot.reads == 1  # both boards share one read per instant
 
@@ -199,6 +216,46 @@ def test_sensor_sample_counter_advances_with_new_measurements(rig: tuple) -> Non
     assert sensor.handle([m.GetSensor(1)])[0].sample == a
     motor.handle([m.StepTo(20_000)])
     assert sensor.handle([m.GetSensor(0)])[0].sample == (a + 1) & 0xFFFF
+
+
+def test_a_repeated_reading_keeps_its_sample_number(rig: tuple) -> None:
+    """A sensor that has not measured again (its age grew by the step) keeps
+    its sample number; one that measured anew advances."""
+    robot, world, motor, sensor = rig
+    sfr, sfl = (sensor.handle([m.GetSensor(ch)])[0].sample for ch in (0, 1))
+    robot.ages[SensorId.SFR] = 0.02  # the same measurement, 20 ms older
+    motor.handle([m.StepTo(20_000)])
+    assert sensor.handle([m.GetSensor(0)])[0] == m.SensorTelemetry(0, 0, 500, sfr, 20)
+    assert sensor.handle([m.GetSensor(1)])[0].sample == (sfl + 1) & 0xFFFF
+
+
+def test_the_sensor_board_serves_each_readings_age_and_the_imu(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    robot.ages = dict(zip(SensorId, (0.0123, 0.2, 1.5, 100.0), strict=True))
+    robot.imu = Imu(5.234, -0.756, 1.52, -0.24, 0.0031)
+    replies = sensor.handle([m.ReadAll()])
+    assert [r.age_ms for r in replies[1:5]] == [12, 200, 1500, m.AGE_MAX_MS]  # saturated
+    assert replies[5:] == [m.ImuTelemetry(0, m.ImuCode.OK, 523, 15, 3),
+                           m.ImuTelemetry(1, m.ImuCode.OK, -76, -2, 3)]
+    assert sensor.handle([m.GetImu(1)]) == [m.ImuTelemetry(1, m.ImuCode.OK, -76, -2, 3)]
+    assert sensor.handle([m.GetImu(2)]) == [m.Ack(m.GetImu.TYPE, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([m.GetImu(0)]) == [m.Ack(m.GetImu.TYPE, m.AckResult.NOT_SUPPORTED)]
+
+
+@pytest.mark.parametrize(("imu", "pitch", "roll"), [
+    (Imu(float("nan"), 1.0, 0.0, 0.0, 0.0),  # an attitude that is not a number: ERROR
+     m.ImuTelemetry(0, m.ImuCode.ERROR, 0, 0, 0), m.ImuTelemetry(1, m.ImuCode.OK, 100, 0, 0)),
+    (Imu(10.0, 200.0, 0.0, float("inf"), 0.0),  # beyond +-180, a rate that is not a number
+     m.ImuTelemetry(0, m.ImuCode.OK, 1000, 0, 0), m.ImuTelemetry(1, m.ImuCode.ERROR, 0, 0, 0)),
+    (Imu(-180.0, 180.0, 5000.0, -5000.0, float("nan")),  # rates saturate; an unknown age too
+     m.ImuTelemetry(0, m.ImuCode.OK, -18000, 32767, m.AGE_MAX_MS),
+     m.ImuTelemetry(1, m.ImuCode.OK, 18000, -32767, m.AGE_MAX_MS)),
+])
+def test_an_imu_value_the_wire_cannot_carry_goes_as_error_or_saturates(
+        rig: tuple, imu: Imu, pitch: m.ImuTelemetry, roll: m.ImuTelemetry) -> None:
+    robot, world, motor, sensor = rig
+    robot.imu = imu
+    assert sensor.handle([m.ReadAll()])[5:] == [pitch, roll]
 
 
 def test_a_failed_world_is_a_latched_simulation_fault(rig: tuple) -> None:

@@ -144,6 +144,20 @@ def test_downward_ray_hits_the_tread_surface() -> None:
     assert prof.ray(-0.1, 0.3, -0.1, -1.0) == pytest.approx((-0.1, 0.001))
 
 
+def _crossing(seg: tuple[float, float, float, float], x0: float, y0: float, x1: float,
+              y1: float) -> float:
+    """Where the segment (x0, y0)-(x1, y1) crosses ``seg`` (its parameter), or inf:
+    plain line-segment intersection, written apart from StairsProfile's."""
+    ax, ay, bx, by = seg
+    rx, ry, sx, sy = x1 - x0, y1 - y0, bx - ax, by - ay
+    denom = rx * sy - ry * sx
+    if denom == 0.0:
+        return math.inf
+    t = ((ax - x0) * sy - (ay - y0) * sx) / denom
+    u = ((ax - x0) * ry - (ay - y0) * rx) / denom
+    return t if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0 else math.inf
+
+
 def test_profile_agrees_with_brute_force_on_random_rays() -> None:
     prof = StairsProfile(STEPS, radius=0.0)
     rng = random.Random(3)
@@ -153,7 +167,7 @@ def test_profile_agrees_with_brute_force_on_random_rays() -> None:
         x1, y1 = x0 + 1.5 * math.cos(a), y0 + 1.5 * math.sin(a)
         best = math.inf
         for seg in prof.segments:
-            best = min(best, StairsProfile._hit(seg, x0, y0, x1 - x0, y1 - y0, 0.0))
+            best = min(best, _crossing(seg, x0, y0, x1, y1))
         got = prof.ray(x0, y0, x1, y1)
         if best == math.inf:
             assert got is None

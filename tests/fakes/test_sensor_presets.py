@@ -139,13 +139,14 @@ def test_hcsr04_loses_the_echo_beyond_its_incidence_angle(yaw_deg: float, heard:
     s = model_sensor(HCSR04)
     s.measure(None, 0.0)  # the first reading: nothing
     s.sample(combine(HCSR04, hits, total_weight(HCSR04.cone)), 0.06)
-    assert s.reading(0.06).distance_m == 4.0  # not yet: 25 ms of latency
+    # (the config's 1.3 m, within the sensor's own 4 m, is the far end)
+    assert s.reading(0.06).distance_m == 1.3  # not yet: 25 ms of latency
     reading = s.reading(0.085)
     if heard:  # ... and comes back: the nearest ray, square-ish to it
         assert reading.ok and reading.distance_m == pytest.approx(0.3, abs=0.02)
     else:  # ... but a smooth riser turned 25 degrees reflects the ping away
         assert s.cause is Cause.ECHO_LOST
-        assert (reading.status, reading.distance_m) == (SensorStatus.OUT_OF_RANGE, 4.0)
+        assert (reading.status, reading.distance_m) == (SensorStatus.OUT_OF_RANGE, 1.3)
 
 
 def test_a_preset_robot_reads_reproducibly_and_holds_between_updates() -> None:
