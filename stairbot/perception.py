@@ -103,6 +103,37 @@ def pair_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1.0,
     return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
 
 
+def standing_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1.0,
+                       back: bool = False) -> float:
+    """How far the pair may differ while the robot drives or lifts before the
+    standing rule stops it: what calibration may have left
+    (:func:`square_tolerance`), plus SIGMAS sigmas of the (smoothed) difference."""
+    return square_tolerance(cfg, distance_m, back) + pair_tolerance(cfg, distance_m, smoothing,
+                                                                    back)
+
+
+MAX_STILL_S = 5.0
+"""The longest calibration stands still to square up (a very noisy sensor
+squares up as well as this allows, and the standing rule allows for it)."""
+
+
+def still_samples(cfg: RobotConfig, distance_m: float, back: bool = False) -> int:
+    """Ticks of standing still whose mean pair difference is known to within
+    equal_tolerance (:func:`still_tolerance`), at most MAX_STILL_S of them:
+    calibration squares up to that yaw."""
+    repeats = measurement_period(cfg, back) / cfg.algorithm.tick
+    one = SIGMAS * math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m)
+    independent = (one / cfg.algorithm.equal_tolerance) ** 2
+    return max(1, min(round(MAX_STILL_S / cfg.algorithm.tick),
+                      math.ceil(independent * repeats)))
+
+
+def square_tolerance(cfg: RobotConfig, distance_m: float, back: bool = False) -> float:
+    """The pair difference calibration leaves at most when it squares up:
+    equal_tolerance, or more for a sensor too noisy to get there in MAX_STILL_S."""
+    return still_tolerance(cfg, still_samples(cfg, distance_m, back), distance_m, back)
+
+
 def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
                     back: bool = False) -> float:
     """Like :func:`pair_tolerance`, for the mean of ``samples`` ticks' filtered

@@ -16,7 +16,7 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
-from stairbot._schema import convert, load_toml, read_text
+from stairbot._schema import convert, load_toml, read_named, shipped
 from stairbot.errors import ScenarioError
 
 Pos = Annotated[float, msgspec.Meta(gt=0)]
@@ -166,13 +166,7 @@ SHIPPED_DIR = "scenarios"
 
 def shipped_scenarios() -> list[str]:
     """Names of the scenarios shipped with stairbot (``--scenario NAME``)."""
-    folder = resources.files("stairbot").joinpath(SHIPPED_DIR)
-    return sorted(f.name.removesuffix(".toml") for f in folder.iterdir()
-                  if f.name.endswith(".toml"))
-
-
-def _is_name(text: str) -> bool:
-    return "/" not in text and "\\" not in text and not text.endswith(".toml")
+    return shipped(SHIPPED_DIR)
 
 
 def load_scenario(path: str | Path | None = None) -> Scenario:
@@ -182,16 +176,7 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
     if path is None:
         text = resources.files("stairbot").joinpath("default_scenario.toml").read_text("utf-8")
         return parse_scenario(text, "<default scenario>")
-    p = Path(path)
-    if isinstance(path, str) and _is_name(path) and not p.exists():
-        names = shipped_scenarios()
-        if path not in names:
-            raise ScenarioError(path, None, "no such file, nor a shipped scenario; shipped: "
-                                + ", ".join(names))
-        entry = resources.files("stairbot").joinpath(SHIPPED_DIR, f"{path}.toml")
-        return parse_scenario(entry.read_text("utf-8"), f"<scenario {path}>")
-    text = read_text(p, ScenarioError)
-    return parse_scenario(text, str(p))
+    return parse_scenario(*read_named(path, SHIPPED_DIR, "scenario", ScenarioError))
 
 
 def expectation_mismatches(expect: Expect | None, result: Mapping[str, Any]) -> list[str]:

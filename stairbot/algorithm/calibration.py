@@ -30,7 +30,7 @@ from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
-from stairbot.perception import still_tolerance
+from stairbot.perception import still_samples, still_tolerance
 
 P = Phase
 FLOW = "calibration"
@@ -180,7 +180,8 @@ def _turn(t: Tick, w: Work) -> Step:
     if w.checked:  # stopped at SFR = SFL: measuring standing still
         w.diff_sum += sfl - sfr
         w.diff_n += 1
-        if w.diff_n < STILL_TICKS:
+        # as long as it takes to know the difference to within equal_tolerance
+        if w.diff_n < max(STILL_TICKS, still_samples(cfg, min(sfr, sfl))):
             return stay(NO_MOTION)
         diff = w.diff_sum / w.diff_n
         if abs(diff) <= still_tolerance(cfg, w.diff_n, min(sfr, sfl)):
@@ -190,7 +191,7 @@ def _turn(t: Tick, w: Work) -> Step:
             return go(P.CAL_LOWER)
         # Not square yet: turn on, slowly, the way the difference says.
         w.checked, w.diff_sum, w.diff_n = False, 0.0, 0
-        w.turn_direction = 1 if diff > 0 else -1
+        w.turn_direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
         w.turn_diff = diff
     w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
     # Turning left closes SFL - SFR from below, turning right from above: stop

@@ -7,9 +7,10 @@ sensors of the pair look at the same flat surface): SBR/SBL in descent 2,
 SFR/SFL elsewhere.  A disagreement only counts when both sensors give a
 usable distance, and both the (filtered) difference and its smoothed value
 (:data:`~stairbot.algorithm.motion.DIFF_SMOOTHING`) must exceed their
-tolerances (equal_tolerance, or more for sensors whose stated noise needs
-it: :func:`~stairbot.perception.pair_tolerance`) for DEBOUNCE_TICKS ticks in
-a row: neither a short spike nor sensor noise stops the robot.
+tolerances for DEBOUNCE_TICKS ticks in a row: what calibration may have left
+when it squared up, plus four sigmas of the difference from the sensors'
+stated noise (:func:`~stairbot.perception.standing_tolerance`).  Neither a
+short spike, sensor noise, nor a yaw calibration accepted stops the robot.
 
 :func:`watch` runs before an armed phase's step and returns the pause; the
 PAUSED phase's step returns the resume (to the phase it stopped in) or the
@@ -22,7 +23,7 @@ from stairbot.algorithm import motion
 from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
-from stairbot.perception import pair_tolerance
+from stairbot.perception import standing_tolerance
 
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after
@@ -48,9 +49,9 @@ def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
         return False
     ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
     near = min(r.distance_m for r in motion.pair(t.snap, back))
-    smoothed_tol = pair_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
+    smoothed_tol = standing_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
     return abs(ctx.standing_diff) > smoothed_tol and \
-        (not raw_too or abs(diff) > pair_tolerance(t.cfg, near, back=back))
+        (not raw_too or abs(diff) > standing_tolerance(t.cfg, near, back=back))
 
 
 def watch(t: Tick, phase: PhaseDef) -> Step | None:

@@ -50,7 +50,8 @@ class SimSensors:
         s, n = config.sensors, scenario.sensors
         self.front_model, self.back_model = model_for(s, back=False), model_for(s, back=True)
         self.sensors = {
-            sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults)
+            sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults,
+                             n.outliers)
             for sid, model, lo, hi in (
                 (SensorId.SFR, self.front_model, s.front_min_range, s.front_max_range),
                 (SensorId.SFL, self.front_model, s.front_min_range, s.front_max_range),
@@ -58,9 +59,13 @@ class SimSensors:
                 (SensorId.SBL, self.back_model, s.back_min_range, s.back_max_range),
             )
         }
-        # only a model with a period or a latency publishes readings older than now
-        self._front_timed = self.front_model.period_s > 0.0 or self.front_model.latency_s > 0.0
-        self._back_timed = self.back_model.period_s > 0.0 or self.back_model.latency_s > 0.0
+        # only a model with a period or a latency, or a sensor that a freeze fault
+        # stops, publishes readings older than now
+        frozen = {f.sensor for f in scenario.faults if f.kind == "freeze"}
+        self._front_timed = (self.front_model.period_s > 0.0 or self.front_model.latency_s > 0.0
+                             or bool(frozen & {"SFR", "SFL"}))
+        self._back_timed = (self.back_model.period_s > 0.0 or self.back_model.latency_s > 0.0
+                            or bool(frozen & {"SBR", "SBL"}))
         self._front_weight = total_weight(self.front_model.cone)
         self._back_weight = total_weight(self.back_model.fan)
         r = config.geometry.wheel_radius

@@ -147,3 +147,22 @@ def test_later_steps_square_up_again_when_yawed() -> None:
     assert abs(robot.yaw) < SQUARE
     run(ctrl, robot)
     assert ctrl.result.outcome == "completed"
+
+
+@pytest.mark.parametrize("slip", [5.0, -5.0])
+def test_not_square_when_measured_standing_still_it_turns_back_the_right_way(
+        slip: float) -> None:
+    """The squaring turn stops, stands and measures; when the robot is not
+    square then (here: it slipped 5° while standing), it turns the way the
+    difference says and squares up, as at the start.  (It once turned the
+    wrong way round: it stood and measured again and again until noise, or
+    the phase timeout, ended it.)"""
+    ctrl = Controller(CFG, lambda _e: None, Mode.CALIBRATE_ONLY)
+    robot = KinematicRobot(CFG, yaw_deg=15.0)
+    run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_TURN and c.context.work.checked)
+    robot.yaw += math.radians(slip)
+    started = robot.t
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "completed"
+    assert abs(robot.yaw) < SQUARE
+    assert robot.t - started < 5.0

@@ -1,5 +1,6 @@
 """A sensor fault in every phase (issue 10): a front or back sensor dropping
-out for 0.5 s, or reading 10 mm long from then on, entered at the moment the
+out for 0.5 s, reading 10 mm long from then on, or frozen from then on (it
+repeats its last reading, growing old), entered at the moment the
 default run enters each phase.  Whatever the phase, the robot ends safe:
 completed (climbed or refused, home), or stopped or ended with an error that
 says why, every motor stopped; it never falls.
@@ -35,10 +36,11 @@ seed = 3
 FAULTS = {
     "dropout": 'kind = "error"\nduration = 0.5',
     "bias": 'kind = "offset"\noffset = 0.01',
+    "freeze": 'kind = "freeze"',
 }
 
 
-HOME_M = {"dropout": 0.05, "bias": 0.10}
+HOME_M = {"dropout": 0.05, "bias": 0.10, "freeze": 0.05}
 """How near the start a completed run ends.  A front sensor biased 10 mm after
 the first calibration cannot be told from a turned robot: the next case-2
 calibration squares up to it, 5.7° askew, and the robot comes back 53-57 mm
