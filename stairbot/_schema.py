@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from importlib import resources
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -33,6 +34,31 @@ def read_text(path: Path, error: type[InputError]) -> str:
         raise error(str(path), None, f"cannot read: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
         raise error(str(path), None, "not a UTF-8 text file") from None
+
+
+def shipped(folder: str) -> list[str]:
+    """Names of the TOML files shipped in the package's ``folder``."""
+    entries = resources.files("stairbot").joinpath(folder)
+    return sorted(f.name.removesuffix(".toml") for f in entries.iterdir()
+                  if f.name.endswith(".toml"))
+
+
+def read_named(path: str | Path, folder: str, what: str,
+               error: type[InputError], also: tuple[str, ...] = ()) -> tuple[str, str]:
+    """The text and source name of a file, or of a ``what`` shipped in
+    ``folder`` by name (a plain word that is no existing file).  Raises
+    ``error`` naming the shipped ones (and ``also``) when it is neither."""
+    p = Path(path)
+    if isinstance(path, str) and "/" not in path and "\\" not in path \
+            and not path.endswith(".toml") and not p.exists():
+        names = shipped(folder)
+        if path not in names:
+            names = sorted([*names, *also])
+            raise error(path, None, f"no such file, nor a shipped {what}; shipped: "
+                        + ", ".join(names))
+        entry = resources.files("stairbot").joinpath(folder, f"{path}.toml")
+        return entry.read_text("utf-8"), f"<{what} {path}>"
+    return read_text(p, error), str(p)
 
 
 def load_toml(text: str, source: str, error: type[InputError]) -> dict[str, Any]:

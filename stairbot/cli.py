@@ -55,7 +55,8 @@ ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N
               "can://INTERFACE/CHANNEL?bitrate=N")
 SCENARIO_HELP = ("scenario TOML file, or the name of a shipped scenario (see "
                  "`stairbot scenario list`); default: five residential steps")
-CONFIG_HELP = "robot config TOML file (default: the shipped reference robot)"
+CONFIG_HELP = ("robot config TOML file, or a shipped robot's name (reference, tof); "
+               "default: the reference robot")
 
 
 class _Formatter(argparse.RawDescriptionHelpFormatter):
@@ -355,7 +356,10 @@ def cmd_config_show(args: argparse.Namespace) -> int:
     for section in ("geometry", "masses", "motors", "sensors", "algorithm", "safety"):
         print(f"\n[{section}]")
         for key, value in data[section].items():
-            print(f"{key} = {value!r}")
+            if value is None:  # TOML has no null: a key left out takes its default
+                print(f"# {key}: not set")
+            else:
+                print(f"{key} = {json.dumps(value)}")
     print("\n[derived]  # computed from the values above, not read from the file")
     width = max(len(k) for k in data["derived"])
     for key, value in data["derived"].items():

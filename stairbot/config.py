@@ -17,7 +17,8 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
-from stairbot._schema import convert, load_toml, read_text
+from stairbot._schema import convert, load_toml, read_named, shipped
+from stairbot.config_checks import check_consistency
 from stairbot.errors import ConfigError
 from stairbot.sensor_specs import SPECS, SensorSpec
 
@@ -308,94 +309,70 @@ class RobotConfig:
 
 
 DEFAULT_CONFIG_NAME = "default_robot.toml"
-BACK_RANGE_MARGIN = 0.005
-"""The floor must read at least this far inside the back sensors' range."""
 
 
 def parse_config(text: str, source: str) -> RobotConfig:
-    """Parse and validate a config document.  Raises ConfigError naming the
-    file, the field and what it allows."""
-    raw = load_toml(text, source, ConfigError)
+    """Parse and validate a config document (and the one it ``extends``).
+    Raises ConfigError naming the file, the field and what it allows."""
+    raw = _extended(load_toml(text, source, ConfigError), source, ())
     data = convert(raw, ConfigFile, source, ConfigError)
     cfg = RobotConfig(source, data.geometry, data.masses, data.motors, data.sensors,
                       data.algorithm, data.safety)
-    _check_consistency(cfg)
+    check_consistency(cfg)
     return cfg
 
 
-def _check_consistency(cfg: RobotConfig) -> None:
-    src = cfg.source
-    g, s, m, a = cfg.geometry, cfg.sensors, cfg.motors, cfg.algorithm
-    if g.LENGTH_OF_A_ROBOT is not None and abs(g.LENGTH_OF_A_ROBOT - cfg.LENGTH_OF_A_ROBOT) > 1e-3:
-        raise ConfigError(
-            src, "geometry.LENGTH_OF_A_ROBOT",
-            f"{g.LENGTH_OF_A_ROBOT} m, but the segments add up to {cfg.LENGTH_OF_A_ROBOT:.4f} m; "
-            "the robot is its three segments end to end (leave the key out to derive it)",
-        )
-    for name in ("LENGTH_OF_FIRST_MODULE", "LENGTH_OF_SECOND_MODULE", "LENGTH_OF_THIRD_MODULE"):
-        length = getattr(g, name)
-        if 2 * g.wheel_inset > length or g.wheel_inset < g.wheel_radius:
-            raise ConfigError(
-                src, "geometry.wheel_inset",
-                f"{g.wheel_inset} m does not fit {name} = {length} m with wheel_radius "
-                f"{g.wheel_radius} m; allowed: wheel_radius <= wheel_inset <= {length / 2} m",
-            )
-    if s.front_min_range >= s.front_max_range:
-        raise ConfigError(src, "sensors.front_min_range", "must be below front_max_range")
-    if s.back_min_range >= s.back_max_range:
-        raise ConfigError(src, "sensors.back_min_range", "must be below back_max_range")
-    back_lo = s.range(back=True)[0]
-    if s.back_height < back_lo + BACK_RANGE_MARGIN:
-        raise ConfigError(src, "sensors.back_height",
-                          f"{s.back_height} m, but SBR/SBL ({s.back_model}) read from "
-                          f"{back_lo} m: the floor would be out of range; allowed: at "
-                          f"least {back_lo + BACK_RANGE_MARGIN:.3f} m (mount them higher, "
-                          "or choose a back_model that reads nearer)")
-    front_hi = s.range(back=False)[1]
-    if a.LENGTH_OF_INFINITY > front_hi:
-        raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
-                          f"{a.LENGTH_OF_INFINITY} m, but SFR/SFL ({s.front_model}) read "
-                          f"at most {front_hi} m (sensors.front_max_range, within the "
-                          f"sensor's own range); allowed: at most {front_hi} m")
-    for back, fov in ((False, s.front_fov_deg), (True, s.back_fov_deg)):
-        full = s.spec(back).fov_deg
-        if fov is not None and full > 0 and fov > full:
-            pair = "back" if back else "front"
-            raise ConfigError(src, f"sensors.{pair}_fov_deg",
-                              f"{fov} degrees, wider than the {s.spec(back).name}'s "
-                              f"{full}-degree cone; allowed: up to {full} (an ROI narrows it)")
-    if a.SAFE_DISTANCE_IN_FRONT_OF_STEP <= a.approach_gap:
-        raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
-                          f"must exceed approach_gap ({a.approach_gap} m)")
-    if a.SAFE_DISTANCE_IN_FRONT_OF_STEP < s.front_min_range:
-        raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
-                          f"must be at least sensors.front_min_range ({s.front_min_range} m)")
-    if a.SAFE_LENGTH < s.front_min_range:
-        raise ConfigError(src, "algorithm.SAFE_LENGTH",
-                          f"must be at least sensors.front_min_range ({s.front_min_range} m): "
-                          "the last drive of each step stops at that reading")
-    if s.front_height + a.drive_clearance >= m.lift_travel:
-        raise ConfigError(src, "motors.lift_travel",
-                          "must exceed sensors.front_height + algorithm.drive_clearance")
-    if a.clearance_lift >= m.lift_travel:
-        raise ConfigError(src, "algorithm.clearance_lift", "must be below motors.lift_travel")
-    half_base = g.LENGTH_OF_SECOND_MODULE / 2 - g.wheel_inset
-    if cfg.safety.stability_margin >= half_base:
-        raise ConfigError(
-            src, "safety.stability_margin",
-            f"{cfg.safety.stability_margin} m leaves no room: segment 2's wheels alone carry "
-            "the robot while segments 1 and 3 are lifted (calibration); allowed: 0 <= "
-            f"stability_margin < LENGTH_OF_SECOND_MODULE / 2 - wheel_inset = {half_base:.4f} m")
-    if a.LENGTH_OF_INFINITY <= cfg.LENGTH_OF_A_ROBOT + a.SAFE_LENGTH:
-        raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
-                          "must exceed LENGTH_OF_A_ROBOT + SAFE_LENGTH")
+REFERENCE = "reference"
+"""The shipped reference robot's name (``extends = "reference"``, ``--config reference``)."""
+
+
+def _extended(raw: dict[str, Any], source: str, seen: tuple[str, ...]) -> dict[str, Any]:
+    """``raw`` laid over the config it names in ``extends`` (a shipped robot, or
+    a file beside it): its tables key by key, anything else replaced."""
+    base = raw.pop("extends", None)
+    if base is None:
+        return raw
+    if not isinstance(base, str) or not base:
+        raise ConfigError(source, "extends", "must be a shipped robot's name ("
+                          + ", ".join(shipped_configs()) + ") or a config file's path")
+    if base in seen or len(seen) >= 5:
+        raise ConfigError(source, "extends", f"{base!r} extends itself (through "
+                          + " -> ".join(seen) + "); allowed: a chain without loops")
+    text, base_source = _config_text(base, Path(source).parent if Path(source).exists() else None)
+    base_raw = _extended(load_toml(text, base_source, ConfigError), base_source, (*seen, base))
+    return _merged(base_raw, raw)
+
+
+def _merged(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    out = dict(base)
+    for key, value in over.items():
+        old = base.get(key)
+        out[key] = _merged(old, value) if isinstance(value, dict) and isinstance(old, dict) \
+            else value
+    return out
+
+
+def _config_text(path: str | Path | None, beside: Path | None = None) -> tuple[str, str]:
+    """The text and source name of a config: the reference robot (None or
+    ``"reference"``), a shipped robot by name, or a file (relative to
+    ``beside`` when given)."""
+    if path is None or path == REFERENCE:
+        text = resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
+        return text, f"<default {DEFAULT_CONFIG_NAME}>"
+    if beside is not None and isinstance(path, str) and (beside / path).exists():
+        path = beside / path
+    return read_named(path, SHIPPED_DIR, "robot", ConfigError, also=(REFERENCE,))
+
+
+SHIPPED_DIR = "configs"
+
+
+def shipped_configs() -> list[str]:
+    """Names of the robot configs shipped with stairbot (``--config NAME``)."""
+    return sorted([REFERENCE, *shipped(SHIPPED_DIR)])
 
 
 def load_config(path: str | Path | None = None) -> RobotConfig:
-    """Load a config file, or the shipped default when ``path`` is None."""
-    if path is None:
-        text = resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
-        return parse_config(text, f"<default {DEFAULT_CONFIG_NAME}>")
-    p = Path(path)
-    text = read_text(p, ConfigError)
-    return parse_config(text, str(p))
+    """Load a config file, a shipped robot by name (a plain word that is no
+    existing file), or the reference robot when ``path`` is None."""
+    return parse_config(*_config_text(path))

@@ -4,6 +4,7 @@ file, the field and what is allowed."""
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -137,3 +138,30 @@ def test_the_default_file_is_valid_toml_with_seed_names() -> None:
     raw = tomllib.loads(DEFAULT_TEXT)
     assert "SAFE_DISTANCE_IN_FRONT_OF_STEP" in raw["algorithm"]
     assert "LENGTH_OF_FIRST_MODULE" in raw["geometry"]
+
+
+def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Path) -> None:
+    tof = load_config("tof")
+    assert (tof.sensors.front_model, tof.sensors.back_model) == ("vl53l1x", "vl53l0x")
+    assert tof.geometry == load_config().geometry  # the rest is the reference robot's
+    assert load_config("reference").sensors == load_config().sensors
+    mine = tmp_path / "mine.toml"
+    mine.write_text('extends = "tof"\n[sensors]\nfront_tilt_deg = 5.0\n')
+    cfg = load_config(mine)
+    assert (cfg.sensors.front_model, cfg.sensors.front_tilt_deg) == ("vl53l1x", 5.0)
+    beside = tmp_path / "beside.toml"
+    beside.write_text('extends = "mine.toml"\n[algorithm]\nmax_steps = 3\n')
+    cfg = load_config(beside)
+    assert (cfg.sensors.front_tilt_deg, cfg.algorithm.max_steps) == (5.0, 3)
+
+
+@pytest.mark.parametrize(("text", "words"), [
+    ('extends = "lidar-bot"\n', "no such file, nor a shipped robot; shipped: reference, tof"),
+    ("extends = 3\n", "must be a shipped robot's name (reference, tof)"),
+    ('extends = "loop.toml"\n', "extends itself"),
+])
+def test_bad_extends_is_one_clear_error(tmp_path: Path, text: str, words: str) -> None:
+    path = tmp_path / "loop.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=re.escape(words)):
+        load_config(path)
