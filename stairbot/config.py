@@ -253,11 +253,27 @@ class RobotConfig:
 
     @property
     def min_step_rise_m(self) -> float:
-        """Lowest rise it climbs: once the front sensors see over a riser,
-        segment 1 rises number_of_vertical_turns more before the tread is
-        measured, and must not see past the next riser meanwhile (with 10 mm
-        to spare).  Lower steps are refused."""
-        return self.sensors.front_height + self.algorithm.drive_clearance + 0.01
+        """Lowest rise it climbs: :meth:`min_rise_for` the shortest tread it
+        enters.  Lower steps are refused."""
+        return self.min_rise_for(self.min_tread_m)
+
+    @property
+    def front_cone_top_rad(self) -> float:
+        """How far above level the front pair's highest ray looks: the mount's
+        tilt plus half the cone (0 for one level ray)."""
+        s = self.sensors
+        fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
+        return math.radians(max(0.0, s.front_tilt_deg + fov / 2.0))
+
+    def min_rise_for(self, tread_m: float) -> float:
+        """Lowest next riser it can measure a tread of ``tread_m`` against:
+        once the front sensors see over a riser, segment 1 rises
+        number_of_vertical_turns more before the tread is measured, and the
+        pair must not see past the next riser meanwhile (with 10 mm to spare)
+        -- nor may the top of a cone, which climbs (tread + approach_gap) x
+        tan(front_cone_top_rad) over that distance."""
+        reach = (tread_m + self.algorithm.approach_gap) * math.tan(self.front_cone_top_rad)
+        return self.sensors.front_height + self.algorithm.drive_clearance + 0.01 + reach
 
     @property
     def min_tread_m(self) -> float:
@@ -370,6 +386,13 @@ SHIPPED_DIR = "configs"
 def shipped_configs() -> list[str]:
     """Names of the robot configs shipped with stairbot (``--config NAME``)."""
     return sorted([REFERENCE, *shipped(SHIPPED_DIR)])
+
+
+def config_table(path: str | Path | None = None) -> dict[str, Any]:
+    """A config's document as plain data with what it ``extends`` laid under
+    it (no ``extends`` left): a sweep's base for its cases.  Raises ConfigError."""
+    text, source = _config_text(path)
+    return _extended(load_toml(text, source, ConfigError), source, ())
 
 
 def load_config(path: str | Path | None = None) -> RobotConfig:

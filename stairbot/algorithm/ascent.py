@@ -9,6 +9,8 @@ reading when the distance is measurable and by turns when it is not.
 
 from __future__ import annotations
 
+import math
+
 from stairbot.algorithm import motion
 from stairbot.algorithm.moves import drive_phase, lift, lift_phase, reading_drive
 from stairbot.algorithm.phase import (
@@ -161,7 +163,19 @@ def _lifted_first(t: Tick, _w: Work) -> Step:
               f"LENGTH_OF_A_ROBOT + SAFE_LENGTH = {need:.3f} m; the ascent ends (obstacle)",
               ascent_end="obstacle")
         return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than LENGTH_OF_A_ROBOT + SAFE_LENGTH")
-    ctx.number_of_turns_for_step_height = t.snap.turns(MotorId.MTF) - ctx.return_mtf
+    lifted = t.snap.turns(MotorId.MTF) - ctx.return_mtf
+    rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
+        + cfg.sensors.front_height
+    if tread is not None and tread != float("inf") and rise < cfg.min_rise_for(tread):
+        # A cone looking up sees over the next riser (as high as this one, we
+        # assume) this far away: the readings mix what lies beyond it.
+        ctx.ascent_end = "obstacle"
+        t.say(f"step {ctx.number_of_steps + 1} is too low for its tread: rise about {rise:.3f} "
+              f"m < {cfg.min_rise_for(tread):.3f} m (the front cone's top, "
+              f"{math.degrees(cfg.front_cone_top_rad):.1f}° up, would see over the next riser "
+              f"{tread:.3f} m away); the ascent ends (obstacle)", ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE, "rise too low for the tread the front cone measures")
+    ctx.number_of_turns_for_step_height = lifted
     t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
           f"(step {ctx.number_of_steps + 1})",
           number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
@@ -176,7 +190,8 @@ LIFT_FIRST_MORE = PhaseDef(
     to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
                               "number_of_turns_for_step_height stored",
         P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
-                                 "tread too short",
+                                 "tread too short; or a rise too low for the tread "
+                                 "(min_rise_for)",
         P.ERROR: FAULT})
 
 

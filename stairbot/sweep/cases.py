@@ -117,7 +117,8 @@ def first_sight(scenario: Scenario, config: RobotConfig) -> float:
 def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, float, float]:
     """("inside" | "band" | "outside", max rise, min tread) of the steps the robot
     attempts (the first max_steps) against its limits (rises between
-    min_step_rise_m and max_step_rise_m, treads of min_tread_m or more), give
+    min_step_rise_m and max_step_rise_m, and each at least min_rise_for the
+    tread before it; treads of min_tread_m or more), give
     or take the margins; stairs out of sight at the start (see
     :func:`first_sight`) are outside.
     A tread counts where the robot must fit on it: every tread it climbs onto,
@@ -132,12 +133,15 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     min_tread = min(treads, default=math.inf)
     lr, lo, lt = config.max_step_rise_m, config.min_step_rise_m, config.min_tread_m
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
+    # how far each riser clears what the front cone needs to measure the tread before it
+    low = min([min_rise - lo] + [steps[i + 1].rise - config.min_rise_for(steps[i].tread)
+                                 for i in range(len(steps) - 1)])
     sight = first_sight(scenario, config)
     far = config.LENGTH_OF_INFINITY
-    if (max_rise > lr + rm or min_rise < lo - rm or min_tread < lt - tm
+    if (max_rise > lr + rm or low < -rm or min_tread < lt - tm
             or sight > far + SIGHT_MARGIN_M):
         return "outside", max_rise, min_tread
-    if (max_rise <= lr - rm and min_rise >= lo + rm and min_tread >= lt + tm
+    if (max_rise <= lr - rm and low >= rm and min_tread >= lt + tm
             and sight <= far - SIGHT_MARGIN_M):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread

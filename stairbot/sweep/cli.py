@@ -65,6 +65,9 @@ def run_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true",
                    help="keep the cases already in the results folder, run the rest")
     p.add_argument("--limit", metavar="N", type=_jobs, help="run only the first N cases")
+    p.add_argument("--config", metavar="FILE|NAME",
+                   help="run the cases on this robot config (a file, or a shipped robot: "
+                        "reference, tof) instead of the spec's")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress, no tables")
     _plot_options(p)
     return p
@@ -101,10 +104,12 @@ def cmd_sweep(argv: list[str]) -> int:
     args = run_parser().parse_args(argv)
     from stairbot.sweep.cases import check_spec
     from stairbot.sweep.execute import default_jobs, open_executor, run_cases
-    from stairbot.sweep.spec import load_spec
+    from stairbot.sweep.spec import load_spec, with_config
     from stairbot.sweep.store import ResultStore, meta_of
 
     spec = load_spec(args.spec)
+    if args.config is not None:
+        spec = with_config(spec, args.config)
     cases = check_spec(spec)  # a bad spec never starts work
     if args.limit is not None:
         cases = cases[:args.limit]

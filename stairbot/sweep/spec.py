@@ -33,7 +33,7 @@ import hashlib
 import json
 import math
 import random
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any
@@ -42,9 +42,10 @@ import msgspec
 import msgspec.inspect as mi
 
 from stairbot._schema import _tokens, _type_at, convert, load_toml, read_text
-from stairbot.config import ConfigFile
-from stairbot.errors import InputError
+from stairbot.config import ConfigFile, config_table
+from stairbot.errors import ConfigError, InputError
 from stairbot.scenario import ScenarioFile
+from stairbot.sweep import tomlw
 
 
 class SpecError(InputError):
@@ -308,6 +309,23 @@ def _base_text(spec_dir: Path, name: str | None, src: str, key: str, default: st
                     + (", nor a shipped scenario" if folder else ""))
 
 
+def _config_text(spec_dir: Path, name: str, src: str) -> str:
+    """The robot config a spec names (a file beside it, or a shipped robot), as
+    one TOML document with what it extends laid in."""
+    beside = spec_dir / name
+    try:
+        return tomlw.dumps(config_table(beside if beside.is_file() else name))
+    except ConfigError as exc:
+        raise SpecError(src, "sweep.config", str(exc)) from None
+
+
+def with_config(spec: Spec, name: str) -> Spec:
+    """``spec`` run with another robot config (``stairbot sweep --config``): a
+    file, or a shipped robot's name.  Raises SpecError."""
+    text = _config_text(Path.cwd(), name, spec.source)
+    return replace(spec, config_text=text)
+
+
 def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
     """Parse a spec document; the cases themselves are checked by
     :func:`stairbot.sweep.cases.check_spec`.  Raises SpecError."""
@@ -327,8 +345,7 @@ def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
     s = data.sweep
     scenario_text = _base_text(spec_dir, s.scenario, source, "scenario",
                                "default_scenario.toml", "scenarios")
-    config_text = (None if s.config is None else
-                   _base_text(spec_dir, s.config, source, "config", "", None))
+    config_text = None if s.config is None else _config_text(spec_dir, s.config, source)
     v = data.verdict
     return Spec(source=source, name=s.name or Path(source).stem, description=s.description,
                 seed=s.seed, samples=s.cases, axes=tuple(axes),
