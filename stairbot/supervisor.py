@@ -44,6 +44,8 @@ class Supervisor:
     def __init__(self, cfg: RobotConfig) -> None:
         m = cfg.motors
         self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
+        self._watched = tuple((mo, MIN_COMMAND * v) for mo, v in self._vmax.items())
+        """Each motor, and the least command watched on it."""
         self._watch: dict[MotorId, _Watch] = {}
         self._sent: Speeds = {}
         self._prev: Snapshot | None = None
@@ -63,12 +65,14 @@ class Supervisor:
         if prev is None:
             return None
         dt = snap.time_s - prev.time_s
-        for motor in MotorId:
-            v = self._sent.get(motor, 0.0)
-            if dt <= 0.0 or abs(v) < MIN_COMMAND * self._vmax[motor]:
-                self._watch.pop(motor, None)
+        sent, watch = self._sent, self._watch
+        for motor, least in self._watched:
+            v = sent.get(motor, 0.0)
+            if dt <= 0.0 or -least < v < least:
+                if motor in watch:
+                    del watch[motor]
                 continue
-            w = self._watch.get(motor)
+            w = watch.get(motor)
             if w is None or (w.expected > 0) != (v > 0):
                 w = self._watch[motor] = _Watch(prev.time_s, prev.turns(motor))
             w.expected += v * dt

@@ -124,14 +124,17 @@ def encode(msg: Message) -> tuple[int, bytes]:
 
 def decode(type_code: int, payload: bytes) -> Message:
     """The message of this type and payload.  Raises CodecError (only) for an
-    unknown type or a payload of the wrong length."""
+    unknown type, a payload of the wrong length, or padding that is not zero."""
     s = _STRUCTS.get(type_code)
     if s is None:
         raise CodecError(f"unknown message type 0x{type_code:02X}")
+    name = MESSAGES[type_code].__name__
     if len(payload) != s.size:
-        raise CodecError(
-            f"{MESSAGES[type_code].__name__}: payload of {len(payload)} bytes, expected {s.size}")
-    return MESSAGES[type_code].from_fields(s.unpack(payload))
+        raise CodecError(f"{name}: payload of {len(payload)} bytes, expected {s.size}")
+    fields = s.unpack(payload)
+    if "x" in s.format and s.pack(*fields) != payload:
+        raise CodecError(f"{name}: padding bytes must be zero (payload {payload.hex()})")
+    return MESSAGES[type_code].from_fields(fields)
 
 
 __all__ = [

@@ -6,6 +6,7 @@ Modules:
 
 * :mod:`~stairbot.fakes.stairs` -- the stairs as one side-view polyline (floor,
   risers and treads, a landing or a wall at the top) and ray casts against it;
+* :mod:`~stairbot.fakes.world_params` -- the physics and instability settings;
 * :mod:`~stairbot.fakes.world` -- the pymunk side view: x forward, y up,
   gravity -9.81 m/s^2; three box segments with two driven wheels each, two
   lead-screw lifts, friction, and the instability checks (pitch beyond the

@@ -17,7 +17,8 @@ which the simulated clock makes once per control tick.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from typing import Any
 
 import pymunk
 
@@ -27,6 +28,7 @@ except ImportError:  # pragma: no cover - another pymunk layout: the public API 
     _cp = None
 from stairbot.config import RobotConfig
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
+from stairbot.fakes.world_params import WorldParams
 from stairbot.scenario import Scenario
 
 TWO_PI = 2.0 * math.pi
@@ -35,26 +37,6 @@ _PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's 
 CAT_STAIRS = 0b01
 CAT_ROBOT = 0b10
 ROBOT_GROUP = 1
-
-
-@dataclass(frozen=True)
-class WorldParams:
-    """Physics and instability settings (not part of the robot config)."""
-
-    dt: float = 1.0 / 600.0  # 12 physics steps per 20 ms control tick
-    iterations: int = 10
-    stairs_friction: float = 1.0  # combined by product with the wheels' 0.9
-    wheel_friction: float = 0.9  # rubber on wood
-    body_friction: float = 0.3  # ABS chassis on wood
-    chamfer: float = 0.005  # bottom edges of each segment's chassis, m
-    stairs_radius: float = 0.001  # rounds the step nosings
-    collision_slop: float = 0.0005
-    lift_stall: float = 0.002  # a lift's target never runs further ahead than this, m
-    lift_hold_speed: float = 0.02  # a held lift corrects any creep at most this fast, m/s
-    pitch_limit_deg: float = 35.0
-    fall_speed: float = 1.0  # m/s downward counts as falling
-    airborne_limit_s: float = 0.3  # every wheel off every support this long: fell
-    contact_check_s: float = 0.1  # how often the wheels' contacts are looked up
 
 
 class World:
@@ -168,6 +150,7 @@ class World:
             self._wptrs = [(b._body, w[1]._body)
                            for b, w in zip(self.segments, self.wheels, strict=True)]
         self._px, self._py, self._pa = [0.0] * 3, [0.0] * 3, [0.0] * 3
+        self._cp_step: tuple[Callable[[Any, float], None], Any] | None = None
         self._fetch()
         self._check_y, self._check_t = list(self._py), 0.0
         self.start_x = self._px[1]
@@ -184,6 +167,28 @@ class World:
     def set_lift_speed(self, lift: int, metres_per_s: float) -> None:
         """Move lift 0 (MTF) or 1 (MTB) at ``metres_per_s`` (+ = end segment up); 0 holds."""
         self.lift_speed[lift] = metres_per_s
+
+    def _steps(self, n: int) -> None:
+        """``n`` physics steps.  The first goes through pymunk's Space.step,
+        which checks the bodies; after it, with no collision handlers,
+        post-step callbacks or objects added while stepping (this world has
+        none), cpSpaceStep alone is the whole of a step, without the
+        wrapper's Python."""
+        dt = self.params.dt
+        if n <= 0:
+            return
+        if self._cp_step is None:
+            self.space.step(dt)
+            n -= 1
+            if _cp is not None and hasattr(self.space, "_space"):
+                self._cp_step = (_cp.cpSpaceStep, self.space._space)
+            else:  # pragma: no cover - another pymunk layout
+                for _ in range(n):
+                    self.space.step(dt)
+                return
+        step, handle = self._cp_step
+        for _ in range(n):
+            step(handle, dt)
 
     # -- state (read once per physics state, then from the cache) -----------------
     def _fetch(self) -> None:
@@ -260,9 +265,8 @@ class World:
     def step_bare(self, seconds: float) -> None:
         """Step the physics ``seconds`` with nothing else: no lifts, no checks."""
         n = self._steps_for(seconds)
-        step, dt = self.space.step, self.params.dt
-        for _ in range(n):
-            step(dt)
+        dt = self.params.dt
+        self._steps(n)
         self._steps_done += n
         self.time = self._steps_done * dt
 
@@ -274,9 +278,7 @@ class World:
             return
         dt = self.params.dt
         self._set_lifts(n * dt)
-        step = self.space.step
-        for _ in range(n):
-            step(dt)
+        self._steps(n)
         self._steps_done += n
         self.time = self._steps_done * dt
         self._check()

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import random
+import struct
 from collections.abc import Iterator
 from importlib import resources
 from pathlib import Path
@@ -77,8 +78,9 @@ def test_every_frame_round_trips_and_matches_the_struct_payload() -> None:
         board, _ = w.decode(fid, bytes(w.db.get_message_by_frame_id(fid).length))
         cls = type(w.decode(fid, bytes(w.db.get_message_by_frame_id(fid).length))[1])
         for _ in range(100):
-            size = m.payload_size(cls.TYPE)
-            msg = m.decode(cls.TYPE, bytes(rng.randrange(256) for _ in range(size)))
+            layout = struct.Struct(cls.FORMAT)
+            raw = bytes(rng.randrange(256) for _ in range(layout.size))
+            msg = m.decode(cls.TYPE, layout.pack(*layout.unpack(raw)))  # padding zeroed
             assert w.encode(board, msg) == (fid, m.encode(msg)[1])
             assert w.decode(fid, m.encode(msg)[1]) == (board, msg)
 

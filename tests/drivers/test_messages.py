@@ -61,6 +61,14 @@ def test_wrong_length_and_unknown_type_are_codec_errors() -> None:
         m.decode(0x33, b"")
 
 
+def test_padding_that_is_not_zero_is_refused() -> None:
+    # Truth has a pad byte; hypothesis once found that decoding dropped it
+    # silently, so a frame's bytes and the message it became disagreed
+    with pytest.raises(m.CodecError, match="Truth: padding bytes must be zero"):
+        m.decode(m.Truth.TYPE, b"\x00\x01" + b"\x00" * 6)
+    assert m.decode(m.Truth.TYPE, b"\x01\x00" + b"\x00" * 6) == m.Truth(1, 0, 0)
+
+
 @given(st.integers(0, 255), st.binary(max_size=12))
 def test_decode_raises_only_codec_error(code: int, payload: bytes) -> None:
     try:
