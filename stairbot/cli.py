@@ -26,6 +26,14 @@ from types import FrameType
 from typing import IO, Any, TextIO
 
 from stairbot import __version__
+from stairbot.cli_show import (
+    EXIT_INPUT,
+    EXIT_OK,
+    PROG,
+    cmd_config_show,
+    cmd_scenario_check,
+    cmd_scenario_list,
+)
 from stairbot.config import RobotConfig, load_config
 from stairbot.errors import HardwareError, InputError, NoBoardError
 from stairbot.events import Event, EventKind
@@ -33,11 +41,9 @@ from stairbot.scenario import (
     Scenario,
     expectation_mismatches,
     load_scenario,
-    shipped_scenarios,
 )
 
-PROG = "stairbot"
-EXIT_OK, EXIT_MISMATCH, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_MISMATCH, EXIT_INTERRUPTED = 1, 130
 
 # Subcommands that other subpackages implement: name -> ("module:function", help).
 # The function takes the remaining argv (list[str]) and returns an exit code.
@@ -331,75 +337,3 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
                                     else "NO: " + "; ".join(mismatches)),
     ]
     print("\n".join(lines), flush=True)
-
-
-# -- config show ---------------------------------------------------------------------
-
-_DERIVED_UNITS = {"_m_s": "m/s", "_m": "m", "TURNS": "turns", "turns": "turns"}
-
-
-def _unit(name: str) -> str:
-    for suffix, unit in _DERIVED_UNITS.items():
-        if name.endswith(suffix) or suffix in name:
-            return unit
-    return "m"
-
-
-def cmd_config_show(args: argparse.Namespace) -> int:
-    """``stairbot config show``: the resolved config and its derived values."""
-    cfg = load_config(args.config)
-    data = cfg.to_dict()
-    if args.json:
-        print(json.dumps(data, indent=2, sort_keys=True))
-        return EXIT_OK
-    print(f"# robot config from {data['source']}")
-    for section in ("geometry", "masses", "motors", "sensors", "algorithm", "safety"):
-        print(f"\n[{section}]")
-        for key, value in data[section].items():
-            if value is None:  # TOML has no null: a key left out takes its default
-                print(f"# {key}: not set")
-            else:
-                print(f"{key} = {json.dumps(value)}")
-    print("\n[derived]  # computed from the values above, not read from the file")
-    width = max(len(k) for k in data["derived"])
-    for key, value in data["derived"].items():
-        print(f"{key:<{width}} = {value:<10g} # {_unit(key)}")
-    return EXIT_OK
-
-
-# -- scenarios ---------------------------------------------------------------------
-
-
-def _describe(s: Scenario) -> str:
-    stairs = (f"{len(s.steps)} steps, top {s.top}" if s.steps else "open floor")
-    exp = s.expect
-    want = "completed" if exp is None else ", ".join(
-        f"{k}={v}" for k, v in (
-            ("outcome", exp.outcome), ("ascent_end", exp.ascent_end),
-            ("steps_climbed", exp.steps_climbed), ("steps_descended", exp.steps_descended),
-            ("pauses", exp.pauses)) if v is not None)
-    return f"{stairs}; {len(s.faults)} fault(s); expects {want}"
-
-
-def cmd_scenario_check(args: argparse.Namespace) -> int:
-    """``stairbot scenario check``: validate each file; exit 2 if any is invalid."""
-    bad = 0
-    for name in args.files:
-        try:
-            s = load_scenario(name)
-        except InputError as exc:
-            print(f"{PROG}: error: {exc}", file=sys.stderr)
-            bad += 1
-            continue
-        print(f"ok  {name}: {_describe(s)}")
-    return EXIT_INPUT if bad else EXIT_OK
-
-
-def cmd_scenario_list(_args: argparse.Namespace) -> int:
-    """``stairbot scenario list``: the shipped scenarios with their descriptions."""
-    names = shipped_scenarios()
-    width = max((len(n) for n in names), default=0)
-    for name in names:
-        s = load_scenario(name)
-        print(f"{name:<{width}}  {s.description}")
-    return EXIT_OK

@@ -291,26 +291,18 @@ class RobotConfig:
 
     def derived(self) -> dict[str, float]:
         """Everything that follows from the file, for ``config show``."""
-        return {
-            "LENGTH_OF_A_ROBOT": self.LENGTH_OF_A_ROBOT,
-            "BACK_CLEARANCE": self.BACK_CLEARANCE,
-            "MAX_OF_VERTICAL_TURNS": self.MAX_OF_VERTICAL_TURNS,
-            "NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE": self.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE,
-            "NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH": self.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
-            "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE": (
-                self.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE
-            ),
-            "NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE": (
-                self.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE
-            ),
-            "number_of_vertical_turns": self.initial_number_of_vertical_turns,
-            "wheel_circumference_m": self.wheel_circumference,
-            "wheel_speed_m_s": self.wheel_speed_m_s,
-            "lift_speed_m_s": self.lift_speed_m_s,
-            "max_step_rise_m": self.max_step_rise_m,
-            "min_tread_m": self.min_tread_m,
-            "min_step_rise_m": self.min_step_rise_m,
-        }
+        names = ("LENGTH_OF_A_ROBOT", "BACK_CLEARANCE", "MAX_OF_VERTICAL_TURNS",
+                 "NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE",
+                 "NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH",
+                 "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE",
+                 "NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE")
+        out = {name: float(getattr(self, name)) for name in names}
+        out["number_of_vertical_turns"] = self.initial_number_of_vertical_turns
+        out["wheel_circumference_m"] = self.wheel_circumference
+        for name in ("wheel_speed_m_s", "lift_speed_m_s", "max_step_rise_m", "min_tread_m",
+                     "min_step_rise_m"):
+            out[name] = float(getattr(self, name))
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved config as plain data: the file's sections plus ``derived``."""
