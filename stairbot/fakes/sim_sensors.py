@@ -70,11 +70,12 @@ class SimSensors:
         self._back_weight = total_weight(self.back_model.fan)
         r = config.geometry.wheel_radius
         # sensor mounts in their segment's frame (origin: centre of the axle line)
+        # rays reach a little past what the sensor reports (its range within the config's)
         self._front_mount = (world.lengths[0] / 2, s.front_height - r,
-                             (self.front_model.max_range or s.front_max_range) * 1.05)
+                             self.sensors[SensorId.SFR].max_range * 1.05)
         self._back_mount = (-world.lengths[2] / 2 + s.back_from_rear,
                             s.back_height - r,
-                            (self.back_model.max_range or s.back_max_range) * 1.05)
+                            self.sensors[SensorId.SBR].max_range * 1.05)
 
     def read(self, t: float) -> dict[SensorId, SensorReading]:
         """Every distance sensor's published reading at ``t``, with its age."""
