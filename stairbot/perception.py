@@ -83,6 +83,13 @@ def max_age(cfg: RobotConfig, back: bool) -> float:
     return spec.latency_s + STALE_PERIODS * measurement_period(cfg, back) + cfg.algorithm.tick
 
 
+def settle_s(cfg: RobotConfig, back: bool = False) -> float:
+    """How long the pair's filtered readings take to stand for where the robot
+    stands now, once it stops: its latency and a full window of measurements.
+    Measurements to average standing still start after it."""
+    return cfg.sensors.spec(back).latency_s + window(cfg, back) * measurement_period(cfg, back)
+
+
 def median_sigma(cfg: RobotConfig, back: bool, distance_m: float) -> float:
     """Sigma of the pair's filtered reading at ``distance_m``."""
     n = window(cfg, back)

@@ -30,7 +30,7 @@ from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
-from stairbot.perception import still_samples, still_tolerance
+from stairbot.perception import settle_s, still_samples, still_tolerance
 
 P = Phase
 FLOW = "calibration"
@@ -72,7 +72,13 @@ def _check(t: Tick, w: Work) -> Step:
     cfg, ctx = t.cfg, t.ctx
     sfr, sfl = motion.pair(t.snap)
     # Standing still, the pair is averaged over STILL_TICKS before it is
-    # called equal or not: one noisy reading must not choose the case.
+    # called equal or not: one noisy reading must not choose the case; and
+    # only once the filter has settled (a full window of measurements taken
+    # standing here: not the first one or two, nor ones taken while moving).
+    if w.still_since is None:
+        w.still_since = t.snap.time_s
+    if t.snap.time_s - w.still_since < settle_s(cfg) - 1e-9:  # (clocks round alike)
+        return stay(NO_MOTION)
     if w.diff_n < STILL_TICKS:
         w.diff_sum += sfl.distance_m - sfr.distance_m
         w.diff_n += 1
@@ -177,7 +183,11 @@ def _turned_past_limit(t: Tick, w: Work) -> Step | None:
 def _turn(t: Tick, w: Work) -> Step:
     cfg = t.cfg
     sfr, sfl = _readings(t)
-    if w.checked:  # stopped at SFR = SFL: measuring standing still
+    if w.checked:  # stopped at SFR = SFL: measuring standing still, once settled
+        if w.still_since is None:
+            w.still_since = t.snap.time_s
+        if t.snap.time_s - w.still_since < settle_s(cfg) - 1e-9:  # (clocks round alike)
+            return stay(NO_MOTION)
         w.diff_sum += sfl - sfr
         w.diff_n += 1
         # as long as it takes to know the difference to within equal_tolerance
@@ -190,7 +200,7 @@ def _turn(t: Tick, w: Work) -> Step:
                   diff=diff)
             return go(P.CAL_LOWER)
         # Not square yet: turn on, slowly, the way the difference says.
-        w.checked, w.diff_sum, w.diff_n = False, 0.0, 0
+        w.checked, w.diff_sum, w.diff_n, w.still_since = False, 0.0, 0, None
         w.turn_direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
         w.turn_diff = diff
     w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)

@@ -49,6 +49,8 @@ class Work:
     """A pair difference summed over ticks standing still, and how many."""
     checked: bool = False
     """The phase's entry condition has been checked (on its first step)."""
+    still_since: float | None = None
+    """When the robot stopped to measure standing still (calibration)."""
     balanced: bool = False
     """The static-stability check has run (before a lift phase's first step)."""
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import replace
 
@@ -24,6 +25,7 @@ from stairbot.algorithm.transitions import (
 from stairbot.algorithm.work import Work
 from stairbot.config import load_config
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.perception import settle_s
 
 CFG = load_config()
 
@@ -72,14 +74,19 @@ def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
     said: list[str] = []
     sensors = {SensorId.SFR: SensorReading(0.50), SensorId.SFL: SensorReading(0.53),
                SensorId.SBR: SensorReading(0.04), SensorId.SBL: SensorReading(0.04)}
-    snap = Snapshot(0.0, sensors, {m: MotorState(0.0) for m in MotorId})
-    tick = Tick(snap, CFG, ctx, Mode.FULL, lambda message, **_: said.append(message))
+    motors = {m: MotorState(0.0) for m in MotorId}
     record = Phase.CAL_CHECK.record
     assert record.step is not None
-    work = Work.at_entry(snap)
-    steps = [record.step(tick, work) for _ in range(STILL_TICKS + 1)]
+    work = Work.at_entry(Snapshot(0.0, sensors, motors))
+    # the filter settles, then the pair is averaged over STILL_TICKS, standing still
+    ticks = math.ceil(settle_s(CFG) / CFG.algorithm.tick - 1e-9) + STILL_TICKS + 1
+    steps = []
+    for i in range(ticks):
+        snap = Snapshot(i * CFG.algorithm.tick, sensors, motors)
+        tick = Tick(snap, CFG, ctx, Mode.FULL, lambda message, **_: said.append(message))
+        steps.append(record.step(tick, work))
     assert all(isinstance(s, Step) and not s.speeds for s in steps)
-    assert [s.next for s in steps[:-1]] == [None] * STILL_TICKS  # averaging, standing still
+    assert [s.next for s in steps[:-1]] == [None] * (ticks - 1)
     step = steps[-1]
     assert step.next is Phase.CAL_LIFT
     assert ctx.phase == Phase.CAL_CHECK.value  # not entered by the step

@@ -61,8 +61,9 @@ def test_quick_spec_end_to_end(tmp_path: Path) -> None:
     assert "stairs.rise" in rep.stdout and (tmp_path / "map.png").stat().st_size > 10_000
 
 
-# home_m is tiny, so every case ends "stranded" (a failure that does not depend on
-# the robot's present faults) -- with a robot config override, to write both files.
+# SFR fails for good half way up the step, so every case ends "stranded" (by
+# design: the robot stops there, lifts holding) -- with a robot config
+# override, to write both files.
 STRANDED = """
 [sweep]
 name = "stranded"
@@ -72,8 +73,7 @@ seed = 5
 "stairs.count" = 1
 "config.masses.second_module" = { uniform = [1.2, 1.4] }
 "sensors.seed" = { randint = [1, 1000] }
-[verdict]
-home_m = 0.00001
+"faults" = [[{ at = 20.0, sensor = "SFR", kind = "error" }]]
 """
 
 
@@ -95,7 +95,7 @@ def test_a_failing_case_reproduces_its_verdict_with_stairbot_run(tmp_path: Path)
         for key in ("outcome", "steps_climbed", "steps_descended", "final_offset_m",
                     "max_pitch_deg", "sim_time_s", "ascent_end", "error"):
             assert got[key] == rec["result"][key], key  # the very same run
-        assert run.returncode == 1  # its [expect] says home within 0.00001 m
+        assert run.returncode == 1  # its [expect] says climbed and home
 
 
 RESUMABLE = """
