@@ -60,3 +60,14 @@ def test_a_sweep_runs_on_another_robot_by_name() -> None:
     assert "extends" not in tof.config_text  # laid in: the cases stand on their own
     with pytest.raises(SpecError, match="no such file, nor a shipped robot"):
         with_config(spec, "lidar-bot")
+
+
+def test_refused_at_the_first_step_it_comes_back_by_the_odometer() -> None:
+    # found by the envelope sweep: from 0.77 m a cone tilted up sees over a
+    # 0.10 m riser and reads it long; going back by that reading left the robot
+    # 11-14 cm from its start
+    r = run_tof("[stairs]\ncount = 9\nrise = 0.10\ntread = 0.30\ntop = \"wall\"\n"
+                "[start]\ndistance = 0.768\nlateral = 0.09\nyaw_deg = -15.25\n"
+                "[sensors]\nseed = 283009\n")
+    assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()

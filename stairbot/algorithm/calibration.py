@@ -332,6 +332,7 @@ def _lowered(t: Tick, _w: Work) -> Step:
     if ctx.purpose == "start":
         if motion.measurable(t.snap, cfg):
             ctx.start_reading = motion.mean_distance(t.snap)
+            ctx.start_wheel = motion.wheel_position(t.snap)
             t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
                   start_reading=ctx.start_reading)
         if t.mode is Mode.CALIBRATE_ONLY:

@@ -50,6 +50,8 @@ class Context:
     """The first calibration's case: "1", "2", "3A" or "3B"."""
     start_reading: float | None = None
     """Mean SFR/SFL reading when the first calibration ended: the start position."""
+    start_wheel: float | None = None
+    """The drive's odometer (turns) there."""
     steps_descended: int = 0
     pauses: int = 0
     ascent_end: str | None = None

@@ -179,13 +179,28 @@ LOWER_FIRST = PhaseDef(
 
 
 # -- descent 7: back to the start ----------------------------------------------------------------
-_finish = reading_drive(-1, lambda t: t.ctx.start_reading,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
+def _on_the_floor_all_along(t: Tick) -> bool:
+    """No step was climbed: the wheels drove only on the floor, and their
+    odometer knows the way back better than a reading of stairs it refused
+    (a cone may see over low risers there)."""
+    return t.ctx.number_of_steps == 0 and t.ctx.start_wheel is not None
+
+
+def _finish_turns(t: Tick) -> float:
+    if _on_the_floor_all_along(t):
+        assert t.ctx.start_wheel is not None
+        return max(0.0, motion.wheel_position(t.snap) - t.ctx.start_wheel)
+    return t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+
+
+_finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start_reading,
+                        _finish_turns,
                         lambda _t, _w: end("completed", "back at the start position"))
 FINISH = PhaseDef(
     P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW, _finish[1],
     enter=_finish[0], watches="front",
-    to={P.DONE: "reads the start reading (or turns made)", P.ERROR: FAULT})
+    to={P.DONE: "reads the start reading (or turns made; with no step climbed: back by the "
+                "odometer to the start position)", P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (
     BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST, LOWER_FIRST,
