@@ -129,7 +129,7 @@ def still_samples(cfg: RobotConfig, distance_m: float, back: bool = False) -> in
     equal_tolerance (:func:`still_tolerance`), at most MAX_STILL_S of them:
     calibration squares up to that yaw."""
     repeats = measurement_period(cfg, back) / cfg.algorithm.tick
-    one = SIGMAS * math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m)
+    one = SIGMAS * _still_sigma(cfg, back, distance_m, 1.0)
     independent = (one / cfg.algorithm.equal_tolerance) ** 2
     return max(1, min(round(MAX_STILL_S / cfg.algorithm.tick),
                       math.ceil(independent * repeats)))
@@ -146,10 +146,14 @@ def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
     """Like :func:`pair_tolerance`, for the mean of ``samples`` ticks' filtered
     differences taken standing still."""
     repeats = measurement_period(cfg, back) / cfg.algorithm.tick
-    independent = max(1.0, samples / repeats)
-    sigma_diff = math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m) \
-        / math.sqrt(independent)
+    sigma_diff = _still_sigma(cfg, back, distance_m, max(1.0, samples / repeats))
     return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
+
+
+def _still_sigma(cfg: RobotConfig, back: bool, distance_m: float, independent: float) -> float:
+    """Sigma of the mean of ``independent`` filtered pair differences."""
+    return math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m) \
+        / math.sqrt(independent)
 
 
 class _Track:

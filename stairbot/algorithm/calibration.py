@@ -67,6 +67,14 @@ def _after_calibration(t: Tick) -> Step:
     return go(P.DESCENT_BACK_TO_EDGE if t.ctx.purpose == "descent" else P.ASCENT_APPROACH)
 
 
+def _settled(t: Tick, w: Work) -> bool:
+    """Standing still since ``w.still_since`` (set now if unset) for as long
+    as the filter takes to stand for here (:func:`settle_s`)."""
+    if w.still_since is None:
+        w.still_since = t.snap.time_s
+    return t.snap.time_s - w.still_since >= settle_s(t.cfg) - 1e-9  # (clocks round alike)
+
+
 # -- check the readings --------------------------------------------------------------
 def _check(t: Tick, w: Work) -> Step:
     cfg, ctx = t.cfg, t.ctx
@@ -75,9 +83,7 @@ def _check(t: Tick, w: Work) -> Step:
     # called equal or not: one noisy reading must not choose the case; and
     # only once the filter has settled (a full window of measurements taken
     # standing here: not the first one or two, nor ones taken while moving).
-    if w.still_since is None:
-        w.still_since = t.snap.time_s
-    if t.snap.time_s - w.still_since < settle_s(cfg) - 1e-9:  # (clocks round alike)
+    if not _settled(t, w):
         return stay(NO_MOTION)
     if w.diff_n < STILL_TICKS:
         w.diff_sum += sfl.distance_m - sfr.distance_m
@@ -184,9 +190,7 @@ def _turn(t: Tick, w: Work) -> Step:
     cfg = t.cfg
     sfr, sfl = _readings(t)
     if w.checked:  # stopped at SFR = SFL: measuring standing still, once settled
-        if w.still_since is None:
-            w.still_since = t.snap.time_s
-        if t.snap.time_s - w.still_since < settle_s(cfg) - 1e-9:  # (clocks round alike)
+        if not _settled(t, w):
             return stay(NO_MOTION)
         w.diff_sum += sfl - sfr
         w.diff_n += 1
