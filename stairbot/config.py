@@ -265,6 +265,18 @@ class RobotConfig:
         fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
         return math.radians(max(0.0, s.front_tilt_deg + fov / 2.0))
 
+    @property
+    def square_range_m(self) -> float:
+        """Farthest reading the front pair squares up from at the start: within
+        it, a cone looking up front_cone_top_rad rises no higher than the
+        lowest riser the robot climbs (min_step_rise_m), so both beams read
+        the first riser alone; farther, the upper rays pass over it and the
+        reading blends the risers beyond.  Infinite for level rays."""
+        top = self.front_cone_top_rad
+        if top <= 0.0:
+            return math.inf
+        return (self.min_step_rise_m - self.sensors.front_height) / math.tan(top)
+
     def min_rise_for(self, tread_m: float) -> float:
         """Lowest next riser it can measure a tread of ``tread_m`` against:
         once the front sensors see over a riser, segment 1 rises

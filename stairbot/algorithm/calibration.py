@@ -97,6 +97,16 @@ def _check(t: Tick, w: Work) -> Step:
         t.say("calibration case 1: nothing ahead (SFR and SFL read at least "
               f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
         return end("stopped", "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
+    if ctx.purpose == "start":
+        if ctx.home_wheel is None:
+            ctx.home_wheel = motion.wheel_position(t.snap)
+        near = _nearer(t)
+        if near is not None and near > cfg.square_range_m + cfg.algorithm.equal_tolerance:
+            t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
+                  f"farther than square_range_m ({cfg.square_range_m:.3f} m), where the front "
+                  "cones see over the first riser; closing in before squaring up",
+                  SFR=sfr.distance_m, SFL=sfl.distance_m)
+            return go(P.CAL_CLOSE_IN)
     diff = w.diff_sum / w.diff_n
     equal = abs(diff) <= still_tolerance(cfg, w.diff_n, min(sfr.distance_m, sfl.distance_m))
     if equal and ctx.purpose != "start":
@@ -120,16 +130,52 @@ def _one_riser(cfg: RobotConfig) -> float:
     return 2 * cfg.sensors.front_lateral * math.tan(MAX_SQUARE_YAW_RAD)
 
 
+def _nearer(t: Tick) -> float | None:
+    """The nearer of SFR and SFL that reads a distance (None: neither)."""
+    seen = [r.distance_m for r in motion.pair(t.snap) if r.ok and not motion.far(r, t.cfg)]
+    return min(seen, default=None)
+
+
 CHECK = PhaseDef(
     P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check,
     to={
         P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead)",
+        P.CAL_CLOSE_IN: "start: the nearer reads farther than square_range_m",
         P.CAL_LIFT: "start: case 2 (SFR ≠ SFL), 2W (too far apart for one riser) or case 3 "
                     "(SFR = SFL); later: SFR ≠ SFL",
         P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL",
         P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL",
         P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be",
     })
+
+
+# -- close in (start) -------------------------------------------------------------------
+def _close_in_enter(t: Tick, w: Work) -> None:
+    # No further than the first reading allows: its nearer beam to square_range_m.
+    near = _nearer(t)
+    assert near is not None  # CAL_CHECK closes in only on a reading
+    w.start_reading = near
+    w.target_wheel = w.entry_wheel + t.cfg.wheel_turns(near - t.cfg.square_range_m)
+
+
+def _close_in(t: Tick, w: Work) -> Step:
+    """Drive straight on, not squared up (the standing rule is not armed), until
+    the nearer beam reads square_range_m or the first reading's distance is
+    driven; then check the readings again, standing still."""
+    assert w.target_wheel is not None  # set on entry
+    near = _nearer(t)
+    remaining = w.target_wheel - motion.wheel_position(t.snap)
+    if remaining <= motion.WHEEL_DONE or (near is not None and near <= t.cfg.square_range_m):
+        return go(P.CAL_CHECK, f"closed in: SFR/SFL nearer reads "
+                               f"{'nothing' if near is None else f'{near:.3f} m'}")
+    return stay(motion.drive(t.cfg, 1, remaining))
+
+
+CLOSE_IN = PhaseDef(
+    P.CAL_CLOSE_IN, "calibration — close in to square_range_m (start)", FLOW, _close_in,
+    enter=_close_in_enter,
+    to={P.CAL_CHECK: "the nearer reads square_range_m, or the first reading's distance driven",
+        P.ERROR: FAULT})
 
 
 # -- lift segments 1 and 3 for clearance -----------------------------------------------
@@ -143,6 +189,8 @@ def _lift_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
 
 def _lifted(t: Tick, _w: Work) -> Step:
     t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
+    if t.ctx.purpose == "home":
+        return go(P.DESCENT_TURN_BACK)
     case = t.ctx.calibration_case
     return go(P.CAL_TURN if case == "2" else P.CAL_AWAY if case == "2W" else P.CAL_PROBE)
 
@@ -152,7 +200,8 @@ LIFT = PhaseDef(
     P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
     enter=_lift_enter, carried_by=(2,),
     to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
-        P.CAL_PROBE: "lifted; case 3", P.ERROR: FAULT})
+        P.CAL_PROBE: "lifted; case 3", P.DESCENT_TURN_BACK: "lifted; descent 7 turns back",
+        P.ERROR: FAULT})
 
 
 # -- turning ---------------------------------------------------------------------------
@@ -333,7 +382,10 @@ def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
 
 def _lowered(t: Tick, _w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
+    if ctx.purpose == "home":
+        return go(P.DESCENT_FINISH_FLOOR)
     if ctx.purpose == "start":
+        ctx.square_turn = t.snap.turns(MotorId.MWR) - ctx.turn_origin
         if motion.measurable(t.snap, cfg):
             ctx.start_reading = motion.mean_distance(t.snap)
             ctx.start_wheel = motion.wheel_position(t.snap)
@@ -350,6 +402,7 @@ LOWER = PhaseDef(
     carried_by=(2,),
     to={P.ASCENT_APPROACH: "lowered (start or ascent 1)",
         P.DESCENT_BACK_TO_EDGE: "lowered (descent 1)",
+        P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back)",
         P.DONE: "lowered; calibrate-only mode", P.ERROR: FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (CHECK, LIFT, PROBE, CORNER, AWAY, TURN, LOWER)
+PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, PROBE, CORNER, AWAY, TURN, LOWER)

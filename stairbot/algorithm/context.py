@@ -45,13 +45,21 @@ class Context:
     phase: str = "cal_check"
     """Value of the present :class:`~stairbot.algorithm.phases.Phase`."""
     purpose: str = "start"
-    """What the calibration phases are doing: "start", "ascent" or "descent"."""
+    """What the calibration phases are doing: "start", "ascent", "descent", or
+    "home" (descent 7 lifts and lowers segments 1 and 3 to turn back)."""
     calibration_case: str | None = None
     """The first calibration's case: "1", "2", "3A" or "3B"."""
     start_reading: float | None = None
     """Mean SFR/SFL reading when the first calibration ended: the start position."""
     start_wheel: float | None = None
     """The drive's odometer (turns) there."""
+    home_wheel: float | None = None
+    """The drive's odometer where the program began: where descent 7 returns
+    to (the first calibration may have closed in on the riser before it
+    squared up, its start position is then nearer the stairs)."""
+    square_turn: float = 0.0
+    """MWR turns the first calibration made, net, after closing in: descent 7
+    turns them back before it backs the closed-in distance."""
     steps_descended: int = 0
     pauses: int = 0
     ascent_end: str | None = None
@@ -139,6 +147,8 @@ def _work_from(data: object, source: str) -> Work:
 
 
 def _type_ok(value: object, annotation: str) -> bool:
+    if annotation.startswith("list["):
+        return isinstance(value, list) and all(_type_ok(v, annotation[5:-1]) for v in value)
     allowed: list[type] = []
     if "None" in annotation:
         allowed.append(type(None))

@@ -11,7 +11,10 @@ counts.
 
 from __future__ import annotations
 
+import math
+
 from stairbot.algorithm import motion
+from stairbot.algorithm.calibration import TURN_SLOW_FLOOR
 from stairbot.algorithm.moves import (
     checked_first,
     drive_phase,
@@ -32,7 +35,9 @@ from stairbot.algorithm.phase import (
 )
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
+from stairbot.config import RobotConfig
 from stairbot.hardware import BACK_SENSORS, MotorId
+from stairbot.perception import median_sigma
 
 P = Phase
 FLOW = "descent"
@@ -86,10 +91,27 @@ def _lower_third_enter(t: Tick, w: Work) -> None:
     w.target_mtb = -t.cfg.MAX_OF_VERTICAL_TURNS
 
 
+FLOOR_SIGMAS = 2.0
+"""Descent 2: SBR/SBL "read BACK_CLEARANCE" within this many sigmas of their
+filtered mean (and half a resolution step)."""
+
+
+def floor_tolerance(cfg: RobotConfig) -> float:
+    """How far above BACK_CLEARANCE the pair's mean may read and segment 3
+    stand on the floor: half a resolution step, and FLOOR_SIGMAS sigmas of
+    the mean of two filtered readings there.  Without the sigmas, a noisy
+    pair (or a cone, whose slanted rays read a little long) that reads above
+    BACK_CLEARANCE standing keeps the lift pushing segment 3 down, and
+    segment 2 tips nose down (found by the envelope sweep on the tof robot:
+    15 deg at the top of a flight)."""
+    sigma = median_sigma(cfg, True, cfg.BACK_CLEARANCE) / math.sqrt(2.0)
+    return cfg.sensors.resolution / 2 + FLOOR_SIGMAS * sigma
+
+
 def _over_an_edge(t: Tick, _w: Work) -> Step | None:
     cfg = t.cfg
     reading = motion.mean_distance(t.snap, back=True)
-    if reading <= cfg.BACK_CLEARANCE + cfg.sensors.resolution / 2:
+    if reading <= cfg.BACK_CLEARANCE + floor_tolerance(cfg):
         return fail(f"floor not found: SBR/SBL read {reading:.3f} m, at or below BACK_CLEARANCE "
                     f"({cfg.BACK_CLEARANCE} m), before segment 3 was lowered (step "
                     f"{t.descent_index + 1}): segment 3 is not over an edge")
@@ -100,7 +122,16 @@ def _lower_third(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     reading = motion.mean_distance(t.snap, back=True)
     to_go = reading - cfg.BACK_CLEARANCE
-    if to_go <= cfg.sensors.resolution / 2:
+    if w.start_reading is None and to_go <= floor_tolerance(cfg):
+        # Within the noise of BACK_CLEARANCE: the rest the reading says, by
+        # turns, and no further (an unbiased finish, never a push on the floor).
+        w.start_reading = to_go
+        w.target_mtb = t.snap.turns(MotorId.MTB) - cfg.lift_turns(max(0.0, to_go))
+    if w.start_reading is not None:
+        assert w.target_mtb is not None
+        finish = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
+        if finish is not None:
+            return stay({MotorId.MTB: finish})
         ctx.number_of_turns_for_step_height = ctx.return_mtb - t.snap.turns(MotorId.MTB)
         t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
               f"{ctx.number_of_turns_for_step_height:.2f} (step {t.descent_index + 1})",
@@ -193,16 +224,65 @@ def _finish_turns(t: Tick) -> float:
     return t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
 
 
+def _closed_in_turns(t: Tick) -> float:
+    """How far the first calibration closed in before it squared up (turns)."""
+    ctx = t.ctx
+    if ctx.start_wheel is None or ctx.home_wheel is None:
+        return 0.0
+    return max(0.0, ctx.start_wheel - ctx.home_wheel)
+
+
+def _at_start_position(t: Tick, _w: Work) -> Step:
+    """At the start position (where the first calibration squared up).  If it
+    closed in first, the way home retraces it: turn back the squaring turn
+    (segments 1 and 3 lifted, as calibration turns), then back the distance."""
+    ctx = t.ctx
+    if _closed_in_turns(t) <= motion.WHEEL_DONE:
+        return end("completed", "back at the start position")
+    if abs(ctx.square_turn) <= motion.WHEEL_DONE:
+        return go(P.DESCENT_FINISH_FLOOR)
+    ctx.purpose = "home"
+    return go(P.CAL_LIFT)
+
+
 _finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start_reading,
-                        _finish_turns,
-                        lambda _t, _w: end("completed", "back at the start position"))
+                        _finish_turns, _at_start_position)
 FINISH = PhaseDef(
     P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW, _finish[1],
     enter=_finish[0], watches="front",
     to={P.DONE: "reads the start reading (or turns made; with no step climbed: back by the "
-                "odometer to the start position)", P.ERROR: FAULT})
+                "odometer to the start position)",
+        P.CAL_LIFT: "the first calibration closed in and turned: lift to turn back",
+        P.DESCENT_FINISH_FLOOR: "the first calibration closed in, square already",
+        P.ERROR: FAULT})
+
+
+def _turn_back_enter(t: Tick, w: Work) -> None:
+    w.turn_from = t.snap.turns(MotorId.MWR)
+
+
+def _turn_back(t: Tick, w: Work) -> Step:
+    """Turn on segment 2's wheels until MWR has undone the squaring turn."""
+    remaining = w.turn_from - t.ctx.square_turn - t.snap.turns(MotorId.MWR)
+    if abs(remaining) <= motion.WHEEL_DONE:
+        return go(P.CAL_LOWER)
+    slow = min(1.0, max(TURN_SLOW_FLOOR, abs(remaining) / motion.WHEEL_SLOW_ZONE))
+    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, slow))
+
+
+TURN_BACK = PhaseDef(
+    P.DESCENT_TURN_BACK, "descent 7 — turn back as far as the first calibration turned",
+    FLOW, _turn_back, enter=_turn_back_enter,
+    to={P.CAL_LOWER: "turned back", P.ERROR: FAULT})
+
+_floor = turns_drive(-1, _closed_in_turns,
+                     lambda _t, _w: end("completed", "back where the program began"))
+FINISH_FLOOR = PhaseDef(
+    P.DESCENT_FINISH_FLOOR, "descent 7 — finish: back the distance calibration closed in",
+    FLOW, _floor[1], enter=_floor[0],
+    to={P.DONE: "turns made: where the program began", P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (
     BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST, LOWER_FIRST,
-    FINISH,
+    FINISH, TURN_BACK, FINISH_FLOOR,
 )

@@ -10,6 +10,7 @@ descent's mirrored drives and lifts of segments 1 and 2).
 
 from __future__ import annotations
 
+import statistics
 from collections.abc import Callable
 
 from stairbot.algorithm import motion
@@ -28,6 +29,10 @@ JUMP_M = 0.02
 """A reading drive trusts its reading while it stays within this (or JUMP_SIGMAS
 of the filtered reading's sigma, if more) of what the wheels explain."""
 JUMP_SIGMAS = 6.0
+KEY_TICKS = 5
+"""The surface a reading drive starts on is the median of its first this many
+ticks' readings (less what the wheels drove): a stray first reading (an
+outlier just after the pair came into range) found by the 20-seed noise test."""
 
 
 def jump_limit(cfg: RobotConfig, distance_m: float) -> float:
@@ -64,10 +69,12 @@ def reading_drive(
                 and motion.measurable(t.snap, cfg):
             reading = motion.mean_distance(t.snap)
             key = reading + here * cfg.wheel_circumference
-            if w.reading_key is None:
-                w.reading_key = key
+            if len(w.first_keys) < KEY_TICKS:
+                w.first_keys.append(key)
+                w.reading_key = statistics.median(w.first_keys)
+            assert w.reading_key is not None
             jump = key - w.reading_key
-            if abs(jump) > jump_limit(cfg, reading):
+            if len(w.first_keys) >= KEY_TICKS and abs(jump) > jump_limit(cfg, reading):
                 # Not the surface the drive started on (the beams slid over an
                 # edge, or onto a side wall): the wheels carry on to the last
                 # target the readings gave.

@@ -124,11 +124,14 @@ def where(ctx: Context, phase: Phase) -> str:
             return "start"
         if ctx.purpose == "ascent":
             return f"ascent 1, step {ctx.number_of_steps + 1}"
+        if ctx.purpose == "home":
+            return "descent 7"
         return f"descent 1, step {ctx.number_of_steps - ctx.steps_descended}"
     if flow == "ascent":
         counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
         return f"step {ctx.number_of_steps + (0 if counted else 1)}"
-    if flow == "descent" and phase is not Phase.DESCENT_FINISH:
+    if flow == "descent" and phase not in (Phase.DESCENT_FINISH, Phase.DESCENT_TURN_BACK,
+                                             Phase.DESCENT_FINISH_FLOOR):
         return f"step {ctx.number_of_steps - ctx.steps_descended}"
     return ""
 

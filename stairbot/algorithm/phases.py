@@ -31,6 +31,7 @@ class Phase(Enum):
     """A phase of the algorithm; ``value`` is a stable name for logs and JSON."""
 
     CAL_CHECK = "cal_check"
+    CAL_CLOSE_IN = "cal_close_in"
     CAL_LIFT = "cal_lift"
     CAL_TURN = "cal_turn"
     CAL_PROBE = "cal_probe"
@@ -56,6 +57,8 @@ class Phase(Enum):
     DESCENT_DRIVE_FIRST = "descent_drive_first"
     DESCENT_LOWER_FIRST = "descent_lower_first"
     DESCENT_FINISH = "descent_finish"
+    DESCENT_TURN_BACK = "descent_turn_back"
+    DESCENT_FINISH_FLOOR = "descent_finish_floor"
     PAUSED = "paused"
     DONE = "done"
     ERROR = "error"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from stairbot.algorithm import motion
 from stairbot.hardware import MotorId, Snapshot
@@ -37,8 +37,10 @@ class Work:
     probe_sfl: float = 0.0
     """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""
     reading_key: float | None = None
-    """A reading drive: the first mean SFR/SFL reading plus the odometer (m) --
-    constant while the sensors see the same surface."""
+    """A reading drive: the mean SFR/SFL reading plus the odometer (m) --
+    constant while the sensors see the same surface: the median of its first
+    KEY_TICKS values (``first_keys``), so one stray first reading does not set it."""
+    first_keys: list[float] = field(default_factory=list)
     reading_lost: bool = False
     """A reading drive: the reading jumped away from what the wheels explain;
     the rest is driven by turns."""

@@ -128,6 +128,22 @@ class SimSensors:
                     sensor.sample(combine(model, seen, self._back_weight), t)
         return right.reading(t), left.reading(t)
 
+    def front_seen(self) -> tuple[float | None, float | None]:
+        """What SFR's and SFL's beams meet now, before the sensor's noise,
+        outliers, dropouts, range and timing: one ray each for a single-ray
+        model, else the cone combined as the model combines it (None: nothing,
+        or too weak an echo).  The sweep's verdict asks this of the start pose
+        (is the first riser in sight?)."""
+        model = self.front_model
+        if model.single_ray:
+            return self._front_truth()
+        mx, my, a1, _c, _s, forward = self._front_origin()
+        lat = self.config.sensors.front_lateral
+        hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
+                          (-lat, lat), self._front_mount[2])
+        right, left = (combine(model, seen, self._front_weight)[0] for seen in hits)
+        return right, left
+
     def _front_origin(self) -> tuple[float, float, float, float, float, float]:
         """The front mount in the side view (x, y), segment 1's angle, its cos
         and sin, and the mount's distance ahead of segment 2's centre."""

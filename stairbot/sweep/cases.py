@@ -99,26 +99,42 @@ def _jitter(spec: Spec, index: int, stairs: dict[str, Any], values: dict[str, An
 
 SIGHT_MARGIN_M = 0.02
 """The band either side of LENGTH_OF_INFINITY in which the start's nearer
-front beam may or may not see the first riser (the robot's pose as placed,
-the sensors' noise)."""
+front sensor may or may not read the first riser as nearer (the noise of one
+reading, or three of the sensor's stated sigma there if that is more)."""
 
 
 def first_sight(scenario: Scenario, config: RobotConfig) -> float:
-    """The shorter of the two front beams, from the start pose to the first
-    riser (top view: the mounts ``front_lateral`` either side of the centre
-    line, the robot turned ``yaw_deg``).  The calibration's case 1 stops the
-    robot, rightly, when both read LENGTH_OF_INFINITY or more: stairs that
+    """The nearer front sensor's reading at the start pose, before noise (inf:
+    nothing in range): what the simulated beams meet -- one level ray each,
+    or a cone as the sensor model combines it, so a cone tilted up that takes
+    in the risers beyond the first reads long.  The calibration's case 1 stops
+    the robot, rightly, when both read LENGTH_OF_INFINITY or more: stairs that
     far are not in sight, whatever their steps."""
-    yaw = math.radians(scenario.start.yaw_deg)
-    lateral = config.sensors.front_lateral * abs(math.sin(yaw))
-    return (scenario.start.distance - lateral) / math.cos(yaw)
+    from stairbot.fakes.plan import Plan
+    from stairbot.fakes.sim_sensors import SimSensors  # the sweep runs the sim anyway
+    from stairbot.fakes.world import World
+
+    world = World(config, scenario)
+    plan = Plan(scenario.width, scenario.side_wall, y=scenario.start.lateral,
+                yaw=math.radians(scenario.start.yaw_deg))
+    right, left = SimSensors(config, scenario, world, plan).front_seen()
+    hi = config.sensors.range(back=False)[1]
+    seen = [d for d in (right, left) if d is not None and d <= hi]
+    return min(seen, default=math.inf)
+
+
+def sight_margin(config: RobotConfig) -> float:
+    """How far either side of LENGTH_OF_INFINITY the sight rule leaves a band."""
+    far = config.LENGTH_OF_INFINITY
+    return max(SIGHT_MARGIN_M, 3.0 * config.sensors.sigma(False, far))
 
 
 def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, float, float]:
     """("inside" | "band" | "outside", max rise, min tread) of the steps the robot
     attempts (the first max_steps) against its limits (rises between
-    min_step_rise_m and max_step_rise_m, and each at least min_rise_for the
-    tread before it; treads of min_tread_m or more), give
+    min_step_rise_m and max_step_rise_m, each at least min_rise_for the
+    tread before it and, where that tread is measured (all but a landing's),
+    min_rise_for the tread after it; treads of min_tread_m or more), give
     or take the margins; stairs out of sight at the start (see
     :func:`first_sight`) are outside.
     A tread counts where the robot must fit on it: every tread it climbs onto,
@@ -133,16 +149,21 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     min_tread = min(treads, default=math.inf)
     lr, lo, lt = config.max_step_rise_m, config.min_step_rise_m, config.min_tread_m
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
-    # how far each riser clears what the front cone needs to measure the tread before it
-    low = min([min_rise - lo] + [steps[i + 1].rise - config.min_rise_for(steps[i].tread)
-                                 for i in range(len(steps) - 1)])
-    sight = first_sight(scenario, config)
+    # how far each riser clears what the front cone needs to measure the tread
+    # before it, and each measured tread's own riser what the robot asks of it
+    # (it takes the next riser to be as high: ascent 3)
+    measured = [i for i in range(len(steps)) if not (i == last and scenario.top == "landing")]
+    low = min([min_rise - lo]
+              + [steps[i + 1].rise - config.min_rise_for(steps[i].tread)
+                 for i in range(len(steps) - 1)]
+              + [steps[i].rise - config.min_rise_for(steps[i].tread) for i in measured])
+    sight, margin = first_sight(scenario, config), sight_margin(config)
     far = config.LENGTH_OF_INFINITY
     if (max_rise > lr + rm or low < -rm or min_tread < lt - tm
-            or sight > far + SIGHT_MARGIN_M):
+            or sight > far + margin):
         return "outside", max_rise, min_tread
     if (max_rise <= lr - rm and low >= rm and min_tread >= lt + tm
-            and sight <= far - SIGHT_MARGIN_M):
+            and sight <= far - margin):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread
 
