@@ -71,3 +71,82 @@ def test_refused_at_the_first_step_it_comes_back_by_the_odometer() -> None:
                 "[sensors]\nseed = 283009\n")
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+
+
+def test_square_range_is_where_the_cone_rises_to_the_lowest_riser_it_climbs() -> None:
+    assert load_config().square_range_m == math.inf  # a level ray squares up from anywhere
+    expected = (TOF.min_step_rise_m - TOF.sensors.front_height) / math.tan(TOF.front_cone_top_rad)
+    assert TOF.square_range_m == pytest.approx(expected)
+    assert TOF.SAFE_DISTANCE_IN_FRONT_OF_STEP < TOF.square_range_m < 0.4
+
+
+FAR_ASKEW = """
+[stairs]
+steps = [{rise = 0.1628, tread = 0.3012}, {rise = 0.1581, tread = 0.2983},
+         {rise = 0.1607, tread = 0.3011}, {rise = 0.1613, tread = 0.2991}]
+top = "wall"
+width = 1.0
+[start]
+distance = 0.911426
+yaw_deg = -18.640306
+lateral = -0.066314
+[sensors]
+noise = 0.001
+seed = 990114
+"""
+
+
+def test_far_and_askew_it_closes_in_squares_up_and_retraces_its_way_home() -> None:
+    """Found by the envelope sweep: squared up 0.97 m away, where the cone
+    reads a blend of the risers, the tof robot stood 11 deg askew and the
+    standing rule ended the run in the approach.  Now it closes in to
+    square_range_m (no further than its first reading allows), squares up
+    there, climbs, and comes home the way it went: turning back the squaring
+    turn before it backs the distance it closed in."""
+    from stairbot.algorithm.phases import Phase
+    from stairbot.events import Event
+
+    scenario = parse_scenario(FAR_ASKEW, "<far askew>")
+    events: list[Event] = []
+    session = open_robot("sim://", TOF, RobotOptions(world=scenario))
+    try:
+        r = run(session, TOF, events.append)
+    finally:
+        session.close()
+    assert (r.outcome, r.steps_climbed, r.steps_descended, r.pauses) == (
+        "completed", 4, 4, 0), r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+    labels = {e.phase for e in events}
+    for phase in (Phase.CAL_CLOSE_IN, Phase.DESCENT_TURN_BACK, Phase.DESCENT_FINISH_FLOOR):
+        assert phase.label in labels
+    closing = [e for e in events if "closing in before squaring up" in e.message]
+    assert len(closing) == 1
+    squared = [e for e in events if e.message.startswith("squared up")]
+    assert squared and max(squared[0].data["SFR"], squared[0].data["SFL"]) < 0.4
+
+
+TOP_OF_A_FLIGHT = """
+[stairs]
+steps = [{rise = 0.153893, tread = 0.284283}, {rise = 0.153903, tread = 0.280612},
+         {rise = 0.148586, tread = 0.279524}, {rise = 0.145488, tread = 0.280215}]
+top = "landing"
+width = 1.0
+[start]
+distance = 0.454258
+yaw_deg = 13.048304
+lateral = 0.038764
+[sensors]
+noise = 0.001
+seed = 275795
+"""
+
+
+def test_at_the_top_segment_3_is_lowered_onto_its_tread_without_pushing() -> None:
+    """Found by the envelope sweep: the VL53L0X pair reads a few mm above
+    BACK_CLEARANCE standing (noise; its cone's slanted rays), so descent 2
+    kept lowering segment 3 onto the tread it stood on and tipped segment 2
+    15 deg nose down.  Now BACK_CLEARANCE is read within the pair's noise."""
+    r = run_tof(TOP_OF_A_FLIGHT)
+    assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
+        "completed", "top_reached", 4, 4), r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()

@@ -11,7 +11,7 @@ import pytest
 from stairbot.cli import main
 from stairbot.config import load_config
 from stairbot.scenario import parse_scenario
-from stairbot.sweep.cases import build_case, check_spec, zone
+from stairbot.sweep.cases import build_case, check_spec, first_sight, zone
 from stairbot.sweep.spec import Rules, parse_spec
 
 GOOD = """
@@ -150,3 +150,29 @@ def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
     zones = {c.facts["zone"] for c in check_spec(
         parse_spec((root / "quick.toml").read_text("utf-8"), "quick.toml", root))}
     assert zones == {"inside", "band", "outside"}
+
+
+def test_a_cone_that_looks_up_sees_the_first_riser_nearer_than_a_level_ray() -> None:
+    """In sight is what the simulated beams read at the start pose: 0.95 m
+    from a 0.15 m riser, the tof robot's cone (tilted 7.5 deg up) takes in the
+    risers beyond and reads past LENGTH_OF_INFINITY; the level ray does not."""
+    rules = Rules()
+    scen = parse_scenario("[stairs]\ncount = 4\nrise = 0.15\ntread = 0.3\n"
+                          "[start]\ndistance = 0.95\n", "x")
+    assert first_sight(scen, load_config()) == pytest.approx(0.95, abs=0.002)
+    assert first_sight(scen, load_config("tof")) > 1.0
+    assert zone(scen, load_config(), rules)[0] == "inside"
+    assert zone(scen, load_config("tof"), rules)[0] == "outside"
+
+
+def test_a_measured_tread_asks_its_own_riser_to_reach_min_rise_for_it() -> None:
+    """The robot takes the next riser to be as high as the one it climbs
+    (ascent 3), so a tread it measures (a wall on top, not a landing) needs
+    its own riser at min_rise_for(tread)."""
+    tof, rules = load_config("tof"), Rules()
+    text = "[stairs]\ncount = 1\nrise = 0.135\ntread = {tread}\ntop = '{top}'\n"
+    long_wall = parse_scenario(text.format(tread=0.38, top="wall"), "x")
+    assert 0.135 < tof.min_rise_for(0.38) - rules.rise_margin_m
+    assert zone(long_wall, tof, rules)[0] == "outside"
+    assert zone(parse_scenario(text.format(tread=0.38, top="landing"), "x"), tof,
+                rules)[0] == "inside"
