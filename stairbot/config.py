@@ -314,6 +314,8 @@ class RobotConfig:
         for name in ("wheel_speed_m_s", "lift_speed_m_s", "max_step_rise_m", "min_tread_m",
                      "min_step_rise_m"):
             out[name] = float(getattr(self, name))
+        if math.isfinite(self.square_range_m):  # a cone looking up (level rays: anywhere)
+            out["square_range_m"] = self.square_range_m
         return out
 
     def to_dict(self) -> dict[str, Any]:
