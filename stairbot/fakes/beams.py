@@ -3,7 +3,7 @@
 The side view (the stairs' polyline) gives each ray's angle up or down; the
 top view (:class:`~stairbot.fakes.plan.Plan`) turns a forward ray by the
 robot's yaw plus the ray's angle across the cone and finds the riser or the
-side wall it meets.  A ray's incidence is the angle between it and the normal
+side wall it meets, from the mount where the robot's yaw alone puts it.  A ray's incidence is the angle between it and the normal
 of the surface it meets, in three dimensions: a riser's normal is along x, a
 tread's along y (up), a side wall's across the flight.
 
@@ -48,7 +48,7 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
         slant = 1.0 / max(c, 1e-6)
         psi = yaw + across
         for i, lat in enumerate(laterals):
-            got = plan.front_hit(forward, lat, hit_dx, slant, psi)
+            got = plan.front_hit(forward, lat, hit_dx, slant, psi, yaw)
             if got is None:
                 continue
             d, on_wall = got

@@ -55,17 +55,23 @@ class Plan:
         return None if hit is None else hit[0]
 
     def front_hit(self, forward: float, lateral: float, hit_dx: float | None,
-                  slant: float, yaw: float) -> tuple[float, bool] | None:
+                  slant: float, yaw: float, mount_yaw: float | None = None
+                  ) -> tuple[float, bool] | None:
         """:meth:`front_distance` for a beam turned ``yaw`` (the robot's yaw plus
-        a ray's angle across a sensor's cone), and whether it meets a side wall
-        (True) or the stairs (False); None: nothing."""
+        a ray's angle across a sensor's cone) from a mount placed by the
+        robot's yaw ``mount_yaw`` (default: ``yaw``), and whether it meets a
+        side wall (True) or the stairs (False); None: nothing."""
         c, s = math.cos(yaw), math.sin(yaw)
+        if mount_yaw is None or mount_yaw == yaw:
+            mc, ms = c, s
+        else:
+            mc, ms = math.cos(mount_yaw), math.sin(mount_yaw)
         # the side view puts the mount at `forward` straight ahead; in the top view it
         # sits forward*cos - lateral*sin ahead of the centre and y_m to the side
-        y_m = self.y + forward * s + lateral * c
+        y_m = self.y + forward * ms + lateral * mc
         best: float | None = None
         if hit_dx is not None and c > 1e-9:
-            dx = hit_dx + forward * (1.0 - c) + lateral * s
+            dx = hit_dx + forward * (1.0 - mc) + lateral * ms
             if dx > 0.0:
                 y_hit = y_m + dx * s / c
                 if abs(y_hit) <= self.width / 2:
