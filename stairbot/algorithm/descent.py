@@ -218,10 +218,18 @@ def _on_the_floor_all_along(t: Tick) -> bool:
 
 
 def _finish_turns(t: Tick) -> float:
+    """How far descent 7 backs while the front pair cannot measure: by the
+    odometer if no step was climbed; else from the riser (approach_gap
+    away) to the start reading -- not the seed's
+    NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, which a pair that reads from
+    10 cm (a Sharp) had not yet measured within, and stopped 0.4 m short."""
+    ctx, cfg = t.ctx, t.cfg
     if _on_the_floor_all_along(t):
-        assert t.ctx.start_wheel is not None
-        return max(0.0, motion.wheel_position(t.snap) - t.ctx.start_wheel)
-    return t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+        assert ctx.start_wheel is not None
+        return max(0.0, motion.wheel_position(t.snap) - ctx.start_wheel)
+    if ctx.start_reading is None:
+        return cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+    return cfg.wheel_turns(max(0.0, ctx.start_reading - cfg.algorithm.approach_gap))
 
 
 def _closed_in_turns(t: Tick) -> float:

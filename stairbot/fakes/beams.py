@@ -3,9 +3,10 @@
 The side view (the stairs' polyline) gives each ray's angle up or down; the
 top view (:class:`~stairbot.fakes.plan.Plan`) turns a forward ray by the
 robot's yaw plus the ray's angle across the cone and finds the riser or the
-side wall it meets, from the mount where the robot's yaw alone puts it.  A ray's incidence is the angle between it and the normal
-of the surface it meets, in three dimensions: a riser's normal is along x, a
-tread's along y (up), a side wall's across the flight.
+side wall it meets, from the mount where the robot's yaw alone puts it.  A
+ray's incidence is the angle between it and the normal of the surface it
+meets, in three dimensions: a riser's normal is along x, a tread's along y
+(up), a side wall's across the flight.
 
 Cost: a forward pair shares its side-view casts (``model.rays`` of them) and
 adds ``rays * rays_across`` top-view evaluations per sensor; a downward sensor
