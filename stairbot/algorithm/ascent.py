@@ -15,6 +15,7 @@ from stairbot.algorithm import motion
 from stairbot.algorithm.moves import drive_phase, lift, lift_phase, reading_drive
 from stairbot.algorithm.phase import (
     FAULT,
+    NO_MOTION,
     PhaseDef,
     Step,
     Tick,
@@ -36,12 +37,26 @@ times the sensors' noise: a noisy reading of the riser never passes for it."""
 
 
 # -- ascent 2: approach --------------------------------------------------------------------
-def _approach(t: Tick, _w: Work) -> Step:
+RISER_LOST_WAIT_S = 0.5
+"""Ascent 2: a beam that reads "nothing ahead" stops the approach; the riser
+is lost (an error) only if it still does after this long standing still."""
+
+
+def _approach(t: Tick, w: Work) -> Step:
     cfg, ctx = t.cfg, t.ctx
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) or motion.far(sfl, cfg):
+        # A riser does not vanish from in front of a robot on the floor: stand
+        # and measure again before calling it lost (two outliers among a slow
+        # sensor's three last measurements pass its median).
+        if w.still_since is None:
+            w.still_since = t.snap.time_s
+        if t.snap.time_s - w.still_since < RISER_LOST_WAIT_S:
+            return stay(NO_MOTION)
         return fail(f"riser lost during the approach (step {ctx.number_of_steps + 1}): "
-                    f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead")
+                    f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead "
+                    f"for {RISER_LOST_WAIT_S:g} s")
+    w.still_since = None
     reading = motion.mean_distance(t.snap)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     if reading <= safe:
@@ -54,7 +69,7 @@ APPROACH = PhaseDef(
     P.ASCENT_APPROACH, "ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", FLOW, _approach,
     watches="front",
     to={P.ASCENT_APPROACH_TURNS: "reads SAFE_DISTANCE_IN_FRONT_OF_STEP",
-        P.ERROR: "riser lost (nothing ahead); " + FAULT})
+        P.ERROR: "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); " + FAULT})
 
 
 def _approach_turns_enter(t: Tick, w: Work) -> None:
