@@ -56,7 +56,7 @@ def wait_for(cond: Any, what: str) -> None:
     """Wait on a condition the run thread makes true (no timing assertion: the
     limit only keeps a broken test from hanging)."""
     ev = threading.Event()
-    for _ in range(20000):
+    for _ in range(120000):  # at least 2 minutes: a machine busy with a sweep is slow
         if cond():
             return
         ev.wait(0.001)
