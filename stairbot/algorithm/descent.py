@@ -36,7 +36,7 @@ from stairbot.algorithm.phase import (
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
-from stairbot.hardware import BACK_SENSORS, MotorId
+from stairbot.hardware import BACK_SENSORS, MotorId, SensorStatus
 from stairbot.perception import median_sigma
 
 P = Phase
@@ -77,11 +77,42 @@ def _edge_fallback(t: Tick) -> float:
     return t.cfg.wheel_turns(max(0.0, tab - t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
 
 
-_to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD))
+def edge_clearance_m(cfg: RobotConfig) -> float:
+    """How far the robot backs after its back pair (``back_from_rear`` from
+    segment 3's rear) crossed the edge until segment 3's front wheels are a
+    wheel radius past it: over the step below, and not yet so far that the
+    robot tips back off segment 2's rear wheels."""
+    g = cfg.geometry
+    return (g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear - g.wheel_inset
+            + g.wheel_radius)
+
+
+def _edge_bound(t: Tick, w: Work) -> float | None:
+    """Descent 1's backing never passes edge_clearance_m beyond where the back
+    pair saw the drop (more than half the lowest rise below BACK_CLEARANCE,
+    or nothing in range): tab_length_to_edge, read on the way up, may be
+    a centimetre or two off, and the robot tipped back where it was."""
+    cfg = t.cfg
+    if w.edge_wheel is None:
+        backs = [t.snap.sensors[s] for s in BACK_SENSORS]
+        drop = cfg.BACK_CLEARANCE + floor_tolerance(cfg) + cfg.min_step_rise_m / 2
+        if all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
+               or r.ok and r.distance_m > drop for r in backs):
+            w.edge_wheel = motion.wheel_position(t.snap)
+            t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m):"
+                  f" backing at most {edge_clearance_m(cfg):.3f} m more")
+    if w.edge_wheel is None:
+        return None
+    return w.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
+
+
+_to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD),
+                         _edge_bound)
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
     checked_first(_edge_known, _to_edge[1]), enter=_to_edge[0], watches="front",
-    to={P.DESCENT_LOWER_THIRD: "reads tab_length_to_edge[i]",
+    to={P.DESCENT_LOWER_THIRD: "reads tab_length_to_edge[i], or backed edge_clearance_m "
+                                "past where SBR/SBL saw the edge",
         P.ERROR: "tab_length_to_edge[i] unknown; " + FAULT})
 
 

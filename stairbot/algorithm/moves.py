@@ -46,6 +46,7 @@ def reading_drive(
     target: Callable[[Tick], float | None],
     fallback_turns: Callable[[Tick], float],
     done: Done,
+    bound: Callable[[Tick, Work], float | None] | None = None,
 ) -> tuple[Enter, StepFn]:
     """A drive (``direction`` +1 forward, -1 back) that ends when the mean
     SFR/SFL reading reaches ``target(t)`` metres.
@@ -55,7 +56,8 @@ def reading_drive(
     reading); while they are not, the drive carries on to the last such
     target — or, if they never were, to ``fallback_turns(t)`` turns from the
     phase's start (the seed's "not measurable" fallback).  A ``target`` of
-    None means a drive by turns only.
+    None means a drive by turns only.  ``bound(t, w)``, when it gives one, is
+    a wheel-counter position the drive never passes, whatever the readings say.
     """
 
     def enter(t: Tick, w: Work) -> None:
@@ -86,6 +88,9 @@ def reading_drive(
                 remaining_m = direction * (reading - w.target_reading)
                 w.target_wheel = here + direction * cfg.wheel_turns(remaining_m)
         assert w.target_wheel is not None  # set on entry
+        limit = None if bound is None else bound(t, w)
+        if limit is not None and direction * (w.target_wheel - limit) > 0:
+            w.target_wheel = limit
         remaining = direction * (w.target_wheel - here)
         if remaining <= motion.WHEEL_DONE:
             return done(t, w)

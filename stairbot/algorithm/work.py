@@ -53,6 +53,9 @@ class Work:
     """The phase's entry condition has been checked (on its first step)."""
     still_since: float | None = None
     """When the robot stopped to measure standing still (calibration)."""
+    edge_wheel: float | None = None
+    """Descent 1: the odometer where the back pair first read the drop past
+    the edge."""
     balanced: bool = False
     """The static-stability check has run (before a lift phase's first step)."""
 
