@@ -150,3 +150,36 @@ def test_at_the_top_segment_3_is_lowered_onto_its_tread_without_pushing() -> Non
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
         "completed", "top_reached", 4, 4), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+
+
+NINE_STEPS = """
+[stairs]
+top = "wall"
+width = 1.0
+steps = [{rise = 0.151992, tread = 0.316024}, {rise = 0.145985, tread = 0.319762},
+         {rise = 0.151061, tread = 0.322781}, {rise = 0.153645, tread = 0.315707},
+         {rise = 0.148681, tread = 0.316283}, {rise = 0.145012, tread = 0.315254},
+         {rise = 0.15256, tread = 0.320094}, {rise = 0.146124, tread = 0.321481},
+         {rise = 0.148392, tread = 0.323285}]
+[start]
+distance = 0.840602
+yaw_deg = 11.250605
+lateral = -0.070019
+[sensors]
+noise = 0.001
+seed = 126550
+"""
+
+
+def test_backing_to_an_edge_stops_where_the_back_pair_saw_it() -> None:
+    """Found by the envelope sweep (case 962 on tof): tab_length_to_edge of
+    step 6, read on the way up, was 1.4 cm long; backing up to it, the
+    robot tipped back 15 deg off segment 2's rear wheels.  The back pair
+    now bounds the backing: edge_clearance_m past where it saw the drop."""
+    from stairbot.algorithm.descent import edge_clearance_m
+
+    assert edge_clearance_m(TOF) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016)
+    r = run_tof(NINE_STEPS)
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()

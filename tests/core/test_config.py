@@ -156,7 +156,8 @@ def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Pat
 
 
 @pytest.mark.parametrize(("text", "words"), [
-    ('extends = "lidar-bot"\n', "no such file, nor a shipped robot; shipped: ir, reference, sonar, tof"),
+    ('extends = "lidar-bot"\n',
+     "no such file, nor a shipped robot; shipped: ir, reference, sonar, tof"),
     ("extends = 3\n", "must be a shipped robot's name (ir, reference, sonar, tof)"),
     ('extends = "loop.toml"\n', "extends itself"),
 ])
