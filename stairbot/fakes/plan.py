@@ -51,7 +51,8 @@ class Plan:
         (None: nothing); ``slant``: beam length per metre of x travelled in the
         side view (1 / cos(pitch)).  Valid for |yaw| < 90 degrees.
         """
-        hit = self.front_hit(forward, lateral, hit_dx, slant, self.yaw)
+        yaw = self.yaw
+        hit = self.front_hit_at(forward, lateral, hit_dx, slant, math.cos(yaw), math.sin(yaw))
         return None if hit is None else hit[0]
 
     def front_hit(self, forward: float, lateral: float, hit_dx: float | None,
@@ -59,7 +60,12 @@ class Plan:
         """:meth:`front_distance` for a beam turned ``yaw`` (the robot's yaw plus
         a ray's angle across a sensor's cone), and whether it meets a side wall
         (True) or the stairs (False); None: nothing."""
-        c, s = math.cos(yaw), math.sin(yaw)
+        return self.front_hit_at(forward, lateral, hit_dx, slant, math.cos(yaw), math.sin(yaw))
+
+    def front_hit_at(self, forward: float, lateral: float, hit_dx: float | None,
+                     slant: float, c: float, s: float) -> tuple[float, bool] | None:
+        """:meth:`front_hit` for a beam turned by the angle whose cosine is ``c``
+        and sine ``s`` (beams at the same angle share them)."""
         # the side view puts the mount at `forward` straight ahead; in the top view it
         # sits forward*cos - lateral*sin ahead of the centre and y_m to the side
         y_m = self.y + forward * s + lateral * c
