@@ -184,6 +184,11 @@ class ModelSensor:
         self._pending: deque[tuple[float, float, SensorReading, Cause]] = deque()
         self._current: tuple[float, SensorReading, Cause] | None = None
         self.measurements = 0
+        # the model's figures each measurement needs, looked up once
+        self._period, self._latency = model.period_s, model.latency_s
+        self._noisy = self.noise_a > 0.0 or self.noise_b > 0.0
+        self._outlier_rate, self._dropout_rate = model.outlier_rate, model.dropout_rate
+        self._bias = model.bias
 
     # -- timing ---------------------------------------------------------------------
     def due(self, t: float) -> bool:
@@ -194,15 +199,18 @@ class ModelSensor:
     def sample(self, seen: tuple[float | None, Cause], t: float) -> None:
         """Take a measurement now of what the beam sees (a distance, or None and
         why not); it is published ``latency_s`` later."""
-        period = self.model.period_s
+        self._sample(seen[0], seen[1], t)
+
+    def _sample(self, distance: float | None, seen: Cause, t: float) -> None:
+        period = self._period
         if period > 0.0:  # the next whole multiple of the period (0: every read)
             self._next = (math.floor(t / period + 1e-9) + 1) * period
-        reading, cause = self._measure(seen[0], seen[1], t)
+        reading, cause = self._measure(distance, seen, t)
         self.measurements += 1
-        if self._current is None or self.model.latency_s <= 0.0:
+        if self._current is None or self._latency <= 0.0:
             self._current = (t, reading, cause)
         else:
-            self._pending.append((t + self.model.latency_s, t, reading, cause))
+            self._pending.append((t + self._latency, t, reading, cause))
 
     def reading(self, t: float) -> SensorReading:
         """The reading published at time ``t``: the latest measurement whose
@@ -229,23 +237,23 @@ class ModelSensor:
         """One ray, square to its target: measure ``true_distance`` (None:
         nothing) if a measurement is due, and return the published reading."""
         if t >= self._next and not (self._freezes and frozen(self._freezes, t)):
-            self.sample((true_distance, Cause.OK if true_distance is not None
-                         else Cause.NOTHING), t)
+            self._sample(true_distance, Cause.OK if true_distance is not None
+                         else Cause.NOTHING, t)
         return self.reading(t)
 
     # -- one measurement --------------------------------------------------------------
     def _measure(self, true_distance: float | None, cause: Cause, t: float
                  ) -> tuple[SensorReading, Cause]:
-        m = self.model
-        a, b = self.noise_a, self.noise_b
         noise = 0.0
-        if a > 0.0 or b > 0.0:
-            sigma = a + b * true_distance if true_distance is not None else a
+        if self._noisy:
+            a = self.noise_a
+            sigma = a + self.noise_b * true_distance if true_distance is not None else a
             noise = self._gauss(0.0, sigma)
-        outlier = m.outlier_rate > 0.0 and self._uniform() < m.outlier_rate
-        outlier_at = self._uniform() if m.outlier_rate > 0.0 else 0.0
-        dropout = m.dropout_rate > 0.0 and self._uniform() < m.dropout_rate
-        dropout_kind = self._uniform() if m.dropout_rate > 0.0 else 0.0
+        outliers, dropouts = self._outlier_rate, self._dropout_rate
+        outlier = outliers > 0.0 and self._uniform() < outliers
+        outlier_at = self._uniform() if outliers > 0.0 else 0.0
+        dropout = dropouts > 0.0 and self._uniform() < dropouts
+        dropout_kind = self._uniform() if dropouts > 0.0 else 0.0
         if dropout:
             return (self._error if dropout_kind < 0.5 else self._far), Cause.DROPOUT
         if outlier:
@@ -254,7 +262,7 @@ class ModelSensor:
         if true_distance is None:
             return self._far, cause
         offset = active_faults(self.faults, t)[0] if self.faults else 0.0
-        d = true_distance + offset + m.bias + noise
+        d = true_distance + offset + self._bias + noise
         if d > self.max_range:
             return self._far, Cause.FAR
         if d < self.min_range:
