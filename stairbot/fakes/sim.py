@@ -67,13 +67,14 @@ class SimRobot:
         m = config.motors
         self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
                         for mid in MotorId}
+        self._per_turn = m.lift_travel_per_turn
         self._speeds = dict(ZERO_SPEEDS)
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
         self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
         self._lift_turns = [0.0, 0.0]
         # Wheel encoders count the wheels' travel along the robot's heading; the
         # side view moves only its projection on the flight's axis (see _apply).
-        self._wheel_seen = [self.world.wheel_state(i)[0] for i in range(3)]
+        self._wheel_seen = [self.world.wheel_turns(i) for i in range(3)]
         self._wheel_turns = [0.0, 0.0, 0.0]
         self._wheel_tps = [0.0, 0.0, 0.0]
         self._lift_tps = [0.0, 0.0]  # measured over the last advance
@@ -92,8 +93,7 @@ class SimRobot:
             raise RobotFellError(w.fall_reason or "unstable")
         if self._snap is not None and self._snap_at == w.steps_done:
             return self._snap
-        snap = Snapshot(time_s=w.time, sensors=self.board.read(w.time),
-                        motors=self._motor_states(), health={}, imu=imu(w))
+        snap = Snapshot(w.time, self.board.read(w.time), self._motor_states(), {}, imu(w))
         self._snap, self._snap_at = snap, w.steps_done
         return snap
 
@@ -109,7 +109,7 @@ class SimRobot:
         for motor, value in speeds.items():
             limit = limits[motor]
             v = float(value)
-            if v != v or v in (math.inf, -math.inf):
+            if v - v != 0.0:  # NaN or infinite
                 v = 0.0
             new[motor] = limit if v > limit else (-limit if v < -limit else v)
         self._apply(new)
@@ -190,7 +190,7 @@ class SimRobot:
         self.plan.move(w.centre_x() - x0)
         along = self._along()
         for i in range(3):
-            seen = w.wheel_state(i)[0]
+            seen = w.wheel_turns(i)
             turned = (seen - self._wheel_seen[i]) / along
             self._wheel_seen[i] = seen
             self._wheel_turns[i] += turned
@@ -201,7 +201,7 @@ class SimRobot:
             if turning:
                 v = 2.0 * diff * self.config.wheel_circumference  # vR - vL, m/s
                 self.plan.turn(v / self.config.geometry.track_width * elapsed)
-        per_turn = self.config.motors.lift_travel_per_turn
+        per_turn = self._per_turn
         for i in (0, 1):
             turns = w.lift_offset(i) / per_turn
             self._lift_tps[i] = (turns - self._lift_turns[i]) / elapsed
@@ -223,7 +223,7 @@ class SimRobot:
         w.set_wheel_speed(0, speeds[MotorId.MWF] * along)
         w.set_wheel_speed(1, (speeds[MotorId.MWR] + speeds[MotorId.MWL]) / 2.0 * along)
         w.set_wheel_speed(2, speeds[MotorId.MWB] * along)
-        per_turn = self.config.motors.lift_travel_per_turn
+        per_turn = self._per_turn
         w.set_lift_speed(0, speeds[MotorId.MTF] * per_turn)
         w.set_lift_speed(1, speeds[MotorId.MTB] * per_turn)
 
@@ -233,7 +233,7 @@ class SimRobot:
 
     def _motor_states(self) -> dict[MotorId, MotorState]:
         w = self.world
-        per_turn = self.config.motors.lift_travel_per_turn
+        per_turn = self._per_turn
         turns, tps = self._wheel_turns, self._wheel_tps
         mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
