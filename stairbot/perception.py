@@ -66,6 +66,11 @@ class Kind(IntEnum):
     ERROR = 3
 
 
+# bound once: an enum's member costs a slow attribute look-up, every sensor every tick
+_KIND_OK, _KIND_ERROR = Kind.OK, Kind.ERROR
+_STATUS_OK = SensorStatus.OK
+
+
 def measurement_period(cfg: RobotConfig, back: bool) -> float:
     """How often the pair gives a new measurement: its period, or every tick."""
     return max(cfg.sensors.spec(back).period_s, cfg.algorithm.tick)
@@ -272,12 +277,12 @@ class Perception:
             track = tracks[sid]
             age = reading.age_s
             if age <= 0.0:  # measured now (a sensor as fast as the tick)
-                if reading.status is SensorStatus.OK:
+                if reading.status is _STATUS_OK:
                     d = reading.distance_m
                     if d - d != 0.0:  # inf or NaN: not a measurement but a broken board
                         sensors[sid] = reading
                         continue
-                    if track.kind is Kind.OK and track.run_kind is Kind.OK:
+                    if track.kind is _KIND_OK and track.run_kind is _KIND_OK:
                         # the common case, kept short: another OK measurement
                         track.newest, track.taken_s = reading, now
                         track.run += 1
@@ -344,14 +349,14 @@ class Perception:
                               f"(at most {track.max_age:.2f} s)")
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         kind = track.kind
-        if kind is Kind.OK:
+        if kind is _KIND_OK:
             if track.ok_keys:
                 m = _median(track.ok_keys)
                 self._why.pop(sid, None)
-                return SensorReading(m - odometer if track.front else m, SensorStatus.OK, age)
+                return SensorReading(m - odometer if track.front else m, _STATUS_OK, age)
             self._why[sid] = "no valid measurement among its last ones"
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
-        if kind is Kind.ERROR:
+        if kind is _KIND_ERROR:
             self._why[sid] = f"{CONFIRM} measurements in a row report an error"
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         self._why.pop(sid, None)

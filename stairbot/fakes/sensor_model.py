@@ -69,6 +69,9 @@ class Cause(StrEnum):
     FAULT = "fault"  # a scenario fault (error) is active
 
 
+_OK, _NOTHING = Cause.OK, Cause.NOTHING  # bound once: an enum's member is a slow look-up
+
+
 @dataclass(frozen=True)
 class SensorModel:
     """What a kind of distance sensor does; None means "the robot config's"
@@ -237,8 +240,7 @@ class ModelSensor:
         """One ray, square to its target: measure ``true_distance`` (None:
         nothing) if a measurement is due, and return the published reading."""
         if t >= self._next and not (self._freezes and frozen(self._freezes, t)):
-            self._sample(true_distance, Cause.OK if true_distance is not None
-                         else Cause.NOTHING, t)
+            self._sample(true_distance, _OK if true_distance is not None else _NOTHING, t)
         return self.reading(t)
 
     # -- one measurement --------------------------------------------------------------
@@ -267,7 +269,7 @@ class ModelSensor:
             return self._far, Cause.FAR
         if d < self.min_range:
             return self._near, Cause.NEAR
-        return self._quantized(d), Cause.OK
+        return self._quantized(d), _OK
 
     def _quantized(self, d: float) -> SensorReading:
         if self.resolution <= 0.0:

@@ -50,6 +50,10 @@ from stairbot.scenario import Scenario, load_scenario
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
 
+# bound once: an enum's member is a slow look-up, and every tick names each motor
+_MWF, _MWB, _MWR, _MWL, _MTF, _MTB = (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL,
+                                      MotorId.MTF, MotorId.MTB)
+
 
 class SimRobot:
     """The simulated robot (see the module docstring): a Robot, with the
@@ -179,7 +183,7 @@ class SimRobot:
         """Simulate ``dt`` seconds with the motors as last commanded."""
         w = self.world
         sp = self._speeds
-        diff = (sp[MotorId.MWR] - sp[MotorId.MWL]) / 2.0  # turns/s
+        diff = (sp[_MWR] - sp[_MWL]) / 2.0  # turns/s
         turning = diff != 0.0 and (w.clear_of_ground(0, TURN_CLEARANCE)
                                    and w.clear_of_ground(2, TURN_CLEARANCE))
         x0, t0 = w.centre_x(), w.time
@@ -220,12 +224,12 @@ class SimRobot:
         # closes on the risers at v cos(psi) and drifts sideways at v sin(psi)
         # (Plan.move), never faster than its wheels.
         along = self._along()
-        w.set_wheel_speed(0, speeds[MotorId.MWF] * along)
-        w.set_wheel_speed(1, (speeds[MotorId.MWR] + speeds[MotorId.MWL]) / 2.0 * along)
-        w.set_wheel_speed(2, speeds[MotorId.MWB] * along)
+        w.set_wheel_speed(0, speeds[_MWF] * along)
+        w.set_wheel_speed(1, (speeds[_MWR] + speeds[_MWL]) / 2.0 * along)
+        w.set_wheel_speed(2, speeds[_MWB] * along)
         per_turn = self._per_turn
-        w.set_lift_speed(0, speeds[MotorId.MTF] * per_turn)
-        w.set_lift_speed(1, speeds[MotorId.MTB] * per_turn)
+        w.set_lift_speed(0, speeds[_MTF] * per_turn)
+        w.set_lift_speed(1, speeds[_MTB] * per_turn)
 
     def _along(self) -> float:
         """cos(yaw): the share of the robot's travel along the flight's axis."""
@@ -238,12 +242,12 @@ class SimRobot:
         mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
         return {
-            MotorId.MWF: MotorState(turns[0], tps[0]),
-            MotorId.MWB: MotorState(turns[2], tps[2]),
-            MotorId.MWR: MotorState(mean + d, mean_speed + ds),
-            MotorId.MWL: MotorState(mean - d, mean_speed - ds),
-            MotorId.MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
-            MotorId.MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
+            _MWF: MotorState(turns[0], tps[0]),
+            _MWB: MotorState(turns[2], tps[2]),
+            _MWR: MotorState(mean + d, mean_speed + ds),
+            _MWL: MotorState(mean - d, mean_speed - ds),
+            _MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
+            _MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
         }
 
 

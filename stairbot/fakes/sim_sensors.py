@@ -29,6 +29,8 @@ from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.scenario import Scenario
 
+_SFR, _SFL, _SBR, _SBL = SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL  # bound once
+
 IMU_SEGMENT = 1
 """The IMU rides in segment 2 (index 1 in the world)."""
 
@@ -89,7 +91,7 @@ class SimSensors:
             sfr, sfl = self._aged(SensorId.SFR, sfr, t), self._aged(SensorId.SFL, sfl, t)
         if self._back_timed:
             sbr, sbl = self._aged(SensorId.SBR, sbr, t), self._aged(SensorId.SBL, sbl, t)
-        return {SensorId.SFR: sfr, SensorId.SFL: sfl, SensorId.SBR: sbr, SensorId.SBL: sbl}
+        return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl}
 
     def _aged(self, sid: SensorId, reading: SensorReading, t: float) -> SensorReading:
         age = self.sensors[sid].age(t)
