@@ -53,6 +53,7 @@ TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to tu
 # bound once: an enum's member is a slow look-up, and every tick names each motor
 _MWF, _MWB, _MWR, _MWL, _MTF, _MTB = (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL,
                                       MotorId.MTF, MotorId.MTB)
+_ZEROS: dict[MotorId, float] = dict(ZERO_SPEEDS)  # copied by every command (a dict copies fast)
 
 
 class SimRobot:
@@ -105,7 +106,7 @@ class SimRobot:
         """Set every motor's speed in turns/s (clamped to the motor's limit; a
         speed that is not a finite number stops that motor).  While the e-stop
         is latched every motor stays stopped."""
-        new = dict(ZERO_SPEEDS)
+        new = _ZEROS.copy()
         if self._estopped:
             self._apply(new)
             return
@@ -193,12 +194,13 @@ class SimRobot:
             return
         self.plan.move(w.centre_x() - x0)
         along = self._along()
-        for i in range(3):
+        seen_turns, wheel_turns, wheel_tps = self._wheel_seen, self._wheel_turns, self._wheel_tps
+        for i in (0, 1, 2):
             seen = w.wheel_turns(i)
-            turned = (seen - self._wheel_seen[i]) / along
-            self._wheel_seen[i] = seen
-            self._wheel_turns[i] += turned
-            self._wheel_tps[i] = turned / elapsed
+            turned = (seen - seen_turns[i]) / along
+            seen_turns[i] = seen
+            wheel_turns[i] += turned
+            wheel_tps[i] = turned / elapsed
         self._diff_speed = diff
         if diff != 0.0:
             self._diff_turns += diff * elapsed

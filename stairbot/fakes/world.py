@@ -190,7 +190,7 @@ class World:
         for _ in range(n):
             step(handle, dt)
 
-    # -- state (read once per physics state, then from the cache) -----------------
+    # -- state (read once per physics state by _fetch, then from the cache) ---------
     def _fetch(self) -> None:
         if self._pose_at == self._steps_done:
             return
@@ -215,18 +215,21 @@ class World:
 
     def lift_offset(self, lift: int) -> float:
         """Actual height of segment 1 (lift 0) or 3 (lift 1) over segment 2, m."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return self._lifts[0 if lift == 0 else 1]
 
     def wheel_turns(self, segment: int) -> float:
         """Turns of a segment's front wheel relative to the segment (+ = forward):
         what the wheel motor's encoder counts."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return self._wheel_turns[segment]
 
     def pitch_deg(self, segment: int = 1) -> float:
         """Nose-up pitch of a segment in degrees."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return math.degrees(self._pa[segment])
 
     def pitch_rate_dps(self, segment: int = 1) -> float:
@@ -237,12 +240,14 @@ class World:
 
     def pose(self, segment: int) -> tuple[float, float, float]:
         """(x, y, angle) of a segment's local origin: its centre on the axle line."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return self._px[segment], self._py[segment], self._pa[segment]
 
     def centre_x(self) -> float:
         """x of segment 2's centre (its axle line)."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return self._px[1]
 
     @property
