@@ -36,7 +36,7 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
     yaw = plan.yaw
     cast = world.profile.ray_normal
     front_hit = plan.front_hit_at
-    side_view: dict[float, tuple[float | None, float, float, float, float]] = {}
+    side_view: dict[float, tuple[float | None, float, float, float, float, float]] = {}
     turned: dict[float, tuple[float, float]] = {}  # across -> cos, sin of the beam's yaw
     for up, across, weight in model.cone:
         seen = side_view.get(up)
@@ -44,11 +44,11 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
             theta = pitch + tilt + up
             c, s = math.cos(theta), math.sin(theta)
             hit = cast(mx, my, mx + c * reach, my + s * reach)
-            seen = ((None, c, s, 0.0, 0.0) if hit is None
-                    else (hit[0] - mx, c, s, hit[2], hit[3]))
+            slant = 1.0 / max(c, 1e-6)
+            seen = ((None, c, s, 0.0, 0.0, slant) if hit is None
+                    else (hit[0] - mx, c, s, hit[2], hit[3], slant))
             side_view[up] = seen
-        hit_dx, c, s, nx, ny = seen
-        slant = 1.0 / max(c, 1e-6)
+        hit_dx, c, s, nx, ny, slant = seen
         trig = turned.get(across)
         if trig is None:
             psi = yaw + across

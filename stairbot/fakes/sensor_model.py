@@ -136,7 +136,7 @@ def combine(model: SensorModel, hits: Sequence[Hit], total_weight: float
     docstring); ``total_weight``: the weight of every ray of the cone, met or
     not."""
     if not hits:
-        return None, Cause.NOTHING
+        return None, _NOTHING
     if model.max_incidence_deg is not None:
         min_cos = math.cos(math.radians(model.max_incidence_deg))
         hits = [h for h in hits if h[1] >= min_cos]
@@ -144,17 +144,17 @@ def combine(model: SensorModel, hits: Sequence[Hit], total_weight: float
             return None, Cause.ECHO_LOST
     if model.weak_range is not None:
         # the returned signal, relative to a full beam square to a target 1 m away
-        strength = sum(g * c / (d * d) for d, c, g in hits if d > 0.0) / total_weight
+        strength = sum([g * c / (d * d) for d, c, g in hits if d > 0.0]) / total_weight
         if strength * model.weak_range * model.weak_range < 1.0:
             return None, Cause.WEAK
     if model.aggregate == "nearest" or len(hits) == 1:
-        return min(h[0] for h in hits), Cause.OK
+        return min([h[0] for h in hits]), _OK
     num = den = 0.0
     for d, c, g in hits:
         w = g * c / (d * d) if d > 0.0 else g
         num += w * d
         den += w
-    return (num / den if den > 0.0 else min(h[0] for h in hits)), Cause.OK
+    return (num / den if den > 0.0 else min([h[0] for h in hits])), _OK
 
 
 class ModelSensor:

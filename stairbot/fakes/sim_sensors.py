@@ -88,16 +88,12 @@ class SimSensors:
         sfr, sfl = self._front_readings(t)
         sbr, sbl = self._back_readings(t)
         if self._front_timed:
-            sfr, sfl = self._aged(SensorId.SFR, sfr, t), self._aged(SensorId.SFL, sfl, t)
+            right, left = self._pairs[0]
+            sfr, sfl = _aged(right, sfr, t), _aged(left, sfl, t)
         if self._back_timed:
-            sbr, sbl = self._aged(SensorId.SBR, sbr, t), self._aged(SensorId.SBL, sbl, t)
+            right, left = self._pairs[1]
+            sbr, sbl = _aged(right, sbr, t), _aged(left, sbl, t)
         return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl}
-
-    def _aged(self, sid: SensorId, reading: SensorReading, t: float) -> SensorReading:
-        age = self.sensors[sid].age(t)
-        if age == 0.0:
-            return reading
-        return SensorReading(reading.distance_m, reading.status, age)
 
     def _front_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
         """What SFR and SFL report at ``t``: one ray each for a single-ray model,
@@ -194,3 +190,11 @@ class SimSensors:
         if hit is None:
             return None
         return math.hypot(hit[0] - mx, hit[1] - my)
+
+
+def _aged(sensor: ModelSensor, reading: SensorReading, t: float) -> SensorReading:
+    """``reading``, published by ``sensor`` at ``t``, with its age."""
+    age = sensor.age(t)
+    if age == 0.0:
+        return reading
+    return SensorReading(reading.distance_m, reading.status, age)

@@ -73,7 +73,8 @@ class StairsProfile:
                 self._geo.append(None)
                 continue
             nx, ny = -ey / length, ex / length
-            self._geo.append((ax, ay, ex, ey, length * length, nx, ny, radius / length,
+            r_len = radius / length
+            self._geo.append((ax, ay, ex, ey, length * length, nx, ny, -r_len, 1.0 + r_len,
                               ax + nx * radius, ay + ny * radius,
                               ax + -nx * radius, ay + -ny * radius))
 
@@ -120,14 +121,14 @@ class StairsProfile:
             g = geo[i]
             t = inf
             if g is not None:
-                ax, ay, ex, ey, len2, nx, ny, r_len, px, py, mx, my = g
+                ax, ay, ex, ey, len2, nx, ny, u_lo, u_hi, px, py, mx, my = g
                 side = (x0 - ax) * nx + (y0 - ay) * ny
                 if side < 0.0:
                     side, px, py = -side, mx, my
                 if side < r:
                     # inside the surface: touching it; beside the segment's end: not this one
                     along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
-                    if -r_len <= along <= 1.0 + r_len:
+                    if u_lo <= along <= u_hi:
                         t = 0.0
                 else:
                     denom = dx * ey - dy * ex
@@ -136,7 +137,7 @@ class StairsProfile:
                         tt = (wx * ey - wy * ex) / denom
                         if 0.0 <= tt <= 1.0:
                             u = (wx * dy - wy * dx) / denom
-                            if -r_len <= u <= 1.0 + r_len:
+                            if u_lo <= u <= u_hi:
                                 t = tt
             if t < best:
                 best, best_i = t, i
@@ -146,7 +147,8 @@ class StairsProfile:
 
 
 _Geo = tuple[float, float, float, float, float, float, float, float,
-             float, float, float, float]
+             float, float, float, float, float]
 """A segment: start (ax, ay), direction (ex, ey), length squared, unit normal
-(nx, ny), the surface's radius over the length, and the start moved
-``radius`` along the normal and against it."""
+(nx, ny), the range of the segment's parameter its surface covers (its ends
+reach ``radius`` further), and the start moved ``radius`` along the normal
+and against it."""
