@@ -195,7 +195,7 @@ def _pair(cfg: RobotConfig, back: bool) -> _Pair:
     derived = _derived
     if derived is None or derived[0] is not cfg:
         derived = _derived = (cfg, (_Pair(cfg, False), _Pair(cfg, True)))
-    return derived[1][back]
+    return derived[1][1 if back else 0]
 
 
 def _median_sigma(k: _Pair, sigma: float) -> float:
