@@ -76,15 +76,13 @@ class Plan:
                 y_hit = y_m + dx * s / c
                 if abs(y_hit) <= self.width / 2:
                     best = dx / c * slant
-        wall = self._wall_distance(y_m, s)
+        # the side wall the beam turns towards, if there is one
+        wall: float | None = None
+        if s > 1e-9:
+            if self.left_wall:
+                wall = max(0.0, (self.width / 2 - y_m) / s)
+        elif s < -1e-9 and self.right_wall:
+            wall = max(0.0, (-(self.width / 2) - y_m) / s)
         if wall is not None and (best is None or wall * slant < best):
             return wall * slant, True
         return None if best is None else (best, False)
-
-    def _wall_distance(self, y_m: float, s: float) -> float | None:
-        half = self.width / 2
-        if s > 1e-9 and self.left_wall:
-            return max(0.0, (half - y_m) / s)
-        if s < -1e-9 and self.right_wall:
-            return max(0.0, (-half - y_m) / s)
-        return None
