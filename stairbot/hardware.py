@@ -53,6 +53,9 @@ class SensorStatus(StrEnum):
     ERROR = "error"  # the sensor reports a fault; the distance means nothing
 
 
+_STATUS_OK = SensorStatus.OK  # bound once: an enum's member is a slow look-up
+
+
 @dataclass(frozen=True, slots=True)
 class SensorReading:
     """One distance reading.  With OUT_OF_RANGE the distance is clamped to the
@@ -68,7 +71,7 @@ class SensorReading:
 
     @property
     def ok(self) -> bool:
-        return self.status is SensorStatus.OK
+        return self.status is _STATUS_OK
 
 
 @dataclass(frozen=True, slots=True)

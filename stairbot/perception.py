@@ -66,6 +66,11 @@ class Kind(IntEnum):
     ERROR = 3
 
 
+# bound once: an enum's member costs a slow attribute look-up, every sensor every tick
+_KIND_OK, _KIND_ERROR = Kind.OK, Kind.ERROR
+_STATUS_OK = SensorStatus.OK
+
+
 def measurement_period(cfg: RobotConfig, back: bool) -> float:
     """How often the pair gives a new measurement: its period, or every tick."""
     return max(cfg.sensors.spec(back).period_s, cfg.algorithm.tick)
@@ -92,8 +97,8 @@ def settle_s(cfg: RobotConfig, back: bool = False) -> float:
 
 def median_sigma(cfg: RobotConfig, back: bool, distance_m: float) -> float:
     """Sigma of the pair's filtered reading at ``distance_m``."""
-    n = window(cfg, back)
-    return MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m) / math.sqrt(n)
+    k = _pair(cfg, back)
+    return _median_sigma(k, k.sigma(distance_m))
 
 
 def pair_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1.0,
@@ -104,10 +109,8 @@ def pair_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1.0,
     the weight of an exponential smoothing applied each tick on top (1.0:
     none); it averages fewer independent values when the sensor is slower
     than the tick."""
-    sigma_diff = math.sqrt(2.0) * median_sigma(cfg, back, distance_m)
-    repeats = measurement_period(cfg, back) / cfg.algorithm.tick
-    sigma_diff *= math.sqrt(min(1.0, repeats * smoothing / (2.0 - smoothing)))
-    return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
+    k = _pair(cfg, back)
+    return _pair_tolerance(k, k.sigma(distance_m), smoothing)
 
 
 def standing_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1.0,
@@ -115,8 +118,17 @@ def standing_tolerance(cfg: RobotConfig, distance_m: float, smoothing: float = 1
     """How far the pair may differ while the robot drives or lifts before the
     standing rule stops it: what calibration may have left
     (:func:`square_tolerance`), plus SIGMAS sigmas of the (smoothed) difference."""
-    return square_tolerance(cfg, distance_m, back) + pair_tolerance(cfg, distance_m, smoothing,
-                                                                    back)
+    k = _pair(cfg, back)
+    sigma = k.sigma(distance_m)
+    # the standing rule asks every tick; the answer depends on the sigma alone
+    known = k.standing
+    tolerance = known.get((sigma, smoothing))
+    if tolerance is None:
+        if len(known) >= _KNOWN_SIGMAS:
+            known.clear()
+        tolerance = known[sigma, smoothing] = (_square_tolerance(k, sigma)
+                                               + _pair_tolerance(k, sigma, smoothing))
+    return tolerance
 
 
 MAX_STILL_S = 5.0
@@ -128,32 +140,92 @@ def still_samples(cfg: RobotConfig, distance_m: float, back: bool = False) -> in
     """Ticks of standing still whose mean pair difference is known to within
     equal_tolerance (:func:`still_tolerance`), at most MAX_STILL_S of them:
     calibration squares up to that yaw."""
-    repeats = measurement_period(cfg, back) / cfg.algorithm.tick
-    one = SIGMAS * _still_sigma(cfg, back, distance_m, 1.0)
-    independent = (one / cfg.algorithm.equal_tolerance) ** 2
-    return max(1, min(round(MAX_STILL_S / cfg.algorithm.tick),
-                      math.ceil(independent * repeats)))
+    k = _pair(cfg, back)
+    return _still_samples(k, k.sigma(distance_m))
 
 
 def square_tolerance(cfg: RobotConfig, distance_m: float, back: bool = False) -> float:
     """The pair difference calibration leaves at most when it squares up:
     equal_tolerance, or more for a sensor too noisy to get there in MAX_STILL_S."""
-    return still_tolerance(cfg, still_samples(cfg, distance_m, back), distance_m, back)
+    k = _pair(cfg, back)
+    return _square_tolerance(k, k.sigma(distance_m))
 
 
 def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
                     back: bool = False) -> float:
     """Like :func:`pair_tolerance`, for the mean of ``samples`` ticks' filtered
     differences taken standing still."""
-    repeats = measurement_period(cfg, back) / cfg.algorithm.tick
-    sigma_diff = _still_sigma(cfg, back, distance_m, max(1.0, samples / repeats))
-    return max(cfg.algorithm.equal_tolerance, SIGMAS * sigma_diff)
+    k = _pair(cfg, back)
+    return _still_tolerance(k, samples, k.sigma(distance_m))
 
 
-def _still_sigma(cfg: RobotConfig, back: bool, distance_m: float, independent: float) -> float:
+# -- the same, from a pair's figures and the stated sigma at the distance ---------------
+class _Pair:
+    """What the tolerances of one pair need of the config, looked up once."""
+
+    __slots__ = ("spec", "noise", "equal", "repeats", "sqrt_window", "max_still", "standing")
+
+    def __init__(self, cfg: RobotConfig, back: bool) -> None:
+        self.spec = cfg.sensors.spec(back)
+        self.noise = cfg.sensors.noise
+        self.equal = cfg.algorithm.equal_tolerance
+        self.repeats = measurement_period(cfg, back) / cfg.algorithm.tick
+        """Ticks per measurement (at least 1)."""
+        self.sqrt_window = math.sqrt(window(cfg, back))
+        self.max_still = round(MAX_STILL_S / cfg.algorithm.tick)
+        self.standing: dict[tuple[float, float], float] = {}
+        """standing_tolerance by (sigma, smoothing)."""
+
+    def sigma(self, distance_m: float) -> float:
+        """The stated sigma of one reading at ``distance_m`` (Sensors.sigma)."""
+        return self.spec.sigma(distance_m, self.noise)
+
+
+_KNOWN_SIGMAS = 256
+"""standing_tolerance remembers at most this many answers per pair (a sensor
+whose noise grows with the distance gives a new sigma at most ticks)."""
+
+_derived: tuple[RobotConfig, tuple[_Pair, _Pair]] | None = None
+"""The last config asked about and its pairs (front, back): a run asks about
+one config, every tick.  A config is frozen, so its pairs never change."""
+
+
+def _pair(cfg: RobotConfig, back: bool) -> _Pair:
+    global _derived
+    derived = _derived
+    if derived is None or derived[0] is not cfg:
+        derived = _derived = (cfg, (_Pair(cfg, False), _Pair(cfg, True)))
+    return derived[1][1 if back else 0]
+
+
+def _median_sigma(k: _Pair, sigma: float) -> float:
+    return MEDIAN_EFFICIENCY * sigma / k.sqrt_window
+
+
+def _pair_tolerance(k: _Pair, sigma: float, smoothing: float) -> float:
+    sigma_diff = math.sqrt(2.0) * _median_sigma(k, sigma)
+    sigma_diff *= math.sqrt(min(1.0, k.repeats * smoothing / (2.0 - smoothing)))
+    return max(k.equal, SIGMAS * sigma_diff)
+
+
+def _still_samples(k: _Pair, sigma: float) -> int:
+    one = SIGMAS * _still_sigma(sigma, 1.0)
+    independent = (one / k.equal) ** 2
+    return max(1, min(k.max_still, math.ceil(independent * k.repeats)))
+
+
+def _square_tolerance(k: _Pair, sigma: float) -> float:
+    return _still_tolerance(k, _still_samples(k, sigma), sigma)
+
+
+def _still_tolerance(k: _Pair, samples: int, sigma: float) -> float:
+    sigma_diff = _still_sigma(sigma, max(1.0, samples / k.repeats))
+    return max(k.equal, SIGMAS * sigma_diff)
+
+
+def _still_sigma(sigma: float, independent: float) -> float:
     """Sigma of the mean of ``independent`` filtered pair differences."""
-    return math.sqrt(2.0) * MEDIAN_EFFICIENCY * cfg.sensors.sigma(back, distance_m) \
-        / math.sqrt(independent)
+    return math.sqrt(2.0) * MEDIAN_EFFICIENCY * sigma / math.sqrt(independent)
 
 
 class _Track:
@@ -205,12 +277,12 @@ class Perception:
             track = tracks[sid]
             age = reading.age_s
             if age <= 0.0:  # measured now (a sensor as fast as the tick)
-                if reading.status is SensorStatus.OK:
+                if reading.status is _STATUS_OK:
                     d = reading.distance_m
                     if d - d != 0.0:  # inf or NaN: not a measurement but a broken board
                         sensors[sid] = reading
                         continue
-                    if track.kind is Kind.OK and track.run_kind is Kind.OK:
+                    if track.kind is _KIND_OK and track.run_kind is _KIND_OK:
                         # the common case, kept short: another OK measurement
                         track.newest, track.taken_s = reading, now
                         track.run += 1
@@ -277,14 +349,14 @@ class Perception:
                               f"(at most {track.max_age:.2f} s)")
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         kind = track.kind
-        if kind is Kind.OK:
+        if kind is _KIND_OK:
             if track.ok_keys:
                 m = _median(track.ok_keys)
                 self._why.pop(sid, None)
-                return SensorReading(m - odometer if track.front else m, SensorStatus.OK, age)
+                return SensorReading(m - odometer if track.front else m, _STATUS_OK, age)
             self._why[sid] = "no valid measurement among its last ones"
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
-        if kind is Kind.ERROR:
+        if kind is _KIND_ERROR:
             self._why[sid] = f"{CONFIRM} measurements in a row report an error"
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         self._why.pop(sid, None)

@@ -200,15 +200,16 @@ class Controller:
             tilt = self._supervisor.tilt
             self._say(tilt.describe(), tilt_watched=tilt.watched)
             return _zeros()
-        fault = self._fault(snap) or self._supervisor.check(snap)
+        phase, ctx = self.phase, self._ctx
+        needed = _needed_sensors(phase, ctx)
+        fault = self._fault(snap, phase, needed) or self._supervisor.check(snap)
         if fault is not None:
             self._apply(fail(fault), snap)
             return _zeros()
-        if self._sensor_hold(snap):
+        if self._sensor_hold(snap, phase, needed):
             self._supervisor.commanded({})
             return _zeros()
-        ctx = self._ctx
-        record = self.phase.record
+        record = phase.record
         t = Tick(snap, self.config, ctx, self.mode, self._say)
         step = standing.watch(t, record)
         if step is None and record.carried_by and not ctx.work.balanced \
@@ -225,32 +226,34 @@ class Controller:
         self._supervisor.commanded(speeds)
         return speeds
 
-    def _fault(self, snap: Snapshot) -> str | None:
-        phase = self.phase
+    def _fault(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> str | None:
+        """A motor fault, a sensor ``needed`` that reads no number, or the
+        phase's timeout, in words; None when there is none."""
+        isfinite = math.isfinite
         for motor, state in snap.motors.items():
             if state.fault:
                 return f"motor fault: {motor} reports {state.fault!r} in {phase.label}"
-            if not math.isfinite(state.turns):
+            if not isfinite(state.turns):
                 return f"motor fault: {motor} counts {state.turns} turns in {phase.label}"
-        needed = _needed_sensors(phase, self._ctx)
+        sensors = snap.sensors
         for sensor in needed:
             # an ERROR reading's distance means nothing; any other must be a number
-            reading = snap.sensors[sensor]
-            if reading.status is not SensorStatus.ERROR and not math.isfinite(reading.distance_m):
+            reading = sensors[sensor]
+            if reading.status is not _ERROR and not isfinite(reading.distance_m):
                 return f"sensor error: {sensor} reads {reading.distance_m} m in {phase.label}"
         started = self._ctx.phase_started_s
-        if phase is not Phase.PAUSED and started is not None \
+        if phase is not _PAUSED and started is not None \
                 and snap.time_s - started > self._timeout:
             return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
         return None
 
-    def _sensor_hold(self, snap: Snapshot) -> bool:
-        """While a sensor the phase needs reads as ERROR (it reports errors, or
-        it is stale): every motor stops, the lifts hold, the timers stand, for
-        up to SENSOR_WAIT_S; then the program ends with the error.  True while
-        holding."""
-        ctx, phase = self._ctx, self.phase
-        errors = motion.sensor_errors(snap, _needed_sensors(phase, ctx))
+    def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
+        """While a sensor the phase needs (``needed``) reads as ERROR (it reports
+        errors, or it is stale): every motor stops, the lifts hold, the timers
+        stand, for up to SENSOR_WAIT_S; then the program ends with the error.
+        True while holding."""
+        ctx = self._ctx
+        errors = motion.sensor_errors(snap, needed)
         if not errors:
             if self._sensor_since is not None:
                 held = snap.time_s - self._sensor_since
@@ -374,13 +377,14 @@ class Controller:
 
 def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     """The sensors whose ERROR status ends the program in ``phase``."""
-    if phase is Phase.PAUSED and ctx.resume_phase is not None:
+    if phase is _PAUSED and ctx.resume_phase is not None:
         phase = Phase(ctx.resume_phase)
     if phase.terminal:
         return ()
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
 
+_PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
 ALL_MOTORS: tuple[MotorId, ...] = tuple(MotorId)
 _ZEROS: dict[MotorId, float] = dict.fromkeys(ALL_MOTORS, 0.0)
 

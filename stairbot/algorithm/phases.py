@@ -81,7 +81,7 @@ class Phase(Enum):
     @property
     def terminal(self) -> bool:
         """True for the phases a run ends in."""
-        return self in (Phase.DONE, Phase.ERROR)
+        return self in _ENDS
 
     def __str__(self) -> str:
         return self.label
@@ -99,6 +99,9 @@ def _records() -> dict[Phase, PhaseDef]:
         _RECORDS.update(PHASES)
     return _RECORDS
 
+
+_ENDS = (Phase.DONE, Phase.ERROR)
+"""The phases a run ends in (bound once: the control tick asks every tick)."""
 
 BY_VALUE: dict[str, Phase] = {p.value: p for p in Phase}
 """Phase by its value (faster than ``Phase(value)`` in the control tick)."""

@@ -48,7 +48,8 @@ def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
         ctx.standing_diff = None
         return False
     ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
-    near = min(r.distance_m for r in motion.pair(t.snap, back))
+    right, left = motion.pair(t.snap, back)
+    near = min(right.distance_m, left.distance_m)
     smoothed_tol = standing_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
     return abs(ctx.standing_diff) > smoothed_tol and \
         (not raw_too or abs(diff) > standing_tolerance(t.cfg, near, back=back))

@@ -35,25 +35,33 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
     tilt = math.radians(model.tilt_deg)
     out: list[list[Hit]] = [[] for _ in laterals]
     yaw = plan.yaw
-    side_view: dict[float, tuple[float | None, float, float, float, float]] = {}
+    mount_c, mount_s = math.cos(yaw), math.sin(yaw)  # the mounts turn with the robot only
+    cast = world.profile.ray_normal
+    front_hit = plan.front_hit_at
+    side_view: dict[float, tuple[float | None, float, float, float, float, float]] = {}
+    turned: dict[float, tuple[float, float]] = {}  # across -> cos, sin of the beam's yaw
     for up, across, weight in model.cone:
         seen = side_view.get(up)
         if seen is None:
             theta = pitch + tilt + up
             c, s = math.cos(theta), math.sin(theta)
-            hit = world.ray_normal((mx, my), (mx + c * reach, my + s * reach))
-            seen = ((None, c, s, 0.0, 0.0) if hit is None
-                    else (hit[0] - mx, c, s, hit[2], hit[3]))
+            hit = cast(mx, my, mx + c * reach, my + s * reach)
+            slant = 1.0 / max(c, 1e-6)
+            seen = ((None, c, s, 0.0, 0.0, slant) if hit is None
+                    else (hit[0] - mx, c, s, hit[2], hit[3], slant))
             side_view[up] = seen
-        hit_dx, c, s, nx, ny = seen
-        slant = 1.0 / max(c, 1e-6)
-        psi = yaw + across
+        hit_dx, c, s, nx, ny, slant = seen
+        trig = turned.get(across)
+        if trig is None:
+            psi = yaw + across
+            trig = turned[across] = (math.cos(psi), math.sin(psi))
+        cos_psi, sin_psi = trig
         for i, lat in enumerate(laterals):
-            got = plan.front_hit(forward, lat, hit_dx, slant, psi, yaw)
+            got = front_hit(forward, lat, hit_dx, slant, cos_psi, sin_psi, mount_c, mount_s)
             if got is None:
                 continue
             d, on_wall = got
-            cos_inc = abs(c * math.sin(psi)) if on_wall else abs(c * math.cos(psi) * nx + s * ny)
+            cos_inc = abs(c * sin_psi) if on_wall else abs(c * cos_psi * nx + s * ny)
             out[i].append((d, cos_inc, weight))
     return out
 
@@ -65,10 +73,11 @@ def down_hits(world: World, model: SensorModel, mount: tuple[float, float], pitc
     mx, my = mount
     tilt = math.radians(model.tilt_deg)
     out: list[Hit] = []
+    cast = world.profile.ray_normal
     for up, _across, weight in model.fan:
         phi = pitch + tilt + up
         dx, dy = math.sin(phi), -math.cos(phi)
-        hit = world.ray_normal((mx, my), (mx + dx * reach, my + dy * reach))
+        hit = cast(mx, my, mx + dx * reach, my + dy * reach)
         if hit is None:
             continue
         x, y, nx, ny = hit

@@ -51,7 +51,8 @@ class Plan:
         (None: nothing); ``slant``: beam length per metre of x travelled in the
         side view (1 / cos(pitch)).  Valid for |yaw| < 90 degrees.
         """
-        hit = self.front_hit(forward, lateral, hit_dx, slant, self.yaw)
+        yaw = self.yaw
+        hit = self.front_hit_at(forward, lateral, hit_dx, slant, math.cos(yaw), math.sin(yaw))
         return None if hit is None else hit[0]
 
     def front_hit(self, forward: float, lateral: float, hit_dx: float | None,
@@ -62,10 +63,20 @@ class Plan:
         robot's yaw ``mount_yaw`` (default: ``yaw``), and whether it meets a
         side wall (True) or the stairs (False); None: nothing."""
         c, s = math.cos(yaw), math.sin(yaw)
-        if mount_yaw is None or mount_yaw == yaw:
+        if mount_yaw is None:
+            return self.front_hit_at(forward, lateral, hit_dx, slant, c, s)
+        return self.front_hit_at(forward, lateral, hit_dx, slant, c, s,
+                                 math.cos(mount_yaw), math.sin(mount_yaw))
+
+    def front_hit_at(self, forward: float, lateral: float, hit_dx: float | None,
+                     slant: float, c: float, s: float, mc: float | None = None,
+                     ms: float | None = None) -> tuple[float, bool] | None:
+        """:meth:`front_hit` for a beam turned by the angle whose cosine is ``c``
+        and sine ``s`` (beams at the same angle share them), from a mount placed
+        by the robot's yaw, whose cosine and sine are ``mc`` and ``ms``
+        (default: ``c`` and ``s``: a beam along the robot's axis)."""
+        if mc is None or ms is None:
             mc, ms = c, s
-        else:
-            mc, ms = math.cos(mount_yaw), math.sin(mount_yaw)
         # the side view puts the mount at `forward` straight ahead; in the top view it
         # sits forward*cos - lateral*sin ahead of the centre and y_m to the side
         y_m = self.y + forward * ms + lateral * mc
@@ -76,15 +87,13 @@ class Plan:
                 y_hit = y_m + dx * s / c
                 if abs(y_hit) <= self.width / 2:
                     best = dx / c * slant
-        wall = self._wall_distance(y_m, s)
+        # the side wall the beam turns towards, if there is one
+        wall: float | None = None
+        if s > 1e-9:
+            if self.left_wall:
+                wall = max(0.0, (self.width / 2 - y_m) / s)
+        elif s < -1e-9 and self.right_wall:
+            wall = max(0.0, (-(self.width / 2) - y_m) / s)
         if wall is not None and (best is None or wall * slant < best):
             return wall * slant, True
         return None if best is None else (best, False)
-
-    def _wall_distance(self, y_m: float, s: float) -> float | None:
-        half = self.width / 2
-        if s > 1e-9 and self.left_wall:
-            return max(0.0, (half - y_m) / s)
-        if s < -1e-9 and self.right_wall:
-            return max(0.0, (-half - y_m) / s)
-        return None

@@ -69,6 +69,9 @@ class Cause(StrEnum):
     FAULT = "fault"  # a scenario fault (error) is active
 
 
+_OK, _NOTHING = Cause.OK, Cause.NOTHING  # bound once: an enum's member is a slow look-up
+
+
 @dataclass(frozen=True)
 class SensorModel:
     """What a kind of distance sensor does; None means "the robot config's"
@@ -133,7 +136,7 @@ def combine(model: SensorModel, hits: Sequence[Hit], total_weight: float
     docstring); ``total_weight``: the weight of every ray of the cone, met or
     not."""
     if not hits:
-        return None, Cause.NOTHING
+        return None, _NOTHING
     if model.max_incidence_deg is not None:
         min_cos = math.cos(math.radians(model.max_incidence_deg))
         hits = [h for h in hits if h[1] >= min_cos]
@@ -141,17 +144,17 @@ def combine(model: SensorModel, hits: Sequence[Hit], total_weight: float
             return None, Cause.ECHO_LOST
     if model.weak_range is not None:
         # the returned signal, relative to a full beam square to a target 1 m away
-        strength = sum(g * c / (d * d) for d, c, g in hits if d > 0.0) / total_weight
+        strength = sum([g * c / (d * d) for d, c, g in hits if d > 0.0]) / total_weight
         if strength * model.weak_range * model.weak_range < 1.0:
             return None, Cause.WEAK
     if model.aggregate == "nearest" or len(hits) == 1:
-        return min(h[0] for h in hits), Cause.OK
+        return min([h[0] for h in hits]), _OK
     num = den = 0.0
     for d, c, g in hits:
         w = g * c / (d * d) if d > 0.0 else g
         num += w * d
         den += w
-    return (num / den if den > 0.0 else min(h[0] for h in hits)), Cause.OK
+    return (num / den if den > 0.0 else min([h[0] for h in hits])), _OK
 
 
 class ModelSensor:
@@ -184,6 +187,11 @@ class ModelSensor:
         self._pending: deque[tuple[float, float, SensorReading, Cause]] = deque()
         self._current: tuple[float, SensorReading, Cause] | None = None
         self.measurements = 0
+        # the model's figures each measurement needs, looked up once
+        self._period, self._latency = model.period_s, model.latency_s
+        self._noisy = self.noise_a > 0.0 or self.noise_b > 0.0
+        self._outlier_rate, self._dropout_rate = model.outlier_rate, model.dropout_rate
+        self._bias = model.bias
 
     # -- timing ---------------------------------------------------------------------
     def due(self, t: float) -> bool:
@@ -194,15 +202,18 @@ class ModelSensor:
     def sample(self, seen: tuple[float | None, Cause], t: float) -> None:
         """Take a measurement now of what the beam sees (a distance, or None and
         why not); it is published ``latency_s`` later."""
-        period = self.model.period_s
+        self._sample(seen[0], seen[1], t)
+
+    def _sample(self, distance: float | None, seen: Cause, t: float) -> None:
+        period = self._period
         if period > 0.0:  # the next whole multiple of the period (0: every read)
             self._next = (math.floor(t / period + 1e-9) + 1) * period
-        reading, cause = self._measure(seen[0], seen[1], t)
+        reading, cause = self._measure(distance, seen, t)
         self.measurements += 1
-        if self._current is None or self.model.latency_s <= 0.0:
+        if self._current is None or self._latency <= 0.0:
             self._current = (t, reading, cause)
         else:
-            self._pending.append((t + self.model.latency_s, t, reading, cause))
+            self._pending.append((t + self._latency, t, reading, cause))
 
     def reading(self, t: float) -> SensorReading:
         """The reading published at time ``t``: the latest measurement whose
@@ -229,23 +240,22 @@ class ModelSensor:
         """One ray, square to its target: measure ``true_distance`` (None:
         nothing) if a measurement is due, and return the published reading."""
         if t >= self._next and not (self._freezes and frozen(self._freezes, t)):
-            self.sample((true_distance, Cause.OK if true_distance is not None
-                         else Cause.NOTHING), t)
+            self._sample(true_distance, _OK if true_distance is not None else _NOTHING, t)
         return self.reading(t)
 
     # -- one measurement --------------------------------------------------------------
     def _measure(self, true_distance: float | None, cause: Cause, t: float
                  ) -> tuple[SensorReading, Cause]:
-        m = self.model
-        a, b = self.noise_a, self.noise_b
         noise = 0.0
-        if a > 0.0 or b > 0.0:
-            sigma = a + b * true_distance if true_distance is not None else a
+        if self._noisy:
+            a = self.noise_a
+            sigma = a + self.noise_b * true_distance if true_distance is not None else a
             noise = self._gauss(0.0, sigma)
-        outlier = m.outlier_rate > 0.0 and self._uniform() < m.outlier_rate
-        outlier_at = self._uniform() if m.outlier_rate > 0.0 else 0.0
-        dropout = m.dropout_rate > 0.0 and self._uniform() < m.dropout_rate
-        dropout_kind = self._uniform() if m.dropout_rate > 0.0 else 0.0
+        outliers, dropouts = self._outlier_rate, self._dropout_rate
+        outlier = outliers > 0.0 and self._uniform() < outliers
+        outlier_at = self._uniform() if outliers > 0.0 else 0.0
+        dropout = dropouts > 0.0 and self._uniform() < dropouts
+        dropout_kind = self._uniform() if dropouts > 0.0 else 0.0
         if dropout:
             return (self._error if dropout_kind < 0.5 else self._far), Cause.DROPOUT
         if outlier:
@@ -254,12 +264,12 @@ class ModelSensor:
         if true_distance is None:
             return self._far, cause
         offset = active_faults(self.faults, t)[0] if self.faults else 0.0
-        d = true_distance + offset + m.bias + noise
+        d = true_distance + offset + self._bias + noise
         if d > self.max_range:
             return self._far, Cause.FAR
         if d < self.min_range:
             return self._near, Cause.NEAR
-        return self._quantized(d), Cause.OK
+        return self._quantized(d), _OK
 
     def _quantized(self, d: float) -> SensorReading:
         if self.resolution <= 0.0:

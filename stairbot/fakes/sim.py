@@ -50,6 +50,11 @@ from stairbot.scenario import Scenario, load_scenario
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
 
+# bound once: an enum's member is a slow look-up, and every tick names each motor
+_MWF, _MWB, _MWR, _MWL, _MTF, _MTB = (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL,
+                                      MotorId.MTF, MotorId.MTB)
+_ZEROS: dict[MotorId, float] = dict(ZERO_SPEEDS)  # copied by every command (a dict copies fast)
+
 
 class SimRobot:
     """The simulated robot (see the module docstring): a Robot, with the
@@ -67,13 +72,14 @@ class SimRobot:
         m = config.motors
         self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
                         for mid in MotorId}
+        self._per_turn = m.lift_travel_per_turn
         self._speeds = dict(ZERO_SPEEDS)
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
         self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
         self._lift_turns = [0.0, 0.0]
         # Wheel encoders count the wheels' travel along the robot's heading; the
         # side view moves only its projection on the flight's axis (see _apply).
-        self._wheel_seen = [self.world.wheel_state(i)[0] for i in range(3)]
+        self._wheel_seen = [self.world.wheel_turns(i) for i in range(3)]
         self._wheel_turns = [0.0, 0.0, 0.0]
         self._wheel_tps = [0.0, 0.0, 0.0]
         self._lift_tps = [0.0, 0.0]  # measured over the last advance
@@ -92,8 +98,7 @@ class SimRobot:
             raise RobotFellError(w.fall_reason or "unstable")
         if self._snap is not None and self._snap_at == w.steps_done:
             return self._snap
-        snap = Snapshot(time_s=w.time, sensors=self.board.read(w.time),
-                        motors=self._motor_states(), health={}, imu=imu(w))
+        snap = Snapshot(w.time, self.board.read(w.time), self._motor_states(), {}, imu(w))
         self._snap, self._snap_at = snap, w.steps_done
         return snap
 
@@ -101,7 +106,7 @@ class SimRobot:
         """Set every motor's speed in turns/s (clamped to the motor's limit; a
         speed that is not a finite number stops that motor).  While the e-stop
         is latched every motor stays stopped."""
-        new = dict(ZERO_SPEEDS)
+        new = _ZEROS.copy()
         if self._estopped:
             self._apply(new)
             return
@@ -109,7 +114,7 @@ class SimRobot:
         for motor, value in speeds.items():
             limit = limits[motor]
             v = float(value)
-            if v != v or v in (math.inf, -math.inf):
+            if v - v != 0.0:  # NaN or infinite
                 v = 0.0
             new[motor] = limit if v > limit else (-limit if v < -limit else v)
         self._apply(new)
@@ -179,7 +184,7 @@ class SimRobot:
         """Simulate ``dt`` seconds with the motors as last commanded."""
         w = self.world
         sp = self._speeds
-        diff = (sp[MotorId.MWR] - sp[MotorId.MWL]) / 2.0  # turns/s
+        diff = (sp[_MWR] - sp[_MWL]) / 2.0  # turns/s
         turning = diff != 0.0 and (w.clear_of_ground(0, TURN_CLEARANCE)
                                    and w.clear_of_ground(2, TURN_CLEARANCE))
         x0, t0 = w.centre_x(), w.time
@@ -189,19 +194,20 @@ class SimRobot:
             return
         self.plan.move(w.centre_x() - x0)
         along = self._along()
-        for i in range(3):
-            seen = w.wheel_state(i)[0]
-            turned = (seen - self._wheel_seen[i]) / along
-            self._wheel_seen[i] = seen
-            self._wheel_turns[i] += turned
-            self._wheel_tps[i] = turned / elapsed
+        seen_turns, wheel_turns, wheel_tps = self._wheel_seen, self._wheel_turns, self._wheel_tps
+        for i in (0, 1, 2):
+            seen = w.wheel_turns(i)
+            turned = (seen - seen_turns[i]) / along
+            seen_turns[i] = seen
+            wheel_turns[i] += turned
+            wheel_tps[i] = turned / elapsed
         self._diff_speed = diff
         if diff != 0.0:
             self._diff_turns += diff * elapsed
             if turning:
                 v = 2.0 * diff * self.config.wheel_circumference  # vR - vL, m/s
                 self.plan.turn(v / self.config.geometry.track_width * elapsed)
-        per_turn = self.config.motors.lift_travel_per_turn
+        per_turn = self._per_turn
         for i in (0, 1):
             turns = w.lift_offset(i) / per_turn
             self._lift_tps[i] = (turns - self._lift_turns[i]) / elapsed
@@ -220,12 +226,12 @@ class SimRobot:
         # closes on the risers at v cos(psi) and drifts sideways at v sin(psi)
         # (Plan.move), never faster than its wheels.
         along = self._along()
-        w.set_wheel_speed(0, speeds[MotorId.MWF] * along)
-        w.set_wheel_speed(1, (speeds[MotorId.MWR] + speeds[MotorId.MWL]) / 2.0 * along)
-        w.set_wheel_speed(2, speeds[MotorId.MWB] * along)
-        per_turn = self.config.motors.lift_travel_per_turn
-        w.set_lift_speed(0, speeds[MotorId.MTF] * per_turn)
-        w.set_lift_speed(1, speeds[MotorId.MTB] * per_turn)
+        w.set_wheel_speed(0, speeds[_MWF] * along)
+        w.set_wheel_speed(1, (speeds[_MWR] + speeds[_MWL]) / 2.0 * along)
+        w.set_wheel_speed(2, speeds[_MWB] * along)
+        per_turn = self._per_turn
+        w.set_lift_speed(0, speeds[_MTF] * per_turn)
+        w.set_lift_speed(1, speeds[_MTB] * per_turn)
 
     def _along(self) -> float:
         """cos(yaw): the share of the robot's travel along the flight's axis."""
@@ -233,17 +239,17 @@ class SimRobot:
 
     def _motor_states(self) -> dict[MotorId, MotorState]:
         w = self.world
-        per_turn = self.config.motors.lift_travel_per_turn
+        per_turn = self._per_turn
         turns, tps = self._wheel_turns, self._wheel_tps
         mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
         return {
-            MotorId.MWF: MotorState(turns[0], tps[0]),
-            MotorId.MWB: MotorState(turns[2], tps[2]),
-            MotorId.MWR: MotorState(mean + d, mean_speed + ds),
-            MotorId.MWL: MotorState(mean - d, mean_speed - ds),
-            MotorId.MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
-            MotorId.MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
+            _MWF: MotorState(turns[0], tps[0]),
+            _MWB: MotorState(turns[2], tps[2]),
+            _MWR: MotorState(mean + d, mean_speed + ds),
+            _MWL: MotorState(mean - d, mean_speed - ds),
+            _MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
+            _MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
         }
 
 

@@ -29,6 +29,8 @@ from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.scenario import Scenario
 
+_SFR, _SFL, _SBR, _SBL = SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL  # bound once
+
 IMU_SEGMENT = 1
 """The IMU rides in segment 2 (index 1 in the world)."""
 
@@ -66,6 +68,10 @@ class SimSensors:
                              or bool(frozen & {"SFR", "SFL"}))
         self._back_timed = (self.back_model.period_s > 0.0 or self.back_model.latency_s > 0.0
                             or bool(frozen & {"SBR", "SBL"}))
+        self._front_single = self.front_model.single_ray
+        self._back_single = self.back_model.single_ray
+        self._pairs = ((self.sensors[SensorId.SFR], self.sensors[SensorId.SFL]),
+                       (self.sensors[SensorId.SBR], self.sensors[SensorId.SBL]))
         self._front_weight = total_weight(self.front_model.cone)
         self._back_weight = total_weight(self.back_model.fan)
         r = config.geometry.wheel_radius
@@ -82,23 +88,19 @@ class SimSensors:
         sfr, sfl = self._front_readings(t)
         sbr, sbl = self._back_readings(t)
         if self._front_timed:
-            sfr, sfl = self._aged(SensorId.SFR, sfr, t), self._aged(SensorId.SFL, sfl, t)
+            right, left = self._pairs[0]
+            sfr, sfl = _aged(right, sfr, t), _aged(left, sfl, t)
         if self._back_timed:
-            sbr, sbl = self._aged(SensorId.SBR, sbr, t), self._aged(SensorId.SBL, sbl, t)
-        return {SensorId.SFR: sfr, SensorId.SFL: sfl, SensorId.SBR: sbr, SensorId.SBL: sbl}
-
-    def _aged(self, sid: SensorId, reading: SensorReading, t: float) -> SensorReading:
-        age = self.sensors[sid].age(t)
-        if age == 0.0:
-            return reading
-        return SensorReading(reading.distance_m, reading.status, age)
+            right, left = self._pairs[1]
+            sbr, sbl = _aged(right, sbr, t), _aged(left, sbl, t)
+        return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl}
 
     def _front_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
         """What SFR and SFL report at ``t``: one ray each for a single-ray model,
         else their cones, cast only when a measurement is due."""
-        right, left = self.sensors[SensorId.SFR], self.sensors[SensorId.SFL]
+        right, left = self._pairs[0]
         model = self.front_model
-        if model.single_ray:
+        if self._front_single:
             sfr, sfl = self._front_truth()
             return right.measure(sfr, t), left.measure(sfl, t)
         if right.due(t) or left.due(t):
@@ -113,9 +115,9 @@ class SimSensors:
 
     def _back_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
         """What SBR and SBL report at ``t`` (see _front_readings)."""
-        right, left = self.sensors[SensorId.SBR], self.sensors[SensorId.SBL]
+        right, left = self._pairs[1]
         model = self.back_model
-        if model.single_ray:
+        if self._back_single:
             sbr, sbl = self._back_truth()
             return right.measure(sbr, t), left.measure(sbl, t)
         if right.due(t) or left.due(t):
@@ -162,13 +164,16 @@ class SimSensors:
         w = self.world
         reach = self._front_mount[2]
         mx, my, _a1, c, s, forward = self._front_origin()
-        hit = w.ray((mx, my), (mx + c * reach, my + s * reach))
+        hit = w.profile.ray(mx, my, mx + c * reach, my + s * reach)
         hit_dx = None if hit is None else hit[0] - mx
         slant = 1.0 / max(c, 1e-6)
         lat = self.config.sensors.front_lateral
-        front_distance = self.plan.front_distance
-        return (front_distance(forward, -lat, hit_dx, slant),
-                front_distance(forward, lat, hit_dx, slant))
+        # Plan.front_distance for both, turned by the one yaw
+        plan = self.plan
+        cos_yaw, sin_yaw = math.cos(plan.yaw), math.sin(plan.yaw)
+        sfr = plan.front_hit_at(forward, -lat, hit_dx, slant, cos_yaw, sin_yaw)
+        sfl = plan.front_hit_at(forward, lat, hit_dx, slant, cos_yaw, sin_yaw)
+        return None if sfr is None else sfr[0], None if sfl is None else sfl[0]
 
     def _back_truth(self) -> tuple[float | None, float | None]:
         """True distances seen by SBR and SBL, looking down from segment 3.  Turned
@@ -197,7 +202,15 @@ class SimSensors:
         return (mx + shift + lat, mx + shift - lat), my, a3, c, s, reach
 
     def _down(self, mx: float, my: float, c: float, s: float, reach: float) -> float | None:
-        hit = self.world.ray((mx, my), (mx + s * reach, my - c * reach))
+        hit = self.world.profile.ray(mx, my, mx + s * reach, my - c * reach)
         if hit is None:
             return None
         return math.hypot(hit[0] - mx, hit[1] - my)
+
+
+def _aged(sensor: ModelSensor, reading: SensorReading, t: float) -> SensorReading:
+    """``reading``, published by ``sensor`` at ``t``, with its age."""
+    age = sensor.age(t)
+    if age == 0.0:
+        return reading
+    return SensorReading(reading.distance_m, reading.status, age)

@@ -64,8 +64,7 @@ class StairsProfile:
         self.radius = radius
         self._xmin = [s[0] for s in self.segments]
         self._xmax = [s[2] for s in self.segments]
-        # per segment, what every cast needs: its start moved ``radius`` off the
-        # surface on either side, direction, normal and reach past the ends
+        # per segment, what every cast needs (see _Geo); None: zero length
         self._geo: list[_Geo | None] = []
         for ax, ay, bx, by in self.segments:
             ex, ey = bx - ax, by - ay
@@ -74,7 +73,10 @@ class StairsProfile:
                 self._geo.append(None)
                 continue
             nx, ny = -ey / length, ex / length
-            self._geo.append((ax, ay, ex, ey, length * length, nx, ny, radius / length))
+            r_len = radius / length
+            self._geo.append((ax, ay, ex, ey, length * length, nx, ny, -r_len, 1.0 + r_len,
+                              ax + nx * radius, ay + ny * radius,
+                              ax + -nx * radius, ay + -ny * radius))
 
     def ray(self, x0: float, y0: float, x1: float, y1: float) -> Point | None:
         """The first point of the surface on the segment (x0, y0) -> (x1, y1), or
@@ -92,13 +94,18 @@ class StairsProfile:
         best, i = self._first(x0, y0, x1, y1)
         if best == math.inf:
             return None
-        ax, ay, bx, by = self.segments[i]
-        ex, ey = bx - ax, by - ay
-        length = math.hypot(ex, ey)
-        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, -ey / length, ex / length)
+        g = self._geo[i]
+        assert g is not None  # a zero-length segment is never met
+        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, g[5], g[6])
 
     def _first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
-        """Ray parameter of the first surface met (inf: none) and its segment."""
+        """Ray parameter of the first surface met (inf: none) and its segment.
+
+        Per segment: the ray's parameter in [0, 1] where it crosses the
+        segment's surface (the segment moved ``radius`` towards the ray's
+        origin), 0 when the origin lies inside the surface beside the
+        segment, none when it passes beside the segment's ends.  (One loop,
+        no call per segment: every sensor casts here every tick.)"""
         r = self.radius
         lo, hi = (x0, x1) if x0 <= x1 else (x1, x0)
         first = bisect_left(self._xmax, lo - r)
@@ -107,41 +114,41 @@ class StairsProfile:
             return math.inf, -1
         dx, dy = x1 - x0, y1 - y0
         idx = range(first, last) if dx >= 0 else range(last - 1, first - 1, -1)
-        best, best_i = math.inf, -1
+        inf = math.inf
+        best, best_i = inf, -1
         geo = self._geo
         for i in idx:
             g = geo[i]
-            t = math.inf if g is None else _hit(g, x0, y0, dx, dy, r)
+            t = inf
+            if g is not None:
+                ax, ay, ex, ey, len2, nx, ny, u_lo, u_hi, px, py, mx, my = g
+                side = (x0 - ax) * nx + (y0 - ay) * ny
+                if side < 0.0:
+                    side, px, py = -side, mx, my
+                if side < r:
+                    # inside the surface: touching it; beside the segment's end: not this one
+                    along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
+                    if u_lo <= along <= u_hi:
+                        t = 0.0
+                else:
+                    denom = dx * ey - dy * ex
+                    if denom != 0.0:
+                        wx, wy = px - x0, py - y0
+                        tt = (wx * ey - wy * ex) / denom
+                        if 0.0 <= tt <= 1.0:
+                            u = (wx * dy - wy * dx) / denom
+                            if u_lo <= u <= u_hi:
+                                t = tt
             if t < best:
                 best, best_i = t, i
-            elif best < math.inf and dx != 0.0:
+            elif best < inf and dx != 0.0:
                 break  # x-monotonic: later segments lie further along the ray
         return best, best_i
 
 
-_Geo = tuple[float, float, float, float, float, float, float, float]
+_Geo = tuple[float, float, float, float, float, float, float, float,
+             float, float, float, float, float]
 """A segment: start (ax, ay), direction (ex, ey), length squared, unit normal
-(nx, ny), the surface's radius over the length."""
-
-
-def _hit(g: _Geo, x0: float, y0: float, dx: float, dy: float, r: float) -> float:
-    """Ray parameter in [0, 1] where it crosses the segment's surface (the
-    segment moved ``r`` towards the ray's origin), or inf."""
-    ax, ay, ex, ey, len2, nx, ny, r_len = g
-    side = (x0 - ax) * nx + (y0 - ay) * ny
-    if side < 0.0:
-        nx, ny, side = -nx, -ny, -side
-    if side < r:
-        along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
-        # inside the surface: touching it; beside the segment's end: not this one
-        return 0.0 if -r_len <= along <= 1.0 + r_len else math.inf
-    ax, ay = ax + nx * r, ay + ny * r
-    denom = dx * ey - dy * ex
-    if denom == 0.0:
-        return math.inf
-    wx, wy = ax - x0, ay - y0
-    t = (wx * ey - wy * ex) / denom
-    if not 0.0 <= t <= 1.0:
-        return math.inf
-    u = (wx * dy - wy * dx) / denom
-    return t if -r_len <= u <= 1.0 + r_len else math.inf
+(nx, ny), the range of the segment's parameter its surface covers (its ends
+reach ``radius`` further), and the start moved ``radius`` along the normal
+and against it."""

@@ -143,13 +143,13 @@ class World:
         self._bias = [-1.0, -1.0]
         self._moving = [False, False]
         self._pose_at = -1
-        self._ptrs: list[object] | None = None
-        self._wptrs: list[tuple[object, object]] | None = None
+        self._ptrs: list[tuple[object, object]] | None = None  # (segment, its front wheel)
         if _cp is not None and all(hasattr(b, "_body") for b in self.space.bodies):
-            self._ptrs = [b._body for b in self.segments]
-            self._wptrs = [(b._body, w[1]._body)
-                           for b, w in zip(self.segments, self.wheels, strict=True)]
+            self._ptrs = [(b._body, w[1]._body)
+                          for b, w in zip(self.segments, self.wheels, strict=True)]
         self._px, self._py, self._pa = [0.0] * 3, [0.0] * 3, [0.0] * 3
+        self._wheel_turns, self._lifts = [0.0] * 3, [0.0, 0.0]
+        self._stroke, self._stall = config.motors.lift_travel, p.lift_stall
         self._cp_step: tuple[Callable[[Any, float], None], Any] | None = None
         self._fetch()
         self._check_y, self._check_t = list(self._py), 0.0
@@ -190,66 +190,64 @@ class World:
         for _ in range(n):
             step(handle, dt)
 
-    # -- state (read once per physics state, then from the cache) -----------------
+    # -- state (read once per physics state by _fetch, then from the cache) ---------
     def _fetch(self) -> None:
         if self._pose_at == self._steps_done:
             return
-        px, py, pa = self._px, self._py, self._pa
+        px, py, pa, wa = self._px, self._py, self._pa, [0.0] * 3
         if self._ptrs is not None:
             get_pos, get_angle = _cp.cpBodyGetPosition, _cp.cpBodyGetAngle
-            for i, ptr in enumerate(self._ptrs):
+            for i, (ptr, wheel) in enumerate(self._ptrs):
                 pos = get_pos(ptr)
-                px[i], py[i], pa[i] = pos.x, pos.y, get_angle(ptr)
+                px[i], py[i], pa[i], wa[i] = pos.x, pos.y, get_angle(ptr), get_angle(wheel)
         else:
             for i, body in enumerate(self.segments):
                 pos = body.position
-                px[i], py[i], pa[i] = pos.x, pos.y, body.angle
+                px[i], py[i], pa[i], wa[i] = pos.x, pos.y, body.angle, self.wheels[i][1].angle
+        # the front wheels' encoders, and the lifts' offsets across segment 2's axle line
+        for i in (0, 1, 2):
+            self._wheel_turns[i] = -(wa[i] - pa[i] - self._wheel_zero[i]) / TWO_PI
+        sin_a, cos_a = math.sin(pa[1]), math.cos(pa[1])
+        lifts = self._lifts
+        lifts[0] = -sin_a * (px[0] - px[1]) + cos_a * (py[0] - py[1])
+        lifts[1] = -sin_a * (px[2] - px[1]) + cos_a * (py[2] - py[1])
         self._pose_at = self._steps_done
 
     def lift_offset(self, lift: int) -> float:
         """Actual height of segment 1 (lift 0) or 3 (lift 1) over segment 2, m."""
-        self._fetch()
-        e = 0 if lift == 0 else 2
-        a = self._pa[1]
-        return (-math.sin(a) * (self._px[e] - self._px[1])
-                + math.cos(a) * (self._py[e] - self._py[1]))
+        if self._pose_at != self._steps_done:
+            self._fetch()
+        return self._lifts[0 if lift == 0 else 1]
 
-    def wheel_state(self, segment: int) -> tuple[float, float]:
-        """(turns, turns/s) of a segment's front wheel relative to the segment
-        (+ = forward): what the wheel motor's encoder reports."""
-        self._fetch()
-        if self._wptrs is not None:
-            bp, wp = self._wptrs[segment]
-            wheel_angle = _cp.cpBodyGetAngle(wp)
-            w_body = _cp.cpBodyGetAngularVelocity(bp)
-            w_wheel = _cp.cpBodyGetAngularVelocity(wp)
-        else:
-            wheel = self.wheels[segment][1]
-            wheel_angle = wheel.angle
-            w_body = self.segments[segment].angular_velocity
-            w_wheel = wheel.angular_velocity
-        rel = wheel_angle - self._pa[segment] - self._wheel_zero[segment]
-        return -rel / TWO_PI, (w_body - w_wheel) / TWO_PI
+    def wheel_turns(self, segment: int) -> float:
+        """Turns of a segment's front wheel relative to the segment (+ = forward):
+        what the wheel motor's encoder counts."""
+        if self._pose_at != self._steps_done:
+            self._fetch()
+        return self._wheel_turns[segment]
 
     def pitch_deg(self, segment: int = 1) -> float:
         """Nose-up pitch of a segment in degrees."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return math.degrees(self._pa[segment])
 
     def pitch_rate_dps(self, segment: int = 1) -> float:
         """Nose-up pitch rate of a segment in degrees per second."""
         if self._ptrs is not None:
-            return math.degrees(_cp.cpBodyGetAngularVelocity(self._ptrs[segment]))
+            return math.degrees(_cp.cpBodyGetAngularVelocity(self._ptrs[segment][0]))
         return math.degrees(self.segments[segment].angular_velocity)
 
     def pose(self, segment: int) -> tuple[float, float, float]:
         """(x, y, angle) of a segment's local origin: its centre on the axle line."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return self._px[segment], self._py[segment], self._pa[segment]
 
     def centre_x(self) -> float:
         """x of segment 2's centre (its axle line)."""
-        self._fetch()
+        if self._pose_at != self._steps_done:
+            self._fetch()
         return self._px[1]
 
     @property
@@ -287,8 +285,7 @@ class World:
         """Aim each moving lift's pin at where the screw will be in ``seconds``; the
         pin's max_bias makes it travel there at the lift's speed, so no Python runs
         between physics steps."""
-        stroke = self.config.motors.lift_travel
-        stall = self.params.lift_stall
+        stroke, stall = self._stroke, self._stall
         for i in (0, 1):
             v = self.lift_speed[i]
             pin = self.pins[i]
@@ -331,22 +328,23 @@ class World:
             return
         p = self.params
         self._fetch()
-        prev_y, self._check_y = self._check_y, list(self._py)
+        py, pa = self._py, self._pa
+        prev_y, self._check_y = self._check_y, py[:]
         elapsed = max(self.time - self._check_t, 1e-9)
         self._check_t = self.time
-        for i in range(3):
-            pitch = abs(math.degrees(self._pa[i]))
+        for i in (0, 1, 2):
+            pitch = abs(math.degrees(pa[i]))
             if pitch > self.max_pitch_deg:
                 self.max_pitch_deg = pitch
             if pitch > p.pitch_limit_deg:
                 self._fall(f"segment {i + 1} pitched {pitch:.0f} deg (limit "
                            f"{p.pitch_limit_deg:.0f})")
                 return
-            vy = (self._py[i] - prev_y[i]) / elapsed
+            vy = (py[i] - prev_y[i]) / elapsed
             if vy < -p.fall_speed:
                 self._fall(f"segment {i + 1} falling at {-vy:.1f} m/s")
                 return
-            if self._py[i] < -0.1:
+            if py[i] < -0.1:
                 self._fall(f"segment {i + 1} below the floor")
                 return
         # contacts are looked up a few times a second: enough for a 0.3 s limit
