@@ -183,3 +183,38 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it() -> None:
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+
+
+SETTLING = """
+[stairs]
+top = "landing"
+width = 1.0
+steps = [{rise = 0.171083, tread = 0.313664}, {rise = 0.173967, tread = 0.313127},
+         {rise = 0.173358, tread = 0.311512}]
+[start]
+distance = 0.798965
+yaw_deg = 15.465028
+lateral = -0.115377
+[sensors]
+noise = 0.001
+seed = 89926
+"""
+
+
+def test_the_start_reading_is_taken_once_segment_1_has_settled() -> None:
+    """Found by the envelope sweep (case 1297 on tof): read the tick segments
+    1 and 3 came down, the start reading caught the cone pitched onto the
+    floor (0.202 m for 0.327 m) and descent 7 stopped 0.125 m short."""
+    from stairbot.events import Event
+
+    events: list[Event] = []
+    scenario = parse_scenario(SETTLING, "<settling>")
+    session = open_robot("sim://", TOF, RobotOptions(world=scenario))
+    try:
+        r = run(session, TOF, events.append)
+    finally:
+        session.close()
+    start = [e for e in events if e.message.startswith("start position")]
+    assert len(start) == 1 and start[0].data["start_reading"] > 0.3
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 3, 3), r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()

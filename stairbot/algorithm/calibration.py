@@ -380,11 +380,17 @@ def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
     return {MotorId.MTF: ctx.return_mtf - w.entry_mtf, MotorId.MTB: ctx.return_mtb - w.entry_mtb}
 
 
-def _lowered(t: Tick, _w: Work) -> Step:
+def _lowered(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     if ctx.purpose == "home":
         return go(P.DESCENT_FINISH_FLOOR)
     if ctx.purpose == "start":
+        # The start reading is measured once the filter has settled standing
+        # here: segment 1 settling onto its wheels pitches the beams down for
+        # a moment, and a cone then reads the floor (the tof robot read
+        # 0.202 m for 0.327 m, and came home 0.125 m short).
+        if not _settled(t, w):
+            return stay(NO_MOTION)
         ctx.square_turn = t.snap.turns(MotorId.MWR) - ctx.turn_origin
         if motion.measurable(t.snap, cfg):
             ctx.start_reading = motion.mean_distance(t.snap)
