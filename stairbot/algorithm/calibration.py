@@ -154,7 +154,6 @@ def _close_in_enter(t: Tick, w: Work) -> None:
     # No further than the first reading allows: its nearer beam to square_range_m.
     near = _nearer(t)
     assert near is not None  # CAL_CHECK closes in only on a reading
-    w.start_reading = near
     w.target_wheel = w.entry_wheel + t.cfg.wheel_turns(near - t.cfg.square_range_m)
 
 

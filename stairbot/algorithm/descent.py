@@ -153,12 +153,12 @@ def _lower_third(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     reading = motion.mean_distance(t.snap, back=True)
     to_go = reading - cfg.BACK_CLEARANCE
-    if w.start_reading is None and to_go <= floor_tolerance(cfg):
+    if not w.finishing and to_go <= floor_tolerance(cfg):
         # Within the noise of BACK_CLEARANCE: the rest the reading says, by
         # turns, and no further (an unbiased finish, never a push on the floor).
-        w.start_reading = to_go
+        w.finishing = True
         w.target_mtb = t.snap.turns(MotorId.MTB) - cfg.lift_turns(max(0.0, to_go))
-    if w.start_reading is not None:
+    if w.finishing:
         assert w.target_mtb is not None
         finish = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
         if finish is not None:

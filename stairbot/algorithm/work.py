@@ -53,6 +53,9 @@ class Work:
     """The phase's entry condition has been checked (on its first step)."""
     still_since: float | None = None
     """When the robot stopped to measure standing still (calibration)."""
+    finishing: bool = False
+    """Descent 2: the back pair reads BACK_CLEARANCE within its noise; the
+    rest of the lowering goes by turns to ``target_mtb``."""
     edge_wheel: float | None = None
     """Descent 1: the odometer where the back pair first read the drop past
     the edge."""
