@@ -56,6 +56,14 @@ MAX_AWAY_YAW_RAD = math.radians(45.0)
 """Case 2W turns away from the side wall at most this far."""
 TURN_SLOW_FLOOR = 0.1
 """The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
+MAX_SQUARING_TURNS = 4
+"""A calibration that has turned this many times to square up (the squaring
+turn, then corrections by the odometer) and still does not read SFR = SFL
+standing on all wheels ends with an error."""
+HEADING_TOLERANCE_RAD = math.radians(0.3)
+"""Descent 1 turns back to the heading it climbed the step with when the
+odometer says it is further off than this (0.3 deg: 1.6 mm sideways over a
+0.3 m climb)."""
 
 
 def _readings(t: Tick) -> tuple[float, float]:
@@ -64,7 +72,19 @@ def _readings(t: Tick) -> tuple[float, float]:
 
 
 def _after_calibration(t: Tick) -> Step:
-    return go(P.DESCENT_BACK_TO_EDGE if t.ctx.purpose == "descent" else P.ASCENT_APPROACH)
+    ctx = t.ctx
+    if ctx.purpose == "descent":
+        return go(P.DESCENT_BACK_TO_EDGE)
+    if ctx.number_of_steps < len(ctx.climb_twist):
+        # the heading this step is climbed with: descent 1 comes back to it
+        ctx.climb_twist[ctx.number_of_steps] = motion.twist(t.snap)
+    return go(P.ASCENT_APPROACH)
+
+
+def heading_off_rad(t: Tick, twist: float) -> float:
+    """How far (radians, + = left) the robot is turned from the heading whose
+    odometer twist is ``twist``."""
+    return motion.turn_yaw_rad(t.cfg, motion.twist(t.snap) - twist)
 
 
 def _settled(t: Tick, w: Work) -> bool:
@@ -79,16 +99,37 @@ def _settled(t: Tick, w: Work) -> bool:
 def _check(t: Tick, w: Work) -> Step:
     cfg, ctx = t.cfg, t.ctx
     sfr, sfl = motion.pair(t.snap)
+    if ctx.purpose == "descent" and ctx.squaring_turns == 0:
+        # Descent 1 first turns back to the heading it climbed this step with
+        # (by the odometer), so that the way down retraces the way up: squared
+        # up within the pair's noise on the way up and again on the way down,
+        # the two headings may differ by a few degrees, and over a long flight
+        # that put the robot 0.1 m to the side of its start.
+        climbed = ctx.climb_twist[t.descent_index]
+        if climbed is not None:
+            off = heading_off_rad(t, climbed)
+            if abs(off) > HEADING_TOLERANCE_RAD:
+                ctx.turn_to = climbed
+                t.say(f"descent 1, step {t.descent_index + 1}: turned {math.degrees(off):+.2f}° "
+                      "from the heading it climbed this step with (by the odometer); turning "
+                      "back to it", off_deg=math.degrees(off))
+                return go(P.CAL_LIFT)
     # Standing still, the pair is averaged over STILL_TICKS before it is
     # called equal or not: one noisy reading must not choose the case; and
     # only once the filter has settled (a full window of measurements taken
     # standing here: not the first one or two, nor ones taken while moving).
     if not _settled(t, w):
         return stay(NO_MOTION)
-    if w.diff_n < STILL_TICKS:
+    # Checking a squaring turn: as long as it takes to know the difference to
+    # within equal_tolerance, as the turn's own check does.
+    needed = STILL_TICKS if ctx.squaring_turns == 0 else max(
+        STILL_TICKS, still_samples(cfg, min(sfr.distance_m, sfl.distance_m)))
+    if w.diff_n < needed:
         w.diff_sum += sfl.distance_m - sfr.distance_m
         w.diff_n += 1
         return stay(NO_MOTION)
+    if ctx.squaring_turns > 0:
+        return _verify(t, w)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         if ctx.purpose != "start":
             return fail(f"nothing ahead at {where(ctx, P.CAL_CHECK)}: SFR {sfr.distance_m:.3f} m, "
@@ -100,6 +141,7 @@ def _check(t: Tick, w: Work) -> Step:
     if ctx.purpose == "start":
         if ctx.home_wheel is None:
             ctx.home_wheel = motion.wheel_position(t.snap)
+            ctx.home_twist = motion.twist(t.snap)
         near = _nearer(t)
         if near is not None and near > cfg.square_range_m + cfg.algorithm.equal_tolerance:
             t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
@@ -112,7 +154,14 @@ def _check(t: Tick, w: Work) -> Step:
     if equal and ctx.purpose != "start":
         ctx.calibration_case = None
         return _after_calibration(t)
-    wall = not equal and abs(diff) > _one_riser(cfg)
+    # One beam reading nothing ahead is off the flight's open side (a side
+    # wall would be seen): the other sees the riser, and case 2's rule turns
+    # the right way.  Only two readings that both see something, too far
+    # apart for one riser, are a side wall (the envelope sweep: 19 deg askew
+    # near the open side of a flight, SFL read nothing, case 2W turned away
+    # from the riser until it gave up).
+    wall = (not equal and abs(diff) > _one_riser(cfg)
+            and not motion.far(sfr, cfg) and not motion.far(sfl, cfg))
     ctx.calibration_case = "3" if equal else ("2W" if wall else "2")
     said = ("equal, case 3" if equal else
             "too far apart for one riser within "
@@ -122,6 +171,54 @@ def _check(t: Tick, w: Work) -> Step:
           f"SFL {sfl.distance_m:.3f} m: {said}",
           case=ctx.calibration_case, SFR=sfr.distance_m, SFL=sfl.distance_m)
     return go(P.CAL_LIFT)
+
+
+def _verify(t: Tick, w: Work) -> Step:
+    """Check a squaring turn standing on all wheels.  The turn ended on the
+    readings taken with segments 1 and 3 lifted, their sensors a clearance
+    higher: a cone tilted up then sees more of what lies over a low riser,
+    and read equal 17 deg askew on the tof robot (the envelope sweep: the
+    standing rule then ended the approach).  Not equal here, the robot turns
+    by the odometer as far as the difference says (a flat riser, both beams
+    on it), and checks again."""
+    ctx, cfg = t.ctx, t.cfg
+    sfr, sfl = _readings(t)
+    diff = w.diff_sum / w.diff_n
+    if abs(diff) <= still_tolerance(cfg, w.diff_n, min(sfr, sfl)):
+        t.say(f"square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {w.diff_n} "
+              f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)",
+              SFR=sfr, SFL=sfl, diff=diff)
+        ctx.squaring_turns = 0
+        return _squared(t)
+    if ctx.squaring_turns >= MAX_SQUARING_TURNS:
+        return fail(f"calibration ({where(ctx, P.CAL_CHECK)}) cannot square up: after "
+                    f"{ctx.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
+                    f"standing (SFR {sfr:.3f} m, SFL {sfl:.3f} m): the beams do not see one "
+                    "flat riser alike (a riser too low for them, or its edge)")
+    lateral = max(cfg.sensors.front_lateral, 1e-6)
+    # SFL farther than SFR: turned left of square, turn right (and the other way).
+    yaw = -math.atan(diff / (2 * lateral))
+    yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
+    ctx.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
+    ctx.squaring_turns += 1
+    t.say(f"not square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {w.diff_n} "
+          f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m): turning "
+          f"{math.degrees(yaw):+.1f}° by the odometer", SFR=sfr, SFL=sfl, diff=diff)
+    return go(P.CAL_LIFT)
+
+
+def _squared(t: Tick) -> Step:
+    """The calibration is square: the start records where it stands."""
+    ctx, cfg = t.ctx, t.cfg
+    if ctx.purpose == "start":
+        if motion.measurable(t.snap, cfg):
+            ctx.start_reading = motion.mean_distance(t.snap)
+            ctx.start_wheel = motion.wheel_position(t.snap)
+            t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
+                  start_reading=ctx.start_reading)
+        if t.mode is Mode.CALIBRATE_ONLY:
+            return end("completed", "calibrate-only: calibration done")
+    return _after_calibration(t)
 
 
 def _one_riser(cfg: RobotConfig) -> float:
@@ -139,13 +236,16 @@ def _nearer(t: Tick) -> float | None:
 CHECK = PhaseDef(
     P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check,
     to={
-        P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead)",
+        P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead); calibrate-only: "
+                "squared up (checked)",
         P.CAL_CLOSE_IN: "start: the nearer reads farther than square_range_m",
         P.CAL_LIFT: "start: case 2 (SFR ≠ SFL), 2W (too far apart for one riser) or case 3 "
-                    "(SFR = SFL); later: SFR ≠ SFL",
-        P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL",
-        P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL",
-        P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be",
+                    "(SFR = SFL); later: SFR ≠ SFL; descent 1: turned from the heading the "
+                    "step was climbed with; a squaring turn checked and not square: correct it",
+        P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL; or squared up (checked)",
+        P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL; or squared up (checked)",
+        P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be; "
+                 "still not square after MAX_SQUARING_TURNS turns",
     })
 
 
@@ -188,8 +288,8 @@ def _lift_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
 
 def _lifted(t: Tick, _w: Work) -> Step:
     t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
-    if t.ctx.purpose == "home":
-        return go(P.DESCENT_TURN_BACK)
+    if t.ctx.turn_to is not None:
+        return go(P.CAL_TURN_TO)
     case = t.ctx.calibration_case
     return go(P.CAL_TURN if case == "2" else P.CAL_AWAY if case == "2W" else P.CAL_PROBE)
 
@@ -199,7 +299,8 @@ LIFT = PhaseDef(
     P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
     enter=_lift_enter, carried_by=(2,),
     to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
-        P.CAL_PROBE: "lifted; case 3", P.DESCENT_TURN_BACK: "lifted; descent 7 turns back",
+        P.CAL_PROBE: "lifted; case 3",
+        P.CAL_TURN_TO: "lifted; descent 1 or 7 turns back to a heading it had",
         P.ERROR: FAULT})
 
 
@@ -221,7 +322,13 @@ def _turn_enter(t: Tick, w: Work) -> None:
     # from square to it: the turn may make that and a margin, no more.
     w.turn_from = t.snap.turns(MotorId.MWR)
     lateral = max(t.cfg.sensors.front_lateral, 1e-6)
-    w.turn_limit_rad = math.atan(abs(sfl - sfr) / (2 * lateral)) + TURN_MARGIN_RAD
+    r, l_ = motion.pair(t.snap)
+    if motion.far(r, t.cfg) or motion.far(l_, t.cfg):
+        # one beam off the flight's side: no figure, at most as askew as a
+        # calibration may stand
+        w.turn_limit_rad = MAX_SQUARE_YAW_RAD + TURN_MARGIN_RAD
+    else:
+        w.turn_limit_rad = math.atan(abs(sfl - sfr) / (2 * lateral)) + TURN_MARGIN_RAD
 
 
 def _turned_past_limit(t: Tick, w: Work) -> Step | None:
@@ -250,6 +357,7 @@ def _turn(t: Tick, w: Work) -> Step:
             t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {w.diff_n} readings "
                   f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
                   diff=diff)
+            t.ctx.squaring_turns += 1
             return go(P.CAL_LOWER)
         # Not square yet: turn on, slowly, the way the difference says.
         w.checked, w.diff_sum, w.diff_n, w.still_since = False, 0.0, 0, None
@@ -373,41 +481,56 @@ AWAY = PhaseDef(
         P.ERROR: "turned too far; " + FAULT})
 
 
+# -- turn back to a heading (descent 1 and 7) ------------------------------------------
+def _turn_to_enter(t: Tick, w: Work) -> None:
+    w.turn_from = t.snap.turns(MotorId.MWR)
+
+
+def _turn_to(t: Tick, w: Work) -> Step:
+    """Turn on segment 2's wheels until the odometer's heading is ctx.turn_to."""
+    assert t.ctx.turn_to is not None  # set by whoever lifted for this turn
+    remaining = t.ctx.turn_to - motion.twist(t.snap)
+    if abs(remaining) <= motion.WHEEL_DONE:
+        return go(P.CAL_LOWER)
+    too_far = _turned_too_far(t, P.CAL_TURN_TO)
+    if too_far is not None:
+        return too_far
+    slow = min(1.0, max(TURN_SLOW_FLOOR, abs(remaining) / motion.WHEEL_SLOW_ZONE))
+    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, slow))
+
+
+TURN_TO = PhaseDef(
+    P.CAL_TURN_TO, "calibration — turn back to a heading it had, by the odometer", FLOW,
+    _turn_to, enter=_turn_to_enter,
+    to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
+
+
 # -- lower segments 1 and 3 --------------------------------------------------------------
 def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
     ctx = t.ctx
     return {MotorId.MTF: ctx.return_mtf - w.entry_mtf, MotorId.MTB: ctx.return_mtb - w.entry_mtb}
 
 
-def _lowered(t: Tick, w: Work) -> Step:
-    ctx, cfg = t.ctx, t.cfg
+def _lowered(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    ctx.turn_to = None
     if ctx.purpose == "home":
         return go(P.DESCENT_FINISH_FLOOR)
-    if ctx.purpose == "start":
-        # The start reading is measured once the filter has settled standing
-        # here: segment 1 settling onto its wheels pitches the beams down for
-        # a moment, and a cone then reads the floor (the tof robot read
-        # 0.202 m for 0.327 m, and came home 0.125 m short).
-        if not _settled(t, w):
-            return stay(NO_MOTION)
-        ctx.square_turn = t.snap.turns(MotorId.MWR) - ctx.turn_origin
-        if motion.measurable(t.snap, cfg):
-            ctx.start_reading = motion.mean_distance(t.snap)
-            ctx.start_wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
-                  start_reading=ctx.start_reading)
-        if t.mode is Mode.CALIBRATE_ONLY:
-            return end("completed", "calibrate-only: calibration done")
-    return _after_calibration(t)
+    # Check standing on all wheels, once the filter has settled there (the
+    # check waits for it): a squaring turn (squaring_turns > 0), or descent
+    # 1's turn back to the climb's heading (the seed's check).  Segment 1
+    # settling onto its wheels pitches the beams down for a moment, and a
+    # cone then reads the floor (the tof robot took its start reading there,
+    # 0.202 m for 0.327 m, and came home 0.125 m short).
+    return go(P.CAL_CHECK)
 
 
 _lower_enter, _lower_step = lift(_lower_deltas, _lowered)
 LOWER = PhaseDef(
     P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, enter=_lower_enter,
     carried_by=(2,),
-    to={P.ASCENT_APPROACH: "lowered (start or ascent 1)",
-        P.DESCENT_BACK_TO_EDGE: "lowered (descent 1)",
+    to={P.CAL_CHECK: "lowered: check standing on all wheels",
         P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back)",
-        P.DONE: "lowered; calibrate-only mode", P.ERROR: FAULT})
+        P.ERROR: FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, PROBE, CORNER, AWAY, TURN, LOWER)
+PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, PROBE, CORNER, AWAY, TURN, TURN_TO, LOWER)

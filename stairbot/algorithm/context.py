@@ -57,9 +57,21 @@ class Context:
     """The drive's odometer where the program began: where descent 7 returns
     to (the first calibration may have closed in on the riser before it
     squared up, its start position is then nearer the stairs)."""
-    square_turn: float = 0.0
-    """MWR turns the first calibration made, net, after closing in: descent 7
-    turns them back before it backs the closed-in distance."""
+    home_twist: float | None = None
+    """The heading by the odometer where the program began: half of MWR's
+    counter less MWL's (:func:`~stairbot.algorithm.motion.twist`).  Descent 7
+    turns back to it before it backs the distance the first calibration
+    closed in."""
+    climb_twist: list[float | None] = field(default_factory=_empty_tab)
+    """Per step (0-based, as tab_length_to_edge): the heading by the odometer
+    the robot climbed it with (where ascent 1's calibration left it).
+    Descent 1 turns back to it, so that the way down retraces the way up."""
+    turn_to: float | None = None
+    """The heading (twist) the calibration's odometer turn is turning to."""
+    squaring_turns: int = 0
+    """Turns this calibration has made to square up (by the readings, then
+    by the odometer to correct what the check standing on all wheels found);
+    while above 0, the calibration's check verifies the last one."""
     steps_descended: int = 0
     pauses: int = 0
     ascent_end: str | None = None

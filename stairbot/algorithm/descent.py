@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.calibration import TURN_SLOW_FLOOR
+from stairbot.algorithm.calibration import HEADING_TOLERANCE_RAD, heading_off_rad
 from stairbot.algorithm.moves import (
     checked_first,
     drive_phase,
@@ -273,14 +273,16 @@ def _closed_in_turns(t: Tick) -> float:
 
 def _at_start_position(t: Tick, _w: Work) -> Step:
     """At the start position (where the first calibration squared up).  If it
-    closed in first, the way home retraces it: turn back the squaring turn
-    (segments 1 and 3 lifted, as calibration turns), then back the distance."""
+    closed in first, the way home retraces it: turn back to the heading the
+    program began with (segments 1 and 3 lifted, as calibration turns), then
+    back the distance."""
     ctx = t.ctx
     if _closed_in_turns(t) <= motion.WHEEL_DONE:
         return end("completed", "back at the start position")
-    if abs(ctx.square_turn) <= motion.WHEEL_DONE:
+    if ctx.home_twist is None or abs(heading_off_rad(t, ctx.home_twist)) <= HEADING_TOLERANCE_RAD:
         return go(P.DESCENT_FINISH_FLOOR)
     ctx.purpose = "home"
+    ctx.turn_to = ctx.home_twist
     return go(P.CAL_LIFT)
 
 
@@ -291,28 +293,11 @@ FINISH = PhaseDef(
     enter=_finish[0], watches="front",
     to={P.DONE: "reads the start reading (or turns made; with no step climbed: back by the "
                 "odometer to the start position)",
-        P.CAL_LIFT: "the first calibration closed in and turned: lift to turn back",
+        P.CAL_LIFT: "the first calibration closed in, and the robot is turned from the heading "
+                    "the program began with: lift to turn back",
         P.DESCENT_FINISH_FLOOR: "the first calibration closed in, square already",
         P.ERROR: FAULT})
 
-
-def _turn_back_enter(t: Tick, w: Work) -> None:
-    w.turn_from = t.snap.turns(MotorId.MWR)
-
-
-def _turn_back(t: Tick, w: Work) -> Step:
-    """Turn on segment 2's wheels until MWR has undone the squaring turn."""
-    remaining = w.turn_from - t.ctx.square_turn - t.snap.turns(MotorId.MWR)
-    if abs(remaining) <= motion.WHEEL_DONE:
-        return go(P.CAL_LOWER)
-    slow = min(1.0, max(TURN_SLOW_FLOOR, abs(remaining) / motion.WHEEL_SLOW_ZONE))
-    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, slow))
-
-
-TURN_BACK = PhaseDef(
-    P.DESCENT_TURN_BACK, "descent 7 — turn back as far as the first calibration turned",
-    FLOW, _turn_back, enter=_turn_back_enter,
-    to={P.CAL_LOWER: "turned back", P.ERROR: FAULT})
 
 _floor = turns_drive(-1, _closed_in_turns,
                      lambda _t, _w: end("completed", "back where the program began"))
@@ -323,5 +308,5 @@ FINISH_FLOOR = PhaseDef(
 
 PHASES: tuple[PhaseDef, ...] = (
     BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST, LOWER_FIRST,
-    FINISH, TURN_BACK, FINISH_FLOOR,
+    FINISH, FINISH_FLOOR,
 )

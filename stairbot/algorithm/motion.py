@@ -112,9 +112,22 @@ def turn(direction: int, cfg: RobotConfig, fraction: float = 1.0) -> Speeds:
     return {MotorId.MWR: direction * v, MotorId.MWL: -direction * v}
 
 
+def twist(snap: Snapshot) -> float:
+    """The heading by the odometer, in wheel turns: half of MWR's counter less
+    MWL's.  Driving moves both alike; turning in place moves them apart, by
+    :func:`turn_yaw_rad` of this per radian."""
+    return (snap.turns(MotorId.MWR) - snap.turns(MotorId.MWL)) / 2.0
+
+
 def turn_yaw_rad(cfg: RobotConfig, wheel_turns: float) -> float:
     """Yaw made when MWR and MWL each make ``wheel_turns`` turns in opposite directions."""
     return wheel_turns * cfg.wheel_circumference / (cfg.geometry.track_width / 2.0)
+
+
+def yaw_turns(cfg: RobotConfig, yaw_rad: float) -> float:
+    """The turns MWR and MWL each make, in opposite directions, to turn
+    ``yaw_rad`` (the inverse of :func:`turn_yaw_rad`)."""
+    return yaw_rad * (cfg.geometry.track_width / 2.0) / cfg.wheel_circumference
 
 
 def lift_to(cfg: RobotConfig, snap: Snapshot, motor: MotorId, target: float) -> float | None:

@@ -130,8 +130,7 @@ def where(ctx: Context, phase: Phase) -> str:
     if flow == "ascent":
         counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
         return f"step {ctx.number_of_steps + (0 if counted else 1)}"
-    if flow == "descent" and phase not in (Phase.DESCENT_FINISH, Phase.DESCENT_TURN_BACK,
-                                             Phase.DESCENT_FINISH_FLOOR):
+    if flow == "descent" and phase not in (Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR):
         return f"step {ctx.number_of_steps - ctx.steps_descended}"
     return ""
 

@@ -56,7 +56,8 @@ def first_turn(events: list[Event]) -> str:
 def test_case_2_turns_towards_the_nearer_side_until_square(yaw: float) -> None:
     ctrl, robot, events, seen = calibrate(yaw_deg=yaw, noise=0.001)
     assert ctrl.context.calibration_case == "2"
-    assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_TURN, Phase.CAL_LOWER]
+    assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_TURN, Phase.CAL_LOWER,
+                    Phase.CAL_CHECK]  # checked standing on all wheels
     # turned left (+) for SFL < SFR, i.e. when yawed right (-), and vice versa
     assert TURNED[id(ctrl)] == (1 if yaw < 0 else -1)
     assert abs(robot.yaw) < SQUARE
@@ -78,7 +79,7 @@ def test_case_3a_probes_left_then_turns_back_square() -> None:
     ctrl, robot, events, seen = calibrate(noise=0.001)
     assert ctrl.context.calibration_case == "3A"
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_TURN,
-                    Phase.CAL_LOWER]
+                    Phase.CAL_LOWER, Phase.CAL_CHECK]
     assert TURNED[id(ctrl)] == -1  # back right
     assert abs(robot.yaw) < SQUARE
     assert any("case 3A" in e.message for e in events)
@@ -118,7 +119,7 @@ def test_case_3b_a_corner_turns_left_until_both_shrink_then_squares_up() -> None
 
     run(ctrl, robot, until=watch)
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_CORNER,
-                    Phase.CAL_TURN, Phase.CAL_LOWER]
+                    Phase.CAL_TURN, Phase.CAL_LOWER, Phase.CAL_CHECK]
     assert ctrl.context.calibration_case == "3B"
     assert abs(robot.yaw) < SQUARE
     assert ctrl.result.outcome == "completed"
@@ -133,8 +134,8 @@ def test_later_steps_calibrate_only_when_the_readings_differ() -> None:
     assert len(lifts) == 1  # square all the way: only the start lifts and turns
     checks = [e.message for e in events if e.kind is EventKind.PHASE
               and e.data["phase"] == "cal_check"]
-    assert checks[0].endswith("(start)")
-    assert "(ascent 1, step 2)" in checks[1]
+    assert checks[0].endswith("(start)") and checks[1].endswith("(start)")  # and its check
+    assert "(ascent 1, step 2)" in checks[2]
     assert "(descent 1, step 2)" in checks[-2] and "(descent 1, step 1)" in checks[-1]
 
 
@@ -166,7 +167,9 @@ def test_not_square_when_measured_standing_still_it_turns_back_the_right_way(
     run(ctrl, robot)
     assert ctrl.result.outcome == "completed"
     assert abs(robot.yaw) < SQUARE
-    assert robot.t - started < 5.0
+    # turned back, lowered, and checked standing on all wheels: seconds, not
+    # the stand-and-measure loop that only noise or the phase timeout ended
+    assert robot.t - started < 10.0
 
 
 def test_a_bad_first_reading_does_not_choose_the_case() -> None:
@@ -177,3 +180,32 @@ def test_a_bad_first_reading_does_not_choose_the_case() -> None:
         faults=[Fault(SensorId.SFR, 0.0, 0.1, offset=-0.42)], noise=0.001)
     assert ctrl.context.calibration_case in ("3A", "3B", "2")  # not 2W: no side wall here
     assert abs(robot.yaw) < SQUARE
+
+
+def test_descent_1_turns_back_to_the_heading_it_climbed_the_step_with() -> None:
+    """Squared up within the pair's noise, the robot may climb one step a
+    degree or two off the heading it comes down another with; after a long
+    flight that put it 0.1 m to the side of its start (the envelope sweep).
+    Descent 1 turns back, by the odometer, to the heading it climbed the
+    step with, then checks the readings as the seed says."""
+    from stairbot.algorithm import motion
+
+    events: list[Event] = []
+    ctrl = Controller(CFG, events.append)
+    robot = KinematicRobot(CFG, steps=[(0.17, 0.28)] * 2, top="wall")
+    run(ctrl, robot, until=lambda c: c.phase is Phase.DESCENT_BACK_OFF
+        and c.context.steps_descended == 1)
+    ctx = ctrl.context
+    climbed = ctx.climb_twist[0]
+    assert climbed is not None and ctx.climb_twist[1] is not None
+    # as if it had climbed step 1 2 degrees further left than it stands now
+    ctx.climb_twist[0] = climbed + motion.yaw_turns(CFG, math.radians(2.0))
+    yaw = robot.yaw
+    run(ctrl, robot, until=lambda c: c.phase is Phase.DESCENT_BACK_TO_EDGE)
+    said = [e.message for e in events if "from the heading it climbed this step with" in e.message]
+    assert len(said) == 1 and "turned -2.00°" in said[0], said
+    assert robot.yaw - yaw == pytest.approx(math.radians(2.0), abs=math.radians(0.2))
+    # within equal_tolerance of square still (3.5 mm over the pair): the
+    # seed's check lets it go on at the climb's heading
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "completed"

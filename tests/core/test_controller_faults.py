@@ -233,8 +233,11 @@ def test_hold_stops_every_motor_and_freezes_the_timers() -> None:
 
 
 def test_hold_during_the_standing_wait_extends_it() -> None:
-    ctrl, robot, _ = start(faults=[Fault(SensorId.SFL, 5.0, 7.0, offset=0.05)])
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
+    robot.faults.append(Fault(SensorId.SFL, robot.t + 0.2, robot.t + 2.2, offset=0.05))
     run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
+    assert ctrl.context.resume_phase == Phase.ASCENT_APPROACH.value
     paused_at = robot.t
     ctrl.hold("operator")
     run(ctrl, robot, until=lambda _c: robot.t > paused_at + 10.0)

@@ -56,7 +56,7 @@ def test_default_run_walks_every_phase_but_the_obstacle_and_corner(default_run) 
     seen = set(phases(events))
     # level rays square up from anywhere: no closing in, so nothing to retrace
     not_expected = {Phase.ASCENT_LOWER_OBSTACLE, Phase.CAL_CORNER, Phase.CAL_AWAY,
-                    Phase.PAUSED, Phase.ERROR, Phase.CAL_CLOSE_IN, Phase.DESCENT_TURN_BACK,
+                    Phase.PAUSED, Phase.ERROR, Phase.CAL_CLOSE_IN, Phase.CAL_TURN_TO,
                     Phase.DESCENT_FINISH_FLOOR}
     assert seen == set(Phase) - not_expected
 
@@ -170,7 +170,7 @@ def test_calibrate_only_ends_after_the_first_calibration() -> None:
     ctrl, robot, events, _ = go(mode=Mode.CALIBRATE_ONLY, yaw_deg=8.0)
     r = ctrl.result
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", None, 0)
-    assert phases(events)[-2] is Phase.CAL_LOWER
+    assert phases(events)[-3:-1] == [Phase.CAL_LOWER, Phase.CAL_CHECK]  # lowered, checked
     assert abs(robot.yaw) < 0.01
     assert ctrl.context.start_reading == pytest.approx(0.5, abs=0.01)
 
