@@ -200,6 +200,43 @@ def test_after_a_long_flight_it_comes_home(nine_steps: tuple[RunResult, list[Eve
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
 
 
+SHORT_TREADS = """
+[stairs]
+top = "landing"
+width = 1.0
+steps = [{rise = 0.141086, tread = 0.272629}, {rise = 0.143831, tread = 0.269382},
+         {rise = 0.142043, tread = 0.265423}, {rise = 0.140801, tread = 0.271245},
+         {rise = 0.13901, tread = 0.274156}, {rise = 0.140918, tread = 0.267896},
+         {rise = 0.138306, tread = 0.268265}, {rise = 0.139005, tread = 0.265219},
+         {rise = 0.135622, tread = 0.26819}]
+[start]
+distance = 0.615084
+yaw_deg = -10.305475
+lateral = -0.141991
+[sensors]
+noise = 0.001
+seed = 10037
+"""
+
+
+def test_backing_off_a_short_tread_is_bounded_by_the_edge_too() -> None:
+    """Found by the envelope sweep (case 749 on tof): on treads a centimetre
+    longer than the robot's minimum, descent 1's back-off (the seed's
+    approach turns) already took segment 3 past the edge; backing up to the
+    edge then allowed edge_clearance_m more from there, and the robot tipped
+    back (the tilt supervisor stopped it at 145 deg/s).  The back pair now
+    bounds the back-off as well, from where it first saw the drop."""
+    from stairbot.algorithm.phases import Phase
+
+    events: list[Event] = []
+    r = run_tof(SHORT_TREADS, events)
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+    seen = [e for e in events if e.message.startswith("SBR/SBL see the edge")]
+    assert len(seen) == 8  # every step but the top one, which needs no descent 1
+    assert all(e.phase == Phase.DESCENT_BACK_OFF.label for e in seen)
+
+
 LOW_RISER_ASKEW = """
 [stairs]
 top = "landing"

@@ -97,6 +97,9 @@ class Context:
     (and where descent 2 began lowering MTB)."""
     turn_origin: float = 0.0
     """MWR counter when calibration began turning: bounds the total turn."""
+    edge_wheel: float | None = None
+    """Descent 1: the odometer where the back pair first read the drop past
+    the edge of the step it stands on, backing off or backing up to it."""
     riser_gap: float | None = None
     """How far the front sensors stand from the riser when ascent 3 begins:
     the approach's last reading less what it drove after it (the sensors read

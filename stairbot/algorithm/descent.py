@@ -57,11 +57,19 @@ def _backed_off(t: Tick, _w: Work) -> Step:
     return go(P.CAL_CHECK)
 
 
-_back_off = turns_drive(-1, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, _backed_off)
+def _back_off_enter(t: Tick, w: Work) -> None:
+    t.ctx.edge_wheel = None  # a new step: its edge not seen yet
+    _back_off_drive[0](t, w)
+
+
+_back_off_drive = reading_drive(-1, lambda _t: None,
+                                lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
+                                _backed_off, lambda t, _w: _edge_bound(t))
 BACK_OFF = PhaseDef(
-    P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW, _back_off[1],
-    enter=_back_off[0], watches="front",
-    to={P.CAL_CHECK: "turns made: calibrate (case 2)", P.ERROR: FAULT})
+    P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW, _back_off_drive[1],
+    enter=_back_off_enter, watches="front",
+    to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
+                     "edge: calibrate (case 2)", P.ERROR: FAULT})
 
 
 def _edge_known(t: Tick, _w: Work) -> Step | None:
@@ -87,27 +95,31 @@ def edge_clearance_m(cfg: RobotConfig) -> float:
             + g.wheel_radius)
 
 
-def _edge_bound(t: Tick, w: Work) -> float | None:
-    """Descent 1's backing never passes edge_clearance_m beyond where the back
-    pair saw the drop (more than half the lowest rise below BACK_CLEARANCE,
-    or nothing in range): tab_length_to_edge, read on the way up, may be
-    a centimetre or two off, and the robot tipped back where it was."""
-    cfg = t.cfg
-    if w.edge_wheel is None:
+def _edge_bound(t: Tick) -> float | None:
+    """Descent 1's backing (backing off, and backing up to the edge) never
+    passes edge_clearance_m beyond where the back pair saw the drop (more
+    than half the lowest rise below BACK_CLEARANCE, or nothing in range):
+    tab_length_to_edge, read on the way up, may be a centimetre or two off,
+    and the robot tipped back where it was; and on a tread little longer
+    than the robot, backing off the seed's approach turns already takes
+    segment 3 past the edge (the envelope sweep: the tof robot tipped back
+    backing up to the edge after that)."""
+    cfg, ctx = t.cfg, t.ctx
+    if ctx.edge_wheel is None:
         backs = [t.snap.sensors[s] for s in BACK_SENSORS]
         drop = cfg.BACK_CLEARANCE + floor_tolerance(cfg) + cfg.min_step_rise_m / 2
         if all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
                or r.ok and r.distance_m > drop for r in backs):
-            w.edge_wheel = motion.wheel_position(t.snap)
+            ctx.edge_wheel = motion.wheel_position(t.snap)
             t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m):"
                   f" backing at most {edge_clearance_m(cfg):.3f} m more")
-    if w.edge_wheel is None:
+    if ctx.edge_wheel is None:
         return None
-    return w.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
+    return ctx.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
 
 
 _to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD),
-                         _edge_bound)
+                         lambda t, _w: _edge_bound(t))
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
     checked_first(_edge_known, _to_edge[1]), enter=_to_edge[0], watches="front",

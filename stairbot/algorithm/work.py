@@ -56,9 +56,6 @@ class Work:
     finishing: bool = False
     """Descent 2: the back pair reads BACK_CLEARANCE within its noise; the
     rest of the lowering goes by turns to ``target_mtb``."""
-    edge_wheel: float | None = None
-    """Descent 1: the odometer where the back pair first read the drop past
-    the edge."""
     balanced: bool = False
     """The static-stability check has run (before a lift phase's first step)."""
 
