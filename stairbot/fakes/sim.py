@@ -33,7 +33,7 @@ from urllib.parse import urlsplit
 from stairbot.config import RobotConfig
 from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.plan import Plan
-from stairbot.fakes.sim_sensors import SimSensors, imu
+from stairbot.fakes.sim_sensors import SimImu, SimSensors
 from stairbot.fakes.world import World, WorldParams
 from stairbot.hardware import (
     LIFT_MOTORS,
@@ -69,6 +69,7 @@ class SimRobot:
                          yaw=math.radians(scenario.start.yaw_deg))
         self._start_y = self.plan.y
         self.board = SimSensors(config, scenario, self.world, self.plan)
+        self._imu = SimImu(self.world)
         m = config.motors
         self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
                         for mid in MotorId}
@@ -98,7 +99,8 @@ class SimRobot:
             raise RobotFellError(w.fall_reason or "unstable")
         if self._snap is not None and self._snap_at == w.steps_done:
             return self._snap
-        snap = Snapshot(w.time, self.board.read(w.time), self._motor_states(), {}, imu(w))
+        snap = Snapshot(w.time, self.board.read(w.time), self._motor_states(), {},
+                        self._imu.read())
         self._snap, self._snap_at = snap, w.steps_done
         return snap
 

@@ -35,10 +35,29 @@ IMU_SEGMENT = 1
 """The IMU rides in segment 2 (index 1 in the world)."""
 
 
-def imu(world: World) -> Imu:
-    """What the sensor board's IMU reports now: segment 2's pitch (+ nose up)
-    and pitch rate; roll 0 (a side view cannot roll); measured now (age 0)."""
-    return Imu(world.pitch_deg(IMU_SEGMENT), 0.0, world.pitch_rate_dps(IMU_SEGMENT), 0.0)
+class SimImu:
+    """The sensor board's IMU: segment 2's pitch (+ nose up) and pitch rate;
+    roll 0 (a side view cannot roll); measured now (age 0).
+
+    The rate is the mean over the time since the last reading -- the change
+    of pitch over it -- as a MEMS gyro's low-pass filter reports it, not the
+    body's angular velocity after the last physics step: a contact's impulse
+    in one 2 ms step read 124 deg/s at 4.6 deg of pitch, and the tilt
+    supervisor stopped a sound climb (the envelope sweep, case 1669 on tof)."""
+
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self._last: tuple[float, float] | None = None  # (time, pitch) of the last reading
+
+    def read(self) -> Imu:
+        w = self.world
+        t, pitch = w.time, w.pitch_deg(IMU_SEGMENT)
+        last, self._last = self._last, (t, pitch)
+        if last is None or t - last[0] <= 0.0:
+            rate = w.pitch_rate_dps(IMU_SEGMENT)  # nothing to average over yet
+        else:
+            rate = (pitch - last[1]) / (t - last[0])
+        return Imu(pitch, 0.0, rate, 0.0)
 
 
 class SimSensors:
