@@ -36,6 +36,9 @@ class SensorSpec:
     fov_deg: float = 0.0
     """Full angle of the cone as shipped (a ToF's ROI may narrow it: the robot
     config's ``front_fov_deg`` / ``back_fov_deg``)."""
+    first_echo: bool = False
+    """It reports the nearest surface anywhere in its cone (an ultrasonic
+    ranger's first echo), not a mean over the cone."""
 
     def sigma(self, distance_m: float, stated_noise: float) -> float:
         """The stated sigma of a reading at ``distance_m``."""
@@ -74,9 +77,10 @@ VL53L0X = SensorSpec(name="vl53l0x", period_s=0.030, latency_s=0.030, noise_a=0.
 #   cycle"; "ranging accuracy can reach to 3mm".
 # - Latency: the echo pulse lasts up to ~23 ms at 4 m: assumed 25 ms.
 # - Assumed sigma = 2 mm + 0.3 % of the distance.
+# - The first echo back ends the measurement: the nearest surface in the cone.
 HCSR04 = SensorSpec(name="hcsr04", period_s=0.060, latency_s=0.025, noise_a=0.002,
                     noise_b=0.003, resolution=0.003, min_range=0.02, max_range=4.0,
-                    fov_deg=15.0)
+                    fov_deg=15.0, first_echo=True)
 
 # Sharp GP2Y0A21YK0F infrared triangulation ranger (analog output).
 # - Datasheet "Electro-optical Characteristics": 10 to 80 cm; "Timing chart":

@@ -31,3 +31,52 @@ def test_a_shipped_robot_climbs_the_default_stairs_and_comes_home(name: str) -> 
         "completed", "top_reached", 5, 5), r.to_dict()
     assert not r.fell and r.pauses <= 1, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+
+
+SONAR_EDGES = """
+[stairs]
+top = "wall"
+width = 1.0
+steps = [{rise = 0.148569, tread = 0.283204}, {rise = 0.151356, tread = 0.278717},
+         {rise = 0.146252, tread = 0.279848}, {rise = 0.145123, tread = 0.284704}]
+[start]
+distance = 0.348072
+yaw_deg = -7.834614
+lateral = -0.084547
+[sensors]
+noise = 0.001
+seed = 325161
+"""
+
+
+def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
+    """Found by the envelope sweep (case 925 on sonar): an HC-SR04 pair
+    looking down reports the first echo in its 15 deg cone, and kept seeing
+    the riser below an edge until it was 2.4 cm past it; backing
+    edge_clearance_m from where it saw the drop, the robot tipped back.
+    The edge is now placed where the pair crossed it (edge_sight_m), and
+    segment 3's front wheels stop clear of the edge's corner."""
+    from stairbot.algorithm.descent import edge_clearance_m, edge_sight_m
+    from stairbot.events import Event
+    from stairbot.scenario import parse_scenario
+
+    sonar, tof = load_config("sonar"), load_config("tof")
+    full = sonar.motors.wheel_speed * sonar.wheel_circumference
+    # backing at full speed: its latency, then half a period and one more
+    # (the median of three needs two measurements of the drop)
+    assert edge_sight_m(sonar, full) - edge_sight_m(sonar, 0.0) == pytest.approx(
+        full * (0.025 + 1.5 * 0.06), rel=1e-6)
+    # the first echo's cone: the riser is seen until drop x sin 7.5 deg past the edge
+    assert edge_sight_m(sonar, 0.0) > 0.01 and edge_sight_m(tof, 0.0) == 0.0
+    assert edge_clearance_m(sonar) == pytest.approx(0.0685)
+    events: list[Event] = []
+    session = open_robot("sim://", sonar, RobotOptions(world=parse_scenario(SONAR_EDGES, "edges")))
+    try:
+        r = run(session, sonar, events.append)
+    finally:
+        session.close()
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 4, 4), r.to_dict()
+    assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+    seen = [e.message for e in events if e.message.startswith("SBR/SBL see the edge")]
+    assert seen and all("mm past it" in m for m in seen)

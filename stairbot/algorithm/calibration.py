@@ -61,9 +61,9 @@ MAX_SQUARING_TURNS = 4
 turn, then corrections by the odometer) and still does not read SFR = SFL
 standing on all wheels ends with an error."""
 HEADING_TOLERANCE_RAD = math.radians(0.3)
-"""Descent 1 turns back to the heading it climbed the step with when the
-odometer says it is further off than this (0.3 deg: 1.6 mm sideways over a
-0.3 m climb)."""
+"""Descent 1 turns back to the heading it climbed the step with, and descent
+7 to the one the program began with, when the odometer says it is further
+off than this (0.3 deg: 1.6 mm sideways over a 0.3 m climb)."""
 
 
 def _readings(t: Tick) -> tuple[float, float]:
@@ -99,7 +99,7 @@ def _settled(t: Tick, w: Work) -> bool:
 def _check(t: Tick, w: Work) -> Step:
     cfg, ctx = t.cfg, t.ctx
     sfr, sfl = motion.pair(t.snap)
-    if ctx.purpose == "descent" and ctx.squaring_turns == 0:
+    if ctx.purpose == "descent" and ctx.squaring_turns == 0 and not ctx.turned_back:
         # Descent 1 first turns back to the heading it climbed this step with
         # (by the odometer), so that the way down retraces the way up: squared
         # up within the pair's noise on the way up and again on the way down,
@@ -110,6 +110,7 @@ def _check(t: Tick, w: Work) -> Step:
             off = heading_off_rad(t, climbed)
             if abs(off) > HEADING_TOLERANCE_RAD:
                 ctx.turn_to = climbed
+                ctx.turned_back = True  # once a step: then the seed's check
                 t.say(f"descent 1, step {t.descent_index + 1}: turned {math.degrees(off):+.2f}° "
                       "from the heading it climbed this step with (by the odometer); turning "
                       "back to it", off_deg=math.degrees(off))
@@ -182,7 +183,13 @@ def _verify(t: Tick, w: Work) -> Step:
     by the odometer as far as the difference says (a flat riser, both beams
     on it), and checks again."""
     ctx, cfg = t.ctx, t.cfg
-    sfr, sfl = _readings(t)
+    r, l_ = motion.pair(t.snap)
+    sfr, sfl = r.distance_m, l_.distance_m
+    if motion.far(r, cfg) or motion.far(l_, cfg):
+        # no figure to square to, nor a riser where it squared up: stop
+        return fail(f"calibration ({where(ctx, P.CAL_CHECK)}): squared up, but standing on "
+                    f"all wheels SFR reads {sfr:.3f} m and SFL {sfl:.3f} m: at least one sees "
+                    "nothing ahead where the riser should be")
     diff = w.diff_sum / w.diff_n
     if abs(diff) <= still_tolerance(cfg, w.diff_n, min(sfr, sfl)):
         t.say(f"square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {w.diff_n} "
@@ -245,7 +252,8 @@ CHECK = PhaseDef(
         P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL; or squared up (checked)",
         P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL; or squared up (checked)",
         P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be; "
-                 "still not square after MAX_SQUARING_TURNS turns",
+                 "checking a squaring turn: nothing ahead, or still not square after "
+                 "MAX_SQUARING_TURNS turns",
     })
 
 
@@ -287,7 +295,10 @@ def _lift_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
 
 
 def _lifted(t: Tick, _w: Work) -> Step:
-    t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
+    if t.ctx.squaring_turns == 0:
+        # a calibration's first turn; its corrections count towards the same
+        # MAX_TURN_YAW_RAD
+        t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
     if t.ctx.turn_to is not None:
         return go(P.CAL_TURN_TO)
     case = t.ctx.calibration_case
@@ -300,7 +311,8 @@ LIFT = PhaseDef(
     enter=_lift_enter, carried_by=(2,),
     to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
         P.CAL_PROBE: "lifted; case 3",
-        P.CAL_TURN_TO: "lifted; descent 1 or 7 turns back to a heading it had",
+        P.CAL_TURN_TO: "lifted; a correction of the squaring turn, or descent 1 or 7 "
+                       "turning back to a heading it had",
         P.ERROR: FAULT})
 
 
@@ -482,10 +494,6 @@ AWAY = PhaseDef(
 
 
 # -- turn back to a heading (descent 1 and 7) ------------------------------------------
-def _turn_to_enter(t: Tick, w: Work) -> None:
-    w.turn_from = t.snap.turns(MotorId.MWR)
-
-
 def _turn_to(t: Tick, w: Work) -> Step:
     """Turn on segment 2's wheels until the odometer's heading is ctx.turn_to."""
     assert t.ctx.turn_to is not None  # set by whoever lifted for this turn
@@ -500,8 +508,8 @@ def _turn_to(t: Tick, w: Work) -> Step:
 
 
 TURN_TO = PhaseDef(
-    P.CAL_TURN_TO, "calibration — turn back to a heading it had, by the odometer", FLOW,
-    _turn_to, enter=_turn_to_enter,
+    P.CAL_TURN_TO, "calibration — turn by the odometer to a heading", FLOW,
+    _turn_to,
     to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
 
 

@@ -98,8 +98,13 @@ class Context:
     turn_origin: float = 0.0
     """MWR counter when calibration began turning: bounds the total turn."""
     edge_wheel: float | None = None
-    """Descent 1: the odometer where the back pair first read the drop past
-    the edge of the step it stands on, backing off or backing up to it."""
+    """Descent 1: the odometer where the back pair crossed the edge of the
+    step it stands on (where it read the drop, less how far the robot
+    backed while the reading came through:
+    :func:`~stairbot.algorithm.descent.edge_sight_m`), backing
+    off or backing up to it."""
+    turned_back: bool = False
+    """Descent 1 has turned back to the climb's heading on this step (once)."""
     riser_gap: float | None = None
     """How far the front sensors stand from the riser when ascent 3 begins:
     the approach's last reading less what it drove after it (the sensors read
@@ -128,6 +133,10 @@ class Context:
             if key not in known:
                 raise InputError(source, key, "unknown key; allowed: " + ", ".join(known))
             kwargs[key] = value
+        twists = kwargs.get("climb_twist")
+        if twists is not None and (not isinstance(twists, list) or len(twists) != TAB_SIZE):
+            raise InputError(source, "climb_twist",
+                             f"must be a list of {TAB_SIZE} numbers or nulls")
         tab = kwargs.get("tab_length_to_edge")
         if tab is not None:
             if not isinstance(tab, list) or len(tab) != TAB_SIZE or not all(

@@ -36,8 +36,8 @@ from stairbot.algorithm.phase import (
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
-from stairbot.hardware import BACK_SENSORS, MotorId, SensorStatus
-from stairbot.perception import median_sigma
+from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, MotorId, SensorStatus
+from stairbot.perception import measurement_period, median_sigma, window
 
 P = Phase
 FLOW = "descent"
@@ -58,7 +58,8 @@ def _backed_off(t: Tick, _w: Work) -> Step:
 
 
 def _back_off_enter(t: Tick, w: Work) -> None:
-    t.ctx.edge_wheel = None  # a new step: its edge not seen yet
+    t.ctx.edge_wheel = None  # a new step: its edge not seen yet, nor turned back
+    t.ctx.turned_back = False
     _back_off_drive[0](t, w)
 
 
@@ -85,14 +86,49 @@ def _edge_fallback(t: Tick) -> float:
     return t.cfg.wheel_turns(max(0.0, tab - t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
 
 
+EDGE_MARGIN_M = 0.006
+"""Segment 3's front wheels stop this far clear of the edge's corner."""
+
+
 def edge_clearance_m(cfg: RobotConfig) -> float:
     """How far the robot backs after its back pair (``back_from_rear`` from
-    segment 3's rear) crossed the edge until segment 3's front wheels are a
-    wheel radius past it: over the step below, and not yet so far that the
-    robot tips back off segment 2's rear wheels."""
+    segment 3's rear) crossed the edge until segment 3's front wheels are
+    clear of it, their front EDGE_MARGIN_M past its corner: over the step
+    below, and not yet so far that the robot tips back off segment 2's rear
+    wheels.  (Their centre a wheel radius past it, the wheels stood on the
+    corner: lowered, segment 3 stayed up and the lift pitched segment 2 12
+    deg nose down -- the envelope sweep on the sonar robot, once the edge
+    was placed where the pair crossed it.)"""
     g = cfg.geometry
     return (g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear - g.wheel_inset
-            + g.wheel_radius)
+            + g.wheel_radius + EDGE_MARGIN_M)
+
+
+def edge_drop_m(cfg: RobotConfig) -> float:
+    """The back pair reads "past the edge" beyond this: more than half the
+    lowest rise below BACK_CLEARANCE (and its noise)."""
+    return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + cfg.min_step_rise_m / 2
+
+
+def edge_sight_m(cfg: RobotConfig, speed_mps: float) -> float:
+    """How far past an edge the back pair's sensors are when perception first
+    reports the drop, backing at ``speed_mps``: the distance backed while
+    the measurements came through (the sensor's latency, then the median's
+    majority of the window, one period each, the first of them half a
+    period after the crossing on average), and for a sensor that reports
+    the first echo in its cone, the riser's face below the edge that the
+    cone's back half keeps seeing, nearer than the drop, until the sensor
+    is ``edge_drop_m`` x sin(half the cone) past it.  The HC-SR04 pair saw
+    the drop 2.4 cm past the edge; backing edge_clearance_m from there, the
+    sonar robot tipped back (the envelope sweep, case 925)."""
+    spec = cfg.sensors.spec(True)
+    period = measurement_period(cfg, True)
+    lag_s = spec.latency_s + (window(cfg, True) // 2 + 0.5) * period
+    sight = abs(speed_mps) * lag_s
+    if spec.first_echo:
+        fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
+        sight += edge_drop_m(cfg) * math.sin(math.radians(fov) / 2)
+    return sight
 
 
 def _edge_bound(t: Tick) -> float | None:
@@ -107,12 +143,17 @@ def _edge_bound(t: Tick) -> float | None:
     cfg, ctx = t.cfg, t.ctx
     if ctx.edge_wheel is None:
         backs = [t.snap.sensors[s] for s in BACK_SENSORS]
-        drop = cfg.BACK_CLEARANCE + floor_tolerance(cfg) + cfg.min_step_rise_m / 2
+        drop = edge_drop_m(cfg)
         if all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
                or r.ok and r.distance_m > drop for r in backs):
-            ctx.edge_wheel = motion.wheel_position(t.snap)
-            t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m):"
-                  f" backing at most {edge_clearance_m(cfg):.3f} m more")
+            speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
+            sight = edge_sight_m(cfg, speed * cfg.wheel_circumference)
+            # where they crossed it: behind the robot's back (backing, the
+            # odometer runs down), so the crossing was at a larger count
+            ctx.edge_wheel = motion.wheel_position(t.snap) + cfg.wheel_turns(sight)
+            more = max(0.0, edge_clearance_m(cfg) - sight)
+            t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m, "
+                  f"about {sight * 1000:.0f} mm past it): backing at most {more:.3f} m more")
     if ctx.edge_wheel is None:
         return None
     return ctx.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
@@ -307,7 +348,8 @@ FINISH = PhaseDef(
                 "odometer to the start position)",
         P.CAL_LIFT: "the first calibration closed in, and the robot is turned from the heading "
                     "the program began with: lift to turn back",
-        P.DESCENT_FINISH_FLOOR: "the first calibration closed in, square already",
+        P.DESCENT_FINISH_FLOOR: "the first calibration closed in; turned within "
+                                "HEADING_TOLERANCE_RAD of the heading it began with",
         P.ERROR: FAULT})
 
 
