@@ -49,6 +49,9 @@ class Work:
     diff_sum: float = 0.0
     diff_n: int = 0
     """A pair difference summed over ticks standing still, and how many."""
+    diff_skipped: int = 0
+    """Ticks standing still on which a reading of the pair gave no figure
+    for the difference (an error, a dropout, nothing ahead)."""
     checked: bool = False
     """The phase's entry condition has been checked (on its first step)."""
     still_since: float | None = None

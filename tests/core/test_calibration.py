@@ -209,3 +209,16 @@ def test_descent_1_turns_back_to_the_heading_it_climbed_the_step_with() -> None:
     # seed's check lets it go on at the climb's heading
     run(ctrl, robot)
     assert ctrl.result.outcome == "completed"
+
+
+def test_a_dropout_while_standing_is_no_figure_for_the_difference() -> None:
+    """Found by the envelope sweep (case 151 on sonar): one sensor read
+    "nothing ahead" for a moment while calibration averaged the pair
+    standing still; summed in, it moved the mean by centimetres and the
+    robot, square within 6 mm, took it for a side wall (case 2W) and turned
+    45 deg away from the riser.  Ticks without a distance on both are left
+    out of the mean."""
+    ctrl, robot, events, _seen = calibrate(
+        faults=[Fault(SensorId.SFL, 0.3, 0.4, offset=1.2)], noise=0.001)
+    assert ctrl.context.calibration_case == "3A", first_turn(events)
+    assert abs(robot.yaw) < SQUARE
