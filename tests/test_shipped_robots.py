@@ -80,3 +80,42 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
     seen = [e.message for e in events if e.message.startswith("SBR/SBL see the edge")]
     assert seen and all("mm past it" in m for m in seen)
+
+
+IR_EDGES = """
+[stairs]
+top = "landing"
+width = 1.0
+steps = [{rise = 0.137491, tread = 0.306526}, {rise = 0.137578, tread = 0.30747},
+         {rise = 0.136857, tread = 0.305242}, {rise = 0.139671, tread = 0.313933},
+         {rise = 0.135077, tread = 0.314188}, {rise = 0.143918, tread = 0.305806},
+         {rise = 0.137419, tread = 0.307501}, {rise = 0.139544, tread = 0.305127},
+         {rise = 0.144795, tread = 0.306792}, {rise = 0.143367, tread = 0.309614}]
+[start]
+distance = 0.545328
+yaw_deg = 11.999186
+lateral = -0.065899
+[sensors]
+noise = 0.001
+seed = 444091
+"""
+
+
+def test_backing_to_an_edge_ends_where_the_back_pair_says_not_at_the_tab() -> None:
+    """Found by the envelope sweep (cases 781 and 782 on ir): backing up to the edge
+    ended at tab_length_to_edge, read on the way up where segment 3 was
+    lifted over the edge; that left segment 3's front wheels on the edge's
+    corner, and lowered, segment 3 stayed up while the lift pitched the
+    robot nose up (163-171 deg/s).  Once the back pair has crossed the edge the
+    backing ends edge_clearance_m past it."""
+    from stairbot.scenario import parse_scenario
+
+    ir = load_config("ir")
+    session = open_robot("sim://", ir, RobotOptions(world=parse_scenario(IR_EDGES, "ir_edges")))
+    try:
+        r = run(session, ir)
+    finally:
+        session.close()
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 10, 10), r.to_dict()
+    assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()

@@ -159,13 +159,18 @@ def _edge_bound(t: Tick) -> float | None:
     return ctx.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
 
 
+# Once the back pair has crossed the edge, the backing ends edge_clearance_m
+# past it, wherever tab_length_to_edge would stop it: read on the way up
+# where segment 3 was lifted over the edge, it left segment 3's front wheels
+# on the edge's corner, and lowered, segment 3 stayed up while the lift
+# pitched the robot (the envelope sweep, case 781 on ir).
 _to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD),
-                         lambda t, _w: _edge_bound(t))
+                         lambda t, _w: _edge_bound(t), exact=True)
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
     checked_first(_edge_known, _to_edge[1]), enter=_to_edge[0], watches="front",
-    to={P.DESCENT_LOWER_THIRD: "reads tab_length_to_edge[i], or backed edge_clearance_m "
-                                "past where SBR/SBL saw the edge",
+    to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
+                                "edge; or, not crossed yet, reads tab_length_to_edge[i]",
         P.ERROR: "tab_length_to_edge[i] unknown; " + FAULT})
 
 

@@ -47,6 +47,7 @@ def reading_drive(
     fallback_turns: Callable[[Tick], float],
     done: Done,
     bound: Callable[[Tick, Work], float | None] | None = None,
+    exact: bool = False,
 ) -> tuple[Enter, StepFn]:
     """A drive (``direction`` +1 forward, -1 back) that ends when the mean
     SFR/SFL reading reaches ``target(t)`` metres.
@@ -57,7 +58,8 @@ def reading_drive(
     target — or, if they never were, to ``fallback_turns(t)`` turns from the
     phase's start (the seed's "not measurable" fallback).  A ``target`` of
     None means a drive by turns only.  ``bound(t, w)``, when it gives one, is
-    a wheel-counter position the drive never passes, whatever the readings say.
+    a wheel-counter position the drive never passes, whatever the readings say;
+    with ``exact``, the position it ends at.
     """
 
     def enter(t: Tick, w: Work) -> None:
@@ -89,7 +91,7 @@ def reading_drive(
                 w.target_wheel = here + direction * cfg.wheel_turns(remaining_m)
         assert w.target_wheel is not None  # set on entry
         limit = None if bound is None else bound(t, w)
-        if limit is not None and direction * (w.target_wheel - limit) > 0:
+        if limit is not None and (exact or direction * (w.target_wheel - limit) > 0):
             w.target_wheel = limit
         remaining = direction * (w.target_wheel - here)
         if remaining <= motion.WHEEL_DONE:
