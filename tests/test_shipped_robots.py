@@ -7,10 +7,21 @@ from __future__ import annotations
 
 import pytest
 
-from stairbot.config import load_config, shipped_configs
+from stairbot.config import RobotConfig, load_config, shipped_configs
+from stairbot.events import Event, discard
 from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
-from stairbot.scenario import load_scenario
+from stairbot.runner import RunResult, run
+from stairbot.scenario import Scenario, load_scenario, parse_scenario
+
+
+def run_sim(config: RobotConfig, scenario: Scenario,
+            events: list[Event] | None = None) -> RunResult:
+    """``config``'s robot, simulated, on ``scenario``; its events to ``events``."""
+    session = open_robot("sim://", config, RobotOptions(world=scenario))
+    try:
+        return run(session, config, discard if events is None else events.append)
+    finally:
+        session.close()
 
 
 def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:
@@ -22,11 +33,7 @@ def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:
 @pytest.mark.parametrize("name", shipped_configs())
 def test_a_shipped_robot_climbs_the_default_stairs_and_comes_home(name: str) -> None:
     config = load_config(name)
-    session = open_robot("sim://", config, RobotOptions(world=load_scenario()))
-    try:
-        r = run(session, config)
-    finally:
-        session.close()
+    r = run_sim(config, load_scenario())
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
         "completed", "top_reached", 5, 5), r.to_dict()
     assert not r.fell and r.pauses <= 1, r.to_dict()
@@ -57,9 +64,6 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     The edge is now placed where the pair crossed it (edge_sight_m), and
     segment 3's front wheels stop clear of the edge's corner."""
     from stairbot.algorithm.descent import edge_clearance_m, edge_sight_m
-    from stairbot.events import Event
-    from stairbot.scenario import parse_scenario
-
     sonar, tof = load_config("sonar"), load_config("tof")
     full = sonar.motors.wheel_speed * sonar.wheel_circumference
     # backing at full speed: its latency, then half a period and one more
@@ -70,11 +74,7 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     assert edge_sight_m(sonar, 0.0) > 0.01 and edge_sight_m(tof, 0.0) == 0.0
     assert edge_clearance_m(sonar) == pytest.approx(0.0685)
     events: list[Event] = []
-    session = open_robot("sim://", sonar, RobotOptions(world=parse_scenario(SONAR_EDGES, "edges")))
-    try:
-        r = run(session, sonar, events.append)
-    finally:
-        session.close()
+    r = run_sim(sonar, parse_scenario(SONAR_EDGES, "edges"), events)
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 4, 4), r.to_dict()
     assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
@@ -108,14 +108,8 @@ def test_backing_to_an_edge_ends_where_the_back_pair_says_not_at_the_tab() -> No
     corner, and lowered, segment 3 stayed up while the lift pitched the
     robot nose up (163-171 deg/s).  Once the back pair has crossed the edge the
     backing ends edge_clearance_m past it."""
-    from stairbot.scenario import parse_scenario
-
     ir = load_config("ir")
-    session = open_robot("sim://", ir, RobotOptions(world=parse_scenario(IR_EDGES, "ir_edges")))
-    try:
-        r = run(session, ir)
-    finally:
-        session.close()
+    r = run_sim(ir, parse_scenario(IR_EDGES, "ir_edges"))
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 10, 10), r.to_dict()
     assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
