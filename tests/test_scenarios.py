@@ -5,11 +5,11 @@ climbed and descended back to the start at several yaw offsets and noise seeds."
 from __future__ import annotations
 
 import pytest
+import simrun
 
 from stairbot.config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.runner import RunResult
 from stairbot.scenario import Scenario, expectation_mismatches, load_scenario, parse_scenario
 from stairbot.scenario import shipped_scenarios as shipped
 
@@ -18,11 +18,7 @@ CONFIG = load_config()
 
 def run_sim(scenario: Scenario) -> tuple[RunResult, list[Event]]:
     events: list[Event] = []
-    session = open_robot("sim://", CONFIG, RobotOptions(world=scenario))
-    try:
-        return run(session, CONFIG, sink=events.append), events
-    finally:
-        session.close()
+    return simrun.run_sim(CONFIG, scenario, events), events
 
 
 # Phases (Phase.value) a scenario must pass through, and must not: proof that the

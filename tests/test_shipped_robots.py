@@ -6,22 +6,11 @@ within its front pair's range)."""
 from __future__ import annotations
 
 import pytest
+from simrun import run_sim
 
-from stairbot.config import RobotConfig, load_config, shipped_configs
-from stairbot.events import Event, discard
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, load_scenario, parse_scenario
-
-
-def run_sim(config: RobotConfig, scenario: Scenario,
-            events: list[Event] | None = None) -> RunResult:
-    """``config``'s robot, simulated, on ``scenario``; its events to ``events``."""
-    session = open_robot("sim://", config, RobotOptions(world=scenario))
-    try:
-        return run(session, config, discard if events is None else events.append)
-    finally:
-        session.close()
+from stairbot.config import load_config, shipped_configs
+from stairbot.events import Event
+from stairbot.scenario import load_scenario, parse_scenario
 
 
 def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:

@@ -8,11 +8,11 @@ import math
 from pathlib import Path
 
 import pytest
+from simrun import run_sim
 
 from stairbot.config import load_config
-from stairbot.events import Event, discard
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.events import Event
+from stairbot.runner import RunResult
 from stairbot.scenario import load_scenario, parse_scenario
 from stairbot.sweep.spec import SpecError, load_spec, with_config
 
@@ -23,11 +23,7 @@ def run_tof(text: str | None, events: list[Event] | None = None) -> RunResult:
     """The tof robot on ``text``'s stairs (None: the default ones); the run's
     events go to ``events`` if given."""
     scenario = load_scenario() if text is None else parse_scenario(text, "<tof>")
-    session = open_robot("sim://", TOF, RobotOptions(world=scenario))
-    try:
-        return run(session, TOF, discard if events is None else events.append)
-    finally:
-        session.close()
+    return run_sim(TOF, scenario, events)
 
 
 def test_the_default_stairs_up_and_back() -> None:

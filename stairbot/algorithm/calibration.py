@@ -99,10 +99,9 @@ def _measured_standing(t: Tick, w: Work, needed: int) -> bool:
     """True once ``needed`` ticks have been measured; until then, add this
     tick's SFL − SFR to ``w``'s sum when both read a distance.  A reading
     that is an error, a dropout or nothing ahead is no figure for the
-    difference: one HC-SR04 dropout
-    (1.3 m) among 25 ticks moved their mean by 46 mm, and a robot squared
-    up within 6 mm turned 45 deg away from a side wall that was not there
-    (the envelope sweep, case 151 on sonar)."""
+    difference: one HC-SR04 dropout (1.3 m) among 25 ticks moved their mean
+    by 46 mm, and a robot squared up within 6 mm turned 45 deg away from a
+    side wall that was not there (the envelope sweep, case 151 on sonar)."""
     if w.diff_n + w.diff_skipped >= needed:
         return True
     r, l_ = motion.pair(t.snap)
@@ -228,9 +227,8 @@ def _verify(t: Tick, w: Work) -> Step:
                     f"{ctx.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
                     f"standing (SFR {sfr:.3f} m, SFL {sfl:.3f} m): the beams do not see one "
                     "flat riser alike (a riser too low for them, or its edge)")
-    lateral = max(cfg.sensors.front_lateral, 1e-6)
     # SFL farther than SFR: turned left of square, turn right (and the other way).
-    yaw = -math.atan(diff / (2 * lateral))
+    yaw = -_askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
     ctx.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
     ctx.squaring_turns += 1
@@ -252,6 +250,12 @@ def _squared(t: Tick) -> Step:
         if t.mode is Mode.CALIBRATE_ONLY:
             return end("completed", "calibrate-only: calibration done")
     return _after_calibration(t)
+
+
+def _askew_rad(cfg: RobotConfig, diff: float) -> float:
+    """How far the robot is turned left of square (radians) when both beams
+    on one flat riser read SFL − SFR = ``diff``."""
+    return math.atan(diff / (2 * max(cfg.sensors.front_lateral, 1e-6)))
 
 
 def _one_riser(cfg: RobotConfig) -> float:
@@ -352,21 +356,20 @@ def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
 
 
 def _turn_enter(t: Tick, w: Work) -> None:
-    sfr, sfl = _readings(t)
+    r, l_ = motion.pair(t.snap)
+    sfr, sfl = r.distance_m, l_.distance_m
     # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
     w.turn_direction = 1 if sfl < sfr else -1
     w.turn_diff = sfl - sfr
     # Both beams on one riser, the difference says how far the robot is turned
     # from square to it: the turn may make that and a margin, no more.
     w.turn_from = t.snap.turns(MotorId.MWR)
-    lateral = max(t.cfg.sensors.front_lateral, 1e-6)
-    r, l_ = motion.pair(t.snap)
     if motion.far(r, t.cfg) or motion.far(l_, t.cfg):
         # one beam off the flight's side: no figure, at most as askew as a
         # calibration may stand
         w.turn_limit_rad = MAX_SQUARE_YAW_RAD + TURN_MARGIN_RAD
     else:
-        w.turn_limit_rad = math.atan(abs(sfl - sfr) / (2 * lateral)) + TURN_MARGIN_RAD
+        w.turn_limit_rad = abs(_askew_rad(t.cfg, sfl - sfr)) + TURN_MARGIN_RAD
 
 
 def _turned_past_limit(t: Tick, w: Work) -> Step | None:

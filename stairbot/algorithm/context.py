@@ -133,29 +133,30 @@ class Context:
             if key not in known:
                 raise InputError(source, key, "unknown key; allowed: " + ", ".join(known))
             kwargs[key] = value
-        twists = kwargs.get("climb_twist")
-        if twists is not None and (not isinstance(twists, list) or len(twists) != TAB_SIZE):
-            raise InputError(source, "climb_twist",
-                             f"must be a list of {TAB_SIZE} numbers or nulls")
-        tab = kwargs.get("tab_length_to_edge")
-        if tab is not None:
+        for key in _PER_STEP:
+            tab = kwargs.get(key)
+            if tab is None:
+                continue
             if not isinstance(tab, list) or len(tab) != TAB_SIZE or not all(
                 v is None or isinstance(v, int | float) for v in tab
             ):
-                raise InputError(source, "tab_length_to_edge",
-                                 f"must be a list of {TAB_SIZE} numbers or nulls")
-            kwargs["tab_length_to_edge"] = [None if v is None else float(v) for v in tab]
+                raise InputError(source, key, f"must be a list of {TAB_SIZE} numbers or nulls")
+            kwargs[key] = [None if v is None else float(v) for v in tab]
         work = kwargs.get("work")
         if work is not None:
             kwargs["work"] = _work_from(work, source)
         ctx = cls(**kwargs)
         for name, f in known.items():
             value = getattr(ctx, name)
-            if name in ("tab_length_to_edge", "work"):
+            if name in _PER_STEP or name == "work":
                 continue
             if not _type_ok(value, str(f.type)):
                 raise InputError(source, name, f"{value!r} is not of type {f.type}")
         return ctx
+
+
+_PER_STEP = ("tab_length_to_edge", "climb_twist")
+"""The context's lists with one entry per step (TAB_SIZE long)."""
 
 
 def _work_from(data: object, source: str) -> Work:

@@ -1,0 +1,21 @@
+"""Simulated runs for the tests: a robot config on a scenario, through
+``sim://``, the session closed whatever happens."""
+
+from __future__ import annotations
+
+from stairbot.config import RobotConfig
+from stairbot.events import Event, discard
+from stairbot.robots import RobotOptions, open_robot
+from stairbot.runner import RunResult, run
+from stairbot.scenario import Scenario
+
+
+def run_sim(config: RobotConfig, scenario: Scenario,
+            events: list[Event] | None = None) -> RunResult:
+    """``config``'s robot, simulated, on ``scenario``; its events go to
+    ``events`` if given."""
+    session = open_robot("sim://", config, RobotOptions(world=scenario))
+    try:
+        return run(session, config, discard if events is None else events.append)
+    finally:
+        session.close()
