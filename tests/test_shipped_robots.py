@@ -102,3 +102,36 @@ def test_backing_to_an_edge_ends_where_the_back_pair_says_not_at_the_tab() -> No
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 10, 10), r.to_dict()
     assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
+
+
+IR_NEAR_RISERS = """
+[stairs]
+top = "landing"
+width = 1.0
+steps = [{rise = 0.101181, tread = 0.280159}, {rise = 0.097981, tread = 0.284219},
+         {rise = 0.096287, tread = 0.276025}, {rise = 0.097876, tread = 0.279878}]
+[start]
+distance = 0.45
+[sensors]
+noise = 0.001
+seed = 72
+"""
+
+
+def test_the_ir_robot_approaches_a_riser_nearer_than_its_sensors_read() -> None:
+    """Found by the envelope sweep (case 72 and ten more on ir): after ascent 9
+    the next riser is about 6 cm ahead, nearer than a Sharp pair reads
+    (10 cm); ascent 2 took the clamp (0.100 m) for the distance, drove 3 cm
+    into the riser and dead reckoned a gap of 1 cm, so every tread was read
+    1 cm short and a 0.276 m tread was refused.  The approach now starts from
+    where ascent 9's last readings put the riser."""
+    events: list[Event] = []
+    scenario = parse_scenario(IR_NEAR_RISERS, "ir_near_risers")
+    r = run_sim(load_config("ir"), scenario, events)
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 4, 4), r.to_dict()
+    treads = [float(e.message.split("tread ")[1].split(" m")[0]) for e in events
+              if e.message.startswith("step ") and ": tread " in e.message]
+    assert len(treads) == 3  # the last: nothing ahead
+    # every tread read within 6 mm (the Sharp's sigma at 0.28 m is 6.6 mm, of one reading)
+    for seen, step in zip(treads, scenario.steps[:3], strict=True):
+        assert seen == pytest.approx(step.tread, abs=0.006), (treads, scenario.steps)

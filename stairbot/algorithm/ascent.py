@@ -25,7 +25,7 @@ from stairbot.algorithm.phase import (
 )
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
-from stairbot.hardware import MotorId
+from stairbot.hardware import MotorId, SensorStatus
 
 P = Phase
 FLOW = "ascent"
@@ -77,9 +77,24 @@ def _approach_turns_enter(t: Tick, w: Work) -> None:
     # more.  A robot that starts nearer (after ascent 9) drives only the rest.
     cfg = t.cfg
     w.start_reading = motion.mean_distance(t.snap)
+    reckoned = _reckoned_riser(t, w)
+    if reckoned is not None:
+        w.start_reading = reckoned
     nearer = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP - w.start_reading
     w.target_wheel = w.entry_wheel + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH \
         - cfg.wheel_turns(nearer)
+
+
+def _reckoned_riser(t: Tick, w: Work) -> float | None:
+    """How far the riser is by ascent 9's dead reckoning, when a front sensor
+    reads "too near" (its clamp is only a bound) and that is nearer than the
+    clamp; else None."""
+    riser = t.ctx.riser_wheel
+    if riser is None or not any(r.status is SensorStatus.OUT_OF_RANGE and not motion.far(r, t.cfg)
+                                for r in motion.pair(t.snap)):
+        return None
+    reckoned = (riser - w.entry_wheel) * t.cfg.wheel_circumference
+    return reckoned if 0.0 <= reckoned < motion.mean_distance(t.snap) else None
 
 
 def _approach_turns(t: Tick, w: Work) -> Step:
@@ -162,12 +177,13 @@ LIFT_FIRST = PhaseDef(
         P.ERROR: FAULT})
 
 
-def _lifted_first(t: Tick, _w: Work) -> Step:
+def _lifted_first(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     need = cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
-    # Measured now, clear of the edge: at the first sight over it the beam
-    # still grazes the step's own tread and reads short.
-    tread = tread_seen(t)
+    # Measured over the second half of the lift, clear of the edge: at the
+    # first sight over it the beam still grazes the step's own tread and
+    # reads short.
+    tread = _tread_measured(t, w)
     ahead = "nothing ahead" if tread is None or tread == float("inf") \
         else f"tread {tread:.3f} m"
     t.say(f"step {ctx.number_of_steps + 1}: {ahead} (the reading less {_gap(t):.3f} m to the "
@@ -197,8 +213,43 @@ def _lifted_first(t: Tick, _w: Work) -> Step:
     return go(P.ASCENT_DRIVE_FIRST)
 
 
-_more_enter, _more_step = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_vertical_turns},
+def _sample_sight(t: Tick, w: Work) -> None:
+    """Over the second half of the lift past the sight-over, add each front
+    reading that still sees past the riser to ``w.sight_sums``."""
+    if t.snap.turns(MotorId.MTF) - w.entry_mtf < t.ctx.number_of_vertical_turns / 2.0:
+        return
+    gap, cfg = _gap(t), t.cfg
+    for i, r in enumerate(motion.pair(t.snap)):
+        if r.ok and not motion.far(r, cfg) and r.distance_m >= gap + SIGHT_JUMP_M:
+            w.sight_sums[i] += r.distance_m
+            w.sight_counts[i] += 1
+
+
+def _tread_measured(t: Tick, w: Work) -> float | None:
+    """:func:`tread_seen` now, on the mean of each sensor's readings over the
+    lift's second half where it has them."""
+    tread = tread_seen(t)
+    if tread is None or tread == float("inf"):
+        return tread
+    gap, cfg = _gap(t), t.cfg
+    near = []
+    for i, r in enumerate(motion.pair(t.snap)):
+        if motion.far(r, cfg):
+            continue
+        n = w.sight_counts[i]
+        near.append(w.sight_sums[i] / n if n else r.distance_m)
+    return min(near) - gap
+
+
+_more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_vertical_turns},
                                _lifted_first)
+
+
+def _more_step(t: Tick, w: Work) -> Step:
+    _sample_sight(t, w)
+    return _lift_more(t, w)
+
+
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
     _more_step, enter=_more_enter, carried_by=(2, 3),
@@ -318,8 +369,13 @@ CHECK = PhaseDef(
         P.ERROR: FAULT})
 
 
-def _driven_third(t: Tick, _w: Work) -> Step:
+def _driven_third(t: Tick, w: Work) -> Step:
     t.ctx.purpose = "ascent"
+    t.ctx.riser_wheel = None
+    if w.target_reading is not None and not w.reading_lost and w.target_wheel is not None:
+        # where the last readings put the riser: ascent 2 starts from it if
+        # the sensors cannot read that near
+        t.ctx.riser_wheel = w.target_wheel + t.cfg.wheel_turns(w.target_reading)
     return go(P.CAL_CHECK)
 
 

@@ -105,6 +105,12 @@ class Context:
     off or backing up to it."""
     turned_back: bool = False
     """Descent 1 has turned back to the climb's heading on this step (once)."""
+    riser_wheel: float | None = None
+    """Ascent 9's estimate of the next riser: the drive's odometer (turns) at
+    which the front sensors would touch it, dead reckoned from the last
+    readings that measured it.  Ascent 2 starts from it when the sensors read
+    "too near" (a sensor whose minimum range is more than what ascent 9
+    leaves)."""
     riser_gap: float | None = None
     """How far the front sensors stand from the riser when ascent 3 begins:
     the approach's last reading less what it drove after it (the sensors read

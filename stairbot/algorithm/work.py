@@ -44,6 +44,11 @@ class Work:
     reading_lost: bool = False
     """A reading drive: the reading jumped away from what the wheels explain;
     the rest is driven by turns."""
+    sight_sums: list[float] = field(default_factory=lambda: [0.0, 0.0])
+    sight_counts: list[int] = field(default_factory=lambda: [0, 0])
+    """Ascent 3's lift past the sight-over: SFR's and SFL's readings of the
+    next riser summed over its second half, and how many (the tread is
+    measured on their means, not on one noisy reading)."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
     diff_sum: float = 0.0
