@@ -267,15 +267,21 @@ class RobotConfig:
 
     @property
     def square_range_m(self) -> float:
-        """Farthest reading the front pair squares up from at the start: within
-        it, a cone looking up front_cone_top_rad rises no higher than the
-        lowest riser the robot climbs (min_step_rise_m), so both beams read
-        the first riser alone; farther, the upper rays pass over it and the
-        reading blends the risers beyond.  Infinite for level rays."""
+        """Farthest reading the front pair squares up from at the start.
+        Within it, a cone looking up front_cone_top_rad rises no higher than
+        the lowest riser the robot climbs (min_step_rise_m), so both beams
+        read the first riser alone (farther, the upper rays pass over it and
+        the reading blends the risers beyond); and the pair's stated noise
+        lets it square up to equal_tolerance
+        (:func:`~stairbot.perception.quiet_range_m`).  Infinite for level,
+        quiet rays."""
+        # perception builds on the config: imported here, not at the top
+        from stairbot.perception import quiet_range_m
+
         top = self.front_cone_top_rad
-        if top <= 0.0:
-            return math.inf
-        return (self.min_step_rise_m - self.sensors.front_height) / math.tan(top)
+        cone = math.inf if top <= 0.0 else \
+            (self.min_step_rise_m - self.sensors.front_height) / math.tan(top)
+        return min(cone, quiet_range_m(self))
 
     def min_rise_for(self, tread_m: float) -> float:
         """Lowest next riser it can measure a tread of ``tread_m`` against:
@@ -314,7 +320,7 @@ class RobotConfig:
         for name in ("wheel_speed_m_s", "lift_speed_m_s", "max_step_rise_m", "min_tread_m",
                      "min_step_rise_m"):
             out[name] = float(getattr(self, name))
-        if math.isfinite(self.square_range_m):  # a cone looking up (level rays: anywhere)
+        if math.isfinite(self.square_range_m):  # a cone looking up, or a noisy pair
             out["square_range_m"] = self.square_range_m
         return out
 

@@ -151,6 +151,30 @@ def square_tolerance(cfg: RobotConfig, distance_m: float, back: bool = False) ->
     return _square_tolerance(k, k.sigma(distance_m))
 
 
+def quiet_range_m(cfg: RobotConfig) -> float:
+    """Farthest reading from which the front pair squares up to
+    equal_tolerance (:func:`square_tolerance`): farther, its stated noise
+    allows only a looser square in MAX_STILL_S (a Sharp's sigma is 1 mm + 2 %
+    of the distance).  Infinite when the pair does it anywhere short of
+    LENGTH_OF_INFINITY."""
+    k = _pair(cfg, False)
+    if k.quiet is None:
+        equal = cfg.algorithm.equal_tolerance + 1e-12
+        lo, hi = cfg.sensors.range(False)[0], cfg.LENGTH_OF_INFINITY
+        if _square_tolerance(k, k.sigma(hi)) <= equal:
+            k.quiet = math.inf
+        elif _square_tolerance(k, k.sigma(lo)) > equal:
+            k.quiet = lo
+        else:
+            for _ in range(40):  # the sigma grows with the distance: bisect to 0.1 mm
+                mid = (lo + hi) / 2.0
+                lo, hi = (mid, hi) if _square_tolerance(k, k.sigma(mid)) <= equal else (lo, mid)
+                if hi - lo < 1e-4:
+                    break
+            k.quiet = lo
+    return k.quiet
+
+
 def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
                     back: bool = False) -> float:
     """Like :func:`pair_tolerance`, for the mean of ``samples`` ticks' filtered
@@ -163,7 +187,8 @@ def still_tolerance(cfg: RobotConfig, samples: int, distance_m: float,
 class _Pair:
     """What the tolerances of one pair need of the config, looked up once."""
 
-    __slots__ = ("spec", "noise", "equal", "repeats", "sqrt_window", "max_still", "standing")
+    __slots__ = ("spec", "noise", "equal", "repeats", "sqrt_window", "max_still", "standing",
+                 "quiet")
 
     def __init__(self, cfg: RobotConfig, back: bool) -> None:
         self.spec = cfg.sensors.spec(back)
@@ -175,6 +200,8 @@ class _Pair:
         self.max_still = round(MAX_STILL_S / cfg.algorithm.tick)
         self.standing: dict[tuple[float, float], float] = {}
         """standing_tolerance by (sigma, smoothing)."""
+        self.quiet: float | None = None
+        """quiet_range_m, once asked."""
 
     def sigma(self, distance_m: float) -> float:
         """The stated sigma of one reading at ``distance_m`` (Sensors.sigma)."""

@@ -171,7 +171,8 @@ def _check(t: Tick, w: Work) -> Step:
         if near is not None and near > cfg.square_range_m + cfg.algorithm.equal_tolerance:
             t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
                   f"farther than square_range_m ({cfg.square_range_m:.3f} m), where the front "
-                  "cones see over the first riser; closing in before squaring up",
+                  "cones see over the first riser or the pair's noise allows only a loose "
+                  "square; closing in before squaring up",
                   SFR=sfr.distance_m, SFL=sfl.distance_m)
             return go(P.CAL_CLOSE_IN)
     diff = _mean_diff(t, w)
@@ -552,6 +553,8 @@ def _lowered(t: Tick, _w: Work) -> Step:
     ctx.turn_to = None
     if ctx.purpose == "home":
         return go(P.DESCENT_FINISH_FLOOR)
+    if ctx.purpose == "floor":
+        return go(P.DESCENT_FINISH)
     # Check standing on all wheels, once the filter has settled there (the
     # check waits for it): a squaring turn (squaring_turns > 0), or descent
     # 1's turn back to the climb's heading (the seed's check).  Segment 1
@@ -566,7 +569,8 @@ LOWER = PhaseDef(
     P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, enter=_lower_enter,
     carried_by=(2,),
     to={P.CAL_CHECK: "lowered: check standing on all wheels",
-        P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back)",
+        P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back to where the program began)",
+        P.DESCENT_FINISH: "lowered (descent 7, turned back to the floor's heading)",
         P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, PROBE, CORNER, AWAY, TURN, TURN_TO, LOWER)

@@ -46,7 +46,8 @@ class Context:
     """Value of the present :class:`~stairbot.algorithm.phases.Phase`."""
     purpose: str = "start"
     """What the calibration phases are doing: "start", "ascent", "descent", or
-    "home" (descent 7 lifts and lowers segments 1 and 3 to turn back)."""
+    "home" or "floor" (descent 7 lifts and lowers segments 1 and 3 to turn
+    back to the heading the program began with, or crossed the floor with)."""
     calibration_case: str | None = None
     """The first calibration's case: "1", "2", "3A" or "3B"."""
     start_reading: float | None = None

@@ -287,6 +287,7 @@ def _lowered_first(t: Tick, _w: Work) -> Step:
           f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
     if ctx.steps_descended < ctx.number_of_steps:
         return go(P.DESCENT_BACK_OFF)
+    ctx.turned_back = False  # descent 7 turns back to the floor's heading once
     return go(P.DESCENT_FINISH)
 
 
@@ -344,15 +345,39 @@ def _at_start_position(t: Tick, _w: Work) -> Step:
     return go(P.CAL_LIFT)
 
 
+def _floor_heading(t: Tick, _w: Work) -> Step | None:
+    """Before backing to the start position: turn back (once) to the heading
+    the robot crossed the floor with, where the first calibration left it
+    (climb_twist[0]), if the odometer says it is further off than
+    HEADING_TOLERANCE_RAD.  Descent 1 squared up to the first riser again, and
+    a start squared up far away within a noisy pair's tolerance may differ
+    from that by degrees: backing 0.7 m on the squarer heading put the ir
+    robot 5.7 cm to the side of its start (envelope case 304)."""
+    ctx = t.ctx
+    floor = ctx.climb_twist[0]
+    if ctx.turned_back or floor is None:
+        return None
+    ctx.turned_back = True
+    off = heading_off_rad(t, floor)
+    if abs(off) <= HEADING_TOLERANCE_RAD:
+        return None
+    ctx.purpose = "floor"
+    ctx.turn_to = floor
+    t.say(f"descent 7: turned {math.degrees(off):+.2f}° from the heading it crossed the floor "
+          "with (by the odometer); turning back to it", off_deg=math.degrees(off))
+    return go(P.CAL_LIFT)
+
+
 _finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start_reading,
                         _finish_turns, _at_start_position)
 FINISH = PhaseDef(
-    P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW, _finish[1],
-    enter=_finish[0], watches="front",
+    P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW,
+    checked_first(_floor_heading, _finish[1]), enter=_finish[0], watches="front",
     to={P.DONE: "reads the start reading (or turns made; with no step climbed: back by the "
                 "odometer to the start position)",
-        P.CAL_LIFT: "the first calibration closed in, and the robot is turned from the heading "
-                    "the program began with: lift to turn back",
+        P.CAL_LIFT: "turned from the heading it crossed the floor with: lift to turn back to "
+                    "it; or, the first calibration closed in, turned from the heading the "
+                    "program began with: lift to turn back",
         P.DESCENT_FINISH_FLOOR: "the first calibration closed in; turned within "
                                 "HEADING_TOLERANCE_RAD of the heading it began with",
         P.ERROR: FAULT})

@@ -124,7 +124,7 @@ def where(ctx: Context, phase: Phase) -> str:
             return "start"
         if ctx.purpose == "ascent":
             return f"ascent 1, step {ctx.number_of_steps + 1}"
-        if ctx.purpose == "home":
+        if ctx.purpose in ("home", "floor"):
             return "descent 7"
         return f"descent 1, step {ctx.number_of_steps - ctx.steps_descended}"
     if flow == "ascent":

@@ -222,3 +222,29 @@ def test_a_dropout_while_standing_is_no_figure_for_the_difference() -> None:
         faults=[Fault(SensorId.SFL, 0.3, 0.4, offset=1.2)], noise=0.001)
     assert ctrl.context.calibration_case == "3A", first_turn(events)
     assert abs(robot.yaw) < SQUARE
+
+
+def test_descent_7_turns_back_to_the_heading_it_crossed_the_floor_with() -> None:
+    """Found by the envelope sweep (case 304 on ir): the start squared up
+    0.68 m from the riser within a noisy pair's tolerance, 3.7° off; descent
+    1 squared up again on the way down, and backing the floor on the squarer
+    heading put the robot 5.7 cm to the side of its start.  Descent 7 turns
+    back, by the odometer, to the heading the floor was crossed with
+    (climb_twist[0]) before it backs to the start position."""
+    from stairbot.algorithm import motion
+
+    events: list[Event] = []
+    ctrl = Controller(CFG, events.append)
+    robot = KinematicRobot(CFG, steps=[(0.17, 0.28)], top="wall")
+    run(ctrl, robot, until=lambda c: c.phase is Phase.DESCENT_FINISH)
+    ctx = ctrl.context
+    floor = ctx.climb_twist[0]
+    assert floor is not None
+    # as if it had crossed the floor 2 degrees further right than it stands now
+    ctx.climb_twist[0] = floor - motion.yaw_turns(CFG, math.radians(2.0))
+    yaw = robot.yaw
+    run(ctrl, robot)
+    said = [e.message for e in events if "from the heading it crossed the floor with" in e.message]
+    assert len(said) == 1 and "turned +2.00°" in said[0], said
+    assert robot.yaw - yaw == pytest.approx(math.radians(-2.0), abs=math.radians(0.2))
+    assert ctrl.result.outcome == "completed"
