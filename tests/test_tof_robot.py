@@ -178,7 +178,8 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it(
     now bounds the backing: edge_clearance_m past where it saw the drop."""
     from stairbot.algorithm.descent import edge_clearance_m
 
-    assert edge_clearance_m(TOF) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006)
+    assert edge_clearance_m(TOF) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006
+                                                 + TOF.wheel_speed_m_s * 0.030)
     r, _ = nine_steps
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()

@@ -10,9 +10,16 @@ reading when the distance is measurable and by turns when it is not.
 from __future__ import annotations
 
 import math
+import statistics
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.moves import drive_phase, lift, lift_phase, reading_drive
+from stairbot.algorithm.moves import (
+    KEY_TICKS,
+    drive_phase,
+    lift,
+    lift_phase,
+    reading_drive,
+)
 from stairbot.algorithm.phase import (
     FAULT,
     NO_MOTION,
@@ -57,12 +64,39 @@ def _approach(t: Tick, w: Work) -> Step:
                     f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead "
                     f"for {RISER_LOST_WAIT_S:g} s")
     w.still_since = None
-    reading = motion.mean_distance(t.snap)
+    reading = _riser_ahead(t, w)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     if reading <= safe:
         return go(P.ASCENT_APPROACH_TURNS)
     remaining = cfg.wheel_turns(reading - safe) + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
     return stay(motion.drive(cfg, 1, remaining))
+
+
+RISER_KEYS = 15
+"""Ascent 2 places the riser by the median of this many ticks' readings
+(plus the odometer), once it has KEY_TICKS of them."""
+
+
+def _riser_ahead(t: Tick, w: Work) -> float:
+    """How far the riser is: the median over the last RISER_KEYS ticks of
+    the mean reading plus the odometer (``ctx.riser_wheel``), less the
+    odometer now; the reading itself until KEY_TICKS ticks have measured it.
+    Two outliers among an HC-SR04's last three measurements pass its median:
+    one tick's SFR read 0.057 m for 0.100 m, the approach took the pair's
+    mean, 0.081 m, for its start, and stopped 3.2 cm from the riser where it
+    reckoned 1 cm (envelope case 261 on sonar: lifting segment 3 from there
+    tipped the robot nose up)."""
+    cfg, ctx = t.cfg, t.ctx
+    reading = motion.mean_distance(t.snap)
+    here = motion.wheel_position(t.snap)
+    if motion.measurable(t.snap, cfg):
+        keys = w.first_keys
+        keys.append(here + cfg.wheel_turns(reading))
+        del keys[:-RISER_KEYS]
+        if len(keys) >= KEY_TICKS:
+            ctx.riser_wheel = statistics.median(keys)
+            return (ctx.riser_wheel - here) * cfg.wheel_circumference
+    return reading
 
 
 APPROACH = PhaseDef(
@@ -86,15 +120,21 @@ def _approach_turns_enter(t: Tick, w: Work) -> None:
 
 
 def _reckoned_riser(t: Tick, w: Work) -> float | None:
-    """How far the riser is by ascent 9's dead reckoning, when a front sensor
-    reads "too near" (its clamp is only a bound) and that is nearer than the
-    clamp; else None."""
+    """How far the riser is by dead reckoning from where the approach's
+    readings (or ascent 9's) put it, ``ctx.riser_wheel`` (the median of many
+    ticks, where the reading now is one); when a front sensor reads "too
+    near", only if nearer than its clamp (a bound); else None."""
+    cfg = t.cfg
     riser = t.ctx.riser_wheel
-    if riser is None or not any(r.status is SensorStatus.OUT_OF_RANGE and not motion.far(r, t.cfg)
-                                for r in motion.pair(t.snap)):
+    if riser is None:
         return None
-    reckoned = (riser - w.entry_wheel) * t.cfg.wheel_circumference
-    return reckoned if 0.0 <= reckoned < motion.mean_distance(t.snap) else None
+    reckoned = (riser - w.entry_wheel) * cfg.wheel_circumference
+    if reckoned < 0.0:
+        return None
+    if any(r.status is SensorStatus.OUT_OF_RANGE and not motion.far(r, cfg)
+           for r in motion.pair(t.snap)) and reckoned >= motion.mean_distance(t.snap):
+        return None
+    return reckoned
 
 
 def _approach_turns(t: Tick, w: Work) -> Step:

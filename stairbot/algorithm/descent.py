@@ -101,7 +101,19 @@ def edge_clearance_m(cfg: RobotConfig) -> float:
     was placed where the pair crossed it.)"""
     g = cfg.geometry
     return (g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear - g.wheel_inset
-            + g.wheel_radius + EDGE_MARGIN_M)
+            + g.wheel_radius + EDGE_MARGIN_M + edge_doubt_m(cfg))
+
+
+def edge_doubt_m(cfg: RobotConfig) -> float:
+    """How far off :func:`edge_sight_m` may place the crossing: the distance
+    backed at full speed in one of the back pair's measurement periods (the
+    crossing falls anywhere between two measurements, and the median's
+    majority may take one more).  Added to the clearance: an HC-SR04 pair,
+    measuring every 60 ms, placed segment 3's front wheels up to 10 mm short
+    of where it meant to, on the corner, and lowered there, segment 3 pitched
+    the robot 15 deg nose down (the envelope sweep, cases 1631 and 1636 on
+    sonar)."""
+    return cfg.wheel_speed_m_s * measurement_period(cfg, True)
 
 
 def edge_drop_m(cfg: RobotConfig) -> float:

@@ -51,9 +51,8 @@ class Work:
     measured on their means, not on one noisy reading)."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
-    diff_sum: float = 0.0
-    diff_n: int = 0
-    """A pair difference summed over ticks standing still, and how many."""
+    diffs: list[float] = field(default_factory=list)
+    """A pair difference, each tick standing still that gave one."""
     diff_skipped: int = 0
     """Ticks standing still on which a reading of the pair gave no figure
     for the difference (an error, a dropout, nothing ahead)."""

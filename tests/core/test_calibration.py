@@ -248,3 +248,4 @@ def test_descent_7_turns_back_to_the_heading_it_crossed_the_floor_with() -> None
     assert len(said) == 1 and "turned +2.00°" in said[0], said
     assert robot.yaw - yaw == pytest.approx(math.radians(-2.0), abs=math.radians(0.2))
     assert ctrl.result.outcome == "completed"
+
