@@ -309,6 +309,7 @@ class Controller:
         elif nxt is Phase.PAUSED:
             ctx.resume_phase = src.value
             ctx.pause_started_s = snap.time_s
+            ctx.pause_diffs = []
             ctx.pauses += 1
             self._emit(EventKind.PAUSE, step.reason or "paused", snap.time_s,
                        {"resume_phase": ctx.resume_phase})

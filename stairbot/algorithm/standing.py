@@ -19,6 +19,8 @@ error.  The controller does the bookkeeping of both.
 
 from __future__ import annotations
 
+import statistics
+
 from stairbot.algorithm import motion
 from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
 from stairbot.algorithm.phases import Phase
@@ -79,11 +81,22 @@ def _paused(t: Tick, _w: Work) -> Step:
     assert ctx.resume_phase is not None and ctx.pause_started_s is not None
     resume = Phase(ctx.resume_phase).record
     back = resume.watches == "back"
-    # Standing still, the smoothed difference alone decides: it has been kept up
-    # to date through the wait, and one noisy tick must not decide either way.
+    # Standing still, the difference over the wait decides, not one noisy tick
+    # nor a smoothing that a burst at its end fills: the median of the wait's
+    # ticks (two stray HC-SR04 measurements passed SFR's median in its last
+    # 0.2 s, and the smoothed difference ended a sound run: envelope cases
+    # 596 and 1359 on sonar).  Without a figure on any tick, the smoothed one.
     disagree = _disagree(t, back, raw_too=False)
+    diff = motion.pair_difference(t.snap, t.cfg, back)
+    if diff is not None:
+        ctx.pause_diffs.append(diff)
     if t.snap.time_s - ctx.pause_started_s < t.cfg.algorithm.standing_wait:
         return stay(NO_MOTION)
+    if ctx.pause_diffs:
+        right, left = motion.pair(t.snap, back)
+        near = min(right.distance_m, left.distance_m)
+        disagree = abs(statistics.median(ctx.pause_diffs)) > standing_tolerance(
+            t.cfg, near, motion.DIFF_SMOOTHING, back)
     if not disagree:
         ctx.disagree_ticks = 0
         return go(resume.phase, f"standing rule: {_pair_name(back)} agree again "

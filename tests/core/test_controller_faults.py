@@ -358,3 +358,18 @@ def test_a_drive_whose_reading_jumps_goes_on_by_turns_not_by_the_new_reading() -
     jumped, events = _descent_3_travel(0.08)
     assert jumped == pytest.approx(clean, abs=0.005)  # not cut short by 8 cm
     assert any("jumped" in e.message for e in of(events, EventKind.INFO))
+
+
+def test_a_burst_at_the_end_of_the_wait_does_not_decide_it() -> None:
+    """Found by the envelope sweep (cases 596 and 1359 on sonar): two stray
+    HC-SR04 measurements passed SFR's median in the wait's last 0.2 s, and
+    the smoothed difference they filled ended a sound run with "still
+    disagree".  The median of the wait's ticks decides."""
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 7.0, 9.0, offset=0.05)])
+    run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
+    end = robot.t + WAIT
+    robot.faults.append(Fault(SensorId.SFL, end - 0.3, end, offset=0.3))
+    run(ctrl, robot)
+    r = ctrl.result
+    assert (r.outcome, r.pauses, r.steps_climbed, r.steps_descended) == ("completed", 1, 2, 2)
+    assert len(of(events, EventKind.RESUME)) == 1
