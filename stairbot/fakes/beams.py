@@ -30,58 +30,118 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
     """The hits of a forward sensor's cone for each of ``laterals`` (the mounts'
     offsets across the robot, + = left) on one segment: ``mount`` is the
     side-view position, ``pitch`` the segment's angle, ``forward`` the mount's
-    distance ahead of segment 2's centre."""
+    distance ahead of segment 2's centre.  (Each ray's top view is
+    :meth:`Plan.front_hit_at`, written out: a cone has a dozen rays per mount.)"""
     mx, my = mount
     tilt = math.radians(model.tilt_deg)
+    ups, acrosses, rays = model.cone_index
+    profile = world.profile
+    cos, sin = math.cos, math.sin
+    ahead_i, behind_i = profile.starts(mx)
+    cast, normals, inf = profile.first_from, profile.normals, math.inf
+    # the side view, per angle up: how far ahead in x the ray meets the stairs
+    # (None: nothing), the cos and sin of its angle, the normal met, its slant
+    side_view: list[tuple[float | None, float, float, float, float, float]] = []
+    for up in ups:
+        theta = pitch + tilt + up
+        c, s = cos(theta), sin(theta)
+        x1 = mx + c * reach
+        best, i = cast(mx, my, x1, my + s * reach, ahead_i, behind_i)
+        slant = 1.0 / max(c, 1e-6)
+        if best == inf:
+            side_view.append((None, c, s, 0.0, 0.0, slant))
+        else:
+            nx, ny = normals[i]
+            side_view.append(((mx + (x1 - mx) * best) - mx, c, s, nx, ny, slant))
+    # the top view: the mounts turn with the robot's yaw only, a beam by its
+    # angle across too; a mount sits forward*cos - lateral*sin ahead of segment
+    # 2's centre (the side view's ray from ``forward`` ahead meets a riser
+    # ``ahead`` less far) and y_m to the side
+    yaw, half = plan.yaw, plan.width / 2
+    mount_c, mount_s = cos(yaw), sin(yaw)
+    y_fwd, ahead = plan.y + forward * mount_s, forward * (1.0 - mount_c)
+    turned = [(cos(psi), sin(psi)) for psi in [yaw + across for across in acrosses]]
     out: list[list[Hit]] = [[] for _ in laterals]
-    yaw = plan.yaw
-    mount_c, mount_s = math.cos(yaw), math.sin(yaw)  # the mounts turn with the robot only
-    cast = world.profile.ray_normal
-    front_hit = plan.front_hit_at
-    side_view: dict[float, tuple[float | None, float, float, float, float, float]] = {}
-    turned: dict[float, tuple[float, float]] = {}  # across -> cos, sin of the beam's yaw
-    for up, across, weight in model.cone:
-        seen = side_view.get(up)
-        if seen is None:
-            theta = pitch + tilt + up
-            c, s = math.cos(theta), math.sin(theta)
-            hit = cast(mx, my, mx + c * reach, my + s * reach)
-            slant = 1.0 / max(c, 1e-6)
-            seen = ((None, c, s, 0.0, 0.0, slant) if hit is None
-                    else (hit[0] - mx, c, s, hit[2], hit[3], slant))
-            side_view[up] = seen
-        hit_dx, c, s, nx, ny, slant = seen
-        trig = turned.get(across)
-        if trig is None:
-            psi = yaw + across
-            trig = turned[across] = (math.cos(psi), math.sin(psi))
-        cos_psi, sin_psi = trig
-        for i, lat in enumerate(laterals):
-            got = front_hit(forward, lat, hit_dx, slant, cos_psi, sin_psi, mount_c, mount_s)
-            if got is None:
-                continue
-            d, on_wall = got
-            cos_inc = abs(c * sin_psi) if on_wall else abs(c * cos_psi * nx + s * ny)
-            out[i].append((d, cos_inc, weight))
+    mounts = [(hits, y_fwd + lat * mount_c, lat * mount_s)
+              for hits, lat in zip(out, laterals, strict=True)]
+    if plan.left_wall or plan.right_wall:
+        _front_walls(plan, side_view, turned, rays, mounts, ahead)
+        return out
+    for i_up, i_across, weight in rays:  # no side wall: a beam meets a riser or nothing
+        hit_dx, c, s, nx, ny, slant = side_view[i_up]
+        cos_psi, sin_psi = turned[i_across]
+        if hit_dx is None or cos_psi <= 1e-9:
+            continue
+        riser_dx = hit_dx + ahead
+        on_stairs = abs(c * cos_psi * nx + s * ny)  # the cosine of its incidence
+        for hits, y_m, side in mounts:
+            dx = riser_dx + side
+            if dx > 0.0 and abs(y_m + dx * sin_psi / cos_psi) <= half:
+                hits.append((dx / cos_psi * slant, on_stairs, weight))
     return out
+
+
+def _front_walls(plan: Plan, side_view: list[tuple[float | None, float, float, float, float,
+                                                   float]],
+                 turned: list[tuple[float, float]], rays: tuple[tuple[int, int, float], ...],
+                 mounts: list[tuple[list[Hit], float, float]], ahead: float) -> None:
+    """The top view of :func:`front_hits` beside side walls: each beam meets
+    the nearer of the riser and the wall it turns towards."""
+    half, left_wall, right_wall = plan.width / 2, plan.left_wall, plan.right_wall
+    for i_up, i_across, weight in rays:
+        hit_dx, c, s, nx, ny, slant = side_view[i_up]
+        cos_psi, sin_psi = turned[i_across]
+        for hits, y_m, side in mounts:
+            best: float | None = None
+            if hit_dx is not None and cos_psi > 1e-9:
+                dx = hit_dx + ahead + side
+                if dx > 0.0 and abs(y_m + dx * sin_psi / cos_psi) <= half:
+                    best = dx / cos_psi * slant
+            wall: float | None = None
+            if sin_psi > 1e-9:
+                if left_wall:
+                    wall = max(0.0, (half - y_m) / sin_psi)
+            elif sin_psi < -1e-9 and right_wall:
+                wall = max(0.0, (-half - y_m) / sin_psi)
+            if wall is not None and (best is None or wall * slant < best):
+                hits.append((wall * slant, abs(c * sin_psi), weight))
+            elif best is not None:
+                hits.append((best, abs(c * cos_psi * nx + s * ny), weight))
 
 
 def down_hits(world: World, model: SensorModel, mount: tuple[float, float], pitch: float,
               reach: float) -> list[Hit]:
     """The hits of a downward sensor's fan at side-view position ``mount`` on a
     segment at angle ``pitch`` (+ tilt: the fan turned towards the front)."""
-    mx, my = mount
+    return down_fans(world, model, (mount[0],), mount[1], pitch, reach)[0]
+
+
+def down_fans(world: World, model: SensorModel, xs: tuple[float, ...], my: float,
+              pitch: float, reach: float) -> list[list[Hit]]:
+    """:func:`down_hits` for mounts at each of ``xs``, all at height ``my`` on
+    one segment (a pair turned by a yaw): the rays' angles are shared."""
     tilt = math.radians(model.tilt_deg)
-    out: list[Hit] = []
-    cast = world.profile.ray_normal
+    sin, cos, hypot = math.sin, math.cos, math.hypot
+    # per ray: its direction, its extent along x and where it ends in y
+    rays: list[tuple[float, float, float, float, float]] = []
     for up, _across, weight in model.fan:
         phi = pitch + tilt + up
-        dx, dy = math.sin(phi), -math.cos(phi)
-        hit = cast(mx, my, mx + dx * reach, my + dy * reach)
-        if hit is None:
-            continue
-        x, y, nx, ny = hit
-        out.append((math.hypot(x - mx, y - my), abs(dx * nx + dy * ny), weight))
+        dx, dy = sin(phi), -cos(phi)
+        rays.append((dx, dy, dx * reach, my + dy * reach, weight))
+    profile = world.profile
+    cast, normals, inf = profile.first_from, profile.normals, math.inf
+    out: list[list[Hit]] = []
+    for mx in xs:
+        ahead_i, behind_i = profile.starts(mx)
+        hits: list[Hit] = []
+        for dx, dy, ex, y1, weight in rays:
+            x1 = mx + ex
+            best, i = cast(mx, my, x1, y1, ahead_i, behind_i)
+            if best != inf:
+                nx, ny = normals[i]
+                hits.append((hypot((mx + (x1 - mx) * best) - mx, (my + (y1 - my) * best) - my),
+                             abs(dx * nx + dy * ny), weight))
+        out.append(hits)
     return out
 
 

@@ -110,6 +110,25 @@ class SensorModel:
         return self._grid(self.rays_across)
 
     @cached_property
+    def min_cos(self) -> float:
+        """The cosine of ``max_incidence_deg`` (1: none given)."""
+        if self.max_incidence_deg is None:
+            return 1.0
+        return math.cos(math.radians(self.max_incidence_deg))
+
+    @cached_property
+    def cone_index(self) -> tuple[tuple[float, ...], tuple[float, ...],
+                                  tuple[tuple[int, int, float], ...]]:
+        """The :attr:`cone` for casting: its distinct angles up and across, and
+        its rays as the indexes of their two angles, with their weights (the
+        rays at one angle share its cast or its trigonometry)."""
+        ups: dict[float, int] = {}
+        acrosses: dict[float, int] = {}
+        rays = tuple((ups.setdefault(up, len(ups)), acrosses.setdefault(across, len(acrosses)),
+                      weight) for up, across, weight in self.cone)
+        return tuple(ups), tuple(acrosses), rays
+
+    @cached_property
     def fan(self) -> tuple[ConeRay, ...]:
         """The side-view rays only (a downward sensor's cone)."""
         return self._grid(1)
@@ -138,22 +157,30 @@ def combine(model: SensorModel, hits: Sequence[Hit], total_weight: float
     if not hits:
         return None, _NOTHING
     if model.max_incidence_deg is not None:
-        min_cos = math.cos(math.radians(model.max_incidence_deg))
+        min_cos = model.min_cos
         hits = [h for h in hits if h[1] >= min_cos]
         if not hits:
             return None, Cause.ECHO_LOST
-    if model.weak_range is not None:
-        # the returned signal, relative to a full beam square to a target 1 m away
-        strength = sum([g * c / (d * d) for d, c, g in hits if d > 0.0]) / total_weight
-        if strength * model.weak_range * model.weak_range < 1.0:
-            return None, Cause.WEAK
-    if model.aggregate == "nearest" or len(hits) == 1:
+    weak_range = model.weak_range
+    mixed = len(hits) > 1 and model.aggregate != "nearest"
+    if weak_range is None and not mixed:
         return min([h[0] for h in hits]), _OK
+    # each ray's returned signal, relative to a full beam square to a target 1 m
+    # away (its weight in the mix; a ray at 0 m weighs its weight in the beam)
+    signals: list[float] = []
     num = den = 0.0
     for d, c, g in hits:
-        w = g * c / (d * d) if d > 0.0 else g
+        if d > 0.0:
+            w = g * c / (d * d)
+            signals.append(w)
+        else:
+            w = g
         num += w * d
         den += w
+    if weak_range is not None and sum(signals) / total_weight * weak_range * weak_range < 1.0:
+        return None, Cause.WEAK
+    if not mixed:
+        return min([h[0] for h in hits]), _OK
     return (num / den if den > 0.0 else min([h[0] for h in hits])), _OK
 
 
@@ -225,6 +252,14 @@ class ModelSensor:
         if self.faults and active_faults(self.faults, t)[1]:
             return self._error
         return self._current[1] if self._current is not None else self._far
+
+    def published(self, t: float) -> SensorReading:
+        """:meth:`reading` with its :meth:`age` in it (the same object when 0 s
+        old): what the board publishes."""
+        reading = self.reading(t)
+        current = self._current
+        age = math.inf if current is None else t - current[0]
+        return reading if age == 0.0 else SensorReading(reading.distance_m, reading.status, age)
 
     def age(self, t: float) -> float:
         """How old the published reading is at ``t`` (inf before the first)."""

@@ -75,6 +75,7 @@ class SimRobot:
                         for mid in MotorId}
         self._per_turn = m.lift_travel_per_turn
         self._speeds = dict(ZERO_SPEEDS)
+        self._applied_along = math.nan  # cos(yaw) when the world's motors were last set
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
         self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
         self._lift_turns = [0.0, 0.0]
@@ -222,12 +223,15 @@ class SimRobot:
 
     # -- internals -------------------------------------------------------------------
     def _apply(self, speeds: dict[MotorId, float]) -> None:
-        self._speeds = speeds
-        w = self.world
         # The side view is the flight's axis: a robot yawed by psi driving at v
         # closes on the risers at v cos(psi) and drifts sideways at v sin(psi)
         # (Plan.move), never faster than its wheels.
         along = self._along()
+        same = speeds == self._speeds and along == self._applied_along
+        self._speeds, self._applied_along = speeds, along
+        if same:
+            return  # the world's motors run as they were set
+        w = self.world
         w.set_wheel_speed(0, speeds[_MWF] * along)
         w.set_wheel_speed(1, (speeds[_MWR] + speeds[_MWL]) / 2.0 * along)
         w.set_wheel_speed(2, speeds[_MWB] * along)

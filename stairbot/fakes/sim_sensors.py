@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 
 from stairbot.config import RobotConfig
-from stairbot.fakes.beams import down_hits, front_hits, total_weight
+from stairbot.fakes.beams import down_fans, front_hits, total_weight
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensor_model import ModelSensor, combine
 from stairbot.fakes.sensor_presets import model_for
@@ -101,52 +101,65 @@ class SimSensors:
         self._back_mount = (-world.lengths[2] / 2 + s.back_from_rear,
                             s.back_height - r,
                             self.sensors[SensorId.SBR].max_range * 1.05)
+        self._front_laterals = (-s.front_lateral, s.front_lateral)  # SFR, SFL
 
     def read(self, t: float) -> dict[SensorId, SensorReading]:
         """Every distance sensor's published reading at ``t``, with its age."""
         sfr, sfl = self._front_readings(t)
         sbr, sbl = self._back_readings(t)
-        if self._front_timed:
-            right, left = self._pairs[0]
-            sfr, sfl = _aged(right, sfr, t), _aged(left, sfl, t)
-        if self._back_timed:
-            right, left = self._pairs[1]
-            sbr, sbl = _aged(right, sbr, t), _aged(left, sbl, t)
         return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl}
 
     def _front_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
-        """What SFR and SFL report at ``t``: one ray each for a single-ray model,
+        """What SFR and SFL publish at ``t``: one ray each for a single-ray model,
         else their cones, cast only when a measurement is due."""
         right, left = self._pairs[0]
         model = self.front_model
         if self._front_single:
             sfr, sfl = self._front_truth()
-            return right.measure(sfr, t), left.measure(sfl, t)
-        if right.due(t) or left.due(t):
-            mx, my, a1, _c, _s, forward = self._front_origin()
-            lat = self.config.sensors.front_lateral
-            hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
-                              (-lat, lat), self._front_mount[2])
-            for sensor, seen in ((right, hits[0]), (left, hits[1])):
-                if sensor.due(t):
-                    sensor.sample(combine(model, seen, self._front_weight), t)
+            now = right.measure(sfr, t), left.measure(sfl, t)
+            if not self._front_timed:
+                return now
+        else:
+            due_r, due_l = right.due(t), left.due(t)
+            if due_r or due_l:
+                mx, my, a1, _c, _s, forward = self._front_origin()
+                hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
+                                  self._front_laterals, self._front_mount[2])
+                if due_r:
+                    right.sample(combine(model, hits[0], self._front_weight), t)
+                if due_l:
+                    left.sample(combine(model, hits[1], self._front_weight), t)
+        if self._front_timed:
+            return right.published(t), left.published(t)
         return right.reading(t), left.reading(t)
 
     def _back_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
-        """What SBR and SBL report at ``t`` (see _front_readings)."""
+        """What SBR and SBL publish at ``t`` (see _front_readings)."""
         right, left = self._pairs[1]
         model = self.back_model
         if self._back_single:
             sbr, sbl = self._back_truth()
-            return right.measure(sbr, t), left.measure(sbl, t)
-        if right.due(t) or left.due(t):
-            w = self.world
-            (xr, xl), my, a3, _c, _s, reach = self._back_origins()
-            seen_r = down_hits(w, model, (xr, my), a3, reach)
-            seen_l = seen_r if xl == xr else down_hits(w, model, (xl, my), a3, reach)
-            for sensor, seen in ((right, seen_r), (left, seen_l)):
-                if sensor.due(t):
-                    sensor.sample(combine(model, seen, self._back_weight), t)
+            now = right.measure(sbr, t), left.measure(sbl, t)
+            if not self._back_timed:
+                return now
+        else:
+            due_r, due_l = right.due(t), left.due(t)
+            if due_r or due_l:
+                (xr, xl), my, a3, _c, _s, reach = self._back_origins()
+                if xl == xr:  # square to the flight: the two see the same
+                    hits = down_fans(self.world, model, (xr,), my, a3, reach) * 2
+                else:
+                    hits = down_fans(self.world, model, (xr, xl), my, a3, reach)
+                seen = None
+                if due_r:
+                    seen = combine(model, hits[0], self._back_weight)
+                    right.sample(seen, t)
+                if due_l:
+                    if seen is None or hits[1] is not hits[0]:
+                        seen = combine(model, hits[1], self._back_weight)
+                    left.sample(seen, t)
+        if self._back_timed:
+            return right.published(t), left.published(t)
         return right.reading(t), left.reading(t)
 
     def front_seen(self) -> tuple[float | None, float | None]:
@@ -159,9 +172,8 @@ class SimSensors:
         if model.single_ray:
             return self._front_truth()
         mx, my, a1, _c, _s, forward = self._front_origin()
-        lat = self.config.sensors.front_lateral
         hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
-                          (-lat, lat), self._front_mount[2])
+                          self._front_laterals, self._front_mount[2])
         right, left = (combine(model, seen, self._front_weight)[0] for seen in hits)
         return right, left
 
@@ -225,11 +237,3 @@ class SimSensors:
         if hit is None:
             return None
         return math.hypot(hit[0] - mx, hit[1] - my)
-
-
-def _aged(sensor: ModelSensor, reading: SensorReading, t: float) -> SensorReading:
-    """``reading``, published by ``sensor`` at ``t``, with its age."""
-    age = sensor.age(t)
-    if age == 0.0:
-        return reading
-    return SensorReading(reading.distance_m, reading.status, age)

@@ -8,8 +8,9 @@ riser the top is a ``LANDING`` metres long flat landing with nothing beyond
 
 The distance sensors cast their rays here rather than through pymunk's query
 API: the outline is monotonic in x, so a ray meets its first surface among the
-few segments its x-range spans, found by bisection, which costs a fraction of
-a pymunk segment query.  Surfaces are offset by the physics segments' radius so
+few segments its x-range spans, taken from its origin on (found by bisection,
+once for all the rays of a cone from one mount), which costs a fraction of a
+pymunk segment query.  Surfaces are offset by the physics segments' radius so
 that the sensors see the same surface the wheels roll on.
 """
 
@@ -66,13 +67,16 @@ class StairsProfile:
         self._xmax = [s[2] for s in self.segments]
         # per segment, what every cast needs (see _Geo); None: zero length
         self._geo: list[_Geo | None] = []
+        self.normals: list[tuple[float, float]] = []  # per segment (0, 0: zero length)
         for ax, ay, bx, by in self.segments:
             ex, ey = bx - ax, by - ay
             length = math.hypot(ex, ey)
             if length == 0.0:
                 self._geo.append(None)
+                self.normals.append((0.0, 0.0))
                 continue
             nx, ny = -ey / length, ex / length
+            self.normals.append((nx, ny))
             r_len = radius / length
             self._geo.append((ax, ay, ex, ey, length * length, nx, ny, -r_len, 1.0 + r_len,
                               ax + nx * radius, ay + ny * radius,
@@ -81,7 +85,7 @@ class StairsProfile:
     def ray(self, x0: float, y0: float, x1: float, y1: float) -> Point | None:
         """The first point of the surface on the segment (x0, y0) -> (x1, y1), or
         None when it meets nothing."""
-        best, _ = self._first(x0, y0, x1, y1)
+        best, _ = self.first(x0, y0, x1, y1)
         if best == math.inf:
             return None
         return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best)
@@ -91,33 +95,52 @@ class StairsProfile:
         """Like :meth:`ray`, with the unit normal of the segment it meets:
         (x, y, nx, ny), or None.  (At a rounded corner this is the normal of
         the segment hit, not of the rounding.)"""
-        best, i = self._first(x0, y0, x1, y1)
+        best, i = self.first(x0, y0, x1, y1)
         if best == math.inf:
             return None
-        g = self._geo[i]
-        assert g is not None  # a zero-length segment is never met
-        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, g[5], g[6])
+        nx, ny = self.normals[i]
+        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, nx, ny)
 
-    def _first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
-        """Ray parameter of the first surface met (inf: none) and its segment.
+    def first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
+        """Ray parameter of the first surface met (inf: none) and its segment
+        (its unit normal: ``normals[i]``)."""
+        ahead, behind = self.starts(x0)
+        return self.first_from(x0, y0, x1, y1, ahead, behind)
 
+    def starts(self, x0: float) -> tuple[int, int]:
+        """The first segment a ray from ``x0`` can meet going forward (+x) and
+        going back (the rays of a cone share them: see :meth:`first_from`)."""
+        r = self.radius
+        return bisect_left(self._xmax, x0 - r), bisect_right(self._xmin, x0 + r) - 1
+
+    def first_from(self, x0: float, y0: float, x1: float, y1: float, ahead: int,
+                   behind: int) -> tuple[float, int]:
+        """:meth:`first`, given :meth:`starts` of ``x0``.
+
+        The segments whose x-range (widened by ``radius``) overlaps the ray's
+        are taken in the ray's direction along x, from the origin's end on
+        (the far end is checked as it is reached: xmin and xmax are sorted).
         Per segment: the ray's parameter in [0, 1] where it crosses the
         segment's surface (the segment moved ``radius`` towards the ray's
         origin), 0 when the origin lies inside the surface beside the
-        segment, none when it passes beside the segment's ends.  (One loop,
+        segment, none when it passes beside the segment's ends.  The first
+        met ends the walk at the next segment that is not met nearer
+        (x-monotonic: those after it lie further along the ray).  (One loop,
         no call per segment: every sensor casts here every tick.)"""
         r = self.radius
-        lo, hi = (x0, x1) if x0 <= x1 else (x1, x0)
-        first = bisect_left(self._xmax, lo - r)
-        last = bisect_right(self._xmin, hi + r)
-        if first >= last:
-            return math.inf, -1
         dx, dy = x1 - x0, y1 - y0
-        idx = range(first, last) if dx >= 0 else range(last - 1, first - 1, -1)
+        if x0 <= x1:
+            i, step, lim, bound = ahead, 1, x1 + r, self._xmin
+            if i >= len(bound) or bound[i] > lim:
+                return _MISS
+        else:
+            i, step, lim, bound = behind, -1, x1 - r, self._xmax
+            if i < 0 or bound[i] < lim:
+                return _MISS
         inf = math.inf
         best, best_i = inf, -1
         geo = self._geo
-        for i in idx:
+        while True:
             g = geo[i]
             t = inf
             if g is not None:
@@ -142,10 +165,16 @@ class StairsProfile:
             if t < best:
                 best, best_i = t, i
             elif best < inf and dx != 0.0:
-                break  # x-monotonic: later segments lie further along the ray
-        return best, best_i
+                return best, best_i
+            i += step
+            if step > 0:  # past the ray's x-range?
+                if i >= len(bound) or bound[i] > lim:
+                    return best, best_i
+            elif i < 0 or bound[i] < lim:
+                return best, best_i
 
 
+_MISS = (math.inf, -1)
 _Geo = tuple[float, float, float, float, float, float, float, float,
              float, float, float, float, float]
 """A segment: start (ax, ay), direction (ex, ey), length squared, unit normal

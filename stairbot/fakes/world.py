@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import pymunk
@@ -151,6 +152,11 @@ class World:
         self._wheel_turns, self._lifts = [0.0] * 3, [0.0, 0.0]
         self._stroke, self._stall = config.motors.lift_travel, p.lift_stall
         self._cp_step: tuple[Callable[[Any, float], None], Any] | None = None
+        # setting a pin's distance (each tick a lift moves) and a motor's rate,
+        # without pymunk's Python properties where its C functions are at hand
+        self._set_distance = [_setter(pin, "distance", "cpPinJointSetDist") for pin in self.pins]
+        self._set_rate = [[_setter(m, "rate", "cpSimpleMotorSetRate") for m in pair]
+                          for pair in self.motors]
         self._fetch()
         self._check_y, self._check_t = list(self._py), 0.0
         self.start_x = self._px[1]
@@ -161,8 +167,8 @@ class World:
         rate = turns_per_s * TWO_PI
         if rate != self._rates[segment]:  # setting a pymunk attribute is not free
             self._rates[segment] = rate
-            for m in self.motors[segment]:
-                m.rate = rate
+            for set_rate in self._set_rate[segment]:
+                set_rate(rate)
 
     def set_lift_speed(self, lift: int, metres_per_s: float) -> None:
         """Move lift 0 (MTF) or 1 (MTB) at ``metres_per_s`` (+ = end segment up); 0 holds."""
@@ -194,19 +200,26 @@ class World:
     def _fetch(self) -> None:
         if self._pose_at == self._steps_done:
             return
-        px, py, pa, wa = self._px, self._py, self._pa, [0.0] * 3
+        px, py, pa = self._px, self._py, self._pa
         if self._ptrs is not None:
             get_pos, get_angle = _cp.cpBodyGetPosition, _cp.cpBodyGetAngle
-            for i, (ptr, wheel) in enumerate(self._ptrs):
-                pos = get_pos(ptr)
-                px[i], py[i], pa[i], wa[i] = pos.x, pos.y, get_angle(ptr), get_angle(wheel)
+            (b0, w0), (b1, w1), (b2, w2) = self._ptrs
+            p0, p1, p2 = get_pos(b0), get_pos(b1), get_pos(b2)
+            px[0], py[0], pa[0] = p0.x, p0.y, get_angle(b0)
+            px[1], py[1], pa[1] = p1.x, p1.y, get_angle(b1)
+            px[2], py[2], pa[2] = p2.x, p2.y, get_angle(b2)
+            wa = (get_angle(w0), get_angle(w1), get_angle(w2))
         else:
             for i, body in enumerate(self.segments):
                 pos = body.position
-                px[i], py[i], pa[i], wa[i] = pos.x, pos.y, body.angle, self.wheels[i][1].angle
+                px[i], py[i], pa[i] = pos.x, pos.y, body.angle
+            (_r0, f0), (_r1, f1), (_r2, f2) = self.wheels
+            wa = (f0.angle, f1.angle, f2.angle)
         # the front wheels' encoders, and the lifts' offsets across segment 2's axle line
-        for i in (0, 1, 2):
-            self._wheel_turns[i] = -(wa[i] - pa[i] - self._wheel_zero[i]) / TWO_PI
+        turns, zero = self._wheel_turns, self._wheel_zero
+        turns[0] = -(wa[0] - pa[0] - zero[0]) / TWO_PI
+        turns[1] = -(wa[1] - pa[1] - zero[1]) / TWO_PI
+        turns[2] = -(wa[2] - pa[2] - zero[2]) / TWO_PI
         sin_a, cos_a = math.sin(pa[1]), math.cos(pa[1])
         lifts = self._lifts
         lifts[0] = -sin_a * (px[0] - px[1]) + cos_a * (py[0] - py[1])
@@ -285,27 +298,30 @@ class World:
         """Aim each moving lift's pin at where the screw will be in ``seconds``; the
         pin's max_bias makes it travel there at the lift's speed, so no Python runs
         between physics steps."""
+        speed, moving = self.lift_speed, self._moving
+        if (speed[0] == 0.0 and speed[1] == 0.0 and not moving[0] and not moving[1]
+                and self._bias[0] == self._bias[1] == self.params.lift_hold_speed):
+            return  # both held, as they were: nothing to set
         stroke, stall = self._stroke, self._stall
         for i in (0, 1):
-            v = self.lift_speed[i]
-            pin = self.pins[i]
+            v = speed[i]
             if v != 0.0:
                 # a stalled lead screw does not run ahead of its nut
                 actual = self.lift_offset(i)
                 t = min(max(self.lift_target[i], actual - stall), actual + stall) + v * seconds
                 t = stroke if t > stroke else (-stroke if t < -stroke else t)
                 self.lift_target[i] = t
-                pin.distance = _PIN_REACH + t
-            elif self._moving[i]:
+                self._set_distance[i](_PIN_REACH + t)
+            elif moving[i]:
                 # just stopped: the screw stands where the nut is now, no coasting on
                 t = self.lift_offset(i)
                 self.lift_target[i] = t
-                pin.distance = _PIN_REACH + t
-            self._moving[i] = v != 0.0
+                self._set_distance[i](_PIN_REACH + t)
+            moving[i] = v != 0.0
             bias = abs(v) if v != 0.0 else self.params.lift_hold_speed
             if bias != self._bias[i]:
                 self._bias[i] = bias
-                pin.max_bias = bias
+                self.pins[i].max_bias = bias
 
     # -- instability ----------------------------------------------------------------
     def _wheel_in_contact(self) -> bool:
@@ -392,3 +408,13 @@ class World:
         return [(float(v.x), float(v.y))
                 for v in (self.segments[segment].local_to_world(q)
                           for q in self.boxes[segment].get_vertices())]
+
+
+def _setter(obj: pymunk.Constraint, name: str, c_function: str) -> Callable[[float], None]:
+    """A function setting ``obj.name``: pymunk's C function ``c_function`` on it
+    when at hand (what the property does, without its Python), else the
+    property."""
+    handle = getattr(obj, "_constraint", None)
+    if _cp is not None and handle is not None and hasattr(_cp, c_function):
+        return partial(getattr(_cp, c_function), handle)
+    return partial(setattr, obj, name)
