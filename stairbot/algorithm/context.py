@@ -88,8 +88,9 @@ class Context:
     resume_phase: str | None = None
     """The phase the standing rule stopped in, resumed when readings agree."""
     pause_diffs: list[float] = field(default_factory=list)
-    """The watched pair's difference (left − right), each tick of the standing
-    rule's wait that gave one: their median decides at its end."""
+    """The watched pair's difference (left − right) on the standing rule's
+    wait's last ticks that gave one (MEDIAN_S of them): their median decides
+    at its end."""
     disagree_ticks: int = 0
     standing_diff: float | None = None
     """The standing rule's smoothed difference of the watched pair (left − right)."""

@@ -76,6 +76,11 @@ def watch(t: Tick, phase: PhaseDef) -> Step | None:
               f"{t.cfg.algorithm.standing_wait:g} s")
 
 
+MEDIAN_S = 1.0
+"""The end of the standing rule's wait: the median of the pair's difference
+over its last this many seconds decides."""
+
+
 def _paused(t: Tick, _w: Work) -> Step:
     ctx = t.ctx
     assert ctx.resume_phase is not None and ctx.pause_started_s is not None
@@ -83,19 +88,23 @@ def _paused(t: Tick, _w: Work) -> Step:
     back = resume.watches == "back"
     # Standing still, the difference over the wait decides, not one noisy tick
     # nor a smoothing that a burst at its end fills: the median of the wait's
-    # ticks (two stray HC-SR04 measurements passed SFR's median in its last
-    # 0.2 s, and the smoothed difference ended a sound run: envelope cases
-    # 596 and 1359 on sonar).  Without a figure on any tick, the smoothed one.
+    # last MEDIAN_S of ticks (two stray HC-SR04 measurements passed SFR's
+    # median in its last 0.2 s, and the smoothed difference ended a sound run:
+    # envelope cases 596 and 1359 on sonar).  A pair that gives no figure now
+    # (nothing ahead, an error) does not disagree, as before; with none on
+    # any tick, the smoothed difference decides.
     disagree = _disagree(t, back, raw_too=False)
     diff = motion.pair_difference(t.snap, t.cfg, back)
     if diff is not None:
         ctx.pause_diffs.append(diff)
+        del ctx.pause_diffs[:-max(1, round(MEDIAN_S / t.cfg.algorithm.tick))]
     if t.snap.time_s - ctx.pause_started_s < t.cfg.algorithm.standing_wait:
         return stay(NO_MOTION)
-    if ctx.pause_diffs:
+    if diff is not None and ctx.pause_diffs:
+        recent = ctx.pause_diffs  # the last MEDIAN_S of ticks that gave a figure
         right, left = motion.pair(t.snap, back)
         near = min(right.distance_m, left.distance_m)
-        disagree = abs(statistics.median(ctx.pause_diffs)) > standing_tolerance(
+        disagree = abs(statistics.median(recent)) > standing_tolerance(
             t.cfg, near, motion.DIFF_SMOOTHING, back)
     if not disagree:
         ctx.disagree_ticks = 0
