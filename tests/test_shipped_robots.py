@@ -253,3 +253,58 @@ def test_stray_readings_while_standing_do_not_make_a_side_wall() -> None:
     r = run_sim(load_config("sonar"), parse_scenario(SONAR_STRAY_STANDING, "stray"), events)
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 5, 5), r.to_dict()
     assert not any("case 2W" in e.message for e in events)
+
+
+SONAR_STRAY_START = """
+[stairs]
+top = "wall"
+width = 1.0
+steps = [{rise = 0.114714, tread = 0.331205}, {rise = 0.113823, tread = 0.326831},
+         {rise = 0.108267, tread = 0.325093}, {rise = 0.114027, tread = 0.327887},
+         {rise = 0.114144, tread = 0.334232}, {rise = 0.110044, tread = 0.332746},
+         {rise = 0.108541, tread = 0.330587}, {rise = 0.108673, tread = 0.33009}]
+[start]
+distance = 0.666383
+yaw_deg = -6.510606
+lateral = -0.140193
+[sensors]
+noise = 0.001
+seed = 265355
+"""
+
+
+def test_a_reading_drive_does_not_end_on_its_first_stray_reading() -> None:
+    """Found by the envelope sweep (case 298 on sonar): one stray far HC-SR04
+    reading on descent 5's first tick met its target, the drive ended at
+    once, and segment 1, lowered on the step's edge, pitched the robot 15°
+    nose up.  A drive ended by its readings now stands until KEY_TICKS of
+    them agree."""
+    r = run_sim(load_config("sonar"), parse_scenario(SONAR_STRAY_START, "stray_start"))
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 8, 8), r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
+
+
+IR_ASKEW_NEAR = """
+[stairs]
+top = "wall"
+width = 1.0
+steps = [{rise = 0.18247, tread = 0.295372}]
+[start]
+distance = 0.59458
+yaw_deg = -13.918328
+lateral = 0.08578
+[sensors]
+noise = 0.001
+seed = 211622
+"""
+
+
+def test_the_squaring_turns_bound_starts_from_the_standing_mean() -> None:
+    """Found by the envelope sweep (case 1452 on ir): the squaring turn's
+    bound (what the readings say it needs, and 12°) came from one tick of a
+    Sharp pair 0.36 m away, which read 1° askew where the standing mean the
+    case was chosen on had said 16°: the turn gave up at 13°.  The bound now
+    starts from the larger of the two."""
+    r = run_sim(load_config("ir"), parse_scenario(IR_ASKEW_NEAR, "ir_askew_near"))
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 1, 1), r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()

@@ -204,6 +204,7 @@ def _check(t: Tick, w: Work) -> Step:
     wall = (not equal and abs(diff) > _one_riser(cfg)
             and not motion.far(sfr, cfg) and not motion.far(sfl, cfg))
     ctx.calibration_case = "3" if equal else ("2W" if wall else "2")
+    ctx.case_diff = diff
     said = ("equal, case 3" if equal else
             "too far apart for one riser within "
             f"{math.degrees(MAX_SQUARE_YAW_RAD):.0f}°: the nearer sees a side wall, case 2W"
@@ -384,7 +385,11 @@ def _turn_enter(t: Tick, w: Work) -> None:
         # calibration may stand
         w.turn_limit_rad = MAX_SQUARE_YAW_RAD + TURN_MARGIN_RAD
     else:
-        w.turn_limit_rad = abs(_askew_rad(t.cfg, sfl - sfr)) + TURN_MARGIN_RAD
+        # the larger of what the standing mean the case was chosen on says and
+        # what the readings now say: one tick of a Sharp pair 0.36 m away read
+        # 1 deg askew where the mean had said 16 (ir envelope case 1452)
+        diffs = [abs(sfl - sfr)] + ([] if t.ctx.case_diff is None else [abs(t.ctx.case_diff)])
+        w.turn_limit_rad = abs(_askew_rad(t.cfg, max(diffs))) + TURN_MARGIN_RAD
 
 
 def _turned_past_limit(t: Tick, w: Work) -> Step | None:

@@ -67,6 +67,9 @@ class Context:
     """Per step (0-based, as tab_length_to_edge): the heading by the odometer
     the robot climbed it with (where ascent 1's calibration left it).
     Descent 1 turns back to it, so that the way down retraces the way up."""
+    case_diff: float | None = None
+    """SFL − SFR, the standing mean the last calibration check chose its case
+    on: the squaring turn's bound starts from it."""
     turn_to: float | None = None
     """The heading (twist) the calibration's odometer turn is turning to."""
     squaring_turns: int = 0

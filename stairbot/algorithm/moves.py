@@ -14,7 +14,7 @@ import statistics
 from collections.abc import Callable
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.phase import FAULT, Phase, PhaseDef, Step, Tick, go, stay
+from stairbot.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
@@ -95,6 +95,14 @@ def reading_drive(
             w.target_wheel = limit
         remaining = direction * (w.target_wheel - here)
         if remaining <= motion.WHEEL_DONE:
+            if limit is None and w.target_reading is not None and not w.reading_lost \
+                    and 0 < len(w.first_keys) < KEY_TICKS:
+                # Ended by its first ticks' readings: stand until KEY_TICKS of
+                # them agree.  One stray far HC-SR04 reading at its start
+                # ended descent 5 at once, and lowered on the step's edge,
+                # segment 1 pitched the robot 15 deg nose up (the envelope
+                # sweep, case 298 on sonar).
+                return stay(NO_MOTION)
             return done(t, w)
         return stay(motion.drive(cfg, direction, remaining))
 
