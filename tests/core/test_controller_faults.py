@@ -373,3 +373,21 @@ def test_a_burst_at_the_end_of_the_wait_does_not_decide_it() -> None:
     r = ctrl.result
     assert (r.outcome, r.pauses, r.steps_climbed, r.steps_descended) == ("completed", 1, 2, 2)
     assert len(of(events, EventKind.RESUME)) == 1
+
+
+def test_a_pair_that_reads_nothing_when_the_wait_ends_does_not_disagree() -> None:
+    """Found by the envelope sweep (case 474 and four more on ir): near the
+    top the Sharp beams read the landing beyond, grazing, and disagreed for
+    most of the wait; when it ended they read nothing at all.  A median over
+    the whole wait still said "disagree" and ended a sound run; the pair
+    gives no difference at the decision, so it does not disagree (and the
+    median is over the wait's last second)."""
+    ctrl, robot, _events = start(faults=[Fault(SensorId.SFL, 7.0, 9.0, offset=0.05)])
+    run(ctrl, robot, until=lambda c: c.phase is Phase.PAUSED)
+    end = robot.t + WAIT
+    robot.faults += [Fault(SensorId.SFL, 9.0, end - 0.1, offset=0.05),
+                     Fault(SensorId.SFL, end - 0.1, end + 0.1, offset=2.0),
+                     Fault(SensorId.SFR, end - 0.1, end + 0.1, offset=2.0)]
+    run(ctrl, robot)
+    r = ctrl.result
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 2, 2), r.error
