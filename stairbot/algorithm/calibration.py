@@ -388,8 +388,8 @@ def _turn_enter(t: Tick, w: Work) -> None:
         # the larger of what the standing mean the case was chosen on says and
         # what the readings now say: one tick of a Sharp pair 0.36 m away read
         # 1 deg askew where the mean had said 16 (ir envelope case 1452)
-        diffs = [abs(sfl - sfr)] + ([] if t.ctx.case_diff is None else [abs(t.ctx.case_diff)])
-        w.turn_limit_rad = abs(_askew_rad(t.cfg, max(diffs))) + TURN_MARGIN_RAD
+        diff = max(abs(sfl - sfr), abs(t.ctx.case_diff or 0.0))
+        w.turn_limit_rad = _askew_rad(t.cfg, diff) + TURN_MARGIN_RAD
 
 
 def _turned_past_limit(t: Tick, w: Work) -> Step | None:
