@@ -255,35 +255,39 @@ def _lifted_first(t: Tick, w: Work) -> Step:
 
 
 def _sample_sight(t: Tick, w: Work) -> None:
-    """Over the second half of the lift past the sight-over, add each front
-    reading that still sees past the riser to ``w.sight_sums``."""
+    """Over the second half of the lift past the sight-over, keep each front
+    reading that still sees past the riser in ``w.sights``."""
     if t.snap.turns(MotorId.MTF) - w.entry_mtf < t.ctx.number_of_vertical_turns / 2.0:
         return
     gap, cfg = _gap(t), t.cfg
     for i, r in enumerate(motion.pair(t.snap)):
         if r.ok and not motion.far(r, cfg) and r.distance_m >= gap + SIGHT_JUMP_M:
-            w.sight_sums[i] += r.distance_m
-            w.sight_counts[i] += 1
+            w.sights[i].append(r.distance_m)
 
 
-def _sight_means(t: Tick, w: Work) -> list[float | None]:
-    """SFR's and SFL's readings past the riser: each one's mean over the
+def _sight_medians(t: Tick, w: Work) -> list[float | None]:
+    """SFR's and SFL's readings past the riser: each one's median over the
     lift's second half where it has them, else its reading now; None for a
-    sensor that reads nothing ahead now."""
+    sensor that reads nothing ahead now.  The median, not the
+    mean: two stray HC-SR04 measurements in a row passed perception's median
+    of three and held SFR at 0.627 m for the lift's last 12 ticks; their mean
+    made length_of_next_step 2 cm long, segment 2 stopped 2 cm short of the
+    edge and lifting segment 3 pitched the robot 15 deg nose up (the envelope
+    sweep, case 601 on sonar)."""
     out: list[float | None] = []
     for i, r in enumerate(motion.pair(t.snap)):
-        n = w.sight_counts[i]
+        sights = w.sights[i]
         out.append(None if motion.far(r, t.cfg) else
-                   w.sight_sums[i] / n if n else r.distance_m)
+                   statistics.median(sights) if sights else r.distance_m)
     return out
 
 
 def _tread_measured(t: Tick, w: Work) -> float | None:
-    """:func:`tread_seen` now, on :func:`_sight_means`."""
+    """:func:`tread_seen` now, on :func:`_sight_medians`."""
     tread = tread_seen(t)
     if tread is None or tread == float("inf"):
         return tread
-    return min(m for m in _sight_means(t, w) if m is not None) - _gap(t)
+    return min(m for m in _sight_medians(t, w) if m is not None) - _gap(t)
 
 
 _more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_vertical_turns},
@@ -322,13 +326,13 @@ LOWER_OBSTACLE = PhaseDef(
 # -- ascent 4-7: segment by segment onto the step -------------------------------------------
 def _measure_next_step(t: Tick, w: Work) -> None:
     """Ascent 4's "store the reading in length_of_next_step", on the pair's
-    means over ascent 3's last lift (:func:`_sight_means`) rather than one
+    medians over ascent 3's last lift (:func:`_sight_medians`) rather than one
     reading: a Sharp's single reading at 0.35 m is 8 mm off one time in
     five, and segment 2 stopped that short of the edge (case 816 on ir)."""
     ctx = t.ctx
-    means = _sight_means(t, w)
-    if motion.measurable(t.snap, t.cfg) and None not in means:
-        ctx.length_of_next_step = sum(m for m in means if m is not None) / 2.0
+    medians = _sight_medians(t, w)
+    if motion.measurable(t.snap, t.cfg) and None not in medians:
+        ctx.length_of_next_step = sum(m for m in medians if m is not None) / 2.0
         t.say(f"length_of_next_step = {ctx.length_of_next_step:.3f} m",
               length_of_next_step=ctx.length_of_next_step)
         return

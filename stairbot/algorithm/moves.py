@@ -53,10 +53,11 @@ def reading_drive(
     SFR/SFL reading reaches ``target(t)`` metres.
 
     While the front sensors are measurable the target is re-expressed as an
-    absolute wheel-counter target every tick (dead reckoning from the latest
-    reading); while they are not, the drive carries on to the last such
-    target — or, if they never were, to ``fallback_turns(t)`` turns from the
-    phase's start (the seed's "not measurable" fallback).  A ``target`` of
+    absolute wheel-counter target every tick (dead reckoning from the median
+    of its last KEY_TICKS readings, each less what the wheels drove since);
+    while they are not, the drive carries on to the last such target — or,
+    if they never were, to ``fallback_turns(t)`` turns from the phase's start
+    (the seed's "not measurable" fallback).  A ``target`` of
     None means a drive by turns only.  ``bound(t, w)``, when it gives one, is
     a wheel-counter position the drive never passes, whatever the readings say;
     with ``exact``, the position it ends at.
@@ -87,7 +88,18 @@ def reading_drive(
                       f"(reading {reading:.3f} m): the rest of the drive goes by turns",
                       jump=jump)
             else:
-                remaining_m = direction * (reading - w.target_reading)
+                # The target from the median of the last KEY_TICKS keys, not
+                # from this tick's reading alone: two stray HC-SR04
+                # measurements in three passed perception's median on one
+                # tick and set descent 5's target 4.6 cm short (the envelope
+                # sweep, case 808 on sonar); lowered on the step's edge,
+                # segment 1 pitched the robot 15 deg nose up.
+                recent = w.recent_keys
+                recent.append(key)
+                if len(recent) > KEY_TICKS:
+                    del recent[0]
+                surface = recent[0] if len(recent) == 1 else statistics.median(recent)
+                remaining_m = direction * (surface - key + reading - w.target_reading)
                 w.target_wheel = here + direction * cfg.wheel_turns(remaining_m)
         assert w.target_wheel is not None  # set on entry
         limit = None if bound is None else bound(t, w)

@@ -41,14 +41,15 @@ class Work:
     constant while the sensors see the same surface: the median of its first
     KEY_TICKS values (``first_keys``), so one stray first reading does not set it."""
     first_keys: list[float] = field(default_factory=list)
+    recent_keys: list[float] = field(default_factory=list)
+    """A reading drive: its last KEY_TICKS keys; the target is set from their median."""
     reading_lost: bool = False
     """A reading drive: the reading jumped away from what the wheels explain;
     the rest is driven by turns."""
-    sight_sums: list[float] = field(default_factory=lambda: [0.0, 0.0])
-    sight_counts: list[int] = field(default_factory=lambda: [0, 0])
+    sights: list[list[float]] = field(default_factory=lambda: [[], []])
     """Ascent 3's lift past the sight-over: SFR's and SFL's readings of the
-    next riser summed over its second half, and how many (the tread is
-    measured on their means, not on one noisy reading)."""
+    next riser over its second half (the tread is measured on their medians,
+    not on one noisy reading)."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
     diffs: list[float] = field(default_factory=list)
