@@ -116,9 +116,7 @@ class Controller:
         self._perception = Perception(config)
         self._supervisor = Supervisor(config)
         self._sensor_since: float | None = None
-        # the present phase, its record and the sensors it needs, by (phase,
-        # resume phase) of the context: looked up again only when they change
-        self._now_key: tuple[str, str | None] | None = None
+        self._now_key: tuple[str, str | None] | None = None  # see _present
         self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
 
     # -- what the outside sees --------------------------------------------------------
@@ -230,9 +228,8 @@ class Controller:
         return speeds
 
     def _present(self) -> tuple[Phase, PhaseDef, tuple[SensorId, ...]]:
-        """The present phase, its record and the sensors it needs
-        (:func:`_needed_sensors`): the same until the context's phase or the
-        phase a pause resumes changes."""
+        """The present phase, its record and :func:`_needed_sensors`, looked up
+        again only when the context's phase or the one a pause resumes changes."""
         ctx = self._ctx
         key = (ctx.phase, ctx.resume_phase)
         now = self._now

@@ -264,11 +264,9 @@ class World:
         return self._px[1]
 
     def state(self) -> tuple[list[float], list[float], list[float], list[float], list[float]]:
-        """The segments' x, y and angle, the front wheels' turns and the lifts'
-        offsets (what pose, wheel_turns and lift_offset tell one at a time), in
-        one call for the simulated robot's per-tick bookkeeping.  The lists are
-        the world's own cache, refilled in place after the next step: read them
-        now, never change or keep them."""
+        """What pose, wheel_turns and lift_offset tell one at a time, in one call:
+        the segments' x, y, angle, the wheels' turns, the lifts' offsets.  The
+        world's own lists, refilled after each step: read now, never change or keep."""
         if self._pose_at != self._steps_done:
             self._fetch()
         return self._px, self._py, self._pa, self._wheel_turns, self._lifts
