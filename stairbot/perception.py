@@ -259,7 +259,7 @@ class _Track:
     """One sensor's recent measurements and the kind seen."""
 
     __slots__ = ("front", "max_age", "midpoint", "ok_keys", "newest", "taken_s", "kind",
-                 "run_kind", "run", "last_of_kind")
+                 "run_kind", "run", "last_of_kind", "seen_ok")
 
     def __init__(self, front: bool, window: int, max_age: float, midpoint: float) -> None:
         self.front = front
@@ -274,6 +274,7 @@ class _Track:
         self.run_kind: Kind | None = None
         self.run = 0
         self.last_of_kind: dict[Kind, SensorReading] = {}
+        self.seen_ok: SensorReading | None = None  # the last OK one of age 0 given out
 
 
 class Perception:
@@ -281,6 +282,7 @@ class Perception:
 
     def __init__(self, cfg: RobotConfig) -> None:
         self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
+        self._wheels = WHEEL_MOTORS[0], WHEEL_MOTORS[1], WHEEL_MOTORS[2], WHEEL_MOTORS[3]
         self._tracks: dict[SensorId, _Track] = {}
         for back, ids in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
             lo, hi = cfg.sensors.range(back)
@@ -293,8 +295,8 @@ class Perception:
     def see(self, snap: Snapshot) -> Snapshot:
         """The snapshot as the algorithm should see it."""
         turns = snap.motors
-        odometer = (turns[WHEEL_MOTORS[0]].turns + turns[WHEEL_MOTORS[1]].turns
-                    + turns[WHEEL_MOTORS[2]].turns + turns[WHEEL_MOTORS[3]].turns) \
+        w0, w1, w2, w3 = self._wheels
+        odometer = (turns[w0].turns + turns[w1].turns + turns[w2].turns + turns[w3].turns) \
             * self._metres_per_turn
         now = snap.time_s
         self._odometer.append((now, odometer))
@@ -315,8 +317,12 @@ class Perception:
                         track.run += 1
                         keys = track.ok_keys
                         keys.append(d + odometer if track.front else d)
-                        m = _median(keys)
-                        sensors[sid] = SensorReading(m - odometer if track.front else m)
+                        m = _median(keys) - odometer if track.front else _median(keys)
+                        # immutable, and a new one costs: reuse an equal one (0.0 may be -0.0)
+                        seen = track.seen_ok
+                        if seen is None or seen.distance_m != m or m == 0.0:
+                            seen = track.seen_ok = SensorReading(m)
+                        sensors[sid] = seen
                         continue
                 self._measured(track, reading, now, odometer)
             elif now - age > track.taken_s + 1e-9:
@@ -392,7 +398,7 @@ class Perception:
 
 
 def _median(values: Iterable[float]) -> float:
-    """statistics.median, without its generality (a hot path: every sensor, every tick)."""
+    """statistics.median, without its generality (every sensor, every tick)."""
     s = sorted(values)
     n = len(s)
     half = n // 2

@@ -23,7 +23,7 @@ from typing import Any
 
 from stairbot.algorithm import calibration, motion, stability, standing
 from stairbot.algorithm.context import Context
-from stairbot.algorithm.phase import Step, Tick, fail, where
+from stairbot.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.algorithm.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
 from stairbot.algorithm.work import Work
@@ -116,6 +116,8 @@ class Controller:
         self._perception = Perception(config)
         self._supervisor = Supervisor(config)
         self._sensor_since: float | None = None
+        self._now_key: tuple[str, str | None] | None = None  # see _present
+        self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -137,7 +139,7 @@ class Controller:
 
     @property
     def finished(self) -> bool:
-        return self.phase.terminal
+        return _TERMINAL[self._ctx.phase]  # asked twice a tick: no Phase look-up
 
     @property
     def held(self) -> bool:
@@ -200,8 +202,8 @@ class Controller:
             tilt = self._supervisor.tilt
             self._say(tilt.describe(), tilt_watched=tilt.watched)
             return _zeros()
-        phase, ctx = self.phase, self._ctx
-        needed = _needed_sensors(phase, ctx)
+        ctx = self._ctx
+        phase, record, needed = self._present()
         fault = self._fault(snap, phase, needed) or self._supervisor.check(snap)
         if fault is not None:
             self._apply(fail(fault), snap)
@@ -209,7 +211,6 @@ class Controller:
         if self._sensor_hold(snap, phase, needed):
             self._supervisor.commanded({})
             return _zeros()
-        record = phase.record
         t = Tick(snap, self.config, ctx, self.mode, self._say)
         step = standing.watch(t, record)
         if step is None and record.carried_by and not ctx.work.balanced \
@@ -225,6 +226,18 @@ class Controller:
             speeds = self._limit(step.speeds, snap)
         self._supervisor.commanded(speeds)
         return speeds
+
+    def _present(self) -> tuple[Phase, PhaseDef, tuple[SensorId, ...]]:
+        """The present phase, its record and :func:`_needed_sensors`, looked up
+        again only when the context's phase or the one a pause resumes changes."""
+        ctx = self._ctx
+        key = (ctx.phase, ctx.resume_phase)
+        now = self._now
+        if now is None or key != self._now_key:
+            phase = BY_VALUE[ctx.phase]
+            now = self._now = (phase, phase.record, _needed_sensors(phase, ctx))
+            self._now_key = key
+        return now
 
     def _fault(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> str | None:
         """A motor fault, a sensor ``needed`` that reads no number, or the
@@ -280,14 +293,14 @@ class Controller:
     def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
         """Every motor gets a speed within its maximum; a lift at the end of its
         stroke is not driven further."""
-        stroke = self._stroke
+        stroke, vmax_of, isfinite = self._stroke, self._vmax, math.isfinite
         out = _zeros()
         for motor, v in speeds.items():
-            vmax = self._vmax[motor]
+            vmax = vmax_of[motor]
             # min/max pass a NaN through as a full-speed limit: it stops instead
-            v = max(-vmax, min(vmax, v)) if math.isfinite(v) else 0.0
+            v = max(-vmax, min(vmax, v)) if isfinite(v) else 0.0
             if motor in LIFT_MOTORS:
-                turns = snap.turns(motor)
+                turns = snap.motors[motor].turns
                 if (v > 0 and turns >= stroke) or (v < 0 and turns <= -stroke):
                     v = 0.0
             out[motor] = v
@@ -388,6 +401,7 @@ def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
 _PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
 ALL_MOTORS: tuple[MotorId, ...] = tuple(MotorId)
 _ZEROS: dict[MotorId, float] = dict.fromkeys(ALL_MOTORS, 0.0)
+_TERMINAL: dict[str, bool] = {p.value: p.terminal for p in Phase}
 
 
 def _zeros() -> dict[MotorId, float]:

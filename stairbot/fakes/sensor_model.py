@@ -219,6 +219,9 @@ class ModelSensor:
         self._noisy = self.noise_a > 0.0 or self.noise_b > 0.0
         self._outlier_rate, self._dropout_rate = model.outlier_rate, model.dropout_rate
         self._bias = model.bias
+        # measured at every read and published at once, no scenario fault: each
+        # read's reading is its own measurement (measure's short way)
+        self._instant = self._period <= 0.0 and self._latency <= 0.0 and not self.faults
 
     # -- timing ---------------------------------------------------------------------
     def due(self, t: float) -> bool:
@@ -274,6 +277,12 @@ class ModelSensor:
     def measure(self, true_distance: float | None, t: float) -> SensorReading:
         """One ray, square to its target: measure ``true_distance`` (None:
         nothing) if a measurement is due, and return the published reading."""
+        if self._instant:  # what _sample and reading come to for such a sensor
+            reading, cause = self._measure(true_distance,
+                                           _OK if true_distance is not None else _NOTHING, t)
+            self.measurements += 1
+            self._current = (t, reading, cause)
+            return reading
         if t >= self._next and not (self._freezes and frozen(self._freezes, t)):
             self._sample(true_distance, _OK if true_distance is not None else _NOTHING, t)
         return self.reading(t)

@@ -195,13 +195,13 @@ class SimRobot:
         elapsed = w.time - t0
         if elapsed <= 0.0:
             return
-        self.plan.move(w.centre_x() - x0)
+        px, _py, _pa, seen, lifts = w.state()
+        self.plan.move(px[1] - x0)
         along = self._along()
         seen_turns, wheel_turns, wheel_tps = self._wheel_seen, self._wheel_turns, self._wheel_tps
         for i in (0, 1, 2):
-            seen = w.wheel_turns(i)
-            turned = (seen - seen_turns[i]) / along
-            seen_turns[i] = seen
+            turned = (seen[i] - seen_turns[i]) / along
+            seen_turns[i] = seen[i]
             wheel_turns[i] += turned
             wheel_tps[i] = turned / elapsed
         self._diff_speed = diff
@@ -210,11 +210,11 @@ class SimRobot:
             if turning:
                 v = 2.0 * diff * self.config.wheel_circumference  # vR - vL, m/s
                 self.plan.turn(v / self.config.geometry.track_width * elapsed)
-        per_turn = self._per_turn
+        per_turn, lift_turns, lift_tps = self._per_turn, self._lift_turns, self._lift_tps
         for i in (0, 1):
-            turns = w.lift_offset(i) / per_turn
-            self._lift_tps[i] = (turns - self._lift_turns[i]) / elapsed
-            self._lift_turns[i] = turns
+            turns = lifts[i] / per_turn
+            lift_tps[i] = (turns - lift_turns[i]) / elapsed
+            lift_turns[i] = turns
 
     def offset_m(self) -> float:
         """Top-view distance of segment 2's centre from where it started."""
@@ -244,8 +244,8 @@ class SimRobot:
         return max(0.05, math.cos(self.plan.yaw))
 
     def _motor_states(self) -> dict[MotorId, MotorState]:
-        w = self.world
-        per_turn = self._per_turn
+        lifts = self.world.state()[4]
+        per_turn, lift_tps = self._per_turn, self._lift_tps
         turns, tps = self._wheel_turns, self._wheel_tps
         mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
@@ -254,8 +254,8 @@ class SimRobot:
             _MWB: MotorState(turns[2], tps[2]),
             _MWR: MotorState(mean + d, mean_speed + ds),
             _MWL: MotorState(mean - d, mean_speed - ds),
-            _MTF: MotorState(w.lift_offset(0) / per_turn, self._lift_tps[0]),
-            _MTB: MotorState(w.lift_offset(1) / per_turn, self._lift_tps[1]),
+            _MTF: MotorState(lifts[0] / per_turn, lift_tps[0]),
+            _MTB: MotorState(lifts[1] / per_turn, lift_tps[1]),
         }
 
 

@@ -180,14 +180,14 @@ class SimSensors:
     def _front_origin(self) -> tuple[float, float, float, float, float, float]:
         """The front mount in the side view (x, y), segment 1's angle, its cos
         and sin, and the mount's distance ahead of segment 2's centre."""
-        w = self.world
+        px, py, pa, _turns, _lifts = self.world.state()
         lx, ly, _reach = self._front_mount
-        x1, y1, a1 = w.pose(0)
+        a1 = pa[0]
         c, s = math.cos(a1), math.sin(a1)
-        mx, my = x1 + c * lx - s * ly, y1 + s * lx + c * ly
+        mx, my = px[0] + c * lx - s * ly, py[0] + s * lx + c * ly
         # the mount's distance ahead of segment 2's centre, along the robot
-        x2, y2, a2 = w.pose(1)
-        forward = math.cos(a2) * (mx - x2) + math.sin(a2) * (my - y2)
+        a2 = pa[1]
+        forward = math.cos(a2) * (mx - px[1]) + math.sin(a2) * (my - py[1])
         return mx, my, a1, c, s, forward
 
     def _front_truth(self) -> tuple[float | None, float | None]:
@@ -195,8 +195,9 @@ class SimSensors:
         w = self.world
         reach = self._front_mount[2]
         mx, my, _a1, c, s, forward = self._front_origin()
-        hit = w.profile.ray(mx, my, mx + c * reach, my + s * reach)
-        hit_dx = None if hit is None else hit[0] - mx
+        x1 = mx + c * reach
+        best, _i = w.profile.first(mx, my, x1, my + s * reach)  # profile.ray's x, written out
+        hit_dx = None if best == math.inf else (mx + (x1 - mx) * best) - mx
         slant = 1.0 / max(c, 1e-6)
         lat = self.config.sensors.front_lateral
         # Plan.front_distance for both, turned by the one yaw
@@ -217,23 +218,23 @@ class SimSensors:
         """The side-view x of SBR and SBL, their height, segment 3's angle, its
         cos and sin, and the rays' reach.  Turned by a yaw, the two stand at
         different x."""
-        w = self.world
+        px, py, pa, _turns, _lifts = self.world.state()
         lx, ly, reach = self._back_mount
-        x3, y3, a3 = w.pose(2)
+        a3 = pa[2]
         c, s = math.cos(a3), math.sin(a3)
-        mx, my = x3 + c * lx - s * ly, y3 + s * lx + c * ly
+        mx, my = px[2] + c * lx - s * ly, py[2] + s * lx + c * ly
         yaw = self.plan.yaw
         if yaw == 0.0:
             return (mx, mx), my, a3, c, s, reach
         # top view: the mount sits `behind` along the robot and +-lateral across it
-        x2 = w.pose(1)[0]
-        behind = mx - x2
+        behind = mx - px[1]
         shift = behind * (math.cos(yaw) - 1.0)
         lat = self.config.sensors.back_lateral * math.sin(yaw)
         return (mx + shift + lat, mx + shift - lat), my, a3, c, s, reach
 
     def _down(self, mx: float, my: float, c: float, s: float, reach: float) -> float | None:
-        hit = self.world.profile.ray(mx, my, mx + s * reach, my - c * reach)
-        if hit is None:
+        x1, y1 = mx + s * reach, my - c * reach
+        best, _i = self.world.profile.first(mx, my, x1, y1)  # (ray's point, written out)
+        if best == math.inf:
             return None
-        return math.hypot(hit[0] - mx, hit[1] - my)
+        return math.hypot((mx + (x1 - mx) * best) - mx, (my + (y1 - my) * best) - my)

@@ -104,8 +104,9 @@ class StairsProfile:
     def first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
         """Ray parameter of the first surface met (inf: none) and its segment
         (its unit normal: ``normals[i]``)."""
-        ahead, behind = self.starts(x0)
-        return self.first_from(x0, y0, x1, y1, ahead, behind)
+        r = self.radius  # starts(x0), written out: every single-ray sensor casts here
+        return self.first_from(x0, y0, x1, y1, bisect_left(self._xmax, x0 - r),
+                               bisect_right(self._xmin, x0 + r) - 1)
 
     def starts(self, x0: float) -> tuple[int, int]:
         """The first segment a ray from ``x0`` can meet going forward (+x) and

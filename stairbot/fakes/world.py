@@ -263,6 +263,14 @@ class World:
             self._fetch()
         return self._px[1]
 
+    def state(self) -> tuple[list[float], list[float], list[float], list[float], list[float]]:
+        """What pose, wheel_turns and lift_offset tell one at a time, in one call:
+        the segments' x, y, angle, the wheels' turns, the lifts' offsets.  The
+        world's own lists, refilled after each step: read now, never change or keep."""
+        if self._pose_at != self._steps_done:
+            self._fetch()
+        return self._px, self._py, self._pa, self._wheel_turns, self._lifts
+
     @property
     def steps_done(self) -> int:
         """Physics steps taken so far: identifies the physics state."""
