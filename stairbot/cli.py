@@ -61,7 +61,7 @@ ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N
               "can://INTERFACE/CHANNEL?bitrate=N")
 SCENARIO_HELP = ("scenario TOML file, or the name of a shipped scenario (see "
                  "`stairbot scenario list`); default: five residential steps")
-CONFIG_HELP = ("robot config TOML file, or a shipped robot's name (reference, tof, sonar, ir); "
+CONFIG_HELP = ("robot config TOML file, or a shipped robot's name (reference, ideal, sonar, ir); "
                "default: the reference robot")
 
 

@@ -77,11 +77,15 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     models it (stairbot.fakes.sensor_presets)."""
     back_model: SensorModelName = "ideal"
     """... and SBR/SBL."""
-    front_fov_deg: Annotated[float, msgspec.Meta(gt=0, le=90)] | None = None
-    """Full cone of SFR/SFL as mounted (a ToF's ROI narrows it); None: the model's."""
+    front_fov_deg: Annotated[float, msgspec.Meta(ge=0, le=90)] | None = None
+    """Full cone of SFR/SFL as mounted (a ToF's ROI narrows it), at most the
+    model's; 0: one ray along the mount (what the ``ideal`` model has, and
+    how a config that extends one with a cone takes the cone back); None
+    (the key left out): the model's."""
     front_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
     """Mounting tilt of SFR/SFL, degrees up."""
-    back_fov_deg: Annotated[float, msgspec.Meta(gt=0, le=90)] | None = None
+    back_fov_deg: Annotated[float, msgspec.Meta(ge=0, le=90)] | None = None
+    """... of SBR/SBL, the same way."""
     back_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
     """Mounting tilt of SBR/SBL, degrees towards the front."""
 

@@ -54,11 +54,16 @@ def check_consistency(cfg: RobotConfig) -> None:
                           f"sensor's own range); allowed: at most {front_hi} m")
     for back, fov in ((False, s.front_fov_deg), (True, s.back_fov_deg)):
         full = s.spec(back).fov_deg
+        pair = "back" if back else "front"
         if fov is not None and full > 0 and fov > full:
-            pair = "back" if back else "front"
             raise ConfigError(src, f"sensors.{pair}_fov_deg",
                               f"{fov} degrees, wider than the {s.spec(back).name}'s "
                               f"{full}-degree cone; allowed: up to {full} (an ROI narrows it)")
+        if fov is not None and full == 0 and fov > 0:
+            raise ConfigError(src, f"sensors.{pair}_fov_deg",
+                              f"{fov} degrees, but the {s.spec(back).name} model is one ray; "
+                              "allowed: 0, one ray along the mount (say so when the config "
+                              "it extends gives a cone)")
     if a.SAFE_DISTANCE_IN_FRONT_OF_STEP <= a.approach_gap:
         raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
                           f"must exceed approach_gap ({a.approach_gap} m)")

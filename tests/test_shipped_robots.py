@@ -61,7 +61,7 @@ def test_the_ir_robot_closes_in_to_square_up_where_its_noise_allows() -> None:
     assert ir.square_range_m == quiet_range_m(ir) < 0.4
     assert square_tolerance(ir, ir.square_range_m) <= ir.algorithm.equal_tolerance + 1e-9
     assert square_tolerance(ir, ir.square_range_m + 0.01) > ir.algorithm.equal_tolerance
-    assert quiet_range_m(load_config("reference")) == math.inf
+    assert quiet_range_m(load_config("ideal")) == math.inf
     events: list[Event] = []
     r = run_sim(ir, parse_scenario(IR_FAR_START, "ir_far_start"), events)
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 3, 3), r.to_dict()
@@ -94,14 +94,14 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     The edge is now placed where the pair crossed it (edge_sight_m), and
     segment 3's front wheels stop clear of the edge's corner."""
     from stairbot.algorithm.descent import edge_clearance_m, edge_sight_m
-    sonar, tof = load_config("sonar"), load_config("tof")
+    sonar, reference = load_config("sonar"), load_config("reference")
     full = sonar.motors.wheel_speed * sonar.wheel_circumference
     # backing at full speed: its latency, then half a period and one more
     # (the median of three needs two measurements of the drop)
     assert edge_sight_m(sonar, full) - edge_sight_m(sonar, 0.0) == pytest.approx(
         full * (0.025 + 1.5 * 0.06), rel=1e-6)
     # the first echo's cone: the riser is seen until drop x sin 7.5 deg past the edge
-    assert edge_sight_m(sonar, 0.0) > 0.01 and edge_sight_m(tof, 0.0) == 0.0
+    assert edge_sight_m(sonar, 0.0) > 0.01 and edge_sight_m(reference, 0.0) == 0.0
     assert edge_clearance_m(sonar) == pytest.approx(0.0745, abs=1e-4)  # with edge_doubt_m
     events: list[Event] = []
     r = run_sim(sonar, parse_scenario(SONAR_EDGES, "edges"), events)

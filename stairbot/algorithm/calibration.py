@@ -219,7 +219,7 @@ def _verify(t: Tick, w: Work) -> Step:
     """Check a squaring turn standing on all wheels.  The turn ended on the
     readings taken with segments 1 and 3 lifted, their sensors a clearance
     higher: a cone tilted up then sees more of what lies over a low riser,
-    and read equal 17 deg askew on the tof robot (the envelope sweep: the
+    and read equal 17 deg askew on the reference robot (the envelope sweep: the
     standing rule then ended the approach).  Not equal here, the robot turns
     by the odometer as far as the difference says (a flat riser, both beams
     on it), and checks again."""
@@ -577,7 +577,7 @@ def _lowered(t: Tick, _w: Work) -> Step:
     # check waits for it): a squaring turn (squaring_turns > 0), or descent
     # 1's turn back to the climb's heading (the seed's check).  Segment 1
     # settling onto its wheels pitches the beams down for a moment, and a
-    # cone then reads the floor (the tof robot took its start reading there,
+    # cone then reads the floor (the reference robot took its start reading there,
     # 0.202 m for 0.327 m, and came home 0.125 m short).
     return go(P.CAL_CHECK)
 

@@ -150,7 +150,7 @@ def _edge_bound(t: Tick) -> float | None:
     tab_length_to_edge, read on the way up, may be a centimetre or two off,
     and the robot tipped back where it was; and on a tread little longer
     than the robot, backing off the seed's approach turns already takes
-    segment 3 past the edge (the envelope sweep: the tof robot tipped back
+    segment 3 past the edge (the envelope sweep: the reference robot tipped back
     backing up to the edge after that)."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.edge_wheel is None:
@@ -203,7 +203,7 @@ def floor_tolerance(cfg: RobotConfig) -> float:
     the mean of two filtered readings there.  Without the sigmas, a noisy
     pair (or a cone, whose slanted rays read a little long) that reads above
     BACK_CLEARANCE standing keeps the lift pushing segment 3 down, and
-    segment 2 tips nose down (found by the envelope sweep on the tof robot:
+    segment 2 tips nose down (found by the envelope sweep on the reference robot:
     15 deg at the top of a flight)."""
     sigma = median_sigma(cfg, True, cfg.BACK_CLEARANCE) / math.sqrt(2.0)
     return cfg.sensors.resolution / 2 + FLOOR_SIGMAS * sigma

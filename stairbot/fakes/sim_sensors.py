@@ -43,7 +43,7 @@ class SimImu:
     of pitch over it -- as a MEMS gyro's low-pass filter reports it, not the
     body's angular velocity after the last physics step: a contact's impulse
     in one 2 ms step read 124 deg/s at 4.6 deg of pitch, and the tilt
-    supervisor stopped a sound climb (the envelope sweep, case 1669 on tof)."""
+    supervisor stopped a sound climb (the envelope sweep, case 1669 on the reference robot)."""
 
     def __init__(self, world: World) -> None:
         self.world = world

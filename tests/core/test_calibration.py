@@ -14,7 +14,7 @@ from stairbot.config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, SensorId
 
-CFG = load_config()
+CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 CLEARANCE = CFG.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE
 SQUARE = math.radians(1.0)  # about 2 mm over the pair's 0.1 m, well inside the 2.9°
 # that squaring up to equal_tolerance (5 mm) allows

@@ -95,18 +95,22 @@ def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
         (with_change("safety", "stability_margin", "0.02"), "safety.stability_margin",
          "allowed: 0 <= stability_margin < LENGTH_OF_SECOND_MODULE / 2 - wheel_inset = 0.0190 m"),
         (DEFAULT_TEXT[:DEFAULT_TEXT.index("[safety]")], "safety", "required but missing"),
-        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "lidar"\n'),
+        (with_change("sensors", "front_model", '"lidar"'),
          "sensors.front_model",
          "'lidar' is not allowed; allowed: one of 'gp2y0a21', 'hcsr04', 'ideal', 'vl53l0x', "
          "'vl53l1x'"),
-        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nback_model = "gp2y0a21"\n'),
+        (with_change("sensors", "back_model", '"gp2y0a21"'),
          "sensors.back_height", "read from 0.1 m: the floor would be out of range"),
-        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "gp2y0a21"\n'),
+        (with_change("sensors", "front_model", '"gp2y0a21"'),
          "algorithm.LENGTH_OF_INFINITY", "(gp2y0a21) read at most 0.8 m"),
-        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_model = "vl53l1x"\n'
-                              'front_fov_deg = 40\n'),
+        (with_change("sensors", "front_fov_deg", "40"),
          "sensors.front_fov_deg", "wider than the vl53l1x's 27.0-degree cone"),
-        (DEFAULT_TEXT.replace("[sensors]\n", '[sensors]\nfront_tilt_deg = 60\n'),
+        (with_change("sensors", "front_fov_deg", "-1.0"),
+         "sensors.front_fov_deg", "-1.0 is not allowed; allowed: a number >= 0 and <= 90"),
+        (with_change("sensors", "front_model", '"ideal"'),  # the 15-degree ROI left on one ray
+         "sensors.front_fov_deg",
+         "15.0 degrees, but the ideal model is one ray; allowed: 0, one ray along the mount"),
+        (with_change("sensors", "front_tilt_deg", "60"),
          "sensors.front_tilt_deg", "<= 45"),
     ],
 )
@@ -141,12 +145,16 @@ def test_the_default_file_is_valid_toml_with_seed_names() -> None:
 
 
 def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Path) -> None:
-    tof = load_config("tof")
-    assert (tof.sensors.front_model, tof.sensors.back_model) == ("vl53l1x", "vl53l0x")
-    assert tof.geometry == load_config().geometry  # the rest is the reference robot's
-    assert load_config("reference").sensors == load_config().sensors
+    reference = load_config("reference")
+    assert (reference.sensors.front_model, reference.sensors.back_model) == ("vl53l1x", "vl53l0x")
+    assert (reference.sensors.front_fov_deg, reference.sensors.front_tilt_deg) == (15.0, 7.5)
+    assert reference.sensors == load_config().sensors
+    ideal = load_config("ideal")
+    assert (ideal.sensors.front_model, ideal.sensors.back_model) == ("ideal", "ideal")
+    assert ideal.front_cone_top_rad == 0.0  # one level ray: the ROI's cone and tilt taken back
+    assert ideal.geometry == load_config().geometry  # the rest is the reference robot's
     mine = tmp_path / "mine.toml"
-    mine.write_text('extends = "tof"\n[sensors]\nfront_tilt_deg = 5.0\n')
+    mine.write_text('extends = "reference"\n[sensors]\nfront_tilt_deg = 5.0\n')
     cfg = load_config(mine)
     assert (cfg.sensors.front_model, cfg.sensors.front_tilt_deg) == ("vl53l1x", 5.0)
     beside = tmp_path / "beside.toml"
@@ -157,8 +165,8 @@ def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Pat
 
 @pytest.mark.parametrize(("text", "words"), [
     ('extends = "lidar-bot"\n',
-     "no such file, nor a shipped robot; shipped: ir, reference, sonar, tof"),
-    ("extends = 3\n", "must be a shipped robot's name (ir, reference, sonar, tof)"),
+     "no such file, nor a shipped robot; shipped: ideal, ir, reference, sonar"),
+    ("extends = 3\n", "must be a shipped robot's name (ideal, ir, reference, sonar)"),
     ('extends = "loop.toml"\n', "extends itself"),
 ])
 def test_bad_extends_is_one_clear_error(tmp_path: Path, text: str, words: str) -> None:

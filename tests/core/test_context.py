@@ -15,7 +15,7 @@ from stairbot.algorithm.work import Work
 from stairbot.config import load_config
 from stairbot.errors import InputError
 
-CFG = load_config()
+CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 
 
 def test_a_new_context_holds_the_seeds_variables() -> None:

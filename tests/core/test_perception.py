@@ -17,7 +17,7 @@ from stairbot.hardware import (
 )
 from stairbot.perception import CONFIRM, Perception, max_age, pair_tolerance, window
 
-CFG = load_config()
+CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 TICK = CFG.algorithm.tick
 OK, OOR, ERR = SensorStatus.OK, SensorStatus.OUT_OF_RANGE, SensorStatus.ERROR
 SFR, SBR = SensorId.SFR, SensorId.SBR
@@ -25,7 +25,7 @@ SFR, SBR = SensorId.SFR, SensorId.SBR
 
 def with_models(front: str, back: str) -> RobotConfig:
     sensors = msgspec.structs.replace(CFG.sensors, front_model=front, back_model=back,
-                                      back_height=0.05)
+                                      front_fov_deg=None, back_height=0.05)
     return RobotConfig(CFG.source, CFG.geometry, CFG.masses, CFG.motors, sensors, CFG.algorithm,
                        CFG.safety)
 

@@ -22,7 +22,7 @@ from stairbot.runner import run as run_session
 from stairbot.scenario import load_scenario
 from stairbot.tilt import TiltWatch
 
-CFG = load_config()
+CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 SAFETY = CFG.safety
 TICK = CFG.algorithm.tick
 

@@ -27,7 +27,7 @@ from stairbot.config import load_config
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.perception import settle_s
 
-CFG = load_config()
+CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 
 
 def snapshot(t: float = 0.0, front: float = 0.5) -> Snapshot:

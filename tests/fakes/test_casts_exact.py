@@ -50,7 +50,7 @@ def test_casts_agree_with_the_reference() -> None:
 
 
 def _robot(scenario: str) -> SimRobot:
-    return SimRobot(load_config("tof"), load_scenario(scenario))
+    return SimRobot(load_config("reference"), load_scenario(scenario))
 
 
 def test_fans_agree_with_the_reference() -> None:

@@ -18,6 +18,7 @@ from stairbot.scenario import Scenario, load_scenario
 
 F, B, R, L = MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL
 MTF, MTB = MotorId.MTF, MotorId.MTB
+IDEAL = load_config("ideal")  # the mechanics, driven on one exact ray per sensor
 
 
 class OpenLoop:
@@ -132,7 +133,7 @@ class OpenLoop:
 
 @pytest.fixture(scope="module")
 def climbed() -> tuple[OpenLoop, dict[str, float]]:
-    drv = OpenLoop(load_config(), load_scenario())
+    drv = OpenLoop(IDEAL, load_scenario())
     figures = drv.ascend_one_step()
     return drv, figures
 
@@ -172,7 +173,7 @@ def test_one_step_down_returns_to_the_floor(
 
 
 def test_backing_off_the_top_edge_with_lifts_level_falls() -> None:
-    drv = OpenLoop(load_config(), load_scenario())
+    drv = OpenLoop(IDEAL, load_scenario())
     drv.ascend_one_step()
     back = {F: -1.0, B: -1.0, R: -1.0, L: -1.0}
     with pytest.raises(RobotFellError):
@@ -184,7 +185,7 @@ def test_backing_off_the_top_edge_with_lifts_level_falls() -> None:
 
 
 def test_turned_over_a_nosing_the_back_sensors_disagree() -> None:
-    drv = OpenLoop(load_config(), load_scenario())
+    drv = OpenLoop(IDEAL, load_scenario())
     drv.ascend_one_step()  # the rear of segment 3 ends over riser 1's nosing
     w, s = drv.robot.world, drv.cfg.sensors
     rear = min(p[0] for p in w.segment_corners(2))

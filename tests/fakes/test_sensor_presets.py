@@ -30,8 +30,9 @@ def model_sensor(model: SensorModel, noise: float = 0.0, seed: int = 1,
 
 def test_the_presets_are_the_names_the_config_allows() -> None:
     assert set(PRESETS) == set(get_args(SensorModelName))
-    assert load_config().sensors.front_model == "ideal"
-    assert load_config().sensors.back_model == "ideal"
+    reference, ideal = load_config().sensors, load_config("ideal").sensors
+    assert (reference.front_model, reference.back_model) == ("vl53l1x", "vl53l0x")
+    assert (ideal.front_model, ideal.back_model) == ("ideal", "ideal")
     with pytest.raises(KeyError, match="allowed: ideal, vl53l1x"):
         preset("lidar")
 
@@ -112,7 +113,7 @@ def test_beyond_the_weak_signal_limit_the_target_is_out_of_range() -> None:
 
 # -- cones in the simulated world --------------------------------------------------
 def robot() -> SimRobot:
-    return SimRobot(load_config(), load_scenario())
+    return SimRobot(load_config("ideal"), load_scenario())  # its world; the models are given
 
 
 def test_the_cone_sees_a_near_edge_that_a_single_ray_misses() -> None:
@@ -150,9 +151,9 @@ def test_hcsr04_loses_the_echo_beyond_its_incidence_angle(yaw_deg: float, heard:
 
 
 def test_a_preset_robot_reads_reproducibly_and_holds_between_updates() -> None:
-    cfg = load_config()
-    cfg = replace(cfg, sensors=msgspec.structs.replace(
-        cfg.sensors, front_model="vl53l1x", back_model="hcsr04"))
+    cfg = load_config("ideal")
+    cfg = replace(cfg, sensors=msgspec.structs.replace(  # the presets' own cones, level
+        cfg.sensors, front_model="vl53l1x", back_model="hcsr04", front_fov_deg=None))
     runs = []
     for _ in range(2):
         r = SimRobot(cfg, load_scenario())

@@ -26,7 +26,7 @@ from stairbot.hardware import (
 from stairbot.robots import RobotOptions
 from stairbot.scenario import Scenario, parse_scenario
 
-CFG = load_config()
+CFG = load_config("ideal")  # the simulation's mechanics, read with one exact ray
 TICK = CFG.algorithm.tick
 F, B, R, L = MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL
 MTF, MTB = MotorId.MTF, MotorId.MTB
@@ -272,7 +272,7 @@ from stairbot.config import load_config
 from stairbot.scenario import parse_scenario
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import MotorId as M
-r = SimRobot(load_config(), parse_scenario("[sensors]\\nnoise = 0.003\\n", "<child>"))
+r = SimRobot(load_config("ideal"), parse_scenario("[sensors]\\nnoise = 0.003\\n", "<child>"))
 c = SimClock(r)
 h = hashlib.sha256()
 for i in range(150):

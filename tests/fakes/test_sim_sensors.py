@@ -19,7 +19,7 @@ from stairbot.robots import RobotSession
 from stairbot.runner import run
 from stairbot.scenario import parse_scenario
 
-CFG = load_config()
+CFG = load_config("ideal")  # one level ray, fresh at every read
 TICK = CFG.algorithm.tick
 ONE_STEP = parse_scenario("""
 [stairs]
@@ -79,7 +79,7 @@ def test_ideal_readings_are_never_old_and_are_shared() -> None:
 
 def test_a_timed_model_tells_each_reading_its_age() -> None:
     cfg = replace(CFG, sensors=msgspec.structs.replace(
-        CFG.sensors, front_model="vl53l0x", back_model="hcsr04"))
+        CFG.sensors, front_model="vl53l0x", back_model="hcsr04", front_fov_deg=None))
     robot = SimRobot(cfg, ONE_STEP)
     ages: dict[SensorId, set[float]] = {sid: set() for sid in SensorId}
     for _ in range(30):

@@ -63,8 +63,9 @@ def test_last_tread_under_a_landing_does_not_count_but_under_a_wall_it_does() ->
 def test_stairs_out_of_sight_at_the_start_are_outside(distance: float, yaw: float,
                                                       expected: str) -> None:
     """The seed's calibration case 1 stops a robot whose front beams both read
-    LENGTH_OF_INFINITY or more: such stairs must be refused, however easy."""
-    cfg, rules = load_config(), Rules()
+    LENGTH_OF_INFINITY or more: such stairs must be refused, however easy.
+    Level rays (the ideal robot): in sight up to LENGTH_OF_INFINITY exactly."""
+    cfg, rules = load_config("ideal"), Rules()
     scen = parse_scenario("[stairs]\ncount = 2\nrise = 0.15\ntread = 0.3\n"
                           f"[start]\ndistance = {distance}\nyaw_deg = {yaw}\n", "x")
     assert zone(scen, cfg, rules)[0] == expected
@@ -154,25 +155,26 @@ def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
 
 def test_a_cone_that_looks_up_sees_the_first_riser_nearer_than_a_level_ray() -> None:
     """In sight is what the simulated beams read at the start pose: 0.95 m
-    from a 0.15 m riser, the tof robot's cone (tilted 7.5 deg up) takes in the
-    risers beyond and reads past LENGTH_OF_INFINITY; the level ray does not."""
+    from a 0.15 m riser, the reference robot's cone (tilted 7.5 deg up) takes in
+    the risers beyond and reads past LENGTH_OF_INFINITY; the ideal robot's level
+    ray does not."""
     rules = Rules()
     scen = parse_scenario("[stairs]\ncount = 4\nrise = 0.15\ntread = 0.3\n"
                           "[start]\ndistance = 0.95\n", "x")
-    assert first_sight(scen, load_config()) == pytest.approx(0.95, abs=0.002)
-    assert first_sight(scen, load_config("tof")) > 1.0
-    assert zone(scen, load_config(), rules)[0] == "inside"
-    assert zone(scen, load_config("tof"), rules)[0] == "outside"
+    assert first_sight(scen, load_config("ideal")) == pytest.approx(0.95, abs=0.002)
+    assert first_sight(scen, load_config("reference")) > 1.0
+    assert zone(scen, load_config("ideal"), rules)[0] == "inside"
+    assert zone(scen, load_config("reference"), rules)[0] == "outside"
 
 
 def test_a_measured_tread_asks_its_own_riser_to_reach_min_rise_for_it() -> None:
     """The robot takes the next riser to be as high as the one it climbs
     (ascent 3), so a tread it measures (a wall on top, not a landing) needs
     its own riser at min_rise_for(tread)."""
-    tof, rules = load_config("tof"), Rules()
+    reference, rules = load_config("reference"), Rules()
     text = "[stairs]\ncount = 1\nrise = 0.135\ntread = {tread}\ntop = '{top}'\n"
     long_wall = parse_scenario(text.format(tread=0.38, top="wall"), "x")
-    assert 0.135 < tof.min_rise_for(0.38) - rules.rise_margin_m
-    assert zone(long_wall, tof, rules)[0] == "outside"
-    assert zone(parse_scenario(text.format(tread=0.38, top="landing"), "x"), tof,
+    assert 0.135 < reference.min_rise_for(0.38) - rules.rise_margin_m
+    assert zone(long_wall, reference, rules)[0] == "outside"
+    assert zone(parse_scenario(text.format(tread=0.38, top="landing"), "x"), reference,
                 rules)[0] == "inside"

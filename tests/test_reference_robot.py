@@ -1,6 +1,8 @@
-"""The shipped `tof` robot (VL53L1X front pair, ROI narrowed and tilted up;
+"""The shipped reference robot (VL53L1X front pair, ROI narrowed and tilted up;
 VL53L0X back pair) on the simulated stairs: the default stairs up and back,
-and rises too low for what its cone measures refused by design."""
+and rises too low for what its cone measures refused by design.  The envelope
+sweep's cases cited "on tof" were run as `--config tof`: this robot, before its
+sensors became the reference robot's."""
 
 from __future__ import annotations
 
@@ -16,18 +18,18 @@ from stairbot.runner import RunResult
 from stairbot.scenario import load_scenario, parse_scenario
 from stairbot.sweep.spec import SpecError, load_spec, with_config
 
-TOF = load_config("tof")
+REFERENCE = load_config("reference")
 
 
-def run_tof(text: str | None, events: list[Event] | None = None) -> RunResult:
-    """The tof robot on ``text``'s stairs (None: the default ones); the run's
+def run_reference(text: str | None, events: list[Event] | None = None) -> RunResult:
+    """The reference robot on ``text``'s stairs (None: the default ones); the run's
     events go to ``events`` if given."""
-    scenario = load_scenario() if text is None else parse_scenario(text, "<tof>")
-    return run_sim(TOF, scenario, events)
+    scenario = load_scenario() if text is None else parse_scenario(text, "<reference>")
+    return run_sim(REFERENCE, scenario, events)
 
 
 def test_the_default_stairs_up_and_back() -> None:
-    r = run_tof(None)
+    r = run_reference(None)
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
         "completed", "top_reached", 5, 5), r.to_dict()
     assert not r.fell and r.pauses <= 1, r.to_dict()
@@ -35,28 +37,29 @@ def test_the_default_stairs_up_and_back() -> None:
 
 
 def test_its_cone_raises_the_lowest_rise_it_measures_a_tread_against() -> None:
-    reference = load_config()
-    assert reference.min_rise_for(0.5) == reference.min_step_rise_m  # a level ray
+    ideal = load_config("ideal")
+    assert ideal.min_rise_for(0.5) == ideal.min_step_rise_m  # a level ray
     top = math.radians(7.5 + 15.0 / 2)
-    assert TOF.front_cone_top_rad == pytest.approx(top)
-    assert TOF.min_rise_for(0.30) - TOF.min_rise_for(0.26) == pytest.approx(0.04 * math.tan(top))
-    assert TOF.min_step_rise_m == pytest.approx(TOF.min_rise_for(TOF.min_tread_m))
+    ref = REFERENCE
+    assert ref.front_cone_top_rad == pytest.approx(top)
+    assert ref.min_rise_for(0.30) - ref.min_rise_for(0.26) == pytest.approx(0.04 * math.tan(top))
+    assert ref.min_step_rise_m == pytest.approx(ref.min_rise_for(ref.min_tread_m))
 
 
 def test_a_rise_too_low_for_its_cone_is_refused_and_it_comes_home() -> None:
-    # 0.10 m rises: the reference robot climbs them; the tof robot's cone would
+    # 0.10 m rises: the ideal robot climbs them; the reference robot's cone would
     # see over the next riser while measuring the 0.30 m tread
-    r = run_tof("[stairs]\ncount = 3\nrise = 0.10\ntread = 0.30\n[sensors]\nseed = 2\n")
+    r = run_reference("[stairs]\ncount = 3\nrise = 0.10\ntread = 0.30\n[sensors]\nseed = 2\n")
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), r.to_dict()
     assert not r.fell and r.final_offset_m is not None and r.final_offset_m <= 0.05
 
 
 def test_a_sweep_runs_on_another_robot_by_name() -> None:
     spec = load_spec(Path(__file__).parents[1] / "stairbot" / "sweeps" / "quick.toml")
-    tof = with_config(spec, "tof")
-    assert tof.hash != spec.hash
-    assert tof.config_text is not None and 'front_model = "vl53l1x"' in tof.config_text
-    assert "extends" not in tof.config_text  # laid in: the cases stand on their own
+    ideal = with_config(spec, "ideal")
+    assert ideal.hash != spec.hash
+    assert ideal.config_text is not None and 'front_model = "ideal"' in ideal.config_text
+    assert "extends" not in ideal.config_text  # laid in: the cases stand on their own
     with pytest.raises(SpecError, match="no such file, nor a shipped robot"):
         with_config(spec, "lidar-bot")
 
@@ -65,18 +68,19 @@ def test_refused_at_the_first_step_it_comes_back_by_the_odometer() -> None:
     # found by the envelope sweep: from 0.77 m a cone tilted up sees over a
     # 0.10 m riser and reads it long; going back by that reading left the robot
     # 11-14 cm from its start
-    r = run_tof("[stairs]\ncount = 9\nrise = 0.10\ntread = 0.30\ntop = \"wall\"\n"
-                "[start]\ndistance = 0.768\nlateral = 0.09\nyaw_deg = -15.25\n"
-                "[sensors]\nseed = 283009\n")
+    r = run_reference("[stairs]\ncount = 9\nrise = 0.10\ntread = 0.30\ntop = \"wall\"\n"
+                      "[start]\ndistance = 0.768\nlateral = 0.09\nyaw_deg = -15.25\n"
+                      "[sensors]\nseed = 283009\n")
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
 
 
 def test_square_range_is_where_the_cone_rises_to_the_lowest_riser_it_climbs() -> None:
-    assert load_config().square_range_m == math.inf  # a level ray squares up from anywhere
-    expected = (TOF.min_step_rise_m - TOF.sensors.front_height) / math.tan(TOF.front_cone_top_rad)
-    assert TOF.square_range_m == pytest.approx(expected)
-    assert TOF.SAFE_DISTANCE_IN_FRONT_OF_STEP < TOF.square_range_m < 0.4
+    assert load_config("ideal").square_range_m == math.inf  # a level ray squares up from anywhere
+    ref = REFERENCE
+    expected = (ref.min_step_rise_m - ref.sensors.front_height) / math.tan(ref.front_cone_top_rad)
+    assert ref.square_range_m == pytest.approx(expected)
+    assert ref.SAFE_DISTANCE_IN_FRONT_OF_STEP < ref.square_range_m < 0.4
 
 
 FAR_ASKEW = """
@@ -97,7 +101,7 @@ seed = 990114
 
 def test_far_and_askew_it_closes_in_squares_up_and_retraces_its_way_home() -> None:
     """Found by the envelope sweep: squared up 0.97 m away, where the cone
-    reads a blend of the risers, the tof robot stood 11 deg askew and the
+    reads a blend of the risers, the reference robot stood 11 deg askew and the
     standing rule ended the run in the approach.  Now it closes in to
     square_range_m (no further than its first reading allows), squares up
     there, climbs, and comes home the way it went: turning back the squaring
@@ -105,7 +109,7 @@ def test_far_and_askew_it_closes_in_squares_up_and_retraces_its_way_home() -> No
     from stairbot.algorithm.phases import Phase
 
     events: list[Event] = []
-    r = run_tof(FAR_ASKEW, events)
+    r = run_reference(FAR_ASKEW, events)
     assert (r.outcome, r.steps_climbed, r.steps_descended, r.pauses) == (
         "completed", 4, 4, 0), r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
@@ -139,7 +143,7 @@ def test_at_the_top_segment_3_is_lowered_onto_its_tread_without_pushing() -> Non
     BACK_CLEARANCE standing (noise; its cone's slanted rays), so descent 2
     kept lowering segment 3 onto the tread it stood on and tipped segment 2
     15 deg nose down.  Now BACK_CLEARANCE is read within the pair's noise."""
-    r = run_tof(TOP_OF_A_FLIGHT)
+    r = run_reference(TOP_OF_A_FLIGHT)
     assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
         "completed", "top_reached", 4, 4), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
@@ -167,7 +171,7 @@ seed = 126550
 @pytest.fixture(scope="module")
 def nine_steps() -> tuple[RunResult, list[Event]]:
     events: list[Event] = []
-    return run_tof(NINE_STEPS, events), events
+    return run_reference(NINE_STEPS, events), events
 
 
 def test_backing_to_an_edge_stops_where_the_back_pair_saw_it(
@@ -178,8 +182,8 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it(
     now bounds the backing: edge_clearance_m past where it saw the drop."""
     from stairbot.algorithm.descent import edge_clearance_m
 
-    assert edge_clearance_m(TOF) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006
-                                                 + TOF.wheel_speed_m_s * 0.030)
+    assert edge_clearance_m(REFERENCE) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006
+                                                       + REFERENCE.wheel_speed_m_s * 0.030)
     r, _ = nine_steps
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
@@ -226,7 +230,7 @@ def test_backing_off_a_short_tread_is_bounded_by_the_edge_too() -> None:
     from stairbot.algorithm.phases import Phase
 
     events: list[Event] = []
-    r = run_tof(SHORT_TREADS, events)
+    r = run_reference(SHORT_TREADS, events)
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 9, 9), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()
     seen = [e for e in events if e.message.startswith("SBR/SBL see the edge")]
@@ -259,7 +263,7 @@ def test_a_squaring_turn_is_checked_standing_on_all_wheels() -> None:
     rule ended the approach.  Checked on all wheels, the robot now turns the
     rest by the odometer and refuses the low step at home."""
     events: list[Event] = []
-    r = run_tof(LOW_RISER_ASKEW, events)
+    r = run_reference(LOW_RISER_ASKEW, events)
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), \
         r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
@@ -292,7 +296,7 @@ def test_one_beam_off_the_open_side_of_a_flight_is_case_2_not_a_side_wall() -> N
     until it gave up.  One beam reading nothing is case 2: it turns towards
     the riser."""
     events: list[Event] = []
-    r = run_tof(OPEN_SIDE, events)
+    r = run_reference(OPEN_SIDE, events)
     assert r.outcome == "completed" and r.steps_climbed == 3, r.to_dict()
     assert r.final_offset_m is not None and r.final_offset_m <= 0.05, r.to_dict()
     cases = [e.data.get("case") for e in events if "case" in e.data]
@@ -320,7 +324,7 @@ def test_the_start_reading_is_taken_once_segment_1_has_settled() -> None:
     1 and 3 came down, the start reading caught the cone pitched onto the
     floor (0.202 m for 0.327 m) and descent 7 stopped 0.125 m short."""
     events: list[Event] = []
-    r = run_tof(SETTLING, events)
+    r = run_reference(SETTLING, events)
     start = [e for e in events if e.message.startswith("start position")]
     assert len(start) == 1 and start[0].data["start_reading"] > 0.3
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 3, 3), r.to_dict()
