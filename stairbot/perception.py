@@ -9,8 +9,8 @@ tick repeats its last value, and the board says how old it is
   range, nothing within it) or ERROR.  The kind the algorithm sees changes
   only when CONFIRM measurements in a row agree on the new one (hysteresis):
   a dropout, a spike or a lone "out of range" decides nothing.
-* **distance**: the median of the last OK measurements over about WINDOW_S
-  (3 to 5 of them) -- no single outlier moves it.  The front sensors look
+* **distance**: the median of the last WINDOW OK measurements (5) -- no
+  two outliers among them move it.  The front sensors look
   along the drive: each older measurement is carried forward by the distance
   the wheels have driven since it was taken, so the median of a moving robot
   is today's distance.
@@ -44,9 +44,13 @@ from stairbot.hardware import (
     Snapshot,
 )
 
-WINDOW_S = 0.1
-"""The time a median spans (at least MIN_WINDOW, at most MAX_WINDOW measurements)."""
-MIN_WINDOW, MAX_WINDOW = 3, 5
+WINDOW = 5
+"""Measurements a sensor's median spans, whatever its period.  Five, not
+three: with the median of three that a slow sensor's 0.1 s used to allow,
+two stray measurements in a row passed it -- an HC-SR04 pair (1 % outliers,
+a measurement every 60 ms) about three times a run, a VL53L1X pair often
+enough to pause 3 of 20 noisy runs twice (the standing rule) and to set
+reading drives' targets centimetres off (sonar envelope cases 601, 808)."""
 CONFIRM = 3
 """Measurements in a row that must agree before the kind seen changes."""
 STALE_PERIODS = 3.0
@@ -77,9 +81,8 @@ def measurement_period(cfg: RobotConfig, back: bool) -> float:
 
 
 def window(cfg: RobotConfig, back: bool) -> int:
-    """Measurements the pair's median spans."""
-    n = round(WINDOW_S / measurement_period(cfg, back))
-    return max(MIN_WINDOW, min(MAX_WINDOW, n))
+    """Measurements the pair's median spans (WINDOW, for every pair)."""
+    return WINDOW
 
 
 def max_age(cfg: RobotConfig, back: bool) -> float:

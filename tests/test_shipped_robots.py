@@ -96,10 +96,10 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     from stairbot.algorithm.descent import edge_clearance_m, edge_sight_m
     sonar, reference = load_config("sonar"), load_config("reference")
     full = sonar.motors.wheel_speed * sonar.wheel_circumference
-    # backing at full speed: its latency, then half a period and one more
-    # (the median of three needs two measurements of the drop)
+    # backing at full speed: its latency, then half a period and two more
+    # (the median of five needs three measurements of the drop)
     assert edge_sight_m(sonar, full) - edge_sight_m(sonar, 0.0) == pytest.approx(
-        full * (0.025 + 1.5 * 0.06), rel=1e-6)
+        full * (0.025 + 2.5 * 0.06), rel=1e-6)
     # the first echo's cone: the riser is seen until drop x sin 7.5 deg past the edge
     assert edge_sight_m(sonar, 0.0) > 0.01 and edge_sight_m(reference, 0.0) == 0.0
     assert edge_clearance_m(sonar) == pytest.approx(0.0745, abs=1e-4)  # with edge_doubt_m
