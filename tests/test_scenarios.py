@@ -66,6 +66,19 @@ def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
     assert_one_phase_entry_a_tick(events)
 
 
+def test_the_side_wall_reproduction_climbs_all_three_with_ideal_sensors() -> None:
+    """Issue 10's side-wall case as the issue states it: on the robot it was
+    found on (ideal sensors, one level ray) it squares up to the riser, not
+    the wall, climbs all three (the wall at the top ends the ascent) and comes
+    home.  The reference robot refuses its first rise by design (the shipped
+    scenario's [expect])."""
+    result, events = run_sim(load_scenario("side_wall_square"), IDEAL)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "obstacle", 3, 3), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m <= 0.05
+    assert {"cal_away", "cal_turn"} <= phases_visited(events)
+
+
 def test_every_calibration_case_and_error_situation_has_a_scenario() -> None:
     assert set(PATHS) <= set(shipped())
 
