@@ -38,6 +38,9 @@ FLOW = "calibration"
 PROBE_YAW_RAD = math.radians(10.0)
 """Case 3: the probe turn stops after this much yaw if the readings have not
 changed by 2 × equal_tolerance before."""
+PROBE_TICKS = 5
+"""Case 3: the probe turn compares the mean of its last this many ticks'
+readings with their mean standing before it."""
 STILL_TICKS = 25
 """Calibration's check averages the pair's difference over this many ticks
 (0.5 s at the 20 ms tick) before it decides between the cases."""
@@ -107,6 +110,7 @@ def _measured_standing(t: Tick, w: Work, needed: int) -> bool:
     r, l_ = motion.pair(t.snap)
     if r.ok and l_.ok and not motion.far(r, t.cfg) and not motion.far(l_, t.cfg):
         w.diffs.append(l_.distance_m - r.distance_m)
+        w.standing.append((r.distance_m, l_.distance_m))
     else:
         w.diff_skipped += 1
     return False
@@ -125,11 +129,14 @@ def _mean_diff(t: Tick, w: Work) -> float:
     riser for a side wall (case 2W) and turned 45° away from it (envelope
     cases 71 and 470 on sonar).  Trimmed, the mean of normal noise keeps
     about 90 % of its efficiency."""
-    diffs = w.diffs
-    if not diffs:
+    if not w.diffs:
         sfr, sfl = _readings(t)
         return sfl - sfr
-    ordered = sorted(diffs)
+    return _trimmed_mean(w.diffs)
+
+
+def _trimmed_mean(values: list[float]) -> float:
+    ordered = sorted(values)
     k = int(len(ordered) * TRIM)
     kept = ordered[k:len(ordered) - k]
     return sum(kept) / len(kept)
@@ -237,7 +244,7 @@ def _verify(t: Tick, w: Work) -> Step:
               f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)",
               SFR=sfr, SFL=sfl, diff=diff)
         ctx.squaring_turns = 0
-        return _squared(t)
+        return _squared(t, w)
     if ctx.squaring_turns >= MAX_SQUARING_TURNS:
         return fail(f"calibration ({where(ctx, P.CAL_CHECK)}) cannot square up: after "
                     f"{ctx.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
@@ -254,11 +261,21 @@ def _verify(t: Tick, w: Work) -> Step:
     return go(P.CAL_LIFT)
 
 
-def _squared(t: Tick) -> Step:
-    """The calibration is square: the start records where it stands."""
+def _squared(t: Tick, w: Work) -> Step:
+    """The calibration is square: the start records where it stands, the
+    pair's trimmed means over the ticks the check measured standing still
+    (one tick's filtered reading is as noisy as the sensors, and a fault that
+    began after the check would count in it whole)."""
     ctx, cfg = t.ctx, t.cfg
     if ctx.purpose == "start":
-        if motion.measurable(t.snap, cfg):
+        if w.standing:
+            ctx.start_reading = (_trimmed_mean([r for r, _l in w.standing])
+                                 + _trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
+            ctx.start_wheel = motion.wheel_position(t.snap)
+            t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m (their means "
+                  f"over {len(w.standing)} ticks standing still)",
+                  start_reading=ctx.start_reading)
+        elif motion.measurable(t.snap, cfg):
             ctx.start_reading = motion.mean_distance(t.snap)
             ctx.start_wheel = motion.wheel_position(t.snap)
             t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
@@ -449,20 +466,41 @@ def _probe_enter(t: Tick, w: Work) -> None:
 
 
 def _probe(t: Tick, w: Work) -> Step:
+    """Lifted, measure SFR and SFL standing still, then turn left and watch
+    how they change.  Both ends of the comparison are means: the start the
+    trimmed mean standing, now the mean of the last PROBE_TICKS ticks.  One
+    tick at each end let a square VL53L1X pair's noise look like a corner
+    ("SFR grew 12 mm, SFL shrank 4 mm" against a start reading 13 mm long):
+    case 3B turned 42 deg looking for the riser and the robot was stranded
+    (the envelope sweep, cases 1119 and 1967 on reference)."""
     ctx, cfg = t.ctx, t.cfg
-    sfr, sfl = _readings(t)
+    if not w.checked:
+        if not _settled(t, w) or not _measured_standing(t, w, STILL_TICKS):
+            return stay(NO_MOTION)
+        if not w.standing:  # no tick gave both: now's readings, as the seed
+            w.standing.append(_readings(t))
+        w.probe_sfr = _trimmed_mean([r for r, _l in w.standing])
+        w.probe_sfl = _trimmed_mean([l_ for _r, l_ in w.standing])
+        w.checked = True
+    r, l_ = motion.pair(t.snap)
+    if r.ok and l_.ok and not motion.far(r, cfg) and not motion.far(l_, cfg):
+        w.probe_recent = [*w.probe_recent[-(PROBE_TICKS - 1):], (r.distance_m, l_.distance_m)]
+    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
+    if len(w.probe_recent) < PROBE_TICKS:
+        if motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
+            return stay(motion.turn(1, cfg))
+        sfr, sfl = _readings(t)  # no figures while turning: now's readings
+    else:
+        sfr = sum(r_ for r_, _l in w.probe_recent) / len(w.probe_recent)
+        sfl = sum(l_ for _r, l_ in w.probe_recent) / len(w.probe_recent)
     d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
     # Half a resolution step off the readings' grid: whole-millimetre readings
     # that sum to the threshold exactly must not be decided by float rounding
     # (the simulation's and the wire's last bits differ).
     tol = cfg.algorithm.equal_tolerance + cfg.sensors.resolution / 4
-    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
     # A corner only if the changes exceed the pair's noise at the distance
-    # (pair_tolerance), not equal_tolerance alone: a VL53L1X pair standing
-    # square 0.33 m from the riser "grew 3 mm and shrank 8 mm" by noise on the
-    # probe's first ticks, took it for a corner and turned 42 deg looking for
-    # the riser (the envelope sweep, cases 1119 and 1967 on reference).  A
-    # corner's look within the noise is probed further, not decided.
+    # (pair_tolerance), not equal_tolerance alone; a corner's look within the
+    # noise is probed further, not decided.
     corner_tol = max(tol, pair_tolerance(cfg, (w.probe_sfr + w.probe_sfl) / 2.0))
     cornerish = d_sfr > 0 and d_sfl < 0
     unsure = abs(d_sfr) + abs(d_sfl) < 2 * tol or (cornerish and d_sfr - d_sfl < corner_tol)
@@ -482,7 +520,6 @@ def _probe(t: Tick, w: Work) -> Step:
 
 PROBE = PhaseDef(
     P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe,
-    enter=_probe_enter,
     to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
         P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
 

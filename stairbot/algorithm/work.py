@@ -35,7 +35,10 @@ class Work:
     (what the readings at its start say, and a margin)."""
     probe_sfr: float = 0.0
     probe_sfl: float = 0.0
-    """SFR/SFL when the case-3 probe began (in case 3B: the largest SFR seen)."""
+    """SFR/SFL when the case-3 probe began: their trimmed means standing still,
+    lifted (in case 3B: the largest SFR seen)."""
+    probe_recent: list[tuple[float, float]] = field(default_factory=list)
+    """The case-3 probe turn: SFR/SFL on its last PROBE_TICKS ticks that gave both."""
     reading_key: float | None = None
     """A reading drive: the mean SFR/SFL reading plus the odometer (m) --
     constant while the sensors see the same surface: the median of its first
@@ -54,6 +57,8 @@ class Work:
     """A reading the phase measures from (the approach's last, the sight-over)."""
     diffs: list[float] = field(default_factory=list)
     """A pair difference, each tick standing still that gave one."""
+    standing: list[tuple[float, float]] = field(default_factory=list)
+    """SFR and SFL on those ticks."""
     diff_skipped: int = 0
     """Ticks standing still on which a reading of the pair gave no figure
     for the difference (an error, a dropout, nothing ahead)."""
