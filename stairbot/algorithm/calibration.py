@@ -59,6 +59,12 @@ MAX_AWAY_YAW_RAD = math.radians(45.0)
 """Case 2W turns away from the side wall at most this far."""
 TURN_SLOW_FLOOR = 0.1
 """The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
+MAX_TURN_FLIPS = 4
+"""The squaring turn may reverse this many times after a check standing
+still; the next reversal ends it with an error.  One beam off the flight's
+side and the other reading long turned the robot back and forth 6 deg
+until the phase timed out 60 s later, with no reason given (SFL 30 mm long
+from the start, the robot at the flight's side after four steps askew)."""
 MAX_SQUARING_TURNS = 4
 """A calibration that has turned this many times to square up (the squaring
 turn, then corrections by the odometer) and still does not read SFR = SFL
@@ -436,8 +442,17 @@ def _turn(t: Tick, w: Work) -> Step:
             t.ctx.squaring_turns += 1
             return go(P.CAL_LOWER)
         # Not square yet: turn on, slowly, the way the difference says.
+        direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
+        if direction != w.turn_direction:
+            w.turn_flips += 1
+            if w.turn_flips > MAX_TURN_FLIPS:
+                return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned back and forth "
+                            f"{MAX_TURN_FLIPS} times without finding SFR = SFL: standing, "
+                            f"SFL − SFR reads {diff * 1000:+.1f} mm (SFR {sfr:.3f} m, SFL "
+                            f"{sfl:.3f} m); a beam may be off the flight's side, or one "
+                            "sensor reading long or short")
         w.checked, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
-        w.turn_direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
+        w.turn_direction = direction
         w.turn_diff = diff
     w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
     # Turning left closes SFL - SFR from below, turning right from above: stop

@@ -29,6 +29,8 @@ class Work:
     """Calibration turns: +1 left (counter-clockwise), -1 right."""
     turn_diff: float = 0.0
     """Calibration turns: SFL − SFR, smoothed over a few ticks."""
+    turn_flips: int = 0
+    """The squaring turn: how often a check standing still turned it back."""
     turn_from: float = 0.0
     turn_limit_rad: float = 0.0
     """The squaring turn: MWR's counter at its start, and the most it may turn

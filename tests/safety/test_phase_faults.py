@@ -87,3 +87,28 @@ def test_a_sensor_fault_in_any_phase_ends_safe(phase: str, fault: str, sensor: s
         assert r.final_offset_m is not None and r.final_offset_m <= HOME_M[fault], r.to_dict()
     else:
         assert r.error, r.to_dict()
+
+
+BIASED_FROM_START = """
+[stairs]
+count = 5
+rise = 0.17
+tread = 0.28
+[[faults]]
+at = 0.0
+sensor = "SFL"
+kind = "offset"
+offset = 0.03
+"""
+
+
+def test_a_front_sensor_long_from_the_start_ends_with_its_reason_not_a_timeout() -> None:
+    """SFL 30 mm long from the start cannot be told from a robot turned 17°:
+    the robot squares up to it and climbs askew until, four steps up at the
+    flight's side, SFR's beam falls off the side when it turns right and
+    SFL reads 30 mm long when it turns left.  The squaring turn turned back
+    and forth until the phase timed out 60 s later ("phase timeout", no
+    reason); now it ends at its fifth reversal and says what it read."""
+    r, _events = run_sim(parse_scenario(BIASED_FROM_START, "sfl-long-from-start"))
+    assert not r.fell, r.to_dict()
+    assert r.outcome == "error" and "turned back and forth" in str(r.error), r.to_dict()
