@@ -331,6 +331,14 @@ def test_fake_boards_on_a_bad_bus_exit_2_with_one_line(
     assert words in err and "\n" not in err and "Traceback" not in err
 
 
+def test_fake_boards_help_says_udp_multicast_stays_on_loopback() -> None:
+    from stairbot.fakes.boards_cli import build_parser
+
+    text = " ".join(build_parser().format_help().split())
+    assert "on loopback only (127.0.0.1, TTL 0) unless the URL adds ?lan=1" in text
+    assert "no other host can send the boards frames" in text
+
+
 def test_faster_than_real_time_without_lockstep() -> None:
     """--time-scale on both sides: the fake's world runs 20x the wall clock and
     so does the host's clock; the robot drives forward as commanded."""
