@@ -26,18 +26,29 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
                       (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
                       the host's wall clock runs at the same rate
+  - ``lan=1``         ``udp_multicast`` only: open the bus to the network
+                      (python-can's own socket: see below).  Default 0.
   - any other ``key=value`` is passed to ``can.Bus`` as a keyword, its value
     cast as python-can casts its config files (``port=43200``,
     ``receive_own_messages=False``).
 
-``udp_multicast`` is kept to this host: unless the URL says otherwise its
-``hop_limit`` is 0, so frames never leave the machine; use a different
-``port=`` to keep two buses on one group apart.
+``udp_multicast`` is kept on this machine's loopback interface
+(``drivers.udp_loopback``): its socket is bound to ``GROUP:PORT`` (not
+``0.0.0.0``), joins the group on ``127.0.0.1`` only and sends out of
+``127.0.0.1`` with TTL (``hop_limit``) 0, so only processes on this machine
+can send it frames or hear them.  It takes IPv4 groups only (Linux carries no
+IPv6 multicast over loopback).  ``lan=1`` instead opens python-can's own
+socket, bound to ``0.0.0.0:PORT`` (``[::]:PORT``), joined on the interface the
+routing table picks and sending with python-can's ``hop_limit`` 1 unless the
+URL gives one: then any host on that network can send frames to the boards
+or the host (make them stop, or move).  Use a different ``port=`` to keep two
+buses on one group apart.
 
 Examples::
 
     can://virtual/bus0
     can://udp_multicast/239.74.163.2?port=43114&lockstep=1
+    can://udp_multicast/ff15::1?lan=1     (on the LAN, IPv6: anyone there can send frames)
     can://socketcan/vcan0?bitrate=1000000
     can://default/                      (everything from python-can's config)
 """
@@ -55,16 +66,18 @@ import can.util
 from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session
 from stairbot.drivers.can_link import CanLink
+from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 
 OPTION_DEFAULTS: dict[str, float] = {
     "timeout": 0.1, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
+    "lan": 0,
 }
-_INTS = {"retries", "lost", "watchdog", "lockstep"}
+_INTS = {"retries", "lost", "watchdog", "lockstep", "lan"}
 _ALLOWED = {"timeout": "seconds, 0 < timeout <= 60", "retries": "a whole number >= 0",
             "lost": "a whole number >= 1", "watchdog": "ms, 0..65535 (0 = off)",
-            "lockstep": "0 or 1", "time_scale": "a number > 0"}
+            "lockstep": "0 or 1", "time_scale": "a number > 0", "lan": "0 or 1"}
 
 
 @dataclass(frozen=True)
@@ -91,7 +104,7 @@ def _option(url: str, key: str, text: str) -> float:
         raise RobotUrlError(url, key, f"{text!r}; allowed: {_ALLOWED[key]}") from None
     ok = {"timeout": 0 < value <= 60, "retries": value >= 0, "lost": value >= 1,
           "watchdog": 0 <= value <= 65535, "lockstep": value in (0, 1),
-          "time_scale": value > 0}[key]
+          "time_scale": value > 0, "lan": value in (0, 1)}[key]
     if not ok:
         raise RobotUrlError(url, key, f"{text}; allowed: {_ALLOWED[key]}")
     return value
@@ -133,12 +146,15 @@ def parse_can_url(url: str) -> CanUrl:
     if "bitrate" in kwargs and not (isinstance(kwargs["bitrate"], int) and kwargs["bitrate"] > 0):
         raise RobotUrlError(url, "bitrate", f"{kwargs['bitrate']!r} is not a positive "
                             "whole number of bit/s")
+    lan = bool(options["lan"])
+    if lan and interface not in (None, "udp_multicast"):
+        raise RobotUrlError(url, "lan", f"applies to udp_multicast only, not {interface}")
     if interface == "udp_multicast" and channel is not None:
-        _check_multicast(url, channel)
+        _check_multicast(url, channel, lan)
     return CanUrl(url, interface, channel, kwargs, context, options)
 
 
-def _check_multicast(url: str, channel: str) -> None:
+def _check_multicast(url: str, channel: str, lan: bool) -> None:
     try:
         addr = ipaddress.ip_address(channel)
     except ValueError as exc:
@@ -148,6 +164,11 @@ def _check_multicast(url: str, channel: str) -> None:
     if not addr.is_multicast:
         raise RobotUrlError(url, "channel", f"{channel} is not a multicast group; allowed: "
                             "224.0.0.0/4 (IPv4) or ff00::/8 (IPv6)")
+    if addr.version == 6 and not lan:
+        raise RobotUrlError(url, "channel", f"{channel} is an IPv6 group, and udp_multicast is "
+                            "kept on the loopback interface, which carries IPv4 multicast only; "
+                            "allowed: an IPv4 group (224.0.0.0/4, e.g. 239.74.163.2), or lan=1 "
+                            "to open the bus to the network")
 
 
 def resolve_bus_config(spec: CanUrl) -> dict[str, Any]:
@@ -168,21 +189,37 @@ def resolve_bus_config(spec: CanUrl) -> dict[str, Any]:
                             "(CAN_INTERFACE, ~/.canrc)") from exc
     except Exception as exc:  # a malformed config file or CAN_CONFIG
         raise RobotUrlError(spec.url, "python-can config", f"{type(exc).__name__}: {exc}") from exc
+    lan = bool(spec.options["lan"])
     if resolved.get("interface") == "udp_multicast":
         if resolved.get("channel") is not None:
-            _check_multicast(spec.url, str(resolved["channel"]))
-        resolved.setdefault("hop_limit", 0)
+            _check_multicast(spec.url, str(resolved["channel"]), lan)
+        if not lan:
+            resolved.setdefault("hop_limit", 0)
         resolved.setdefault("fd", False)
+    elif lan:
+        raise RobotUrlError(spec.url, "lan", "applies to udp_multicast only, not "
+                            f"{resolved.get('interface')}")
     return resolved
 
 
+def keeps_to_loopback(spec: CanUrl, cfg: dict[str, Any]) -> bool:
+    """Whether the bus ``cfg`` (from :func:`resolve_bus_config`) is opened on
+    the loopback interface only: ``udp_multicast`` without ``lan=1``."""
+    return cfg.get("interface") == "udp_multicast" and not spec.options["lan"]
+
+
 def open_bus(spec: CanUrl) -> can.BusABC:
-    """Open the bus ``spec`` names.  Any failure of the interface (missing
+    """Open the bus ``spec`` names (``udp_multicast``: on loopback unless
+    ``lan=1``; the module header).  Any failure of the interface (missing
     driver library, device absent, address family unsupported) becomes one
     RobotUrlError line naming the interface and channel."""
     cfg = resolve_bus_config(spec)
     where = f"{cfg.get('interface')}/{cfg.get('channel') if cfg.get('channel') is not None else ''}"
     try:
+        if keeps_to_loopback(spec, cfg):
+            kwargs = {k: v for k, v in cfg.items()
+                      if k != "interface" and not (k == "channel" and v is None)}
+            return LoopbackUdpMulticastBus(**kwargs)
         return can.Bus(ignore_config=True, **cfg)
     except Exception as exc:  # vendor back ends raise anything: OSError, NameError...
         detail = str(exc).strip() or type(exc).__name__

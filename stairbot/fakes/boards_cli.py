@@ -5,8 +5,17 @@
 
 opens a pseudo-terminal, prints its path (the line ``serial://PATH``, plus
 ``?lockstep=1`` when in lockstep) and serves both boards on it, backed by the
-same physics world as ``sim://``, until interrupted.  ``--can ...`` is handed
-to the CAN fake (``stairbot.fakes.can_boards.main``).
+same physics world as ``sim://``, until interrupted.
+
+    stairbot fake-boards --can udp_multicast/GROUP[?port=P&lan=1] [...]
+
+serves them on a CAN bus instead (``stairbot.fakes.can_boards.main``) and
+prints the ``can://`` URL a host opens.  ``udp_multicast`` is kept on this
+machine: bound to GROUP:PORT, the group joined on the loopback interface
+(127.0.0.1), sent with TTL 0, IPv4 groups only; no other host can send the
+boards frames.  ``?lan=1`` opens it to the network (python-can's socket on
+0.0.0.0:PORT, TTL 1 unless ?hop_limit=N): then any host there can send them
+frames.
 """
 
 from __future__ import annotations
@@ -44,7 +53,9 @@ def build_parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     wire = p.add_mutually_exclusive_group(required=True)
     wire.add_argument("--serial", action="store_true", help="serve on a new pseudo-terminal")
-    wire.add_argument("--can", metavar="INTERFACE/CHANNEL", help="serve on a CAN bus")
+    wire.add_argument("--can", metavar="INTERFACE/CHANNEL",
+                      help="serve on a CAN bus, e.g. udp_multicast/239.74.163.2: on loopback "
+                      "only (127.0.0.1, TTL 0) unless the URL adds ?lan=1")
     p.add_argument("--scenario", help="scenario TOML file or shipped scenario name")
     p.add_argument("--config", help="robot config TOML file")
     pace = p.add_mutually_exclusive_group()

@@ -10,6 +10,13 @@ same physics world as ``sim://``) on any python-can bus, e.g.
 URL's bus options (``udp_multicast/239.74.163.2?port=43200``).  It prints the
 ``can://`` URL a host opens, then serves until interrupted.
 
+On ``udp_multicast`` the boards listen on this machine's loopback interface
+only, as every ``can://udp_multicast`` bus stairbot opens
+(``drivers.udp_loopback``: bound to ``GROUP:PORT``, the group joined on
+``127.0.0.1``, sent with TTL 0): no other host can send them frames.  The
+URL option ``lan=1`` opens them to the network instead (python-can's socket
+on ``0.0.0.0:PORT``); the line on stderr says which.
+
 :class:`CanBoardServer` decodes each frame with the DBC (``drivers.can_wire``),
 hands a host frame to the board it is for (both boards for id ``..F``), and
 sends each reply as one frame from that board.  Frames from boards (its own
@@ -30,11 +37,13 @@ import time
 from dataclasses import dataclass
 
 import can
+from can.interfaces.udp_multicast import UdpMulticastBus
 
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
+from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.errors import RobotUrlError
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import Board, make_boards
@@ -183,6 +192,16 @@ def host_url(spec: str) -> str:
     return spec if spec.startswith("can://") else f"can://{spec}"
 
 
+def reach(bus: can.BusABC) -> str:
+    """Who can send ``bus`` frames, for the serving line: said for
+    ``udp_multicast``, where it is a choice (``lan=1``)."""
+    if isinstance(bus, LoopbackUdpMulticastBus):
+        return ", this machine only: loopback 127.0.0.1, TTL 0"
+    if isinstance(bus, UdpMulticastBus):
+        return ", OPEN TO THE NETWORK (lan=1): any host on it can send these boards frames"
+    return ""
+
+
 def main(argv: list[str]) -> int:
     """``stairbot fake-boards --can ...`` (the serial engineer's parser hands
     over here).  Bad input raises InputError: the CLI prints one line, exits 2."""
@@ -204,8 +223,8 @@ def main(argv: list[str]) -> int:
     suffix = f"{sep}lockstep=1" if args.lockstep else (
         f"{sep}time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"{url}{suffix}", flush=True)
-    print(f"fake boards serving on CAN {spec.label} (Ctrl-C to stop)", file=sys.stderr,
-          flush=True)
+    print(f"fake boards serving on CAN {spec.label}{reach(bus)} (Ctrl-C to stop)",
+          file=sys.stderr, flush=True)
 
     def on_term(_sig: int, _frame: object) -> None:
         server.stop()

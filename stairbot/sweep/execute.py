@@ -60,8 +60,10 @@ def open_executor(jobs: int, dask: str | None = None) -> Iterator[tuple[Executor
         raise ExtraMissing("--dask", "dask") from None
     cluster = None
     if dask == "local":
+        # The scheduler and workers listen on loopback only (Dask's default for
+        # a LocalCluster, said here so that no config changes it), no dashboard.
         cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=40)
+                               host="127.0.0.1", dashboard_address=None, silence_logs=40)
         client = Client(cluster)
         label = f"Dask LocalCluster, {jobs} worker(s)"
     else:

@@ -71,10 +71,12 @@ def rig() -> Iterator[Rig]:
 # -- the URL ------------------------------------------------------------------------
 
 def test_url_grammar() -> None:
-    s = parse_can_url("can://udp_multicast/ff15::7?port=43210&timeout=0.5&lockstep=1&fd=False")
-    assert (s.interface, s.channel) == ("udp_multicast", "ff15::7")
+    s = parse_can_url("can://udp_multicast/239.74.9.7?port=43210&timeout=0.5&lockstep=1&fd=False")
+    assert (s.interface, s.channel) == ("udp_multicast", "239.74.9.7")
     assert s.bus_kwargs == {"port": 43210, "fd": False}
-    assert s.options["timeout"] == 0.5 and s.options["lockstep"] == 1
+    assert s.options["timeout"] == 0.5 and s.options["lockstep"] == 1 and s.options["lan"] == 0
+    s = parse_can_url("can://udp_multicast/ff15::7?lan=1")  # IPv6: on the network only
+    assert (s.channel, s.options["lan"], s.bus_kwargs) == ("ff15::7", 1, {})
     s = parse_can_url("can://slcan//dev/ttyACM0?bitrate=500000")
     assert (s.interface, s.channel, s.bus_kwargs) == ("slcan", "/dev/ttyACM0", {"bitrate": 500000})
     s = parse_can_url("can://default/")
@@ -98,6 +100,9 @@ def test_missing_parts_come_from_python_cans_config(monkeypatch: pytest.MonkeyPa
     ("can://virtual/x?bitrate=fast", "bitrate"),
     ("can://udp_multicast/10.0.0.1", "not a multicast group"),
     ("can://udp_multicast/not-an-address", "multicast group address"),
+    ("can://udp_multicast/ff15::7", "IPv6 group.*loopback.*lan=1"),
+    ("can://udp_multicast/239.74.9.7?lan=2", "lan.*0 or 1"),
+    ("can://virtual/x?lan=1", "udp_multicast only"),
     ("can://virtual/x?channel=y", "in the path"),
 ])
 def test_bad_urls_say_what_is_allowed(url: str, words: str) -> None:
@@ -324,6 +329,14 @@ def test_fake_boards_on_a_bad_bus_exit_2_with_one_line(
     assert main(["fake-boards", "--can", spec]) == 2
     err = capsys.readouterr().err.strip()
     assert words in err and "\n" not in err and "Traceback" not in err
+
+
+def test_fake_boards_help_says_udp_multicast_stays_on_loopback() -> None:
+    from stairbot.fakes.boards_cli import build_parser
+
+    text = " ".join(build_parser().format_help().split())
+    assert "on loopback only (127.0.0.1, TTL 0) unless the URL adds ?lan=1" in text
+    assert "no other host can send the boards frames" in text
 
 
 def test_faster_than_real_time_without_lockstep() -> None:

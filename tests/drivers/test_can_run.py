@@ -136,6 +136,7 @@ def fake_boards_url(scenario_file: Path) -> Iterator[str]:
         _, err = proc.communicate(timeout=10)
         assert proc.returncode == 0, err
         assert "frames in" in err  # the fake reports its counters on SIGTERM
+        assert "this machine only: loopback 127.0.0.1, TTL 0 (Ctrl-C" in err
 
 
 def test_full_ascent_and_descent_over_udp_multicast_ends_as_sim_does(

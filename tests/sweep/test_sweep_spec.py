@@ -4,6 +4,7 @@ before any case runs (exit 2, one line naming the field and what is allowed)."""
 from __future__ import annotations
 
 import sys
+import types
 from pathlib import Path
 
 import pytest
@@ -12,6 +13,7 @@ from stairbot.cli import main
 from stairbot.config import load_config
 from stairbot.scenario import parse_scenario
 from stairbot.sweep.cases import build_case, check_spec, first_sight, zone
+from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec
 
 GOOD = """
@@ -138,6 +140,36 @@ def test_missing_dask_names_the_extra(tmp_path: Path, monkeypatch: pytest.Monkey
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["stairbot: error: --dask: needs the optional extra: "
                    "pip install 'stairbot[dask]'"]
+
+
+def test_dask_local_listens_on_loopback_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """--dask local's scheduler and workers: on 127.0.0.1, no dashboard (a
+    stand-in for Dask records what the cluster is asked for; nothing starts)."""
+    asked: dict[str, object] = {}
+
+    class Cluster:
+        def __init__(self, **kwargs: object) -> None:
+            asked.update(kwargs)
+
+        def close(self) -> None:
+            pass
+
+    class Client:
+        def __init__(self, cluster: Cluster) -> None:
+            pass
+
+        def get_executor(self, pure: bool) -> None:
+            return None
+
+        def close(self) -> None:
+            pass
+
+    fake = types.ModuleType("distributed")
+    fake.LocalCluster, fake.Client = Cluster, Client  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "distributed", fake)
+    with open_executor(2, "local"):
+        pass
+    assert asked["host"] == "127.0.0.1" and asked["dashboard_address"] is None
 
 
 def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
