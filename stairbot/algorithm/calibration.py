@@ -498,16 +498,21 @@ def _probe(t: Tick, w: Work) -> Step:
         w.probe_sfl = _trimmed_mean([l_ for _r, l_ in w.standing])
         w.checked = True
     r, l_ = motion.pair(t.snap)
-    if r.ok and l_.ok and not motion.far(r, cfg) and not motion.far(l_, cfg):
+    both = r.ok and l_.ok and not motion.far(r, cfg) and not motion.far(l_, cfg)
+    if both:
         w.probe_recent = [*w.probe_recent[-(PROBE_TICKS - 1):], (r.distance_m, l_.distance_m)]
-    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
-    if len(w.probe_recent) < PROBE_TICKS:
-        if motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
-            return stay(motion.turn(1, cfg))
-        sfr, sfl = _readings(t)  # no figures while turning: now's readings
-    else:
         sfr = sum(r_ for r_, _l in w.probe_recent) / len(w.probe_recent)
         sfl = sum(l_ for _r, l_ in w.probe_recent) / len(w.probe_recent)
+    else:
+        # A beam off the riser (or past LENGTH_OF_INFINITY) is as large a
+        # change as there is: now's readings.  Waiting for five ticks that
+        # see something, an ideal robot 18 deg askew 0.97 m away turned on
+        # until both beams read nothing, and squared up to nothing (the
+        # envelope sweep, case 1004 on ideal).
+        sfr, sfl = _readings(t)
+    # a corner is decided on a full window of means only
+    window_full = both and len(w.probe_recent) >= PROBE_TICKS
+    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
     d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
     # Half a resolution step off the readings' grid: whole-millimetre readings
     # that sum to the threshold exactly must not be decided by float rounding
@@ -518,7 +523,8 @@ def _probe(t: Tick, w: Work) -> Step:
     # noise is probed further, not decided.
     corner_tol = max(tol, pair_tolerance(cfg, (w.probe_sfr + w.probe_sfl) / 2.0))
     cornerish = d_sfr > 0 and d_sfl < 0
-    unsure = abs(d_sfr) + abs(d_sfl) < 2 * tol or (cornerish and d_sfr - d_sfl < corner_tol)
+    unsure = abs(d_sfr) + abs(d_sfl) < 2 * tol or (
+        cornerish and (not window_full or d_sfr - d_sfl < corner_tol))
     if unsure and motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
         return stay(motion.turn(1, cfg))
     corner = cornerish and d_sfr - d_sfl >= corner_tol
