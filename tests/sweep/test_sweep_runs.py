@@ -110,11 +110,19 @@ seed = 11
 """
 
 
+def _as_from_a_terminal() -> None:
+    # Ctrl-C's default, as a terminal's shell gives it: a test run started in
+    # the background (`pytest ... &` in a script) inherits SIGINT ignored, and
+    # Python then never raises KeyboardInterrupt: the sweep ran to the end
+    # and exited 0.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start(spec: Path, out: Path, *extra: str) -> subprocess.Popen[str]:
     return subprocess.Popen([sys.executable, "-m", "stairbot", "sweep", str(spec), "-j", "2",
                              "--out", str(out), "-q", "--no-png", *extra], cwd=ROOT, env=ENV,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=_as_from_a_terminal)
 
 
 def _wait_for_lines(out: Path, n: int, proc: subprocess.Popen[str]) -> None:
