@@ -12,7 +12,9 @@ from stairbot.hardware import MotorId, SensorId
 # 2.0: SensorTelemetry carries its reading's age (8 bytes, was 6); the sensor
 # board's IMU (ImuTelemetry, GetImu).  A host refuses a board of another major
 # version; Ident keeps its layout in every version so that it can tell.
-PROTOCOL_MAJOR = 2
+# 3.0: the serial frame header has a length byte, flagged by address bit 4
+# (serial_wire.py); CAN frames are unchanged.
+PROTOCOL_MAJOR = 3
 PROTOCOL_MINOR = 0
 MAX_PAYLOAD = 8
 INT16_MAX = 32767

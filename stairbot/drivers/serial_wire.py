@@ -2,8 +2,10 @@
 
 One frame, before stuffing::
 
-    addr  u8    board address (bits 0-3); bit 7 set in frames from a board
+    addr  u8    board address (bits 0-3); bit 4 always set (FRAMING_3: this
+                header has a length byte); bit 7 set in frames from a board
     seq   u8    the host's sequence number; a reply repeats its request's
+    len   u8    the number of message bytes that follow, up to the CRC
     then one or more messages, each:
       type  u8    message type (messages.py)
       len   u8    payload length (0..8), so an unknown type can be skipped
@@ -11,6 +13,15 @@ One frame, before stuffing::
     crc   u16   CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection,
                 no final xor; check("123456789") = 0x29B1) over addr..payload,
                 big-endian
+
+The length byte closes a blind spot of a CRC without a final xor: the CRC
+of a body followed by its own CRC is 0, so before protocol 3.0 a frame whose
+CRC ended in 0x00, with the bytes ``01 01`` inserted before its delimiter,
+decoded (body + 00 00) as the same frame plus one zero-length message.  Now
+any byte added or lost after the header contradicts ``len``, which the CRC
+covers.  Bit 4 of the address makes a 2.x board drop 3.x frames as
+malformed (reserved bits set) instead of misreading them, and lets a 3.x
+host name a 2.x board's frames for what they are (OldFramingError).
 
 The frame is COBS-stuffed (the ``cobs`` package) so that it holds no 0x00,
 and a 0x00 follows it.  A receiver that joins mid-stream, or sees garbage,
@@ -37,8 +48,15 @@ from stairbot.drivers.messages import (
 )
 
 FROM_BOARD = 0x80
+FRAMING_3 = 0x10  # always set: the header has a length byte (protocol 3.0)
 MAX_FRAME = 254  # stuffed bytes between delimiters; longer runs are dropped as garbage
-MIN_BODY = 4  # addr, seq, crc
+HEADER = 3  # addr, seq, len
+MIN_BODY = HEADER + 2  # and the crc
+
+
+class OldFramingError(CodecError):
+    """A frame with a good CRC but no length byte: a board of protocol 2.x or
+    older (its address byte lacks FRAMING_3)."""
 
 
 class CrcError(CodecError):
@@ -64,7 +82,10 @@ def frame_body(frame: Frame) -> bytes:
     """The unstuffed bytes of a frame, CRC included."""
     if not 0 <= frame.board <= 0x0F or not 0 <= frame.seq <= 0xFF:
         raise CodecError(f"board {frame.board} or seq {frame.seq} out of range")
-    out = bytearray((frame.board | (FROM_BOARD if frame.from_board else 0), frame.seq))
+    if not frame.messages:
+        raise CodecError("a frame needs at least one message")
+    out = bytearray((frame.board | FRAMING_3 | (FROM_BOARD if frame.from_board else 0),
+                     frame.seq, 0))
     for msg in frame.messages:
         if isinstance(msg, RawMessage):
             code, payload = msg.type_code, msg.payload
@@ -74,6 +95,9 @@ def frame_body(frame: Frame) -> bytes:
             raise CodecError(f"payload of {len(payload)} bytes, at most {MAX_PAYLOAD}")
         out += bytes((code, len(payload)))
         out += payload
+    if len(out) - HEADER > 0xFF:
+        raise CodecError(f"{len(out) - HEADER} message bytes, at most 255 in a frame")
+    out[2] = len(out) - HEADER
     out += crc16(bytes(out)).to_bytes(2, "big")
     return bytes(out)
 
@@ -84,17 +108,27 @@ def encode_frame(frame: Frame) -> bytes:
 
 
 def parse_body(body: bytes) -> Frame:
-    """A frame from its unstuffed bytes.  Raises CrcError for a bad CRC and
-    CodecError for anything else malformed (the only exceptions it raises)."""
+    """A frame from its unstuffed bytes.  Raises CrcError for a bad CRC,
+    OldFramingError for a frame of protocol 2.x framing and CodecError for
+    anything else malformed (the only exceptions it raises)."""
     if len(body) < MIN_BODY:
+        if len(body) >= 4 and not body[0] & FRAMING_3 \
+                and crc16(body[:-2]) == int.from_bytes(body[-2:], "big"):
+            raise OldFramingError("a frame without a length byte (protocol 2.x framing)")
         raise CodecError(f"frame of {len(body)} bytes, at least {MIN_BODY}")
     if crc16(body[:-2]) != int.from_bytes(body[-2:], "big"):
         raise CrcError("CRC mismatch")
-    addr, seq = body[0], body[1]
-    if addr & 0x70:
+    addr, seq, length = body[0], body[1], body[2]
+    if not addr & FRAMING_3:
+        raise OldFramingError(f"address byte 0x{addr:02X} lacks bit 4: a frame without a "
+                              "length byte (protocol 2.x framing)")
+    if addr & 0x60:
         raise CodecError(f"address byte 0x{addr:02X} has reserved bits set")
+    if length != len(body) - MIN_BODY:
+        raise CodecError(f"length byte says {length} message bytes; the frame holds "
+                         f"{len(body) - MIN_BODY}")
     msgs: list[Message | RawMessage] = []
-    i, end = 2, len(body) - 2
+    i, end = HEADER, len(body) - 2
     while i < end:
         if i + 2 > end:
             raise CodecError("truncated message header")
@@ -104,6 +138,8 @@ def parse_body(body: bytes) -> Frame:
         payload = body[i + 2:i + 2 + n]
         msgs.append(decode(code, payload) if code in MESSAGES else RawMessage(code, payload))
         i += 2 + n
+    if not msgs:
+        raise CodecError("a frame without a message")
     return Frame(addr & 0x0F, seq, tuple(msgs), bool(addr & FROM_BOARD))
 
 

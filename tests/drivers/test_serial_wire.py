@@ -9,6 +9,7 @@ from importlib import resources
 from typing import Any
 
 import pytest
+from cobs import cobs
 from crc import Calculator, Crc16
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -20,6 +21,7 @@ from stairbot.drivers.serial_wire import (
     CrcError,
     Frame,
     FrameReader,
+    OldFramingError,
     RawMessage,
     crc16,
     decode_frame,
@@ -84,10 +86,39 @@ def test_unknown_type_is_kept_raw_and_bad_length_rejected() -> None:
     frame = Frame(2, 5, (RawMessage(0x33, b"\x01\x02"), m.GetStatus()))
     assert decode_frame(encode_frame(frame)[:-1]) == frame
     body = bytearray(frame_body(Frame(1, 1, (m.Heartbeat(3),))))
-    body[3] = 9  # a length beyond the frame
+    body[4] = 9  # a message length beyond the frame
     body[-2:] = crc16(bytes(body[:-2])).to_bytes(2, "big")
     with pytest.raises(CodecError, match="bad length"):
         parse_body(bytes(body))
+
+
+def test_bytes_inserted_before_the_delimiter_are_never_a_frame() -> None:
+    """Protocol 2's blind spot: a CRC without a final xor is 0 over a body and
+    its own CRC, so ``01 01`` before the delimiter of a frame whose CRC ended
+    in 0x00 unstuffed to body + 00 00 and passed.  The length byte refuses it
+    (and every other insertion after the header)."""
+    hits = 0
+    for seq in range(256):
+        for frame in (Frame(1, seq, (m.ReadAll(),)), Frame(2, seq, (m.GetStatus(),), True),
+                      Frame(1, seq, (m.SetWheelSpeeds(1000, 1000, 0, 0),))):
+            wire = encode_frame(frame)
+            if frame_body(frame)[-1] != 0:
+                continue
+            hits += 1
+            assert crc16(cobs.decode(wire[:-1] + b"\x01\x01")) == 0  # the CRC alone passes it
+            with pytest.raises(CodecError, match="length byte says"):
+                decode_frame(wire[:-1] + b"\x01\x01")
+    assert hits > 0
+
+
+def test_a_protocol_2_frame_is_named_for_what_it_is() -> None:
+    old = bytes((0x01, 2, 0x10, 0x00))
+    old += crc16(old).to_bytes(2, "big")
+    with pytest.raises(OldFramingError, match="protocol 2.x framing"):
+        parse_body(old)
+    with pytest.raises(OldFramingError, match="protocol 2.x framing"):
+        parse_body(old[:2] + b"\x00" + old[2:4] + crc16(old[:2] + b"\x00" + old[2:4]).to_bytes(
+            2, "big"))
 
 
 def test_overrun_is_dropped_and_the_reader_resyncs() -> None:
@@ -132,3 +163,22 @@ def test_arbitrary_bytes_never_crash_the_decoders(data: bytes) -> None:
     assert s.frames == len(frames)
     assert reader.feed(encode_frame(Frame(1, 1, (m.ReadAll(),))) * 2)[-1:] == [
         Frame(1, 1, (m.ReadAll(),))]
+
+
+@given(st.lists(messages_st, min_size=1, max_size=6), st.data())
+def test_a_byte_added_or_lost_after_the_header_is_never_a_frame(
+        msgs: list[m.Message], data: st.DataObject) -> None:
+    body = frame_body(Frame(1, 9, tuple(msgs)))
+    at = data.draw(st.integers(3, len(body)), label="at")
+    if data.draw(st.booleans(), label="insert"):
+        extra = data.draw(st.binary(min_size=1, max_size=4), label="extra")
+        bad = body[:at] + extra + body[at:]
+    else:
+        n = data.draw(st.integers(1, min(4, len(body) - at) or 1), label="n")
+        bad = body[:at] + body[at + n:]
+    if bad == body:
+        return
+    bad = bad[:-2] + crc16(bad[:-2]).to_bytes(2, "big") if data.draw(
+        st.booleans(), label="fix crc") else bad
+    with pytest.raises(CodecError):
+        parse_body(bad)
