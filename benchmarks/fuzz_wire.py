@@ -199,9 +199,12 @@ def fuzz_serial(rng: random.Random, n: int) -> Tally:
                 if kind == "01 01 before the delimiter":
                     t.counts["blind spot"] += 1
         try:
-            t.timed(partial(reader.feed, bad))
+            frames = t.timed(partial(reader.feed, bad))
         except Exception as exc:
             t.unexpected(f"FrameReader.feed({bad.hex()})", exc)
+        else:  # resynchronising may find a frame decode_frame could not: one that was sent
+            assert isinstance(frames, list)
+            t.counts["stream: undetected"] += sum(f not in originals for f in frames)
     s = reader.stats
     t.counts["stream: frames"] = s.frames
     t.counts["stream: crc errors"] = s.crc_errors
