@@ -18,6 +18,7 @@ import json
 import os
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import replace
@@ -52,6 +53,9 @@ EXTERNAL: dict[str, tuple[str, str]] = {
                 "the operator console: a terminal UI that watches and commands the robot"),
     "fake-boards": ("stairbot.fakes.boards_cli:main",
                     "serve simulated motor and sensor boards on a pseudo-terminal or CAN bus"),
+    "clear": ("stairbot.cli_clear:main",
+              "show the boards' latches (emergency stop, tripped watchdog) and clear "
+              "them once you confirm"),
     "sweep": ("stairbot.sweep.cli:main",
               "run many generated cases and judge each (stairbot sweep SPEC.toml; "
               "docs/envelope.md)"),
@@ -215,9 +219,12 @@ def _record_file(path: str | None) -> Iterator[IO[str] | None]:
 
 
 @contextmanager
-def _ctrl_c_stops(request_stop: Callable[[str], None]) -> Iterator[None]:
-    """First Ctrl-C asks the run loop to stop the robot and end cleanly; a second
-    one raises KeyboardInterrupt at once (the loop's finally still stops it)."""
+def _ctrl_c_stops(request_stop: Callable[[str], None],
+                  estop: Callable[[], None]) -> Iterator[None]:
+    """First Ctrl-C latches the emergency stop at once (from a thread of its
+    own: the robot's ``estop()`` does not wait for a read in progress) and
+    asks the run loop to end cleanly; a second one raises KeyboardInterrupt
+    at once (the loop's finally still stops the robot)."""
     pressed = False
 
     def handler(_sig: int, _frame: FrameType | None) -> None:
@@ -225,7 +232,8 @@ def _ctrl_c_stops(request_stop: Callable[[str], None]) -> Iterator[None]:
         if pressed:
             raise KeyboardInterrupt
         pressed = True
-        request_stop("interrupted by Ctrl-C")
+        threading.Thread(target=estop, name="Ctrl-C emergency stop", daemon=True).start()
+        request_stop("interrupted by Ctrl-C: emergency stop latched")
 
     try:
         previous = signal.signal(signal.SIGINT, handler)
@@ -271,11 +279,12 @@ def cmd_run(args: argparse.Namespace) -> int:
                   file=progress, flush=True)
         control = RunControl()
         try:
-            with _ctrl_c_stops(control.request_stop):
+            with _ctrl_c_stops(control.request_stop, session.robot.estop):
                 result = run(session, config, sink=sink, mode=mode, control=control)
         except KeyboardInterrupt:
+            session.robot.estop()
             session.robot.stop_all()
-            print(f"{PROG}: interrupted: every motor stopped", file=sys.stderr)
+            print(f"{PROG}: interrupted: emergency stop latched", file=sys.stderr)
             return EXIT_INTERRUPTED
         finally:
             session.close()
@@ -296,7 +305,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     else:
         _print_summary(data, scenario, args.robot, mismatches)
     if interrupted:
-        print(f"{PROG}: interrupted: every motor stopped", file=sys.stderr)
+        print(f"{PROG}: interrupted: emergency stop latched, every motor stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
     if mismatches:
         print(f"{PROG}: the run did not end as {scenario.source} expects: "

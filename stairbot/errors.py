@@ -47,6 +47,13 @@ class ProtocolVersionError(HardwareError):
     The message names the URL, the board and both versions."""
 
 
+class LatchedError(HardwareError):
+    """A board holds a latch -- its emergency stop, or its watchdog that
+    tripped -- from before this host opened it.  Opening never clears a latch:
+    the operator checks the robot and clears it (``stairbot clear``).  The
+    message is one line naming the URL, the board, the latch and that command."""
+
+
 class RobotFellError(HardwareError):
     """The simulated world detected instability: pitch beyond the limit, a fall."""
 

@@ -31,11 +31,14 @@ class RobotOptions:
     """How to run: ``realtime`` paces a simulation to the wall clock;
     ``time_scale`` (sim seconds per wall second) paces it faster or slower;
     ``world`` is the scenario a simulated robot (``sim://``) is placed in —
-    drivers for real boards never read it."""
+    drivers for real boards never read it.  ``allow_latched`` opens boards
+    that hold a latch (e-stop, tripped watchdog) instead of refusing them:
+    ``stairbot clear`` only."""
 
     realtime: bool = False
     time_scale: float | None = None
     world: Scenario | None = None
+    allow_latched: bool = False
 
 
 @dataclass

@@ -136,7 +136,9 @@ def run(
     """Run the program on ``session`` until the controller finishes.
 
     Never raises for a robot failure: a HardwareError ends the run with outcome
-    "error" (or "fell" for a RobotFellError) after every motor is stopped.
+    "error" (or "fell" for a RobotFellError) after every motor is stopped.  A
+    run that ends otherwise than "completed" or "stopped" latches the robot's
+    emergency stop (``robot.estop()``): boards keep it until cleared.
     ``on_tick(controller, snapshot)`` is called after each tick (for a console).
     A run longer than ``max_sim_time_s`` of robot time ends with an error (by
     default an hour, or 60 phase timeouts for a robot whose slow motors make
@@ -181,6 +183,12 @@ def run(
         if control is not None:  # presses the loop did not come round to
             with contextlib.suppress(HardwareError):  # a clear on a lost link
                 _latch(control, robot)
+        if fell or ctl.result.outcome not in ("completed", "stopped"):
+            # An error -- a fall, a lost link, the supervisor, a phase's own
+            # check, anything unforeseen -- latches the emergency stop: the
+            # robot may stand part way up a step, and nothing moves it until
+            # the operator clears the latch.
+            robot.estop()
         robot.stop_all()
     wall_time = wall() - wall0
     sim_time = clock.now() - t0

@@ -29,7 +29,7 @@ from stairbot.clock import WallClock
 from stairbot.drivers import messages as m
 from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
-from stairbot.drivers.handshake import open_board
+from stairbot.drivers.handshake import LATCHES, open_board
 from stairbot.drivers.health import HealthReport
 from stairbot.drivers.link import BoardLink, Reply, Request
 from stairbot.drivers.telemetry import K, T, V
@@ -37,6 +37,14 @@ from stairbot.errors import HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import Clock, Imu, MotorId, Snapshot
 from stairbot.robots import RobotSession
+
+# The emergency stop (docs/protocol.md, "Emergency stop"): each press puts
+# ESTOP_COPIES EStop frames to each board on the wire at once, sends the
+# unanswered ones again every ESTOP_RESEND_S, and gives up on a board that has
+# not confirmed within ESTOP_CONFIRM_S (a LINK event says so).
+ESTOP_COPIES = 3
+ESTOP_RESEND_S = 0.02
+ESTOP_CONFIRM_S = 0.5
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -69,7 +77,8 @@ class BoardRobot:
     def __init__(self, link: BoardLink, url: str, watchdog_ms: int = 250, *,
                  time_scale: float = 1.0, clock: Clock | None = None,
                  sink: EventSink = discard, keepalive: bool = True,
-                 monotonic: Callable[[], float] = time.monotonic) -> None:
+                 monotonic: Callable[[], float] = time.monotonic,
+                 allow_latched: bool = False) -> None:
         self.link = link
         self.url = url
         self.sink = sink
@@ -91,7 +100,8 @@ class BoardRobot:
         # simulated time: X times the wall time the host has to feed it.
         self.board_watchdog_ms = min(65535, round(watchdog_ms * time_scale))
         self._lock = threading.RLock()
-        self._handshake()
+        self.latched: dict[int, int] = {}  # board -> latch flags found when opening
+        self._handshake(allow_latched)
         # A robot opened and left idle (a console before its run starts) must
         # not trip the boards' watchdogs: a daemon thread sends Heartbeats to
         # any board the host has not addressed for a quarter of the timeout.
@@ -103,13 +113,17 @@ class BoardRobot:
             self._keepalive.start()
 
     # -- setting up ------------------------------------------------------------
-    def _handshake(self) -> None:
+    def _handshake(self, allow_latched: bool) -> None:
         for board in m.Board:
             self.idents[board], status = open_board(
                 self.link, self.url, board, lockstep=self.LOCKSTEP,
-                watchdog_ms=self.board_watchdog_ms)
+                watchdog_ms=self.board_watchdog_ms, allow_latched=allow_latched)
             if status is not None:
                 self.status[board] = status
+                if status.flags & LATCHES:
+                    self.latched[board] = status.flags & LATCHES
+                if status.flags & m.StatusFlag.ESTOP:
+                    self._estopped = True  # this host holds the latch it found
             self._last_tx[board] = self._monotonic()
 
     @property
@@ -183,18 +197,61 @@ class BoardRobot:
         with contextlib.suppress(Exception):
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
 
-    @locked
     def estop(self) -> None:
         """Latch the emergency stop: here at once (``command`` sends only
-        zeros from now on), and on both boards with one EStop each (one
-        broadcast frame on CAN) whose Status is awaited.  Never raises: a board
-        that does not confirm is a LINK event ("link lost"), and its watchdog
-        stops its motors."""
+        zeros from now on), and on both boards.  Callable from any thread, it
+        does not wait for the robot's lock: ESTOP_COPIES EStop frames to each
+        board (broadcast frames on CAN) go on the wire at once, between the
+        retries of a read in progress; the unanswered ones are sent again
+        every ESTOP_RESEND_S until each board has confirmed (its Status), for
+        at most ESTOP_CONFIRM_S.  Never raises: a board that does not confirm
+        is a LINK event naming it."""
         self._estopped = True
         if self._closed:
             return
-        with contextlib.suppress(Exception):  # the Robot protocol: estop never raises
-            self._wait(self.link.broadcast(m.EStop()))
+        t0 = self._monotonic()
+        try:
+            reqs = self.link.urgent(m.EStop(), copies=ESTOP_COPIES)
+        except Exception as exc:  # noqa: BLE001 - the Robot protocol: estop never raises
+            self._estop_unconfirmed(list(m.Board), f"cannot send it: {exc}")
+            return
+        sent = t0
+        while True:
+            waiting = {r.board for r in reqs} - {r.board for r in reqs if r.reply is not None}
+            if not waiting:
+                break
+            now = self._monotonic()
+            if now - t0 >= ESTOP_CONFIRM_S:
+                self.link.forget(reqs)
+                self._estop_unconfirmed(sorted(m.Board(b) for b in waiting),
+                                        f"no Status within {ESTOP_CONFIRM_S * 1e3:.0f} ms of "
+                                        f"{sum(r.attempts for r in reqs)} EStop frames")
+                return
+            if now - sent >= ESTOP_RESEND_S:
+                sent = now
+                # a write that fails: keep trying till the end
+                with contextlib.suppress(Exception):
+                    self.link.resend_urgent([r for r in reqs if r.board in waiting])
+            # Whoever holds the lock (a read in progress) takes in the replies;
+            # when nobody does, this thread does.
+            if self._lock.acquire(blocking=False):
+                try:
+                    self.link.poll()
+                except Exception:  # noqa: BLE001 - a read that fails is a later read()'s news
+                    pass
+                finally:
+                    self._lock.release()
+            time.sleep(0.001)
+        self.link.forget(reqs, lost=False)  # the spare copies: their replies count as late
+
+    def _estop_unconfirmed(self, boards: Sequence[m.Board], why: str) -> None:
+        names = " and ".join(f"the {b.name.lower()} board" for b in boards)
+        watchdog = (f"; if it hears nothing more, its watchdog stops its motors "
+                    f"{self.watchdog_ms} ms later" if self.watchdog_ms else
+                    "; the watchdogs are off (watchdog=0)")
+        self.sink(Event(self.clock.now(), EventKind.LINK,
+                        f"emergency stop not confirmed by {names}: {why}{watchdog}", None,
+                        self.health()))
 
     @locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
@@ -249,9 +306,15 @@ class BoardRobot:
 
     @locked
     def _close(self) -> None:
+        """Stop every motor; once both boards confirm, switch their watchdogs
+        off: a watchdog still armed after a close trips, and its latch then
+        tells the next host that this one stopped without closing."""
         if self._closed:
             return
-        self.stop_all()
+        with contextlib.suppress(Exception):
+            self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
+            if self.watchdog_ms:
+                self._wait(self.link.broadcast(m.SetWatchdog(0)))
         self._closed = True
         self.link.close()
 
@@ -349,18 +412,20 @@ class BoardRobot:
 
 
 def open_board_session(link: BoardLink, url: str, *, watchdog_ms: int, lockstep: bool,
-                       time_scale: float) -> RobotSession:
+                       time_scale: float, allow_latched: bool = False) -> RobotSession:
     """The session of the boards on ``link`` (closed again if they cannot be
     opened).  Fake boards in lockstep (``lockstep``) are opened by
-    ``stairbot.fakes.lockstep``: their clock steps their world."""
+    ``stairbot.fakes.lockstep``: their clock steps their world.  Boards that
+    hold a latch raise LatchedError unless ``allow_latched``."""
     robot: BoardRobot
     try:
         if lockstep:
             from stairbot.fakes.lockstep import LockstepRobot  # the simulation's own part
 
-            robot = LockstepRobot(link, url, watchdog_ms)
+            robot = LockstepRobot(link, url, watchdog_ms, allow_latched=allow_latched)
         else:
-            robot = BoardRobot(link, url, watchdog_ms, time_scale=time_scale)
+            robot = BoardRobot(link, url, watchdog_ms, time_scale=time_scale,
+                               allow_latched=allow_latched)
     except BaseException:
         link.close()
         raise

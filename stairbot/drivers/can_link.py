@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import can
@@ -126,6 +126,10 @@ class CanLink(RequestLink[CanRequest]):
     def flush(self) -> None:
         """Send every held request, in order; a single message held for every
         board in a row (ReadAll to both) becomes one broadcast frame."""
+        with self._mutex:
+            self._flush()
+
+    def _flush(self) -> None:
         held, self._held = self._held, []
         everyone = set(m.READ_ALL_REPLY)
         i = 0
@@ -138,6 +142,21 @@ class CanLink(RequestLink[CanRequest]):
                 i += len(group)
             else:
                 self._send(p)
+                i += 1
+
+    def _send_now(self, requests: Sequence[CanRequest]) -> None:
+        """One broadcast frame for each copy to every board (a request per
+        board), else a frame per request."""
+        boards = set(m.READ_ALL_REPLY)
+        i = 0
+        while i < len(requests):
+            group = requests[i:i + len(boards)]
+            if len(group) == len(boards) and {q.board for q in group} == boards and all(
+                    len(q.messages) == 1 and q.messages == group[0].messages for q in group):
+                self.send(BROADCAST, group[0].messages[0])
+                i += len(group)
+            else:
+                self._send(requests[i])
                 i += 1
 
     def _send(self, p: CanRequest) -> None:
@@ -164,7 +183,8 @@ class CanLink(RequestLink[CanRequest]):
             raise LinkLostError(f"cannot receive from the CAN bus: {exc}") from exc
         if frame is None:
             return False
-        self.take(frame)
+        with self._mutex:
+            self.take(frame)
         return True
 
     def take(self, frame: can.Message) -> None:

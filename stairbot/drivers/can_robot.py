@@ -240,4 +240,5 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
                    max_lost=int(opts["lost"]))
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
-                              time_scale=options.time_scale or opts["time_scale"])
+                              time_scale=options.time_scale or opts["time_scale"],
+                              allow_latched=options.allow_latched)

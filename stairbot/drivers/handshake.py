@@ -3,9 +3,11 @@
 The host identifies each board, refuses one whose protocol major version is
 not its own (one ProtocolVersionError naming the board and both versions,
 before a single telemetry frame of another layout could be misread) or whose
-lockstep does not match the URL, then sets its watchdog and clears a
-watchdog latch left by an earlier session.  ``board_robot`` does this for
-both boards when it opens.
+lockstep does not match the URL, or that holds a latch (its emergency stop,
+or a watchdog that tripped: an earlier host stopped mid-run, crashed or was
+cut off) -- opening never clears one, the operator does (``stairbot clear``)
+-- then sets its watchdog.  ``board_robot`` does this for both boards when it
+opens.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.link import BoardLink
 from stairbot.errors import (
     HardwareError,
+    LatchedError,
     LinkLostError,
     NoBoardError,
     ProtocolVersionError,
@@ -31,11 +34,27 @@ def check_version(url: str, board: m.Board, ident: m.Ident) -> None:
             "(docs/protocol.md): update the board's firmware or the host")
 
 
+LATCHES = m.StatusFlag.ESTOP | m.StatusFlag.WATCHDOG
+
+
+def latch_names(flags: int) -> str:
+    """The latches in a Status's flags, in words."""
+    names = []
+    if flags & m.StatusFlag.ESTOP:
+        names.append("its emergency stop latched")
+    if flags & m.StatusFlag.WATCHDOG:
+        names.append("its watchdog tripped and latched (frames stopped coming while "
+                     "it was armed)")
+    return " and ".join(names)
+
+
 def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
-               watchdog_ms: int) -> tuple[m.Ident, m.Status | None]:
+               watchdog_ms: int, allow_latched: bool = False
+               ) -> tuple[m.Ident, m.Status | None]:
     """Identify ``board`` and set it up; its Ident and the Status after set-up.
     Raises NoBoardError (no answer), ProtocolVersionError, RobotUrlError (a
-    lockstep mismatch) or HardwareError (an answer that is not Ident + Status)."""
+    lockstep mismatch), LatchedError (a latch, unless ``allow_latched``: the
+    clear command) or HardwareError (an answer that is not Ident + Status)."""
     n = link.retries + 1
     tries = f"{n} {'try' if n == 1 else 'tries'} of {link.timeout_s * 1e3:.0f} ms"
     name = board.name.lower()
@@ -56,13 +75,15 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
                 else "start the fake boards with --lockstep")
         state = "run" if board_lockstep else "do not run"
         raise RobotUrlError(url, "lockstep", f"the boards {state} in lockstep; {hint}")
-    # Opening the robot is the explicit clear of a watchdog latch left by an
-    # earlier session; an emergency stop stays latched.  Setting up is the one
-    # place where a command frame is sent again after a timeout.
+    if status.flags & LATCHES and not allow_latched:
+        raise LatchedError(
+            f"{url}: the {name} board has {latch_names(status.flags)}; opening never "
+            f"clears a latch: check the robot, then `stairbot clear --robot {url}`")
+    # Setting up is the one place where a command frame is sent again after a
+    # timeout (SetWatchdog sets a value: the same effect however often it runs).
     for attempt in range(link.retries + 1):
         try:
-            reply = link.exchange(board, [m.SetWatchdog(watchdog_ms),
-                                          m.Clear(m.ClearMask.WATCHDOG)])
+            reply = link.exchange(board, [m.SetWatchdog(watchdog_ms)])
             break
         except LinkLostError:
             if attempt == link.retries:

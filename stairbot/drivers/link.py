@@ -20,17 +20,24 @@ Rules (docs/protocol.md, "Requests and replies"):
 * :meth:`RequestLink.wait` raises LinkLostError when a waited-for request got
   no reply after its retries; ``max_lost`` commands in a row (in the order
   they were sent) that went unanswered also mean the link is lost.
+* :meth:`RequestLink.urgent` (the emergency stop) may be called from any
+  thread while another waits for replies: its frames go on the wire at once,
+  ahead of anything held back and between a waiting read's retries.  The
+  link's state is guarded by a mutex that is never held while a read blocks;
+  an urgent request never expires by itself (its sender resends it and gives
+  it up with :meth:`RequestLink.forget`).
 """
 
 from __future__ import annotations
 
 import statistics
+import threading
 import time
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Generic, Protocol, TypeVar
+from typing import Generic, Protocol, TypeVar, cast
 
 from stairbot.drivers.codes import Board
 from stairbot.drivers.records import Message, RawMessage
@@ -60,6 +67,7 @@ class Request:
     attempts: int = 1
     reply: Reply | None = None
     failed: bool = False
+    urgent: bool = False  # sent by urgent(): resent and given up by its sender
 
     @property
     def done(self) -> bool:
@@ -156,6 +164,20 @@ class BoardLink(Protocol):
         """Send ``msg`` to every board at once, one request per board."""
         ...
 
+    def urgent(self, msg: Message, copies: int = 1) -> Sequence[Request]:
+        """Put ``msg`` on the wire to every board now, ``copies`` times, from
+        any thread (one request per board and copy)."""
+        ...
+
+    def resend_urgent(self, requests: Sequence[Request]) -> None:
+        """Send the still unanswered ``requests`` of :meth:`urgent` again, now."""
+        ...
+
+    def forget(self, requests: Sequence[Request], lost: bool = True) -> None:
+        """Stop waiting for ``requests`` (a reply that still comes is late);
+        ``lost``: count those unanswered as lost (not spare copies)."""
+        ...
+
     def flush(self) -> None:
         """Send every request held back."""
         ...
@@ -200,6 +222,8 @@ class RequestLink(ABC, Generic[R]):
         self._last_answered = -1  # order of the latest-sent command that was answered
         self._failed: deque[int] = deque(maxlen=256)  # orders of unanswered commands
         self.lost_streak = 0
+        # Guards everything above and the writes; never held while a read blocks.
+        self._mutex = threading.RLock()
 
     # -- what a wire provides ----------------------------------------------------
     @abstractmethod
@@ -216,9 +240,14 @@ class RequestLink(ABC, Generic[R]):
         """Send ``req`` again after a timeout (an idempotent request)."""
 
     @abstractmethod
+    def _send_now(self, requests: Sequence[R]) -> None:
+        """Write ``requests`` (of :meth:`urgent`) at once, ahead of anything held."""
+
+    @abstractmethod
     def _receive(self, timeout_s: float) -> bool:
         """Take in what arrives within ``timeout_s``, handing each complete
-        reply to :meth:`_complete`; False when nothing came."""
+        reply to :meth:`_complete` (under ``_mutex``, taken only once the
+        bytes are in); False when nothing came."""
 
     def _given_up(self, req: R) -> None:
         """``req`` failed: remember what a late reply to it would look like."""
@@ -239,19 +268,59 @@ class RequestLink(ABC, Generic[R]):
         for :meth:`flush` (or the next request that sends), so that several go
         out together."""
         msgs = tuple(messages)
-        req = self._new(board, msgs, all(x.IDEMPOTENT for x in msgs), self._now())
-        if not req.idempotent:
-            req.order = self._commands_sent
-            self._commands_sent += 1
-        self._in_flight.setdefault(board, []).append(req)
-        self._transmit(req, send)
+        with self._mutex:
+            req = self._new(board, msgs, all(x.IDEMPOTENT for x in msgs), self._now())
+            if not req.idempotent:
+                req.order = self._commands_sent
+                self._commands_sent += 1
+            self._in_flight.setdefault(board, []).append(req)
+            self._transmit(req, send)
         return req
 
     def broadcast(self, msg: Message) -> list[R]:
         """``msg`` to every board, sent together (on CAN as one frame to board 15)."""
-        out = [self.request(board, [msg], send=False) for board in Board]
-        self.flush()
+        with self._mutex:
+            out = [self.request(board, [msg], send=False) for board in Board]
+            self.flush()
         return out
+
+    def urgent(self, msg: Message, copies: int = 1) -> list[R]:
+        """``msg`` to every board, ``copies`` times, written at once from any
+        thread: it does not wait for a read in progress, nor go behind
+        requests held back.  The requests never expire on their own: resend
+        them with :meth:`resend_urgent`, give them up with :meth:`forget`."""
+        with self._mutex:
+            now = self._now()
+            out = []
+            for _ in range(copies):
+                for board in Board:
+                    req = self._new(board, (msg,), msg.IDEMPOTENT, now)
+                    req.urgent = True
+                    self._in_flight.setdefault(board, []).append(req)
+                    out.append(req)
+            self._send_now(out)
+        return out
+
+    def resend_urgent(self, requests: Sequence[Request]) -> None:
+        with self._mutex:
+            waiting = [cast(R, r) for r in requests if r.reply is None and not r.failed]
+            for req in waiting:
+                req.attempts += 1
+                self.stats.retries += 1
+            if waiting:
+                self._send_now(waiting)
+
+    def forget(self, requests: Sequence[Request], lost: bool = True) -> None:
+        with self._mutex:
+            for r in requests:
+                req = cast(R, r)
+                if req.reply is None and not req.failed:
+                    req.failed = True
+                    self.stats.lost += lost
+                    queue = self._in_flight.get(req.board, [])
+                    if req in queue:
+                        queue.remove(req)
+                    self._given_up(req)
 
     def in_flight(self, board: int) -> list[R]:
         """The requests to ``board`` still waiting for their reply, oldest first."""
@@ -272,7 +341,7 @@ class RequestLink(ABC, Generic[R]):
         now = self._now()
         for queue in self._in_flight.values():
             for req in list(queue):
-                if now < req.deadline:
+                if now < req.deadline or req.urgent:
                     continue
                 self.stats.timeouts += 1
                 if req.idempotent and req.attempts <= self.retries:
@@ -302,18 +371,21 @@ class RequestLink(ABC, Generic[R]):
         """Take in whatever has arrived, without waiting; expire old requests.
         Requests held back with ``send=False`` stay held."""
         self._drain()
-        self._expire()
+        with self._mutex:
+            self._expire()
 
     def wait(self, requests: Sequence[Request]) -> list[Reply]:
         """The replies of ``requests``, in order.  Sends idempotent requests
         that time out again; raises LinkLostError when one gets no reply at
         all, or when ``max_lost`` commands in a row went unanswered."""
-        self.flush()
+        with self._mutex:
+            self.flush()
         while True:
             # Take in what has already arrived before judging deadlines: a host
             # descheduled past a timeout must not call a waiting reply late.
             self._drain()
-            self._expire()
+            with self._mutex:
+                self._expire()
             for req in requests:
                 if req.failed:
                     names = "+".join(type(x).__name__ for x in req.messages)

@@ -16,7 +16,7 @@ import os
 import select
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -148,9 +148,19 @@ class SerialLink(RequestLink[SerialRequest]):
 
     def flush(self) -> None:
         """Write every frame still in the output buffer (one write)."""
-        if not self._out:
-            return
-        data, self._out = bytes(self._out), bytearray()
+        with self._mutex:
+            if not self._out:
+                return
+            data, self._out = bytes(self._out), bytearray()
+            self._write(data)
+
+    def _send_now(self, requests: Sequence[SerialRequest]) -> None:
+        data = b"".join(r.frame for r in requests)
+        self.stats.frames_tx += len(requests)
+        self.stats.bytes_tx += len(data)
+        self._write(data)
+
+    def _write(self, data: bytes) -> None:
         try:
             self.channel.write(data)
         except OSError as exc:
@@ -164,18 +174,19 @@ class SerialLink(RequestLink[SerialRequest]):
             raise LinkLostError(f"cannot read from the port: {exc}") from exc
         if not data:
             return False
-        self.stats.bytes_rx += len(data)
-        rs = self._reader.stats
-        for frame in self._reader.feed(data):
-            req = self._match(frame) if frame.from_board else None
-            if req is not None:
-                self._complete(req, frame.messages)
-            elif (frame.board, frame.seq) in self._expired:
-                self.stats.late += 1
-            else:
-                self.stats.stray += 1
-        self.stats.crc_errors = rs.crc_errors
-        self.stats.malformed = rs.malformed + rs.overruns
+        with self._mutex:
+            self.stats.bytes_rx += len(data)
+            rs = self._reader.stats
+            for frame in self._reader.feed(data):
+                req = self._match(frame) if frame.from_board else None
+                if req is not None:
+                    self._complete(req, frame.messages)
+                elif (frame.board, frame.seq) in self._expired:
+                    self.stats.late += 1
+                else:
+                    self.stats.stray += 1
+            self.stats.crc_errors = rs.crc_errors
+            self.stats.malformed = rs.malformed + rs.overruns
         return True
 
     def _match(self, frame: Frame) -> SerialRequest | None:

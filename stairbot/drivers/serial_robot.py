@@ -107,7 +107,8 @@ def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> R
                       max_lost=int(opts["lost"]))
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
-                              time_scale=options.time_scale or opts["time_scale"])
+                              time_scale=options.time_scale or opts["time_scale"],
+                              allow_latched=options.allow_latched)
 
 
 __all__ = ["DEFAULTS", "open_channel", "open_serial_robot", "parse_serial_url"]

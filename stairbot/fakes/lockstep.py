@@ -56,10 +56,10 @@ class LockstepRobot(BoardRobot):
     PIPELINED_STEP = True  # False: each advance() waits for its StepDone
 
     def __init__(self, link: BoardLink, url: str, watchdog_ms: int = 250,
-                 sink: EventSink = discard) -> None:
+                 sink: EventSink = discard, allow_latched: bool = False) -> None:
         self._step: Request | None = None
         super().__init__(link, url, watchdog_ms, clock=LockstepClock(self), sink=sink,
-                         keepalive=False)
+                         keepalive=False, allow_latched=allow_latched)
 
     @locked
     def step_to(self, time_us: int) -> None:

@@ -4,15 +4,18 @@ exit codes against [expect], --calibrate-only, Ctrl-C."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 
 import pytest
 
-from stairbot.cli import main
+from stairbot.cli import _ctrl_c_stops, main
 
 RESULT_KEYS = {"outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "error",
                "fell", "max_pitch_deg", "final_offset_m", "sim_time_s", "wall_time_s",
@@ -105,6 +108,25 @@ def test_ctrl_c_stops_the_robot_and_exits_130(tmp_path: Path) -> None:
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 130
-    assert "interrupted" in err and "every motor stopped" in err
+    assert "interrupted" in err and "emergency stop latched" in err
     assert "outcome           stopped" in out
     assert "Traceback" not in err
+
+
+def test_ctrl_c_latches_the_emergency_stop_from_a_thread_of_its_own() -> None:
+    """The first Ctrl-C calls the robot's estop() at once, from another thread
+    (it must not wait for the run loop's read), and asks the loop to stop."""
+    stopped: list[tuple[str, str]] = []
+    estopped = threading.Event()
+    reasons: list[str] = []
+
+    def estop() -> None:
+        stopped.append(("estop", threading.current_thread().name))
+        estopped.set()
+
+    with _ctrl_c_stops(reasons.append, estop):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)  # the handler runs between bytecodes
+        assert estopped.wait(5)
+    assert stopped == [("estop", "Ctrl-C emergency stop")]
+    assert reasons == ["interrupted by Ctrl-C: emergency stop latched"]

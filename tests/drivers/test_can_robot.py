@@ -8,6 +8,7 @@ from __future__ import annotations
 import itertools
 import os
 import threading
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -16,6 +17,7 @@ import pytest
 
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
+from stairbot.drivers.board_robot import ESTOP_COPIES
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import open_bus, open_can_robot, parse_can_url, resolve_bus_config
 from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
@@ -187,12 +189,12 @@ def test_watchdog_trips_when_the_host_goes_quiet_and_only_a_clear_resets_it(rig:
     assert rig.world.speeds()[MotorId.MWF] == 1.0
 
 
-def test_emergency_stop_is_one_broadcast_frame_and_latches(rig: Rig) -> None:
+def test_emergency_stop_is_broadcast_frames_and_latches(rig: Rig) -> None:
     rig.tick(FORWARD)
     rig.robot.link.flush()  # the tick's held command and StepTo go out first
     tx = rig.robot.link.stats.frames_tx
     rig.robot.estop()
-    assert rig.robot.link.stats.frames_tx == tx + 1  # EStop_All, id 0x00F
+    assert rig.robot.link.stats.frames_tx == tx + ESTOP_COPIES  # EStop_All (0x00F), copies
     assert rig.robot.estopped
     assert rig.world.speeds() == {mid: 0.0 for mid in MotorId}
     assert all(b.estop for b in rig.boards.values())  # latched on both boards
@@ -221,13 +223,15 @@ def test_estop_never_raises_and_latches_on_a_silent_bus() -> None:
     rig = make_rig(WireFaults(silent_after_s=0.05), timeout=0.01)
     try:
         rig.tick(FORWARD)
-        rig.clock.advance(0.04)  # the StepTo goes out with the EStop: silent from then on
+        rig.clock.advance(0.04)
+        rig.robot.link.flush()  # the StepTo goes out: silent from then on
         events: list[Event] = []
         rig.robot.attach_sink(events.append)
         rig.robot.estop()
         assert rig.robot.estopped
         assert all(b.estop for b in rig.boards.values())  # they heard it
-        assert any("link lost" in e.message for e in events)
+        assert [e.message.split(":")[0] for e in events] == [
+            "emergency stop not confirmed by the motor board and the sensor board"]
         rig.robot.close()
         rig.robot.estop()  # closed: still no exception, still latched
         rig.robot.stop_all()
@@ -237,20 +241,41 @@ def test_estop_never_raises_and_latches_on_a_silent_bus() -> None:
         rig.server.bus.shutdown()
 
 
-def test_the_emergency_stop_runs_under_the_robots_lock(
+def test_the_emergency_stop_does_not_wait_for_the_robots_lock(
         rig: Rig, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The keepalive thread shares the link: EStop_All goes out under the lock."""
-    link = rig.robot.link
-    held: list[bool] = []
-    broadcast = link.broadcast
+    """While another thread holds the robot (a read retrying), the EStop frames
+    go on the bus at once; the confirmation is taken in once the lock comes free."""
+    rig.tick(FORWARD)
+    rig.robot.link.flush()
+    bus = rig.robot.link.bus
+    sent: list[tuple[int, bool]] = []  # (id, whether the holder still held the lock)
+    holding, release = threading.Event(), threading.Event()
+    send = bus.send
 
-    def spy(msg: m.Message) -> list:  # type: ignore[type-arg]
-        held.append(rig.robot._lock._is_owned())  # type: ignore[attr-defined]
-        return broadcast(msg)
+    def spy(msg: can.Message, timeout: float | None = None) -> None:
+        sent.append((msg.arbitration_id, not release.is_set()))
+        send(msg, timeout)
 
-    monkeypatch.setattr(link, "broadcast", spy)
-    rig.robot.estop()
-    assert held == [True]
+    def hold() -> None:
+        with rig.robot._lock:
+            holding.set()
+            release.wait(5)
+
+    monkeypatch.setattr(bus, "send", spy)
+    holder = threading.Thread(target=hold)
+    holder.start()
+    holding.wait(5)
+    stopper = threading.Thread(target=rig.robot.estop)
+    stopper.start()
+    deadline = time.monotonic() + 5
+    while len(sent) < ESTOP_COPIES and time.monotonic() < deadline:
+        time.sleep(0.001)
+    release.set()
+    holder.join(5)
+    stopper.join(5)
+    assert sent[:ESTOP_COPIES] == [(0x00F, True)] * ESTOP_COPIES  # EStop_All, lock held
+    assert all(b.estop for b in rig.boards.values())
+    assert rig.robot.estopped and rig.robot.link.stats.lost == 0  # confirmed, not given up
 
 
 def test_a_silent_board_means_link_lost_and_a_link_event() -> None:

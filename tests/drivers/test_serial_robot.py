@@ -15,11 +15,18 @@ import pytest
 import serial
 import serial.rfc2217
 
+from stairbot.cli_clear import main as clear_main
 from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_robot import parse_serial_url
-from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
+from stairbot.errors import (
+    HardwareError,
+    LatchedError,
+    LinkLostError,
+    NoBoardError,
+    RobotUrlError,
+)
 from stairbot.events import Event, EventKind
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
@@ -100,13 +107,13 @@ def test_read_command_and_lockstep_clock(fake: Fake) -> None:
 def test_estop_latches_on_the_boards_until_cleared(fake: Fake) -> None:
     session = fake.open()
     robot = robot_of(session)
-    robot.command({MotorId.MWF: 1.0})
-    robot.estop()
+    robot.command({MotorId.MWF: 1.0})  # held for the next StepTo (lockstep) ...
+    robot.estop()  # ... and overtaken by the EStops: both boards latch first
     assert robot.estopped and fake.world.speeds()[MotorId.MWF] == 0.0
     assert robot.read().motors[MotorId.MWF].fault == "estop"  # reading goes on
     robot.command({MotorId.MWF: 1.0})
     robot.flush()
-    assert robot.refused == 2 and fake.world.speeds()[MotorId.MWF] == 0.0
+    assert robot.refused == 4 and fake.world.speeds()[MotorId.MWF] == 0.0  # 2 frames x 2
     robot.clear(m.ClearMask.ESTOP)
     assert not robot.estopped
     robot.read()
@@ -126,10 +133,12 @@ def test_estop_never_raises_when_the_boards_fall_silent() -> None:
         session = fake.open("lockstep=1&timeout=0.05&retries=0")
         events: list[Event] = []
         robot_of(session).attach_sink(events.append)
-        session.clock.advance(0.1)  # the StepTo goes out with the EStops: silent from then on
+        session.clock.advance(0.1)
+        robot_of(session).link.flush()  # the StepTo goes out: silent from then on
         session.robot.estop()
         assert session.robot.estopped
-        assert any("link lost" in e.message for e in events)
+        assert [e.message.split(":")[0] for e in events if e.kind == EventKind.LINK] == [
+            "emergency stop not confirmed by the motor board and the sensor board"]
         assert all(b.estop for b in fake.server.boards.values())  # they did hear it
         session.close()
         session.robot.estop()  # closed: no exception either
@@ -149,7 +158,8 @@ def test_heartbeat_feeds_boards_the_host_has_not_addressed_lately(fake: Fake) ->
     session.close()
 
 
-def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake: Fake) -> None:
+def test_watchdog_trips_when_the_host_falls_silent_and_only_the_operator_clears_it(
+        fake: Fake, capsys: pytest.CaptureFixture[str]) -> None:
     session = fake.open("lockstep=1&timeout=0.5&watchdog=100")
     robot = robot_of(session)
     robot.read()
@@ -159,9 +169,42 @@ def test_watchdog_trips_when_the_host_falls_silent_and_reopening_clears_it(fake:
     with pytest.raises(LinkLostError, match="motor board's watchdog tripped"):
         robot.read()
     session.close()
+    url = f"serial://{fake.path}?lockstep=1&timeout=0.5"
+    with pytest.raises(LatchedError) as info:  # opening never clears a latch
+        fake.open()
+    assert str(info.value) == (
+        f"{url}: the motor board has its watchdog tripped and latched (frames stopped "
+        "coming while it was armed); opening never clears a latch: check the robot, "
+        f"then `stairbot clear --robot {url}`")
+    assert clear_main(["--robot", url], confirm=lambda _q: False) == 2  # not confirmed
+    assert "not cleared" in capsys.readouterr().err
+    with pytest.raises(LatchedError):
+        fake.open()
+    asked: list[str] = []
+    assert clear_main(["--robot", url], confirm=lambda q: asked.append(q) or True) == 0
+    out = capsys.readouterr().out
+    assert "the motor board has its watchdog tripped" in out and out.endswith("cleared\n")
+    assert asked and "Look at the robot first" in asked[0]
     again = fake.open()
-    again.robot.read()  # opening is the explicit clear of a watchdog latch
+    again.robot.read()
     again.close()
+    assert clear_main(["--robot", url]) == 0  # a clean close leaves nothing latched
+    assert "nothing to clear" in capsys.readouterr().out
+
+
+def test_a_run_that_ends_in_an_error_leaves_the_emergency_stop_latched(fake: Fake) -> None:
+    session = fake.open()
+    events: list[Event] = []
+    robot_of(session).attach_sink(events.append)
+    result = run(session, CONFIG, max_sim_time_s=0.5)  # "took longer than 0.5 s": an error
+    session.close()
+    assert result.outcome == "error"
+    assert all(b.estop for b in fake.server.boards.values())
+    with pytest.raises(LatchedError, match="motor board has its emergency stop latched"):
+        fake.open()
+    assert clear_main(["--robot", f"serial://{fake.path}?lockstep=1&timeout=0.5",
+                       "--yes"]) == 0
+    fake.open().close()
 
 
 def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
