@@ -149,8 +149,8 @@ class BoardRobot:
         An IMU whose values the protocol does not allow reads as None."""
         self._reap()
         sent = self.clock.now()
-        pm = self.link.request(m.Board.MOTOR, [m.ReadAll()], send=False)
-        ps = self.link.request(m.Board.SENSOR, [m.ReadAll()])
+        pm = self._request(m.Board.MOTOR, [m.ReadAll()], send=False)
+        ps = self._request(m.Board.SENSOR, [m.ReadAll()])
         fm, fs = self._collect([pm, ps])
         self._link_lost = False  # both boards answered: any earlier loss is over
         now = self.clock.now()
@@ -257,7 +257,7 @@ class BoardRobot:
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
         """Clear latches (e-stop, watchdog, faults) on both boards; the host's
         e-stop latch once both boards confirm.  LinkLostError if they do not."""
-        self._wait(self.link.broadcast(m.Clear(mask)))
+        self._wait(self._broadcast(m.Clear(mask)))
         if mask & m.ClearMask.ESTOP:
             self._estopped = False
 
@@ -314,7 +314,7 @@ class BoardRobot:
         with contextlib.suppress(Exception):
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
             if self.watchdog_ms:
-                self._wait(self.link.broadcast(m.SetWatchdog(0)))
+                self._wait(self._broadcast(m.SetWatchdog(0)))
         self._closed = True
         self.link.close()
 
@@ -330,7 +330,18 @@ class BoardRobot:
     # -- internals ---------------------------------------------------------------
     def _request(self, board: int, msgs: list[m.Message], send: bool = True) -> Request:
         self._last_tx[board] = self._monotonic()
-        return self.link.request(board, msgs, send=send)
+        try:
+            return self.link.request(board, msgs, send=send)
+        except LinkLostError as exc:  # the wire itself failed (a port that went away)
+            self._lost(str(exc))
+            raise  # unreachable: _lost raises
+
+    def _broadcast(self, msg: m.Message) -> Sequence[Request]:
+        try:
+            return self.link.broadcast(msg)
+        except LinkLostError as exc:  # the wire itself failed
+            self._lost(str(exc))
+            raise  # unreachable: _lost raises
 
     def _wait(self, requests: Sequence[Request]) -> list[Reply]:
         try:
@@ -350,13 +361,19 @@ class BoardRobot:
         if boards_stopped:
             after = ""
         elif self.watchdog_ms:
-            after = f"; the boards' watchdogs stop every motor within {self.watchdog_ms} ms"
+            # What the host cannot know it does not say: whether the boards
+            # are alive, and so whether their watchdogs have stopped anything.
+            after = (f"; a board that hears nothing more stops its motors when its "
+                     f"watchdog ({self.watchdog_ms} ms) runs out")
         else:
             after = "; the boards' watchdogs are off (watchdog=0): motors may still run"
         raise LinkLostError(f"{self.url}: link lost: {reason}{after}")
 
     def _reap(self) -> None:
-        self.link.poll()
+        try:
+            self.link.poll()
+        except LinkLostError as exc:  # the wire itself failed
+            self._lost(str(exc))
         still = []
         for p in self._commands:
             if p.reply is not None:

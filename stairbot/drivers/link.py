@@ -389,9 +389,12 @@ class RequestLink(ABC, Generic[R]):
             for req in requests:
                 if req.failed:
                     names = "+".join(type(x).__name__ for x in req.messages)
+                    who = (f"the {Board(req.board).name.lower()} board"
+                           if req.board in Board._value2member_map_ else f"board {req.board}")
                     raise LinkLostError(
-                        f"board {req.board} did not answer {names} ({req.attempts} "
-                        f"attempt(s) of {self.timeout_s * 1e3:.0f} ms{req.progress()})")
+                        f"no reply from {who} for {req.attempts * self.timeout_s:.2f} s "
+                        f"({names}: {req.attempts} attempt(s) of "
+                        f"{self.timeout_s * 1e3:.0f} ms{req.progress()})")
             if self.lost_streak >= self.max_lost:
                 raise LinkLostError(f"{self.lost_streak} commands in a row went unanswered")
             waiting = [req for req in requests if req.reply is None]

@@ -164,14 +164,14 @@ class SerialLink(RequestLink[SerialRequest]):
         try:
             self.channel.write(data)
         except OSError as exc:
-            raise LinkLostError(f"cannot write to the port: {exc}") from exc
+            raise LinkLostError(f"cannot write to the serial port: {exc}") from exc
 
     # -- receiving -------------------------------------------------------------
     def _receive(self, timeout_s: float) -> bool:
         try:
             data = self.channel.read_some(timeout_s)
         except OSError as exc:
-            raise LinkLostError(f"cannot read from the port: {exc}") from exc
+            raise LinkLostError(f"cannot read from the serial port: {exc}") from exc
         if not data:
             return False
         with self._mutex:

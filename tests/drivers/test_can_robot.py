@@ -285,7 +285,7 @@ def test_a_silent_board_means_link_lost_and_a_link_event() -> None:
     try:
         for _ in range(4):
             r.tick()
-        with pytest.raises(LinkLostError, match="board 2 did not answer ReadAll"):
+        with pytest.raises(LinkLostError, match="no reply from the sensor board .*ReadAll"):
             for _ in range(10):
                 r.tick()
         assert r.robot.health()["lost"] >= 1 and r.robot.health()["retries"] >= 1

@@ -214,8 +214,10 @@ def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
         robot_of(session).attach_sink(events.append)
         result = run(session, CONFIG, sink=events.append)
         assert result.outcome == "error"
-        assert result.error is not None and "did not answer" in result.error
-        assert "the boards' watchdogs stop every motor within 250 ms" in result.error
+        assert result.error is not None and "no reply from the motor board for 0.20 s" in (
+            result.error)
+        assert result.error.endswith("a board that hears nothing more stops its motors when "
+                                     "its watchdog (250 ms) runs out")
         assert robot_of(session).link.stats.retries >= 1
         session.close()
         # one loss, one LINK event: the stop, truth and close that follow do not repeat it
@@ -421,3 +423,31 @@ def test_no_board_answering_is_a_hardware_error_naming_board_and_url() -> None:
     assert str(info.value) == (f"{url}: no motor board answered on the serial port "
                                "(2 tries of 10 ms)")
     assert (info.value.board, info.value.url) == ("motor", url)
+
+
+def test_boards_that_go_away_mid_run_are_a_link_event_and_an_error() -> None:
+    """The fake boards' process dies (its pty closes): the host's next write
+    or read fails, and that is reported as a lost link, once, with what the
+    host saw -- not a bare OSError, and not a run that merely ended."""
+    world = make_world(CONFIG, SCENARIO, lockstep=True)
+    pty = PtyPair()
+    server = SerialBoardServer(pty.master, world, make_boards(world))
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    session = open_robot(f"serial://{pty.path}?lockstep=1&timeout=0.1", CONFIG)
+    events: list[Event] = []
+    robot_of(session).attach_sink(events.append)
+    for _ in range(3):
+        session.robot.read()
+        session.clock.advance(0.02)
+    server.stop()
+    thread.join(5)
+    pty.close()  # both ends: the port is gone
+    with pytest.raises(LinkLostError) as info:
+        for _ in range(20):
+            session.robot.read()
+            session.clock.advance(0.02)
+    assert "link lost: cannot " in str(info.value) and "the serial port" in str(info.value)
+    lost = [e for e in events if e.kind is EventKind.LINK]
+    assert len(lost) == 1 and lost[0].message.startswith("link lost: ")
+    session.close()
