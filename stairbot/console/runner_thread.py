@@ -235,9 +235,12 @@ class ConsoleEngine:
         robot's own ``estop()``, from this thread at once (the run loop, told
         too, holds the program and does not repeat it)."""
         self.state.set_status(estopped=True, paused=self.running, severity="error",
-                              message="EMERGENCY STOP — every motor stopped; c clears it")
+                              message="EMERGENCY STOP latched — c clears it")
         if self.robot is not None:
-            self.robot.estop()  # (a robot that fails to confirm it says so in the banner)
+            # The boards' estop() puts the stop on the wire at once, then waits
+            # for their confirmation (a few ms; at most half a second, after
+            # which a LINK event names the board that did not confirm).
+            self.robot.estop()
         if self.control is not None and self.running:
             self.control.estop()
         self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))

@@ -91,8 +91,14 @@ class WatchedRobot:
         any thread: the flag alone makes the run thread's next command a stop,
         so even if the lock is busy for a moment no further motion is
         commanded, and the run thread's own call then reaches the robot.
-        Never raises."""
+        Never raises.  A robot whose ``estop()`` is made for any thread
+        (``estop_any_thread``: the boards' driver) is called at once, without
+        the lock, which a read retrying on a lossy wire may hold."""
         self._estop.set()
+        if getattr(type(self.inner), "estop_any_thread", False):
+            if not self._estop_sent:
+                self._send_estop()
+            return
         if self._lock.acquire(timeout=0.5):
             try:
                 if not self._estop_sent:

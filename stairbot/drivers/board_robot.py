@@ -72,6 +72,7 @@ class BoardRobot:
     ``monotonic`` is the wall clock the keepalive goes by."""
 
     LOCKSTEP = False  # what the boards' LOCKSTEP flag must say (fakes.lockstep: True)
+    estop_any_thread = True  # estop() does not wait for the lock (the console relies on it)
     HOLD_COMMANDS = False  # True: commands wait for the next frame sent (a StepTo)
 
     def __init__(self, link: BoardLink, url: str, watchdog_ms: int = 250, *,
