@@ -108,6 +108,16 @@ def build_parser() -> argparse.ArgumentParser:
                         "[expect] is not checked: exit 0 when calibration completes")
     r.add_argument("-q", "--quiet", action="store_true",
                    help="print no progress lines, only the summary (or the JSON)")
+    r.add_argument("--journal", metavar="FILE",
+                   help="where the run's journal goes (every tick, durable: what --resume "
+                        "reads); default for boards: $XDG_STATE_HOME/stairbot/journal-"
+                        "<robot>.jsonl; a simulation keeps none unless given")
+    r.add_argument("--resume", action="store_true",
+                   help="carry on the run the journal says a host left unfinished: checks "
+                        "the boards are the same and did not restart, says where the robot "
+                        "believes it is, and asks before anything moves")
+    r.add_argument("--yes", action="store_true",
+                   help="with --resume: resume without asking (you have looked at the robot)")
     r.set_defaults(func=cmd_run)
 
     c = sub.add_parser("config", help="show the robot config and what follows from it",
@@ -251,11 +261,16 @@ def cmd_run(args: argparse.Namespace) -> int:
     config, scenario = _load_inputs(args)
     # Imported here: the runner pulls in the controller, which `config show` needs not.
     from stairbot.algorithm.phases import Mode
+    from stairbot.cli_journal import NotConfirmed, journal_path, start_journal
+    from stairbot.cli_journal import resume as resume_run
+    from stairbot.resume import ResumeRefused
     from stairbot.robots import RobotOptions, open_robot
     from stairbot.runner import RunControl, run
 
     progress: TextIO = sys.stderr if args.json else sys.stdout
-    options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale)
+    options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale,
+                           allow_latched=args.resume)
+    path = journal_path(args.robot, args.journal)
     mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
     with _record_file(args.record) as record:
         def sink(event: Event) -> None:
@@ -272,15 +287,37 @@ def cmd_run(args: argparse.Namespace) -> int:
         except HardwareError as exc:
             print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
+        controller = journal = None
+        try:
+            if args.resume:
+                resumed = resume_run(path, args.robot, session, config, sink, yes=args.yes,
+                                     out=progress)
+                controller, journal = resumed.controller, resumed.journal
+            else:
+                journal = start_journal(path, args.robot, session, config, scenario.name, mode)
+        except NotConfirmed as exc:
+            session.close()
+            print(f"{PROG}: error: {exc}", file=sys.stderr)
+            return EXIT_INPUT
+        except ResumeRefused as exc:
+            session.close()
+            print(f"{PROG}: error: cannot resume: {exc}", file=sys.stderr)
+            return EXIT_MISMATCH
+        except BaseException:
+            session.close()
+            raise
         if not args.quiet:
             what = f" ({scenario.description})" if scenario.description else ""
-            print(f"running {scenario.name}{what} on {args.robot}"
-                  + (", calibration only" if args.calibrate_only else ""),
+            verb = "resuming" if args.resume else "running"
+            print(f"{verb} {scenario.name}{what} on {args.robot}"
+                  + (", calibration only" if args.calibrate_only else "")
+                  + (f"; journal {path}" if journal is not None else ""),
                   file=progress, flush=True)
         control = RunControl()
         try:
             with _ctrl_c_stops(control.request_stop, session.robot.estop):
-                result = run(session, config, sink=sink, mode=mode, control=control)
+                result = run(session, config, sink=sink, mode=mode, control=control,
+                             controller=controller, journal=journal)
         except KeyboardInterrupt:
             session.robot.estop()
             session.robot.stop_all()
@@ -288,6 +325,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             return EXIT_INTERRUPTED
         finally:
             session.close()
+            if journal is not None:
+                journal.close()
     data = result.to_dict()
     interrupted = control.stop_reason is not None
     if interrupted:

@@ -13,7 +13,7 @@ import contextlib
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
@@ -22,7 +22,8 @@ from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
 from stairbot.errors import HardwareError, LinkLostError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import HasTruth, ReportsEvents, Robot, Snapshot, Truth
+from stairbot.hardware import HasTruth, MotorId, ReportsEvents, Robot, Snapshot, Truth
+from stairbot.journal import JournalError, JournalWriter
 from stairbot.robots import RobotSession
 
 Latch = Literal["estop", "clear"]
@@ -132,6 +133,7 @@ def run(
     max_sim_time_s: float | None = None,
     wall: Callable[[], float] = time.perf_counter,
     on_tick: Callable[[Controller, Snapshot], None] | None = None,
+    journal: JournalWriter | None = None,
 ) -> RunResult:
     """Run the program on ``session`` until the controller finishes.
 
@@ -143,7 +145,9 @@ def run(
     A run longer than ``max_sim_time_s`` of robot time ends with an error (by
     default an hour, or 60 phase timeouts for a robot whose slow motors make
     that longer).  Fell, pitch and offset in the result come from the robot's
-    ``truth()`` (HasTruth; None for a robot without it).
+    ``truth()`` (HasTruth; None for a robot without it).  ``journal`` (started
+    by the caller) gets a durable record after every tick and the run's end; a
+    journal the disk refuses ends the run with an error.
     """
     robot, clock = session.robot, session.clock
     ctl = controller or Controller(config, sink, mode)
@@ -167,6 +171,8 @@ def run(
             # robot's latch holds every motor, and boards would refuse it).
             if control is None or not _latch(control, robot):
                 robot.command(speeds)
+            if journal is not None:
+                _journal_tick(journal, ctl, robot, snap, speeds)
             if on_tick is not None:
                 on_tick(ctl, snap)
             clock.advance(tick)
@@ -179,6 +185,9 @@ def run(
         ctl.abort(str(exc), "error")
     except HardwareError as exc:
         ctl.abort(f"hardware failure: {exc}", "error")
+    except JournalError as exc:
+        ctl.abort(str(exc), "error")
+        journal = None  # it cannot take the end either
     finally:
         if control is not None:  # presses the loop did not come round to
             with contextlib.suppress(HardwareError):  # a clear on a lost link
@@ -210,8 +219,24 @@ def run(
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
         tilt_watched=ctl.config.safety.imu,
     )
+    if journal is not None:
+        with contextlib.suppress(JournalError):  # the result still stands
+            journal.end(result.outcome, result.error, clock.now())
     sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
+
+
+def board_identity(robot: Robot) -> dict[str, dict[str, int]] | None:
+    """The boards' serial numbers and uptimes (a robot on a wire), else None."""
+    identity = getattr(robot, "identity", None)
+    return identity() if callable(identity) else None
+
+
+def _journal_tick(journal: JournalWriter, ctl: Controller, robot: Robot, snap: Snapshot,
+                  speeds: Mapping[MotorId, float]) -> None:
+    journal.tick(time_s=snap.time_s, phase=ctl.context.phase, estopped=robot.estopped,
+                 command={m.name: float(v) for m, v in speeds.items()},
+                 boards=board_identity(robot), context=ctl.context.to_dict)
 
 
 def _truth(robot: Robot) -> Truth | None:

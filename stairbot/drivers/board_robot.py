@@ -127,6 +127,15 @@ class BoardRobot:
                     self._estopped = True  # this host holds the latch it found
             self._last_tx[board] = self._monotonic()
 
+    def identity(self) -> dict[str, dict[str, int]]:
+        """Each board's serial number and uptime (ms, from its last Status):
+        what a journal keeps, and what tells a resumed run whether these are
+        the same boards, still running since (their counters still valid)."""
+        return {m.Board(b).name.lower(): {
+                    "serial": ident.serial,
+                    "uptime_ms": self.status[b].uptime_ms if b in self.status else -1}
+                for b, ident in self.idents.items()}
+
     @property
     def simulated(self) -> bool:
         """Whether the boards say they are fake (StatusFlag.SIMULATED)."""

@@ -41,6 +41,10 @@ class LockstepClock:
     def now(self) -> float:
         return self._us / 1e6
 
+    def start_at(self, time_us: int) -> None:
+        """Begin at the world's time (boards a host opens after another ran them)."""
+        self._us = time_us
+
     def advance(self, dt: float) -> None:
         self._us += round(dt * 1e6)
         self._robot.step_to(self._us)
@@ -60,6 +64,13 @@ class LockstepRobot(BoardRobot):
         self._step: Request | None = None
         super().__init__(link, url, watchdog_ms, clock=LockstepClock(self), sink=sink,
                          keepalive=False, allow_latched=allow_latched)
+        # The world may have run before this host opened it (a resumed run):
+        # the clock starts where the world stands (StepTo 0 steps nothing).
+        (done,) = self._wait([self._request(m.Board.MOTOR, [m.StepTo(0)])])
+        self._check_step(done)
+        step = done.messages[0]
+        if isinstance(step, m.StepDone) and isinstance(self.clock, LockstepClock):
+            self.clock.start_at(step.time_us)
 
     @locked
     def step_to(self, time_us: int) -> None:

@@ -1,0 +1,194 @@
+"""The run journal: where a run stands, on disk, after every tick, so that a
+host that crashes, is killed or loses power leaves behind what the next one
+needs to carry on (``stairbot run --resume``).
+
+A journal is a JSON-lines file, one object a line, each written whole with
+one ``write`` and made durable with ``fsync`` before the tick goes on:
+
+* ``{"kind": "start", "run_id", "url", "config", "config_sha256",
+  "scenario", "mode", "boards", "time_s"}`` -- a run began
+  (``boards``: each board's serial number and uptime, or null in the
+  simulation);
+* ``{"kind": "tick", "run_id", "n", "time_s", "phase", "estopped",
+  "command", "boards", "context"?}`` -- after each tick's command:
+  ``command`` the speeds sent (turns/s), ``context`` the controller's whole
+  context (:meth:`Context.to_dict`), written when the phase changes and
+  otherwise every ``CONTEXT_EVERY`` ticks (it is about 2 kB; the phases'
+  motion targets in it are absolute counter values, so a context a few
+  ticks old carries on as well);
+* ``{"kind": "resume", "run_id", "time_s", "boards"}`` -- a resumed run
+  carries on here;
+* ``{"kind": "end", "run_id", "outcome", "error", "time_s"}`` -- the run
+  ended (a run with an end has nothing to resume).
+
+A line cut short by a power loss is the last one, and is ignored when read.
+Pure Python, standard library only: part of the core.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import uuid
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from stairbot.errors import InputError
+
+CONTEXT_EVERY = 25  # ticks: half a second at the 20 ms tick
+MAX_LINE = 1 << 20  # a journal line longer than this is not one of ours
+TAIL_BYTES = 1 << 20  # how much of a journal's end is read to resume from
+
+
+class JournalError(InputError):
+    """A journal that cannot be written or read: names the file and why."""
+
+
+def digest(data: Any) -> str:
+    """SHA-256 of ``data`` as canonical JSON (a config's values, whatever file
+    or name they came from)."""
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+class JournalWriter:
+    """Appends records to a journal, each durable (fsync) before it returns.
+    ``fresh`` starts the file anew (a new run); otherwise records are added
+    (a resumed run).  ``sync=False`` is for measuring what fsync costs."""
+
+    def __init__(self, path: str | Path, *, fresh: bool, sync: bool = True) -> None:
+        self.path = Path(path)
+        self.sync = sync
+        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | (os.O_TRUNC if fresh else 0)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._fd = os.open(self.path, flags, 0o644)
+            if sync:  # the file's name is durable too
+                dir_fd = os.open(self.path.parent, os.O_RDONLY)
+                try:
+                    os.fsync(dir_fd)
+                finally:
+                    os.close(dir_fd)
+        except OSError as exc:
+            raise JournalError(str(self.path), None,
+                               f"cannot write the journal: {exc.strerror or exc}") from None
+        self.run_id = ""
+        self._ticks = 0
+        self._phase: str | None = None
+
+    def write(self, record: Mapping[str, Any]) -> None:
+        """One record, whole and durable.  JournalError when the disk refuses it."""
+        line = (json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n").encode()
+        try:
+            os.write(self._fd, line)
+            if self.sync:
+                os.fsync(self._fd)
+        except OSError as exc:
+            raise JournalError(str(self.path), None,
+                               f"cannot write the journal: {exc.strerror or exc}") from None
+
+    def start(self, *, url: str, config: str, config_sha256: str, scenario: str, mode: str,
+              boards: Any, time_s: float, run_id: str | None = None) -> None:
+        self.run_id = run_id or uuid.uuid4().hex
+        self.write({"kind": "start", "run_id": self.run_id, "url": url, "config": config,
+                    "config_sha256": config_sha256, "scenario": scenario, "mode": mode,
+                    "boards": boards, "time_s": time_s})
+
+    def resume(self, run_id: str, boards: Any, time_s: float) -> None:
+        self.run_id = run_id
+        self._phase = None
+        self.write({"kind": "resume", "run_id": run_id, "time_s": time_s, "boards": boards})
+
+    def tick(self, *, time_s: float, phase: str, estopped: bool,
+             command: Mapping[str, float], boards: Any,
+             context: Callable[[], dict[str, Any]]) -> None:
+        """A tick's record (``context`` is called only when it is written)."""
+        record: dict[str, Any] = {
+            "kind": "tick", "run_id": self.run_id, "n": self._ticks, "time_s": time_s,
+            "phase": phase, "estopped": estopped, "command": dict(command), "boards": boards}
+        if phase != self._phase or self._ticks % CONTEXT_EVERY == 0:
+            record["context"] = context()
+        self._phase = phase
+        self._ticks += 1
+        self.write(record)
+
+    def end(self, outcome: str, error: str | None, time_s: float) -> None:
+        self.write({"kind": "end", "run_id": self.run_id, "outcome": outcome,
+                    "error": error, "time_s": time_s})
+
+    def close(self) -> None:
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
+
+
+@dataclass
+class JournalState:
+    """What a journal says of its last run: its start record, the last tick
+    and the last context written, and its end (None: the run did not end)."""
+
+    path: str
+    start: dict[str, Any]
+    last: dict[str, Any]
+    context: dict[str, Any] | None
+    context_time_s: float | None
+    end: dict[str, Any] | None
+    resumes: int = 0
+    boards: Any = field(default=None)
+
+
+def _records(data: bytes) -> list[dict[str, Any]]:
+    out = []
+    for raw in data.split(b"\n"):
+        if not raw.strip():
+            continue
+        try:
+            rec = json.loads(raw)
+        except (ValueError, RecursionError):
+            continue  # a line cut short by a power loss (the last), or a torn head
+        if isinstance(rec, dict) and isinstance(rec.get("kind"), str):
+            out.append(rec)
+    return out
+
+
+def read_journal(path: str | Path) -> JournalState:
+    """The last run of the journal at ``path``.  JournalError (one line
+    naming the file) when it is missing, not a regular file, or holds no run."""
+    p = Path(path)
+    try:
+        with open(p, "rb") as f:
+            if not os.path.isfile(p):
+                raise JournalError(str(p), None, "not a regular file")
+            size = os.fstat(f.fileno()).st_size
+            f.seek(max(0, size - TAIL_BYTES))
+            tail = f.read()
+            if size > TAIL_BYTES:
+                tail = tail[tail.find(b"\n") + 1:]  # the first line there may be cut
+            records = _records(tail)
+            starts = [r for r in records if r["kind"] == "start"]
+            if not starts and size > TAIL_BYTES:  # a long run: find its start
+                f.seek(0)
+                head = f.read(MAX_LINE)
+                starts = [r for r in _records(head) if r["kind"] == "start"]
+    except OSError as exc:
+        raise JournalError(str(p), None, f"cannot read the journal: {exc.strerror or exc}"
+                           ) from None
+    if not starts:
+        raise JournalError(str(p), None, "holds no run (no start record)")
+    start = starts[-1]
+    run = [r for r in records if r.get("run_id") == start["run_id"]]
+    ticks = [r for r in run if r["kind"] == "tick"]
+    with_context = [r for r in ticks if isinstance(r.get("context"), dict)]
+    ends = [r for r in run if r["kind"] == "end"]
+    last = ticks[-1] if ticks else start
+    ctx = with_context[-1] if with_context else None
+    return JournalState(
+        path=str(p), start=start, last=last,
+        context=ctx["context"] if ctx else None,
+        context_time_s=ctx["time_s"] if ctx else None,
+        end=ends[-1] if ends else None,
+        resumes=sum(1 for r in run if r["kind"] == "resume"),
+        boards=last.get("boards"))

@@ -1,0 +1,175 @@
+"""A host killed mid-lift, then ``stairbot run --resume``: without the
+operator's confirmation nothing moves; with it the robot finishes and comes
+home.  A resume is refused, one line, when the boards restarted, when the
+run ended, or on the simulation.  The fake boards run in a process of their
+own on a pseudo-terminal, in lockstep (their world stands still while no
+host steps it, so the test is as fast as the machine and its timing cannot
+flake)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from stairbot.journal import JournalWriter, read_journal
+
+
+def stairbot(*args: str, env: dict[str, str], **kw: object) -> subprocess.Popen[str]:
+    return subprocess.Popen([sys.executable, "-m", "stairbot", *args], text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            stdin=subprocess.DEVNULL, env=env, **kw)  # type: ignore[call-overload]
+
+
+@pytest.fixture
+def env(tmp_path: Path) -> dict[str, str]:
+    return {**os.environ, "XDG_STATE_HOME": str(tmp_path / "state")}
+
+
+@pytest.fixture
+def boards(env: dict[str, str], tmp_path: Path) -> Iterator[tuple[str, subprocess.Popen[str]]]:
+    """Fake boards in lockstep in another process: (their URL, the process)."""
+    proc = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=tmp_path)
+    assert proc.stdout is not None
+    url = proc.stdout.readline().strip()
+    assert url.startswith("serial://") and url.endswith("?lockstep=1")
+    yield url, proc
+    proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
+def last_tick(journal: Path) -> dict[str, object]:
+    lines = journal.read_text().splitlines()
+    return json.loads(lines[-1]) if lines else {}
+
+
+def kill_mid_lift(url: str, journal: Path, env: dict[str, str], cwd: Path) -> dict[str, object]:
+    """Start a run and kill -9 it while segment 1 lifts (ascent 3); the
+    journal's last tick then."""
+    host = stairbot("run", "--robot", url, "--journal", str(journal), "-q", env=env, cwd=cwd)
+    deadline = time.monotonic() + 120
+    try:
+        while time.monotonic() < deadline:
+            if journal.exists():
+                tick = last_tick(journal)
+                command = tick.get("command")
+                if (tick.get("phase") == "ascent_lift_first" and isinstance(command, dict)
+                        and command.get("MTF", 0) > 0):
+                    break
+            time.sleep(0.02)
+        else:
+            raise AssertionError("the run never reached ascent 3 lifting")
+    finally:
+        host.kill()  # SIGKILL: no finally, no close, no end record
+        host.wait()
+    return last_tick(journal)
+
+
+def test_kill_9_mid_lift_then_resume_with_confirmation_finishes_and_comes_home(
+        boards: tuple[str, subprocess.Popen[str]], env: dict[str, str],
+        tmp_path: Path) -> None:
+    url, _ = boards
+    journal = tmp_path / "run.jsonl"
+    killed = kill_mid_lift(url, journal, env, tmp_path)
+    assert read_journal(journal).end is None
+
+    # Without confirmation (no terminal, no --yes): one line, exit 2, nothing moved.
+    refused = stairbot("run", "--robot", url, "--journal", str(journal), "--resume",
+                       env=env, cwd=tmp_path)
+    out, err = refused.communicate(timeout=60)
+    assert refused.returncode == 2, err
+    assert err.strip().splitlines() == [
+        "stairbot: error: not resumed: no confirmation (answer y on a terminal, or add "
+        "--yes); nothing moved"]
+    assert "the host stopped in: ascent 3 — lift segment 1" in out
+    assert "last command: MTF +10.00 turn/s" in out
+    assert last_tick(journal) == killed  # nothing written: the run did not go on
+
+    resumed = stairbot("run", "--robot", url, "--journal", str(journal), "--resume", "--yes",
+                       "--json", env=env, cwd=tmp_path)
+    out, err = resumed.communicate(timeout=600)
+    assert resumed.returncode == 0, err[-2000:]
+    result = json.loads(out)
+    assert (result["outcome"], result["steps_climbed"], result["steps_descended"],
+            result["fell"]) == ("completed", 5, 5, False)
+    assert result["final_offset_m"] < 0.05
+    records = [json.loads(x) for x in journal.read_text().splitlines()]
+    resume = next(i for i, r in enumerate(records) if r["kind"] == "resume")
+    first = records[resume + 1]
+    # The world stood still in between (lockstep): the refused resume moved nothing.
+    assert first["time_s"] == pytest.approx(float(killed["time_s"]) + 0.02, abs=1e-6)
+    assert records[-1]["kind"] == "end" and records[-1]["outcome"] == "completed"
+
+
+def test_a_resume_on_boards_that_restarted_is_refused(
+        boards: tuple[str, subprocess.Popen[str]], env: dict[str, str],
+        tmp_path: Path) -> None:
+    url, proc = boards
+    journal = tmp_path / "run.jsonl"
+    kill_mid_lift(url, journal, env, tmp_path)
+    proc.send_signal(signal.SIGINT)
+    proc.wait(10)
+    again = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=tmp_path)
+    assert again.stdout is not None
+    url2 = again.stdout.readline().strip()
+    try:
+        host = stairbot("run", "--robot", url2, "--journal", str(journal), "--resume", "--yes",
+                        env=env, cwd=tmp_path)
+        _, err = host.communicate(timeout=60)
+    finally:
+        again.send_signal(signal.SIGINT)
+        again.wait(10)
+    assert host.returncode == 1
+    (line,) = err.strip().splitlines()
+    assert line.startswith(f"stairbot: error: cannot resume: {url2}: the motor board restarted")
+    assert "bring the robot to the floor by hand" in line
+
+
+def test_a_run_that_ended_has_nothing_to_resume(tmp_path: Path, env: dict[str, str]) -> None:
+    journal = tmp_path / "sim.jsonl"
+    done = stairbot("run", "--journal", str(journal), "--scenario", "step_too_high", "-q",
+                    env=env, cwd=tmp_path)
+    done.communicate(timeout=300)
+    assert done.returncode == 0
+    assert read_journal(journal).end is not None
+    again = stairbot("run", "--journal", str(journal), "--resume", "--yes", env=env,
+                     cwd=tmp_path)
+    _, err = again.communicate(timeout=60)
+    assert again.returncode == 1
+    assert err.strip().splitlines() == [
+        f"stairbot: error: cannot resume: {journal}: the last run ended (completed): "
+        "nothing to resume"]
+
+
+def test_the_simulation_cannot_be_resumed(tmp_path: Path, env: dict[str, str]) -> None:
+    proc = stairbot("run", "--resume", env=env, cwd=tmp_path)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 1
+    assert err.strip().splitlines() == [
+        "stairbot: error: cannot resume: sim://: a simulation cannot be resumed: its world "
+        "ended with the host that ran it"]
+
+
+def test_a_line_cut_short_by_a_power_loss_is_skipped(tmp_path: Path) -> None:
+    path = tmp_path / "j.jsonl"
+    w = JournalWriter(path, fresh=True)
+    w.start(url="serial://x", config="c", config_sha256="0", scenario="s", mode="full",
+            boards=None, time_s=0.0)
+    w.tick(time_s=0.02, phase="cal_check", estopped=False, command={}, boards=None,
+           context=lambda: {"phase": "cal_check"})
+    w.close()
+    with open(path, "ab") as f:
+        f.write(b'{"kind":"tick","run_id":"')  # the power went here
+    state = read_journal(path)
+    assert state.last["time_s"] == 0.02 and state.context == {"phase": "cal_check"}
