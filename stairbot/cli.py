@@ -14,6 +14,7 @@ and are imported only when used, so ``stairbot run`` never loads textual.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import signal
@@ -314,6 +315,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                   + (f"; journal {path}" if journal is not None else ""),
                   file=progress, flush=True)
         control = RunControl()
+        link: object = None
         try:
             with _ctrl_c_stops(control.request_stop, session.robot.estop):
                 result = run(session, config, sink=sink, mode=mode, control=control,
@@ -324,10 +326,14 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"{PROG}: interrupted: emergency stop latched", file=sys.stderr)
             return EXIT_INTERRUPTED
         finally:
+            with contextlib.suppress(Exception):  # a summary extra, never a reason to fail
+                link = session.robot.diagnostics().get("link")
             session.close()
             if journal is not None:
                 journal.close()
     data = result.to_dict()
+    if isinstance(link, dict):  # a robot on a wire: what its link counted
+        data["link"] = link
     interrupted = control.stop_reason is not None
     if interrupted:
         mismatches = ["interrupted: not judged"]
@@ -361,6 +367,13 @@ def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
     return f"{value}{unit}"
 
 
+def _link_line(link: dict[str, Any]) -> str:
+    keys = ("frames_tx", "frames_rx", "retries", "revived", "lost", "late", "stray",
+            "crc_errors")
+    return "  link              " + ", ".join(
+        f"{k.replace('_', ' ')} {link[k]:g}" for k in keys if k in link)
+
+
 def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
                    mismatches: list[str]) -> None:
     rtf = d.get("realtime_factor")
@@ -380,6 +393,7 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
         f"  time              {_fmt(d['sim_time_s'], ' s', 2)} robot time, "
         f"{_fmt(d['wall_time_s'], ' s', 2)} wall"
         + (f" (realtime x{rtf:.0f})" if isinstance(rtf, float | int) else ""),
+        *([_link_line(d["link"])] if isinstance(d.get("link"), dict) else []),
         "  expected          " + ("yes" if not mismatches else "; ".join(mismatches)
                                     if mismatches[0].startswith("interrupted")
                                     else "NO: " + "; ".join(mismatches)),

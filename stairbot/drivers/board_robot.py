@@ -184,8 +184,9 @@ class BoardRobot:
         """Send every motor's speed in one frame; its Ack is checked later.
         While the e-stop is latched every speed sent is 0."""
         self._reap()
-        if self.link.lost_streak >= self.link.max_lost:
-            self._lost(f"{self.link.lost_streak} commands in a row went unanswered")
+        reason = self.link.commands_lost()
+        if reason is not None:
+            self._lost(reason)
         wheels, lifts = u.speeds_to_wire({} if self._estopped else speeds)
         self._commands.append(self._request(m.Board.MOTOR, [wheels, lifts],
                                             send=not self.HOLD_COMMANDS))

@@ -99,8 +99,8 @@ class CanLink(RequestLink[CanRequest]):
 
     def __init__(self, bus: can.BusABC, timeout_s: float = 0.1, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
-                 codec: CanWire | None = None) -> None:
-        super().__init__(CanStats(), timeout_s, retries, max_lost, now)
+                 codec: CanWire | None = None, grace_s: float = 0.0) -> None:
+        super().__init__(CanStats(), timeout_s, retries, max_lost, now, grace_s)
         self.bus = bus
         self.codec = codec or wire()
         self._owed: dict[int, int] = {}  # replies still due to requests given up

@@ -18,7 +18,11 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
   - ``timeout=S``     seconds to wait for a board's replies, default 0.1
   - ``retries=N``     re-sends of a query that timed out, default 2
   - ``lost=N``        unanswered commands in a row that mean the link is
-                      lost, default 3
+                      lost (once the grace period is over), default 3
+  - ``grace=S``       seconds a board may stay silent before the link is
+                      lost, default 0.5: until then a query that got no
+                      reply after its retries is sent again; 0 = lost at the
+                      first query given up
   - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
                       default 250 (0 = off); time-scaled fake boards get X times it
   - ``lockstep=1``    simulation only: the fake boards' world advances only
@@ -72,12 +76,13 @@ from stairbot.robots import RobotOptions, RobotSession
 
 OPTION_DEFAULTS: dict[str, float] = {
     "timeout": 0.1, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
-    "lan": 0,
+    "lan": 0, "grace": 0.5,
 }
 _INTS = {"retries", "lost", "watchdog", "lockstep", "lan"}
 _ALLOWED = {"timeout": "seconds, 0 < timeout <= 60", "retries": "a whole number >= 0",
             "lost": "a whole number >= 1", "watchdog": "ms, 0..65535 (0 = off)",
-            "lockstep": "0 or 1", "time_scale": "a number > 0", "lan": "0 or 1"}
+            "lockstep": "0 or 1", "time_scale": "a number > 0", "lan": "0 or 1",
+            "grace": "seconds, 0 <= grace <= 60"}
 
 
 @dataclass(frozen=True)
@@ -104,7 +109,7 @@ def _option(url: str, key: str, text: str) -> float:
         raise RobotUrlError(url, key, f"{text!r}; allowed: {_ALLOWED[key]}") from None
     ok = {"timeout": 0 < value <= 60, "retries": value >= 0, "lost": value >= 1,
           "watchdog": 0 <= value <= 65535, "lockstep": value in (0, 1),
-          "time_scale": value > 0, "lan": value in (0, 1)}[key]
+          "time_scale": value > 0, "lan": value in (0, 1), "grace": 0 <= value <= 60}[key]
     if not ok:
         raise RobotUrlError(url, key, f"{text}; allowed: {_ALLOWED[key]}")
     return value
@@ -237,7 +242,7 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     opts = spec.options
     bus = open_bus(spec)
     link = CanLink(bus, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                   max_lost=int(opts["lost"]))
+                   max_lost=int(opts["lost"]), grace_s=opts["grace"])
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=options.time_scale or opts["time_scale"],

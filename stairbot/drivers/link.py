@@ -18,8 +18,11 @@ Rules (docs/protocol.md, "Requests and replies"):
 * A reply to a request given up is counted ``late``; a reply matching
   nothing (a duplicate, an echo) is counted ``stray``.
 * :meth:`RequestLink.wait` raises LinkLostError when a waited-for request got
-  no reply after its retries; ``max_lost`` commands in a row (in the order
-  they were sent) that went unanswered also mean the link is lost.
+  no reply after its retries and its board has not answered anything for
+  ``grace_s``; until then the request is sent again (a query) -- ordinary
+  line noise, a lost frame here and there, is ridden out.  ``max_lost``
+  commands in a row (in the order they were sent) that went unanswered mean
+  the link is lost too, again once the board has been silent for ``grace_s``.
 * :meth:`RequestLink.urgent` (the emergency stop) may be called from any
   thread while another waits for replies: its frames go on the wire at once,
   ahead of anything held back and between a waiting read's retries.  The
@@ -64,7 +67,8 @@ class Request:
     sent_at: float
     deadline: float
     order: int = -1
-    attempts: int = 1
+    attempts: int = 1  # since it was (re)vived: see RequestLink._revive
+    revived: int = 0  # times sent again, as fresh, after every retry was used
     reply: Reply | None = None
     failed: bool = False
     urgent: bool = False  # sent by urgent(): resent and given up by its sender
@@ -89,6 +93,7 @@ class LinkStats:
     retries: int = 0
     timeouts: int = 0  # requests whose (last) attempt got no reply in time
     lost: int = 0  # requests given up: no reply after every allowed attempt
+    revived: int = 0  # queries sent again beyond their retries, within the grace period
     late: int = 0
     stray: int = 0
     crc_errors: int = 0
@@ -152,6 +157,10 @@ class BoardLink(Protocol):
         """Commands unanswered in a row, in sending order."""
         ...
 
+    def commands_lost(self) -> str | None:
+        """Why the unanswered commands mean the link is lost, or None."""
+        ...
+
     @property
     def stats(self) -> LinkStats: ...
 
@@ -211,17 +220,20 @@ class RequestLink(ABC, Generic[R]):
     wire = "link"
 
     def __init__(self, stats: LinkStats, timeout_s: float, retries: int, max_lost: int,
-                 now: Callable[[], float] = time.perf_counter) -> None:
+                 now: Callable[[], float] = time.perf_counter, grace_s: float = 0.0) -> None:
         self.stats = stats
         self.timeout_s = timeout_s
         self.retries = retries
         self.max_lost = max_lost
+        self.grace_s = grace_s
         self._now = now
+        self._heard: dict[int, float] = {}  # board -> when its latest reply came
         self._in_flight: dict[int, list[R]] = {}  # per board, in sending order
         self._commands_sent = 0
         self._last_answered = -1  # order of the latest-sent command that was answered
         self._failed: deque[int] = deque(maxlen=256)  # orders of unanswered commands
         self.lost_streak = 0
+        self._opened = now()
         # Guards everything above and the writes; never held while a read blocks.
         self._mutex = threading.RLock()
 
@@ -330,7 +342,9 @@ class RequestLink(ABC, Generic[R]):
                   frames: int = 1) -> None:
         """``req`` has its whole reply, ``frames`` frames of it."""
         self.stats.frames_rx += frames
-        self.stats.add_rtt(self._now() - req.sent_at)
+        now = self._now()
+        self._heard[req.board] = now
+        self.stats.add_rtt(now - req.sent_at)
         req.reply = Reply(req.board, messages)
         self._in_flight[req.board].remove(req)
         if not req.idempotent and req.order > self._last_answered:
@@ -374,10 +388,41 @@ class RequestLink(ABC, Generic[R]):
         with self._mutex:
             self._expire()
 
+    def silent_s(self, board: int) -> float:
+        """How long ``board`` has not answered (since the link opened, if never)."""
+        return self._now() - self._heard.get(board, self._opened)
+
+    def commands_lost(self) -> str | None:
+        """Why the commands say the link is lost, or None: ``max_lost`` in a row
+        went unanswered, and the motor board has said nothing for ``grace_s``."""
+        if self.lost_streak >= self.max_lost and self.silent_s(Board.MOTOR) >= self.grace_s:
+            return (f"{self.lost_streak} commands in a row went unanswered, nothing from the "
+                    f"motor board for {self.silent_s(Board.MOTOR):.2f} s")
+        return None
+
+    def _revive(self, req: R) -> bool:
+        """Send a query that got no reply again, as a fresh request, while its
+        board is within its grace period; False once it is beyond it."""
+        if not req.idempotent or self.silent_s(req.board) >= self.grace_s:
+            return False
+        with self._mutex:
+            self.stats.revived += 1
+            req.revived += 1
+            req.failed = False
+            req.attempts = 1
+            now = self._now()
+            req.sent_at, req.deadline = now, now + self.timeout_s
+            self._in_flight.setdefault(req.board, []).append(req)
+            self._resend(req)
+        return True
+
     def wait(self, requests: Sequence[Request]) -> list[Reply]:
         """The replies of ``requests``, in order.  Sends idempotent requests
-        that time out again; raises LinkLostError when one gets no reply at
-        all, or when ``max_lost`` commands in a row went unanswered."""
+        that time out again -- beyond their retries too while their board is
+        within ``grace_s`` -- and raises LinkLostError once one gets no reply
+        and its board has been silent for ``grace_s``, or when ``max_lost``
+        commands in a row went unanswered and the motor board has been
+        silent as long."""
         with self._mutex:
             self.flush()
         while True:
@@ -387,16 +432,19 @@ class RequestLink(ABC, Generic[R]):
             with self._mutex:
                 self._expire()
             for req in requests:
-                if req.failed:
+                if req.failed and not self._revive(cast(R, req)):
                     names = "+".join(type(x).__name__ for x in req.messages)
                     who = (f"the {Board(req.board).name.lower()} board"
                            if req.board in Board._value2member_map_ else f"board {req.board}")
+                    attempts = req.attempts + req.revived * (self.retries + 1)
+                    silent = max(self.silent_s(req.board), attempts * self.timeout_s)
                     raise LinkLostError(
-                        f"no reply from {who} for {req.attempts * self.timeout_s:.2f} s "
-                        f"({names}: {req.attempts} attempt(s) of "
+                        f"no reply from {who} for {silent:.2f} s "
+                        f"({names}: {attempts} attempt(s) of "
                         f"{self.timeout_s * 1e3:.0f} ms{req.progress()})")
-            if self.lost_streak >= self.max_lost:
-                raise LinkLostError(f"{self.lost_streak} commands in a row went unanswered")
+            reason = self.commands_lost()
+            if reason is not None:
+                raise LinkLostError(reason)
             waiting = [req for req in requests if req.reply is None]
             if not waiting:
                 return [req.reply for req in requests if req.reply is not None]

@@ -112,8 +112,9 @@ class SerialLink(RequestLink[SerialRequest]):
     wire = "serial port"
 
     def __init__(self, channel: ByteChannel, timeout_s: float = 0.05, retries: int = 2,
-                 max_lost: int = 3, now: Callable[[], float] = time.perf_counter) -> None:
-        super().__init__(LinkStats(), timeout_s, retries, max_lost, now)
+                 max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
+                 grace_s: float = 0.0) -> None:
+        super().__init__(LinkStats(), timeout_s, retries, max_lost, now, grace_s)
         self.channel = channel
         self._reader = FrameReader()
         self._expired: deque[tuple[int, int]] = deque(maxlen=64)

@@ -14,7 +14,11 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
   - ``timeout=S``     seconds to wait for a reply, default 0.05
   - ``retries=N``     re-sends of a query that timed out, default 2
   - ``lost=N``        unanswered commands in a row that mean the link is
-                      lost, default 3
+                      lost (once the grace period is over), default 3
+  - ``grace=S``       seconds a board may stay silent before the link is
+                      lost, default 0.5: until then a query that got no reply
+                      after its retries is sent again (line noise is ridden
+                      out); 0 = lost at the first query given up
   - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
                       default 250 (0 = off)
   - ``lockstep=1``    simulation only: the fake boards' world advances only
@@ -43,7 +47,7 @@ from stairbot.robots import RobotOptions, RobotSession
 
 DEFAULTS: dict[str, float] = {
     "baud": 1_000_000, "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250,
-    "lockstep": 0, "time_scale": 1.0,
+    "lockstep": 0, "time_scale": 1.0, "grace": 0.5,
 }
 _INTS = {"baud", "retries", "lost", "watchdog", "lockstep"}
 
@@ -104,7 +108,7 @@ def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> R
     port, opts = parse_serial_url(url)
     channel = open_channel(port, int(opts["baud"]), url)
     link = SerialLink(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                      max_lost=int(opts["lost"]))
+                      max_lost=int(opts["lost"]), grace_s=opts["grace"])
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=options.time_scale or opts["time_scale"],

@@ -4,6 +4,7 @@ injection on the wire, and bad URLs."""
 
 from __future__ import annotations
 
+import re
 import socket
 import threading
 import time
@@ -209,13 +210,19 @@ def test_a_run_that_ends_in_an_error_leaves_the_emergency_stop_latched(fake: Fak
 
 def test_a_silent_board_loses_the_link_and_the_run_stops() -> None:
     for fake in serve(WireFaults(silent_board=1, silent_after_s=0.2)):
-        session = fake.open("lockstep=1&timeout=0.1&retries=1")
+        # silent from 0.2 s of board time on: two attempts of 0.1 s, sent again
+        # while the board is within its grace period (0.3 s of silence), then lost
+        session = fake.open("lockstep=1&timeout=0.1&retries=1&grace=0.3")
         events: list[Event] = []
         robot_of(session).attach_sink(events.append)
         result = run(session, CONFIG, sink=events.append)
         assert result.outcome == "error"
-        assert result.error is not None and "no reply from the motor board for 0.20 s" in (
-            result.error)
+        assert result.error is not None
+        said = re.search(r"no reply from the motor board for (\d+\.\d\d) s \(StepTo: (\d+) "
+                         r"attempt\(s\) of 100 ms", result.error)
+        assert said, result.error
+        assert float(said[1]) >= 0.3 and int(said[2]) >= 3
+        assert robot_of(session).link.stats.revived >= 1
         assert result.error.endswith("a board that hears nothing more stops its motors when "
                                      "its watchdog (250 ms) runs out")
         assert robot_of(session).link.stats.retries >= 1

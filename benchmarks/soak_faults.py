@@ -1,0 +1,126 @@
+"""Default runs over a faulty wire: does the run ride out ordinary link noise?
+
+    python benchmarks/soak_faults.py [--seeds N] [--wire serial|can]
+                                     [--fault drop|corrupt|late|duplicate]
+                                     [--p 0.05] [-j 2] [--url-options OPTS]
+
+For each wire, fault and seed it starts ``stairbot fake-boards --lockstep``
+with that fault at probability P on every frame the boards send or take
+(``--fault-seed`` = the seed), then ``stairbot run --robot URL --json`` with
+the URL's default options, and prints one line per run (outcome, steps,
+fell, what the link counted) and a count per wire and fault.  Lockstep: the
+boards' world stands still while the host waits or retries, so a run's
+physics is the same at any machine load; what the faults change is what the
+host hears.  Serial boards sit on a pseudo-terminal, CAN boards on
+``udp_multicast`` on loopback, each run on a group of its own.  Exit status
+1 if any run did not complete or fell.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+FAULTS = ("drop", "corrupt", "late", "duplicate")
+_groups = itertools.count(1)
+
+
+@dataclass
+class Outcome:
+    wire: str
+    fault: str
+    seed: int
+    outcome: str
+    climbed: int
+    descended: int
+    fell: bool
+    link: dict[str, int]
+    wall_s: float
+    error: str | None
+
+    @property
+    def ok(self) -> bool:
+        return self.outcome == "completed" and not self.fell
+
+
+def one_run(wire: str, fault: str, p: float, seed: int, url_options: str) -> Outcome:
+    t0 = time.monotonic()
+    where = ["--serial"] if wire == "serial" else [
+        "--can", f"udp_multicast/239.74.164.{next(_groups) % 250 + 1}"]
+    boards = subprocess.Popen(
+        [sys.executable, "-m", "stairbot", "fake-boards", *where, "--lockstep",
+         f"--{fault}", str(p), "--fault-seed", str(seed)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert boards.stdout is not None
+        url = boards.stdout.readline().strip()
+        if url_options:
+            url += ("&" if "?" in url else "?") + url_options
+        host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
+                               "--json", "-q"], capture_output=True, text=True, timeout=1800)
+    finally:
+        boards.terminate()
+        try:
+            boards.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            boards.kill()
+            boards.communicate()
+    wall = time.monotonic() - t0
+    try:
+        r = json.loads(host.stdout)
+    except json.JSONDecodeError:
+        last = (host.stderr.strip().splitlines() or ["no output"])[-1]
+        return Outcome(wire, fault, seed, f"exit {host.returncode}", 0, 0, False, {}, wall,
+                       last)
+    link = r.get("link") or {}
+    return Outcome(wire, fault, seed, r["outcome"], r["steps_climbed"], r["steps_descended"],
+                   bool(r["fell"]), {k: int(v) for k, v in link.items()
+                                     if isinstance(v, (int, float)) and not isinstance(v, bool)},
+                   wall, r.get("error"))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--wire", choices=("serial", "can"), action="append")
+    ap.add_argument("--fault", choices=FAULTS, action="append")
+    ap.add_argument("--p", type=float, default=0.05, help="probability per frame")
+    ap.add_argument("-j", type=int, default=2, help="runs at once")
+    ap.add_argument("--url-options", default="", help="added to the boards' URL, e.g. grace=0")
+    args = ap.parse_args(argv)
+    wires = args.wire or ["serial", "can"]
+    faults = args.fault or ["drop", "corrupt", "late"]
+    jobs = [(w, f, s) for w in wires for f in faults for s in range(1, args.seeds + 1)]
+    print(f"{len(jobs)} runs: wires {wires}, faults {faults} at {args.p:.0%}, "
+          f"seeds 1..{args.seeds}, {args.j} at once", flush=True)
+    results: list[Outcome] = []
+    with ThreadPoolExecutor(args.j) as pool:
+        futures = [pool.submit(one_run, w, f, args.p, s, args.url_options) for w, f, s in jobs]
+        for fut in futures:
+            o = fut.result()
+            results.append(o)
+            keys = ("retries", "revived", "lost", "late", "stray", "crc_errors")
+            counts = " ".join(f"{k} {o.link[k]}" for k in keys if k in o.link)
+            print(f"{o.wire:6} {o.fault:9} seed {o.seed:2}: {o.outcome:9} up {o.climbed} "
+                  f"down {o.descended} fell {o.fell!s:5} {o.wall_s:5.0f} s  {counts}"
+                  + (f"  error: {o.error}" if o.error else ""), flush=True)
+    print()
+    bad = 0
+    for w in wires:
+        for f in faults:
+            group = [o for o in results if (o.wire, o.fault) == (w, f)]
+            good = sum(o.ok for o in group)
+            bad += len(group) - good
+            print(f"{w:6} {f:9} {args.p:.0%}: {good}/{len(group)} completed, "
+                  f"fell {sum(o.fell for o in group)}")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
