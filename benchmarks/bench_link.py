@@ -39,13 +39,14 @@ BITS_PER_BYTE = 10  # 8N1
 def cycle_bytes() -> tuple[int, int]:
     """(host -> boards, boards -> host) bytes on the wire per cycle."""
     status = m.Status(0, 0, 250, 0)
-    tx = [Frame(1, 1, (m.ReadAll(),)), Frame(2, 2, (m.ReadAll(),)),
-          Frame(1, 3, u.speeds_to_wire({}))]
+    s = 0x5A  # a host session (a zero would cost COBS a byte)
+    tx = [Frame(1, 1, (m.ReadAll(),), session=s), Frame(2, 2, (m.ReadAll(),), session=s),
+          Frame(1, 3, u.speeds_to_wire({}), session=s)]
     rx = [Frame(1, 1, (status, *(m.MotorTelemetry(c, 1, 0, 1000, 123456) for c in range(6))),
-                True),
+                True, s),
           Frame(2, 2, (status, *(m.SensorTelemetry(c, 0, 500, 7, 12) for c in range(4)),
-                       *(m.ImuTelemetry(a, 0, -250, 15, 3) for a in m.IMU_AXES)), True),
-          Frame(1, 3, (m.Ack(0x20, 0), m.Ack(0x21, 0)), True)]
+                       *(m.ImuTelemetry(a, 0, -250, 15, 3) for a in m.IMU_AXES)), True, s),
+          Frame(1, 3, (m.Ack(0x20, 0), m.Ack(0x21, 0)), True, s)]
     return sum(len(encode_frame(f)) for f in tx), sum(len(encode_frame(f)) for f in rx)
 
 

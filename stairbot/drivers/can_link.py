@@ -51,34 +51,69 @@ class CanStats(LinkStats):
     ignored: int = 0  # frames from hosts (our own echo included)
 
 
+def _key(msg: m.Message) -> int | None:
+    """Which channel (or IMU axis) a telemetry reply is for; None for others."""
+    if isinstance(msg, (m.MotorTelemetry, m.SensorTelemetry)):
+        return msg.channel
+    if isinstance(msg, m.ImuTelemetry):
+        return msg.axis
+    return None
+
+
 @dataclass(eq=False)
 class CanRequest(Request):
-    """A request on the bus: the replies that came and those still to come."""
+    """A request on the bus: the replies that came and those still to come.
+
+    A reply is matched by kind and, for telemetry, by channel (or IMU axis):
+    the n-th telemetry of a kind a ReadAll is answered with is channel n, so
+    a duplicated frame is not taken as another channel's.  A board sends a
+    request's replies back to back and CAN keeps their order, so a reply that
+    matches a later expected one means the ones before it were lost
+    (``gap``): the request cannot complete, and the link sends it again as
+    soon as the last reply has come, without waiting for the timeout."""
 
     got: list[m.Message] = field(default_factory=list)
-    todo: deque[tuple[int, int, type[m.Message]]] = field(default_factory=deque)
+    # (message index, request type code, reply kind, channel or axis or None)
+    todo: deque[tuple[int, int, type[m.Message], int | None]] = field(default_factory=deque)
+    gap: bool = False
 
     def expect(self) -> None:
         """(Re)start waiting for every reply."""
         self.got = []
-        self.todo = deque((i, msg.TYPE, kind) for i, msg in enumerate(self.messages)
-                          for kind in expected_replies(self.board, msg))
+        self.gap = False
+        self.todo = deque()
+        for i, msg in enumerate(self.messages):
+            seen: dict[type[m.Message], int] = {}
+            for kind in expected_replies(self.board, msg):
+                n = seen.get(kind, 0)
+                seen[kind] = n + 1
+                keyed = kind in (m.MotorTelemetry, m.SensorTelemetry, m.ImuTelemetry)
+                self.todo.append((i, msg.TYPE, kind, n if keyed else None))
+
+    def _fits(self, entry: tuple[int, int, type[m.Message], int | None],
+              msg: m.Message) -> bool:
+        _, request_type, kind, key = entry
+        if isinstance(msg, m.Ack):
+            return msg.request == request_type
+        return isinstance(msg, kind) and (key is None or _key(msg) == key)
 
     def offer(self, msg: m.Message) -> bool:
-        """Take ``msg`` if it is the next reply this request waits for."""
-        if not self.todo:
+        """Take ``msg`` if it is a reply this request still waits for: the
+        next one, or a later one (then those before it were lost: ``gap``)."""
+        pos = next((i for i, entry in enumerate(self.todo) if self._fits(entry, msg)), None)
+        if pos is None:
             return False
-        index, request_type, kind = self.todo[0]
+        if pos:
+            self.gap = True
+            for _ in range(pos):
+                self.todo.popleft()
+        index = self.todo[0][0]
         if isinstance(msg, m.Ack):
-            if msg.request != request_type:
-                return False
             # An Ack answers the message whole: nothing else comes for it.
             while self.todo and self.todo[0][0] == index:
                 self.todo.popleft()
-        elif isinstance(msg, kind):
-            self.todo.popleft()
         else:
-            return False
+            self.todo.popleft()
         self.got.append(msg)
         return True
 
@@ -207,9 +242,15 @@ class CanLink(RequestLink[CanRequest]):
         self._match(board, msg)
 
     def _match(self, board: int, msg: m.Message) -> None:
+        self._hear(board)
         for p in self.in_flight(board):
             if p.offer(msg):
-                if not p.todo:
+                if p.todo:
+                    pass
+                elif p.gap:  # every reply that will come came, some were lost
+                    self.stats.frames_rx += len(p.got)
+                    p.deadline = self._now()  # sent again (or given up) at once
+                else:
                     self._complete(p, tuple(p.got), frames=len(p.got))
                 return
         if self._owed.get(board, 0) > 0:

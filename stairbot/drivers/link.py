@@ -342,8 +342,7 @@ class RequestLink(ABC, Generic[R]):
                   frames: int = 1) -> None:
         """``req`` has its whole reply, ``frames`` frames of it."""
         self.stats.frames_rx += frames
-        now = self._now()
-        self._heard[req.board] = now
+        now = self._hear(req.board)
         self.stats.add_rtt(now - req.sent_at)
         req.reply = Reply(req.board, messages)
         self._in_flight[req.board].remove(req)
@@ -387,6 +386,13 @@ class RequestLink(ABC, Generic[R]):
         self._drain()
         with self._mutex:
             self._expire()
+
+    def _hear(self, board: int) -> float:
+        """``board`` said something (any valid frame, late or stray too): it is
+        alive.  Returns the time."""
+        now = self._now()
+        self._heard[board] = now
+        return now
 
     def silent_s(self, board: int) -> float:
         """How long ``board`` has not answered (since the link opened, if never)."""

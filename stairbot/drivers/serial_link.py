@@ -13,6 +13,7 @@ Retries, expiry and the health counters are :class:`~stairbot.drivers.link.Reque
 from __future__ import annotations
 
 import os
+import secrets
 import select
 import time
 from collections import deque
@@ -118,14 +119,20 @@ class SerialLink(RequestLink[SerialRequest]):
         self.channel = channel
         self._reader = FrameReader()
         self._expired: deque[tuple[int, int]] = deque(maxlen=64)
-        self._seq = 0
+        # This link's session: a reply of another (an earlier host's, a
+        # previous run's still on the line) is never taken for one of ours.
+        self.session = secrets.randbelow(255) + 1
+        self.other_session = 0  # replies of another session seen (counted stray too)
+        # Where the sequence numbers start: random too, so that a new session
+        # that drew an earlier one's number still seldom repeats a request.
+        self._seq = secrets.randbelow(256)
         self._out = bytearray()
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[Message, ...], idempotent: bool,
              now: float) -> SerialRequest:
         seq = self._next_seq(board)
-        frame = encode_frame(Frame(board, seq, messages))
+        frame = encode_frame(Frame(board, seq, messages, session=self.session))
         return SerialRequest(board, messages, idempotent, now, now + self.timeout_s,
                              seq=seq, frame=frame)
 
@@ -179,10 +186,12 @@ class SerialLink(RequestLink[SerialRequest]):
             self.stats.bytes_rx += len(data)
             rs = self._reader.stats
             for frame in self._reader.feed(data):
+                if frame.from_board:
+                    self._hear(frame.board)
                 req = self._match(frame) if frame.from_board else None
                 if req is not None:
                     self._complete(req, frame.messages)
-                elif (frame.board, frame.seq) in self._expired:
+                elif frame.session == self.session and (frame.board, frame.seq) in self._expired:
                     self.stats.late += 1
                 else:
                     self.stats.stray += 1
@@ -191,6 +200,9 @@ class SerialLink(RequestLink[SerialRequest]):
         return True
 
     def _match(self, frame: Frame) -> SerialRequest | None:
+        if frame.session != self.session:
+            self.other_session += 1
+            return None
         for req in self.in_flight(frame.board):
             if req.seq == frame.seq:
                 return req

@@ -4,6 +4,8 @@ One frame, before stuffing::
 
     addr  u8    board address (bits 0-3); bit 4 always set (FRAMING_3: this
                 header has a length byte); bit 7 set in frames from a board
+    sess  u8    the host's session: a number the host draws when it opens the
+                link; a reply repeats its request's
     seq   u8    the host's sequence number; a reply repeats its request's
     len   u8    the number of message bytes that follow, up to the CRC
     then one or more messages, each:
@@ -19,7 +21,10 @@ of a body followed by its own CRC is 0, so before protocol 3.0 a frame whose
 CRC ended in 0x00, with the bytes ``01 01`` inserted before its delimiter,
 decoded (body + 00 00) as the same frame plus one zero-length message.  Now
 any byte added or lost after the header contradicts ``len``, which the CRC
-covers.  Bit 4 of the address makes a 2.x board drop 3.x frames as
+covers.  The session byte tells one host's requests from another's (or from
+the same host's before a restart) that reuse a sequence number: a board's
+duplicate filter compares it too, and a host takes only replies of its own
+session.  Bit 4 of the address makes a 2.x board drop 3.x frames as
 malformed (reserved bits set) instead of misreading them, and lets a 3.x
 host name a 2.x board's frames for what they are (OldFramingError).
 
@@ -50,7 +55,7 @@ from stairbot.drivers.messages import (
 FROM_BOARD = 0x80
 FRAMING_3 = 0x10  # always set: the header has a length byte (protocol 3.0)
 MAX_FRAME = 254  # stuffed bytes between delimiters; longer runs are dropped as garbage
-HEADER = 3  # addr, seq, len
+HEADER = 4  # addr, session, seq, len
 MIN_BODY = HEADER + 2  # and the crc
 
 
@@ -65,12 +70,14 @@ class CrcError(CodecError):
 
 @dataclass(frozen=True, slots=True)
 class Frame:
-    """One frame: who it is for or from, its sequence number, its messages."""
+    """One frame: who it is for or from, its sequence number, its messages,
+    and the host session it belongs to."""
 
     board: int
     seq: int
     messages: tuple[Message | RawMessage, ...]
     from_board: bool = False
+    session: int = 0
 
 
 def crc16(data: bytes) -> int:
@@ -80,12 +87,14 @@ def crc16(data: bytes) -> int:
 
 def frame_body(frame: Frame) -> bytes:
     """The unstuffed bytes of a frame, CRC included."""
-    if not 0 <= frame.board <= 0x0F or not 0 <= frame.seq <= 0xFF:
-        raise CodecError(f"board {frame.board} or seq {frame.seq} out of range")
+    if not 0 <= frame.board <= 0x0F or not 0 <= frame.seq <= 0xFF \
+            or not 0 <= frame.session <= 0xFF:
+        raise CodecError(f"board {frame.board}, session {frame.session} or seq {frame.seq} "
+                         "out of range")
     if not frame.messages:
         raise CodecError("a frame needs at least one message")
     out = bytearray((frame.board | FRAMING_3 | (FROM_BOARD if frame.from_board else 0),
-                     frame.seq, 0))
+                     frame.session, frame.seq, 0))
     for msg in frame.messages:
         if isinstance(msg, RawMessage):
             code, payload = msg.type_code, msg.payload
@@ -97,7 +106,7 @@ def frame_body(frame: Frame) -> bytes:
         out += payload
     if len(out) - HEADER > 0xFF:
         raise CodecError(f"{len(out) - HEADER} message bytes, at most 255 in a frame")
-    out[2] = len(out) - HEADER
+    out[HEADER - 1] = len(out) - HEADER
     out += crc16(bytes(out)).to_bytes(2, "big")
     return bytes(out)
 
@@ -118,7 +127,7 @@ def parse_body(body: bytes) -> Frame:
         raise CodecError(f"frame of {len(body)} bytes, at least {MIN_BODY}")
     if crc16(body[:-2]) != int.from_bytes(body[-2:], "big"):
         raise CrcError("CRC mismatch")
-    addr, seq, length = body[0], body[1], body[2]
+    addr, session, seq, length = body[0], body[1], body[2], body[3]
     if not addr & FRAMING_3:
         raise OldFramingError(f"address byte 0x{addr:02X} lacks bit 4: a frame without a "
                               "length byte (protocol 2.x framing)")
@@ -140,7 +149,7 @@ def parse_body(body: bytes) -> Frame:
         i += 2 + n
     if not msgs:
         raise CodecError("a frame without a message")
-    return Frame(addr & 0x0F, seq, tuple(msgs), bool(addr & FROM_BOARD))
+    return Frame(addr & 0x0F, seq, tuple(msgs), bool(addr & FROM_BOARD), session)
 
 
 def decode_frame(stuffed: bytes) -> Frame:

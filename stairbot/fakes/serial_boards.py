@@ -4,8 +4,9 @@
 each valid one to the board it addresses (``fakes.boards``), writes the reply
 frame back, and -- unless in lockstep -- advances the simulated world as wall
 time passes.  A frame identical to the previous one to the same board (same
-seq, same messages: a retry or a duplicate) gets the previous reply again
-without being executed twice, as docs/protocol.md requires of firmware.
+session, same seq, same messages: a retry or a duplicate) gets the previous
+reply again without being executed twice, as docs/protocol.md requires of
+firmware; a new host session reusing a sequence number is executed.
 
 Fault injection (:class:`WireFaults`) acts on the wire: frames dropped,
 corrupted (one byte flipped, so the CRC fails), duplicated, or delayed, in
@@ -196,7 +197,8 @@ class SerialBoardServer:
             wire = last[1]
         else:
             replies: list[Message] = board.handle(frame.messages)
-            wire = encode_frame(Frame(frame.board, frame.seq, tuple(replies), from_board=True))
+            wire = encode_frame(Frame(frame.board, frame.seq, tuple(replies), from_board=True,
+                                      session=frame.session))
             self._last[frame.board] = (frame, wire)
         if not self._silent(frame.board):
             self._write(wire)

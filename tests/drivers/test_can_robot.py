@@ -414,3 +414,34 @@ def test_a_read_all_reply_without_every_channel_is_a_hardware_error(rig: Rig) ->
     with pytest.raises(HardwareError, match="sensor board answered ReadAll with"):
         rig.robot._read_all(m.Board.SENSOR, tel, m.SensorTelemetry, m.SENSOR_CHANNELS,
                             lambda t: t)  # type: ignore[arg-type,return-value]
+
+
+def test_every_frame_twice_reads_every_channel_once_and_counts_the_copies() -> None:
+    # CAN frames carry no sequence number: a duplicated telemetry frame must not
+    # stand in for another channel's ("ReadAll reply lacks channels").
+    r = make_rig(WireFaults(duplicate=1.0, seed=1), timeout=0.05)
+    try:
+        for _ in range(20):
+            r.tick()
+        snap = r.robot.read()
+        assert set(snap.motors) == set(MotorId)
+        h = r.robot.health()
+        assert h["stray"] >= 20 and h["lost"] == 0
+    finally:
+        r.robot.close()
+        r.server.bus.shutdown()
+
+
+def test_a_reply_frame_lost_between_others_is_a_gap_matched_by_channel() -> None:
+    from stairbot.drivers.can_link import CanRequest
+
+    req = CanRequest(int(m.Board.MOTOR), (m.ReadAll(),), True, 0.0, 1.0)
+    req.expect()
+    tel = [m.MotorTelemetry(c, 1, 0, 1000, 5) for c in range(6)]
+    assert req.offer(m.Status(0x40, 0, 250, 0)) and req.offer(tel[0])
+    assert not req.offer(tel[0])  # a copy of channel 0: not channel 1
+    assert req.offer(tel[2]) and req.gap  # channel 1 was lost on the way
+    assert not req.offer(tel[1])  # too late: the board sends in order
+    for t in tel[3:]:
+        assert req.offer(t)
+    assert req.owed == 0 and req.gap  # every reply that will come came; incomplete

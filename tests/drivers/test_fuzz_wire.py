@@ -55,8 +55,8 @@ def test_it_counts_the_blind_spot_on_protocol_2_framing(
     body = serial_wire.parse_body
 
     def no_length_check(data: bytes) -> serial_wire.Frame:
-        if len(data) >= 6 and serial_wire.crc16(data[:-2]) == int.from_bytes(data[-2:], "big"):
-            data = data[:2] + bytes((len(data) - 5,)) + data[3:]
+        if len(data) >= 7 and serial_wire.crc16(data[:-2]) == int.from_bytes(data[-2:], "big"):
+            data = data[:3] + bytes((len(data) - 6,)) + data[4:]
             data = data[:-2] + serial_wire.crc16(data[:-2]).to_bytes(2, "big")
         return body(data)
 

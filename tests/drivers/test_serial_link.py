@@ -53,7 +53,8 @@ class ScriptedChannel:
 
 
 def answer(frame: Frame, *msgs: m.Message) -> bytes:
-    return encode_frame(Frame(frame.board, frame.seq, msgs, from_board=True))
+    return encode_frame(Frame(frame.board, frame.seq, msgs, from_board=True,
+                              session=frame.session))
 
 
 def status_reply(frame: Frame) -> bytes:
@@ -139,6 +140,20 @@ def test_late_reply_is_counted_late_and_stray_reply_stray() -> None:
     ch._due.append((ch.t, answer(Frame(1, 200, ()), m.Ack(0, 0))))  # nobody asked for seq 200
     link.poll()
     assert link.stats.stray == 1
+
+
+def test_a_reply_of_another_session_is_never_taken() -> None:
+    """The same board and seq, but another host's session (a reply still on the
+    line from a host before this one): stray, and the request is asked again."""
+    def respond(frame: Frame) -> bytes | None:
+        other = Frame(frame.board, frame.seq, frame.messages, session=frame.session ^ 0xFF)
+        return status_reply(other) + status_reply(frame)
+
+    link, ch = make_link(respond)
+    reply = link.exchange(1, [m.GetStatus()])
+    assert isinstance(reply.messages[0], m.Status)
+    assert link.stats.stray == 1 and link.other_session == 1
+    assert len({f.session for f in ch.heard}) == 1 and ch.heard[0].session == link.session
 
 
 def test_unanswered_commands_in_a_row_lose_the_link() -> None:

@@ -37,7 +37,7 @@ REFERENCE_CRC = Calculator(Crc16.IBM_3740)  # = CRC-16/CCITT-FALSE
 
 def frame_of(spec: dict[str, Any]) -> Frame:
     msgs = tuple(getattr(m, x["type"])(**x["fields"]) for x in spec["messages"])
-    return Frame(spec["board"], spec["seq"], msgs, spec["from_board"])
+    return Frame(spec["board"], spec["seq"], msgs, spec["from_board"], spec["session"])
 
 
 def test_crc_is_ccitt_false() -> None:
@@ -86,7 +86,7 @@ def test_unknown_type_is_kept_raw_and_bad_length_rejected() -> None:
     frame = Frame(2, 5, (RawMessage(0x33, b"\x01\x02"), m.GetStatus()))
     assert decode_frame(encode_frame(frame)[:-1]) == frame
     body = bytearray(frame_body(Frame(1, 1, (m.Heartbeat(3),))))
-    body[4] = 9  # a message length beyond the frame
+    body[5] = 9  # a message length beyond the frame
     body[-2:] = crc16(bytes(body[:-2])).to_bytes(2, "big")
     with pytest.raises(CodecError, match="bad length"):
         parse_body(bytes(body))

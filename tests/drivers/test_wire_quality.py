@@ -293,7 +293,7 @@ def test_a_serial_reply_without_an_imu_axis_reads_as_no_imu() -> None:
 
 def test_an_imu_frame_of_the_wrong_length_is_malformed_on_both_wires() -> None:
     """Counted and dropped by the receiver (CodecError inside), never decoded."""
-    body = bytearray((0x92, 5, 9, m.ImuTelemetry.TYPE, 7, 0, 0, 0x0B, 0x02, 0x0F, 0x00, 0x03))
+    body = bytearray((0x92, 0x5A, 5, 9, m.ImuTelemetry.TYPE, 7, 0, 0, 0x0B, 0x02, 0x0F, 0x00, 0x03))
     body += crc16(bytes(body)).to_bytes(2, "big")  # a good CRC over a 7-byte ImuTelemetry
     reader = FrameReader()
     assert reader.feed(cobs.encode(bytes(body)) + b"\x00") == []

@@ -78,12 +78,13 @@ def test_arbitrary_messages_in_valid_frames_never_crash_a_board(
     # keep the stub world's time small: a StepTo to an hour would be obeyed
     msgs = [(c, p) for c, p in msgs if c != m.StepTo.TYPE]
     payload = b"".join(bytes((c, len(p))) + p for c, p in msgs)
-    body = bytes((board | FRAMING_3, seq, len(payload))) + payload
+    body = bytes((board | FRAMING_3, 0x5A, seq, len(payload))) + payload
     body += crc16(body).to_bytes(2, "big")
     srv.receive(cobs.encode(body) + b"\x00")
     out = FrameReader().feed(drain(r))
     for frame in out:  # whatever it answered is well-formed and from that board
         assert frame.from_board and frame.board == board and frame.seq == seq
+        assert frame.session == 0x5A
 
 
 def test_a_repeated_frame_is_answered_again_but_executed_once(server: tuple) -> None:
@@ -96,6 +97,19 @@ def test_a_repeated_frame_is_answered_again_but_executed_once(server: tuple) -> 
     robot = srv.world.robot
     assert isinstance(robot, StubRobot)
     assert robot.commands == 1
+
+
+def test_the_same_seq_and_bytes_of_another_session_are_executed(server: tuple) -> None:
+    """A new host (or the same one restarted) starts its sequence numbers over:
+    its request is not a duplicate of the last host's, even byte for byte."""
+    srv, r = server
+    robot = srv.world.robot
+    assert isinstance(robot, StubRobot)
+    for session in (1, 1, 2):
+        srv.receive(encode_frame(Frame(1, 5, (m.Move(0, 1000, 1000),), session=session)))
+        (reply,) = FrameReader().feed(drain(r))
+        assert reply.session == session and reply.seq == 5
+    assert robot.commands == 2 and srv.stats.duplicates == 1
 
 
 @settings(max_examples=200, deadline=None)
