@@ -112,6 +112,9 @@ class RunResult:
     realtime_factor: float | None
     tilt_watched: bool
     """Whether the supervisor watched the tilt (the config declares an IMU)."""
+    fault: str | None = None
+    """"link" when the run ended on a lost link, "hardware" on another
+    failure the robot reported; None otherwise."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -158,6 +161,7 @@ def run(
     tick = config.algorithm.tick
     t0, wall0 = clock.now(), wall()
     fell = False
+    fault: str | None = None
     try:
         while not ctl.finished:
             if control is not None:
@@ -182,8 +186,10 @@ def run(
         fell = True
         ctl.abort(f"robot fell: {exc}", "error")
     except LinkLostError as exc:  # the driver's message already says "link lost" and why
+        fault = "link"
         ctl.abort(str(exc), "error")
     except HardwareError as exc:
+        fault = "hardware"
         ctl.abort(f"hardware failure: {exc}", "error")
     except JournalError as exc:
         ctl.abort(str(exc), "error")
@@ -218,6 +224,7 @@ def run(
         wall_time_s=wall_time,
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
         tilt_watched=ctl.config.safety.imu,
+        fault=fault,
     )
     if journal is not None:
         with contextlib.suppress(JournalError):  # the result still stands

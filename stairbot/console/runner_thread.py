@@ -203,7 +203,10 @@ class ConsoleEngine:
         line, severity = describe_result(result)
         if self.robot.estopped:
             line += " · EMERGENCY STOP still set: c clears it"
-        self.state.set_status(robot="ended", paused=False, message=line, severity=severity)
+        # A lost link or a failing board is a fault of the robot, not an ending:
+        # its values stop being live, and the operator must look before a rerun.
+        self.state.set_status(robot="fault" if result.fault else "ended", paused=False,
+                              message=line, severity=severity)
         return result
 
     def _sink(self, event: Event) -> None:

@@ -332,7 +332,9 @@ def test_a_lost_link_shows_as_a_banner_not_a_traceback(
 
             robot.read = failing_read
             await press(pilot, "s")
-            await until(pilot, lambda: "ENDED" in banner(app), "the run ends")
+            # A lost link is a fault of the robot, not an ordinary ending.
+            await until(pilot, lambda: "FAULT" in banner(app), "the run ends in FAULT")
+            assert "ENDED" not in banner(app)
             assert "no reply to 3 attempts" in banner(app)
             assert "-error" in app.banner.classes
             assert robot.stops > 0  # the runner stopped every motor

@@ -225,3 +225,37 @@ def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
     assert engine.robot.estopped
     engine.robot.command(FORWARD)  # turned into a stop
     assert engine.state.view().commands == dict.fromkeys(MotorId, 0.0)
+
+
+class LosesTheLink:
+    """The simulated robot, whose link is lost at its 50th read."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner, self.reads = inner, 0
+
+    def read(self) -> Snapshot:
+        from stairbot.errors import LinkLostError
+
+        self.reads += 1
+        if self.reads >= 50:
+            raise LinkLostError("link lost: no reply from the sensor board for 0.62 s")
+        snap: Snapshot = self.inner.read()
+        return snap
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.inner, name)
+
+
+def test_a_lost_link_leaves_the_robot_in_fault_not_ended() -> None:
+    from stairbot.console.runner_thread import _default_open
+
+    def open_fn(*args: Any) -> Any:
+        session = _default_open(*args)
+        return replace(session, robot=LosesTheLink(session.robot))
+
+    engine = ConsoleEngine(LiveState(), load_config(), open_fn=open_fn)
+    engine.open("sim://", None)
+    result = engine.run("full")
+    assert result is not None and result.outcome == "error" and result.fault == "link"
+    status = engine.state.view().status
+    assert status.robot == "fault" and "no reply from the sensor board" in status.message
