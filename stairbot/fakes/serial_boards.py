@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from stairbot.drivers.messages import Message
-from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
+from stairbot.drivers.serial_wire import CodecError, Frame, FrameReader, encode_frame
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import Board
 
@@ -90,6 +90,7 @@ class ServerStats:
     stray: int = 0  # frames for no board here, or from a board
     injected: int = 0  # faults injected
     overflows: int = 0  # replies dropped because nobody read the line
+    cut: int = 0  # reply frames that could not hold every reply (the rest left off)
 
 
 class SerialBoardServer:
@@ -197,11 +198,27 @@ class SerialBoardServer:
             wire = last[1]
         else:
             replies: list[Message] = board.handle(frame.messages)
-            wire = encode_frame(Frame(frame.board, frame.seq, tuple(replies), from_board=True,
-                                      session=frame.session))
+            wire = self._reply_frame(frame, replies)
             self._last[frame.board] = (frame, wire)
         if not self._silent(frame.board):
             self._write(wire)
+
+    def _reply_frame(self, frame: Frame, replies: list[Message]) -> bytes:
+        """The reply frame: the replies that fit in one frame (255 message
+        bytes), in order; a request asking for more has the rest left off
+        (counted as ``cut``), as a board's fixed reply buffer would."""
+        kept = list(replies)
+        while True:
+            try:
+                wire = encode_frame(Frame(frame.board, frame.seq, tuple(kept),
+                                          from_board=True, session=frame.session))
+            except CodecError:
+                if len(kept) <= 1:
+                    raise
+                kept.pop()
+                continue
+            self.stats.cut += len(kept) < len(replies)
+            return wire
 
     # -- serving -------------------------------------------------------------------
     def stop(self) -> None:

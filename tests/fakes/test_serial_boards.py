@@ -128,3 +128,16 @@ def test_arbitrary_bytes_from_the_boards_never_crash_the_host(data: bytes) -> No
     finally:
         os.close(r)
         os.close(w)
+
+
+def test_a_request_whose_replies_cannot_fit_one_frame_gets_those_that_fit(
+        server: tuple) -> None:
+    """Forty ReadAlls in one frame ask for far more than 255 message bytes of
+    replies (the fuzz script found the board raising here): the board answers
+    with one frame of the replies that fit, in order, and counts the cut."""
+    srv, r = server
+    srv.receive(encode_frame(Frame(1, 9, (m.ReadAll(),) * 40)))
+    (reply,) = FrameReader().feed(drain(r))
+    assert reply.from_board and reply.seq == 9 and isinstance(reply.messages[0], m.Status)
+    assert srv.stats.cut == 1
+    assert sum(2 + len(p) for p in (m.encode(x)[1] for x in reply.messages)) <= 255
