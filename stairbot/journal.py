@@ -115,9 +115,15 @@ class JournalWriter:
         self._ticks += 1
         self.write(record)
 
-    def end(self, outcome: str, error: str | None, time_s: float) -> None:
-        self.write({"kind": "end", "run_id": self.run_id, "outcome": outcome,
-                    "error": error, "time_s": time_s})
+    def end(self, outcome: str, error: str | None, time_s: float,
+            resumable: bool = False) -> None:
+        """The run's end.  ``resumable``: it ended on a lost link, the robot
+        part way through its program, so ``--resume`` may carry it on."""
+        record = {"kind": "end", "run_id": self.run_id, "outcome": outcome,
+                  "error": error, "time_s": time_s}
+        if resumable:
+            record["resumable"] = True
+        self.write(record)
 
     def close(self) -> None:
         if self._fd >= 0:

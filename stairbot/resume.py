@@ -39,7 +39,7 @@ def check(state: JournalState, url: str, boards: dict[str, dict[str, int]] | Non
     """ResumeRefused unless the journal's run can go on on the boards at ``url``
     (``boards``: their identity now, None for the simulation)."""
     where = state.path
-    if state.end is not None:
+    if state.end is not None and not state.end.get("resumable"):
         raise ResumeRefused(f"{where}: the last run ended ({state.end.get('outcome')}"
                             f"{': ' + str(state.end['error']) if state.end.get('error') else ''})"
                             ": nothing to resume")
@@ -88,6 +88,8 @@ def describe(state: JournalState) -> list[str]:
                                          if moving else "every motor stopped"))
     if state.last.get("estopped"):
         lines.append("the emergency stop was latched")
+    if state.end is not None:
+        lines.append(f"the run stopped: {state.end.get('error')}")
     return lines
 
 

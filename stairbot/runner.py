@@ -228,7 +228,10 @@ def run(
     )
     if journal is not None:
         with contextlib.suppress(JournalError):  # the result still stands
-            journal.end(result.outcome, result.error, clock.now())
+            # a lost link stopped the program, not the program itself: the
+            # journal offers --resume once the wire is back
+            journal.end(result.outcome, result.error, clock.now(),
+                        resumable=fault == "link" and not fell)
     sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
 

@@ -83,6 +83,11 @@ class CanBoardServer:
         self.last_send_error: str | None = None
 
     # -- faults ------------------------------------------------------------------
+    def set_faults(self, faults: WireFaults) -> None:
+        """From now on, these faults (a fault matrix starts them mid-run)."""
+        self.faults = faults
+        self._dice = FaultDice(faults, self.stats)
+
     def _chance(self, p: float) -> bool:
         return self._dice.chance(p)
 

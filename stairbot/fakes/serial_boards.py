@@ -117,6 +117,12 @@ class SerialBoardServer:
         self._out = bytearray()
 
     # -- faults ------------------------------------------------------------------
+    def set_faults(self, faults: WireFaults) -> None:
+        """From now on, these faults (a fault matrix starts them mid-run)."""
+        self.faults = faults
+        self._dice = FaultDice(faults, self.stats)
+        self._rng = self._dice.rng
+
     def _chance(self, p: float) -> bool:
         return self._dice.chance(p)
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import pytest
 
 from stairbot.journal import JournalWriter, read_journal
+from stairbot.resume import ResumeRefused, check, describe
 
 
 def stairbot(*args: str, env: dict[str, str], **kw: object) -> subprocess.Popen[str]:
@@ -176,3 +177,29 @@ def test_a_line_cut_short_by_a_power_loss_is_skipped(tmp_path: Path) -> None:
         f.write(b'{"kind":"tick","run_id":"')  # the power went here
     state = read_journal(path)
     assert state.last["time_s"] == 0.02 and state.context == {"phase": "cal_check"}
+
+
+def test_a_run_stopped_by_a_lost_link_can_be_resumed_one_that_failed_cannot(
+        tmp_path: Path) -> None:
+    """The journal's end says resumable only for a lost link: the program was
+    stopped from outside, part way through, and the boards may come back."""
+    boards = {"motor": {"serial": 1, "uptime_ms": 5000}, "sensor": {"serial": 2,
+                                                                     "uptime_ms": 5000}}
+    for resumable in (True, False):
+        path = tmp_path / f"j-{resumable}.jsonl"
+        w = JournalWriter(path, fresh=True)
+        w.start(url="serial://x", config="c", config_sha256="0", scenario="s", mode="full",
+                boards=boards, time_s=0.0)
+        w.tick(time_s=0.02, phase="ascent_lift_first", estopped=False, command={},
+               boards=boards, context=lambda: {"phase": "ascent_lift_first"})
+        w.end("error", "link lost: no reply from the motor board for 0.52 s", 0.04,
+              resumable=resumable)
+        w.close()
+        state = read_journal(path)
+        if resumable:
+            check(state, "serial://x", boards)
+            assert describe(state)[-1] == ("the run stopped: link lost: no reply from the "
+                                           "motor board for 0.52 s")
+        else:
+            with pytest.raises(ResumeRefused, match="the last run ended"):
+                check(state, "serial://x", boards)

@@ -1,0 +1,361 @@
+"""The fault matrix: one fault, started as the run enters one phase, on a
+two-step flight over the fake boards in lockstep -- and what the run must
+end as.
+
+Faults (:data:`FAULTS`):
+
+* ``drop``, ``corrupt``, ``late``, ``duplicate`` at 1, 5 and 20 % of the frames,
+  both ways, from the phase to the end of the run (a late frame comes
+  :data:`LATE_S` after it was due, well past the host's timeout);
+* a board **killed**: from the phase on it answers nothing and its motors
+  stop (its power is gone; the lifts are self-locking and hold);
+* a board **hung**: it answers nothing, and its motors run on as last told
+  until its watchdog -- a timer of its own, not its firmware -- stops them;
+* the **host killed**: from the phase on the host sends nothing (as after
+  ``kill -9``); a second later a new host reads the journal, the operator
+  says yes, and it carries the run on.
+
+A cell is **safe** (:func:`run_cell`) when the run
+
+* completed the flight up and back down and never fell; or
+* stopped with a reason (the driver's words: "no reply from the motor board
+  for 0.52 s ..."), never fell, every motor the host still reached stopped
+  at once, and -- the host gone, the world run on for :data:`AFTER_S` --
+  every motor stopped and the lifts holding (their turns unchanged), with a
+  journal that ends resumable (a lost link) so ``--resume`` can carry on;
+* for the host killed: the resumed run completed and never fell.
+
+``benchmarks/fault_matrix.py`` runs every cell and prints the table of
+docs/reliability.md; tests/safety/test_fault_matrix.py runs a subset in CI.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, cast
+
+import can
+
+from stairbot.algorithm.controller import Controller
+from stairbot.algorithm.phases import Mode
+from stairbot.cli_journal import resume, start_journal
+from stairbot.config import RobotConfig, load_config
+from stairbot.drivers import messages as m
+from stairbot.drivers.can_link import CanLink
+from stairbot.errors import HardwareError
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import Board, make_boards
+from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.can_boards import CanBoardServer, InlineBus
+from stairbot.fakes.lockstep import LockstepRobot
+from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
+from stairbot.hardware import Snapshot
+from stairbot.journal import read_journal
+from stairbot.robots import RobotOptions, RobotSession, open_robot
+from stairbot.runner import RunResult, run
+from stairbot.scenario import parse_scenario
+
+SCENARIO = """
+name = "fault_matrix"
+description = "Two residential steps, then a landing, starting close"
+[stairs]
+count = 2
+rise = 0.17
+tread = 0.28
+top = "landing"
+width = 1.0
+side_wall = "none"
+[start]
+distance = 0.2
+[sensors]
+noise = 0.001
+seed = 3
+"""
+
+TIMEOUT_S = {"can": 0.0005, "serial": 0.005}
+"""The host's reply timeout on each wire: a lost frame costs this much wall
+time.  The CAN boards answer in the host's own thread (InlineBus), at once;
+the serial boards answer from a thread of their own."""
+GRACE_S = 0.5  # the URLs' default grace period
+LATE_S = {"can": 0.005, "serial": 0.03}  # a late frame: ten and six timeouts late
+AFTER_S = 2.0  # world seconds run on after a stopped run, no host
+HOST_DEAD_S = 1.0  # world seconds between the host killed and the new host
+LIFT_HELD_TURNS = 1e-3  # a held lift's give under load is 1e-5 turns
+MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)
+
+PHASES: tuple[str, ...] = (
+    "cal_check", "cal_lift", "cal_probe", "cal_turn", "cal_lower",
+    "ascent_approach", "ascent_approach_turns", "ascent_lift_first", "ascent_lift_first_more",
+    "ascent_drive_first", "ascent_lift_second", "ascent_drive_second", "ascent_lift_third",
+    "ascent_check", "ascent_drive_third",
+    "descent_lower_third", "descent_drive_second", "descent_lower_second",
+    "descent_drive_first", "descent_lower_first", "descent_back_off", "descent_back_to_edge",
+    "descent_finish",
+)
+"""The phases a fault starts in (at the first time the run enters it): every
+phase the two-step flight goes through -- calibration, each of the seed's
+ascent and descent phases -- in that order."""
+
+
+@dataclass(frozen=True)
+class Fault:
+    name: str
+    kind: str  # "wire", "kill", "hang" or "host"
+    wire: dict[str, float] = field(default_factory=dict)
+    board: int | None = None
+
+
+def _faults() -> dict[str, Fault]:
+    out: list[Fault] = []
+    for kind in ("drop", "corrupt", "late", "duplicate"):
+        for pct in (1, 5, 20):
+            out.append(Fault(f"{kind} {pct}%", "wire", {kind: pct / 100}))
+    for kind in ("kill", "hang"):
+        for name, board in (("motor", MOTOR), ("sensor", SENSOR)):
+            out.append(Fault(f"{name} board {'killed' if kind == 'kill' else 'hung'}",
+                             kind, board=board))
+    out.append(Fault("host killed", "host"))
+    return {f.name: f for f in out}
+
+
+FAULTS: dict[str, Fault] = _faults()
+WIRES = ("can", "serial")
+
+
+@dataclass
+class Cell:
+    """One cell's run: ``verdict`` is "completed", "stopped", "resumed" (the
+    host killed, the new host finished) or "UNSAFE"; ``reason`` the run's
+    error, or what made it unsafe."""
+
+    fault: str
+    phase: str
+    wire: str
+    verdict: str
+    reason: str = ""
+    injected: bool = False
+    wall_s: float = 0.0
+
+    @property
+    def safe(self) -> bool:
+        return self.verdict != "UNSAFE"
+
+
+class _HostKilled(BaseException):
+    """Raised in the tick callback: the host dies where it stands."""
+
+
+class _DeadBoard:
+    """A board that answers nothing and executes nothing (killed or hung)."""
+
+    def __init__(self, board: Board) -> None:
+        self.board = board
+
+    def handle(self, msgs: Any) -> list[m.Message]:
+        return []
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.board, name)
+
+
+class _Boards:
+    """The fake boards on one wire, and sessions of hosts opening them."""
+
+    def __init__(self, wire: str, world: BoardWorld, boards: dict[int, Board],
+                 config: RobotConfig) -> None:
+        self.wire, self.world, self.boards, self.config = wire, world, boards, config
+        self._thread: threading.Thread | None = None
+        if wire == "can":
+            self.channel = f"fault-matrix-{uuid.uuid4().hex[:8]}"
+            self.url = f"can://virtual/{self.channel}?lockstep=1"
+            self.server: CanBoardServer | SerialBoardServer = CanBoardServer(
+                can.Bus(interface="virtual", channel=self.channel), world, dict(boards))
+        else:
+            self.pty = PtyPair()
+            self.url = f"serial://{self.pty.path}?lockstep=1&timeout={TIMEOUT_S['serial']}"
+            self.server = SerialBoardServer(self.pty.master, world, dict(boards))
+            self._thread = threading.Thread(target=self.server.serve, daemon=True)
+            self._thread.start()
+
+    def open(self, allow_latched: bool = False) -> RobotSession:
+        if isinstance(self.server, CanBoardServer):
+            bus = InlineBus(can.Bus(interface="virtual", channel=self.channel), self.server)
+            link = CanLink(cast(can.BusABC, bus), timeout_s=TIMEOUT_S["can"], grace_s=GRACE_S)
+            robot = LockstepRobot(link, self.url, allow_latched=allow_latched)
+            return RobotSession(robot, robot.clock, self.url, robot.simulated)
+        return open_robot(self.url, self.config, RobotOptions(allow_latched=allow_latched))
+
+    def deaf(self, on: bool) -> None:
+        """The boards hear nothing from the host (it is dead), or again."""
+        server: Any = self.server
+        if on:
+            server.receive = lambda *_: None
+        else:
+            vars(server).pop("receive", None)
+
+    def close(self) -> None:
+        if isinstance(self.server, CanBoardServer):
+            self.server.bus.shutdown()
+            return
+        self.server.stop()
+        if self._thread is not None:
+            self._thread.join(5)
+        self.pty.close()
+
+
+def _lifts(world: BoardWorld) -> tuple[float, ...]:
+    snap = world.snapshot()
+    if snap is None:
+        return ()
+    return tuple(snap.motors[m.MOTOR_CHANNELS[ch]].turns for ch in sorted(m.LIFT_CHANNELS))
+
+
+def _run_on(world: BoardWorld, boards: dict[int, Board], seconds: float) -> None:
+    """The world goes on with no host: the boards' watchdogs see time pass."""
+    t_us = round(world.now() * 1e6)
+    for _ in range(round(seconds / 0.01)):
+        t_us += 10_000
+        world.step_to(t_us)
+        for board in boards.values():
+            board.poll()
+
+
+def _after_stop(cell: Cell, result: RunResult, boards: _Boards, journal: Path,
+                alive: bool) -> Cell:
+    """Check a run that did not complete: see the module docstring."""
+    world = boards.world
+    problems: list[str] = []
+    if result.fell:
+        problems.append("fell")
+    if not result.error:
+        problems.append("stopped with no reason given")
+    if alive and any(world.speeds().values()):
+        problems.append(f"motors left running: {world.speeds()}")
+    _run_on(world, boards.boards, 0.5)  # every watchdog has tripped by now
+    before = _lifts(world)
+    _run_on(world, boards.boards, AFTER_S - 0.5)
+    after = _lifts(world)
+    if any(world.speeds().values()):
+        problems.append(f"motors running {AFTER_S:.0f} s on: {world.speeds()}")
+    if any(abs(a - b) > LIFT_HELD_TURNS for a, b in zip(before, after, strict=True)):
+        problems.append(f"a lift moved with no host: {before} -> {after}")
+    truth = world.truth()
+    if truth.flags:
+        problems.append("fell once left alone")
+    if result.fault == "link":
+        end = read_journal(journal).end or {}
+        if not end.get("resumable"):
+            problems.append("the journal does not offer --resume after a lost link")
+    if problems:
+        cell.verdict, cell.reason = "UNSAFE", "; ".join(problems) + f" ({result.error})"
+    else:
+        cell.verdict, cell.reason = "stopped", result.error or ""
+    return cell
+
+
+def run_cell(fault_name: str, phase: str, wire: str = "can", seed: int = 1,
+             workdir: Path | None = None) -> Cell:
+    """Run one cell of the matrix and judge it (see the module docstring)."""
+    fault = FAULTS[fault_name]
+    if phase not in PHASES or wire not in WIRES:
+        raise ValueError(f"unknown phase {phase!r} or wire {wire!r}")
+    t0 = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        if workdir is None:
+            workdir = Path(stack.enter_context(tempfile.TemporaryDirectory()))
+        cell = _run(fault, phase, wire, seed, workdir / "journal.jsonl")
+    cell.wall_s = time.perf_counter() - t0
+    return cell
+
+
+def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
+    config = load_config()
+    scenario = parse_scenario(SCENARIO, "<fault matrix>")
+    world = make_world(config, scenario, lockstep=True)
+    real = make_boards(world)
+    boards = _Boards(wire, world, real, config)
+    cell = Cell(fault.name, phase, wire, "UNSAFE")
+    try:
+        session = boards.open()
+        writer = start_journal(journal, boards.url, session, config, scenario.name, Mode.FULL)
+        assert writer is not None
+
+        def inject(ctl: Controller, snap: Snapshot) -> None:
+            if cell.injected or ctl.context.phase != phase:
+                return
+            cell.injected = True
+            if fault.kind == "wire":
+                boards.server.set_faults(WireFaults(seed=seed, late_s=LATE_S[wire],
+                                                    **fault.wire))  # type: ignore[arg-type]
+            elif fault.kind in ("kill", "hang"):
+                assert fault.board is not None
+                if fault.kind == "kill":
+                    real[fault.board].halt()
+                boards.server.boards[fault.board] = _DeadBoard(real[fault.board])  # type: ignore[assignment]
+                boards.server.set_faults(WireFaults(silent_board=fault.board,
+                                                    silent_after_s=0.0))
+            else:
+                boards.deaf(True)
+                raise _HostKilled
+
+        try:
+            result = run(session, config, on_tick=inject, journal=writer)
+        except _HostKilled:
+            result = None
+        finally:
+            writer.close()
+            with contextlib.suppress(HardwareError):
+                session.close()
+        if not cell.injected:
+            cell.reason = f"the run never entered {phase}"
+            return cell
+        if result is None:
+            return _resumed(cell, boards, config, journal)
+        if result.outcome == "completed" and not result.fell:
+            cell.verdict, cell.reason = "completed", ""
+            return cell
+        alive = fault.kind == "wire" or fault.board != MOTOR
+        return _after_stop(cell, result, boards, journal, alive)
+    finally:
+        boards.close()
+
+
+def _resumed(cell: Cell, boards: _Boards, config: RobotConfig, journal: Path) -> Cell:
+    """The host was killed: the world runs on, then a new host resumes."""
+    _run_on(boards.world, boards.boards, HOST_DEAD_S)
+    boards.deaf(False)
+    session = boards.open(allow_latched=True)
+    try:
+        resumed = resume(journal, boards.url, session, config, lambda _e: None, yes=True,
+                         out=io.StringIO())
+        try:
+            result = run(session, config, controller=resumed.controller,
+                         journal=resumed.journal)
+        finally:
+            resumed.journal.close()
+    finally:
+        with contextlib.suppress(HardwareError):
+            session.close()
+    if result.outcome == "completed" and not result.fell:
+        cell.verdict, cell.reason = "resumed", ""
+    else:
+        cell.reason = f"the resumed run ended {result.outcome}: {result.error}"
+    return cell
+
+
+def cells(wires: tuple[str, ...] = WIRES) -> Iterator[tuple[str, str, str]]:
+    """Every (fault, phase, wire) of the matrix."""
+    for wire in wires:
+        for fault in FAULTS:
+            for phase in PHASES:
+                yield fault, phase, wire
+
+
