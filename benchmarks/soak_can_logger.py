@@ -40,13 +40,14 @@ def decode_count(log: Path) -> tuple[int, int]:
     db = cantools.database.load_string(
         resources.files("stairbot.drivers").joinpath("stairbot.dbc").read_text("utf-8"),
         database_format="dbc")
+    assert isinstance(db, cantools.database.can.Database)
     frames = unknown = 0
     for msg in can.LogReader(str(log)):
         if msg.is_error_frame:
             continue
         frames += 1
         try:
-            db.decode_message(msg.arbitration_id, msg.data)
+            db.decode_message(msg.arbitration_id, bytes(msg.data))
         except (KeyError, ValueError, cantools.database.DecodeError):
             unknown += 1
     return frames, unknown
