@@ -95,6 +95,13 @@ HUNG = {
                                ["timeout", "inf", "0 < timeout <= 60"]),
     "url-serial-retries-huge": (["run", "--robot", "serial://loop://?retries=99999999999"], 2,
                                 ["retries", "99999999999", "0 to 100"]),
+    "url-serial-grace-inf": (["run", "--robot", "serial://loop://?grace=inf"], 2,
+                             ["grace", "inf", "0 <= grace <= 60"]),
+    "url-can-retries-huge": (["run", "--robot", "can://virtual/x?retries=99999999999"], 2,
+                             ["retries", "0 to 100"]),
+    "config-lift-too-slow-in-m-s": (["run", "--config", "@c5.toml=" + robot(
+        "lift_speed = 10.0", "lift_speed = 0.05")], 2,
+        ["motors.lift_speed", "0.0001 m/s", "0.0002 to 1 m/s"]),
     "config-wheel-mass-1e-9": (["run", "--config", "@m.toml=" + robot("wheel = 0.02",
                                                                        "wheel = 1e-9")], 2,
                                ["masses.wheel", ">= 0.001"]),
@@ -151,14 +158,10 @@ REFUSED = {
                              ["baud", "20000000"]),
     "url-serial-watchdog-huge": (["run", "--robot", "serial://loop://?watchdog=1000000000"],
                                  ["watchdog", "65535"]),
-    "url-serial-grace-inf": (["run", "--robot", "serial://loop://?grace=inf"],
-                             ["grace", "inf"]),
     "url-can-time-scale-1e308": (["run", "--robot", "can://virtual/x?time_scale=1e308"],
                                  ["time_scale", "1e308", "0.01 to 1000"]),
     "url-can-time-scale-nan": (["run", "--robot", "can://virtual/x?time_scale=nan"],
                                ["time_scale", "nan"]),
-    "url-can-retries-huge": (["run", "--robot", "can://virtual/x?retries=99999999999"],
-                             ["retries", "0 to 100"]),
     "url-can-bad-percent": (["run", "--robot", "can://virtual/x?a=%ff"],
                             ["percent-encoding"]),
     # scenarios
@@ -189,9 +192,6 @@ REFUSED = {
         "lift_speed = 10.0", "lift_speed = 1e-300")], ["motors.lift_speed", ">= 0.01"]),
     "config-lift-speed-1e300": (["run", "--config", "@c4.toml=" + robot(
         "lift_speed = 10.0", "lift_speed = 1e300")], ["motors.lift_speed", "<= 1000"]),
-    "config-lift-too-slow-in-m-s": (["run", "--config", "@c5.toml=" + robot(
-        "lift_speed = 10.0", "lift_speed = 0.05")], ["motors.lift_speed", "0.0001 m/s",
-                                                     "0.0002 to 1 m/s"]),
     "config-wheel-speed-1e300": (["run", "--config", "@c6.toml=" + robot(
         "wheel_speed = 1.0", "wheel_speed = 1e300")], ["motors.wheel_speed", "<= 1000"]),
     "config-wheel-too-fast-in-m-s": (["run", "--config", "@c7.toml=" + robot(
