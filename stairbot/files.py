@@ -170,8 +170,8 @@ class LineFile:
                 except FileNotFoundError:
                     mode = stat.S_IFREG
                 if not stat.S_ISREG(mode):
-                    raise error(shown(self.path), None, f"{_kind(mode)}; allowed: "
-                                     f"{what} in a regular file (or a new one)")
+                    raise error(shown(self.path), None, f"cannot write {what}: "
+                                f"{_kind(mode)}; allowed: a regular file (or a new one)")
             fd = os.open(self.path, flags, 0o644)
             # writes block as usual once open (a FIFO with a reader, a slow disk)
             os.set_blocking(fd, True)
