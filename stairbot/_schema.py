@@ -18,6 +18,7 @@ import msgspec
 import msgspec.inspect as mi
 
 from stairbot.errors import InputError
+from stairbot.files import is_file, read_input, shown
 
 T = TypeVar("T")
 
@@ -25,15 +26,11 @@ _PATH = re.compile(r"^(?P<problem>.*) - at `\$(?P<path>[^`]*)`$", re.S)
 _TOKEN = re.compile(r"\.([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]")
 
 
-def read_text(path: Path, error: type[InputError]) -> str:
-    """A file's text.  Raises ``error`` naming the file when it cannot be read
-    or is not UTF-8."""
-    try:
-        return path.read_text("utf-8")
-    except OSError as exc:
-        raise error(str(path), None, f"cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise error(str(path), None, "not a UTF-8 text file") from None
+def read_text(path: Path, error: type[InputError], what: str = "a TOML file") -> str:
+    """A file's text.  Raises ``error`` naming the file when it is no regular
+    file, larger than :data:`~stairbot.files.MAX_TOML_BYTES`, cannot be read
+    or is not UTF-8 (:func:`stairbot.files.read_input`)."""
+    return read_input(path, error, what=what)
 
 
 def shipped(folder: str) -> list[str]:
@@ -50,23 +47,54 @@ def read_named(path: str | Path, folder: str, what: str,
     ``error`` naming the shipped ones (and ``also``) when it is neither."""
     p = Path(path)
     if isinstance(path, str) and "/" not in path and "\\" not in path \
-            and not path.endswith(".toml") and not p.exists():
+            and not path.endswith(".toml") and not is_file(p):
         names = shipped(folder)
         if path not in names:
             names = sorted([*names, *also])
-            raise error(path, None, f"no such file, nor a shipped {what}; shipped: "
+            raise error(shown(path), None, f"no such file, nor a shipped {what}; shipped: "
                         + ", ".join(names))
         entry = resources.files("stairbot").joinpath(folder, f"{path}.toml")
         return entry.read_text("utf-8"), f"<{what} {path}>"
-    return read_text(p, error), str(p)
+    return read_text(p, error, f"a {what} file"), str(p)
+
+
+MAX_DEPTH = 16
+"""Deepest nesting of tables and lists a TOML input may have (the schemas
+need 4)."""
 
 
 def load_toml(text: str, source: str, error: type[InputError]) -> dict[str, Any]:
-    """Parse TOML text.  Raises ``error`` (an InputError class) when it is not TOML."""
+    """Parse TOML text.  Raises ``error`` (an InputError class) when it is not
+    TOML, or nests tables and lists deeper than :data:`MAX_DEPTH`."""
     try:
-        return tomllib.loads(text)
+        raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise error(source, None, f"not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib parses nested arrays and inline tables recursively
+        raise error(source, None, f"nested too deeply; allowed: at most {MAX_DEPTH} levels "
+                    "of tables and lists") from None
+    if _depth(raw) > MAX_DEPTH:
+        raise error(source, None, f"nested too deeply; allowed: at most {MAX_DEPTH} levels "
+                    "of tables and lists")
+    return raw
+
+
+def _depth(raw: Any) -> int:
+    """How deep tables and lists nest in ``raw`` (counted without recursion;
+    stops counting past MAX_DEPTH)."""
+    deepest = 0
+    todo: list[tuple[Any, int]] = [(raw, 1)]
+    while todo:
+        value, level = todo.pop()
+        children = value.values() if isinstance(value, dict) else (
+            value if isinstance(value, list) else None)
+        if children is None:
+            continue
+        deepest = max(deepest, level)
+        if level > MAX_DEPTH:
+            break
+        todo.extend((child, level + 1) for child in children)
+    return deepest
 
 
 def convert(raw: dict[str, Any], kind: type[T], source: str, error: type[InputError]) -> T:
@@ -205,4 +233,6 @@ def explain(message: str, raw: dict[str, Any], kind: Any) -> tuple[str | None, s
         return _dotted(full), f"required but missing; allowed: {describe(_type_at(kind, full))}"
     field = _dotted(tokens) or None
     value = _value_at(raw, tokens)
-    return field, f"{_shown(value)} is not allowed; allowed: {describe(_type_at(kind, tokens))}"
+    finite = ", finite" if isinstance(value, float) and not math.isfinite(value) else ""
+    return field, (f"{_shown(value)} is not allowed; allowed: "
+                   f"{describe(_type_at(kind, tokens))}{finite}")

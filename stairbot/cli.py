@@ -3,7 +3,9 @@
 Exit codes (every subcommand):
 
 * 0  the run ended as the scenario's ``[expect]`` says (or the command worked)
-* 1  the run ended otherwise (the mismatching fields are named)
+* 1  the run ended otherwise (the mismatching fields are named), or on a
+     fault: a lost link, a failing board, a record or journal the disk
+     refused (the robot is stopped first; one line on stderr)
 * 2  bad input: config, scenario, robot URL, options; one line on stderr
 * 130  interrupted with Ctrl-C (the robot is stopped first)
 
@@ -25,7 +27,7 @@ from contextlib import contextmanager
 from dataclasses import replace
 from importlib import import_module
 from types import FrameType
-from typing import IO, Any, TextIO
+from typing import Any, TextIO
 
 from stairbot import __version__
 from stairbot.cli_show import (
@@ -37,8 +39,10 @@ from stairbot.cli_show import (
     cmd_scenario_list,
 )
 from stairbot.config import RobotConfig, load_config
-from stairbot.errors import HardwareError, InputError, NoBoardError
+from stairbot.errors import HardwareError, InputError, NoBoardError, OutputError
 from stairbot.events import Event, EventKind
+from stairbot.files import LineFile
+from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 from stairbot.scenario import (
     Scenario,
     expectation_mismatches,
@@ -100,8 +104,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="print one JSON object (the result) on stdout; progress goes to stderr")
     r.add_argument("--realtime", action="store_true",
                    help="pace a simulated robot to the wall clock (default: as fast as possible)")
-    r.add_argument("--time-scale", metavar="X", type=_positive_float,
-                   help="pace a simulated robot at X simulated seconds per wall second")
+    r.add_argument("--time-scale", metavar="X", type=_time_scale,
+                   help="pace a simulated robot at X simulated seconds per wall second "
+                        f"({TIME_SCALE_MIN:g} to {TIME_SCALE_MAX:g})")
     r.add_argument("--record", metavar="FILE",
                    help="write the event stream to FILE, one JSON object a line")
     r.add_argument("--calibrate-only", action="store_true",
@@ -154,14 +159,23 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
-    return value
+def bounded(lo: float, hi: float, unit: str = "") -> Callable[[str], float]:
+    """An argparse type: a number from ``lo`` to ``hi`` (finite; nan and inf
+    are refused), the message naming the value and the bounds."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not lo <= value <= hi:  # nan fails too
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is out of range; allowed: {lo:g} to {hi:g}{unit}")
+        return value
+    parse.__name__ = "number"  # what argparse says when the type fails
+    return parse
+
+
+_time_scale = bounded(TIME_SCALE_MIN, TIME_SCALE_MAX)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -175,6 +189,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return func(args)
     except InputError as exc:
         return _input_error(exc)
+    except OutputError as exc:  # before the robot moved (a run's own ends in cmd_run)
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return EXIT_MISMATCH
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -217,16 +234,18 @@ def _load_inputs(args: argparse.Namespace) -> tuple[RobotConfig, Scenario]:
 
 
 @contextmanager
-def _record_file(path: str | None) -> Iterator[IO[str] | None]:
+def _record_file(path: str | None) -> Iterator[LineFile | None]:
+    """The event record, one whole line a write (InputError when it cannot be
+    opened; a write the disk refuses raises OutputError once, then the file
+    is silent and ``failed`` says why)."""
     if path is None:
         yield None
         return
+    f = LineFile(path, "the record")
     try:
-        f = open(path, "w", encoding="utf-8")  # noqa: SIM115 - closed below
-    except OSError as exc:
-        raise InputError(path, None, f"cannot write the record: {exc.strerror or exc}") from None
-    with f:
         yield f
+    finally:
+        f.close()
 
 
 @contextmanager
@@ -275,7 +294,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
     with _record_file(args.record) as record:
         def sink(event: Event) -> None:
-            if record is not None:
+            if record is not None:  # OutputError (a full disk) ends the run
                 record.write(event.to_json() + "\n")
             if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(event.line(), file=progress, flush=True)
@@ -331,6 +350,12 @@ def cmd_run(args: argparse.Namespace) -> int:
             session.close()
             if journal is not None:
                 journal.close()
+        refused = (record.failed if record is not None else None) or (
+            journal.failed if journal is not None else None)
+    if refused is not None:  # the run ended on it: the robot is stopped
+        print(f"{PROG}: error: {refused}; the run stopped, every motor stopped",
+              file=sys.stderr)
+        return EXIT_MISMATCH
     data = result.to_dict()
     if isinstance(link, dict):  # a robot on a wire: what its link counted
         data["link"] = link

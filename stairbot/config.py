@@ -22,52 +22,67 @@ from stairbot.config_checks import check_consistency
 from stairbot.errors import ConfigError
 from stairbot.sensor_specs import SPECS, SensorSpec
 
-Pos = Annotated[float, msgspec.Meta(gt=0)]
-NonNeg = Annotated[float, msgspec.Meta(ge=0)]
+# Physical bounds: generous around any robot of this kind (the reference robot
+# is 0.225 m long and 2.4 kg), tight enough that the simulation's pymunk world
+# stays sane and a run ends (README, "Bounds of the inputs").
+Length = Annotated[float, msgspec.Meta(ge=0.001, le=10.0)]
+"""A length that must be there: 1 mm to 10 m."""
+Gap = Annotated[float, msgspec.Meta(ge=0.0, le=10.0)]
+"""A length that may be zero: 0 to 10 m."""
+Mass = Annotated[float, msgspec.Meta(ge=0.001, le=1000.0)]
+"""A mass: 1 g to 1 t."""
+TurnsPerSecond = Annotated[float, msgspec.Meta(ge=0.01, le=1000.0)]
 
 # The kinds of distance sensor (stairbot.sensor_specs; the names must agree)
 SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"]
 
 
 class Geometry(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    LENGTH_OF_FIRST_MODULE: Pos
-    LENGTH_OF_SECOND_MODULE: Pos
-    LENGTH_OF_THIRD_MODULE: Pos
-    segment_height: Pos
-    track_width: Pos
-    wheel_radius: Pos
-    wheel_inset: Pos
-    LENGTH_OF_A_ROBOT: Pos | None = None  # optional; must equal the sum of the segments
+    LENGTH_OF_FIRST_MODULE: Length
+    LENGTH_OF_SECOND_MODULE: Length
+    LENGTH_OF_THIRD_MODULE: Length
+    segment_height: Length
+    track_width: Length
+    wheel_radius: Length
+    wheel_inset: Length
+    LENGTH_OF_A_ROBOT: Annotated[float, msgspec.Meta(gt=0, le=30.0)] | None = None
+    """Optional; must equal the sum of the segments."""
 
 
 class Masses(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    first_module: Pos
-    second_module: Pos
-    third_module: Pos
-    wheel: Pos
+    first_module: Mass
+    second_module: Mass
+    third_module: Mass
+    wheel: Mass
 
 
 class Motors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    wheel_speed: Pos
-    wheel_torque: Pos
-    lift_travel_per_turn: Pos
-    lift_speed: Pos
-    lift_travel: Pos
-    lift_force: Pos
+    """Speeds in turns per second; what they make in m/s is bounded too
+    (config_checks: WHEEL_SPEED_M_S, LIFT_SPEED_M_S)."""
+
+    wheel_speed: TurnsPerSecond
+    wheel_torque: Annotated[float, msgspec.Meta(ge=0.001, le=10000.0)]
+    """N*m: 1 mN*m to 10 kN*m."""
+    lift_travel_per_turn: Annotated[float, msgspec.Meta(ge=0.00001, le=1.0)]
+    """m: 10 um to 1 m."""
+    lift_speed: TurnsPerSecond
+    lift_travel: Length
+    lift_force: Annotated[float, msgspec.Meta(ge=0.01, le=100000.0)]
+    """N: 10 mN to 100 kN."""
 
 
 class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    front_height: Pos
-    front_lateral: NonNeg
-    front_min_range: NonNeg
-    front_max_range: Pos
-    back_from_rear: NonNeg
-    back_height: Pos
-    back_lateral: NonNeg
-    back_min_range: NonNeg
-    back_max_range: Pos
-    resolution: NonNeg
-    noise: NonNeg = 0.005
+    front_height: Length
+    front_lateral: Gap
+    front_min_range: Gap
+    front_max_range: Length
+    back_from_rear: Gap
+    back_height: Length
+    back_lateral: Gap
+    back_min_range: Gap
+    back_max_range: Length
+    resolution: Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
+    noise: Annotated[float, msgspec.Meta(ge=0.0, le=1.0)] = 0.005
     """Stated sigma of a distance reading of the ``ideal`` model: perception
     derives its tolerances from it.  A named model states its own
     (stairbot.sensor_specs)."""
@@ -107,14 +122,15 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 
 
 class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    SAFE_DISTANCE_IN_FRONT_OF_STEP: Pos
-    SAFE_LENGTH: Pos
-    LENGTH_OF_INFINITY: Pos
-    approach_gap: NonNeg
-    clearance_lift: Pos
-    drive_clearance: Pos
-    equal_tolerance: Pos
-    standing_wait: Pos
+    SAFE_DISTANCE_IN_FRONT_OF_STEP: Length
+    SAFE_LENGTH: Length
+    LENGTH_OF_INFINITY: Length
+    approach_gap: Gap
+    clearance_lift: Length
+    drive_clearance: Length
+    equal_tolerance: Annotated[float, msgspec.Meta(ge=0.0001, le=1.0)]
+    standing_wait: Annotated[float, msgspec.Meta(gt=0, le=3600.0)]
+    """Controller seconds, at most an hour."""
     max_steps: Annotated[int, msgspec.Meta(ge=1, le=20)]
     # at most 1 kHz: what a host drives over a serial link or a CAN bus (and the
     # simulation's physics step, 1/600 s, must fit in a tick for time to move)
@@ -137,7 +153,7 @@ class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     """Pitch or roll rate beyond which every motor stops, degrees per second."""
     imu_max_age_s: Annotated[float, msgspec.Meta(gt=0, le=1)]
     """An IMU reading older than this counts as missing."""
-    stability_margin: NonNeg
+    stability_margin: Gap
     """Metres the centre of mass must stay inside the wheels that carry the
     robot while a lift moves."""
 

@@ -15,6 +15,12 @@ if TYPE_CHECKING:
 BACK_RANGE_MARGIN = 0.005
 """The floor must read at least this far inside the back sensors' range."""
 
+WHEEL_SPEED_M_S = (0.001, 5.0)
+"""What the wheels' speed may make at the rim, m/s: slower, a run of a few
+steps outlasts a day; faster, the simulation's wheels skip over a 1/600 s step."""
+LIFT_SPEED_M_S = (0.0002, 1.0)
+"""What the lifts' speed may make, m/s (a 0.21 m stroke in 18 min at the least)."""
+
 
 def check_consistency(cfg: RobotConfig) -> None:
     """Raise ConfigError naming the field when the config's values do not fit
@@ -35,6 +41,13 @@ def check_consistency(cfg: RobotConfig) -> None:
                 f"{g.wheel_inset} m does not fit {name} = {length} m with wheel_radius "
                 f"{g.wheel_radius} m; allowed: wheel_radius <= wheel_inset <= {length / 2} m",
             )
+    for field, value, unit, (lo, hi) in (
+            ("motors.wheel_speed", cfg.wheel_speed_m_s, "at the rim", WHEEL_SPEED_M_S),
+            ("motors.lift_speed", cfg.lift_speed_m_s, "with lift_travel_per_turn",
+             LIFT_SPEED_M_S)):
+        if not lo <= value <= hi:
+            raise ConfigError(src, field, f"{getattr(m, field.split('.')[1]):g} turns/s makes "
+                              f"{value:.3g} m/s {unit}; allowed: {lo:g} to {hi:g} m/s")
     if s.front_min_range >= s.front_max_range:
         raise ConfigError(src, "sensors.front_min_range", "must be below front_max_range")
     if s.back_min_range >= s.back_max_range:

@@ -33,6 +33,19 @@ class RobotUrlError(InputError):
     """A robot URL names an unknown scheme or cannot be opened."""
 
 
+class OutputError(StairbotError):
+    """A file a run writes (the event record, the journal) refused a write --
+    a full disk, a file grown past its limit.  The run stops (the robot is
+    stopped) and the CLI exits 1 with the message, one line naming the file:
+    ``PATH: cannot write WHAT: REASON``.  What was written before stays."""
+
+    def __init__(self, path: str, what: str, problem: str) -> None:
+        self.path = path
+        self.what = what
+        self.problem = problem
+        super().__init__(f"{path}: cannot write {what}: {problem}")
+
+
 class HardwareError(StairbotError):
     """The robot (real or simulated) failed: the run stops in a safe state."""
 

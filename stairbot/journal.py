@@ -36,7 +36,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from stairbot.errors import InputError
+from stairbot.errors import InputError, OutputError
+from stairbot.files import LineFile, open_regular, shown
 
 CONTEXT_EVERY = 25  # ticks: half a second at the 20 ms tick
 MAX_LINE = 1 << 20  # a journal line longer than this is not one of ours
@@ -62,33 +63,37 @@ class JournalWriter:
     def __init__(self, path: str | Path, *, fresh: bool, sync: bool = True) -> None:
         self.path = Path(path)
         self.sync = sync
-        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | (os.O_TRUNC if fresh else 0)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._fd = os.open(self.path, flags, 0o644)
-            if sync:  # the file's name is durable too
+        except OSError as exc:
+            raise JournalError(shown(self.path), None,
+                               f"cannot write the journal: {exc.strerror or exc}") from None
+        self._file = LineFile(self.path, "the journal", fresh=fresh, sync=sync, regular=True,
+                              error=JournalError)
+        if sync:  # the file's name is durable too
+            try:
                 dir_fd = os.open(self.path.parent, os.O_RDONLY)
                 try:
                     os.fsync(dir_fd)
                 finally:
                     os.close(dir_fd)
-        except OSError as exc:
-            raise JournalError(str(self.path), None,
-                               f"cannot write the journal: {exc.strerror or exc}") from None
+            except OSError as exc:
+                self._file.close()
+                raise JournalError(shown(self.path), None,
+                                   f"cannot write the journal: {exc.strerror or exc}") from None
         self.run_id = ""
         self._ticks = 0
         self._phase: str | None = None
 
+    @property
+    def failed(self) -> OutputError | None:
+        """Why the disk refused a record (the journal takes no more then)."""
+        return self._file.failed
+
     def write(self, record: Mapping[str, Any]) -> None:
-        """One record, whole and durable.  JournalError when the disk refuses it."""
-        line = (json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n").encode()
-        try:
-            os.write(self._fd, line)
-            if self.sync:
-                os.fsync(self._fd)
-        except OSError as exc:
-            raise JournalError(str(self.path), None,
-                               f"cannot write the journal: {exc.strerror or exc}") from None
+        """One record, whole and durable.  OutputError when the disk refuses
+        it; after that the journal is silent."""
+        self._file.write(json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n")
 
     def start(self, *, url: str, config: str, config_sha256: str, scenario: str, mode: str,
               boards: Any, time_s: float, run_id: str | None = None) -> None:
@@ -126,9 +131,7 @@ class JournalWriter:
         self.write(record)
 
     def close(self) -> None:
-        if self._fd >= 0:
-            os.close(self._fd)
-            self._fd = -1
+        self._file.close()
 
 
 @dataclass
@@ -162,15 +165,16 @@ def _records(data: bytes) -> list[dict[str, Any]]:
 
 def read_journal(path: str | Path) -> JournalState:
     """The last run of the journal at ``path``.  JournalError (one line
-    naming the file) when it is missing, not a regular file, or holds no run."""
+    naming the file) when it is missing, not a regular file, or holds no run.
+    A journal may be any size: only its last ``TAIL_BYTES`` (1 MiB) are read,
+    and its first ``MAX_LINE`` bytes when no run starts in them."""
     p = Path(path)
+    fd = open_regular(p, JournalError, "a journal")
     try:
-        with open(p, "rb") as f:
-            if not os.path.isfile(p):
-                raise JournalError(str(p), None, "not a regular file")
+        with os.fdopen(fd, "rb") as f:
             size = os.fstat(f.fileno()).st_size
             f.seek(max(0, size - TAIL_BYTES))
-            tail = f.read()
+            tail = f.read(TAIL_BYTES)
             if size > TAIL_BYTES:
                 tail = tail[tail.find(b"\n") + 1:]  # the first line there may be cut
             records = _records(tail)
@@ -180,7 +184,7 @@ def read_journal(path: str | Path) -> JournalState:
                 head = f.read(MAX_LINE)
                 starts = [r for r in _records(head) if r["kind"] == "start"]
     except OSError as exc:
-        raise JournalError(str(p), None, f"cannot read the journal: {exc.strerror or exc}"
+        raise JournalError(shown(p), None, f"cannot read the journal: {exc.strerror or exc}"
                            ) from None
     if not starts:
         raise JournalError(str(p), None, "holds no run (no start record)")

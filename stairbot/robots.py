@@ -25,6 +25,12 @@ from stairbot.errors import RobotUrlError
 from stairbot.hardware import Clock, HasScene, Robot
 from stairbot.scenario import Scenario
 
+TIME_SCALE_MIN, TIME_SCALE_MAX = 0.01, 1000.0
+"""The pace a simulated robot may run at, simulated seconds per wall second
+(``--time-scale``, a URL's ``time_scale=``): slower than 1/100 a run of
+minutes takes days; faster than 1000x the fake boards' timers fall below a
+millisecond."""
+
 
 @dataclass(frozen=True)
 class RobotOptions:

@@ -20,10 +20,10 @@ from typing import Any, Literal
 from stairbot.algorithm.controller import Controller, phase_timeout_s
 from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
-from stairbot.errors import HardwareError, LinkLostError, RobotFellError
+from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import HasTruth, MotorId, ReportsEvents, Robot, Snapshot, Truth
-from stairbot.journal import JournalError, JournalWriter
+from stairbot.journal import JournalWriter
 from stairbot.robots import RobotSession
 
 Latch = Literal["estop", "clear"]
@@ -114,7 +114,8 @@ class RunResult:
     """Whether the supervisor watched the tilt (the config declares an IMU)."""
     fault: str | None = None
     """"link" when the run ended on a lost link, "hardware" on another
-    failure the robot reported; None otherwise."""
+    failure the robot reported, "output" when the journal or the event
+    record could not be written (a full disk); None otherwise."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -150,7 +151,8 @@ def run(
     that longer).  Fell, pitch and offset in the result come from the robot's
     ``truth()`` (HasTruth; None for a robot without it).  ``journal`` (started
     by the caller) gets a durable record after every tick and the run's end; a
-    journal the disk refuses ends the run with an error.
+    journal (or a ``sink`` writing the event record) the disk refuses -- an
+    OutputError -- ends the run with an error, the robot stopped.
     """
     robot, clock = session.robot, session.clock
     ctl = controller or Controller(config, sink, mode)
@@ -191,9 +193,9 @@ def run(
     except HardwareError as exc:
         fault = "hardware"
         ctl.abort(f"hardware failure: {exc}", "error")
-    except JournalError as exc:
+    except OutputError as exc:  # the journal or the event record: the disk refused a write
+        fault = "output"
         ctl.abort(str(exc), "error")
-        journal = None  # it cannot take the end either
     finally:
         if control is not None:  # presses the loop did not come round to
             with contextlib.suppress(HardwareError):  # a clear on a lost link
@@ -227,7 +229,7 @@ def run(
         fault=fault,
     )
     if journal is not None:
-        with contextlib.suppress(JournalError):  # the result still stands
+        with contextlib.suppress(OutputError):  # the result still stands
             # a lost link stopped the program, not the program itself: the
             # journal offers --resume once the wire is back
             journal.end(result.outcome, result.error, clock.now(),

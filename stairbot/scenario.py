@@ -19,25 +19,28 @@ import msgspec
 from stairbot._schema import convert, load_toml, read_named, shipped
 from stairbot.errors import ScenarioError
 
-Pos = Annotated[float, msgspec.Meta(gt=0)]
-NonNeg = Annotated[float, msgspec.Meta(ge=0)]
+# Bounds that keep the simulated world sane (docs/scenarios.md): a riser from
+# 5 mm to 1 m, a tread from 1 cm to 10 m, a flight from 0.1 to 20 m wide.
+Rise = Annotated[float, msgspec.Meta(ge=0.005, le=1.0)]
+Tread = Annotated[float, msgspec.Meta(ge=0.01, le=10.0)]
+Seconds = Annotated[float, msgspec.Meta(ge=0, le=86400.0)]
 SensorName = Literal["SFR", "SFL", "SBR", "SBL"]
 Outcome = Literal["completed", "stopped", "error", "fell"]
 AscentEnd = Literal["top_reached", "obstacle", "step_limit"]
 
 
 class Step(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    rise: Pos
-    tread: Pos
+    rise: Rise
+    tread: Tread
 
 
 class Stairs(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     count: Annotated[int, msgspec.Meta(ge=0, le=40)] | None = None
-    rise: Pos | None = None
-    tread: Pos | None = None
-    steps: list[Step] | None = None
+    rise: Rise | None = None
+    tread: Tread | None = None
+    steps: Annotated[list[Step], msgspec.Meta(max_length=40)] | None = None
     top: Literal["landing", "wall"] = "landing"
-    width: Pos = 1.0
+    width: Annotated[float, msgspec.Meta(ge=0.1, le=20.0)] = 1.0
     side_wall: Literal["none", "left", "right", "both"] = "none"
 
 
@@ -48,11 +51,11 @@ MAX_START_DISTANCE = 20.0
 class Start(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     distance: Annotated[float, msgspec.Meta(gt=0, le=MAX_START_DISTANCE)] = 0.5
     yaw_deg: Annotated[float, msgspec.Meta(ge=-80, le=80)] = 0.0
-    lateral: float = 0.0
+    lateral: Annotated[float, msgspec.Meta(ge=-10.0, le=10.0)] = 0.0
 
 
 class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    noise: NonNeg = 0.001
+    noise: Annotated[float, msgspec.Meta(ge=0, le=1.0)] = 0.001
     seed: int = 1
     outliers: Annotated[float, msgspec.Meta(ge=0, le=0.5)] = 0.0
     """Share of measurements replaced by a value anywhere within range (on top
@@ -60,11 +63,11 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 
 
 class Fault(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    at: NonNeg
+    at: Seconds
     sensor: SensorName
     kind: Literal["offset", "error", "freeze"]
-    offset: float = 0.0
-    duration: Pos | None = None
+    offset: Annotated[float, msgspec.Meta(ge=-10.0, le=10.0)] = 0.0
+    duration: Annotated[float, msgspec.Meta(gt=0, le=86400.0)] | None = None
 
 
 class Expect(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
@@ -74,7 +77,7 @@ class Expect(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     steps_descended: Annotated[int, msgspec.Meta(ge=0)] | None = None
     pauses: Annotated[int, msgspec.Meta(ge=0)] | None = None
     error_contains: str | None = None
-    max_final_offset_m: Pos | None = None
+    max_final_offset_m: Annotated[float, msgspec.Meta(gt=0, le=100.0)] | None = None
 
 
 class ScenarioFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

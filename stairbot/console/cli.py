@@ -14,7 +14,8 @@ from urllib.parse import urlsplit
 
 from stairbot.config import load_config
 from stairbot.console.runner_thread import SPEEDS
-from stairbot.errors import InputError, RobotUrlError
+from stairbot.errors import RobotUrlError
+from stairbot.files import LineFile
 from stairbot.robots import known_schemes
 from stairbot.scenario import load_scenario
 
@@ -56,14 +57,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     config = load_config(args.config)
     load_scenario(args.scenario)  # a bad scenario fails here, not behind the screen
     _check_url(args.robot)
-    if args.record:
-        from pathlib import Path
-
-        try:
-            Path(args.record).open("a", encoding="utf-8").close()
-        except OSError as exc:
-            raise InputError(args.record, None,
-                                f"cannot write the record: {exc.strerror or exc}") from None
+    if args.record:  # a FIFO no process reads is refused here, not waited on
+        LineFile(args.record, "the record", fresh=False).close()
     from stairbot.console.app import build_app  # textual loads only when the screen opens
 
     app = build_app(config, url=args.robot, scenario=args.scenario, record=args.record,

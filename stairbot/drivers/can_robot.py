@@ -15,21 +15,24 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
 
   - ``bitrate=N``     bit/s, given to the interface (else ``CAN_BITRATE``...)
   - ``context=NAME``  the section of python-can's config file to read
-  - ``timeout=S``     seconds to wait for a board's replies, default 0.1
-  - ``retries=N``     re-sends of a query that timed out, default 2
+  - ``timeout=S``     seconds to wait for a board's replies, default 0.1;
+                      0 < S <= 60
+  - ``retries=N``     re-sends of a query that timed out, default 2; 0 to 100
   - ``lost=N``        unanswered commands in a row that mean the link is
-                      lost (once the grace period is over), default 3
+                      lost (once the grace period is over), default 3; 1 to
+                      1000
   - ``grace=S``       seconds a board may stay silent before the link is
                       lost, default 0.5: until then a query that got no
                       reply after its retries is sent again; 0 = lost at the
-                      first query given up
+                      first query given up; at most 60
   - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
-                      default 250 (0 = off); time-scaled fake boards get X times it
+                      default 250 (0 = off), at most 65535; time-scaled fake
+                      boards get X times it
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
                       (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
-                      the host's wall clock runs at the same rate
+                      the host's wall clock runs at the same rate; 0.01 to 1000
   - ``lan=1``         ``udp_multicast`` only: open the bus to the network
                       (python-can's own socket: see below).  Default 0.
   - any other ``key=value`` is passed to ``can.Bus`` as a keyword, its value
@@ -62,7 +65,7 @@ from __future__ import annotations
 import ipaddress
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import parse_qsl, unquote
+from urllib.parse import unquote
 
 import can
 import can.util
@@ -71,6 +74,7 @@ from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
+from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 
@@ -78,11 +82,6 @@ OPTION_DEFAULTS: dict[str, float] = {
     "timeout": 0.1, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
     "lan": 0, "grace": 0.5,
 }
-_INTS = {"retries", "lost", "watchdog", "lockstep", "lan"}
-_ALLOWED = {"timeout": "seconds, 0 < timeout <= 60", "retries": "a whole number >= 0",
-            "lost": "a whole number >= 1", "watchdog": "ms, 0..65535 (0 = off)",
-            "lockstep": "0 or 1", "time_scale": "a number > 0", "lan": "0 or 1",
-            "grace": "seconds, 0 <= grace <= 60"}
 
 
 @dataclass(frozen=True)
@@ -100,19 +99,6 @@ class CanUrl:
     def label(self) -> str:
         """``INTERFACE/CHANNEL`` as given (``default`` where left to the config)."""
         return f"{self.interface or 'default'}/{self.channel or ''}"
-
-
-def _option(url: str, key: str, text: str) -> float:
-    try:
-        value = int(text) if key in _INTS else float(text)
-    except ValueError:
-        raise RobotUrlError(url, key, f"{text!r}; allowed: {_ALLOWED[key]}") from None
-    ok = {"timeout": 0 < value <= 60, "retries": value >= 0, "lost": value >= 1,
-          "watchdog": 0 <= value <= 65535, "lockstep": value in (0, 1),
-          "time_scale": value > 0, "lan": value in (0, 1), "grace": 0 <= value <= 60}[key]
-    if not ok:
-        raise RobotUrlError(url, key, f"{text}; allowed: {_ALLOWED[key]}")
-    return value
 
 
 def parse_can_url(url: str) -> CanUrl:
@@ -133,14 +119,9 @@ def parse_can_url(url: str) -> CanUrl:
     kwargs: dict[str, Any] = {}
     options = dict(OPTION_DEFAULTS)
     context: str | None = None
-    try:
-        pairs = parse_qsl(query, keep_blank_values=True, strict_parsing=bool(query))
-    except ValueError as exc:
-        raise RobotUrlError(url, "query", f"malformed options ({exc}); "
-                            "expected key=value&key=value") from exc
-    for key, value in pairs:
+    for key, value in query_pairs(url, query):
         if key in OPTION_DEFAULTS:
-            options[key] = _option(url, key, value)
+            options[key] = number_option(url, key, value)
         elif key == "context":
             context = value or None
         elif key in ("interface", "bustype", "channel"):

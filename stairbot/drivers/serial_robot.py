@@ -10,22 +10,26 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
 * options (the query after the last ``?``; keys not listed here go back to
   the pyserial URL, e.g. ``logging=debug`` for ``socket://``):
 
-  - ``baud=N``        bit rate, default 1000000 (UART 8N1)
-  - ``timeout=S``     seconds to wait for a reply, default 0.05
-  - ``retries=N``     re-sends of a query that timed out, default 2
+  - ``baud=N``        bit rate, default 1000000 (UART 8N1); 50 to 20000000
+  - ``timeout=S``     seconds to wait for a reply, default 0.05; 0 < S <= 60
+  - ``retries=N``     re-sends of a query that timed out, default 2; 0 to 100
   - ``lost=N``        unanswered commands in a row that mean the link is
-                      lost (once the grace period is over), default 3
+                      lost (once the grace period is over), default 3; 1 to
+                      1000
   - ``grace=S``       seconds a board may stay silent before the link is
                       lost, default 0.5: until then a query that got no reply
                       after its retries is sent again (line noise is ridden
-                      out); 0 = lost at the first query given up
+                      out); 0 = lost at the first query given up; at most 60
   - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
-                      default 250 (0 = off)
+                      default 250 (0 = off); at most 65535
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
                       (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
-                      the host's wall clock runs at the same rate
+                      the host's wall clock runs at the same rate; 0.01 to 1000
+
+Every number must be finite and within its bounds (``url_options.py``); the
+query must decode as UTF-8.
 
 The board logic -- Robot protocol, handshake, keepalive, link health, lost
 links -- is ``board_robot.BoardRobot``; this module adds the serial port and
@@ -35,13 +39,14 @@ the ``SerialLink`` (``serial_link.py``) that frames messages for it.
 from __future__ import annotations
 
 import io
-from urllib.parse import parse_qsl, urlencode
+from urllib.parse import urlencode
 
 import serial
 
 from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
+from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 
@@ -49,7 +54,6 @@ DEFAULTS: dict[str, float] = {
     "baud": 1_000_000, "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250,
     "lockstep": 0, "time_scale": 1.0, "grace": 0.5,
 }
-_INTS = {"baud", "retries", "lost", "watchdog", "lockstep"}
 
 
 def parse_serial_url(url: str) -> tuple[str, dict[str, float]]:
@@ -61,21 +65,11 @@ def parse_serial_url(url: str) -> tuple[str, dict[str, float]]:
     port, _, query = rest.rpartition("?") if "?" in rest else (rest, "", "")
     opts = dict(DEFAULTS)
     passthrough: list[tuple[str, str]] = []
-    for key, value in parse_qsl(query, keep_blank_values=True):
-        if key not in DEFAULTS:
+    for key, value in query_pairs(url, query, strict=False):
+        if key in DEFAULTS:
+            opts[key] = number_option(url, key, value)
+        else:
             passthrough.append((key, value))
-            continue
-        try:
-            number = int(value) if key in _INTS else float(value)
-        except ValueError:
-            kind = "an integer" if key in _INTS else "a number"
-            raise RobotUrlError(url, key, f"{value!r} is not {kind}") from None
-        if number < 0 or (key in {"baud", "timeout", "time_scale"} and number == 0):
-            raise RobotUrlError(url, key, f"{value} is out of range; allowed: > 0"
-                                if key in {"baud", "timeout", "time_scale"} else ">= 0")
-        if key == "lockstep" and number not in (0, 1):
-            raise RobotUrlError(url, key, f"{value} is not allowed; allowed: 0 or 1")
-        opts[key] = number
     if passthrough:
         port += ("&" if "?" in port else "?") + urlencode(passthrough)
     if not port:
@@ -88,8 +82,9 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     in one line when it cannot open."""
     try:
         ser = serial.serial_for_url(port, baudrate=baud, timeout=0)
-    except (serial.SerialException, ValueError, OSError) as exc:
-        raise RobotUrlError(url, None, f"cannot open port {port}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - pyserial's URL handlers raise anything
+        detail = str(exc).strip() or type(exc).__name__
+        raise RobotUrlError(url, None, f"cannot open port {port}: {detail}") from None
     # Only a plain POSIX port may be read around pyserial's back: a wrapper
     # such as spy:// must see every byte.
     if type(ser).__module__ != "serial.serialposix":

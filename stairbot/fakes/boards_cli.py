@@ -26,26 +26,16 @@ import signal
 import sys
 from importlib import import_module
 
+from stairbot.cli import bounded
 from stairbot.config import RobotConfig, load_config
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
+from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 from stairbot.scenario import Scenario, load_scenario
 
-
-def _probability(text: str) -> float:
-    value = float(text)
-    if not 0.0 <= value <= 1.0:
-        raise argparse.ArgumentTypeError(f"{text} is not a probability; allowed: 0..1")
-    return value
-
-
-def _positive(text: str) -> float:
-    value = float(text)
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"{text} is out of range; allowed: > 0")
-    return value
+_probability = bounded(0.0, 1.0, " (a probability)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -59,8 +49,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenario", help="scenario TOML file or shipped scenario name")
     p.add_argument("--config", help="robot config TOML file")
     pace = p.add_mutually_exclusive_group()
-    pace.add_argument("--time-scale", type=_positive, default=1.0, metavar="X",
-                      help="simulated seconds per wall second (default 1: real time)")
+    pace.add_argument("--time-scale", type=bounded(TIME_SCALE_MIN, TIME_SCALE_MAX),
+                      default=1.0, metavar="X",
+                      help="simulated seconds per wall second (default 1: real time; "
+                           f"{TIME_SCALE_MIN:g} to {TIME_SCALE_MAX:g})")
     pace.add_argument("--lockstep", action="store_true",
                       help="advance the world only on the host's StepTo (host URL ?lockstep=1)")
     f = p.add_argument_group("fault injection on the wire (probabilities per frame)")
@@ -68,8 +60,10 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--corrupt", type=_probability, default=0.0)
     f.add_argument("--duplicate", type=_probability, default=0.0)
     f.add_argument("--late", type=_probability, default=0.0)
-    f.add_argument("--late-s", type=_positive, default=0.1, help="delay of a late frame, s")
-    f.add_argument("--silent-after", type=float, default=None, metavar="S",
+    f.add_argument("--late-s", type=bounded(0.0001, 60.0, " s"), default=0.1,
+                   help="delay of a late frame, s (at most 60)")
+    f.add_argument("--silent-after", type=bounded(0.0, 86400.0, " s"), default=None,
+                   metavar="S",
                    help="boards stop answering after S seconds of board time")
     f.add_argument("--silent-board", choices=("motor", "sensor"), default=None,
                    help="only this board goes silent")

@@ -77,7 +77,8 @@ def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
     [
         (DEFAULT_TEXT.replace("[geometry]\n", "[geometry]\nLENGTH_OF_A_ROBOT = 0.3\n"),
          "geometry.LENGTH_OF_A_ROBOT", "add up to"),
-        (with_change("geometry", "wheel_radius", "-0.016"), "geometry.wheel_radius", "> 0"),
+        (with_change("geometry", "wheel_radius", "-0.016"), "geometry.wheel_radius",
+         ">= 0.001 and <= 10"),
         (with_change("motors", "lift_speed", '"fast"'), "motors.lift_speed", "a number"),
         (with_change("masses", "wheel", None), "masses.wheel", "required"),
         (DEFAULT_TEXT.replace("[masses]\n", "[masses]\nbattery = 1.0\n"), "masses.battery",

@@ -45,6 +45,6 @@ def test_run_where_no_board_answers_exits_1_naming_the_board_and_the_url(
 
 def test_fake_boards_bad_input_exits_2() -> None:
     proc = stairbot("fake-boards", "--serial", "--drop", "1.5")
-    assert proc.returncode == 2 and "allowed: 0..1" in proc.stderr
+    assert proc.returncode == 2 and "allowed: 0 to 1 (a probability)" in proc.stderr
     proc = stairbot("fake-boards", "--serial", "--scenario", "/no/such/scenario.toml")
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
