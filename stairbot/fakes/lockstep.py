@@ -92,6 +92,14 @@ class LockstepRobot(BoardRobot):
             return self._wait(reads)
         done, *replies = self._wait([step, *reads])  # the world stepped before ReadAll
         self._check_step(done)
+        if step.attempts > 1 or step.revived:
+            # The StepTo was sent again: the first copy (or its StepDone) was
+            # lost, and the boards may have answered the ReadAlls before the
+            # world stepped -- the last tick's world, taken for this one's
+            # (5 % of frames lost on CAN: the robot seemed to stand still a
+            # tick, then leap two, and backed 13 mm too far at an edge).
+            # Read again, now that StepDone says the world has stepped.
+            replies = self._wait([self._request(r.board, list(r.messages)) for r in reads])
         return replies
 
     def _check_step(self, reply: Reply) -> None:
