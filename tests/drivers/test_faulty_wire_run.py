@@ -58,14 +58,20 @@ def run_serial(scenario_file: Path, faults: WireFaults) -> tuple[RunResult, dict
         pty.close()
 
 
-def run_can(scenario_file: Path, faults: WireFaults, channel: str
-            ) -> tuple[RunResult, dict[str, int]]:
+def can_boards(scenario_file: Path, faults: WireFaults | None, channel: str
+               ) -> tuple[LockstepRobot, CanLink, CanBoardServer]:
+    """A lockstep host on CAN (``virtual``) with the fake boards served inline."""
     world = make_world(load_config(), load_scenario(scenario_file), True)
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
                             make_boards(world), faults)
     link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), server),
                    timeout_s=TIMEOUT, grace_s=GRACE)
-    robot = LockstepRobot(link, f"can://virtual/{channel}?lockstep=1")
+    return LockstepRobot(link, f"can://virtual/{channel}?lockstep=1"), link, server
+
+
+def run_can(scenario_file: Path, faults: WireFaults, channel: str
+            ) -> tuple[RunResult, dict[str, int]]:
+    robot, _, server = can_boards(scenario_file, faults, channel)
     try:
         return finish(RobotSession(robot, robot.clock, f"can://virtual/{channel}",
                                    robot.simulated))
@@ -116,13 +122,7 @@ def test_a_read_after_a_lost_stepto_sees_the_stepped_world(scenario_file: Path) 
     the last tick's world for this one's (CAN, 5 % of frames lost: the robot
     seemed to stand still a tick, then leap two, and backed 13 mm too far at
     the last edge; benchmarks/soak_faults.py seed 9)."""
-    channel = "lost-stepto"
-    world = make_world(load_config(), load_scenario(scenario_file), True)
-    server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
-                            make_boards(world))
-    link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), server),
-                   timeout_s=TIMEOUT, grace_s=GRACE)
-    robot = LockstepRobot(link, f"can://virtual/{channel}?lockstep=1")
+    robot, link, server = can_boards(scenario_file, None, "lost-stepto")
     receive = server.receive
     drop_next_step = [False]
 
