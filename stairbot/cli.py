@@ -41,7 +41,7 @@ from stairbot.cli_show import (
 from stairbot.config import RobotConfig, load_config
 from stairbot.errors import HardwareError, InputError, NoBoardError, OutputError
 from stairbot.events import Event, EventKind
-from stairbot.files import LineFile
+from stairbot.recording.record import EventRecord, RecordsTicks, open_record
 from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 from stairbot.scenario import (
     Scenario,
@@ -64,6 +64,9 @@ EXTERNAL: dict[str, tuple[str, str]] = {
     "sweep": ("stairbot.sweep.cli:main",
               "run many generated cases and judge each (stairbot sweep SPEC.toml; "
               "docs/envelope.md)"),
+    "plot": ("stairbot.recording.cli:main",
+             "draw a recording (--record FILE.mcap or JSON lines) over time as a PNG "
+             "(needs the extra stairbot[plot])"),
 }
 
 ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N, "
@@ -108,7 +111,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="pace a simulated robot at X simulated seconds per wall second "
                         f"({TIME_SCALE_MIN:g} to {TIME_SCALE_MAX:g})")
     r.add_argument("--record", metavar="FILE",
-                   help="write the event stream to FILE, one JSON object a line")
+                   help="record the run to FILE: FILE.mcap as MCAP (every tick: pose, "
+                        "motors, sensors, link; phases and events; for Foxglove), any "
+                        "other name the event stream, one JSON object a line")
     r.add_argument("--calibrate-only", action="store_true",
                    help="only square up to the first riser (calibration), then stop; "
                         "[expect] is not checked: exit 0 when calibration completes")
@@ -220,6 +225,9 @@ def _external(name: str) -> Callable[[argparse.Namespace], int]:
             return func(list(args.rest))
         except InputError as exc:
             return _input_error(exc)
+        except OutputError as exc:  # a file the command writes: the disk refused it
+            print(f"{PROG}: error: {exc}", file=sys.stderr)
+            return EXIT_MISMATCH
         except KeyboardInterrupt:
             print(f"{PROG}: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
@@ -234,14 +242,14 @@ def _load_inputs(args: argparse.Namespace) -> tuple[RobotConfig, Scenario]:
 
 
 @contextmanager
-def _record_file(path: str | None) -> Iterator[LineFile | None]:
-    """The event record, one whole line a write (InputError when it cannot be
-    opened; a write the disk refuses raises OutputError once, then the file
-    is silent and ``failed`` says why)."""
+def _record_file(path: str | None, config: RobotConfig) -> Iterator[EventRecord | None]:
+    """The run's record: MCAP for FILE.mcap, else JSON lines (InputError when
+    it cannot be opened; a write the disk refuses raises OutputError once,
+    then the record is silent and ``failed`` says why)."""
     if path is None:
         yield None
         return
-    f = LineFile(path, "the record")
+    f = open_record(path, config)
     try:
         yield f
     finally:
@@ -292,10 +300,10 @@ def cmd_run(args: argparse.Namespace) -> int:
                            allow_latched=args.resume)
     path = journal_path(args.robot, args.journal)
     mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
-    with _record_file(args.record) as record:
+    with _record_file(args.record, config) as record:
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
-                record.write(event.to_json() + "\n")
+                record.write(event)
             if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(event.line(), file=progress, flush=True)
 
@@ -336,9 +344,15 @@ def cmd_run(args: argparse.Namespace) -> int:
         control = RunControl()
         link: object = None
         try:
+            tap = None
+            if isinstance(record, RecordsTicks):  # MCAP: every tick, and the pose
+                from stairbot.recording.pose import pose_source
+
+                record.watch(pose_source(session.sim, config, scenario), scenario, args.robot)
+                tap = record.tick
             with _ctrl_c_stops(control.request_stop, session.robot.estop):
                 result = run(session, config, sink=sink, mode=mode, control=control,
-                             controller=controller, journal=journal)
+                             controller=controller, journal=journal, tap=tap)
         except KeyboardInterrupt:
             session.robot.estop()
             session.robot.stop_all()

@@ -22,11 +22,23 @@ from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import HasTruth, MotorId, ReportsEvents, Robot, Snapshot, Truth
+from stairbot.hardware import (
+    HasTruth,
+    MotorId,
+    ReportsEvents,
+    Robot,
+    Snapshot,
+    Speeds,
+    Truth,
+)
 from stairbot.journal import JournalWriter
 from stairbot.robots import RobotSession
 
 Latch = Literal["estop", "clear"]
+
+TickTap = Callable[[Snapshot, Speeds | None], None]
+"""Told after each tick: the snapshot read and the speeds sent to the robot
+(None when the latched emergency stop kept them back)."""
 
 
 class RunControl:
@@ -138,6 +150,7 @@ def run(
     wall: Callable[[], float] = time.perf_counter,
     on_tick: Callable[[Controller, Snapshot], None] | None = None,
     journal: JournalWriter | None = None,
+    tap: TickTap | None = None,
 ) -> RunResult:
     """Run the program on ``session`` until the controller finishes.
 
@@ -145,14 +158,15 @@ def run(
     "error" (or "fell" for a RobotFellError) after every motor is stopped.  A
     run that ends otherwise than "completed" or "stopped" latches the robot's
     emergency stop (``robot.estop()``): boards keep it until cleared.
-    ``on_tick(controller, snapshot)`` is called after each tick (for a console).
+    ``on_tick(controller, snapshot)`` is called after each tick (for a console);
+    ``tap(snapshot, sent)`` too, with the speeds sent (for a record).
     A run longer than ``max_sim_time_s`` of robot time ends with an error (by
     default an hour, or 60 phase timeouts for a robot whose slow motors make
     that longer).  Fell, pitch and offset in the result come from the robot's
     ``truth()`` (HasTruth; None for a robot without it).  ``journal`` (started
     by the caller) gets a durable record after every tick and the run's end; a
-    journal (or a ``sink`` writing the event record) the disk refuses -- an
-    OutputError -- ends the run with an error, the robot stopped.
+    journal (or a ``sink`` or ``tap`` writing the record) the disk refuses --
+    an OutputError -- ends the run with an error, the robot stopped.
     """
     robot, clock = session.robot, session.clock
     ctl = controller or Controller(config, sink, mode)
@@ -175,8 +189,12 @@ def run(
             # An e-stop pressed during this tick is carried out now rather
             # than after one more command; while latched nothing is sent (the
             # robot's latch holds every motor, and boards would refuse it).
+            sent: Speeds | None = None
             if control is None or not _latch(control, robot):
                 robot.command(speeds)
+                sent = speeds
+            if tap is not None:
+                tap(snap, sent)
             if journal is not None:
                 _journal_tick(journal, ctl, robot, snap, speeds)
             if on_tick is not None:
