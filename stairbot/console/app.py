@@ -53,7 +53,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("choose_robot", "Choose robot URL", "sim://, serial://PORT, can://IF/CH (key: u)"),
     ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
     ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
-    ("record", "Record events", "Start/stop writing events as JSON lines (key: w)"),
+    ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
+                                "the events as JSON lines (key: w)"),
     ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
 )
 
@@ -325,10 +326,10 @@ class StairbotConsole(App[None]):
             except InputError as exc:
                 self.notify(str(exc), severity="error", timeout=8)
                 return
-            self.notify(f"recording events to {path}")
+            self.notify(f"recording to {path}")
 
-        self.push_screen(AskScreen("Record the event stream (JSON lines) to", "events.jsonl"),
-                         chosen)
+        self.push_screen(AskScreen("Record to (FILE.mcap: every tick, MCAP; else the events, "
+                                   "JSON lines)", "events.jsonl"), chosen)
 
     def action_zoom(self) -> None:
         mode = self.picture.cycle_zoom()

@@ -26,7 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="The operator console: watch and command the robot in a terminal.\n"
                     "Keys: space EMERGENCY STOP (everywhere), c clear it, s start, k calibrate\n"
                     "only, p pause/resume, x stop, r reset the simulation, u robot URL,\n"
-                    "o scenario, f simulation speed, w record events, q quit; ctrl+p lists all.",
+                    "o scenario, f simulation speed, w record, q quit; ctrl+p lists all.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--robot", metavar="URL", default="sim://",
@@ -36,7 +36,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="scenario TOML file or shipped scenario name (default stairs)")
     p.add_argument("--config", metavar="FILE", help="robot config TOML file")
     p.add_argument("--record", metavar="FILE",
-                   help="write the event stream to FILE, one JSON object a line")
+                   help="record to FILE: FILE.mcap as MCAP (every tick and event, for "
+                        "Foxglove), any other name the event stream, one JSON object a line")
     p.add_argument("--speed", choices=tuple(SPEEDS), default="1x",
                    help="simulation speed: 1x real time (default), 10x, max")
     return p

@@ -15,19 +15,23 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import replace
-from typing import TypedDict
+from typing import TYPE_CHECKING, TypedDict
 
 from stairbot.algorithm.controller import Controller
 from stairbot.config import RobotConfig
 from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
-from stairbot.errors import InputError, StairbotError
+from stairbot.errors import InputError, OutputError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, ReportsEvents, Snapshot
+from stairbot.recording.record import RecordsTicks, is_mcap
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
+
+if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
+    from stairbot.recording.mcap_sink import McapRecord
 
 SPEEDS: dict[str, float | None] = {"1x": 1.0, "10x": 10.0, "max": None}
 """Simulation speeds the operator can pick: sim seconds per wall second."""
@@ -100,7 +104,7 @@ class ConsoleEngine:
         self.clock: PacedClock | None = None
         self.scenario: Scenario | None = None
         self.control: RunControl | None = None
-        self.recorder: Recorder | None = None
+        self.recorder: Recorder | McapRecord | None = None
         self._running = threading.Event()
         self._speed = "max"
         self._last_phase: object = None
@@ -146,6 +150,7 @@ class ConsoleEngine:
         self.clock.set_scale(SPEEDS[self._speed] if sim is not None else None)
         stairs = stairs_from_scenario(scenario, self.config.LENGTH_OF_A_ROBOT)
         self.state.set_robot(url, scenario.name, session.simulated, stairs, wired=sim is None)
+        self._recording_safely(self._watch_recording)
         try:
             self.robot.read()  # first readings and picture, before any motion
         except StairbotError as exc:
@@ -210,13 +215,41 @@ class ConsoleEngine:
         return result
 
     def _sink(self, event: Event) -> None:
+        """The run's events (and the engine's own): the live state, the record.
+        A record the disk refuses raises OutputError, which ends a run as it
+        does ``stairbot run``'s."""
         self.state.on_event(event)
         if self.recorder is not None:
             self.recorder.write(event)
 
+    def _say(self, event: Event) -> None:
+        """An event from the UI thread: a refused record write stops the
+        recording (and says so) rather than reach the key that pressed it."""
+        self._recording_safely(lambda: self._sink(event))
+
+    def _recording_safely(self, write: Callable[[], None]) -> None:
+        try:
+            write()
+        except (OutputError, OSError) as exc:
+            self.state.set_status(severity="error", message=f"recording stopped: {exc}")
+            self.stop_recording()
+
     def _on_tick(self, ctl: Controller, snap: Snapshot) -> None:
         self._controller = ctl
         self._watch_phase(ctl)
+        recorder = self.recorder
+        if isinstance(recorder, RecordsTicks) and self.robot is not None:
+            recorder.tick(snap, self.robot.sent)
+
+    def _watch_recording(self) -> None:
+        """Tell an MCAP record which robot its ticks come from (and where it
+        stands: the simulation's pose, or a dead-reckoned one)."""
+        recorder, session, scenario = self.recorder, self.session, self.scenario
+        if isinstance(recorder, RecordsTicks) and session is not None and scenario is not None:
+            from stairbot.recording.pose import pose_source
+
+            recorder.watch(pose_source(session.sim, self.config, scenario), scenario,
+                           session.url)
 
     def _watch_phase(self, ctl: Controller, final: bool = False) -> None:
         try:
@@ -246,7 +279,7 @@ class ConsoleEngine:
             self.robot.estop()
         if self.control is not None and self.running:
             self.control.estop()
-        self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
+        self._say(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
 
     def clear_estop(self) -> bool:
         """Clear the latched stop (the robot's ``clear()``: on the run thread
@@ -268,7 +301,7 @@ class ConsoleEngine:
         msg = "emergency stop cleared; p resumes the run" if self.running else \
             "emergency stop cleared"
         self.state.set_status(estopped=False, severity="warning", message=msg)
-        self._sink(Event(self._now(), EventKind.INFO, "emergency stop cleared by the operator"))
+        self._say(Event(self._now(), EventKind.INFO, "emergency stop cleared by the operator"))
         return True
 
     def pause(self) -> None:
@@ -300,15 +333,34 @@ class ConsoleEngine:
         self.state.set_speed(speed)
 
     def start_recording(self, path: str) -> None:
-        """Append every event from now on to ``path``.  Raises InputError."""
+        """Record from now on to ``path``: for a name ending .mcap every tick
+        and event as MCAP (as ``stairbot run --record FILE.mcap``), else the
+        events as JSON lines.  Raises InputError (the file cannot be opened,
+        or an MCAP file's start cannot be written)."""
         self.stop_recording()
-        self.recorder = Recorder(path)
+        if is_mcap(path):
+            from stairbot.recording.mcap_sink import McapRecord
+
+            try:
+                self.recorder = McapRecord(path, self.config)
+                self._watch_recording()
+            except OutputError as exc:
+                self.stop_recording()
+                raise InputError(exc.path, None, f"cannot write {exc.what}: "
+                                 f"{exc.problem}") from None
+        else:
+            self.recorder = Recorder(path)
         self.state.set_recording(path)
 
     def stop_recording(self) -> None:
-        if self.recorder is not None:
-            self.recorder.close()
-            self.recorder = None
+        """Stop recording (an MCAP file is finished: its summary written).
+        Never raises: a file the disk refused to finish keeps what it had."""
+        recorder, self.recorder = self.recorder, None
+        if recorder is not None:
+            try:
+                recorder.close()
+            except (OutputError, OSError) as exc:
+                self.state.set_status(severity="error", message=f"recording stopped: {exc}")
         self.state.set_recording(None)
 
     def shutdown(self, wait_s: float = 2.0) -> None:

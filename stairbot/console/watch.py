@@ -40,6 +40,9 @@ class WatchedRobot:
         self._estop_sent = False  # the inner robot's estop() was called for this latch
         self.estop_tick: int | None = None  # the tick count when the stop reached the robot
         self.ticks = 0
+        self.sent: Speeds | None = None
+        """The speeds commanded since the last read (None: none, or the
+        latched e-stop turned the command into a stop): what a record keeps."""
 
     @property
     def estopped(self) -> bool:
@@ -49,6 +52,7 @@ class WatchedRobot:
         with self._lock:
             snap = self.inner.read()
             self.ticks += 1
+            self.sent = None
             self._state.on_read(snap)
             self._maybe_scene()
         return snap
@@ -78,6 +82,7 @@ class WatchedRobot:
                 self._state.on_command(dict(ZERO_SPEEDS))
             else:
                 self.inner.command(speeds)
+                self.sent = speeds
                 self._state.on_command(dict(speeds))
 
     def stop_all(self) -> None:
