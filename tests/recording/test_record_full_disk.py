@@ -1,0 +1,98 @@
+"""An MCAP record the disk refuses, or cannot open, behaves as the JSON-lines
+record does (README, "Writes"): one line, no traceback; exit 2 for a path
+that cannot be opened, exit 1 for a refused write -- during a run after
+every motor is stopped, the file keeping what was written before."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from stairbot import files
+from stairbot.cli import main
+from stairbot.recording import topics
+from stairbot.recording.read import read_recording
+
+QUICK = "[stairs]\ncount = 1\n"
+
+
+def one_error_line(err: str) -> str:
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert "Traceback" not in err
+    assert len(lines) == 1, f"expected one line, got: {err!r}"
+    assert lines[0].startswith("stairbot: error: ")
+    return lines[0]
+
+
+@pytest.fixture
+def quick(tmp_path: Path) -> Path:
+    path = tmp_path / "quick.toml"
+    path.write_text(QUICK, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("name", ["x.mcap", "x.jsonl"])
+def test_a_record_path_that_cannot_be_opened(tmp_path: Path, name: str,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "no such folder" / name
+    assert main(["run", "-q", "--record", str(path)]) == 2
+    line = one_error_line(capsys.readouterr().err)
+    assert f"{path}: cannot write the record: No such file or directory" in line
+
+
+def test_a_record_on_a_full_device_is_refused_before_the_robot_moves(
+        tmp_path: Path, quick: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    full = tmp_path / "full.mcap"
+    full.symlink_to("/dev/full")
+    journal = tmp_path / "journal.jsonl"
+    argv = ["run", "-q", "--scenario", str(quick), "--record", str(full),
+            "--journal", str(journal)]
+    assert main(argv) == 1
+    line = one_error_line(capsys.readouterr().err)
+    assert f"{full}: cannot write the record: No space left on device" in line
+    assert not journal.exists()  # refused before the robot was opened: nothing moved
+
+
+@pytest.fixture
+def disk_fills(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, int]]:
+    """The disk fills after ``left[NAME]`` more writes to a file named NAME."""
+    left: dict[str, int] = {}
+    real = files._write
+
+    def write(fd: int, data: bytes) -> int:
+        name = Path(os.readlink(f"/proc/self/fd/{fd}")).name
+        if name in left:
+            if left[name] <= 0:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+            left[name] -= 1
+        return real(fd, data)
+
+    monkeypatch.setattr(files, "_write", write)
+    yield left
+
+
+def test_the_disk_filling_mid_run_stops_the_robot(tmp_path: Path, quick: Path,
+                                                  disk_fills: dict[str, int],
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    record, journal = tmp_path / "r.mcap", tmp_path / "j.jsonl"
+    disk_fills[record.name] = 60  # the start takes about 10 writes, a flush about 15
+    argv = ["run", "-q", "--scenario", str(quick), "--record", str(record),
+            "--journal", str(journal)]
+    assert main(argv) == 1
+    line = one_error_line(capsys.readouterr().err)
+    assert "r.mcap: cannot write the record: No space left on device" in line
+    assert "the run stopped, every motor stopped" in line
+    end = json.loads(journal.read_text().splitlines()[-1])
+    assert end["kind"] == "end" and end["outcome"] == "error"
+    assert "cannot write the record" in end["error"]
+    # what was written before the disk filled stays readable
+    rec = read_recording(record)
+    assert not rec.complete
+    assert rec.counts[topics.SENSORS] > 0
+    assert rec.events and rec.events[0]["kind"] == "phase"
+    assert rec.telemetry.time_s[-1] <= end["time_s"]
