@@ -114,8 +114,8 @@ def render(rec: Recording, *, width_in: float = 12.0, dpi: int = 100) -> bytes:
                 ax.axvline(float(e["time_s"]), color=colour, linewidth=0.8, zorder=1)
         ax.grid(True, linewidth=0.3, alpha=0.6)
     axes[-1].set_xlabel("robot time (s)")
-    axes[0].set_xlim(0.0 if end <= 0 else min(0.0, bands[0].start_s if bands else 0.0),
-                     max(end, 1e-3))
+    start = min([0.0, *(b.start_s for b in bands[:1])])
+    axes[0].set_xlim(start, max(end, start + 1e-3))
     fig.suptitle(_title(rec), fontsize=9, x=0.01, ha="left")
     fig.tight_layout()
     buf = io.BytesIO()
@@ -215,6 +215,7 @@ def _events_only(ax: Any, rec: Recording) -> None:
                 color=EVENT_LINES.get(str(e.get("kind")), "black"), markersize=10)
     ax.set_yticks(range(len(kinds)), kinds, fontsize=7)
     ax.set_ylabel("events", fontsize=8)
-    ax.text(0.5, -0.35, "a JSON-lines record holds the events alone: record to FILE.mcap "
-            "for the pitch, heights, lifts and sensors", transform=ax.transAxes,
-            ha="center", fontsize=8, color="#555555")
+    why = ("a JSON-lines record holds the events alone: record to FILE.mcap for the pitch, "
+           "heights, lifts and sensors" if rec.kind == "jsonl"
+           else "no tick was recorded: the events alone")
+    ax.text(0.5, -0.35, why, transform=ax.transAxes, ha="center", fontsize=8, color="#555555")
