@@ -49,8 +49,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         f.close()
     tel = recording.telemetry
-    what = (f"{len(tel.time_s)} ticks, {len(recording.events)} events" if tel.time_s
-            else f"{len(recording.events)} events (a record of events alone)")
+    events = len(recording.events)
+    what = (f"{len(tel.time_s)} ticks, {events} events" if tel.time_s
+            else f"{events} events: a record of events alone" if recording.kind == "jsonl"
+            else f"no tick, {events} events")
     cut = "" if recording.complete else "; the recording is cut short, read up to its end"
     print(f"wrote {shown(out)} ({what}{cut})")
     return 0

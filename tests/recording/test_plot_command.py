@@ -15,6 +15,7 @@ from mcap.writer import Writer
 
 from stairbot.cli import main
 from stairbot.config import load_config
+from stairbot.events import Event, EventKind
 from stairbot.recording.mcap_sink import McapRecord
 
 QUICK = "[stairs]\ncount = 1\n"
@@ -132,3 +133,15 @@ def test_without_matplotlib_one_line_names_the_extra(recordings: dict[str, Path]
     assert proc.stderr == ("stairbot: error: stairbot plot: needs matplotlib, which is not "
                            "installed: pip install 'stairbot[plot]'\n")
     assert not recordings["mcap"].with_suffix(".none.png").exists()
+
+
+def test_an_mcap_recording_without_ticks_plots_its_events(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "events-only.mcap"
+    record = McapRecord(path, load_config(None))
+    record.write(Event(0.0, EventKind.WARNING, "emergency stop by the operator"))
+    record.close()
+    assert main(["plot", str(path)]) == 0
+    width, height = png_size(path.with_suffix(".png").read_bytes())
+    assert width == 1200 and height < 500  # the phases and the events alone
+    assert "(no tick, 1 events)" in capsys.readouterr().out
