@@ -316,7 +316,13 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
         controller = journal = None
+        tap = None
         try:
+            if isinstance(record, RecordsTicks):  # MCAP: every tick, and the pose
+                from stairbot.recording.pose import pose_source
+
+                record.watch(pose_source(session.sim, config, scenario), scenario, args.robot)
+                tap = record.tick
             if args.resume:
                 resumed = resume_run(path, args.robot, session, config, sink, yes=args.yes,
                                      out=progress)
@@ -344,12 +350,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         control = RunControl()
         link: object = None
         try:
-            tap = None
-            if isinstance(record, RecordsTicks):  # MCAP: every tick, and the pose
-                from stairbot.recording.pose import pose_source
-
-                record.watch(pose_source(session.sim, config, scenario), scenario, args.robot)
-                tap = record.tick
             with _ctrl_c_stops(control.request_stop, session.robot.estop):
                 result = run(session, config, sink=sink, mode=mode, control=control,
                              controller=controller, journal=journal, tap=tap)

@@ -16,7 +16,7 @@ import pytest
 from stairbot import files
 from stairbot.cli import main
 from stairbot.recording import topics
-from stairbot.recording.read import read_recording
+from stairbot.recording.read import RecordingError, read_recording
 
 QUICK = "[stairs]\ncount = 1\n"
 
@@ -96,3 +96,19 @@ def test_the_disk_filling_mid_run_stops_the_robot(tmp_path: Path, quick: Path,
     assert rec.counts[topics.SENSORS] > 0
     assert rec.events and rec.events[0]["kind"] == "phase"
     assert rec.telemetry.time_s[-1] <= end["time_s"]
+
+
+def test_the_disk_filling_as_the_robot_is_described_stops_before_the_journal(
+        tmp_path: Path, quick: Path, disk_fills: dict[str, int],
+        capsys: pytest.CaptureFixture[str]) -> None:
+    record, journal = tmp_path / "r.mcap", tmp_path / "j.jsonl"
+    disk_fills[record.name] = 7  # the file's start, not the scenario and scene after it
+    argv = ["run", "-q", "--scenario", str(quick), "--record", str(record),
+            "--journal", str(journal)]
+    assert main(argv) == 1
+    line = one_error_line(capsys.readouterr().err)
+    assert "r.mcap: cannot write the record: No space left on device" in line
+    assert "the run stopped" not in line  # it never started
+    assert not journal.exists()
+    with pytest.raises(RecordingError, match="holds no messages"):  # its start, no run
+        read_recording(record)
