@@ -51,8 +51,9 @@ def boards(env: dict[str, str], tmp_path: Path) -> Iterator[tuple[str, subproces
 
 
 def last_tick(journal: Path) -> dict[str, object]:
-    lines = journal.read_text().splitlines()
-    return json.loads(lines[-1]) if lines else {}
+    """The journal's last whole line (a run still writing may have begun the next)."""
+    whole = journal.read_text().rpartition("\n")[0]
+    return json.loads(whole.rpartition("\n")[2]) if whole else {}
 
 
 def kill_mid_lift(url: str, journal: Path, env: dict[str, str], cwd: Path) -> dict[str, object]:
