@@ -20,6 +20,7 @@ from pathlib import Path
 
 from rich.console import Console
 
+from stairbot.errors import OutputError
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.spec import SpecError
 from stairbot.sweep.verdict import passing
@@ -125,6 +126,10 @@ def cmd_sweep(argv: list[str]) -> int:
                 out = run_cases(cases, store, executor, view.update, jobs)
             finally:
                 view.close()
+    except OutputError as exc:  # a full disk: the cases already written stay
+        raise OutputError(exc.path, exc.what, f"{exc.problem}; the sweep stopped, "
+                          f"{len(store.done)} finished case(s) kept in {folder}: rerun with "
+                          "--resume once there is room") from None
     finally:
         store.close()
     records = [r for r in store.records if r["case"] < len(cases)]

@@ -10,7 +10,9 @@
         case-000123.robot.toml   (when the spec overrides the robot config)
 
 A SIGKILL can leave at most a torn last line; opening the folder again cuts it
-off, so no case is lost (it runs again) and none is counted twice.
+off, so no case is lost (it runs again) and none is counted twice.  A write the
+disk refuses (a full disk) raises OutputError naming the file: the sweep stops,
+every line written before stays, and ``--resume`` finishes once there is room.
 """
 
 from __future__ import annotations
@@ -18,10 +20,13 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 from stairbot import __version__
+from stairbot.errors import OutputError
+from stairbot.files import LineFile, shown
 from stairbot.sweep import tomlw
 from stairbot.sweep.cases import Case
 from stairbot.sweep.spec import Spec, SpecError
@@ -52,6 +57,9 @@ def read_records(folder: Path) -> Iterator[dict[str, Any]]:
     path = folder / CASES
     if not path.exists():
         return
+    if not path.is_file():  # a FIFO or a device would hang or never end
+        raise ResultsError(str(path), None, "not a regular file; allowed: the cases.jsonl a "
+                           "sweep wrote")
     with path.open(encoding="utf-8") as f:
         for line in f:
             if not line.endswith("\n"):
@@ -98,14 +106,19 @@ class ResultStore:
             raise ResultsError(str(folder), None,
                                f"already holds {len(self.done)} finished case(s); allowed: "
                                "--resume to finish them, or a new --out folder")
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / FAILURES).mkdir(exist_ok=True)
+        with _writing(folder, "the sweep results folder"):
+            folder.mkdir(parents=True, exist_ok=True)
+            (folder / FAILURES).mkdir(exist_ok=True)
         if not meta_path.exists():
             tmp = meta_path.with_suffix(".tmp")
-            tmp.write_text(json.dumps(meta_of(spec), indent=2) + "\n", "utf-8")
-            os.replace(tmp, meta_path)
-        self._cut_torn_line(folder / CASES)
-        self._f: IO[str] = (folder / CASES).open("a", encoding="utf-8")
+            with _writing(tmp, "the sweep's spec"):
+                tmp.write_text(json.dumps(meta_of(spec), indent=2) + "\n", "utf-8")
+                os.replace(tmp, meta_path)
+        with _writing(folder / CASES, "the sweep results"):
+            self._cut_torn_line(folder / CASES)
+        # each line whole and fsynced before the next case counts as done
+        self._f = LineFile(folder / CASES, "the sweep results", fresh=False, sync=True,
+                           regular=True, error=ResultsError)
 
     @staticmethod
     def _cut_torn_line(path: Path) -> None:
@@ -122,8 +135,6 @@ class ResultStore:
         if not passing(str(record.get("verdict"))):
             record["reproduce"] = self.write_failure(record, case)
         self._f.write(json.dumps(record, sort_keys=True) + "\n")
-        self._f.flush()
-        os.fsync(self._f.fileno())
         self.done.add(case.index)
         self.records.append(record)
 
@@ -132,7 +143,8 @@ class ResultStore:
         scen, robot = stem.with_suffix(".toml"), Path(f"{stem}.robot.toml")
         cmd = f"stairbot run --scenario {scen}"
         if case.config_text is not None:
-            robot.write_text(case.config_text, "utf-8")
+            with _writing(robot, "a failing case's robot config"):
+                robot.write_text(case.config_text, "utf-8")
             cmd += f" --config {robot}"
         f = case.facts
         header = (f"case {case.index} of sweep {self.spec.name} (spec hash {self.spec.hash})\n"
@@ -148,11 +160,21 @@ class ResultStore:
         text = header_comment(header) + case.scenario_text
         if expect:
             text += "\n" + tomlw.dumps({"expect": expect})
-        scen.write_text(text, "utf-8")
+        with _writing(scen, "a failing case's scenario"):
+            scen.write_text(text, "utf-8")
         return cmd
 
     def close(self) -> None:
         self._f.close()
+
+
+@contextmanager
+def _writing(path: Path, what: str) -> Iterator[None]:
+    """OSError from writing ``path`` as OutputError naming it (a full disk)."""
+    try:
+        yield
+    except OSError as exc:
+        raise OutputError(shown(path), what, exc.strerror or str(exc)) from None
 
 
 def header_comment(text: str) -> str:
