@@ -1,6 +1,10 @@
-"""What the run journal costs a tick: the time ``JournalWriter.tick`` takes,
-with and without fsync, and the bytes it writes, over the ticks of a real
-default run (its phases, commands and contexts, replayed into the journal).
+"""What the run journal costs a tick: the time ``JournalWriter.tick`` takes
+the control loop, with and without fsync, and the bytes it writes, over the
+ticks of a real default run (its phases, commands and contexts, replayed into
+the journal, back to back).  With fsync, a tick is written at once and its
+fsync done by the journal's own thread; the line says how many fsyncs that
+thread did (one covers every line written before it) and how long closing
+waited for the last.
 
     python benchmarks/bench_journal.py [--dir DIR] [--ticks N]
 
@@ -44,7 +48,8 @@ def recorded_ticks(n: int) -> list[dict[str, Any]]:
     return ticks
 
 
-def measure(folder: Path, ticks: list[dict[str, Any]], sync: bool) -> tuple[list[float], int]:
+def measure(folder: Path, ticks: list[dict[str, Any]],
+            sync: bool) -> tuple[list[float], int, int, float]:
     fd, name = tempfile.mkstemp(prefix="bench-journal-", suffix=".jsonl", dir=folder)
     os.close(fd)
     try:
@@ -59,8 +64,9 @@ def measure(folder: Path, ticks: list[dict[str, Any]], sync: bool) -> tuple[list
             w.tick(time_s=t["time_s"], phase=t["phase"], estopped=False, command=command,
                    boards=boards, context=partial(dict, t["context"]))
             times.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
         w.close()
-        return times, os.path.getsize(name)
+        return times, os.path.getsize(name), w.syncs, time.perf_counter() - t0
     finally:
         os.unlink(name)
 
@@ -77,13 +83,14 @@ def main(argv: list[str] | None = None) -> int:
     ticks = recorded_ticks(args.ticks)
     print(f"bench_journal: {len(ticks)} ticks of the default run, journal in {args.dir}")
     for sync in (True, False):
-        times, size = measure(args.dir, ticks, sync)
+        times, size, syncs, closing = measure(args.dir, ticks, sync)
         ordered = sorted(times)
         print(f"  {'fsync' if sync else 'no fsync':8s}  per tick: median "
               f"{statistics.median(times) * 1e6:8.0f} us, p99 "
               f"{ordered[int(0.99 * (len(ordered) - 1))] * 1e6:8.0f} us, max "
               f"{ordered[-1] * 1e6:8.0f} us; {size / len(ticks):.0f} bytes a tick "
-              f"(the 20 ms tick: {statistics.median(times) / 0.02 * 100:.2f} %)")
+              f"(the 20 ms tick: {statistics.median(times) / 0.02 * 100:.2f} %)"
+              + (f"; {syncs} fsyncs, close waited {closing * 1e3:.1f} ms" if sync else ""))
     return 0
 
 
