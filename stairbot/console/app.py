@@ -15,6 +15,7 @@ from collections.abc import Awaitable, Callable, Iterable
 from pathlib import Path
 from typing import Unpack
 
+from rich.text import Text
 from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
@@ -119,10 +120,7 @@ class StairbotConsole(App[None]):
 
     def on_mount(self) -> None:
         if self._record:
-            try:
-                self.engine.start_recording(self._record)
-            except InputError as exc:
-                self.notify(str(exc), severity="error", timeout=8)
+            self._start_recording(self._record)
         self.refresh_view()
         self.set_interval(1 / REFRESH_HZ, self.refresh_view)
         self.open_robot(self.url, self.scenario)
@@ -139,7 +137,7 @@ class StairbotConsole(App[None]):
     def _show(self, v: StateView) -> None:
         self.banner.show(v.url, v.scenario, v.status, v.recording)
         picture = self.picture
-        picture.border_title = f"side view · {v.url} · {v.scenario}"
+        picture.border_title = Text(f"side view · {v.url} · {v.scenario}")  # never markup
         snap = v.snapshot
         lifts = None
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
@@ -195,8 +193,17 @@ class StairbotConsole(App[None]):
             self._tell(f"run {result.outcome}", "information")
 
     def _tell(self, message: str, severity: str) -> None:
-        self.call_from_thread(self.notify, message, severity=severity,
-                              timeout=6)
+        self.call_from_thread(self.say, message, severity)
+
+    def say(self, message: str, severity: str = "information", *, keep: bool = True,
+            timeout: float = 6) -> None:
+        """Tell the operator: a toast, and (``keep``) a line in the event list
+        that stays after the toast has gone.  The text is shown as it is, never
+        parsed as markup: URLs, paths and drivers' messages hold brackets."""
+        if keep:
+            self.state.note(message, severity)
+        self.notify(message, severity=severity, timeout=timeout,  # type: ignore[arg-type]
+                    markup=False)
 
     # -- actions -------------------------------------------------------------------
     async def on_event(self, event: events.Event) -> None:
@@ -217,22 +224,22 @@ class StairbotConsole(App[None]):
 
     def action_clear_estop(self) -> None:
         if not self.engine.clear_estop():
-            self.notify("the emergency stop is not set")
+            self.say("the emergency stop is not set")
         self.refresh_view()
 
     def action_start(self, mode: str) -> None:
         if self.engine.running:
-            self.notify("a run is already going on", severity="warning")
+            self.say("a run is already going on", severity="warning")
             return
         if self.engine.session is None:
-            self.notify("no robot open: choose one with u", severity="error")
+            self.say("no robot open: choose one with u", severity="error")
             return
         what = "Start calibration" if mode == "calibrate" else "Start the full run"
         self._after_consent(what, lambda: self.run_program(mode))
 
     def action_pause(self) -> None:
         if not self.engine.running:
-            self.notify("no run is going on")
+            self.say("no run is going on")
         elif self.state.view().status.paused:
             self._after_consent("Resume motion", self.engine.resume)
         else:
@@ -255,7 +262,7 @@ class StairbotConsole(App[None]):
                 go()
                 self.refresh_view()
             else:
-                self.notify("nothing moved")
+                self.say("nothing moved")
 
         self.push_screen(ConfirmScreen(
             f"{what} on {session.url}?\n{boards}\n"
@@ -265,20 +272,20 @@ class StairbotConsole(App[None]):
         if self.engine.running:
             self.engine.stop()
         else:
-            self.notify("no run is going on")
+            self.say("no run is going on")
 
     def action_reset(self) -> None:
         if self.engine.running:
-            self.notify("stop the run first (x)", severity="warning")
+            self.say("stop the run first (x)", severity="warning")
         elif self.engine.session is not None and not self.engine.in_process:
-            self.notify("reset is for the in-process simulation (sim://)", severity="warning")
+            self.say("reset is for the in-process simulation (sim://)", severity="warning")
         else:
             self.log_panel.reset_log()
             self.open_robot(self.url, self.scenario)
 
     def action_choose_robot(self) -> None:
         if self.engine.running:
-            self.notify("stop the run first (x)", severity="warning")
+            self.say("stop the run first (x)", severity="warning")
             return
 
         def chosen(url: str | None) -> None:
@@ -290,7 +297,7 @@ class StairbotConsole(App[None]):
 
     def action_choose_scenario(self) -> None:
         if self.engine.running:
-            self.notify("stop the run first (x)", severity="warning")
+            self.say("stop the run first (x)", severity="warning")
             return
 
         def chosen(name: str | None) -> None:
@@ -302,7 +309,7 @@ class StairbotConsole(App[None]):
 
     def action_speed(self) -> None:
         if self.engine.session is not None and not self.engine.in_process:
-            self.notify("a robot on a wire keeps its own time (fake boards: --time-scale)",
+            self.say("a robot on a wire keeps its own time (fake boards: --time-scale)",
                         severity="warning")
             return
         current = self.state.view().speed
@@ -314,26 +321,33 @@ class StairbotConsole(App[None]):
         if self.engine.recorder is not None:
             path = self.engine.recorder.path
             self.engine.stop_recording()
-            self.notify(f"recording stopped: {path}")
+            self.say(f"recording stopped: {path}")
             return
 
         def chosen(path: str | None) -> None:
-            if not path:
-                return
-            try:
-                self.engine.start_recording(path)
-            except InputError as exc:
-                self.notify(str(exc), severity="error", timeout=8)
-                return
-            self.notify(f"recording events to {path}")
+            if path:
+                self._start_recording(path)
 
         self.push_screen(AskScreen("Record the event stream (JSON lines) to", "events.jsonl"),
                          chosen)
 
+    def _start_recording(self, path: str) -> None:
+        """Record to ``path``, or beside it when a file is there (never over it)."""
+        try:
+            chosen = self.engine.start_recording(path)
+        except InputError as exc:
+            self.say(str(exc), "error", timeout=8)
+            return
+        if chosen != path:
+            self.say(f"{path} exists (not overwritten): recording events to {chosen}",
+                     "warning", timeout=8)
+        else:
+            self.say(f"recording events to {chosen}")
+
     def action_zoom(self) -> None:
         mode = self.picture.cycle_zoom()
         names = {"auto": "auto zoom", "flight": "whole flight", "robot": "following the robot"}
-        self.notify(f"picture: {names[mode]}")
+        self.say(f"picture: {names[mode]}", keep=False)
 
     def get_system_commands(self, screen: Screen) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)

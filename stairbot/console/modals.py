@@ -22,7 +22,7 @@ class ConfirmScreen(ModalScreen[bool]):
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Label(self.question, classes="question")
+            yield Label(self.question, classes="question", markup=False)
             with Horizontal(classes="buttons"):
                 yield Button("Yes, start (y)", variant="warning", id="yes", compact=True)
                 yield Button("No (n)", variant="primary", id="no", compact=True)
@@ -53,10 +53,10 @@ class AskScreen(ModalScreen[str | None]):
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Label(self.title_text, classes="question")
+            yield Label(self.title_text, classes="question", markup=False)
             yield Input(value=self.value, placeholder=self.placeholder, id="answer")
             if self.hint:
-                yield Label(self.hint, classes="hint")
+                yield Label(self.hint, classes="hint", markup=False)
             yield Label("space is the EMERGENCY STOP even here: no spaces", classes="hint")
 
     def on_mount(self) -> None:

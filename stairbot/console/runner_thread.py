@@ -25,6 +25,7 @@ from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
 from stairbot.errors import InputError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, ReportsEvents, Snapshot
+from stairbot.paths import unused_path
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
@@ -299,11 +300,19 @@ class ConsoleEngine:
             self.clock.set_scale(SPEEDS[speed])
         self.state.set_speed(speed)
 
-    def start_recording(self, path: str) -> None:
-        """Append every event from now on to ``path``.  Raises InputError."""
+    def start_recording(self, path: str) -> str:
+        """Write every event from now on to ``path``, or, when a file is
+        there already, beside it under a name not taken (``name-1.jsonl``:
+        a recording is never overwritten); returns the path written to.
+        Raises InputError."""
         self.stop_recording()
-        self.recorder = Recorder(path)
-        self.state.set_recording(path)
+        try:
+            chosen = unused_path(path)
+        except FileExistsError as exc:
+            raise InputError(path, None, f"cannot write the record: {exc}") from None
+        self.recorder = Recorder(chosen)
+        self.state.set_recording(chosen)
+        return chosen
 
     def stop_recording(self) -> None:
         if self.recorder is not None:

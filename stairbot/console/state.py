@@ -12,11 +12,14 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from stairbot.console.scene import SceneView
-from stairbot.events import Event
+from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, Snapshot
 from stairbot.runner import RunResult
 
 LOG_LENGTH = 1000
+NOTE_KINDS = {"information": EventKind.INFO, "warning": EventKind.WARNING,
+              "error": EventKind.ERROR}
+CONSOLE = "console"  # the phase field of what the console itself says
 
 
 @dataclass(frozen=True)
@@ -146,6 +149,14 @@ class LiveState:
                     {k: float(v) for k, v in event.data.items() if isinstance(v, int | float)}
                 )
             self._bump()
+
+    def note(self, message: str, severity: str = "information") -> None:
+        """What the console told the operator, kept in the event list (on the
+        robot's clock as last read; not in the record: the run's events are
+        what `stairbot run --record` writes)."""
+        time_s = self._snapshot.time_s if self._snapshot is not None else 0.0
+        self.on_event(Event(time_s, NOTE_KINDS.get(severity, EventKind.INFO), message,
+                            CONSOLE))
 
     def on_result(self, result: RunResult | None) -> None:
         with self._lock:

@@ -11,8 +11,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from pilot import banner, press, ready, until
 from still_robot import still_open
-from textual import events
 from textual.widgets import Input
 
 from stairbot.cli import main as cli_main
@@ -74,35 +74,6 @@ def spied_open(spies: list[SpyRobot]) -> Callable[..., RobotSession]:
         spies.append(spy)
         return RobotSession(spy, session.clock, session.url, session.simulated, session.sim)
     return open_fn
-
-
-async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:
-    """Let the app run until ``cond`` holds (the bound only stops a broken test)."""
-    for _ in range(1200):
-        if cond():
-            await pilot.pause(0.01)
-            return
-        await asyncio.sleep(0.05)
-    raise AssertionError(f"never happened: {what}")
-
-
-async def press(pilot: Any, *keys: str) -> None:
-    """Send key events the way the terminal driver does and let the app handle
-    them.  (Pilot.press also waits for the process to go idle, up to 2 s a key,
-    which a running simulation never does.)"""
-    for key in keys:
-        char = " " if key == "space" else (key if len(key) == 1 else None)
-        pilot.app.post_message(events.Key(key, char))
-        await pilot.pause(0.02)
-
-
-def banner(app: StairbotConsole) -> str:
-    return app.banner.plain
-
-
-async def ready(pilot: Any) -> None:
-    await pilot.app.workers.wait_for_complete()
-    await until(pilot, lambda: "READY" in banner(pilot.app), "the robot is ready")
 
 
 def _comparable(line: str) -> dict[str, Any]:

@@ -1,0 +1,57 @@
+"""Driving the console in tests: keys sent as the terminal sends them, and
+waiting for what the app's threads make true (the bounds only stop a broken
+test; no test asserts a time).  A module of its own, not conftest.py."""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable
+from typing import Any
+
+from textual import events
+from textual.widgets import Input
+
+from stairbot.console.app import StairbotConsole
+
+
+async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:
+    """Let the app run until ``cond`` holds (the bound only stops a broken test)."""
+    for _ in range(1200):
+        if cond():
+            await pilot.pause(0.01)
+            return
+        await asyncio.sleep(0.05)
+    raise AssertionError(f"never happened: {what}")
+
+
+async def press(pilot: Any, *keys: str) -> None:
+    """Send key events the way the terminal driver does and let the app handle
+    them.  (Pilot.press also waits for the process to go idle, up to 2 s a key,
+    which a running simulation never does.)"""
+    for key in keys:
+        char = " " if key == "space" else (key if len(key) == 1 else None)
+        pilot.app.post_message(events.Key(key, char))
+        await pilot.pause(0.02)
+
+
+def banner(app: StairbotConsole) -> str:
+    return app.banner.plain
+
+
+async def ready(pilot: Any) -> None:
+    await pilot.app.workers.wait_for_complete()
+    await until(pilot, lambda: "READY" in banner(pilot.app), "the robot is ready")
+
+
+async def answer_prompt(pilot: Any, key: str, value: str) -> None:
+    """Press ``key``, put ``value`` into the prompt it opens, press enter."""
+    await press(pilot, key)
+    await until(pilot, lambda: bool(pilot.app.screen.query(Input)), "the prompt")
+    pilot.app.screen.query_one(Input).value = value
+    await press(pilot, "enter")
+
+
+def said(app: StairbotConsole) -> str:
+    """Every message in the state's event list (the run's events and what the
+    console told the operator), one a line."""
+    return "\n".join(event.message for _, event in app.state.view().events)
