@@ -26,7 +26,7 @@ from textual.widgets import Footer
 from stairbot.config import RobotConfig, load_config
 from stairbot.console.modals import AskScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
-from stairbot.console.runner_thread import SPEEDS, ConsoleEngine, EngineHooks
+from stairbot.console.runner_thread import LATCH_HINT, SPEEDS, ConsoleEngine, EngineHooks
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
@@ -40,6 +40,8 @@ from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 
 REFRESH_HZ = 10.0
+LOOK_FIRST = ("Look at the robot first: it may stand part way up a step, and the next run "
+              "starts from where it stands.")
 SPEED_ORDER = tuple(SPEEDS)
 
 # (action, palette title, palette help) for every operator action.
@@ -163,12 +165,13 @@ class StairbotConsole(App[None]):
 
     # -- workers -------------------------------------------------------------------
     @work(thread=True, group="robot", exclusive=True, exit_on_error=False)
-    def open_robot(self, url: str, scenario: str | None) -> None:
+    def open_robot(self, url: str, scenario: str | None, clear_latches: bool = False) -> None:
         """Open a robot off the UI thread; on bad input say so and reopen the
-        previous robot (if opening the new one closed it)."""
+        previous robot (if opening the new one closed it).  ``clear_latches``:
+        the operator confirmed clearing the latches the boards hold."""
         previous = (self.url, self.scenario) if self.engine.session is not None else None
         try:
-            self.engine.open(url, scenario)
+            self.engine.open(url, scenario, clear_latches=clear_latches)
         except Exception as exc:  # noqa: BLE001 - any failure is a message, not a traceback
             message = f"cannot open {url}: {_why(exc)}"
             self._tell(message, "error")
@@ -223,11 +226,42 @@ class StairbotConsole(App[None]):
         self.refresh_view()
 
     def action_clear_estop(self) -> None:
-        if not self.engine.clear_estop():
+        """Clear the emergency stop -- the console's latch, or the latches of
+        boards refused for holding one -- once the operator confirms."""
+        pending = self.engine.latched_boards
+        if pending is not None and self.engine.session is None:
+            url, scenario, why = pending
+            question = (f"{why}\n\n{LOOK_FIRST}\nClear the latches the boards hold?")
+
+            def clear_boards(yes: bool | None) -> None:
+                if yes:
+                    self.open_robot(url, scenario, clear_latches=True)
+                else:
+                    self.say("not cleared: the boards keep their latches")
+
+            self.push_screen(ConfirmScreen(question, yes="Yes, clear (y)"), clear_boards)
+            return
+        if not self.engine.estop_set:
             self.say("the emergency stop is not set")
-        self.refresh_view()
+            return
+
+        def clear(yes: bool | None) -> None:
+            if not yes:
+                self.say("not cleared: the emergency stop stays latched")
+            elif not self.engine.clear_estop():
+                self.say("the emergency stop is not set")
+            self.refresh_view()
+
+        then = "p resumes the run" if self.engine.running else "s starts a run"
+        self.push_screen(ConfirmScreen(
+            f"Clear the EMERGENCY STOP?\n{LOOK_FIRST}\nClearing moves nothing: {then}.",
+            yes="Yes, clear (y)"), clear)
 
     def action_start(self, mode: str) -> None:
+        if self.engine.estop_set:
+            self.state.set_status(message=LATCH_HINT, severity="error")
+            self.say(LATCH_HINT, "error")
+            return
         if self.engine.running:
             self.say("a run is already going on", severity="warning")
             return

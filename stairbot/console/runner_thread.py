@@ -22,13 +22,15 @@ from stairbot.config import RobotConfig
 from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
-from stairbot.errors import InputError, StairbotError
+from stairbot.errors import InputError, LatchedError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, ReportsEvents, Snapshot
 from stairbot.paths import unused_path
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
+
+LATCH_HINT = "EMERGENCY STOP latched — c clears it (after you look at the robot)"
 
 SPEEDS: dict[str, float | None] = {"1x": 1.0, "10x": 10.0, "max": None}
 """Simulation speeds the operator can pick: sim seconds per wall second."""
@@ -107,6 +109,8 @@ class ConsoleEngine:
         self._last_phase: object = None
         self._controller: Controller | None = None  # the run's, as the last tick saw it
         self._last_ctx = -1.0
+        self.latched_boards: tuple[str, str | None, str] | None = None
+        """(url, scenario, why) of boards refused for the latch they hold."""
 
     # -- robot -----------------------------------------------------------------
     @property
@@ -124,16 +128,46 @@ class ConsoleEngine:
         """The simulation runs here (sim://): the console draws it and sets its speed."""
         return self.session is not None and self.session.sim is not None
 
-    def open(self, url: str, scenario_path: str | None) -> None:
+    @property
+    def latched(self) -> bool:
+        """The console's emergency stop latch: set by the operator or by a run
+        that ended on an error; it outlives the robot (a reset, another URL)
+        and only :meth:`clear_estop` clears it."""
+        return self.state.view().status.estopped
+
+    def open(self, url: str, scenario_path: str | None, *, clear_latches: bool = False) -> None:
         """Open the robot at ``url`` on the scenario (None: the default stairs),
-        closing the previous one.  Raises InputError (bad URL or scenario) or
-        StairbotError (the robot cannot be opened); the old robot stays closed."""
+        closing the previous one.  Opening never clears a latch: the
+        console's own carries over to the new robot (its ``estop()`` is
+        called at once), and boards that hold one are refused (LatchedError,
+        naming ``c`` and ``stairbot clear``; :attr:`latched_boards` remembers
+        them) -- unless ``clear_latches``: the operator pressed ``c`` and
+        confirmed, and the boards' latches and the console's are cleared.
+        Raises InputError (bad URL or scenario) or StairbotError (the robot
+        cannot be opened); the old robot stays closed."""
         if self.running:
             raise InputError(url, None, "a run is going on; stop it first")
         scenario = load_scenario(scenario_path)
         self.close()
         self.state.set_status(robot="connecting", message=f"opening {url}", severity="info")
-        session = self._open_fn(url, self.config, scenario, RobotOptions())
+        try:
+            session = self._open_fn(url, self.config, scenario,
+                                    RobotOptions(allow_latched=clear_latches))
+        except LatchedError as exc:
+            message = f"{exc}; or press c here once you have looked at the robot"
+            self.latched_boards = (url, scenario_path, message)
+            raise LatchedError(message) from None
+        self.latched_boards = None
+        if clear_latches:
+            try:
+                session.robot.clear()  # the boards' latches, as `stairbot clear` does
+            except BaseException:
+                with contextlib.suppress(Exception):
+                    session.close()
+                raise
+            self.state.set_status(estopped=False, latch="")
+            self._sink(Event(self._now(), EventKind.INFO,
+                             "latches cleared by the operator (confirmed)"))
         self.session, self.scenario = session, scenario
         sim = session.sim
         scene_fn: Callable[[], SceneView] | None = None
@@ -143,6 +177,8 @@ class ConsoleEngine:
         if isinstance(session.robot, ReportsEvents):  # LINK events: the log and the record
             session.robot.attach_sink(self._sink)
         self.robot = watch(session.robot, self.state, self._lock, scene_fn, self._wall)
+        if self.latched:  # the latch outlives the robot it was pressed on
+            self.robot.estop()
         self.clock = PacedClock(session.clock, self._lock, self._wall, self._sleep)
         self.clock.set_scale(SPEEDS[self._speed] if sim is not None else None)
         stairs = stairs_from_scenario(scenario, self.config.LENGTH_OF_A_ROBOT)
@@ -154,8 +190,10 @@ class ConsoleEngine:
                                   severity="error")
             return
         self.robot.refresh_scene()
-        self.state.set_status(robot="ready", estopped=False, paused=False,
-                              message="", severity="info")
+        latched = self.latched
+        self.state.set_status(robot="ready", paused=False,
+                              message=LATCH_HINT if latched else "",
+                              severity="error" if latched else "info")
 
     def close(self) -> None:
         """Stop and release the robot (never raises)."""
@@ -172,9 +210,8 @@ class ConsoleEngine:
             self.state.set_status(message="no robot open: choose a robot first (u)",
                                   severity="warning")
             return None
-        if self.robot.estopped:
-            self.state.set_status(message="emergency stop is set: clear it (c) first",
-                                  severity="warning")
+        if self.robot.estopped or self.latched:
+            self.state.set_status(message=LATCH_HINT, severity="error")
             return None
         if self._running.is_set():
             return None
@@ -203,7 +240,9 @@ class ConsoleEngine:
         self.state.on_result(result)
         line, severity = describe_result(result)
         if self.robot.estopped:
-            line += " · EMERGENCY STOP still set: c clears it"
+            line += " · EMERGENCY STOP latched: c clears it"
+            if not self.latched:  # the run latched it (an error): the console holds it too
+                self.state.set_status(estopped=True, latch=f"automatic: {result.error or line}")
         # A lost link or a failing board is a fault of the robot, not an ending:
         # its values stop being live, and the operator must look before a rerun.
         self.state.set_status(robot="fault" if result.fault else "ended", paused=False,
@@ -239,7 +278,7 @@ class ConsoleEngine:
         robot's own ``estop()``, from this thread at once (the run loop, told
         too, holds the program and does not repeat it)."""
         self.state.set_status(estopped=True, paused=self.running, severity="error",
-                              message="EMERGENCY STOP latched — c clears it")
+                              message=LATCH_HINT, latch="operator")
         if self.robot is not None:
             # The boards' estop() puts the stop on the wire at once, then waits
             # for their confirmation (a few ms; at most half a second, after
@@ -248,6 +287,11 @@ class ConsoleEngine:
         if self.control is not None and self.running:
             self.control.estop()
         self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
+
+    @property
+    def estop_set(self) -> bool:
+        """The console's latch or the robot's (what :meth:`clear_estop` clears)."""
+        return self.latched or (self.robot is not None and self.robot.estopped)
 
     def clear_estop(self) -> bool:
         """Clear the latched stop (the robot's ``clear()``: on the run thread
@@ -268,7 +312,7 @@ class ConsoleEngine:
                 return True
         msg = "emergency stop cleared; p resumes the run" if self.running else \
             "emergency stop cleared"
-        self.state.set_status(estopped=False, severity="warning", message=msg)
+        self.state.set_status(estopped=False, severity="warning", message=msg, latch="")
         self._sink(Event(self._now(), EventKind.INFO, "emergency stop cleared by the operator"))
         return True
 

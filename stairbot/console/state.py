@@ -31,6 +31,7 @@ class RunStatus:
     paused: bool = False
     message: str = ""  # how the run ended, or what went wrong
     severity: str = "info"  # info | good | warning | error
+    latch: str = ""  # who latched the emergency stop: "operator", or "automatic: why"
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,7 @@ class LiveState:
 
     def set_status(self, *, robot: str | None = None, estopped: bool | None = None,
                    paused: bool | None = None, message: str | None = None,
-                   severity: str | None = None) -> None:
+                   severity: str | None = None, latch: str | None = None) -> None:
         """Change the fields given (None: left as it is)."""
         with self._lock:
             st = self._status
@@ -112,6 +113,7 @@ class LiveState:
                 paused=st.paused if paused is None else paused,
                 message=st.message if message is None else message,
                 severity=st.severity if severity is None else severity,
+                latch=st.latch if latch is None else latch,
             )
             self._bump()
 

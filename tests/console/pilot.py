@@ -6,12 +6,15 @@ from __future__ import annotations
 
 import asyncio
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 from textual import events
 from textual.widgets import Input
 
 from stairbot.console.app import StairbotConsole
+from stairbot.hardware import MotorId, Speeds
+from stairbot.robots import RobotSession, open_robot
 
 
 async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:
@@ -55,3 +58,56 @@ def said(app: StairbotConsole) -> str:
     """Every message in the state's event list (the run's events and what the
     console told the operator), one a line."""
     return "\n".join(event.message for _, event in app.state.view().events)
+
+
+class SpyRobot:
+    """Passes every call to the simulated robot and logs it, so a test can see
+    exactly what reached the robot and in which order."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner = inner
+        self.calls: list[tuple[str, dict[MotorId, float] | None]] = []
+
+    def read(self) -> Any:
+        self.calls.append(("read", None))
+        return self.inner.read()
+
+    def command(self, speeds: Speeds) -> None:
+        self.calls.append(("command", dict(speeds)))
+        self.inner.command(speeds)
+
+    def stop_all(self) -> None:
+        self.calls.append(("stop_all", None))
+        self.inner.stop_all()
+
+    def estop(self) -> None:
+        self.calls.append(("estop", None))
+        self.inner.estop()
+
+    def clear(self) -> None:
+        self.calls.append(("clear", None))
+        self.inner.clear()
+
+    @property
+    def estopped(self) -> bool:
+        return bool(self.inner.estopped)
+
+    def diagnostics(self) -> dict[str, object]:
+        return self.inner.diagnostics()
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def motion(self, since: int) -> list[dict[MotorId, float]]:
+        """The commands from call ``since`` on that asked some motor to turn."""
+        return [c[1] for c in self.calls[since:]
+                if c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())]
+
+
+def spied_open(spies: list[SpyRobot]) -> Callable[..., RobotSession]:
+    def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
+        session = open_robot(url, config, replace(options, world=scenario))
+        spy = SpyRobot(session.robot)
+        spies.append(spy)
+        return RobotSession(spy, session.clock, session.url, session.simulated, session.sim)
+    return open_fn

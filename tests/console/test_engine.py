@@ -111,7 +111,7 @@ def test_a_run_cannot_start_until_the_estop_is_cleared(
     engine, loop = engine_and_loop
     engine.estop()
     assert engine.run("full") is None
-    assert "clear it" in engine.state.view().status.message
+    assert "c clears it" in engine.state.view().status.message
     assert engine.clear_estop()
     assert not engine.state.view().status.estopped
 
