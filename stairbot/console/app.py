@@ -11,9 +11,13 @@ a second key to remember when it matters); the binding shows it in the footer.
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
 from collections.abc import Awaitable, Callable, Iterable
 from pathlib import Path
-from typing import Unpack
+from types import FrameType
+from typing import Any, Unpack
 
 from rich.text import Text
 from textual import events, work
@@ -75,7 +79,9 @@ class StairbotConsole(App[None]):
         Binding("p", "pause", "pause"),
         Binding("x", "stop_run", "stop"),
         Binding("k", "start('calibrate')", "calib"),
-        Binding("q", "quit", "quit"),
+        Binding("q", "quit_console('q')", "quit"),
+        Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
+        Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
         Binding("u", "choose_robot", "robot"),
         Binding("o", "choose_scenario", "scenario"),
         Binding("f", "speed", "speed"),
@@ -94,6 +100,8 @@ class StairbotConsole(App[None]):
         self._record = record
         self._shown_version = -1
         self._shown_event = 0
+        self._asking_quit = False
+        self._sigint: Any = None  # the SIGINT handler before ours
         # The panels, kept here: refresh_view must reach them while a modal
         # screen is on top (app.query_one looks only at the top screen).
         self.banner = Banner(id="banner")  # the line that says how things stand
@@ -121,6 +129,10 @@ class StairbotConsole(App[None]):
         yield Footer(compact=True)
 
     def on_mount(self) -> None:
+        # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):
+        # the robot stops first, then the console asks, as for Ctrl-C typed.
+        with contextlib.suppress(ValueError):  # not the main thread: left as it is
+            self._sigint = signal.signal(signal.SIGINT, self._on_sigint)
         if self._record:
             self._start_recording(self._record)
         self.refresh_view()
@@ -395,6 +407,45 @@ class StairbotConsole(App[None]):
 
     def on_unmount(self) -> None:
         self.engine.shutdown()
+        if self._sigint is not None:
+            with contextlib.suppress(ValueError):
+                signal.signal(signal.SIGINT, self._sigint)
+
+    # -- quitting ------------------------------------------------------------------
+    def action_quit_console(self, key: str = "q") -> None:
+        """Quit; mid-run the robot stops first (the emergency stop, latched),
+        then the console asks: the answer may take a while, and the robot must
+        not drive on meanwhile."""
+        if not self.engine.running:
+            self.exit()
+            return
+        if not self.engine.latched:
+            self.engine.estop(f"{key} pressed mid-run")
+            self.refresh_view()
+        if self._asking_quit:
+            return
+        self._asking_quit = True
+
+        def answered(yes: bool | None) -> None:
+            self._asking_quit = False
+            if yes:
+                self.exit()  # on_unmount ends the run and releases the robot
+            else:
+                self.say("not quitting: the run is held, EMERGENCY STOP latched "
+                         "(c clears it, then p resumes)", "warning")
+
+        self.push_screen(ConfirmScreen(
+            "The robot is stopped: EMERGENCY STOP latched (every motor stopped, the lifts "
+            "hold).\nQuit the console? The run ends; the robot stays where it stands, "
+            "latched.", yes="Yes, quit (y)", no="No, stay (n)"), answered)
+
+    def _on_sigint(self, _sig: int, _frame: FrameType | None) -> None:
+        def stop_then_ask() -> None:
+            if self.engine.running and not self.engine.latched:
+                self.engine.estop("SIGINT")
+            self.call_from_thread(self.action_quit_console, "SIGINT")
+        threading.Thread(target=stop_then_ask, name="SIGINT emergency stop",
+                         daemon=True).start()
 
 
 def _why(exc: Exception) -> str:

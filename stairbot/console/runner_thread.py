@@ -273,10 +273,12 @@ class ConsoleEngine:
         self.state.on_phase(phase.label, ctl.flow, ctl.context.to_dict())
 
     # -- operator controls (UI thread) -------------------------------------------
-    def estop(self) -> None:
+    def estop(self, why: str = "") -> None:
         """Stop every motor now and latch it until :meth:`clear_estop`: the
         robot's own ``estop()``, from this thread at once (the run loop, told
-        too, holds the program and does not repeat it)."""
+        too, holds the program and does not repeat it).  ``why``: what the
+        operator did (the key, "quit pressed mid-run"), for the event list.
+        Safe from any thread."""
         self.state.set_status(estopped=True, paused=self.running, severity="error",
                               message=LATCH_HINT, latch="operator")
         if self.robot is not None:
@@ -286,7 +288,8 @@ class ConsoleEngine:
             self.robot.estop()
         if self.control is not None and self.running:
             self.control.estop()
-        self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"))
+        self._sink(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"
+                         + (f" ({why})" if why else "")))
 
     @property
     def estop_set(self) -> bool:
