@@ -1,5 +1,6 @@
 """`stairbot console` in a real terminal (tmux): the robot is drawn on the
-stairs, the picture changes as it climbs, and q quits (asking first mid-run).  Skipped without tmux."""
+stairs, the picture changes as it climbs, and q quits (asking first
+mid-run).  Skipped without tmux."""
 
 from __future__ import annotations
 
