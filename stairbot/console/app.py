@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
+import time
 from collections.abc import Awaitable, Callable, Iterable
 from pathlib import Path
 from types import FrameType
@@ -28,6 +29,7 @@ from textual.screen import Screen
 from textual.widgets import Footer
 
 from stairbot.config import RobotConfig, load_config
+from stairbot.console.freshness import age_key, age_words, is_stale
 from stairbot.console.modals import AskScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
 from stairbot.console.runner_thread import LATCH_HINT, SPEEDS, ConsoleEngine, EngineHooks
@@ -40,6 +42,7 @@ from stairbot.console.widgets.motors import MotorPanel
 from stairbot.console.widgets.phase import PhasePanel
 from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
+from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 
@@ -98,7 +101,7 @@ class StairbotConsole(App[None]):
         self.url = url
         self.scenario = scenario
         self._record = record
-        self._shown_version = -1
+        self._shown_key: object = None
         self._shown_event = 0
         self._asking_quit = False
         self._sigint: Any = None  # the SIGINT handler before ours
@@ -138,20 +141,28 @@ class StairbotConsole(App[None]):
         self.refresh_view()
         self.set_interval(1 / REFRESH_HZ, self.refresh_view)
         self.open_robot(self.url, self.scenario)
+        self.engine.start_polling()
 
     # -- the view ------------------------------------------------------------------
     def refresh_view(self) -> None:
-        """Copy the live state and update every panel that changed."""
+        """Copy the live state and update every panel that changed (the ages
+        of the values shown change with the wall clock alone)."""
         view = self.state.view(events_after=self._shown_event)
-        if view.version == self._shown_version:
+        key = (view.version, age_key(view.read_age_s))
+        if key == self._shown_key:
             return
-        self._shown_version = view.version
+        self._shown_key = key
         self._show(view)
 
     def _show(self, v: StateView) -> None:
         self.banner.show(v.url, v.scenario, v.status, v.recording)
         picture = self.picture
-        picture.border_title = Text(f"side view · {v.url} · {v.scenario}")  # never markup
+        age = v.read_age_s
+        title = Text("side view · ")  # never markup: the URL may hold brackets
+        title.append(age_words(age), "bold red" if is_stale(age) else "dim")
+        title.append(f" · {v.url} · {v.scenario}")
+        picture.border_title = title
+        picture.set_class(is_stale(age), "-stale")
         snap = v.snapshot
         lifts = None
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
@@ -166,10 +177,11 @@ class StairbotConsole(App[None]):
             else:
                 note = "no pose from a wired robot"
         picture.show(scene, v.stairs, lifts, note)
-        self.sensors.show(snap)
-        self.motors.show(snap, v.commands)
-        self.phase.show(v.phase, v.flow, v.context)
-        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health)
+        running = v.status.robot == "running"
+        self.sensors.show(snap, age)
+        self.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
+        self.phase.show(v.phase, v.flow, v.context, v.phase_id)
+        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age)
         if v.events:
             log = self.log_panel
             log.add(v.events)
@@ -185,7 +197,9 @@ class StairbotConsole(App[None]):
         try:
             self.engine.open(url, scenario, clear_latches=clear_latches)
         except Exception as exc:  # noqa: BLE001 - any failure is a message, not a traceback
-            message = f"cannot open {url}: {_why(exc)}"
+            why = _why(exc)
+            message = f"cannot open {why}" if why.startswith(f"{url}: ") else \
+                f"cannot open {url}: {why}"
             self._tell(message, "error")
             if previous is not None and self.engine.session is None and previous != (url,
                                                                                        scenario):
@@ -458,14 +472,17 @@ def _why(exc: Exception) -> str:
 
 def build_app(config: RobotConfig | str | Path | None = None, *, url: str = "sim://",
               scenario: str | None = None, record: str | None = None, speed: str = "1x",
+              ages_wall: Callable[[], float] = time.monotonic,
               **engine_hooks: Unpack[EngineHooks]) -> StairbotConsole:
     """Build the console.  ``config`` is a RobotConfig, a file, or None for the
-    shipped robot (raises ConfigError for a bad file).  ``engine_hooks``
-    (open_fn, run_fn, control_fn, wall, sleep) replace the engine's defaults."""
+    shipped robot (raises ConfigError for a bad file).  ``ages_wall`` is the
+    clock the values' ages go by (a test that pins the picture stops it).
+    ``engine_hooks`` (open_fn, run_fn, control_fn, wall, sleep) replace the
+    engine's defaults."""
     cfg = config if isinstance(config, RobotConfig) else load_config(config)
     if speed not in SPEEDS:
         raise InputError("--speed", None, f"{speed!r}; allowed: {', '.join(SPEEDS)}")
-    state = LiveState(url=url)
+    state = LiveState(url=url, wall=ages_wall)
     engine = ConsoleEngine(state, cfg, **engine_hooks)
     engine.set_speed(speed)
     return StairbotConsole(engine, url, scenario, record)

@@ -19,6 +19,7 @@ from typing import TypedDict
 
 from stairbot.algorithm.controller import Controller
 from stairbot.config import RobotConfig
+from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
@@ -109,6 +110,10 @@ class ConsoleEngine:
         self._last_phase: object = None
         self._controller: Controller | None = None  # the run's, as the last tick saw it
         self._last_ctx = -1.0
+        self._poller: threading.Thread | None = None
+        self._closing = threading.Event()
+        self._poll_fault: str | None = None  # why the last idle read failed
+        self._opening = False
         self.latched_boards: tuple[str, str | None, str] | None = None
         """(url, scenario, why) of boards refused for the latch they hold."""
 
@@ -148,7 +153,16 @@ class ConsoleEngine:
         if self.running:
             raise InputError(url, None, "a run is going on; stop it first")
         scenario = load_scenario(scenario_path)
+        self._opening = True
+        try:
+            self._open(url, scenario, scenario_path, clear_latches)
+        finally:
+            self._opening = False
+
+    def _open(self, url: str, scenario: Scenario, scenario_path: str | None,
+              clear_latches: bool) -> None:
         self.close()
+        self._poll_fault = None
         self.state.set_status(robot="connecting", message=f"opening {url}", severity="info")
         try:
             session = self._open_fn(url, self.config, scenario,
@@ -194,6 +208,45 @@ class ConsoleEngine:
         self.state.set_status(robot="ready", paused=False,
                               message=LATCH_HINT if latched else "",
                               severity="error" if latched else "info")
+
+    # -- idle polling --------------------------------------------------------------
+    def start_polling(self, period_s: float = POLL_PERIOD_S) -> None:
+        """Read the robot every ``period_s`` while no run goes on (a daemon
+        thread, until :meth:`shutdown`): its sensors and link stay live on
+        the screen, and a link that dies while idle shows as a FAULT."""
+        if self._poller is not None:
+            return
+        self._poller = threading.Thread(target=self._poll_loop, args=(period_s,),
+                                        name="console idle poll", daemon=True)
+        self._poller.start()
+
+    def _poll_loop(self, period_s: float) -> None:
+        while not self._closing.wait(period_s):
+            self.poll()
+
+    def poll(self) -> None:
+        """One idle read (nothing while a run goes on: the run reads every
+        tick).  A read that fails makes the state FAULT with the driver's
+        reason, once; one that works again after that makes it READY."""
+        robot = self.robot
+        if robot is None or self.running or self._opening:
+            return
+        try:
+            robot.read()
+        except Exception as exc:  # noqa: BLE001 - a failing read is news, not a crash
+            if self.running or robot is not self.robot:
+                return  # a run or another robot took over meanwhile
+            why = f"no reading from {self.state.view().url}: {exc}"
+            if why != self._poll_fault:
+                self._poll_fault = why
+                self.state.set_status(robot="fault", severity="error", message=why)
+                self.state.note(why, "error")
+            return
+        if self._poll_fault is not None and robot is self.robot and not self.running:
+            self._poll_fault = None
+            self.state.set_status(robot="ready", severity="warning",
+                                  message="the robot answers again")
+            self.state.note("the robot answers again", "warning")
 
     def close(self) -> None:
         """Stop and release the robot (never raises)."""
@@ -242,7 +295,10 @@ class ConsoleEngine:
         if self.robot.estopped:
             line += " · EMERGENCY STOP latched: c clears it"
             if not self.latched:  # the run latched it (an error): the console holds it too
-                self.state.set_status(estopped=True, latch=f"automatic: {result.error or line}")
+                why = result.error or line
+                self.state.set_status(estopped=True, latch=f"automatic: {why}")
+                # the record has the run's own ERROR event; the list says who latched
+                self.state.note(f"emergency stop latched automatically: {why}", "warning")
         # A lost link or a failing board is a fault of the robot, not an ending:
         # its values stop being live, and the operator must look before a rerun.
         self.state.set_status(robot="fault" if result.fault else "ended", paused=False,
@@ -270,7 +326,7 @@ class ConsoleEngine:
         if not force and phase is self._last_phase and now - self._last_ctx < PHASE_PERIOD_S:
             return
         self._last_phase, self._last_ctx = phase, now
-        self.state.on_phase(phase.label, ctl.flow, ctl.context.to_dict())
+        self.state.on_phase(phase.label, ctl.flow, ctl.context.to_dict(), phase.value)
 
     # -- operator controls (UI thread) -------------------------------------------
     def estop(self, why: str = "") -> None:
@@ -369,6 +425,7 @@ class ConsoleEngine:
 
     def shutdown(self, wait_s: float = 2.0) -> None:
         """Stop any run, wait a little for it to end, stop recording, release the robot."""
+        self._closing.set()
         self.stop("the console closed")
         deadline = self._wall() + wait_s
         while self.running and self._wall() < deadline:

@@ -7,7 +7,9 @@ Every method takes one lock for a short time; the UI never waits for a tick.
 from __future__ import annotations
 
 import threading
+import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -45,9 +47,11 @@ class StateView:
     wired: bool  # no in-process world to draw: a driver on a serial link or CAN bus
     status: RunStatus
     snapshot: Snapshot | None
+    read_age_s: float | None  # wall seconds since the snapshot was read (None: never)
     commands: dict[MotorId, float]
     ticks: int
     phase: str
+    phase_id: str  # the phase's value ("ascent_lift_first"); "" before a run
     flow: str
     context: dict[str, Any]
     scene: SceneView | None
@@ -62,8 +66,11 @@ class StateView:
 class LiveState:
     """Thread-safe latest state.  Writers: the run thread and the UI's actions."""
 
-    def __init__(self, *, url: str = "", scenario: str = "", simulated: bool = True) -> None:
+    def __init__(self, *, url: str = "", scenario: str = "", simulated: bool = True,
+                 wall: Callable[[], float] = time.monotonic) -> None:
         self._lock = threading.Lock()
+        self._wall = wall
+        self._read_at: float | None = None  # wall time of the last reading taken
         self._version = 0
         self._url = url
         self._scenario = scenario
@@ -74,6 +81,7 @@ class LiveState:
         self._commands: dict[MotorId, float] = {}
         self._ticks = 0
         self._phase = "—"
+        self._phase_id = ""
         self._flow = "idle"
         self._context: dict[str, Any] = {}
         self._scene: SceneView | None = None
@@ -96,7 +104,9 @@ class LiveState:
             self._url, self._scenario, self._simulated = url, scenario, simulated
             self._wired = wired
             self._snapshot, self._commands, self._ticks = None, {}, 0
+            self._read_at = None
             self._phase, self._flow, self._context = "—", "idle", {}
+            self._phase_id = ""
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
             self._bump()
 
@@ -120,6 +130,7 @@ class LiveState:
     def on_read(self, snap: Snapshot) -> None:
         with self._lock:
             self._snapshot = snap
+            self._read_at = self._wall()
             self._ticks += 1
             if snap.health:
                 self._health = dict(snap.health)
@@ -130,9 +141,10 @@ class LiveState:
             self._commands = speeds
             self._bump()
 
-    def on_phase(self, label: str, flow: str, context: dict[str, Any] | None) -> None:
+    def on_phase(self, label: str, flow: str, context: dict[str, Any] | None,
+                 phase_id: str = "") -> None:
         with self._lock:
-            self._phase, self._flow = label, flow
+            self._phase, self._flow, self._phase_id = label, flow, phase_id
             if context is not None:
                 self._context = context
             self._bump()
@@ -192,9 +204,11 @@ class LiveState:
                 wired=self._wired,
                 status=self._status,
                 snapshot=self._snapshot,
+                read_age_s=None if self._read_at is None else self._wall() - self._read_at,
                 commands=dict(self._commands),
                 ticks=self._ticks,
                 phase=self._phase,
+                phase_id=self._phase_id,
                 flow=self._flow,
                 context=dict(self._context),
                 scene=self._scene,

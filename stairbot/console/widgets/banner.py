@@ -32,7 +32,7 @@ def banner_text(url: str, scenario: str, status: RunStatus,
 class Banner(Static):
     """One line, coloured by severity; red while the emergency stop is set."""
 
-    DEFAULT_CSS = "Banner { height: auto; max-height: 5; width: 1fr; }"
+    DEFAULT_CSS = "Banner { height: auto; max-height: 6; width: 1fr; }"
 
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id)
