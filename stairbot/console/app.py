@@ -28,11 +28,19 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widgets import Footer
 
+from stairbot.cli_journal import ResumePlan
 from stairbot.config import RobotConfig, load_config
+from stairbot.console.climb_gate import MidClimb
 from stairbot.console.freshness import age_key, age_words, is_stale
-from stairbot.console.modals import AskScreen, ConfirmScreen
+from stairbot.console.modals import AskScreen, ChoiceScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
-from stairbot.console.runner_thread import LATCH_HINT, SPEEDS, ConsoleEngine, EngineHooks
+from stairbot.console.runner_thread import (
+    LATCH_HINT,
+    MID_CLIMB_HINT,
+    SPEEDS,
+    ConsoleEngine,
+    EngineHooks,
+)
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
@@ -216,8 +224,8 @@ class StairbotConsole(App[None]):
         self.url, self.scenario = url, scenario
 
     @work(thread=True, group="run", exclusive=False, exit_on_error=False)
-    def run_program(self, mode: str) -> None:
-        result = self.engine.run(mode)
+    def run_program(self, mode: str, resume: ResumePlan | None = None) -> None:
+        result = self.engine.run(mode, resume)
         if result is not None:
             self._tell(f"run {result.outcome}", "information")
 
@@ -294,8 +302,72 @@ class StairbotConsole(App[None]):
         if self.engine.session is None:
             self.say("no robot open: choose one with u", severity="error")
             return
+        if self.engine.mid_climb is not None:
+            self._mid_climb(mode, self.engine.mid_climb)
+            return
         what = "Start calibration" if mode == "calibrate" else "Start the full run"
         self._after_consent(what, lambda: self.run_program(mode))
+
+    def _mid_climb(self, mode: str, gate: MidClimb) -> None:
+        """The robot may stand part way up: no fresh start from there.  Offer
+        what is safe -- resume (boards: the journal's run, checked first),
+        reset (the simulation), or the operator's word that it is back at
+        the start -- and move nothing until one is chosen and confirmed."""
+        wired = not self.engine.in_process
+        lines = "\n".join(gate.lines)
+        question = (f"The robot may stand part way up the stairs:\n{lines}\n\n"
+                    "A new run would square up and drive at the riser from there: not "
+                    "started.  " + ("Resume carries on the journal's run, after checks"
+                                    if wired else "Reset puts the simulated robot at the start")
+                    + "; or say the robot is back at the start.")
+        first = ("r", "Resume (r)") if wired else ("r", "Reset (r)")
+
+        def chosen(key: str | None) -> None:
+            if key == "r":
+                if wired:
+                    self._resume(mode)
+                else:
+                    self.action_reset()
+            elif key == "b":
+                self.push_screen(ConfirmScreen(
+                    "Start a new run from where the robot stands?\nOnly if it stands on the "
+                    "floor before the first step: a new run squares up, then drives at the "
+                    "stairs.", yes="Yes, it is at the start (y)"), back)
+            else:
+                self.say("nothing moved")
+
+        def back(yes: bool | None) -> None:
+            if yes:
+                self.engine.back_at_start()
+                self.action_start(mode)
+            else:
+                self.say("nothing moved")
+
+        self.state.set_status(message=MID_CLIMB_HINT, severity="error")
+        self.push_screen(ChoiceScreen(question, [first, ("b", "Back at start (b)")]), chosen)
+
+    def _resume(self, mode: str) -> None:
+        """Check the journal's run against the boards, show where the robot
+        believes it is, and carry it on once the operator confirms."""
+        try:
+            plan = self.engine.plan_resume()
+        except StairbotError as exc:
+            message = f"cannot resume: {exc}"
+            self.state.set_status(message=message, severity="error")
+            self.say(message, "error", timeout=10)
+            return
+
+        def answered(yes: bool | None) -> None:
+            if yes:
+                self.run_program(mode, plan)
+            else:
+                self.say("not resumed: nothing moved")
+
+        lines = "\n".join(plan.lines)
+        self.push_screen(ConfirmScreen(
+            f"Resume on {plan.state.start.get('url')}:\n{lines}\n\nLook at the robot: does "
+            "it stand where these lines say?  Resume and let it move?  Space stops every "
+            "motor.", yes="Yes, resume (y)"), answered)
 
     def action_pause(self) -> None:
         if not self.engine.running:

@@ -69,3 +69,35 @@ class AskScreen(ModalScreen[str | None]):
 
     def action_cancel(self) -> None:
         self.dismiss(None)
+
+
+class ChoiceScreen(ModalScreen[str | None]):
+    """A question with a few answers, each its own key; Escape (or n) answers
+    None: nothing is done."""
+
+    def __init__(self, question: str, choices: list[tuple[str, str]]) -> None:
+        super().__init__()
+        self.question = question
+        self.choices = choices  # (key, label), e.g. ("r", "Resume (r)")
+        for key, _ in choices:
+            self._bindings.bind(key, f"choose({key!r})", show=False)
+        self._bindings.bind("n,escape", "choose(None)", show=False)
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog"):
+            yield Label(self.question, classes="question", markup=False)
+            with Horizontal(classes="buttons"):
+                for key, label in self.choices:
+                    yield Button(label, id=f"choice-{key}", compact=True)
+                yield Button("Cancel (n)", variant="primary", id="choice-none", compact=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#choice-none", Button).focus()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        key = (event.button.id or "").removeprefix("choice-")
+        self.dismiss(None if key == "none" else key)
+
+    def action_choose(self, key: str | None) -> None:
+        self.dismiss(key)

@@ -14,11 +14,14 @@ import contextlib
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TypedDict
 
 from stairbot.algorithm.controller import Controller
+from stairbot.algorithm.phases import Mode
+from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume, start_journal
 from stairbot.config import RobotConfig
+from stairbot.console.climb_gate import MidClimb, after_run, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
@@ -26,12 +29,16 @@ from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, ReportsEvents, Snapshot
+from stairbot.journal import JournalWriter
 from stairbot.paths import unused_path
+from stairbot.resume import ResumeRefused
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
 
 LATCH_HINT = "EMERGENCY STOP latched — c clears it (after you look at the robot)"
+MID_CLIMB_HINT = ("the robot may stand part way up the stairs: a new run would drive it at "
+                  "the riser; s offers resume (boards) or your word it is back at the start")
 
 SPEEDS: dict[str, float | None] = {"1x": 1.0, "10x": 10.0, "max": None}
 """Simulation speeds the operator can pick: sim seconds per wall second."""
@@ -40,9 +47,21 @@ PHASE_PERIOD_S = 0.2  # wall seconds between copies of the controller's context
 
 OnTick = Callable[[Controller, Snapshot], None]
 OpenFn = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
-RunFn = Callable[[RobotSession, RobotConfig, EventSink, str, RunControl, OnTick], RunResult]
-"""(session, config, sink, mode, control, on_tick) -> result: the run loop,
-``mode`` "full" or "calibrate"."""
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What a run starts from: the journal it writes (boards on a wire), and
+    the controller of a resumed run (None: a fresh one)."""
+
+    journal: JournalWriter | None = None
+    controller: Controller | None = None
+
+
+RunFn = Callable[[RobotSession, RobotConfig, EventSink, str, RunControl, OnTick, RunPlan],
+                 RunResult]
+"""(session, config, sink, mode, control, on_tick, plan) -> result: the run
+loop, ``mode`` "full" or "calibrate"."""
 
 
 class EngineHooks(TypedDict, total=False):
@@ -64,12 +83,15 @@ def _default_open(url: str, config: RobotConfig, scenario: Scenario,
 
 
 def _default_run(session: RobotSession, config: RobotConfig, sink: EventSink,
-                 mode: str, control: RunControl, on_tick: OnTick) -> RunResult:
-    from stairbot.algorithm.phases import Mode
+                 mode: str, control: RunControl, on_tick: OnTick, plan: RunPlan) -> RunResult:
     from stairbot.runner import run
 
-    return run(session, config, sink, Mode.CALIBRATE_ONLY if mode == "calibrate" else Mode.FULL,
-               control, on_tick=on_tick)
+    return run(session, config, sink, _mode(mode), control, on_tick=on_tick,
+               controller=plan.controller, journal=plan.journal)
+
+
+def _mode(mode: str) -> Mode:
+    return Mode.CALIBRATE_ONLY if mode == "calibrate" else Mode.FULL
 
 
 def describe_result(result: RunResult) -> tuple[str, str]:
@@ -114,6 +136,10 @@ class ConsoleEngine:
         self._closing = threading.Event()
         self._poll_fault: str | None = None  # why the last idle read failed
         self._opening = False
+        self.mid_climb: MidClimb | None = None
+        """The robot may stand part way up (stairbot.console.climb_gate): no
+        fresh start until the operator resumes or says it is back at the start."""
+        self._last_flow, self._last_label = "", ""  # the run's last phase before its end
         self.latched_boards: tuple[str, str | None, str] | None = None
         """(url, scenario, why) of boards refused for the latch they hold."""
 
@@ -204,6 +230,9 @@ class ConsoleEngine:
                                   severity="error")
             return
         self.robot.refresh_scene()
+        # boards: their journal says whether an earlier host left them mid-climb
+        self.mid_climb = None if sim is not None else from_journal(
+            default_path(url), self.robot.identity())
         latched = self.latched
         self.state.set_status(robot="ready", paused=False,
                               message=LATCH_HINT if latched else "",
@@ -256,9 +285,12 @@ class ConsoleEngine:
         self.session = self.robot = self.clock = None
 
     # -- the run (worker thread) -----------------------------------------------
-    def run(self, mode: str = "full") -> RunResult | None:
+    def run(self, mode: str = "full", resume: ResumePlan | None = None) -> RunResult | None:
         """Run the program until it ends; returns its result, or None when it
-        could not run.  Never raises: failures end up in the live state."""
+        could not run.  ``resume``: carry on the journal's run (checked by
+        :meth:`plan_resume` and confirmed by the operator).  Refused while
+        the robot may stand mid-climb (:attr:`mid_climb`) unless resuming.
+        Never raises: failures end up in the live state."""
         if self.session is None or self.robot is None or self.clock is None:
             self.state.set_status(message="no robot open: choose a robot first (u)",
                                   severity="warning")
@@ -266,29 +298,43 @@ class ConsoleEngine:
         if self.robot.estopped or self.latched:
             self.state.set_status(message=LATCH_HINT, severity="error")
             return None
+        if self.mid_climb is not None and resume is None:
+            self.state.set_status(message=MID_CLIMB_HINT, severity="error")
+            return None
         if self._running.is_set():
+            return None
+        try:
+            plan = self._plan(mode, resume)
+        except StairbotError as exc:
+            self.state.set_status(message=f"not started: {exc}", severity="error")
             return None
         self._running.set()
         session = RobotSession(self.robot, self.clock, self.session.url,
                                self.session.simulated, self.session.sim)
         self.state.on_result(None)
-        self.state.set_status(robot="running", paused=False, severity="info",
-                              message="calibrating only" if mode == "calibrate" else "full run")
+        what = "resumed from the journal" if resume is not None else (
+            "calibrating only" if mode == "calibrate" else "full run")
+        self.state.set_status(robot="running", paused=False, severity="info", message=what)
         self._controller = None
+        self._last_flow, self._last_label = "", ""
         try:
             self.control = control = self._control_fn()
             result = self._run_fn(session, self.config, self._sink, mode, control,
-                                  self._on_tick)
+                                  self._on_tick, plan)
         except Exception as exc:  # noqa: BLE001 - a fault shows as a banner, not a traceback
             with contextlib.suppress(Exception):
                 self.robot.stop_all()
             self.state.set_status(robot="fault", severity="error",
                                   message=f"the run failed: {type(exc).__name__}: {exc}")
+            self.mid_climb = MidClimb((f"the run failed: {exc}",))  # where it is, unknown
             return None
         finally:
             self._running.clear()
+            if plan.journal is not None:
+                plan.journal.close()
         if self._controller is not None:  # a stop or a fault ends the run between ticks
             self._watch_phase(self._controller, final=True)
+        self.mid_climb = after_run(result, self._last_flow, self._last_label)
         self.robot.refresh_scene()
         self.state.on_result(result)
         line, severity = describe_result(result)
@@ -304,6 +350,32 @@ class ConsoleEngine:
         self.state.set_status(robot="fault" if result.fault else "ended", paused=False,
                               message=line, severity=severity)
         return result
+
+    def _plan(self, mode: str, resume: ResumePlan | None) -> RunPlan:
+        """The journal (boards on a wire: a fresh one, or the resumed run's)
+        and the controller.  StairbotError when the journal cannot be written."""
+        session, scenario = self.session, self.scenario
+        if session is None or self.in_process or scenario is None:
+            return RunPlan()
+        if resume is not None:
+            resumed = carry_on(resume, session, self.config, self._sink)
+            return RunPlan(resumed.journal, resumed.controller)
+        return RunPlan(start_journal(default_path(session.url), session.url, session,
+                                     self.config, scenario.name, _mode(mode)))
+
+    def plan_resume(self) -> ResumePlan:
+        """The journal's run, checked against the boards as ``stairbot run
+        --resume`` checks it; its ``lines`` say where the robot believes it
+        is.  Moves nothing.  ResumeRefused (or JournalError) says why not."""
+        if self.session is None:
+            raise ResumeRefused("no robot open")
+        return plan_resume(default_path(self.session.url), self.session.url, self.session,
+                           self.config)
+
+    def back_at_start(self) -> None:
+        """The operator says the robot stands at the start again: a fresh run may go."""
+        self.mid_climb = None
+        self.state.note("the operator says the robot is back at the start", "warning")
 
     def _sink(self, event: Event) -> None:
         self.state.on_event(event)
@@ -322,6 +394,8 @@ class ConsoleEngine:
 
     def _copy_phase(self, ctl: Controller, force: bool = False) -> None:
         phase = ctl.phase
+        if ctl.flow != "end":  # where the run was before it ended: mid-climb or not
+            self._last_flow, self._last_label = ctl.flow, phase.label
         now = self._wall()
         if not force and phase is self._last_phase and now - self._last_ctx < PHASE_PERIOD_S:
             return

@@ -39,7 +39,7 @@ class DriveLoop:
         self.started = threading.Event()
 
     def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: RunControl,
-                 on_tick: Any) -> RunResult:
+                 on_tick: Any, plan: Any) -> RunResult:
         robot, clock = session.robot, session.clock
         while control.stop_reason is None and len(self.snaps) < 20000:
             snap = robot.read()
@@ -149,7 +149,7 @@ class HeldLoop(DriveLoop):
         self.release = threading.Event()
 
     def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: RunControl,
-                 on_tick: Any) -> RunResult:
+                 on_tick: Any, plan: Any) -> RunResult:
         robot, clock = session.robot, session.clock
         while control.stop_reason is None:
             self.snaps.append(robot.read())
