@@ -32,6 +32,7 @@ from stairbot.cli_journal import ResumePlan
 from stairbot.config import RobotConfig, load_config
 from stairbot.console.climb_gate import MidClimb
 from stairbot.console.freshness import age_key, age_words, is_stale
+from stairbot.console.help import HelpScreen
 from stairbot.console.modals import AskScreen, ChoiceScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
 from stairbot.console.runner_thread import (
@@ -73,6 +74,7 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
     ("record", "Record events", "Start/stop writing events as JSON lines (key: w)"),
     ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+    ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
 
 
@@ -81,24 +83,25 @@ class StairbotConsole(App[None]):
 
     CSS_PATH = "console.tcss"
     TITLE = "stairbot console"
-    # In footer order, most needed first: at 80 columns the footer shows the
-    # first eight (the e-stop to the robot URL); ctrl+p lists them all.
+    # The footer shows what an operator needs at once, and fits 80 columns;
+    # ? (the help screen) and ctrl+p list every key.
     BINDINGS = [
         Binding(ESTOP_KEY, "estop", "E-STOP", priority=True),
         Binding("c", "clear_estop", "clear"),
         Binding("s", "start('full')", "start"),
         Binding("p", "pause", "pause"),
         Binding("x", "stop_run", "stop"),
-        Binding("k", "start('calibrate')", "calib"),
         Binding("q", "quit_console('q')", "quit"),
+        Binding("question_mark", "help", "help", key_display="?"),
+        Binding("k", "start('calibrate')", "calib", show=False),
+        Binding("u", "choose_robot", "robot", show=False),
+        Binding("o", "choose_scenario", "scenario", show=False),
+        Binding("f", "speed", "speed", show=False),
+        Binding("r", "reset", "reset", show=False),
+        Binding("w", "record", "rec", show=False),
+        Binding("z", "zoom", "zoom", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
-        Binding("u", "choose_robot", "robot"),
-        Binding("o", "choose_scenario", "scenario"),
-        Binding("f", "speed", "speed"),
-        Binding("r", "reset", "reset"),
-        Binding("w", "record", "rec"),
-        Binding("z", "zoom", "zoom"),
     ]
 
     def __init__(self, engine: ConsoleEngine, url: str, scenario: str | None,
@@ -475,6 +478,10 @@ class StairbotConsole(App[None]):
                      "warning", timeout=8)
         else:
             self.say(f"recording events to {chosen}")
+
+    def action_help(self) -> None:
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen())
 
     def action_zoom(self) -> None:
         mode = self.picture.cycle_zoom()

@@ -10,6 +10,7 @@ from dataclasses import replace
 from typing import Any
 
 from textual import events
+from textual.geometry import Region
 from textual.widgets import Input
 
 from stairbot.console.app import StairbotConsole
@@ -52,6 +53,12 @@ async def answer_prompt(pilot: Any, key: str, value: str) -> None:
     await until(pilot, lambda: bool(pilot.app.screen.query(Input)), "the prompt")
     pilot.app.screen.query_one(Input).value = value
     await press(pilot, "enter")
+
+
+def shown(widget: Any) -> str:
+    """The text a widget shows on screen now (its padding too), lines joined."""
+    w, h = widget.outer_size
+    return "\n".join(strip.text.rstrip() for strip in widget.render_lines(Region(0, 0, w, h)))
 
 
 def said(app: StairbotConsole) -> str:

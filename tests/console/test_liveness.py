@@ -21,9 +21,8 @@ from typing import Any
 
 import pytest
 from fake_boards import stairbot
-from pilot import banner, press, ready, said, until
+from pilot import banner, press, ready, said, shown, until
 from still_robot import StillClock, StillRobot, make_still_app
-from textual.geometry import Region
 
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ConfirmScreen
@@ -44,12 +43,6 @@ def boards(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     if proc.poll() is None:
         proc.send_signal(signal.SIGINT)
         proc.wait(10)
-
-
-def shown(widget: Any) -> str:
-    """The text a widget shows on screen now, its lines joined."""
-    w, h = widget.outer_size
-    return "\n".join(strip.text for strip in widget.render_lines(Region(0, 0, w, h)))
 
 
 def stale(app: StairbotConsole) -> bool:

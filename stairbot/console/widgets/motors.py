@@ -61,7 +61,8 @@ def motor_line(motor: MotorId, state: MotorState | None, commanded: float | None
         return line
     glyph, style = direction(motor, state.speed_tps, carried_by)
     line.append(f"{glyph:<2}", style)
-    line.append(f" {state.speed_tps:+5.1f} {state.turns:7.1f}")
+    speed = state.speed_tps if abs(state.speed_tps) >= 0.05 else 0.0  # no "-0.0"
+    line.append(f" {speed:+5.1f} {state.turns:7.1f}")
     if state.fault:
         line.append(f" {state.fault}", "bold red")
     elif commanded is not None and abs(commanded - state.speed_tps) > 0.05:
