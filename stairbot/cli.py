@@ -41,6 +41,7 @@ from stairbot.cli_show import (
 from stairbot.config import RobotConfig, load_config
 from stairbot.errors import HardwareError, InputError, NoBoardError, OutputError
 from stairbot.events import Event, EventKind
+from stairbot.paths import unused_path
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
 from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 from stairbot.scenario import (
@@ -256,6 +257,23 @@ def _record_file(path: str | None, config: RobotConfig) -> Iterator[EventRecord 
         f.close()
 
 
+def unused_record(path: str | None) -> str | None:
+    """Where the event record goes: ``path``, or beside it under a name not
+    taken (``name-1.jsonl``) when a recording is already there -- a record
+    never overwrites one -- saying so on stderr.  InputError when every
+    such name is taken."""
+    if path is None:
+        return None
+    try:
+        chosen = unused_path(path)
+    except FileExistsError as exc:
+        raise InputError(path, None, f"cannot write the record: {exc}") from None
+    if chosen != path:
+        print(f"{PROG}: {path} exists (not overwritten): recording to {chosen}",
+              file=sys.stderr, flush=True)
+    return chosen
+
+
 @contextmanager
 def _ctrl_c_stops(request_stop: Callable[[str], None],
                   estop: Callable[[], None]) -> Iterator[None]:
@@ -300,7 +318,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                            allow_latched=args.resume)
     path = journal_path(args.robot, args.journal)
     mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
-    with _record_file(args.record, config) as record:
+    with _record_file(unused_record(args.record), config) as record:
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
                 record.write(event)

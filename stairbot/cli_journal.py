@@ -82,13 +82,22 @@ def ask(prompt: str) -> bool:
         return False
 
 
-def resume(path: Path | None, url: str, session: RobotSession, config: RobotConfig,
-           sink: EventSink, *, yes: bool, out: TextIO,
-           confirm: Callable[[str], bool] = ask) -> Resumed:
-    """Check the journal's run against the boards, say where the robot
-    believes it is, and -- once the operator confirms -- clear the boards'
-    latches and hand back the restored controller.  ResumeRefused (one line)
-    otherwise; nothing has moved then."""
+@dataclass
+class ResumePlan:
+    """A run the journal says can go on, checked against the boards; nothing
+    has moved yet.  ``lines``: where the robot believes it is."""
+
+    path: Path
+    state: JournalState
+    lines: list[str]
+
+
+def plan_resume(path: Path | None, url: str, session: RobotSession,
+                config: RobotConfig) -> ResumePlan:
+    """Check the journal's run against the boards and say where the robot
+    believes it is (the checks of ``stairbot run --resume``: the run did not
+    end, the boards are the journal's and did not restart, the same config).
+    ResumeRefused (one line) otherwise.  Moves nothing."""
     if path is None:
         raise ResumeRefused(f"{url}: a simulation cannot be resumed: its world ended with "
                             "the host that ran it")
@@ -99,24 +108,45 @@ def resume(path: Path | None, url: str, session: RobotSession, config: RobotConf
         raise ResumeRefused(f"{path}: the run began with config {state.start.get('config')}, "
                             f"which differs from {config.source}: pass --config "
                             f"{state.start.get('config')}")
-    for line in describe(state):
-        print(f"resume: {line}", file=out)
+    lines = describe(state)
     latched = getattr(robot, "latched", {})
     if latched:
-        print(f"resume: the boards hold latches ({len(latched)} board(s)); resuming "
-              "clears them", file=out)
+        lines.append(f"the boards hold latches ({len(latched)} board(s)); resuming "
+                     "clears them")
+    return ResumePlan(path, state, lines)
+
+
+def carry_on(plan: ResumePlan, session: RobotSession, config: RobotConfig,
+             sink: EventSink) -> Resumed:
+    """Once the operator has confirmed ``plan``: clear the boards' latches and
+    hand back the restored controller and the journal, appended to."""
+    robot = session.robot
+    if getattr(robot, "latched", {}) or robot.estopped:
+        robot.clear()
+    now = session.clock.now()
+    state = plan.state
+    ctx = restored_context(state, now)
+    mode = Mode(state.start.get("mode", Mode.FULL.value))
+    controller = Controller(config, sink, mode, context=ctx)
+    writer = JournalWriter(plan.path, fresh=False)
+    writer.resume(str(state.start["run_id"]), board_identity(robot), now)
+    return Resumed(controller, writer, state)
+
+
+def resume(path: Path | None, url: str, session: RobotSession, config: RobotConfig,
+           sink: EventSink, *, yes: bool, out: TextIO,
+           confirm: Callable[[str], bool] = ask) -> Resumed:
+    """Check the journal's run against the boards, say where the robot
+    believes it is, and -- once the operator confirms -- clear the boards'
+    latches and hand back the restored controller.  ResumeRefused (one line)
+    otherwise; nothing has moved then."""
+    plan = plan_resume(path, url, session, config)
+    for line in plan.lines:
+        print(f"resume: {line}", file=out)
     out.flush()
     question = ("Look at the robot: does it stand where the lines above say?  Resume and "
                 "let it move? [y/N] ")
     if not yes and not confirm(question):
         raise NotConfirmed("not resumed: no confirmation (answer y on a terminal, or add "
                            "--yes); nothing moved")
-    if latched or robot.estopped:
-        robot.clear()
-    now = session.clock.now()
-    ctx = restored_context(state, now)
-    mode = Mode(state.start.get("mode", Mode.FULL.value))
-    controller = Controller(config, sink, mode, context=ctx)
-    writer = JournalWriter(path, fresh=False)
-    writer.resume(str(state.start["run_id"]), board_identity(robot), now)
-    return Resumed(controller, writer, state)
+    return carry_on(plan, session, config, sink)

@@ -67,6 +67,11 @@ class LatchedError(HardwareError):
     message is one line naming the URL, the board, the latch and that command."""
 
 
+class PortBusyError(HardwareError):
+    """Another stairbot has the serial port open (docs/protocol.md: one host
+    on a port at a time).  One line naming the port and who holds it."""
+
+
 class RobotFellError(HardwareError):
     """The simulated world detected instability: pitch beyond the limit, a fall."""
 

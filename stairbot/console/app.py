@@ -11,10 +11,16 @@ a second key to remember when it matters); the binding shows it in the footer.
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
+import time
 from collections.abc import Awaitable, Callable, Iterable
 from pathlib import Path
-from typing import Unpack
+from types import FrameType
+from typing import Any, Unpack
 
+from rich.text import Text
 from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
@@ -22,10 +28,20 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widgets import Footer
 
+from stairbot.cli_journal import ResumePlan
 from stairbot.config import RobotConfig, load_config
-from stairbot.console.modals import AskScreen, ConfirmScreen
+from stairbot.console.climb_gate import MidClimb
+from stairbot.console.freshness import age_key, age_words, is_stale
+from stairbot.console.help import HelpScreen
+from stairbot.console.modals import AskScreen, ChoiceScreen, ConfirmScreen
 from stairbot.console.reckon import dead_reckon
-from stairbot.console.runner_thread import SPEEDS, ConsoleEngine, EngineHooks
+from stairbot.console.runner_thread import (
+    LATCH_HINT,
+    MID_CLIMB_HINT,
+    SPEEDS,
+    ConsoleEngine,
+    EngineHooks,
+)
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
@@ -35,10 +51,13 @@ from stairbot.console.widgets.motors import MotorPanel
 from stairbot.console.widgets.phase import PhasePanel
 from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
+from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 
 REFRESH_HZ = 10.0
+LOOK_FIRST = ("Look at the robot first: it may stand part way up a step, and the next run "
+              "starts from where it stands.")
 SPEED_ORDER = tuple(SPEEDS)
 
 # (action, palette title, palette help) for every operator action.
@@ -56,6 +75,7 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
                                 "the events as JSON lines (key: w)"),
     ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+    ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
 
 
@@ -64,22 +84,25 @@ class StairbotConsole(App[None]):
 
     CSS_PATH = "console.tcss"
     TITLE = "stairbot console"
-    # In footer order, most needed first: at 80 columns the footer shows the
-    # first eight (the e-stop to the robot URL); ctrl+p lists them all.
+    # The footer shows what an operator needs at once, and fits 80 columns;
+    # ? (the help screen) and ctrl+p list every key.
     BINDINGS = [
         Binding(ESTOP_KEY, "estop", "E-STOP", priority=True),
         Binding("c", "clear_estop", "clear"),
         Binding("s", "start('full')", "start"),
         Binding("p", "pause", "pause"),
         Binding("x", "stop_run", "stop"),
-        Binding("k", "start('calibrate')", "calib"),
-        Binding("q", "quit", "quit"),
-        Binding("u", "choose_robot", "robot"),
-        Binding("o", "choose_scenario", "scenario"),
-        Binding("f", "speed", "speed"),
-        Binding("r", "reset", "reset"),
-        Binding("w", "record", "rec"),
-        Binding("z", "zoom", "zoom"),
+        Binding("q", "quit_console('q')", "quit"),
+        Binding("question_mark", "help", "help", key_display="?"),
+        Binding("k", "start('calibrate')", "calib", show=False),
+        Binding("u", "choose_robot", "robot", show=False),
+        Binding("o", "choose_scenario", "scenario", show=False),
+        Binding("f", "speed", "speed", show=False),
+        Binding("r", "reset", "reset", show=False),
+        Binding("w", "record", "rec", show=False),
+        Binding("z", "zoom", "zoom", show=False),
+        Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
+        Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
     ]
 
     def __init__(self, engine: ConsoleEngine, url: str, scenario: str | None,
@@ -90,8 +113,10 @@ class StairbotConsole(App[None]):
         self.url = url
         self.scenario = scenario
         self._record = record
-        self._shown_version = -1
+        self._shown_key: object = None
         self._shown_event = 0
+        self._asking_quit = False
+        self._sigint: Any = None  # the SIGINT handler before ours
         # The panels, kept here: refresh_view must reach them while a modal
         # screen is on top (app.query_one looks only at the top screen).
         self.banner = Banner(id="banner")  # the line that says how things stand
@@ -119,28 +144,37 @@ class StairbotConsole(App[None]):
         yield Footer(compact=True)
 
     def on_mount(self) -> None:
+        # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):
+        # the robot stops first, then the console asks, as for Ctrl-C typed.
+        with contextlib.suppress(ValueError):  # not the main thread: left as it is
+            self._sigint = signal.signal(signal.SIGINT, self._on_sigint)
         if self._record:
-            try:
-                self.engine.start_recording(self._record)
-            except InputError as exc:
-                self.notify(str(exc), severity="error", timeout=8)
+            self._start_recording(self._record)
         self.refresh_view()
         self.set_interval(1 / REFRESH_HZ, self.refresh_view)
         self.open_robot(self.url, self.scenario)
+        self.engine.start_polling()
 
     # -- the view ------------------------------------------------------------------
     def refresh_view(self) -> None:
-        """Copy the live state and update every panel that changed."""
+        """Copy the live state and update every panel that changed (the ages
+        of the values shown change with the wall clock alone)."""
         view = self.state.view(events_after=self._shown_event)
-        if view.version == self._shown_version:
+        key = (view.version, age_key(view.read_age_s))
+        if key == self._shown_key:
             return
-        self._shown_version = view.version
+        self._shown_key = key
         self._show(view)
 
     def _show(self, v: StateView) -> None:
         self.banner.show(v.url, v.scenario, v.status, v.recording)
         picture = self.picture
-        picture.border_title = f"side view · {v.url} · {v.scenario}"
+        age = v.read_age_s
+        title = Text("side view · ")  # never markup: the URL may hold brackets
+        title.append(age_words(age), "bold red" if is_stale(age) else "dim")
+        title.append(f" · {v.url} · {v.scenario}")
+        picture.border_title = title
+        picture.set_class(is_stale(age), "-stale")
         snap = v.snapshot
         lifts = None
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
@@ -155,10 +189,11 @@ class StairbotConsole(App[None]):
             else:
                 note = "no pose from a wired robot"
         picture.show(scene, v.stairs, lifts, note)
-        self.sensors.show(snap)
-        self.motors.show(snap, v.commands)
-        self.phase.show(v.phase, v.flow, v.context)
-        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health)
+        running = v.status.robot == "running"
+        self.sensors.show(snap, age)
+        self.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
+        self.phase.show(v.phase, v.flow, v.context, v.phase_id)
+        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age)
         if v.events:
             log = self.log_panel
             log.add(v.events)
@@ -166,14 +201,17 @@ class StairbotConsole(App[None]):
 
     # -- workers -------------------------------------------------------------------
     @work(thread=True, group="robot", exclusive=True, exit_on_error=False)
-    def open_robot(self, url: str, scenario: str | None) -> None:
+    def open_robot(self, url: str, scenario: str | None, clear_latches: bool = False) -> None:
         """Open a robot off the UI thread; on bad input say so and reopen the
-        previous robot (if opening the new one closed it)."""
+        previous robot (if opening the new one closed it).  ``clear_latches``:
+        the operator confirmed clearing the latches the boards hold."""
         previous = (self.url, self.scenario) if self.engine.session is not None else None
         try:
-            self.engine.open(url, scenario)
+            self.engine.open(url, scenario, clear_latches=clear_latches)
         except Exception as exc:  # noqa: BLE001 - any failure is a message, not a traceback
-            message = f"cannot open {url}: {_why(exc)}"
+            why = _why(exc)
+            message = f"cannot open {why}" if why.startswith(f"{url}: ") else \
+                f"cannot open {url}: {why}"
             self._tell(message, "error")
             if previous is not None and self.engine.session is None and previous != (url,
                                                                                        scenario):
@@ -190,14 +228,23 @@ class StairbotConsole(App[None]):
         self.url, self.scenario = url, scenario
 
     @work(thread=True, group="run", exclusive=False, exit_on_error=False)
-    def run_program(self, mode: str) -> None:
-        result = self.engine.run(mode)
+    def run_program(self, mode: str, resume: ResumePlan | None = None) -> None:
+        result = self.engine.run(mode, resume)
         if result is not None:
             self._tell(f"run {result.outcome}", "information")
 
     def _tell(self, message: str, severity: str) -> None:
-        self.call_from_thread(self.notify, message, severity=severity,
-                              timeout=6)
+        self.call_from_thread(self.say, message, severity)
+
+    def say(self, message: str, severity: str = "information", *, keep: bool = True,
+            timeout: float = 6) -> None:
+        """Tell the operator: a toast, and (``keep``) a line in the event list
+        that stays after the toast has gone.  The text is shown as it is, never
+        parsed as markup: URLs, paths and drivers' messages hold brackets."""
+        if keep:
+            self.state.note(message, severity)
+        self.notify(message, severity=severity, timeout=timeout,  # type: ignore[arg-type]
+                    markup=False)
 
     # -- actions -------------------------------------------------------------------
     async def on_event(self, event: events.Event) -> None:
@@ -217,23 +264,118 @@ class StairbotConsole(App[None]):
         self.refresh_view()
 
     def action_clear_estop(self) -> None:
-        if not self.engine.clear_estop():
-            self.notify("the emergency stop is not set")
-        self.refresh_view()
+        """Clear the emergency stop -- the console's latch, or the latches of
+        boards refused for holding one -- once the operator confirms."""
+        pending = self.engine.latched_boards
+        if pending is not None and self.engine.session is None:
+            url, scenario, why = pending
+            question = (f"{why}\n\n{LOOK_FIRST}\nClear the latches the boards hold?")
+
+            def clear_boards(yes: bool | None) -> None:
+                if yes:
+                    self.open_robot(url, scenario, clear_latches=True)
+                else:
+                    self.say("not cleared: the boards keep their latches")
+
+            self.push_screen(ConfirmScreen(question, yes="Yes, clear (y)"), clear_boards)
+            return
+        if not self.engine.estop_set:
+            self.say("the emergency stop is not set")
+            return
+
+        def clear(yes: bool | None) -> None:
+            if not yes:
+                self.say("not cleared: the emergency stop stays latched")
+            elif not self.engine.clear_estop():
+                self.say("the emergency stop is not set")
+            self.refresh_view()
+
+        then = "p resumes the run" if self.engine.running else "s starts a run"
+        self.push_screen(ConfirmScreen(
+            f"Clear the EMERGENCY STOP?\n{LOOK_FIRST}\nClearing moves nothing: {then}.",
+            yes="Yes, clear (y)"), clear)
 
     def action_start(self, mode: str) -> None:
+        if self.engine.estop_set:
+            self.state.set_status(message=LATCH_HINT, severity="error")
+            self.say(LATCH_HINT, "error")
+            return
         if self.engine.running:
-            self.notify("a run is already going on", severity="warning")
+            self.say("a run is already going on", severity="warning")
             return
         if self.engine.session is None:
-            self.notify("no robot open: choose one with u", severity="error")
+            self.say("no robot open: choose one with u", severity="error")
+            return
+        if self.engine.mid_climb is not None:
+            self._mid_climb(mode, self.engine.mid_climb)
             return
         what = "Start calibration" if mode == "calibrate" else "Start the full run"
         self._after_consent(what, lambda: self.run_program(mode))
 
+    def _mid_climb(self, mode: str, gate: MidClimb) -> None:
+        """The robot may stand part way up: no fresh start from there.  Offer
+        what is safe -- resume (boards: the journal's run, checked first),
+        reset (the simulation), or the operator's word that it is back at
+        the start -- and move nothing until one is chosen and confirmed."""
+        wired = not self.engine.in_process
+        lines = "\n".join(gate.lines)
+        question = (f"The robot may stand part way up the stairs:\n{lines}\n\n"
+                    "A new run would square up and drive at the riser from there: not "
+                    "started.  " + ("Resume carries on the journal's run, after checks"
+                                    if wired else "Reset puts the simulated robot at the start")
+                    + "; or say the robot is back at the start.")
+        first = ("r", "Resume (r)") if wired else ("r", "Reset (r)")
+
+        def chosen(key: str | None) -> None:
+            if key == "r":
+                if wired:
+                    self._resume(mode)
+                else:
+                    self.action_reset()
+            elif key == "b":
+                self.push_screen(ConfirmScreen(
+                    "Start a new run from where the robot stands?\nOnly if it stands on the "
+                    "floor before the first step: a new run squares up, then drives at the "
+                    "stairs.", yes="Yes, it is at the start (y)"), back)
+            else:
+                self.say("nothing moved")
+
+        def back(yes: bool | None) -> None:
+            if yes:
+                self.engine.back_at_start()
+                self.action_start(mode)
+            else:
+                self.say("nothing moved")
+
+        self.state.set_status(message=MID_CLIMB_HINT, severity="error")
+        self.push_screen(ChoiceScreen(question, [first, ("b", "Back at start (b)")]), chosen)
+
+    def _resume(self, mode: str) -> None:
+        """Check the journal's run against the boards, show where the robot
+        believes it is, and carry it on once the operator confirms."""
+        try:
+            plan = self.engine.plan_resume()
+        except StairbotError as exc:
+            message = f"cannot resume: {exc}"
+            self.state.set_status(message=message, severity="error")
+            self.say(message, "error", timeout=10)
+            return
+
+        def answered(yes: bool | None) -> None:
+            if yes:
+                self.run_program(mode, plan)
+            else:
+                self.say("not resumed: nothing moved")
+
+        lines = "\n".join(plan.lines)
+        self.push_screen(ConfirmScreen(
+            f"Resume on {plan.state.start.get('url')}:\n{lines}\n\nLook at the robot: does "
+            "it stand where these lines say?  Resume and let it move?  Space stops every "
+            "motor.", yes="Yes, resume (y)"), answered)
+
     def action_pause(self) -> None:
         if not self.engine.running:
-            self.notify("no run is going on")
+            self.say("no run is going on")
         elif self.state.view().status.paused:
             self._after_consent("Resume motion", self.engine.resume)
         else:
@@ -256,7 +398,7 @@ class StairbotConsole(App[None]):
                 go()
                 self.refresh_view()
             else:
-                self.notify("nothing moved")
+                self.say("nothing moved")
 
         self.push_screen(ConfirmScreen(
             f"{what} on {session.url}?\n{boards}\n"
@@ -266,20 +408,20 @@ class StairbotConsole(App[None]):
         if self.engine.running:
             self.engine.stop()
         else:
-            self.notify("no run is going on")
+            self.say("no run is going on")
 
     def action_reset(self) -> None:
         if self.engine.running:
-            self.notify("stop the run first (x)", severity="warning")
+            self.say("stop the run first (x)", severity="warning")
         elif self.engine.session is not None and not self.engine.in_process:
-            self.notify("reset is for the in-process simulation (sim://)", severity="warning")
+            self.say("reset is for the in-process simulation (sim://)", severity="warning")
         else:
             self.log_panel.reset_log()
             self.open_robot(self.url, self.scenario)
 
     def action_choose_robot(self) -> None:
         if self.engine.running:
-            self.notify("stop the run first (x)", severity="warning")
+            self.say("stop the run first (x)", severity="warning")
             return
 
         def chosen(url: str | None) -> None:
@@ -291,7 +433,7 @@ class StairbotConsole(App[None]):
 
     def action_choose_scenario(self) -> None:
         if self.engine.running:
-            self.notify("stop the run first (x)", severity="warning")
+            self.say("stop the run first (x)", severity="warning")
             return
 
         def chosen(name: str | None) -> None:
@@ -303,7 +445,7 @@ class StairbotConsole(App[None]):
 
     def action_speed(self) -> None:
         if self.engine.session is not None and not self.engine.in_process:
-            self.notify("a robot on a wire keeps its own time (fake boards: --time-scale)",
+            self.say("a robot on a wire keeps its own time (fake boards: --time-scale)",
                         severity="warning")
             return
         current = self.state.view().speed
@@ -315,26 +457,37 @@ class StairbotConsole(App[None]):
         if self.engine.recorder is not None:
             path = self.engine.recorder.path
             self.engine.stop_recording()
-            self.notify(f"recording stopped: {path}")
+            self.say(f"recording stopped: {path}")
             return
 
         def chosen(path: str | None) -> None:
-            if not path:
-                return
-            try:
-                self.engine.start_recording(path)
-            except InputError as exc:
-                self.notify(str(exc), severity="error", timeout=8)
-                return
-            self.notify(f"recording to {path}")
+            if path:
+                self._start_recording(path)
 
         self.push_screen(AskScreen("Record to (FILE.mcap: every tick, MCAP; else the events, "
                                    "JSON lines)", "events.jsonl"), chosen)
 
+    def _start_recording(self, path: str) -> None:
+        """Record to ``path``, or beside it when a file is there (never over it)."""
+        try:
+            chosen = self.engine.start_recording(path)
+        except InputError as exc:
+            self.say(str(exc), "error", timeout=8)
+            return
+        if chosen != path:
+            self.say(f"{path} exists (not overwritten): recording to {chosen}",
+                     "warning", timeout=8)
+        else:
+            self.say(f"recording to {chosen}")
+
+    def action_help(self) -> None:
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen())
+
     def action_zoom(self) -> None:
         mode = self.picture.cycle_zoom()
         names = {"auto": "auto zoom", "flight": "whole flight", "robot": "following the robot"}
-        self.notify(f"picture: {names[mode]}")
+        self.say(f"picture: {names[mode]}", keep=False)
 
     def get_system_commands(self, screen: Screen) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)
@@ -348,6 +501,45 @@ class StairbotConsole(App[None]):
 
     def on_unmount(self) -> None:
         self.engine.shutdown()
+        if self._sigint is not None:
+            with contextlib.suppress(ValueError):
+                signal.signal(signal.SIGINT, self._sigint)
+
+    # -- quitting ------------------------------------------------------------------
+    def action_quit_console(self, key: str = "q") -> None:
+        """Quit; mid-run the robot stops first (the emergency stop, latched),
+        then the console asks: the answer may take a while, and the robot must
+        not drive on meanwhile."""
+        if not self.engine.running:
+            self.exit()
+            return
+        if not self.engine.latched:
+            self.engine.estop(f"{key} pressed mid-run")
+            self.refresh_view()
+        if self._asking_quit:
+            return
+        self._asking_quit = True
+
+        def answered(yes: bool | None) -> None:
+            self._asking_quit = False
+            if yes:
+                self.exit()  # on_unmount ends the run and releases the robot
+            else:
+                self.say("not quitting: the run is held, EMERGENCY STOP latched "
+                         "(c clears it, then p resumes)", "warning")
+
+        self.push_screen(ConfirmScreen(
+            "The robot is stopped: EMERGENCY STOP latched (every motor stopped, the lifts "
+            "hold).\nQuit the console? The run ends; the robot stays where it stands, "
+            "latched.", yes="Yes, quit (y)", no="No, stay (n)"), answered)
+
+    def _on_sigint(self, _sig: int, _frame: FrameType | None) -> None:
+        def stop_then_ask() -> None:
+            if self.engine.running and not self.engine.latched:
+                self.engine.estop("SIGINT")
+            self.call_from_thread(self.action_quit_console, "SIGINT")
+        threading.Thread(target=stop_then_ask, name="SIGINT emergency stop",
+                         daemon=True).start()
 
 
 def _why(exc: Exception) -> str:
@@ -360,14 +552,17 @@ def _why(exc: Exception) -> str:
 
 def build_app(config: RobotConfig | str | Path | None = None, *, url: str = "sim://",
               scenario: str | None = None, record: str | None = None, speed: str = "1x",
+              ages_wall: Callable[[], float] = time.monotonic,
               **engine_hooks: Unpack[EngineHooks]) -> StairbotConsole:
     """Build the console.  ``config`` is a RobotConfig, a file, or None for the
-    shipped robot (raises ConfigError for a bad file).  ``engine_hooks``
-    (open_fn, run_fn, control_fn, wall, sleep) replace the engine's defaults."""
+    shipped robot (raises ConfigError for a bad file).  ``ages_wall`` is the
+    clock the values' ages go by (a test that pins the picture stops it).
+    ``engine_hooks`` (open_fn, run_fn, control_fn, wall, sleep) replace the
+    engine's defaults."""
     cfg = config if isinstance(config, RobotConfig) else load_config(config)
     if speed not in SPEEDS:
         raise InputError("--speed", None, f"{speed!r}; allowed: {', '.join(SPEEDS)}")
-    state = LiveState(url=url)
+    state = LiveState(url=url, wall=ages_wall)
     engine = ConsoleEngine(state, cfg, **engine_hooks)
     engine.set_speed(speed)
     return StairbotConsole(engine, url, scenario, record)

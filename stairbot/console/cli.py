@@ -9,13 +9,15 @@ turns into one line on stderr and exit 2.
 from __future__ import annotations
 
 import argparse
+import os
 from collections.abc import Sequence
 from urllib.parse import urlsplit
 
 from stairbot.config import load_config
 from stairbot.console.runner_thread import SPEEDS
-from stairbot.errors import RobotUrlError
+from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
+from stairbot.paths import unused_path
 from stairbot.robots import known_schemes
 from stairbot.scenario import load_scenario
 
@@ -51,6 +53,21 @@ def _check_url(url: str) -> None:
         raise RobotUrlError(url, None, f"unknown scheme {scheme!r}; allowed: {allowed}")
 
 
+def check_record(path: str) -> None:
+    """InputError unless the record can be written where the console will
+    put it (``path``, or beside it when a file is there: never over it).  A
+    FIFO no process reads is refused here, not waited on; a file this check
+    creates is removed again, so the console still finds the name free."""
+    try:
+        chosen = unused_path(path)
+    except FileExistsError as exc:
+        raise InputError(path, None, f"cannot write the record: {exc}") from None
+    existed = os.path.lexists(chosen)
+    LineFile(chosen, "the record", fresh=False).close()
+    if not existed:
+        os.unlink(chosen)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the console until the operator quits; returns the exit code.
     Raises InputError (exit 2 in ``stairbot``) for bad input."""
@@ -58,14 +75,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     config = load_config(args.config)
     load_scenario(args.scenario)  # a bad scenario fails here, not behind the screen
     _check_url(args.robot)
-    if args.record:  # a FIFO no process reads is refused here, not waited on
-        LineFile(args.record, "the record", fresh=False).close()
+    if args.record:
+        check_record(args.record)
     from stairbot.console.app import build_app  # textual loads only when the screen opens
 
     app = build_app(config, url=args.robot, scenario=args.scenario, record=args.record,
                     speed=args.speed)
     app.run()
-    return 0
+    # Textual sets 1 when the app ended on an unhandled error (the engine
+    # stopped the robot on the way out): not the exit of a clean quit.
+    return app.return_code or 0
 
 
 console_main = main

@@ -16,16 +16,17 @@ class ConfirmScreen(ModalScreen[bool]):
 
     BINDINGS = [Binding("y", "answer(True)", "yes"), Binding("n,escape", "answer(False)", "no")]
 
-    def __init__(self, question: str) -> None:
+    def __init__(self, question: str, yes: str = "Yes, start (y)", no: str = "No (n)") -> None:
         super().__init__()
         self.question = question
+        self.yes, self.no = yes, no
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Label(self.question, classes="question")
+            yield Label(self.question, classes="question", markup=False)
             with Horizontal(classes="buttons"):
-                yield Button("Yes, start (y)", variant="warning", id="yes", compact=True)
-                yield Button("No (n)", variant="primary", id="no", compact=True)
+                yield Button(self.yes, variant="warning", id="yes", compact=True)
+                yield Button(self.no, variant="primary", id="no", compact=True)
 
     def on_mount(self) -> None:
         self.query_one("#no", Button).focus()
@@ -53,10 +54,10 @@ class AskScreen(ModalScreen[str | None]):
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Label(self.title_text, classes="question")
+            yield Label(self.title_text, classes="question", markup=False)
             yield Input(value=self.value, placeholder=self.placeholder, id="answer")
             if self.hint:
-                yield Label(self.hint, classes="hint")
+                yield Label(self.hint, classes="hint", markup=False)
             yield Label("space is the EMERGENCY STOP even here: no spaces", classes="hint")
 
     def on_mount(self) -> None:
@@ -68,3 +69,35 @@ class AskScreen(ModalScreen[str | None]):
 
     def action_cancel(self) -> None:
         self.dismiss(None)
+
+
+class ChoiceScreen(ModalScreen[str | None]):
+    """A question with a few answers, each its own key; Escape (or n) answers
+    None: nothing is done."""
+
+    def __init__(self, question: str, choices: list[tuple[str, str]]) -> None:
+        super().__init__()
+        self.question = question
+        self.choices = choices  # (key, label), e.g. ("r", "Resume (r)")
+        for key, _ in choices:
+            self._bindings.bind(key, f"choose({key!r})", show=False)
+        self._bindings.bind("n,escape", "choose(None)", show=False)
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog"):
+            yield Label(self.question, classes="question", markup=False)
+            with Horizontal(classes="buttons"):
+                for key, label in self.choices:
+                    yield Button(label, id=f"choice-{key}", compact=True)
+                yield Button("Cancel (n)", variant="primary", id="choice-none", compact=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#choice-none", Button).focus()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        key = (event.button.id or "").removeprefix("choice-")
+        self.dismiss(None if key == "none" else key)
+
+    def action_choose(self, key: str | None) -> None:
+        self.dismiss(key)

@@ -7,16 +7,21 @@ Every method takes one lock for a short time; the UI never waits for a tick.
 from __future__ import annotations
 
 import threading
+import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 from stairbot.console.scene import SceneView
-from stairbot.events import Event
+from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, Snapshot
 from stairbot.runner import RunResult
 
 LOG_LENGTH = 1000
+NOTE_KINDS = {"information": EventKind.INFO, "warning": EventKind.WARNING,
+              "error": EventKind.ERROR}
+CONSOLE = "console"  # the phase field of what the console itself says
 
 
 @dataclass(frozen=True)
@@ -28,6 +33,7 @@ class RunStatus:
     paused: bool = False
     message: str = ""  # how the run ended, or what went wrong
     severity: str = "info"  # info | good | warning | error
+    latch: str = ""  # who latched the emergency stop: "operator", or "automatic: why"
 
 
 @dataclass(frozen=True)
@@ -41,9 +47,11 @@ class StateView:
     wired: bool  # no in-process world to draw: a driver on a serial link or CAN bus
     status: RunStatus
     snapshot: Snapshot | None
+    read_age_s: float | None  # wall seconds since the snapshot was read (None: never)
     commands: dict[MotorId, float]
     ticks: int
     phase: str
+    phase_id: str  # the phase's value ("ascent_lift_first"); "" before a run
     flow: str
     context: dict[str, Any]
     scene: SceneView | None
@@ -58,8 +66,11 @@ class StateView:
 class LiveState:
     """Thread-safe latest state.  Writers: the run thread and the UI's actions."""
 
-    def __init__(self, *, url: str = "", scenario: str = "", simulated: bool = True) -> None:
+    def __init__(self, *, url: str = "", scenario: str = "", simulated: bool = True,
+                 wall: Callable[[], float] = time.monotonic) -> None:
         self._lock = threading.Lock()
+        self._wall = wall
+        self._read_at: float | None = None  # wall time of the last reading taken
         self._version = 0
         self._url = url
         self._scenario = scenario
@@ -70,6 +81,7 @@ class LiveState:
         self._commands: dict[MotorId, float] = {}
         self._ticks = 0
         self._phase = "—"
+        self._phase_id = ""
         self._flow = "idle"
         self._context: dict[str, Any] = {}
         self._scene: SceneView | None = None
@@ -92,13 +104,15 @@ class LiveState:
             self._url, self._scenario, self._simulated = url, scenario, simulated
             self._wired = wired
             self._snapshot, self._commands, self._ticks = None, {}, 0
+            self._read_at = None
             self._phase, self._flow, self._context = "—", "idle", {}
+            self._phase_id = ""
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
             self._bump()
 
     def set_status(self, *, robot: str | None = None, estopped: bool | None = None,
                    paused: bool | None = None, message: str | None = None,
-                   severity: str | None = None) -> None:
+                   severity: str | None = None, latch: str | None = None) -> None:
         """Change the fields given (None: left as it is)."""
         with self._lock:
             st = self._status
@@ -109,12 +123,14 @@ class LiveState:
                 paused=st.paused if paused is None else paused,
                 message=st.message if message is None else message,
                 severity=st.severity if severity is None else severity,
+                latch=st.latch if latch is None else latch,
             )
             self._bump()
 
     def on_read(self, snap: Snapshot) -> None:
         with self._lock:
             self._snapshot = snap
+            self._read_at = self._wall()
             self._ticks += 1
             if snap.health:
                 self._health = dict(snap.health)
@@ -125,9 +141,10 @@ class LiveState:
             self._commands = speeds
             self._bump()
 
-    def on_phase(self, label: str, flow: str, context: dict[str, Any] | None) -> None:
+    def on_phase(self, label: str, flow: str, context: dict[str, Any] | None,
+                 phase_id: str = "") -> None:
         with self._lock:
-            self._phase, self._flow = label, flow
+            self._phase, self._flow, self._phase_id = label, flow, phase_id
             if context is not None:
                 self._context = context
             self._bump()
@@ -146,6 +163,14 @@ class LiveState:
                     {k: float(v) for k, v in event.data.items() if isinstance(v, int | float)}
                 )
             self._bump()
+
+    def note(self, message: str, severity: str = "information") -> None:
+        """What the console told the operator, kept in the event list (on the
+        robot's clock as last read; not in the record: the run's events are
+        what `stairbot run --record` writes)."""
+        time_s = self._snapshot.time_s if self._snapshot is not None else 0.0
+        self.on_event(Event(time_s, NOTE_KINDS.get(severity, EventKind.INFO), message,
+                            CONSOLE))
 
     def on_result(self, result: RunResult | None) -> None:
         with self._lock:
@@ -179,9 +204,11 @@ class LiveState:
                 wired=self._wired,
                 status=self._status,
                 snapshot=self._snapshot,
+                read_age_s=None if self._read_at is None else self._wall() - self._read_at,
                 commands=dict(self._commands),
                 ticks=self._ticks,
                 phase=self._phase,
+                phase_id=self._phase_id,
                 flow=self._flow,
                 context=dict(self._context),
                 scene=self._scene,

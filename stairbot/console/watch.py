@@ -140,6 +140,14 @@ class WatchedRobot:
         with self._lock:
             return self.inner.diagnostics()
 
+    def identity(self) -> dict[str, dict[str, int]] | None:
+        """The boards' serial numbers and uptimes (what a journal keeps), or
+        None for a robot that has none (the simulation)."""
+        from stairbot.runner import board_identity
+
+        with self._lock:
+            return board_identity(self.inner)
+
     def close(self) -> None:
         with self._lock:
             self.inner.close()

@@ -77,8 +77,9 @@ class PortChannel:
 
     POLL_S = 0.002
 
-    def __init__(self, port: Any) -> None:
+    def __init__(self, port: Any, on_close: Callable[[], None] | None = None) -> None:
         self.port = port
+        self._on_close = on_close  # after the port closes (a port lock's release)
         port.timeout = self.POLL_S
 
     def write(self, data: bytes) -> None:
@@ -92,7 +93,11 @@ class PortChannel:
                 return data
 
     def close(self) -> None:
-        self.port.close()
+        try:
+            self.port.close()
+        finally:
+            if self._on_close is not None:
+                self._on_close()
 
 
 @dataclass(eq=False)

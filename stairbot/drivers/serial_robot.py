@@ -31,6 +31,10 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
 Every number must be finite and within its bounds (``url_options.py``); the
 query must decode as UTF-8.
 
+A device port is held by one host at a time (``port_lock.py``): a second
+``stairbot run`` or console on it is refused with one line naming the
+process that holds it (PortBusyError, exit 1).
+
 The board logic -- Robot protocol, handshake, keepalive, link health, lost
 links -- is ``board_robot.BoardRobot``; this module adds the serial port and
 the ``SerialLink`` (``serial_link.py``) that frames messages for it.
@@ -45,6 +49,7 @@ import serial
 
 from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session
+from stairbot.drivers.port_lock import PortLock, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
@@ -77,23 +82,51 @@ def parse_serial_url(url: str) -> tuple[str, dict[str, float]]:
     return port, opts
 
 
+class _LockedPort:
+    """A pyserial port and the lock taken for it, closed together."""
+
+    def __init__(self, port: serial.SerialBase, lock: PortLock | None) -> None:
+        self.port = port
+        self.lock = lock
+
+    def close(self) -> None:
+        try:
+            self.port.close()
+        finally:
+            if self.lock is not None:
+                self.lock.release()
+
+
 def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
-    """Open a pyserial port; a tty gets the fast fd channel.  RobotUrlError
-    in one line when it cannot open."""
+    """Open a pyserial port; a tty gets the fast fd channel.  A device path
+    is locked for this host first (``port_lock.py``): PortBusyError, one
+    line naming who holds it, when another stairbot has it open.
+    RobotUrlError in one line when it cannot open."""
+    lock: PortLock | None = None
+    if "://" not in port:  # a device: one host at a time
+        try:
+            lock = take_port_lock(port)
+        except OSError as exc:
+            raise RobotUrlError(url, None, f"cannot lock port {port}: "
+                                f"{exc.strerror or exc}") from None
     try:
-        ser = serial.serial_for_url(port, baudrate=baud, timeout=0)
+        ser = serial.serial_for_url(port, baudrate=baud, timeout=0,
+                                    **({"exclusive": True} if lock is not None else {}))
     except Exception as exc:  # noqa: BLE001 - pyserial's URL handlers raise anything
+        if lock is not None:
+            lock.release()
         detail = str(exc).strip() or type(exc).__name__
         raise RobotUrlError(url, None, f"cannot open port {port}: {detail}") from None
     # Only a plain POSIX port may be read around pyserial's back: a wrapper
     # such as spy:// must see every byte.
+    release = lock.release if lock is not None else None
     if type(ser).__module__ != "serial.serialposix":
-        return PortChannel(ser)
+        return PortChannel(ser, on_close=release)
     try:
         fd = ser.fileno()
     except (AttributeError, io.UnsupportedOperation, serial.SerialException, OSError):
-        return PortChannel(ser)
-    return FdChannel(fd, owner=ser)
+        return PortChannel(ser, on_close=release)
+    return FdChannel(fd, owner=_LockedPort(ser, lock))
 
 
 def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:

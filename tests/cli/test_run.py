@@ -130,3 +130,18 @@ def test_ctrl_c_latches_the_emergency_stop_from_a_thread_of_its_own() -> None:
         assert estopped.wait(5)
     assert stopped == [("estop", "Ctrl-C emergency stop")]
     assert reasons == ["interrupted by Ctrl-C: emergency stop latched"]
+
+
+def test_record_to_an_existing_file_never_overwrites_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 12 item 5, "it loses recordings": `--record` to a file that exists
+    writes beside it and says so."""
+    record = tmp_path / "events.jsonl"
+    record.write_text("an earlier recording\n")
+    assert main(["run", "-q", "--scenario", "calibration_case1_open_floor",
+                 "--record", str(record)]) == 0
+    assert record.read_text() == "an earlier recording\n"
+    beside = tmp_path / "events-1.jsonl"
+    assert json.loads(beside.read_text().splitlines()[-1])["kind"] == "summary"
+    err = capsys.readouterr().err
+    assert f"{record} exists (not overwritten): recording to {beside}" in err

@@ -125,12 +125,15 @@ EVENTS = [
 def show_climbing(app: StairbotConsole) -> None:
     """Put a mid-climb phase, context and events into the live state."""
     app.state.on_phase("ascent 3 — lift segment 1", "ascent",
-                       {"number_of_steps": 2, "tab_length_to_edge": [0.143, 0.146] + [0.0] * 18})
+                       {"number_of_steps": 2, "tab_length_to_edge": [0.143, 0.146] + [0.0] * 18},
+                       "ascent_lift_first")
     for e in EVENTS:
         app.state.on_event(e)
 
 
 def make_still_app(simulated: bool = True, wired: bool | None = None,
                    **kw: Any) -> StairbotConsole:
-    """The console on a still robot (``simulated=False``: a wired one)."""
+    """The console on a still robot (``simulated=False``: a wired one); the
+    values' ages are pinned at 0 (a stopped clock) unless ``ages_wall`` is given."""
+    kw.setdefault("ages_wall", lambda: 0.0)
     return build_app(load_config(), open_fn=still_open(simulated, wired), **kw)

@@ -6,103 +6,20 @@ from __future__ import annotations
 import asyncio
 import json
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import pytest
+from pilot import SpyRobot, banner, press, ready, spied_open, until
 from still_robot import still_open
-from textual import events
 from textual.widgets import Input
 
 from stairbot.cli import main as cli_main
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ConfirmScreen
 from stairbot.errors import LinkLostError
-from stairbot.hardware import MotorId, Snapshot, Speeds
-from stairbot.robots import RobotSession, open_robot
-
-
-class SpyRobot:
-    """Passes every call to the simulated robot and logs it, so a test can see
-    exactly what reached the robot and in which order."""
-
-    def __init__(self, inner: Any) -> None:
-        self.inner = inner
-        self.calls: list[tuple[str, dict[MotorId, float] | None]] = []
-
-    def read(self) -> Any:
-        self.calls.append(("read", None))
-        return self.inner.read()
-
-    def command(self, speeds: Speeds) -> None:
-        self.calls.append(("command", dict(speeds)))
-        self.inner.command(speeds)
-
-    def stop_all(self) -> None:
-        self.calls.append(("stop_all", None))
-        self.inner.stop_all()
-
-    def estop(self) -> None:
-        self.calls.append(("estop", None))
-        self.inner.estop()
-
-    def clear(self) -> None:
-        self.calls.append(("clear", None))
-        self.inner.clear()
-
-    @property
-    def estopped(self) -> bool:
-        return bool(self.inner.estopped)
-
-    def diagnostics(self) -> dict[str, object]:
-        return self.inner.diagnostics()
-
-    def close(self) -> None:
-        self.inner.close()
-
-    def motion(self, since: int) -> list[dict[MotorId, float]]:
-        """The commands from call ``since`` on that asked some motor to turn."""
-        return [c[1] for c in self.calls[since:]
-                if c[0] == "command" and c[1] and any(v != 0 for v in c[1].values())]
-
-
-def spied_open(spies: list[SpyRobot]) -> Callable[..., RobotSession]:
-    def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
-        session = open_robot(url, config, replace(options, world=scenario))
-        spy = SpyRobot(session.robot)
-        spies.append(spy)
-        return RobotSession(spy, session.clock, session.url, session.simulated, session.sim)
-    return open_fn
-
-
-async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:
-    """Let the app run until ``cond`` holds (the bound only stops a broken test)."""
-    for _ in range(1200):
-        if cond():
-            await pilot.pause(0.01)
-            return
-        await asyncio.sleep(0.05)
-    raise AssertionError(f"never happened: {what}")
-
-
-async def press(pilot: Any, *keys: str) -> None:
-    """Send key events the way the terminal driver does and let the app handle
-    them.  (Pilot.press also waits for the process to go idle, up to 2 s a key,
-    which a running simulation never does.)"""
-    for key in keys:
-        char = " " if key == "space" else (key if len(key) == 1 else None)
-        pilot.app.post_message(events.Key(key, char))
-        await pilot.pause(0.02)
-
-
-def banner(app: StairbotConsole) -> str:
-    return app.banner.plain
-
-
-async def ready(pilot: Any) -> None:
-    await pilot.app.workers.wait_for_complete()
-    await until(pilot, lambda: "READY" in banner(pilot.app), "the robot is ready")
+from stairbot.hardware import MotorId, Snapshot
+from stairbot.robots import RobotSession
 
 
 def _comparable(line: str) -> dict[str, Any]:
@@ -200,7 +117,9 @@ def test_estop_key_stops_every_motor_at_once_and_latches() -> None:
             await press(pilot, "p")
             await until(pilot, lambda: "clear the emergency stop" in banner(app), "refused")
             assert app.state.view().status.estopped
-            await press(pilot, "c")
+            await press(pilot, "c")  # asks first (tests/console/test_latch.py)
+            await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
+            await press(pilot, "y")
             await until(pilot, lambda: not app.state.view().status.estopped, "cleared")
             await until(pilot, lambda: not spy.inner.estopped, "the robot's clear()")
             assert [c[0] for c in spy.calls[n_stop:]].count("estop") == 1
@@ -336,7 +255,8 @@ def test_a_lost_link_shows_as_a_banner_not_a_traceback(
             await until(pilot, lambda: "FAULT" in banner(app), "the run ends in FAULT")
             assert "ENDED" not in banner(app)
             assert "no reply to 3 attempts" in banner(app)
-            assert "-error" in app.banner.classes
+            # the run latched the emergency stop, and the banner says it did
+            assert "E-STOP  (automatic)" in banner(app) and "-estop" in app.banner.classes
             assert robot.stops > 0  # the runner stopped every motor
             await pilot.pause(0.2)
             # The run ended between two ticks: the phase panel still shows the end.

@@ -85,9 +85,27 @@ def test_motor_direction_glyphs() -> None:
 
     assert direction(MotorId.MWF, 1.0)[0] == "▶"
     assert direction(MotorId.MWL, -1.0)[0] == "◀"
-    assert direction(MotorId.MTF, 10.0)[0] == "▲"
-    assert direction(MotorId.MTB, -10.0)[0] == "▼"
+    assert direction(MotorId.MTF, 10.0)[0] == "1▲"
+    assert direction(MotorId.MTB, -10.0)[0] == "3▼"
     assert direction(MotorId.MTB, 0.0)[0] == "■"
+
+
+def test_lift_arrows_show_the_segment_that_moves() -> None:
+    """Issue 12 item 5, "it speaks code": a lift's arrow showed the motor's
+    sign, not which segment moves.  Lifting segment 2 (ascent 5: segments 1
+    and 3 stand) turns both lifts negative, and segment 2 rises."""
+    from stairbot.console.widgets.motors import direction
+    from stairbot.console.words import carried_by
+    from stairbot.hardware import MotorId
+
+    standing = carried_by("ascent_lift_second")
+    assert standing == (1, 3)
+    assert direction(MotorId.MTF, -10.0, standing)[0] == "2▲"
+    assert direction(MotorId.MTB, -10.0, standing)[0] == "2▲"
+    # Lifting segment 1 (ascent 3: segments 2 and 3 stand): segment 1 rises.
+    assert direction(MotorId.MTF, 10.0, carried_by("ascent_lift_first"))[0] == "1▲"
+    # Going down, lowering segment 3 (segments 1 and 2 stand).
+    assert direction(MotorId.MTB, -10.0, carried_by("descent_lower_third"))[0] == "3▼"
 
 
 def test_dead_reckoning_follows_the_simulated_climb() -> None:

@@ -39,7 +39,7 @@ class DriveLoop:
         self.started = threading.Event()
 
     def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: RunControl,
-                 on_tick: Any) -> RunResult:
+                 on_tick: Any, plan: Any) -> RunResult:
         robot, clock = session.robot, session.clock
         while control.stop_reason is None and len(self.snaps) < 20000:
             snap = robot.read()
@@ -111,7 +111,7 @@ def test_a_run_cannot_start_until_the_estop_is_cleared(
     engine, loop = engine_and_loop
     engine.estop()
     assert engine.run("full") is None
-    assert "clear it" in engine.state.view().status.message
+    assert "c clears it" in engine.state.view().status.message
     assert engine.clear_estop()
     assert not engine.state.view().status.estopped
 
@@ -149,7 +149,7 @@ class HeldLoop(DriveLoop):
         self.release = threading.Event()
 
     def __call__(self, session: Any, config: Any, sink: Any, mode: str, control: RunControl,
-                 on_tick: Any) -> RunResult:
+                 on_tick: Any, plan: Any) -> RunResult:
         robot, clock = session.robot, session.clock
         while control.stop_reason is None:
             self.snaps.append(robot.read())

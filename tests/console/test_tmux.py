@@ -1,5 +1,6 @@
 """`stairbot console` in a real terminal (tmux): the robot is drawn on the
-stairs, the picture changes as it climbs, and q quits.  Skipped without tmux."""
+stairs, the picture changes as it climbs, and q quits (asking first
+mid-run).  Skipped without tmux."""
 
 from __future__ import annotations
 
@@ -62,5 +63,7 @@ def test_console_in_a_real_terminal_draws_the_robot_climbing(
     assert "RUNNING" in climbing
     picture = [line[:60] for line in first.splitlines()[2:24]]
     assert [line[:60] for line in climbing.splitlines()[2:24]] != picture
-    tmux("send-keys", "-t", "console", "q")  # quits mid-run: the run is stopped first
+    tmux("send-keys", "-t", "console", "q")  # mid-run: the robot stops first, then it asks
+    wait_screen(tmux, lambda s: "E-STOP" in s and "Quit the console?" in s, "the question")
+    tmux("send-keys", "-t", "console", "y")
     wait_screen(tmux, lambda s: s == "", "the console quits and its pane closes")

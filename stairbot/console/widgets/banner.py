@@ -13,13 +13,16 @@ SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
 
 def banner_text(url: str, scenario: str, status: RunStatus,
                 recording: str | None = None) -> Text:
-    if status.estopped:
-        state = "E-STOP"
-    elif status.paused and status.robot == "running":
-        state = "PAUSED"
-    else:
-        state = status.robot.upper()
+    """`` FAULT  E-STOP (automatic)  why...``: the robot's state, the latch and
+    who set it, then the one thing to know now (whole: the banner wraps)."""
+    state = "PAUSED" if status.paused and status.robot == "running" else status.robot.upper()
     out = Text(f" {state} ", "bold reverse")
+    if status.estopped:
+        who = status.latch.split(":", 1)[0] if status.latch else ""
+        out.append(" ")
+        out.append(" E-STOP ", "bold reverse")
+        if who:
+            out.append(f" ({who})", "bold")
     if recording:
         out.append(" ● REC", "bold")
     out.append(f" {status.message}" if status.message else f" {url or '—'} · {scenario}")
@@ -29,7 +32,7 @@ def banner_text(url: str, scenario: str, status: RunStatus,
 class Banner(Static):
     """One line, coloured by severity; red while the emergency stop is set."""
 
-    DEFAULT_CSS = "Banner { height: 1; width: 1fr; }"
+    DEFAULT_CSS = "Banner { height: auto; max-height: 6; width: 1fr; }"
 
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id)

@@ -10,6 +10,8 @@ from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
+from stairbot.console.freshness import age_key, is_stale, titled
+
 SPEED_NAMES = {"1x": "1×", "10x": "10×", "max": "max"}
 ERROR_KEYS = ("crc_errors", "malformed", "stray")
 
@@ -54,23 +56,25 @@ class LinkPanel(Static):
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id)
         self._last: object = None
-        self.border_title = "link"
+        self.border_title = titled("link", None)
 
     def show(self, in_process: bool, time_s: float | None, speed: str,
-             health: Mapping[str, float]) -> None:
-        """``in_process``: the simulation runs in the console (no link to show)."""
+             health: Mapping[str, float], age_s: float | None = None) -> None:
+        """``in_process``: the simulation runs in the console (no link to show);
+        ``age_s``: wall seconds since the robot was last read (None: never)."""
         key = (in_process, None if time_s is None else round(time_s, 1), speed,
-               tuple(sorted(health.items())))
+               tuple(sorted(health.items())), age_key(age_s))
         if key == self._last:
             return
         self._last = key
+        self.set_class(is_stale(age_s), "-stale")
         if in_process:
-            self.border_title = "simulation"
+            self.border_title = titled("simulation", age_s)
             out = Text("t ", "dim", no_wrap=True, overflow="ellipsis")
             out.append("—" if time_s is None else f"{time_s:7.1f} s")
             out.append("  speed ", "dim")
             out.append(SPEED_NAMES.get(speed, speed), "bold")
             self.update(out)
         else:
-            self.border_title = "link health"
+            self.border_title = titled("link health", age_s)
             self.update(Group(*health_text(health)))

@@ -1,4 +1,13 @@
-"""The six motors: direction, speed (turns/s) and turn counter, and any fault."""
+"""The six motors: what each moves (operator words first, the seed's name
+beside it), its direction, speed (turns/s) and turn counter, and any fault.
+
+A lift's arrow shows the segment that moves, not the motor's sign: with
+segments 2 and 3 standing, MTF turning positive raises segment 1 (``1▲``);
+with segments 1 and 3 standing, the same sign lowers segment 2 (``2▼``).
+Which segments stand is the running phase's ``carried_by``; with no phase
+to say (idle), the arrow is the end segment's motion relative to segment 2,
+which is what the sign means (docs/protocol.md, section 1).
+"""
 
 from __future__ import annotations
 
@@ -7,28 +16,53 @@ from collections.abc import Mapping
 from rich.text import Text
 from textual.widgets import Static
 
+from stairbot.console.freshness import age_key, is_stale, titled
 from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, Snapshot
 
 STILL = 1e-3  # turns/s below which a motor counts as stopped
+NAMES = {MotorId.MWF: "front wheels", MotorId.MWB: "back wheels",
+         MotorId.MWR: "mid wheels R", MotorId.MWL: "mid wheels L",
+         MotorId.MTF: "front lift", MotorId.MTB: "back lift"}
+END_SEGMENT = {MotorId.MTF: 1, MotorId.MTB: 3}  # the segment a lift raises against segment 2
+SEGMENT_STYLES = ("bold bright_cyan", "bold yellow", "bold magenta")  # as the picture
 
 
-def direction(motor: MotorId, speed: float) -> tuple[str, str]:
-    """A glyph and a style: wheels ▶ forward ◀ back, lifts ▲ up ▼ down, ■ stopped."""
+def lift_motion(motor: MotorId, speed: float, carried_by: tuple[int, ...] = ()) -> tuple[int, str]:
+    """(segment, arrow) for a lift turning at ``speed``: the segment that
+    moves and which way.  When the end segment stands (it is in
+    ``carried_by``), the lift moves segment 2 the other way."""
+    end = END_SEGMENT[motor]
+    up = speed > 0
+    if end in carried_by:
+        return 2, "▼" if up else "▲"
+    return end, "▲" if up else "▼"
+
+
+def direction(motor: MotorId, speed: float,
+              carried_by: tuple[int, ...] = ()) -> tuple[str, str]:
+    """A glyph and a style: wheels ▶ forward ◀ back; lifts the segment and
+    ▲ up ▼ down (``1▲``); ■ stopped."""
     if abs(speed) < STILL:
         return "■", "dim"
     if motor in LIFT_MOTORS:
-        return ("▲", "bold cyan") if speed > 0 else ("▼", "bold cyan")
+        segment, arrow = lift_motion(motor, speed, carried_by)
+        return f"{segment}{arrow}", SEGMENT_STYLES[segment - 1]
     return ("▶", "bold green") if speed > 0 else ("◀", "bold yellow")
 
 
-def motor_line(motor: MotorId, state: MotorState | None, commanded: float | None) -> Text:
-    line = Text(f"{motor.value} ", style="bold")
+def motor_line(motor: MotorId, state: MotorState | None, commanded: float | None,
+               carried_by: tuple[int, ...] = ()) -> Text:
+    """``front lift   MTF 1▲ +10.0    95.0``: name, seed name, direction,
+    speed (turns/s), turn counter; then a fault or the commanded speed."""
+    line = Text(f"{NAMES[motor]:<12} ", style="bold")
+    line.append(f"{motor.value} ", "dim")
     if state is None:
         line.append("—", "dim")
         return line
-    glyph, style = direction(motor, state.speed_tps)
-    line.append(glyph, style)
-    line.append(f" {state.speed_tps:+6.2f} t/s {state.turns:9.2f} t")
+    glyph, style = direction(motor, state.speed_tps, carried_by)
+    line.append(f"{glyph:<2}", style)
+    speed = state.speed_tps if abs(state.speed_tps) >= 0.05 else 0.0  # no "-0.0"
+    line.append(f" {speed:+5.1f} {state.turns:7.1f}")
     if state.fault:
         line.append(f" {state.fault}", "bold red")
     elif commanded is not None and abs(commanded - state.speed_tps) > 0.05:
@@ -44,15 +78,20 @@ class MotorPanel(Static):
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id)
         self._last: object = ()
-        self.border_title = "motors  dir  speed  turns"
+        self.border_title = titled("motors  turn/s  turns", None)
 
-    def show(self, snap: Snapshot | None, commands: Mapping[MotorId, float]) -> None:
+    def show(self, snap: Snapshot | None, commands: Mapping[MotorId, float],
+             age_s: float | None = None, carried_by: tuple[int, ...] = ()) -> None:
+        """``age_s``: wall seconds since ``snap`` was read (None: never);
+        ``carried_by``: the segments that stand in the running phase."""
         motors = dict(snap.motors) if snap is not None else {}
-        key = (motors, dict(commands))
+        key = (motors, dict(commands), age_key(age_s), carried_by)
         if key == self._last:
             return
         self._last = key
+        self.border_title = titled("motors  turn/s  turns", age_s)
+        self.set_class(is_stale(age_s), "-stale")
         self.update(Text("\n").join(
-            motor_line(m, motors.get(m), commands.get(m) if commands else None)
+            motor_line(m, motors.get(m), commands.get(m) if commands else None, carried_by)
             for m in MotorId
         ))

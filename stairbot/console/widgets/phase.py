@@ -1,6 +1,7 @@
-"""The current phase as the seed names it, where it stands in the flow, and the
-seed's variables the operator watches: ``number_of_steps`` and
-``tab_length_to_edge``."""
+"""The current phase -- what it does in the operator's words, the seed's
+label beneath it -- where it stands in the flow, and the seed's variables
+the operator watches: the steps climbed (``number_of_steps``) and the
+treads measured (``tab_length_to_edge``), the seed's names after them."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from rich.text import Text
 from textual.widgets import Static
 
 from stairbot.algorithm.phases import FLOWS
+from stairbot.console.words import phase_words
 
 
 def flow_text(flow: str) -> Text:
@@ -34,7 +36,7 @@ def flow_text(flow: str) -> Text:
 
 def tab_text(context: Mapping[str, Any]) -> Text:
     """The filled entries of ``tab_length_to_edge``, in millimetres."""
-    out = Text("tab_length_to_edge mm ", "bold")
+    out = Text("treads mm ", "bold", no_wrap=True, overflow="ellipsis")
     tab = context.get("tab_length_to_edge")
     values: list[str] = []
     if isinstance(tab, Sequence) and not isinstance(tab, str):
@@ -42,6 +44,7 @@ def tab_text(context: Mapping[str, Any]) -> Text:
         used = tab[: n] if isinstance(n, int) and n > 0 else [v for v in tab if v]
         values = [f"{float(v) * 1000:.0f}" if isinstance(v, int | float) else "—" for v in used]
     out.append(" ".join(values) if values else "—")
+    out.append("  tab_length_to_edge", "dim")
     return out
 
 
@@ -55,16 +58,24 @@ class PhasePanel(Static):
         self._last: object = None
         self.border_title = "phase"
 
-    def show(self, label: str, flow: str, context: Mapping[str, Any]) -> None:
-        key = (label, flow, repr(context.get("number_of_steps")),
-               repr(context.get("tab_length_to_edge")))
+    def show(self, label: str, flow: str, context: Mapping[str, Any],
+             phase_id: str = "") -> None:
+        """``label``: the seed's; ``phase_id``: the phase's value, for the
+        operator's words (stairbot.console.words)."""
+        key = (label, flow, phase_id, repr(context.get("number_of_steps")),
+               repr(context.get("steps_descended")), repr(context.get("tab_length_to_edge")))
         if key == self._last:
             return
         self._last = key
-        steps = Text("number_of_steps ", "bold", no_wrap=True)
+        words = phase_words(phase_id)
+        steps = Text("steps climbed ", "bold", no_wrap=True, overflow="ellipsis")
         steps.append(str(context.get("number_of_steps", "—")))
+        if context.get("steps_descended"):
+            steps.append(f", down {context['steps_descended']}")
+        steps.append("  number_of_steps", "dim")
         self.update(Group(
-            Text(label or "—", "bold", no_wrap=True, overflow="ellipsis"),
+            Text(words or label or "—", "bold", no_wrap=True, overflow="ellipsis"),
+            Text(label if words else "", "dim", no_wrap=True, overflow="ellipsis"),
             flow_text(flow),
             steps,
             tab_text(context),

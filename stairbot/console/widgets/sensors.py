@@ -1,8 +1,13 @@
 """The four distance sensors: value and status, and whether each pair that
-must agree (SFR/SFL, SBR/SBL) agrees within ``equal_tolerance``.
+must agree (front right/left, back right/left) agrees within
+``equal_tolerance``.  Operator words first (``front R``), the seed's names
+(SFR...) beside them, dimmer.
 
 Four lines, a bracket joining each pair to its verdict: two lines fewer than a
-verdict line per pair, which an 80x24 screen needs for the panels below.
+verdict line per pair, which an 80x24 screen needs for the panels below.  The
+title says when the values were read; stale ones are dimmed and marked
+(:mod:`stairbot.console.freshness`), and a sensor whose own measurement is
+older than that says ``old`` instead of ``ok``.
 """
 
 from __future__ import annotations
@@ -10,23 +15,31 @@ from __future__ import annotations
 from rich.text import Text
 from textual.widgets import Static
 
+from stairbot.console.freshness import STALE_S, age_key, is_stale, titled
 from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
 
 PAIRS = ((SensorId.SFR, SensorId.SFL), (SensorId.SBR, SensorId.SBL))
-READING_WIDTH = 26  # "SFR  1.234 m  out of range"
+NAMES = {SensorId.SFR: "front R", SensorId.SFL: "front L", SensorId.SBR: "back R",
+         SensorId.SBL: "back L"}
+READING_WIDTH = 25  # "front R SFR 0.265 m ERROR"
 
 
-def _reading(name: str, r: SensorReading | None) -> Text:
-    line = Text(f"{name} ", style="bold")
+def _reading(sensor: SensorId, r: SensorReading | None) -> Text:
+    line = Text(f"{NAMES[sensor]:<7} ", style="bold")
+    line.append(f"{sensor.value} ", "dim")
     if r is None:
-        line.append("    —     no reading", "dim")
-    elif r.status is SensorStatus.OK:
-        line.append(f"{r.distance_m:6.3f} m  ok", "green")
-    elif r.status is SensorStatus.OUT_OF_RANGE:
-        line.append(f"{r.distance_m:6.3f} m  out of range", "yellow")
+        line.append("   —    none", "dim")
+    elif r.status is SensorStatus.ERROR:
+        line.append("   —    ", "dim")
+        line.append("ERROR", "bold red")
     else:
-        line.append("    —     ", "dim")
-        line.append("sensor error", "bold red")
+        line.append(f"{r.distance_m:5.3f} m ")
+        if r.age_s > STALE_S:  # the sensor has not measured for that long
+            line.append("old", "bold yellow")
+        elif r.status is SensorStatus.OUT_OF_RANGE:
+            line.append("out", "yellow")  # of range: the value is the sensor's limit
+        else:
+            line.append("ok", "green")
     line.pad_right(READING_WIDTH - line.cell_len)
     return line
 
@@ -56,18 +69,22 @@ class SensorPanel(Static):
         super().__init__(id=id)
         self.tolerance = tolerance
         self._last: object = ()
-        self.border_title = f"sensors  pairs agree within {tolerance * 1000:.0f} mm"
+        self.border_title = titled("sensors", None)
 
-    def show(self, snap: Snapshot | None) -> None:
+    def show(self, snap: Snapshot | None, age_s: float | None = None) -> None:
+        """``age_s``: wall seconds since ``snap`` was read (None: never)."""
         sensors = dict(snap.sensors) if snap is not None else {}
-        if sensors == self._last:
+        key = (sensors, age_key(age_s))
+        if key == self._last:
             return
-        self._last = sensors
+        self._last = key
+        self.border_title = titled(f"sensors ±{self.tolerance * 1000:.0f} mm", age_s)
+        self.set_class(is_stale(age_s), "-stale")
         lines = []
         for a, b in PAIRS:
             top, bottom = pair_verdict(sensors.get(a), sensors.get(b), self.tolerance)
             for sensor, bracket, verdict in ((a, " ┐ ", top), (b, " ┘ ", bottom)):
-                line = _reading(sensor.value, sensors.get(sensor))
+                line = _reading(sensor, sensors.get(sensor))
                 line.append(bracket, "dim")
                 line.append_text(verdict)
                 lines.append(line)

@@ -1,0 +1,46 @@
+"""Save the console as an operator sees it mid-climb, at 80x24, as SVG:
+the picture docs/console-80x24.svg (README links it).
+
+    python scripts/console_screenshot.py [OUT.svg] [--size 80x24]
+
+The simulated robot at 10x, started with s, taken once a segment stands over
+the first tread.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+from pathlib import Path
+
+from stairbot.console.app import build_app
+
+
+async def shoot(out: Path, width: int, height: int) -> None:
+    app = build_app(speed="10x")
+    async with app.run_test(size=(width, height)) as pilot:
+        await app.workers.wait_for_complete()
+        await pilot.press("s")
+        for _ in range(2400):
+            scene = app.state.view().scene
+            if scene is not None and max(scene.segment_steps()) >= 1:
+                break
+            await asyncio.sleep(0.05)
+        await pilot.pause(0.3)
+        app.save_screenshot(filename=out.name, path=str(out.parent))
+        await pilot.press("space")
+        await pilot.pause(0.2)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("out", nargs="?", default="docs/console-80x24.svg")
+    p.add_argument("--size", default="80x24")
+    args = p.parse_args()
+    width, height = (int(v) for v in args.size.split("x"))
+    asyncio.run(shoot(Path(args.out), width, height))
+    print(args.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,56 @@
+"""The help screen (``?``): every key, and how to read the screen."""
+
+from __future__ import annotations
+
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import VerticalScroll
+from textual.screen import ModalScreen
+from textual.widgets import Static
+
+HELP = """\
+KEYS
+  space   EMERGENCY STOP: every motor stops at once, from any screen,
+          even over a prompt; latched until c
+  c       clear the emergency stop (asks first; look at the robot)
+  s       start the full run      k  calibrate only
+  p       pause / resume          x  stop the run
+  q       quit (mid-run: the robot stops first, then it asks);
+          Ctrl+Q and Ctrl-C do the same
+  u       robot URL               o  scenario
+  f       simulation speed        r  reset the simulation
+  w       record events to a file (never over an existing one)
+  z       picture zoom            ?  this help
+  Ctrl+P  every action by name
+
+READING THE SCREEN
+  Banner: the state (READY, RUNNING, PAUSED, ENDED, FAULT), E-STOP
+  and who latched it (operator, or automatic: why), then what to
+  know now, whole.
+  Every panel says how old its values are; values not read for
+  1.5 s are dimmed and marked STALE: they are not live.
+  Sensors: front R/L look ahead (SFR, SFL), back R/L look down
+  (SBR, SBL); ok, out (of range: the value is the sensor's limit),
+  old (the sensor's own reading is stale), ERROR.
+  Motors: ▶ forward ◀ back; a lift shows the segment that moves:
+  1▲ segment 1 rises, 2▼ segment 2 sinks (segments 1 front, 2
+  middle, 3 back, coloured as in the picture).  With no run going,
+  a lift's arrow is its end segment against segment 2.
+  Phase: what the robot is doing, the seed's name for it beneath.
+  Events: the run's events and everything the console said.
+
+  Escape or ? closes this help.
+"""
+
+
+class HelpScreen(ModalScreen[None]):
+    """Every key and how to read the screen; Escape, q or ? closes it."""
+
+    BINDINGS = [Binding("escape,question_mark,q", "close", "close")]
+
+    def compose(self) -> ComposeResult:
+        with VerticalScroll(classes="dialog help"):
+            yield Static(HELP, markup=False)
+
+    def action_close(self) -> None:
+        self.dismiss(None)
