@@ -25,13 +25,13 @@ from stairbot.console.climb_gate import MidClimb, after_run, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
-from stairbot.console.watch import PacedClock, Recorder, WatchedRobot, watch
+from stairbot.console.watch import PacedClock, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, ReportsEvents, Snapshot
 from stairbot.journal import JournalWriter
 from stairbot.paths import unused_path
-from stairbot.recording.record import RecordsTicks, is_mcap
+from stairbot.recording.record import JsonLinesRecord, RecordsTicks, is_mcap
 from stairbot.resume import ResumeRefused
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
@@ -130,7 +130,7 @@ class ConsoleEngine:
         self.clock: PacedClock | None = None
         self.scenario: Scenario | None = None
         self.control: RunControl | None = None
-        self.recorder: Recorder | McapRecord | None = None
+        self.recorder: JsonLinesRecord | McapRecord | None = None
         self._running = threading.Event()
         self._speed = "max"
         self._last_phase: object = None
@@ -534,7 +534,7 @@ class ConsoleEngine:
                 raise InputError(exc.path, None, f"cannot write {exc.what}: "
                                  f"{exc.problem}") from None
         else:
-            self.recorder = Recorder(chosen)
+            self.recorder = JsonLinesRecord(chosen)  # whole lines; a full disk: OutputError
         self.state.set_recording(chosen)
         return chosen
 

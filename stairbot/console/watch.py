@@ -10,13 +10,10 @@ import contextlib
 import threading
 import time
 from collections.abc import Callable
-from pathlib import Path
-from typing import IO, Protocol
+from typing import Protocol
 
 from stairbot.console.scene import SceneView
 from stairbot.console.state import LiveState
-from stairbot.errors import InputError
-from stairbot.events import Event
 from stairbot.hardware import ZERO_SPEEDS, Clock, HasTruth, Robot, Snapshot, Speeds, Truth
 
 SCENE_PERIOD_S = 0.04  # wall seconds between pictures taken from the simulation
@@ -213,25 +210,3 @@ class PacedClock:
             self._sleep(due - wall_now)
         elif wall_now - due > 0.5:  # fell behind (a slow machine): do not race to catch up
             self._anchor = (sim_now, wall_now)
-
-
-class Recorder:
-    """Writes events as JSON lines (the format of ``stairbot run --record``)."""
-
-    def __init__(self, path: str) -> None:
-        self.path = path
-        try:
-            self._file: IO[str] = Path(path).open("w", encoding="utf-8")  # noqa: SIM115 - closed by close()
-        except OSError as exc:
-            raise InputError(path, None, f"cannot write: {exc.strerror or exc}") from None
-        self._lock = threading.Lock()
-
-    def write(self, event: Event) -> None:
-        with self._lock:
-            if not self._file.closed:
-                self._file.write(event.to_json() + "\n")
-                self._file.flush()
-
-    def close(self) -> None:
-        with self._lock:
-            self._file.close()

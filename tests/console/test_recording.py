@@ -5,11 +5,15 @@ beside it, under a name not taken, and says so."""
 from __future__ import annotations
 
 import asyncio
+import errno
 import json
+import os
 from pathlib import Path
 
-from pilot import answer_prompt, banner, press, ready, said, until
+import pytest
+from pilot import SpyRobot, answer_prompt, banner, press, ready, said, spied_open, until
 
+from stairbot import files
 from stairbot.console.app import build_app
 from stairbot.console.cli import check_record
 
@@ -35,7 +39,7 @@ def test_w_twice_to_the_same_name_keeps_the_first_recording(tmp_path: Path) -> N
             await until(pilot, lambda: "REC" in banner(app), "recording again")
             assert first.read_text() == kept
             assert app.engine.recorder is not None
-            assert app.engine.recorder.path == str(second)
+            assert str(app.engine.recorder.path) == str(second)
             assert f"{first} exists (not overwritten): recording to {second}" in said(app)
     asyncio.run(go())
     assert json.loads(first.read_text().splitlines()[-1])["kind"] == "summary"
@@ -52,7 +56,7 @@ def test_record_option_to_an_existing_file_writes_beside_it(tmp_path: Path) -> N
         async with app.run_test(size=(80, 24)) as pilot:
             await ready(pilot)
             assert app.engine.recorder is not None
-            assert app.engine.recorder.path == str(tmp_path / "events-1.jsonl")
+            assert str(app.engine.recorder.path) == str(tmp_path / "events-1.jsonl")
             assert "exists (not overwritten)" in said(app)
     asyncio.run(go())
     assert old.read_text() == "an earlier recording\n"
@@ -67,3 +71,42 @@ def test_the_command_line_check_of_record_leaves_nothing_behind(tmp_path: Path) 
     check_record(str(new))
     check_record(str(old))
     assert not new.exists() and old.read_text() == "kept\n"
+
+
+def test_a_disk_that_fills_mid_run_stops_the_run_and_says_which_file(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 11: the console's JSON-lines recorder raised a bare OSError on a
+    full disk.  Now the run ends as ``stairbot run``'s does: the robot
+    stopped, the reason names the file, the lines before kept whole."""
+    path = tmp_path / "rec.jsonl"
+    left = 5
+    real = files._write
+
+    def write(fd: int, data: bytes) -> int:
+        nonlocal left
+        if Path(os.readlink(f"/proc/self/fd/{fd}")).name == path.name:
+            if left <= 0:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+            left -= 1
+        return real(fd, data)
+
+    monkeypatch.setattr(files, "_write", write)
+
+    spies: list[SpyRobot] = []
+
+    async def go() -> None:
+        app = build_app(speed="max", record=str(path), open_fn=spied_open(spies))
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, "s")  # a full run: far more than five events
+            await until(pilot, lambda: not app.engine.running and "cannot write the record"
+                        in " ".join([said(app), banner(app)]), "the run stops, saying why")
+            assert f"{path.name}: cannot write the record: No space left on device" in \
+                " ".join([said(app), banner(app)])
+            (spy,) = spies
+            last = [c for c in spy.calls if c[0] in ("command", "stop_all", "estop")][-1]
+            assert last[0] in ("stop_all", "estop")  # the robot stopped last
+            assert spy.inner.estopped  # an error: the e-stop latched, as stairbot run does
+    asyncio.run(go())
+    kept = path.read_text().splitlines()
+    assert len(kept) == 5 and all(json.loads(k) for k in kept)
