@@ -197,3 +197,21 @@ def test_lan_1_is_python_cans_socket_and_takes_the_frame_from_the_lan(
 def test_an_ipv6_group_cannot_be_kept_on_loopback() -> None:
     with pytest.raises(can.CanInitializationError, match="IPv6.*IPv4 group"):
         LoopbackUdpMulticastBus("ff15::1", port=random.randrange(40000, 60000))
+
+
+def test_a_bus_does_not_hear_its_own_frames_every_other_one_does(
+        bus_url: tuple[str, str, int]) -> None:
+    """python-can's receive_own_messages=False, done in the kernel: a fake
+    board process woke for 14 echoes of its own replies each control cycle."""
+    bus, peer = open_bus(parse_can_url(bus_url[0])), open_bus(parse_can_url(bus_url[0]))
+    try:
+        bus.send(frame(b"mine"))
+        got = peer.recv(timeout=2.0)
+        assert got is not None and bytes(got.data) == b"mine"  # the others hear it
+        peer.send(frame(b"yours"))
+        got = bus.recv(timeout=2.0)
+        assert got is not None and bytes(got.data) == b"yours"  # not b"mine" first
+        assert bus.recv(timeout=0.2) is None and peer.recv(timeout=0.2) is None
+    finally:
+        bus.shutdown()
+        peer.shutdown()
