@@ -257,9 +257,11 @@ class BoardRobot:
 
     def _estop_unconfirmed(self, boards: Sequence[m.Board], why: str) -> None:
         names = " and ".join(f"the {b.name.lower()} board" for b in boards)
-        watchdog = (f"; if it hears nothing more, its watchdog stops its motors "
-                    f"{self.watchdog_ms} ms later" if self.watchdog_ms else
-                    "; the watchdogs are off (watchdog=0)")
+        # What the host knows: not whether the board stopped, only what a
+        # working board's watchdog is set to do.
+        watchdog = (f"; this host cannot tell whether it stopped (a board that still runs "
+                    f"stops its motors {self.watchdog_ms} ms after it last heard the host)"
+                    if self.watchdog_ms else "; the watchdogs are off (watchdog=0)")
         self.sink(Event(self.clock.now(), EventKind.LINK,
                         f"emergency stop not confirmed by {names}: {why}{watchdog}", None,
                         self.health()))

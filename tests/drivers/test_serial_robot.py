@@ -140,6 +140,9 @@ def test_estop_never_raises_when_the_boards_fall_silent() -> None:
         assert session.robot.estopped
         assert [e.message.split(":")[0] for e in events if e.kind == EventKind.LINK] == [
             "emergency stop not confirmed by the motor board and the sensor board"]
+        (said,) = [e.message for e in events if e.kind == EventKind.LINK]
+        # the host cannot know a silent board stopped: it says so, never that it did
+        assert "this host cannot tell whether it stopped" in said
         assert all(b.estop for b in fake.server.boards.values())  # they did hear it
         session.close()
         session.robot.estop()  # closed: no exception either
