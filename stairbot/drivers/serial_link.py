@@ -119,6 +119,7 @@ class SerialLink(RequestLink[SerialRequest]):
         self.channel = channel
         self._reader = FrameReader()
         self._expired: deque[tuple[int, int]] = deque(maxlen=64)
+        self._answered: deque[tuple[int, int]] = deque(maxlen=64)
         # This link's session: a reply of another (an earlier host's, a
         # previous run's still on the line) is never taken for one of ours.
         self.session = secrets.randbelow(255) + 1
@@ -189,10 +190,14 @@ class SerialLink(RequestLink[SerialRequest]):
                 if frame.from_board:
                     self._hear(frame.board)
                 req = self._match(frame) if frame.from_board else None
+                mine = frame.session == self.session
                 if req is not None:
                     self._complete(req, frame.messages)
-                elif frame.session == self.session and (frame.board, frame.seq) in self._expired:
+                    self._answered.append((req.board, req.seq))
+                elif mine and (frame.board, frame.seq) in self._expired:
                     self.stats.late += 1
+                elif mine and frame.from_board and (frame.board, frame.seq) in self._answered:
+                    self.stats.duplicates += 1  # a second copy of a reply taken
                 else:
                     self.stats.stray += 1
             self.stats.crc_errors = rs.crc_errors
