@@ -39,6 +39,7 @@ import can
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_wire import BROADCAST, SESSION_MAX, CanFrame, CanWire, frame_bits, wire
+from stairbot.drivers.frame_log import CanFrameLog
 from stairbot.drivers.link import LinkStats, Request, RequestLink
 from stairbot.errors import LinkLostError
 
@@ -182,9 +183,10 @@ class CanLink(RequestLink[CanRequest]):
     def __init__(self, bus: can.BusABC, timeout_s: float = 0.1, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
                  codec: CanWire | None = None, grace_s: float = 0.0,
-                 session: int | None = None) -> None:
+                 session: int | None = None, log: CanFrameLog | None = None) -> None:
         super().__init__(CanStats(), timeout_s, retries, max_lost, now, grace_s)
         self.bus = bus
+        self.log = log  # every frame sent and received
         self.codec = codec or wire()
         # This link's session: a reply of another (an earlier host's, still on
         # the bus) is never taken for one of ours, and a board executes a
@@ -278,6 +280,8 @@ class CanLink(RequestLink[CanRequest]):
             self.bus.send(frame, timeout=self.timeout_s)
         except (can.CanError, OSError, ValueError) as exc:
             raise LinkLostError(f"cannot send on the CAN bus: {exc}") from exc
+        if self.log is not None:
+            self.log.write(frame, rx=False)
         self.stats.frames_tx += 1
         self.stats.bytes_tx += len(frame.data)
         self.stats.bits_tx += frame_bits(len(frame.data))
@@ -291,6 +295,8 @@ class CanLink(RequestLink[CanRequest]):
             raise LinkLostError(f"cannot receive from the CAN bus: {exc}") from exc
         if frame is None:
             return False
+        if self.log is not None:
+            self.log.write(frame, rx=True)
         with self._mutex:
             self.take(frame)
         return True
@@ -378,9 +384,16 @@ class CanLink(RequestLink[CanRequest]):
         return self.old_idents.get(board)
 
     def describe(self) -> dict[str, object]:
-        return {"wire": self.wire, "bus": {"interface": type(self.bus).__name__,
-                                           "channel": str(self.bus.channel_info)},
-                "session": self.session}
+        out: dict[str, object] = {
+            "wire": self.wire, "session": self.session,
+            "bus": {"interface": type(self.bus).__name__, "channel": str(self.bus.channel_info)}}
+        if self.log is not None:
+            out["frame_log"] = self.log.describe()
+        return out
 
     def close(self) -> None:
-        self.bus.shutdown()
+        try:
+            self.bus.shutdown()
+        finally:
+            if self.log is not None:
+                self.log.close()

@@ -21,6 +21,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.link import LinkStats, Request, RequestLink
 from stairbot.drivers.records import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
@@ -114,9 +115,10 @@ class SerialLink(RequestLink[SerialRequest]):
 
     def __init__(self, channel: ByteChannel, timeout_s: float = 0.05, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
-                 grace_s: float = 0.0) -> None:
+                 grace_s: float = 0.0, log: SerialFrameLog | None = None) -> None:
         super().__init__(LinkStats(), timeout_s, retries, max_lost, now, grace_s)
         self.channel = channel
+        self.log = log  # every byte written and read, a line per frame
         self._reader = FrameReader()
         self._expired: deque[tuple[int, int]] = deque(maxlen=64)
         self._answered: deque[tuple[int, int]] = deque(maxlen=64)
@@ -174,6 +176,8 @@ class SerialLink(RequestLink[SerialRequest]):
             self.channel.write(data)
         except OSError as exc:
             raise LinkLostError(f"cannot write to the serial port: {exc}") from exc
+        if self.log is not None:
+            self.log.tx(data)
 
     # -- receiving -------------------------------------------------------------
     def _receive(self, timeout_s: float) -> bool:
@@ -183,6 +187,8 @@ class SerialLink(RequestLink[SerialRequest]):
             raise LinkLostError(f"cannot read from the serial port: {exc}") from exc
         if not data:
             return False
+        if self.log is not None:
+            self.log.rx(data)
         with self._mutex:
             self.stats.bytes_rx += len(data)
             rs = self._reader.stats
@@ -217,7 +223,14 @@ class SerialLink(RequestLink[SerialRequest]):
         self._expired.append((req.board, req.seq))
 
     def describe(self) -> dict[str, object]:
-        return {"wire": self.wire}
+        out: dict[str, object] = {"wire": self.wire}
+        if self.log is not None:
+            out["frame_log"] = self.log.describe()
+        return out
 
     def close(self) -> None:
-        self.channel.close()
+        try:
+            self.channel.close()
+        finally:
+            if self.log is not None:
+                self.log.close()
