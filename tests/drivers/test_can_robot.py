@@ -437,7 +437,7 @@ def test_every_frame_twice_reads_every_channel_once_and_counts_the_copies() -> N
 
 
 def test_a_reply_frame_lost_between_others_is_a_gap_matched_by_channel() -> None:
-    from stairbot.drivers.can_link import CanRequest, Offer
+    from stairbot.drivers.can_request import CanRequest, Offer
 
     req = CanRequest(int(m.Board.MOTOR), (m.ReadAll(),), True, 0.0, 1.0)
     req.expect()
