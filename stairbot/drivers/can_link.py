@@ -138,6 +138,8 @@ class CanLink(RequestLink[CanRequest]):
                             and q.seqs == first.seqs for q in group)):
                 seqs = first.seqs or (self._next_seq(),)
                 for q in group:
+                    if not q.seqs:
+                        self._going_out(q)
                     q.seqs = seqs
                 yield BROADCAST, first.messages[0], seqs[0]
                 i += len(group)
@@ -147,9 +149,21 @@ class CanLink(RequestLink[CanRequest]):
 
     def _frames_of(self, req: CanRequest) -> Iterator[tuple[int, m.Message, int]]:
         if not req.seqs:
+            self._going_out(req)
             req.seqs = tuple(self._next_seq() for _ in req.messages)
         for msg, seq in zip(req.messages, req.seqs, strict=True):
             yield req.board, msg, seq
+
+    def _going_out(self, req: CanRequest) -> None:
+        """``req`` goes on the bus for the first time: its timeout (and its
+        round trip) starts now, not when it was held back."""
+        req.sent_at = self._now()
+        req.deadline = req.sent_at + self.timeout_s
+
+    def _on_wire(self, req: CanRequest) -> bool:
+        # A request held back (send=False) has no seq yet: it cannot time out
+        # before it is sent -- given up then, its replies would be nobody's.
+        return bool(req.seqs)
 
     def _send(self, req: CanRequest) -> None:
         for board, msg, seq in self._frames_of(req):

@@ -278,6 +278,11 @@ class RequestLink(ABC, Generic[R]):
     def _given_up(self, req: R) -> None:
         """``req`` failed: remember what a late reply to it would look like."""
 
+    def _on_wire(self, req: R) -> bool:
+        """Whether ``req`` has gone out (a wire that holds requests back until
+        :meth:`flush` says; its timeout runs from then)."""
+        return True
+
     @abstractmethod
     def flush(self) -> None: ...
 
@@ -368,7 +373,7 @@ class RequestLink(ABC, Generic[R]):
         now = self._now()
         for queue in self._in_flight.values():
             for req in list(queue):
-                if now < req.deadline or req.urgent:
+                if now < req.deadline or req.urgent or not self._on_wire(req):
                     continue
                 self.stats.timeouts += 1
                 if req.idempotent and req.attempts <= self.retries:

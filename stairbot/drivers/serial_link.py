@@ -103,6 +103,7 @@ class SerialRequest(Request):
 
     seq: int = 0
     frame: bytes = b""
+    on_wire: bool = False  # written (not only held in the output buffer)
 
     def progress(self) -> str:
         return f"; seq {self.seq}"
@@ -130,6 +131,7 @@ class SerialLink(RequestLink[SerialRequest]):
         # that drew an earlier one's number still seldom repeats a request.
         self._seq = secrets.randbelow(256)
         self._out = bytearray()
+        self._unsent: list[SerialRequest] = []  # their frames are in _out
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[Message, ...], idempotent: bool,
@@ -149,6 +151,7 @@ class SerialLink(RequestLink[SerialRequest]):
 
     def _transmit(self, req: SerialRequest, send: bool) -> None:
         self._out += req.frame
+        self._unsent.append(req)
         self.stats.frames_tx += 1
         self.stats.bytes_tx += len(req.frame)
         if send:
@@ -164,8 +167,20 @@ class SerialLink(RequestLink[SerialRequest]):
                 return
             data, self._out = bytes(self._out), bytearray()
             self._write(data)
+            # their timeouts (and round trips) run from now, not from when
+            # they were held back
+            now = self._now()
+            for req in self._unsent:
+                req.on_wire, req.sent_at, req.deadline = True, now, now + self.timeout_s
+            self._unsent = []
+
+    def _on_wire(self, req: SerialRequest) -> bool:
+        # A request held back cannot time out before it is written.
+        return req.on_wire
 
     def _send_now(self, requests: Sequence[SerialRequest]) -> None:
+        for req in requests:
+            req.on_wire = True
         data = b"".join(r.frame for r in requests)
         self.stats.frames_tx += len(requests)
         self.stats.bytes_tx += len(data)

@@ -149,6 +149,21 @@ def test_each_message_of_a_request_is_a_frame_of_its_own_seq(bus: Wire) -> None:
     assert req.reply is None and bus.link.stats.late == 1
 
 
+def test_a_request_held_back_does_not_time_out_before_it_is_sent(bus: Wire) -> None:
+    """Lockstep holds commands back until the tick's StepTo goes: a poll in
+    between must not give them up unsent (counted lost, and their Acks, when
+    they came, nobody's)."""
+    held = bus.link.request(MOTOR, [m.SetWheelSpeeds(0, 0, 0, 0)], send=False)
+    bus.t[0] = 1.0  # ten timeouts later, still held
+    bus.link.poll()
+    assert not held.failed and bus.link.stats.timeouts == bus.link.stats.lost == 0
+    bus.link.flush()
+    assert held.sent_at == 1.0 and held.seqs
+    bus.answer(MOTOR, held.seqs[0], [m.Ack(0x20, 0)])
+    assert bus.link.wait([held])[0].messages == (m.Ack(0x20, 0),)
+    assert bus.link.stats.stray == 0
+
+
 # -- the boards ---------------------------------------------------------------------
 
 
