@@ -91,8 +91,8 @@ def one_run(n: int, scale: float, folder: Path) -> tuple[bool, str]:
         last = (host.stderr.strip().splitlines() or ["no output"])[-1]
         return False, f"run {n:2}: exit {host.returncode}: {last}"
     link = r.get("link") or {}
-    counts = " ".join(f"{k} {link[k]}" for k in ("retries", "revived", "lost", "late", "stray")
-                      if k in link)
+    keys = ("retries", "revived", "lost", "late", "stray", "duplicates")
+    counts = " ".join(f"{k} {link[k]}" for k in keys if k in link)
     ok = r["outcome"] == "completed" and not r["fell"] and frames > 0 and unknown == 0
     return ok, (f"run {n:2}: {r['outcome']:9} up {r['steps_climbed']} down "
                 f"{r['steps_descended']} fell {r['fell']!s:5} {wall:5.1f} s  {counts}  "
