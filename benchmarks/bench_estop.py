@@ -36,6 +36,7 @@ from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_CONFIRM_S, BoardRobot
 from stairbot.drivers.can_robot import open_bus, parse_can_url
+from stairbot.drivers.can_wire import CanFrame
 from stairbot.errors import HardwareError
 from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import make_boards
@@ -70,10 +71,10 @@ class NotingCan(CanBoardServer):
 
     note_fd = -1
 
-    def _handle(self, address: int, msg: m.Message) -> None:
-        if isinstance(msg, m.EStop):
+    def _handle(self, address: int, frame: CanFrame, data: bytes) -> None:
+        if isinstance(frame.message, m.EStop):
             _note(self.note_fd, address)
-        super()._handle(address, msg)
+        super()._handle(address, frame, data)
 
 
 def serve(wire: str, loss: float, where: Connection, note_fd: int) -> None:

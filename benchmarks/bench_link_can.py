@@ -8,7 +8,7 @@ cycle, or awaited in the same cycle).  The fake boards run in real time, as
 `stairbot fake-boards --can` does: on ``virtual`` in a thread of this process,
 on ``udp_multicast`` in another process on this host.  Beside the measured
 figures it prints, for exactly the frames a cycle puts on the bus, the bits
-they take at worst (bit stuffing: 135 bits for an 8-byte frame, see
+they take at worst (bit stuffing, 29-bit ids: 160 bits for an 8-byte frame, see
 ``drivers.can_wire.frame_bits``), the rate a 1 Mbit/s bus would allow, and the
 bus load at the controller's own tick (0.02 s), which must stay <= 20 %.
 

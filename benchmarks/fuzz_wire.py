@@ -14,9 +14,9 @@ Each part sends ``--frames`` frames (default 1,000,000):
   original (spliced: than either of its two) is "undetected": a CRC-16 lets
   about 1 in 65,536 random corruptions through, but none may come from the
   blind spot.
-* **can**: data frames of the DBC's ids with random data, mutated -- flipped
-  bits, a DLC one off, a random id, remote, extended, FD or error flags --
-  through ``CanWire.from_can``.
+* **can**: data frames of the DBC's ids (any session and seq) with random
+  data, mutated -- flipped bits, a DLC one off, a random 29-bit id, an 11-bit
+  id (protocol 3.x), remote, FD or error flags -- through ``CanWire.from_can``.
 * **boards**: the fake boards (the pymunk robot behind them, never stepped)
   take the serial part's mutated bytes on their serial server and the CAN
   part's frames on their CAN server; every reply they send must decode.
@@ -45,7 +45,7 @@ import can
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers import serial_wire
-from stairbot.drivers.can_wire import CanWire, wire
+from stairbot.drivers.can_wire import SESSION_MAX, CanWire, make_id, wire
 from stairbot.drivers.serial_wire import Frame, FrameReader, decode_frame, encode_frame
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -217,23 +217,24 @@ def fuzz_serial(rng: random.Random, n: int) -> Tally:
 
 
 def can_cases(rng: random.Random, codec: CanWire, n: int) -> Iterator[can.Message]:
-    ids = sorted(codec._by_id)  # every id of the DBC
+    bases = sorted(codec._by_id)  # every frame of the DBC, by base
     for _ in range(n):
-        fid = rng.choice(ids)
-        size = codec._by_id[fid][2].length
+        base = rng.choice(bases)
+        size = codec._by_id[base][2].length
+        fid = make_id(base, rng.randrange(SESSION_MAX + 1), rng.randrange(256))
         data = bytearray(rng.randbytes(size))
-        extended = remote = fd = error = False
+        extended, remote, fd, error = True, False, False, False
         kind = rng.randrange(8)
         if kind == 1 and data:
             data[rng.randrange(len(data))] ^= 1 << rng.randrange(8)
         elif kind == 2:
             data = data + rng.randbytes(1) if size < 8 and rng.random() < 0.5 else data[:-1]
         elif kind == 3:
-            fid = rng.randrange(0x800)
+            fid = rng.randrange(1 << 29)
         elif kind == 4:
             remote = True
         elif kind == 5:
-            extended, fid = True, rng.randrange(1 << 29)
+            extended, fid = False, rng.randrange(0x800)  # a protocol 3.x frame
         elif kind == 6:
             fd, data = True, bytearray(rng.randbytes(rng.choice((12, 16, 24, 32, 48, 64))))
         elif kind == 7:
@@ -302,8 +303,7 @@ def fuzz_boards(rng: random.Random, n: int) -> Tally:
             while (reply := host_bus.recv(timeout=0.0)) is not None:
                 t.counts["CAN replies"] += 1
                 try:
-                    _, msg = codec.from_can(reply)
-                    if not msg.REPLY:
+                    if not codec.from_can(reply).message.REPLY:
                         t.counts["CAN replies not a reply type"] += 1
                 except m.CodecError:
                     t.counts["CAN replies undecodable"] += 1

@@ -10,7 +10,9 @@ GROUP -f run-N.log`` (stairbot registers its loopback bus with python-can as
 the interface ``udp_loopback``), then ``stairbot run --robot URL --json``.
 Prints one line a run -- outcome, steps, fell, wall time, what the link
 counted, frames the logger wrote and how many of them the shipped DBC
-(stairbot/drivers/stairbot.dbc, via cantools) cannot decode -- and the count
+(stairbot/drivers/stairbot.dbc, via cantools with the frame id mask
+0x1FFC0000: a frame's id carries the host's session and seq below its base)
+cannot decode -- and the count
 of completed runs.  Exit status 1 unless every run completed and every frame
 decoded.
 
@@ -34,12 +36,14 @@ from pathlib import Path
 import can
 import cantools
 
+from stairbot.drivers.can_wire import FRAME_ID_MASK
+
 
 def decode_count(log: Path) -> tuple[int, int]:
     """(frames in the candump log, frames the DBC cannot decode)."""
     db = cantools.database.load_string(
         resources.files("stairbot.drivers").joinpath("stairbot.dbc").read_text("utf-8"),
-        database_format="dbc")
+        database_format="dbc", strict=True, frame_id_mask=FRAME_ID_MASK)
     assert isinstance(db, cantools.database.can.Database)
     frames = unknown = 0
     for msg in can.LogReader(str(log)):
@@ -47,7 +51,8 @@ def decode_count(log: Path) -> tuple[int, int]:
             continue
         frames += 1
         try:
-            db.decode_message(msg.arbitration_id, bytes(msg.data))
+            # get_message_by_frame_id applies the mask; decode_message does not
+            db.get_message_by_frame_id(msg.arbitration_id).decode(bytes(msg.data))
         except (KeyError, ValueError, cantools.database.DecodeError):
             unknown += 1
     return frames, unknown
@@ -86,8 +91,8 @@ def one_run(n: int, scale: float, folder: Path) -> tuple[bool, str]:
         last = (host.stderr.strip().splitlines() or ["no output"])[-1]
         return False, f"run {n:2}: exit {host.returncode}: {last}"
     link = r.get("link") or {}
-    counts = " ".join(f"{k} {link[k]}" for k in ("retries", "revived", "lost", "late", "stray")
-                      if k in link)
+    keys = ("retries", "revived", "lost", "late", "stray", "duplicates")
+    counts = " ".join(f"{k} {link[k]}" for k in keys if k in link)
     ok = r["outcome"] == "completed" and not r["fell"] and frames > 0 and unknown == 0
     return ok, (f"run {n:2}: {r['outcome']:9} up {r['steps_climbed']} down "
                 f"{r['steps_descended']} fell {r['fell']!s:5} {wall:5.1f} s  {counts}  "

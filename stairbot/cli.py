@@ -426,7 +426,7 @@ def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
 
 def _link_line(link: dict[str, Any]) -> str:
     keys = ("frames_tx", "frames_rx", "retries", "revived", "lost", "late", "stray",
-            "crc_errors")
+            "duplicates", "crc_errors")
     return "  link              " + ", ".join(
         f"{k.replace('_', ' ')} {link[k]:g}" for k in keys if k in link)
 

@@ -2,43 +2,51 @@
 
 :class:`CanLink` is a :class:`~stairbot.drivers.link.RequestLink`, as the
 serial link is: retries, expiry and the health counters are shared.  What is
-CAN's own: each message is one frame, and frames carry no sequence number (a
-message fills the 8 bytes), so replies are matched to requests by what each
-message is answered with (docs/protocol.md, "CAN"):
+CAN's own (docs/protocol.md, "CAN"):
 
-* the reply a message declares (``ANSWER``: Identify -> Ident; Heartbeat,
-  GetStatus, SetWatchdog, EStop, Clear -> Status; GetMotor/GetSensor/GetImu -> one
-  telemetry frame; commands -> Ack); ReadAll -> Status + one telemetry frame
-  per channel and per IMU axis (``messages.READ_ALL_REPLY``).  An Ack naming
-  the message's type answers any of them (a refusal).
-* A board sends its replies in order, and a CAN bus keeps the order of one
-  sender's frames, so a board's replies fill its oldest waiting request first.
-* A request waits ``timeout_s``; only idempotent ones are re-sent (up to
-  ``retries`` times).  Replies still owed by a request given up are counted
-  ``late`` when they come; a reply nobody waits for is ``stray``.  Frames a
-  host sends (its own echo on ``udp_multicast``, another host's) are ignored.
+* Each message is one frame, whose 29-bit id carries the link's ``session``
+  (drawn at random when the link opens, 1-1023) and a ``seq`` (mod 256) of
+  its own: one per frame the host sends.  A request of two messages takes two
+  seqs; a message asked of both boards in a row goes out once, as the
+  broadcast frame of board 15, whose one seq both boards' requests await.
+* A board's replies repeat the session and seq of the frame they answer.  A
+  reply is taken only when its session is ours and its (board, seq) names a
+  frame of a request still waiting; then by what the message is answered with
+  (``ANSWER``: Identify -> Ident; Heartbeat, GetStatus, SetWatchdog, EStop,
+  Clear -> Status; GetMotor/GetSensor/GetImu -> one telemetry frame; commands
+  -> Ack; ReadAll -> Status + one telemetry frame per channel and per IMU axis,
+  ``messages.READ_ALL_REPLY``), telemetry by its channel.  An Ack naming the
+  message's type answers any of them (a refusal).
+* A retry of an idempotent request is the same frame again (same seq): a
+  board answers it from its cache without acting twice.  A second copy of a
+  reply already taken is counted ``duplicates``; a reply to a request given
+  up ``late``; a reply of another session, or of a seq nobody sent, ``stray``.
+  Frames a host sends (its own echo on ``udp_multicast``, another host's) are
+  ``ignored``; 11-bit frames (protocol 3.x) are ``malformed``.
+
+How one request takes its replies is :class:`~stairbot.drivers.can_request.CanRequest`.
 """
 
 from __future__ import annotations
 
+import secrets
 import time
-from collections import deque
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections import OrderedDict
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
 
 import can
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.can_wire import BROADCAST, CanWire, frame_bits, wire
-from stairbot.drivers.link import LinkStats, Request, RequestLink
+from stairbot.drivers.can_request import CanRequest, Offer
+from stairbot.drivers.can_wire import BROADCAST, SESSION_MAX, CanFrame, CanWire, frame_bits, wire
+from stairbot.drivers.frame_log import CanFrameLog
+from stairbot.drivers.link import LinkStats, RequestLink
 from stairbot.errors import LinkLostError
 
-
-def expected_replies(board: int, msg: m.Message) -> list[type[m.Message]]:
-    """The reply messages, in order, a board sends for ``msg`` when it obeys."""
-    if isinstance(msg, m.ReadAll):
-        return list(m.READ_ALL_REPLY.get(board, (m.Status,)))
-    return [m.MESSAGES.get(msg.ANSWER, m.Ack)]
+PAST_SEQS = 512
+"""How many (board, seq) of requests answered or given up are remembered, to
+tell a duplicate or a late reply from a stray one."""
 
 
 @dataclass
@@ -51,81 +59,6 @@ class CanStats(LinkStats):
     ignored: int = 0  # frames from hosts (our own echo included)
 
 
-def _key(msg: m.Message) -> int | None:
-    """Which channel (or IMU axis) a telemetry reply is for; None for others."""
-    if isinstance(msg, (m.MotorTelemetry, m.SensorTelemetry)):
-        return msg.channel
-    if isinstance(msg, m.ImuTelemetry):
-        return msg.axis
-    return None
-
-
-@dataclass(eq=False)
-class CanRequest(Request):
-    """A request on the bus: the replies that came and those still to come.
-
-    A reply is matched by kind and, for telemetry, by channel (or IMU axis):
-    the n-th telemetry of a kind a ReadAll is answered with is channel n, so
-    a duplicated frame is not taken as another channel's.  A board sends a
-    request's replies back to back and CAN keeps their order, so a reply that
-    matches a later expected one means the ones before it were lost
-    (``gap``): the request cannot complete, and the link sends it again as
-    soon as the last reply has come, without waiting for the timeout."""
-
-    got: list[m.Message] = field(default_factory=list)
-    # (message index, request type code, reply kind, channel or axis or None)
-    todo: deque[tuple[int, int, type[m.Message], int | None]] = field(default_factory=deque)
-    gap: bool = False
-
-    def expect(self) -> None:
-        """(Re)start waiting for every reply."""
-        self.got = []
-        self.gap = False
-        self.todo = deque()
-        for i, msg in enumerate(self.messages):
-            seen: dict[type[m.Message], int] = {}
-            for kind in expected_replies(self.board, msg):
-                n = seen.get(kind, 0)
-                seen[kind] = n + 1
-                keyed = kind in (m.MotorTelemetry, m.SensorTelemetry, m.ImuTelemetry)
-                self.todo.append((i, msg.TYPE, kind, n if keyed else None))
-
-    def _fits(self, entry: tuple[int, int, type[m.Message], int | None],
-              msg: m.Message) -> bool:
-        _, request_type, kind, key = entry
-        if isinstance(msg, m.Ack):
-            return msg.request == request_type
-        return isinstance(msg, kind) and (key is None or _key(msg) == key)
-
-    def offer(self, msg: m.Message) -> bool:
-        """Take ``msg`` if it is a reply this request still waits for: the
-        next one, or a later one (then those before it were lost: ``gap``)."""
-        pos = next((i for i, entry in enumerate(self.todo) if self._fits(entry, msg)), None)
-        if pos is None:
-            return False
-        if pos:
-            self.gap = True
-            for _ in range(pos):
-                self.todo.popleft()
-        index = self.todo[0][0]
-        if isinstance(msg, m.Ack):
-            # An Ack answers the message whole: nothing else comes for it.
-            while self.todo and self.todo[0][0] == index:
-                self.todo.popleft()
-        else:
-            self.todo.popleft()
-        self.got.append(msg)
-        return True
-
-    @property
-    def owed(self) -> int:
-        """Replies still to come."""
-        return len(self.todo)
-
-    def progress(self) -> str:
-        return f"; {len(self.got)} of {len(self.got) + self.owed} replies came"
-
-
 class CanLink(RequestLink[CanRequest]):
     """Requests and replies for both boards on one python-can bus."""
 
@@ -134,12 +67,25 @@ class CanLink(RequestLink[CanRequest]):
 
     def __init__(self, bus: can.BusABC, timeout_s: float = 0.1, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
-                 codec: CanWire | None = None, grace_s: float = 0.0) -> None:
+                 codec: CanWire | None = None, grace_s: float = 0.0,
+                 session: int | None = None, log: CanFrameLog | None = None) -> None:
         super().__init__(CanStats(), timeout_s, retries, max_lost, now, grace_s)
         self.bus = bus
+        self.log = log  # every frame sent and received
         self.codec = codec or wire()
-        self._owed: dict[int, int] = {}  # replies still due to requests given up
+        # This link's session: a reply of another (an earlier host's, still on
+        # the bus) is never taken for one of ours, and a board executes a
+        # frame of a new session even if its seq repeats the last one it saw.
+        self.session = session if session is not None else secrets.randbelow(SESSION_MAX) + 1
+        if not 1 <= self.session <= SESSION_MAX:
+            raise ValueError(f"session {self.session}: allowed 1 to {SESSION_MAX}")
+        self.other_session = 0  # replies of another session seen (counted stray too)
+        # Random too, so that a new session that drew an earlier one's number
+        # still seldom repeats a frame.
+        self._seq = secrets.randbelow(256)
+        self._past: OrderedDict[tuple[int, int], bool] = OrderedDict()  # -> answered?
         self._held: list[CanRequest] = []
+        self.old_idents: dict[int, m.Ident] = {}  # boards heard speaking protocol 3.x
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[m.Message, ...], idempotent: bool,
@@ -148,13 +94,23 @@ class CanLink(RequestLink[CanRequest]):
         req.expect()
         return req
 
+    def _next_seq(self) -> int:
+        """A seq no waiting request's frame has; its past is forgotten."""
+        used = {s for queue in self._in_flight.values() for r in queue for s in r.seqs}
+        for _ in range(256):
+            self._seq = (self._seq + 1) & 0xFF
+            if self._seq not in used:
+                for board in m.Board:
+                    self._past.pop((int(board), self._seq), None)
+                return self._seq
+        raise LinkLostError("256 frames await replies: the boards do not answer")
+
     def _transmit(self, req: CanRequest, send: bool) -> None:
         self._held.append(req)
         if send:
             self.flush()
 
     def _resend(self, req: CanRequest) -> None:
-        self._owed[req.board] = self._owed.get(req.board, 0) + req.owed
         req.expect()
         self._send(req)
 
@@ -162,49 +118,69 @@ class CanLink(RequestLink[CanRequest]):
         """Send every held request, in order; a single message held for every
         board in a row (ReadAll to both) becomes one broadcast frame."""
         with self._mutex:
-            self._flush()
-
-    def _flush(self) -> None:
-        held, self._held = self._held, []
-        everyone = set(m.READ_ALL_REPLY)
-        i = 0
-        while i < len(held):
-            p = held[i]
-            group = held[i:i + len(everyone)]
-            if (len(p.messages) == 1 and {q.board for q in group} == everyone
-                    and all(q.messages == p.messages for q in group)):
-                self.send(BROADCAST, p.messages[0])
-                i += len(group)
-            else:
-                self._send(p)
-                i += 1
+            held, self._held = self._held, []
+            self._send_now(held)
 
     def _send_now(self, requests: Sequence[CanRequest]) -> None:
         """One broadcast frame for each copy to every board (a request per
-        board), else a frame per request."""
+        board, with one seq or none yet), else a frame per message."""
+        for board, msg, seq in self._frames(requests):
+            self.send(board, msg, seq)
+
+    def _frames(self, requests: Sequence[CanRequest]) -> Iterator[tuple[int, m.Message, int]]:
         boards = set(m.READ_ALL_REPLY)
         i = 0
         while i < len(requests):
             group = requests[i:i + len(boards)]
-            if len(group) == len(boards) and {q.board for q in group} == boards and all(
-                    len(q.messages) == 1 and q.messages == group[0].messages for q in group):
-                self.send(BROADCAST, group[0].messages[0])
+            first = group[0]
+            if (len(group) == len(boards) and {q.board for q in group} == boards
+                    and all(len(q.messages) == 1 and q.messages == first.messages
+                            and q.seqs == first.seqs for q in group)):
+                seqs = first.seqs or (self._next_seq(),)
+                for q in group:
+                    if not q.seqs:
+                        self._going_out(q)
+                    q.seqs = seqs
+                yield BROADCAST, first.messages[0], seqs[0]
                 i += len(group)
             else:
-                self._send(requests[i])
+                yield from self._frames_of(first)
                 i += 1
 
-    def _send(self, p: CanRequest) -> None:
-        for msg in p.messages:
-            self.send(p.board, msg)
+    def _frames_of(self, req: CanRequest) -> Iterator[tuple[int, m.Message, int]]:
+        if not req.seqs:
+            self._going_out(req)
+            req.seqs = tuple(self._next_seq() for _ in req.messages)
+        for msg, seq in zip(req.messages, req.seqs, strict=True):
+            yield req.board, msg, seq
 
-    def send(self, board: int, msg: m.Message) -> None:
-        """One frame, no reply expected."""
-        frame = self.codec.to_can(board, msg)
+    def _going_out(self, req: CanRequest) -> None:
+        """``req`` goes on the bus for the first time: its timeout (and its
+        round trip) starts now, not when it was held back."""
+        req.sent_at = self._now()
+        req.deadline = req.sent_at + self.timeout_s
+
+    def _on_wire(self, req: CanRequest) -> bool:
+        # A request held back (send=False) has no seq yet: it cannot time out
+        # before it is sent -- given up then, its replies would be nobody's.
+        return bool(req.seqs)
+
+    def _send(self, req: CanRequest) -> None:
+        for board, msg, seq in self._frames_of(req):
+            self.send(board, msg, seq)
+
+    def send(self, board: int, msg: m.Message, seq: int = 0) -> None:
+        """One frame of this session, no reply expected (a request's frames
+        go through :meth:`request`)."""
+        self._put(self.codec.to_can(board, msg, self.session, seq))
+
+    def _put(self, frame: can.Message) -> None:
         try:
             self.bus.send(frame, timeout=self.timeout_s)
         except (can.CanError, OSError, ValueError) as exc:
             raise LinkLostError(f"cannot send on the CAN bus: {exc}") from exc
+        if self.log is not None:
+            self.log.write(frame, rx=False)
         self.stats.frames_tx += 1
         self.stats.bytes_tx += len(frame.data)
         self.stats.bits_tx += frame_bits(len(frame.data))
@@ -218,6 +194,8 @@ class CanLink(RequestLink[CanRequest]):
             raise LinkLostError(f"cannot receive from the CAN bus: {exc}") from exc
         if frame is None:
             return False
+        if self.log is not None:
+            self.log.write(frame, rx=True)
         with self._mutex:
             self.take(frame)
         return True
@@ -230,21 +208,32 @@ class CanLink(RequestLink[CanRequest]):
             self.stats.crc_errors += 1
             return
         try:
-            board, msg = self.codec.from_can(frame)
+            f = self.codec.from_can(frame)
         except m.CodecError:
             self.stats.malformed += 1
+            old = self.codec.old_ident(frame)
+            if old is not None:
+                self.old_idents[old[0]] = old[1]
             return
-        if not msg.REPLY:
+        if not f.message.REPLY:
             self.stats.ignored += 1  # not counted in bits_rx: our own echo is in bits_tx
             return
         self.stats.bits_rx += frame_bits(len(frame.data))
         self.stats.bytes_rx += len(frame.data)
-        self._match(board, msg)
+        self._match(f)
 
-    def _match(self, board: int, msg: m.Message) -> None:
-        self._hear(board)
-        for p in self.in_flight(board):
-            if p.offer(msg):
+    def _match(self, f: CanFrame) -> None:
+        self._hear(f.board)
+        if f.session != self.session:
+            self.other_session += 1
+            self.stats.stray += 1
+            return
+        for p in self.in_flight(f.board):
+            index = p.index_of(f.seq)
+            if index is None:
+                continue
+            verdict = p.offer(f.message, index)
+            if verdict is Offer.TAKEN:
                 if p.todo:
                     pass
                 elif p.gap:  # every reply that will come came, some were lost
@@ -252,19 +241,58 @@ class CanLink(RequestLink[CanRequest]):
                     p.deadline = self._now()  # sent again (or given up) at once
                 else:
                     self._complete(p, tuple(p.got), frames=len(p.got))
-                return
-        if self._owed.get(board, 0) > 0:
-            self._owed[board] -= 1
-            self.stats.late += 1
-        else:
+                    self._remember(p, answered=True)
+            elif verdict is Offer.DUPLICATE:
+                self.stats.duplicates += 1
+            elif verdict is Offer.LATE:
+                self.stats.late += 1
+            else:
+                self.stats.stray += 1
+            return
+        past = self._past.get((f.board, f.seq))
+        if past is None:
             self.stats.stray += 1
+        elif past:
+            self.stats.duplicates += 1
+        else:
+            self.stats.late += 1
+
+    def _remember(self, req: CanRequest, answered: bool) -> None:
+        for seq in req.seqs:
+            self._past[(req.board, seq)] = answered
+            self._past.move_to_end((req.board, seq))
+        while len(self._past) > PAST_SEQS:
+            self._past.popitem(last=False)
 
     def _given_up(self, req: CanRequest) -> None:
-        self._owed[req.board] = min(64, self._owed.get(req.board, 0) + req.owed)
+        self._remember(req, answered=False)
+
+    # -- protocol 3.x boards -------------------------------------------------------
+    def probe_old_ident(self, board: int) -> m.Ident | None:
+        """Send ``board`` the Identify of protocol 3.x (an 11-bit id) and wait,
+        as long as a request's every attempt would, for a 3.x Ident; None if
+        none came.  For a board that ignores this host's frames, to say why."""
+        with self._mutex:
+            self.old_idents.pop(board, None)
+            self._put(self.codec.old_identify(board))
+        deadline = self._now() + self.timeout_s * (self.retries + 1)
+        while board not in self.old_idents:
+            remaining = deadline - self._now()
+            if remaining <= 0 or not self._receive(remaining):
+                break
+        return self.old_idents.get(board)
 
     def describe(self) -> dict[str, object]:
-        return {"wire": self.wire, "bus": {"interface": type(self.bus).__name__,
-                                           "channel": str(self.bus.channel_info)}}
+        out: dict[str, object] = {
+            "wire": self.wire, "session": self.session,
+            "bus": {"interface": type(self.bus).__name__, "channel": str(self.bus.channel_info)}}
+        if self.log is not None:
+            out["frame_log"] = self.log.describe()
+        return out
 
     def close(self) -> None:
-        self.bus.shutdown()
+        try:
+            self.bus.shutdown()
+        finally:
+            if self.log is not None:
+                self.log.close()

@@ -35,6 +35,11 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
                       the host's wall clock runs at the same rate; 0.01 to 1000
   - ``lan=1``         ``udp_multicast`` only: open the bus to the network
                       (python-can's own socket: see below).  Default 0.
+  - ``log=FILE``      write every frame sent and received to FILE with
+                      python-can's writer for its extension: ``.log`` candump
+                      (``cantools decode -m 0x1FFC0000 stairbot.dbc`` reads
+                      it), ``.asc``, ``.trc``, ``.csv``; flushed as written
+                      (``frame_log.py``)
   - any other ``key=value`` is passed to ``can.Bus`` as a keyword, its value
     cast as python-can casts its config files (``port=43200``,
     ``receive_own_messages=False``).
@@ -73,6 +78,7 @@ import can.util
 from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session
 from stairbot.drivers.can_link import CanLink
+from stairbot.drivers.frame_log import CanFrameLog, check_can_log
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
@@ -94,6 +100,7 @@ class CanUrl:
     bus_kwargs: dict[str, Any] = field(default_factory=dict)
     context: str | None = None
     options: dict[str, float] = field(default_factory=lambda: dict(OPTION_DEFAULTS))
+    log: str | None = None  # the frame log's path
 
     @property
     def label(self) -> str:
@@ -119,9 +126,13 @@ def parse_can_url(url: str) -> CanUrl:
     kwargs: dict[str, Any] = {}
     options = dict(OPTION_DEFAULTS)
     context: str | None = None
+    log: str | None = None
     for key, value in query_pairs(url, query):
         if key in OPTION_DEFAULTS:
             options[key] = number_option(url, key, value)
+        elif key == "log":
+            check_can_log(url, value)
+            log = value
         elif key == "context":
             context = value or None
         elif key in ("interface", "bustype", "channel"):
@@ -137,7 +148,7 @@ def parse_can_url(url: str) -> CanUrl:
         raise RobotUrlError(url, "lan", f"applies to udp_multicast only, not {interface}")
     if interface == "udp_multicast" and channel is not None:
         _check_multicast(url, channel, lan)
-    return CanUrl(url, interface, channel, kwargs, context, options)
+    return CanUrl(url, interface, channel, kwargs, context, options, log)
 
 
 def _check_multicast(url: str, channel: str, lan: bool) -> None:
@@ -222,8 +233,13 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     spec = parse_can_url(url)
     opts = spec.options
     bus = open_bus(spec)
+    try:
+        log = CanFrameLog(url, spec.log) if spec.log else None
+    except RobotUrlError:
+        bus.shutdown()
+        raise
     link = CanLink(bus, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                   max_lost=int(opts["lost"]), grace_s=opts["grace"])
+                   max_lost=int(opts["lost"]), grace_s=opts["grace"], log=log)
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=options.time_scale or opts["time_scale"],

@@ -14,7 +14,7 @@ from stairbot.hardware import MotorId, SensorId
 # version; Ident keeps its layout in every version so that it can tell.
 # 3.0: the serial frame header has a length byte, flagged by address bit 4
 # (serial_wire.py); CAN frames are unchanged.
-PROTOCOL_MAJOR = 3
+PROTOCOL_MAJOR = 4
 PROTOCOL_MINOR = 0
 MAX_PAYLOAD = 8
 INT16_MAX = 32767

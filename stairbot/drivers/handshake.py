@@ -2,7 +2,9 @@
 
 The host identifies each board, refuses one whose protocol major version is
 not its own (one ProtocolVersionError naming the board and both versions,
-before a single telemetry frame of another layout could be misread) or whose
+before a single telemetry frame of another layout could be misread; a CAN
+board of protocol 3.x, which ignores 4.x frames, is asked the 3.x way when
+it does not answer) or whose
 lockstep does not match the URL, or that holds a latch (its emergency stop,
 or a watchdog that tripped: an earlier host stopped mid-run, crashed or was
 cut off) -- opening never clears one, the operator does (``stairbot clear``)
@@ -13,7 +15,7 @@ opens.
 from __future__ import annotations
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.link import BoardLink
+from stairbot.drivers.link import BoardLink, ProbesOldBoards
 from stairbot.errors import (
     HardwareError,
     LatchedError,
@@ -61,6 +63,12 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
     try:
         reply = link.exchange(board, [m.Identify(), m.GetStatus()])
     except LinkLostError:
+        # A board of an older protocol may ignore this host's frames (on CAN,
+        # 3.x boards take no 29-bit id): asked the old way, it says what it
+        # speaks, and the error says so rather than "no board".
+        old = link.probe_old_ident(board) if isinstance(link, ProbesOldBoards) else None
+        if old is not None:
+            check_version(url, board, old)
         raise NoBoardError(url, name, f"no {name} board answered on the "
                            f"{link.wire} ({tries})") from None
     ident, status = (reply.messages + (None, None))[:2]

@@ -11,8 +11,8 @@ from stairbot.drivers.link import LinkStats
 from stairbot.events import Event, EventKind, EventSink
 
 EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
-TROUBLE = ("retries", "revived", "timeouts", "lost", "late", "stray", "crc_errors", "malformed",
-           "refused")
+TROUBLE = ("retries", "revived", "timeouts", "lost", "late", "stray", "duplicates", "crc_errors",
+           "malformed", "refused")
 
 
 class HealthReport:

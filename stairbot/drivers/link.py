@@ -5,9 +5,10 @@ retries, expiry and the health counters.
 needs of a wire.  :class:`RequestLink` implements it once -- matching replies
 to requests, retrying, expiring, counting -- and a wire subclasses it with
 what only that wire knows: how a request is encoded and sent, how bytes or
-frames come in and which request a reply belongs to (the serial link by the
-frame's sequence number, ``serial_link.py``; the CAN link by what each
-message is answered with, ``can_link.py``).
+frames come in and which request a reply belongs to (both by the host's
+session and a sequence number: the serial link one per frame of messages,
+``serial_link.py``; the CAN link one per frame, a message each, then by what
+the message is answered with, ``can_link.py``).
 
 Rules (docs/protocol.md, "Requests and replies"):
 
@@ -15,8 +16,9 @@ Rules (docs/protocol.md, "Requests and replies"):
 * Only requests made entirely of idempotent messages (queries, StepTo) are
   sent again, up to ``retries`` times.  Commands are never sent again: the
   next control cycle sends fresh ones.
-* A reply to a request given up is counted ``late``; a reply matching
-  nothing (a duplicate, an echo) is counted ``stray``.
+* A reply to a request given up is counted ``late``; a second copy of a
+  reply already taken ``duplicates``; a reply matching nothing (another
+  session's, an echo) ``stray``.
 * :meth:`RequestLink.wait` raises LinkLostError when a waited-for request got
   no reply after its retries and its board has not answered anything for
   ``grace_s``; until then the request is sent again (a query) -- ordinary
@@ -40,10 +42,10 @@ from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Generic, Protocol, TypeVar, cast
+from typing import Generic, Protocol, TypeVar, cast, runtime_checkable
 
 from stairbot.drivers.codes import Board
-from stairbot.drivers.records import Message, RawMessage
+from stairbot.drivers.records import Ident, Message, RawMessage
 from stairbot.errors import LinkLostError
 
 
@@ -96,6 +98,7 @@ class LinkStats:
     revived: int = 0  # queries sent again beyond their retries, within the grace period
     late: int = 0
     stray: int = 0
+    duplicates: int = 0  # second copies of a reply already taken
     crc_errors: int = 0
     malformed: int = 0
     rtt_s: deque[float] = field(default_factory=lambda: deque(maxlen=2048))
@@ -210,6 +213,17 @@ class BoardLink(Protocol):
     def close(self) -> None: ...
 
 
+@runtime_checkable
+class ProbesOldBoards(Protocol):
+    """A link that can ask a board that ignores it (one of an older protocol
+    whose frames this host's do not match) who it is: the CAN link, whose
+    frame layout changed in protocol 4.0."""
+
+    def probe_old_ident(self, board: int) -> Ident | None:
+        """The Ident an older board sends when asked the old way; None if none."""
+        ...
+
+
 R = TypeVar("R", bound=Request)
 
 
@@ -263,6 +277,11 @@ class RequestLink(ABC, Generic[R]):
 
     def _given_up(self, req: R) -> None:
         """``req`` failed: remember what a late reply to it would look like."""
+
+    def _on_wire(self, req: R) -> bool:
+        """Whether ``req`` has gone out (a wire that holds requests back until
+        :meth:`flush` says; its timeout runs from then)."""
+        return True
 
     @abstractmethod
     def flush(self) -> None: ...
@@ -354,7 +373,7 @@ class RequestLink(ABC, Generic[R]):
         now = self._now()
         for queue in self._in_flight.values():
             for req in list(queue):
-                if now < req.deadline or req.urgent:
+                if now < req.deadline or req.urgent or not self._on_wire(req):
                     continue
                 self.stats.timeouts += 1
                 if req.idempotent and req.attempts <= self.retries:

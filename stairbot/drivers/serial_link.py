@@ -21,6 +21,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.link import LinkStats, Request, RequestLink
 from stairbot.drivers.records import Message
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
@@ -107,6 +108,7 @@ class SerialRequest(Request):
 
     seq: int = 0
     frame: bytes = b""
+    on_wire: bool = False  # written (not only held in the output buffer)
 
     def progress(self) -> str:
         return f"; seq {self.seq}"
@@ -119,11 +121,13 @@ class SerialLink(RequestLink[SerialRequest]):
 
     def __init__(self, channel: ByteChannel, timeout_s: float = 0.05, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
-                 grace_s: float = 0.0) -> None:
+                 grace_s: float = 0.0, log: SerialFrameLog | None = None) -> None:
         super().__init__(LinkStats(), timeout_s, retries, max_lost, now, grace_s)
         self.channel = channel
+        self.log = log  # every byte written and read, a line per frame
         self._reader = FrameReader()
         self._expired: deque[tuple[int, int]] = deque(maxlen=64)
+        self._answered: deque[tuple[int, int]] = deque(maxlen=64)
         # This link's session: a reply of another (an earlier host's, a
         # previous run's still on the line) is never taken for one of ours.
         self.session = secrets.randbelow(255) + 1
@@ -132,6 +136,7 @@ class SerialLink(RequestLink[SerialRequest]):
         # that drew an earlier one's number still seldom repeats a request.
         self._seq = secrets.randbelow(256)
         self._out = bytearray()
+        self._unsent: list[SerialRequest] = []  # their frames are in _out
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[Message, ...], idempotent: bool,
@@ -151,6 +156,7 @@ class SerialLink(RequestLink[SerialRequest]):
 
     def _transmit(self, req: SerialRequest, send: bool) -> None:
         self._out += req.frame
+        self._unsent.append(req)
         self.stats.frames_tx += 1
         self.stats.bytes_tx += len(req.frame)
         if send:
@@ -166,8 +172,20 @@ class SerialLink(RequestLink[SerialRequest]):
                 return
             data, self._out = bytes(self._out), bytearray()
             self._write(data)
+            # their timeouts (and round trips) run from now, not from when
+            # they were held back
+            now = self._now()
+            for req in self._unsent:
+                req.on_wire, req.sent_at, req.deadline = True, now, now + self.timeout_s
+            self._unsent = []
+
+    def _on_wire(self, req: SerialRequest) -> bool:
+        # A request held back cannot time out before it is written.
+        return req.on_wire
 
     def _send_now(self, requests: Sequence[SerialRequest]) -> None:
+        for req in requests:
+            req.on_wire = True
         data = b"".join(r.frame for r in requests)
         self.stats.frames_tx += len(requests)
         self.stats.bytes_tx += len(data)
@@ -178,6 +196,8 @@ class SerialLink(RequestLink[SerialRequest]):
             self.channel.write(data)
         except OSError as exc:
             raise LinkLostError(f"cannot write to the serial port: {exc}") from exc
+        if self.log is not None:
+            self.log.tx(data)
 
     # -- receiving -------------------------------------------------------------
     def _receive(self, timeout_s: float) -> bool:
@@ -187,6 +207,8 @@ class SerialLink(RequestLink[SerialRequest]):
             raise LinkLostError(f"cannot read from the serial port: {exc}") from exc
         if not data:
             return False
+        if self.log is not None:
+            self.log.rx(data)
         with self._mutex:
             self.stats.bytes_rx += len(data)
             rs = self._reader.stats
@@ -194,10 +216,14 @@ class SerialLink(RequestLink[SerialRequest]):
                 if frame.from_board:
                     self._hear(frame.board)
                 req = self._match(frame) if frame.from_board else None
+                mine = frame.session == self.session
                 if req is not None:
                     self._complete(req, frame.messages)
-                elif frame.session == self.session and (frame.board, frame.seq) in self._expired:
+                    self._answered.append((req.board, req.seq))
+                elif mine and (frame.board, frame.seq) in self._expired:
                     self.stats.late += 1
+                elif mine and frame.from_board and (frame.board, frame.seq) in self._answered:
+                    self.stats.duplicates += 1  # a second copy of a reply taken
                 else:
                     self.stats.stray += 1
             self.stats.crc_errors = rs.crc_errors
@@ -217,7 +243,14 @@ class SerialLink(RequestLink[SerialRequest]):
         self._expired.append((req.board, req.seq))
 
     def describe(self) -> dict[str, object]:
-        return {"wire": self.wire}
+        out: dict[str, object] = {"wire": self.wire}
+        if self.log is not None:
+            out["frame_log"] = self.log.describe()
+        return out
 
     def close(self) -> None:
-        self.channel.close()
+        try:
+            self.channel.close()
+        finally:
+            if self.log is not None:
+                self.log.close()

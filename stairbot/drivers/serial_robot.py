@@ -27,6 +27,9 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
                       (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
                       the host's wall clock runs at the same rate; 0.01 to 1000
+  - ``log=FILE``      write every frame sent and received to FILE, one line
+                      each: time, TX or RX, the bytes on the line in hex
+                      (``frame_log.py``); flushed as written
 
 Every number must be finite and within its bounds (``url_options.py``); the
 query must decode as UTF-8.
@@ -49,6 +52,7 @@ import serial
 
 from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session
+from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.port_lock import PortLock, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
 from stairbot.drivers.url_options import number_option, query_pairs
@@ -64,22 +68,33 @@ DEFAULTS: dict[str, float] = {
 def parse_serial_url(url: str) -> tuple[str, dict[str, float]]:
     """(pyserial port, options) of a ``serial://`` URL.  RobotUrlError names
     the option and what is allowed."""
+    port, opts, _ = parse_serial_url_log(url)
+    return port, opts
+
+
+def parse_serial_url_log(url: str) -> tuple[str, dict[str, float], str | None]:
+    """(pyserial port, options, frame log path or None) of a ``serial://`` URL."""
     if not url.startswith("serial://") or len(url) == len("serial://"):
         raise RobotUrlError(url, None, "expected serial://PORT[?baud=N&timeout=S...]")
     rest = url[len("serial://"):]
     port, _, query = rest.rpartition("?") if "?" in rest else (rest, "", "")
     opts = dict(DEFAULTS)
     passthrough: list[tuple[str, str]] = []
+    log: str | None = None
     for key, value in query_pairs(url, query, strict=False):
         if key in DEFAULTS:
             opts[key] = number_option(url, key, value)
+        elif key == "log":
+            if not value:
+                raise RobotUrlError(url, "log", "no file name; e.g. log=run.txt")
+            log = value
         else:
             passthrough.append((key, value))
     if passthrough:
         port += ("&" if "?" in port else "?") + urlencode(passthrough)
     if not port:
         raise RobotUrlError(url, None, "no port; e.g. serial:///dev/ttyUSB0")
-    return port, opts
+    return port, opts, log
 
 
 class _LockedPort:
@@ -133,14 +148,20 @@ def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> R
     """Open ``serial://PORT?...``.  RobotUrlError (one line) when the URL is
     malformed or the port cannot open; NoBoardError (a HardwareError, one
     line naming the board and the URL) when no board answers."""
-    port, opts = parse_serial_url(url)
+    port, opts, log_path = parse_serial_url_log(url)
     channel = open_channel(port, int(opts["baud"]), url)
+    try:
+        log = SerialFrameLog(url, log_path) if log_path else None
+    except RobotUrlError:
+        channel.close()
+        raise
     link = SerialLink(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                      max_lost=int(opts["lost"]), grace_s=opts["grace"])
+                      max_lost=int(opts["lost"]), grace_s=opts["grace"], log=log)
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=options.time_scale or opts["time_scale"],
                               allow_latched=options.allow_latched)
 
 
-__all__ = ["DEFAULTS", "open_channel", "open_serial_robot", "parse_serial_url"]
+__all__ = ["DEFAULTS", "open_channel", "open_serial_robot", "parse_serial_url",
+           "parse_serial_url_log"]

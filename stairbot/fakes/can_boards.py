@@ -18,10 +18,16 @@ URL option ``lan=1`` opens them to the network instead (python-can's socket
 on ``0.0.0.0:PORT``); the line on stderr says which.
 
 :class:`CanBoardServer` decodes each frame with the DBC (``drivers.can_wire``),
-hands a host frame to the board it is for (both boards for id ``..F``), and
-sends each reply as one frame from that board.  Frames from boards (its own
-echo on ``udp_multicast``) are ignored; unknown ids and wrong lengths are
-counted and ignored, as CAN firmware ignores frames it does not understand.
+hands a host frame to the board it is for (both boards for board 15), and
+sends each reply as one frame from that board, with the session and seq of
+the host frame it answers.  A host frame identical to the previous one to
+the same board (same session, seq, kind and data -- a retry, or a copy the
+bus made; sent to that board or to every board) gets the previous replies
+again without being executed twice, as docs/protocol.md requires of
+firmware; a frame of a new session is executed.  Frames from boards (its
+own echo on ``udp_multicast``) are ignored; unknown ids, wrong lengths and
+11-bit ids (a protocol 3.x host) are counted as malformed and ignored, as
+CAN firmware ignores frames it does not understand.
 Fault injection (``WireFaults``, as on the serial wire) acts on whole frames:
 dropped, corrupted (the receiver's CAN controller rejects it: modelled as an
 error frame), duplicated, late, and a board that goes silent.
@@ -42,7 +48,7 @@ from can.interfaces.udp_multicast import UdpMulticastBus
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
-from stairbot.drivers.can_wire import BROADCAST, CanWire, wire
+from stairbot.drivers.can_wire import BROADCAST, CanFrame, CanWire, wire
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.errors import RobotUrlError
 from stairbot.fakes.board_world import BoardWorld, Pacer
@@ -56,7 +62,8 @@ class CanServerStats:
     frames_rx: int = 0  # host frames handled
     frames_tx: int = 0
     error_frames: int = 0
-    malformed: int = 0  # unknown ids, wrong lengths
+    malformed: int = 0  # unknown ids, wrong lengths, 11-bit ids (protocol 3.x)
+    duplicates: int = 0  # repeated host frames answered from the cache
     ignored: int = 0  # frames from boards (our own echo included)
     stray: int = 0  # host frames for a board not served here
     injected: int = 0  # faults injected
@@ -79,6 +86,9 @@ class CanBoardServer:
         self.stats = CanServerStats()
         self._dice = FaultDice(self.faults, self.stats)
         self._late: list[tuple[float, can.Message]] = []
+        # per board: the last host frame it executed (session, seq, type, data)
+        # and its replies
+        self._last: dict[int, tuple[tuple[int, int, int, bytes], list[m.Message]]] = {}
         self._stop = threading.Event()
         self.last_send_error: str | None = None
 
@@ -101,7 +111,7 @@ class CanBoardServer:
             return
         if self._chance(f.corrupt):
             frame = can.Message(arbitration_id=frame.arbitration_id, is_error_frame=True,
-                                is_extended_id=False, data=b"")
+                                is_extended_id=True, data=b"")
         if self._chance(f.late):
             self._late.append((time.monotonic() + f.late_s, frame))
             return
@@ -132,11 +142,11 @@ class CanBoardServer:
             self.stats.error_frames += 1
             return
         try:
-            board_id, msg = self.codec.from_can(frame)
+            decoded = self.codec.from_can(frame)
         except m.CodecError:
             self.stats.malformed += 1
             return
-        if msg.REPLY:
+        if decoded.message.REPLY:
             self.stats.ignored += 1
             return
         f = self.faults
@@ -145,22 +155,32 @@ class CanBoardServer:
         if self._chance(f.corrupt):
             self.stats.error_frames += 1
             return
-        targets = list(self.boards) if board_id == BROADCAST else [board_id]
+        targets = list(self.boards) if decoded.board == BROADCAST else [decoded.board]
         for _ in range(2 if self._chance(f.duplicate) else 1):
             for address in targets:
-                self._handle(address, msg)
+                self._handle(address, decoded, bytes(frame.data))
 
-    def _handle(self, address: int, msg: m.Message) -> None:
+    def _handle(self, address: int, frame: CanFrame, data: bytes) -> None:
         board = self.boards.get(address)
         if board is None:
             self.stats.stray += 1
             return
         self.stats.frames_rx += 1
-        replies = board.handle([msg])
+        # The board field is left out: a retry to one board of a frame first
+        # broadcast to both is the same frame to this board.
+        key = (frame.session, frame.seq, frame.message.TYPE, data)
+        last = self._last.get(address)
+        if last is not None and last[0] == key:
+            self.stats.duplicates += 1
+            board.handle([])  # feeds the watchdog, executes nothing
+            replies = last[1]
+        else:
+            replies = board.handle([frame.message])
+            self._last[address] = (key, replies)
         if self._silent(address):
             return
         for reply in replies:
-            self._send(self.codec.to_can(address, reply))
+            self._send(self.codec.to_can(address, reply, frame.session, frame.seq))
 
     # -- serving -------------------------------------------------------------------
     def pump(self) -> None:
@@ -244,7 +264,8 @@ def main(argv: list[str]) -> int:
         bus.shutdown()
         s = server.stats
         print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.error_frames} "
-              f"error frames, {s.malformed} malformed, {s.injected} faults injected, "
+              f"error frames, {s.malformed} malformed, {s.duplicates} repeated frames "
+              f"answered from the cache, {s.injected} faults injected, "
               f"{s.send_errors} replies the bus refused",
               file=sys.stderr)
     return 0

@@ -20,6 +20,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_COPIES
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import open_bus, open_can_robot, parse_can_url, resolve_bus_config
+from stairbot.drivers.can_wire import make_id, split_id
 from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event
 from stairbot.fakes.board_world import BoardWorld
@@ -145,9 +146,9 @@ def test_socketcan_vcan0_opens() -> None:  # pragma: no cover - needs a kernel C
     bus, other = open_bus(s), open_bus(s)
     try:
         assert isinstance(bus, SocketcanBus) and bus.channel == "vcan0"
-        bus.send(can.Message(arbitration_id=0x0EF, data=b"", is_extended_id=False))
+        bus.send(can.Message(arbitration_id=0x0EF << 18, data=b"", is_extended_id=True))
         heard = other.recv(timeout=5.0)
-        assert heard is not None and heard.arbitration_id == 0x0EF  # Identify_All
+        assert heard is not None and heard.arbitration_id == 0x0EF << 18  # Identify_All
     finally:
         bus.shutdown()
         other.shutdown()
@@ -273,7 +274,8 @@ def test_the_emergency_stop_does_not_wait_for_the_robots_lock(
     release.set()
     holder.join(5)
     stopper.join(5)
-    assert sent[:ESTOP_COPIES] == [(0x00F, True)] * ESTOP_COPIES  # EStop_All, lock held
+    assert [(split_id(i)[0], held) for i, held in sent[:ESTOP_COPIES]] == [
+        (0x00F, True)] * ESTOP_COPIES  # EStop_All, lock held
     assert all(b.estop for b in rig.boards.values())
     assert rig.robot.estopped and rig.robot.link.stats.lost == 0  # confirmed, not given up
 
@@ -399,7 +401,7 @@ def test_a_bus_that_refuses_the_boards_replies_costs_frames_not_the_server() -> 
     world = make_world(load_config(), load_scenario(), True)
     bus = can.Bus(interface="virtual", channel=f"refuse-{next(_names)}")
     server = CanBoardServer(bus, world, make_boards(world))
-    identify = can.Message(arbitration_id=0x0EF, data=b"", is_extended_id=False)
+    identify = can.Message(arbitration_id=make_id(0x0EF, 1, 0), data=b"", is_extended_id=True)
     bus.shutdown()  # every send now raises CanOperationError
     server.receive(identify)  # both boards answer: two replies refused
     assert (server.stats.frames_rx, server.stats.send_errors, server.stats.frames_tx) == (2, 2, 0)
@@ -417,8 +419,9 @@ def test_a_read_all_reply_without_every_channel_is_a_hardware_error(rig: Rig) ->
 
 
 def test_every_frame_twice_reads_every_channel_once_and_counts_the_copies() -> None:
-    # CAN frames carry no sequence number: a duplicated telemetry frame must not
-    # stand in for another channel's ("ReadAll reply lacks channels").
+    # A duplicated telemetry frame must not stand in for another channel's
+    # ("ReadAll reply lacks channels"); each copy of a host frame is answered
+    # from the board's cache, and each copy of a reply counted a duplicate.
     r = make_rig(WireFaults(duplicate=1.0, seed=1), timeout=0.05)
     try:
         for _ in range(20):
@@ -426,22 +429,25 @@ def test_every_frame_twice_reads_every_channel_once_and_counts_the_copies() -> N
         snap = r.robot.read()
         assert set(snap.motors) == set(MotorId)
         h = r.robot.health()
-        assert h["stray"] >= 20 and h["lost"] == 0
+        assert h["duplicates"] >= 20 and h["stray"] == h["late"] == h["lost"] == 0
+        assert r.server.stats.duplicates >= 20
     finally:
         r.robot.close()
         r.server.bus.shutdown()
 
 
 def test_a_reply_frame_lost_between_others_is_a_gap_matched_by_channel() -> None:
-    from stairbot.drivers.can_link import CanRequest
+    from stairbot.drivers.can_request import CanRequest, Offer
 
     req = CanRequest(int(m.Board.MOTOR), (m.ReadAll(),), True, 0.0, 1.0)
     req.expect()
     tel = [m.MotorTelemetry(c, 1, 0, 1000, 5) for c in range(6)]
-    assert req.offer(m.Status(0x40, 0, 250, 0)) and req.offer(tel[0])
-    assert not req.offer(tel[0])  # a copy of channel 0: not channel 1
-    assert req.offer(tel[2]) and req.gap  # channel 1 was lost on the way
-    assert not req.offer(tel[1])  # too late: the board sends in order
+    taken = Offer.TAKEN
+    assert req.offer(m.Status(0x40, 0, 250, 0), 0) is taken and req.offer(tel[0], 0) is taken
+    assert req.offer(tel[0], 0) is Offer.DUPLICATE  # a copy of channel 0: not channel 1
+    assert req.offer(tel[2], 0) is taken and req.gap  # channel 1 was lost on the way
+    assert req.offer(tel[1], 0) is Offer.LATE  # too late: the board sends in order
+    assert req.offer(m.Ident(1, 4, 0, 6, 1, 1), 0) is Offer.STRAY  # no reply to ReadAll
     for t in tel[3:]:
-        assert req.offer(t)
+        assert req.offer(t, 0) is taken
     assert req.owed == 0 and req.gap  # every reply that will come came; incomplete

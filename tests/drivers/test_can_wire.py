@@ -21,7 +21,17 @@ from hypothesis import strategies as st
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.can_wire import CanWire, frame_bits, load_dbc, wire
+from stairbot.drivers.can_wire import (
+    FRAME_ID_MASK,
+    SESSION_MAX,
+    CanFrame,
+    CanWire,
+    frame_bits,
+    load_dbc,
+    make_id,
+    split_id,
+    wire,
+)
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
@@ -38,23 +48,51 @@ def message_of(v: dict[str, Any]) -> m.Message:
 
 def test_the_dbc_loads_and_every_message_has_a_frame() -> None:
     db = cantools.database.load_file(
-        str(resources.files("stairbot.drivers").joinpath("stairbot.dbc")))
+        str(resources.files("stairbot.drivers").joinpath("stairbot.dbc")), strict=True)
     ids = [f.frame_id for f in db.messages]
     assert len(ids) == len(set(ids))
-    assert all(not f.is_extended_frame and f.frame_id <= 0x7FF and f.length <= 8
+    assert all(f.is_extended_frame and f.frame_id & ~FRAME_ID_MASK == 0 and f.length <= 8
                for f in db.messages)
     w = CanWire(db)
     assert set(w.kinds) == set(m.MESSAGES)
-    assert db.get_message_by_frame_id(0x00F).name == "EStop_All"
+    assert db.get_message_by_frame_id(0x00F << 18).name == "EStop_All"
     assert min(ids) == w.frame_id(m.Board.MOTOR, m.EStop)  # e-stop wins arbitration
+
+
+def test_estop_has_the_lowest_id_of_every_frame_whatever_the_session_and_seq() -> None:
+    """Arbitration favours the lowest id: the highest id an EStop can have
+    (any board, session 1023, seq 255) is below the lowest any other frame
+    can have (session 0, seq 0)."""
+    w = wire()
+    estop = [make_id(w.base(b, m.EStop), s, q) for b in (1, 2, 15)
+             for s in (0, 1, SESSION_MAX) for q in (0, 255)]
+    others = [f.frame_id for f in w.db.messages if not f.name.startswith("EStop_")]
+    assert max(estop) < min(others)
+    assert max(estop) == 0x003FFFFF and min(others) == 0x00440000
+
+
+def test_the_id_carries_session_and_seq_below_the_base() -> None:
+    w = wire()
+    fid, data = w.encode(1, m.ReadAll(), session=0x15A, seq=5)
+    assert (fid, data) == (0x0A1 << 18 | 0x15A << 8 | 5, b"") == (0x02855A05, b"")
+    assert split_id(fid) == (0x0A1, 0x15A, 5)
+    assert w.decode(fid, b"") == CanFrame(1, m.ReadAll(), 0x15A, 5)
+    for session, seq in ((-1, 0), (SESSION_MAX + 1, 0), (1, 256), (1, -1)):
+        with pytest.raises(m.CodecError, match="out of range"):
+            w.encode(1, m.ReadAll(), session, seq)
 
 
 def test_a_dbc_that_disagrees_with_the_model_is_refused(tmp_path: Path) -> None:
     text = resources.files("stairbot.drivers").joinpath("stairbot.dbc").read_text()
+    lift = f"BO_ {0x80000000 | 0x051 << 18} SetLiftSpeeds_Motor:"
     bad = tmp_path / "bad.dbc"
-    bad.write_text(text.replace("BO_ 81 SetLiftSpeeds_Motor: 4", "BO_ 81 SetLiftSpeeds_Motor: 6"))
+    bad.write_text(text.replace(f"{lift} 4", f"{lift} 6"))
     with pytest.raises(ValueError, match="SetLiftSpeeds_Motor is 6 bytes"):
         CanWire(load_dbc(str(bad)))
+    standard = tmp_path / "standard.dbc"  # a protocol 3.x frame: an 11-bit id
+    standard.write_text(text.replace(lift, "BO_ 81 SetLiftSpeeds_Motor:"))
+    with pytest.raises(ValueError, match="SetLiftSpeeds_Motor has id 0x00000051"):
+        CanWire(load_dbc(str(standard)))
 
 
 @pytest.mark.parametrize("v", VECTORS, ids=lambda v: f"{v['id']}-{v['message']}")
@@ -62,11 +100,12 @@ def test_vector(v: dict[str, Any]) -> None:
     w = wire()
     fid, data = int(v["id"], 16), bytes.fromhex(v["data"])
     msg = message_of(v)
-    assert w.encode(v["board"], msg) == (fid, data)
-    assert w.decode(fid, data) == (v["board"], msg)
+    assert split_id(fid) == (int(v["base"], 16), v["session"], v["seq"])
+    assert w.encode(v["board"], msg, v["session"], v["seq"]) == (fid, data)
+    assert w.decode(fid, data) == CanFrame(v["board"], msg, v["session"], v["seq"])
     assert m.encode(msg)[1] == data  # the CAN payload is the protocol payload
-    frame = w.db.get_message_by_frame_id(fid)
-    assert frame.name == v["frame"]
+    frame = w.db.get_message_by_frame_id(fid)  # the DBC, masked: any session and seq
+    assert frame.name == v["frame"] and frame.frame_id == int(v["base"], 16) << 18
     decoded = {k: (str(x) if not isinstance(x, int | float) else x)
                for k, x in frame.decode(data).items()}
     assert decoded == pytest.approx(v["signals"])
@@ -75,14 +114,16 @@ def test_vector(v: dict[str, Any]) -> None:
 def test_every_frame_round_trips_and_matches_the_struct_payload() -> None:
     w, rng = wire(), random.Random(7)
     for fid in sorted(f.frame_id for f in w.db.messages):
-        board, _ = w.decode(fid, bytes(w.db.get_message_by_frame_id(fid).length))
-        cls = type(w.decode(fid, bytes(w.db.get_message_by_frame_id(fid).length))[1])
+        first = w.decode(fid, bytes(w.db.get_message_by_frame_id(fid).length))
+        board, cls = first.board, type(first.message)
         for _ in range(100):
             layout = struct.Struct(cls.FORMAT)
             raw = bytes(rng.randrange(256) for _ in range(layout.size))
             msg = m.decode(cls.TYPE, layout.pack(*layout.unpack(raw)))  # padding zeroed
-            assert w.encode(board, msg) == (fid, m.encode(msg)[1])
-            assert w.decode(fid, m.encode(msg)[1]) == (board, msg)
+            session, seq = rng.randrange(SESSION_MAX + 1), rng.randrange(256)
+            sent = w.encode(board, msg, session, seq)
+            assert sent == (fid | session << 8 | seq, m.encode(msg)[1])
+            assert w.decode(*sent) == CanFrame(board, msg, session, seq)
 
 
 def test_fields_that_do_not_fit_and_frames_that_do_not_exist_are_codec_errors() -> None:
@@ -92,14 +133,17 @@ def test_fields_that_do_not_fit_and_frames_that_do_not_exist_are_codec_errors() 
     with pytest.raises(m.CodecError, match="SetWheelSpeeds and board 2"):
         w.encode(2, m.SetWheelSpeeds(0, 0, 0, 0))
     with pytest.raises(m.CodecError, match="unknown CAN id"):
-        w.decode(0x7FF, b"")
+        w.decode(0x7FF << 18, b"")
     with pytest.raises(m.CodecError, match="expected 8"):
-        w.decode(0x221, b"\x00" * 7)
+        w.decode(0x221 << 18 | 0x15A05, b"\x00" * 7)
+    old = can.Message(arbitration_id=0x0A1, data=b"", is_extended_id=False)  # protocol 3.x
+    with pytest.raises(m.CodecError, match="not a classic extended data frame"):
+        w.from_can(old)
 
 
 def test_frame_bits_worst_case_stuffing() -> None:
-    assert frame_bits(8) == 135
-    assert frame_bits(0) == 55
+    assert frame_bits(8) == 160  # 135 with an 11-bit id
+    assert frame_bits(0) == 80  # 55
     assert [frame_bits(n) for n in range(9)] == sorted(frame_bits(n) for n in range(9))
 
 
@@ -125,8 +169,11 @@ def test_captured_traffic_is_decoded_by_cantools(tmp_path: Path) -> None:
     db = load_dbc()
     names = []
     for frame in can.LogReader(str(log)):
-        names.append(db.get_message_by_frame_id(frame.arbitration_id).name)
-        db.decode_message(frame.arbitration_id, frame.data)  # raises if it cannot
+        # get_message_by_frame_id applies the mask (decode_message, in
+        # cantools 45.1, does not)
+        found = db.get_message_by_frame_id(frame.arbitration_id)
+        names.append(found.name)
+        found.decode(frame.data)  # raises if it cannot
     assert names.count("MotorTelemetry_Motor") == 6
     assert names.count("SensorTelemetry_Sensor") == 4
     assert {"Ident_Motor", "Ident_Sensor", "StepTo_Motor", "StepDone_Motor",
@@ -146,9 +193,10 @@ frames = st.builds(
 
 _DBC_FRAMES = [(f.frame_id, f.length) for f in load_dbc().messages]
 valid_frames = st.sampled_from(_DBC_FRAMES).flatmap(lambda spec: st.builds(
-    lambda data: can.Message(arbitration_id=spec[0], data=data, is_extended_id=False,
-                             check=False),
-    st.binary(min_size=spec[1], max_size=spec[1])))
+    lambda data, session, seq: can.Message(arbitration_id=spec[0] | session << 8 | seq,
+                                           data=data, is_extended_id=True, check=False),
+    st.binary(min_size=spec[1], max_size=spec[1]), st.integers(0, SESSION_MAX),
+    st.integers(0, 255)))
 
 
 @pytest.fixture(scope="module")
@@ -187,7 +235,7 @@ def test_arbitrary_frames_never_crash_the_decoders_and_are_counted(
     ls = {k: v - l0[k] for k, v in link.stats.as_dict().items()}
     assert s["error_frames"] + s["malformed"] == bad
     assert ls["crc_errors"] + ls["malformed"] == bad
-    assert ls["ignored"] + ls["stray"] + ls["late"] == len(batch) - bad
+    assert ls["ignored"] + ls["stray"] + ls["late"] + ls["duplicates"] == len(batch) - bad
     assert s["ignored"] + s["frames_rx"] + s["stray"] >= len(batch) - bad
 
 
@@ -202,9 +250,11 @@ def test_link_matches_interleaved_replies_and_counts_late_and_stray() -> None:
     status = m.Status(0x40, 0, 250, 1)
     pm = link.request(1, [m.ReadAll()])
     ps = link.request(2, [m.GetStatus()])
-    replies = [(1, status), (2, status)] + [(1, m.MotorTelemetry(c, 0, 0, 0, c)) for c in range(6)]
-    for board, msg in replies:
-        boards.send(w.to_can(board, msg))
+    (sm,), (ss,) = pm.seqs, ps.seqs
+    replies = [(1, sm, status), (2, ss, status)] + [
+        (1, sm, m.MotorTelemetry(c, 0, 0, 0, c)) for c in range(6)]
+    for board, seq, msg in replies:
+        boards.send(w.to_can(board, msg, link.session, seq))
     motor, sensor = link.wait([pm, ps])
     assert motor.messages[0] == status and len(motor.messages) == 7
     assert [x.turns_mt for x in motor.messages[1:]] == list(range(6))  # type: ignore[attr-defined]
@@ -213,8 +263,8 @@ def test_link_matches_interleaved_replies_and_counts_late_and_stray() -> None:
     t[0] = 1.0  # its time is up: given up (no retries)
     link.poll()
     assert late.failed and link.stats.lost == 1
-    boards.send(w.to_can(2, status))  # the reply it was owed, too late
-    boards.send(w.to_can(1, m.Ack(0x20, 0)))  # an Ack nobody waits for
+    boards.send(w.to_can(2, status, link.session, late.seqs[0]))  # the reply it was owed
+    boards.send(w.to_can(1, m.Ack(0x20, 0), link.session, (late.seqs[0] + 1) % 256))  # unasked
     link.poll()
     assert (link.stats.late, link.stats.stray) == (1, 1)
     for bus in (host, boards):

@@ -127,8 +127,7 @@ def test_a_read_after_a_lost_stepto_sees_the_stepped_world(scenario_file: Path) 
     drop_next_step = [False]
 
     def lose_one_stepto(frame: can.Message) -> None:
-        _, msg = server.codec.from_can(frame)
-        if isinstance(msg, m.StepTo) and drop_next_step[0]:
+        if isinstance(server.codec.from_can(frame).message, m.StepTo) and drop_next_step[0]:
             drop_next_step[0] = False
             return
         receive(frame)

@@ -43,9 +43,10 @@ def test_serial_vectors_in_the_doc_are_the_json_ones() -> None:
 def test_can_vectors_in_the_doc_are_the_json_ones() -> None:
     doc = DOC_PATH.read_text()
     text = _section(doc, "### CAN test vectors", "### Requests and replies on CAN")
-    rows = re.findall(r"^\| `(0x[0-9A-F]{3})` \| (?:`([0-9a-f ]+)`|—) \| (\w+) \| (.+) \|$",
-                      text, re.M)
-    assert rows == [(v["id"], bytes.fromhex(v["data"]).hex(" "), v["frame"], v["meaning"])
+    rows = re.findall(r"^\| `(0x[0-9A-F]{8})` \| `(0x[0-9A-F]{3})` \| (\d+) \| (\d+) \| "
+                      r"(?:`([0-9a-f ]+)`|—) \| (\w+) \| (.+) \|$", text, re.M)
+    assert rows == [(v["id"], v["base"], str(v["session"]), str(v["seq"]),
+                     bytes.fromhex(v["data"]).hex(" "), v["frame"], v["meaning"])
                     for v in _json("vectors_can.json")["vectors"]]
 
 

@@ -142,6 +142,24 @@ def test_late_reply_is_counted_late_and_stray_reply_stray() -> None:
     assert link.stats.stray == 1
 
 
+def test_a_request_held_back_does_not_time_out_before_it_is_written() -> None:
+    link, ch = make_link(status_reply)
+    held = link.request(1, [m.GetStatus()], send=False)
+    ch.t += 1.0  # twenty timeouts later, still in the output buffer
+    link.poll()
+    assert not held.failed and link.stats.timeouts == link.stats.lost == 0
+    assert link.wait([held])[0].messages == (m.Status(0, 0, 250, 0),)  # wait flushes
+    assert held.sent_at == 1.0 and link.stats.retries == 0
+
+
+def test_a_second_copy_of_a_reply_taken_is_counted_a_duplicate() -> None:
+    link, ch = make_link(lambda f: status_reply(f) * 2)
+    reply = link.exchange(1, [m.GetStatus()])
+    assert isinstance(reply.messages[0], m.Status)
+    link.poll()
+    assert (link.stats.duplicates, link.stats.stray, link.stats.late) == (1, 0, 0)
+
+
 def test_a_reply_of_another_session_is_never_taken() -> None:
     """The same board and seq, but another host's session (a reply still on the
     line from a host before this one): stray, and the request is asked again."""

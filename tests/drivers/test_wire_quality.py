@@ -214,7 +214,7 @@ def test_a_protocol_1_sensor_telemetry_is_malformed_on_both_wires_never_misread(
     with pytest.raises(m.CodecError, match="SensorTelemetry: payload of 6 bytes, expected 8"):
         m.decode(m.SensorTelemetry.TYPE, old)
     with pytest.raises(m.CodecError, match="SensorTelemetry_Sensor: 6 data bytes, expected 8"):
-        wire().decode(0x232, old)
+        wire().decode(0x232 << 18, old)
 
 
 # -- IMU values the protocol does not allow ----------------------------------------

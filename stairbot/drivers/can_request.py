@@ -1,0 +1,136 @@
+"""One request on the CAN bus and the replies it takes (``can_link.py``
+sends it and hands it the replies whose session and seq are its own).
+
+A request is one frame per message, each with a seq of its own; a board
+answers each frame with the replies its message declares (``ANSWER``;
+ReadAll: Status + one telemetry frame per channel and IMU axis,
+``messages.READ_ALL_REPLY``), back to back and in order.  Within one frame's
+replies a reply is matched by kind and, for telemetry, by channel or axis.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import NamedTuple
+
+from stairbot.drivers import messages as m
+from stairbot.drivers.link import Request
+
+
+def expected_replies(board: int, msg: m.Message) -> list[type[m.Message]]:
+    """The reply messages, in order, a board sends for ``msg`` when it obeys."""
+    if isinstance(msg, m.ReadAll):
+        return list(m.READ_ALL_REPLY.get(board, (m.Status,)))
+    return [m.MESSAGES.get(msg.ANSWER, m.Ack)]
+
+
+def _key(msg: m.Message) -> int | None:
+    """Which channel (or IMU axis) a telemetry reply is for; None for others."""
+    if isinstance(msg, (m.MotorTelemetry, m.SensorTelemetry)):
+        return msg.channel
+    if isinstance(msg, m.ImuTelemetry):
+        return msg.axis
+    return None
+
+
+class Due(NamedTuple):
+    """A reply a request waits for: of which of its messages, answering which
+    type code, of which kind, for which channel or axis (None: any)."""
+
+    part: int  # which of the request's messages
+    request_type: int
+    kind: type[m.Message]
+    key: int | None
+
+    def fits(self, msg: m.Message) -> bool:
+        if isinstance(msg, m.Ack):
+            return msg.request == self.request_type
+        return isinstance(msg, self.kind) and (self.key is None or _key(msg) == self.key)
+
+
+class Offer(Enum):
+    """What a request made of a reply offered to it."""
+
+    TAKEN = "taken"
+    DUPLICATE = "duplicate"  # a second copy of a reply it has taken
+    LATE = "late"  # a reply it stopped waiting for (one after it came first)
+    STRAY = "stray"  # not a reply to this frame at all
+
+
+@dataclass(eq=False)
+class CanRequest(Request):
+    """A request on the bus: the seq of the frame carrying each message (none
+    until sent), the replies that came and those still to come.
+
+    A reply names its frame by seq; within that frame's replies it is matched
+    by kind and, for telemetry, by channel (or IMU axis): the n-th telemetry of
+    a kind a ReadAll is answered with is channel n.  A board sends a request's
+    replies back to back and CAN keeps their order, so a reply that matches a
+    later expected one means the ones before it were lost (``gap``): the
+    request cannot complete, and the link sends it again as soon as the last
+    reply has come, without waiting for the timeout."""
+
+    seqs: tuple[int, ...] = ()
+    got: list[m.Message] = field(default_factory=list)
+    todo: deque[Due] = field(default_factory=deque)
+    taken: list[Due] = field(default_factory=list)
+    gap: bool = False
+
+    def expect(self) -> None:
+        """(Re)start waiting for every reply."""
+        self.got = []
+        self.taken = []
+        self.gap = False
+        self.todo = deque(self._all_due())
+
+    def _all_due(self) -> Iterator[Due]:
+        for i, msg in enumerate(self.messages):
+            seen: dict[type[m.Message], int] = {}
+            for kind in expected_replies(self.board, msg):
+                n = seen.get(kind, 0)
+                seen[kind] = n + 1
+                keyed = kind in (m.MotorTelemetry, m.SensorTelemetry, m.ImuTelemetry)
+                yield Due(i, msg.TYPE, kind, n if keyed else None)
+
+    def index_of(self, seq: int) -> int | None:
+        """Which message the frame ``seq`` carried; None if none of ours."""
+        return self.seqs.index(seq) if seq in self.seqs else None
+
+    def offer(self, msg: m.Message, index: int | None = None) -> Offer:
+        """Take ``msg`` (a reply to message ``index``; None: to any) if this
+        request still waits for it: the next reply, or a later one (then
+        those before it were lost: ``gap``)."""
+        def mine(due: Due) -> bool:
+            return (index is None or due.part == index) and due.fits(msg)
+
+        pos = next((i for i, due in enumerate(self.todo) if mine(due)), None)
+        if pos is None:
+            if any(mine(due) for due in self.taken):
+                return Offer.DUPLICATE
+            return Offer.LATE if any(mine(due) for due in self._all_due()) else Offer.STRAY
+        if pos:
+            self.gap = True
+            for _ in range(pos):
+                self.todo.popleft()
+        first = self.todo[0]
+        if isinstance(msg, m.Ack):
+            # An Ack answers the message whole: nothing else comes for it.
+            while self.todo and self.todo[0].part == first.part:
+                self.todo.popleft()
+        else:
+            self.todo.popleft()
+        self.taken.append(first)
+        self.got.append(msg)
+        return Offer.TAKEN
+
+    @property
+    def owed(self) -> int:
+        """Replies still to come."""
+        return len(self.todo)
+
+    def progress(self) -> str:
+        seqs = ",".join(str(s) for s in self.seqs)
+        return f"; {len(self.got)} of {len(self.got) + self.owed} replies came; seq {seqs}"
