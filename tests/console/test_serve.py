@@ -4,6 +4,7 @@ each browser tab runs, and the pages it refuses to serve."""
 
 from __future__ import annotations
 
+import contextlib
 import http.client
 import json
 import os
@@ -11,6 +12,7 @@ import re
 import shlex
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -72,6 +74,44 @@ def test_the_served_console_gets_the_options_given(tmp_path: Path) -> None:
         ready = wait_screen(page, lambda s: "READY" in first_row(s), "the console ready")
         assert "wall_at_top" in first_row(ready)
         assert re.search(r"speed max\b", ready), ready
+
+
+def group_members(pgid: int) -> set[int]:
+    """The live processes of a process group (the server and its consoles)."""
+    found = set()
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            with contextlib.suppress(OSError):
+                if os.getpgid(int(entry)) == pgid and not zombie(int(entry)):
+                    found.add(int(entry))
+    return found
+
+
+def zombie(pid: int) -> bool:
+    with open(f"/proc/{pid}/stat") as f:
+        return f.read().rsplit(")", 1)[1].split()[0] == "Z"
+
+
+@needs_chromium
+def test_a_tab_closed_mid_run_stops_the_run_and_ends_its_console(tmp_path: Path) -> None:
+    with served_console("--speed", "10x", "--record", "events.jsonl",
+                        cwd=str(tmp_path)) as (url, server), chromium_page(url) as page:
+        wait_screen(page, lambda s: "READY" in first_row(s), "the console ready")
+        press(page, "s")
+        wait_screen(page, lambda s: "RUNNING" in first_row(s), "the run going")
+        assert len(group_members(server.pid)) > 1  # the server and the tab's console
+        page.close()
+        record = tmp_path / "events.jsonl"
+        for _ in range(600):
+            if group_members(server.pid) == {server.pid}:
+                break
+            time.sleep(0.1)
+        else:
+            raise AssertionError(f"the tab's console still runs: {group_members(server.pid)}")
+        ends = [e for e in map(json.loads, record.read_text().splitlines())
+                if e["kind"] == "end"]
+        assert [e["data"]["reason"] for e in ends] == ["the console closed"]
+        assert ends[0]["data"]["outcome"] == "stopped"
 
 
 def test_host_and_origin_are_checked_before_a_console_opens() -> None:
