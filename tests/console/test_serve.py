@@ -39,6 +39,12 @@ needs_chromium = pytest.mark.skipif(
 
 CAPTION = re.compile(r"steps (\d)\|(\d)\|(\d)\s+MTF")
 BRAILLE = re.compile("[\u2801-\u28ff]")
+MOTOR = re.compile(r"\b(MWF|MWB|MWR|MWL|MTF|MTB)\s+\S+\s+([+-]\d+\.\d)\b")
+
+
+def motor_speeds(screen: str) -> dict[str, float]:
+    """The motors panel's speeds (turns/s), by motor."""
+    return {m.group(1): float(m.group(2)) for m in MOTOR.finditer(screen)}
 
 
 def first_row(screen: str) -> str:
@@ -53,13 +59,17 @@ def test_the_console_in_a_browser_draws_the_robot_climbing_and_the_estop_stops_i
         assert "side view" in ready and BRAILLE.search(ready)  # the picture is there
         m = CAPTION.search(ready)
         assert m is not None and m.group(1, 2, 3) == ("0", "0", "0")
+        assert set(motor_speeds(ready).values()) == {0.0}
         press(page, "s")
         wait_screen(page, lambda s: "RUNNING" in first_row(s)
-                    and (c := CAPTION.search(s)) is not None and c.group(1) == "1",
-                    "running, segment 1 over the first tread")
+                    and (c := CAPTION.search(s)) is not None and c.group(1) == "1"
+                    and any(motor_speeds(s).values()),
+                    "running, segment 1 over the first tread, motors turning")
         press(page, "Space")
-        stopped = wait_screen(page, lambda s: re.search(r"E-STOP\s+\(operator\)", first_row(s))
-                              is not None, "the latched emergency stop in the banner")
+        stopped = wait_screen(
+            page, lambda s: re.search(r"E-STOP\s+\(operator\)", first_row(s)) is not None
+            and len(speeds := motor_speeds(s)) == 6 and not any(speeds.values()),
+            "the latched emergency stop in the banner, every motor stopped")
         assert "RUNNING" not in first_row(stopped)
         press(page, "s")  # latched: a new run is refused until c clears it
         refused = wait_screen(page, lambda s: "EMERGENCY STOP latched" in first_row(s),
