@@ -1,5 +1,6 @@
 """``stairbot console [--robot URL] [--scenario FILE|NAME] [--config FILE]
-[--record FILE] [--speed 1x|10x|max]``: the operator console.
+[--record FILE] [--speed 1x|10x|max] [--serve [HOST:]PORT]``: the operator
+console, in this terminal or (``--serve``) in a browser.
 
 Bad input (config, scenario, an unknown URL scheme, an unwritable record file)
 is found before the screen opens and raises InputError, which ``stairbot``
@@ -15,6 +16,7 @@ from urllib.parse import urlsplit
 
 from stairbot.config import load_config
 from stairbot.console.runner_thread import SPEEDS
+from stairbot.console.serve import parse_bind, serve
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
 from stairbot.paths import unused_path
@@ -42,6 +44,13 @@ def build_parser() -> argparse.ArgumentParser:
                         "Foxglove), any other name the event stream, one JSON object a line")
     p.add_argument("--speed", choices=tuple(SPEEDS), default="1x",
                    help="simulation speed: 1x real time (default), 10x, max")
+    p.add_argument("--serve", metavar="[HOST:]PORT",
+                   help="serve the console to a web browser at http://HOST:PORT/ instead of "
+                        "opening it here (needs the extra stairbot[serve]); each browser tab "
+                        "runs a console of its own with the options above.  HOST is "
+                        "127.0.0.1 unless given: only this machine can connect.  Give "
+                        "0.0.0.0 (every interface) or another address of this machine only "
+                        "to let other machines command the robot")
     return p
 
 
@@ -72,11 +81,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the console until the operator quits; returns the exit code.
     Raises InputError (exit 2 in ``stairbot``) for bad input."""
     args = build_parser().parse_args(list(argv) if argv is not None else None)
+    bind = parse_bind(args.serve) if args.serve is not None else None
     config = load_config(args.config)
     load_scenario(args.scenario)  # a bad scenario fails here, not behind the screen
     _check_url(args.robot)
     if args.record:
         check_record(args.record)
+    if bind is not None:
+        return serve(args, *bind)
     from stairbot.console.app import build_app  # textual loads only when the screen opens
 
     app = build_app(config, url=args.robot, scenario=args.scenario, record=args.record,
