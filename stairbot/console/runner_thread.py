@@ -550,7 +550,12 @@ class ConsoleEngine:
         self.state.set_recording(None)
 
     def shutdown(self, wait_s: float = 2.0) -> None:
-        """Stop any run, wait a little for it to end, stop recording, release the robot."""
+        """Stop any run, wait a little for it to end, stop recording, release the
+        robot.  A console that closes mid-run (a browser tab closed, a hang-up:
+        no quit dialog asked first) latches the e-stop first, as quitting mid-
+        run does: the robot may stand part way up a step."""
+        if self.running and not self.estop_set:
+            self.estop("the console closed mid-run")
         self._closing.set()
         self.stop("the console closed")
         deadline = self._wall() + wait_s

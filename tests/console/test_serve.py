@@ -122,6 +122,9 @@ def test_a_tab_closed_mid_run_stops_the_run_and_ends_its_console(tmp_path: Path)
                 if e["kind"] == "end"]
         assert [e["data"]["reason"] for e in ends] == ["the console closed"]
         assert ends[0]["data"]["outcome"] == "stopped"
+        # no quit dialog could ask first: the e-stop latched, as quitting mid-run does
+        assert any(e["message"] == "emergency stop by the operator (the console closed "
+                   "mid-run)" for e in map(json.loads, record.read_text().splitlines()))
 
 
 def test_host_and_origin_are_checked_before_a_console_opens() -> None:
