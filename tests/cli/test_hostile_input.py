@@ -9,20 +9,17 @@ through ``main(argv)``."""
 
 from __future__ import annotations
 
-import errno
 import json
 import os
 import resource
 import signal
 import subprocess
 import sys
-from collections.abc import Iterator
 from importlib import resources
 from pathlib import Path
 
 import pytest
 
-from stairbot import files
 from stairbot.cli import main
 
 ROBOT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
@@ -255,22 +252,6 @@ def test_journal_on_a_device_is_refused(capsys: pytest.CaptureFixture[str]) -> N
     assert "/dev/full: cannot write the journal: a character device" in line
 
 
-@pytest.fixture
-def disk_fills(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, int]]:
-    """The disk fills after ``left[NAME]`` more writes to a file named NAME."""
-    left: dict[str, int] = {}
-    real = files._write
-
-    def write(fd: int, data: bytes) -> int:
-        name = Path(os.readlink(f"/proc/self/fd/{fd}")).name
-        if name in left:
-            if left[name] <= 0:
-                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-            left[name] -= 1
-        return real(fd, data)
-
-    monkeypatch.setattr(files, "_write", write)
-    yield left
 
 
 @pytest.mark.parametrize("full", ["record", "journal"])

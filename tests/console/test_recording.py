@@ -5,15 +5,11 @@ beside it, under a name not taken, and says so."""
 from __future__ import annotations
 
 import asyncio
-import errno
 import json
-import os
 from pathlib import Path
 
-import pytest
 from pilot import SpyRobot, answer_prompt, banner, press, ready, said, spied_open, until
 
-from stairbot import files
 from stairbot.console.app import build_app
 from stairbot.console.cli import check_record
 
@@ -74,23 +70,12 @@ def test_the_command_line_check_of_record_leaves_nothing_behind(tmp_path: Path) 
 
 
 def test_a_disk_that_fills_mid_run_stops_the_run_and_says_which_file(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        tmp_path: Path, disk_fills: dict[str, int]) -> None:
     """Issue 11: the console's JSON-lines recorder raised a bare OSError on a
     full disk.  Now the run ends as ``stairbot run``'s does: the robot
     stopped, the reason names the file, the lines before kept whole."""
     path = tmp_path / "rec.jsonl"
-    left = 5
-    real = files._write
-
-    def write(fd: int, data: bytes) -> int:
-        nonlocal left
-        if Path(os.readlink(f"/proc/self/fd/{fd}")).name == path.name:
-            if left <= 0:
-                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-            left -= 1
-        return real(fd, data)
-
-    monkeypatch.setattr(files, "_write", write)
+    disk_fills[path.name] = 5
 
     spies: list[SpyRobot] = []
 

@@ -5,15 +5,11 @@ every motor is stopped, the file keeping what was written before."""
 
 from __future__ import annotations
 
-import errno
 import json
-import os
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from stairbot import files
 from stairbot.cli import main
 from stairbot.recording import topics
 from stairbot.recording.read import RecordingError, read_recording
@@ -58,22 +54,6 @@ def test_a_record_on_a_full_device_is_refused_before_the_robot_moves(
     assert not journal.exists()  # refused before the robot was opened: nothing moved
 
 
-@pytest.fixture
-def disk_fills(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, int]]:
-    """The disk fills after ``left[NAME]`` more writes to a file named NAME."""
-    left: dict[str, int] = {}
-    real = files._write
-
-    def write(fd: int, data: bytes) -> int:
-        name = Path(os.readlink(f"/proc/self/fd/{fd}")).name
-        if name in left:
-            if left[name] <= 0:
-                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-            left[name] -= 1
-        return real(fd, data)
-
-    monkeypatch.setattr(files, "_write", write)
-    yield left
 
 
 def test_the_disk_filling_mid_run_stops_the_robot(tmp_path: Path, quick: Path,

@@ -3,14 +3,12 @@ written before kept whole, and ``--resume`` finishes once there is room."""
 
 from __future__ import annotations
 
-import errno
 import json
 import os
 from pathlib import Path
 
 import pytest
 
-from stairbot import files
 from stairbot.cli import main
 
 SPEC = """
@@ -25,22 +23,11 @@ seed = 5
 
 
 def test_a_full_disk_stops_the_sweep_and_resume_finishes_it(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        tmp_path: Path, disk_fills: dict[str, int],
         capsys: pytest.CaptureFixture[str]) -> None:
     spec, out = tmp_path / "fills.toml", tmp_path / "out"
     spec.write_text(SPEC, encoding="utf-8")
-    left = 3  # the disk fills after three case lines
-    real = files._write
-
-    def write(fd: int, data: bytes) -> int:
-        nonlocal left
-        if Path(os.readlink(f"/proc/self/fd/{fd}")).name == "cases.jsonl":
-            if left <= 0:
-                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-            left -= 1
-        return real(fd, data)
-
-    monkeypatch.setattr(files, "_write", write)
+    disk_fills["cases.jsonl"] = 3  # the disk fills after three case lines
     argv = ["sweep", str(spec), "-j", "1", "--out", str(out), "-q", "--no-png"]
     assert main(argv) == 1
     err = capsys.readouterr().err.strip().splitlines()
@@ -50,7 +37,7 @@ def test_a_full_disk_stops_the_sweep_and_resume_finishes_it(
     kept = [json.loads(x) for x in (out / "cases.jsonl").read_text("utf-8").splitlines()]
     assert len(kept) == 3
 
-    monkeypatch.setattr(files, "_write", real)  # room again
+    del disk_fills["cases.jsonl"]  # room again
     assert main([*argv, "--resume"]) == 0
     cases = sorted(json.loads(x)["case"]
                    for x in (out / "cases.jsonl").read_text("utf-8").splitlines())
