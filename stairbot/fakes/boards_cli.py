@@ -105,6 +105,10 @@ def main(argv: list[str]) -> int:
 
     with contextlib.suppress(ValueError):  # not the main thread: no handler
         signal.signal(signal.SIGTERM, on_term)
+        # Ctrl-C (SIGINT) stops the boards, as their banner says, even when they
+        # were started with SIGINT ignored (a background job, a test runner's worker):
+        # Python keeps an inherited SIG_IGN, and `kill -INT` then did nothing.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     suffix = "?lockstep=1" if args.lockstep else (
         f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"serial://{pty.path}{suffix}", flush=True)

@@ -256,6 +256,10 @@ def main(argv: list[str]) -> int:
 
     with contextlib.suppress(ValueError):  # not the main thread: no handler
         signal.signal(signal.SIGTERM, on_term)
+        # Ctrl-C (SIGINT) stops the boards, as their banner says, even when they
+        # were started with SIGINT ignored (a background job, a test runner's worker):
+        # Python keeps an inherited SIG_IGN, and `kill -INT` then did nothing.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         server.serve()
     except KeyboardInterrupt:
