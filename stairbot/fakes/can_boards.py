@@ -244,13 +244,7 @@ def main(argv: list[str]) -> int:
     bus = open_bus(spec)
     server = CanBoardServer(bus, world, make_boards(world), faults_from(args),
                             time_scale=args.time_scale)
-    sep = "&" if "?" in url else "?"
-    suffix = f"{sep}lockstep=1" if args.lockstep else (
-        f"{sep}time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
-    print(f"{url}{suffix}", flush=True)
-    print(f"fake boards serving on CAN {spec.label}{reach(bus)} (Ctrl-C to stop)",
-          file=sys.stderr, flush=True)
-
+    # before the URL is printed: whoever reads it may signal at once
     def on_term(_sig: int, _frame: object) -> None:
         server.stop()
 
@@ -260,6 +254,14 @@ def main(argv: list[str]) -> int:
         # were started with SIGINT ignored (a background job, a test runner's worker):
         # Python keeps an inherited SIG_IGN, and `kill -INT` then did nothing.
         signal.signal(signal.SIGINT, signal.default_int_handler)
+
+    sep = "&" if "?" in url else "?"
+    suffix = f"{sep}lockstep=1" if args.lockstep else (
+        f"{sep}time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
+    print(f"{url}{suffix}", flush=True)
+    print(f"fake boards serving on CAN {spec.label}{reach(bus)} (Ctrl-C to stop)",
+          file=sys.stderr, flush=True)
+
     try:
         server.serve()
     except KeyboardInterrupt:
