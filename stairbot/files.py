@@ -23,6 +23,8 @@ import errno
 import os
 import stat
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from stairbot.errors import InputError, OutputError
@@ -144,6 +146,22 @@ def open_regular(path: str | os.PathLike[str], error: type[InputError], what: st
     return fd
 
 
+def refused(path: str | os.PathLike[str], what: str, exc: OSError) -> OutputError:
+    """The OutputError of a write (or fsync) the disk refused: ``PATH: cannot
+    write WHAT: REASON``."""
+    return OutputError(shown(path), what, exc.strerror or str(exc))
+
+
+@contextmanager
+def writing(path: str | os.PathLike[str], what: str) -> Iterator[None]:
+    """An OSError from writing ``path`` in the block raised as :func:`refused`'s
+    OutputError (a full disk)."""
+    try:
+        yield
+    except OSError as exc:
+        raise refused(path, what, exc) from None
+
+
 class LineFile:
     """A file written one whole line at a time with ``os.write`` (``fresh``:
     truncated first, else appended; ``sync``: each line fsync'ed before
@@ -194,7 +212,7 @@ class LineFile:
             if self.sync:
                 os.fsync(self._fd)
         except OSError as exc:
-            self.failed = OutputError(shown(self.path), self.what, exc.strerror or str(exc))
+            self.failed = refused(self.path, self.what, exc)
             raise self.failed from None
 
     def fileno(self) -> int:

@@ -46,7 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from stairbot.errors import InputError, OutputError
-from stairbot.files import LineFile, open_regular, shown
+from stairbot.files import LineFile, open_regular, refused, shown
 
 CONTEXT_EVERY = 25  # ticks: half a second at the 20 ms tick
 MAX_LINE = 1 << 20  # a journal line longer than this is not one of ours
@@ -157,8 +157,7 @@ class JournalWriter:
                 os.fsync(self._file.fileno())
             except OSError as exc:
                 with self._cv:
-                    self._file.failed = OutputError(shown(self.path), "the journal",
-                                                    exc.strerror or str(exc))
+                    self._file.failed = refused(self.path, "the journal", exc)
                     self._cv.notify_all()
                 return
             with self._cv:

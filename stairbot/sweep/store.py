@@ -20,13 +20,11 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from stairbot import __version__
-from stairbot.errors import OutputError
-from stairbot.files import LineFile, shown
+from stairbot.files import LineFile, writing
 from stairbot.sweep import tomlw
 from stairbot.sweep.cases import Case
 from stairbot.sweep.spec import Spec, SpecError
@@ -106,15 +104,15 @@ class ResultStore:
             raise ResultsError(str(folder), None,
                                f"already holds {len(self.done)} finished case(s); allowed: "
                                "--resume to finish them, or a new --out folder")
-        with _writing(folder, "the sweep results folder"):
+        with writing(folder, "the sweep results folder"):
             folder.mkdir(parents=True, exist_ok=True)
             (folder / FAILURES).mkdir(exist_ok=True)
         if not meta_path.exists():
             tmp = meta_path.with_suffix(".tmp")
-            with _writing(tmp, "the sweep's spec"):
+            with writing(tmp, "the sweep's spec"):
                 tmp.write_text(json.dumps(meta_of(spec), indent=2) + "\n", "utf-8")
                 os.replace(tmp, meta_path)
-        with _writing(folder / CASES, "the sweep results"):
+        with writing(folder / CASES, "the sweep results"):
             self._cut_torn_line(folder / CASES)
         # each line whole and fsynced before the next case counts as done
         self._f = LineFile(folder / CASES, "the sweep results", fresh=False, sync=True,
@@ -143,7 +141,7 @@ class ResultStore:
         scen, robot = stem.with_suffix(".toml"), Path(f"{stem}.robot.toml")
         cmd = f"stairbot run --scenario {scen}"
         if case.config_text is not None:
-            with _writing(robot, "a failing case's robot config"):
+            with writing(robot, "a failing case's robot config"):
                 robot.write_text(case.config_text, "utf-8")
             cmd += f" --config {robot}"
         f = case.facts
@@ -160,21 +158,12 @@ class ResultStore:
         text = header_comment(header) + case.scenario_text
         if expect:
             text += "\n" + tomlw.dumps({"expect": expect})
-        with _writing(scen, "a failing case's scenario"):
+        with writing(scen, "a failing case's scenario"):
             scen.write_text(text, "utf-8")
         return cmd
 
     def close(self) -> None:
         self._f.close()
-
-
-@contextmanager
-def _writing(path: Path, what: str) -> Iterator[None]:
-    """OSError from writing ``path`` as OutputError naming it (a full disk)."""
-    try:
-        yield
-    except OSError as exc:
-        raise OutputError(shown(path), what, exc.strerror or str(exc)) from None
 
 
 def header_comment(text: str) -> str:

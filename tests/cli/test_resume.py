@@ -123,12 +123,8 @@ def test_a_resume_on_boards_that_restarted_is_refused(
     url, proc = boards
     journal = tmp_path / "run.jsonl"
     kill_mid_lift(url, journal, env, tmp_path)
-    proc.send_signal(signal.SIGINT)  # the boards go away (how fast is not this test's)
-    try:
-        proc.wait(30)
-    except subprocess.TimeoutExpired:  # once in CI under load: not gone after 10 s
-        proc.kill()
-        proc.wait()
+    proc.send_signal(signal.SIGINT)
+    proc.wait(10)
     again = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=tmp_path)
     assert again.stdout is not None
     url2 = again.stdout.readline().strip()
