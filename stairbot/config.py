@@ -144,15 +144,17 @@ class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     default_robot.toml."""
 
     imu: bool
-    """The sensor board has an IMU: without one in a snapshot (or with a stale
-    one) the robot stops.  False: tilt is not watched, and the run says so."""
+    """The sensor board has an IMU: without one in a snapshot the robot stops
+    (with a stale one it stands until a fresh one comes, for at most the
+    sensor wait).  False: tilt is not watched, and the run says so."""
     max_pitch_deg: Annotated[float, msgspec.Meta(gt=0, le=30)]
     max_roll_deg: Annotated[float, msgspec.Meta(gt=0, le=30)]
     """Tilt beyond which every motor stops and the lifts hold (either sign)."""
     max_rate_dps: Annotated[float, msgspec.Meta(gt=0, le=1000)]
     """Pitch or roll rate beyond which every motor stops, degrees per second."""
     imu_max_age_s: Annotated[float, msgspec.Meta(gt=0, le=1)]
-    """An IMU reading older than this counts as missing."""
+    """An IMU reading older than this cannot watch tilt: every motor stops
+    until a fresher one comes (stairbot/tilt.py)."""
     stability_margin: Gap
     """Metres the centre of mass must stay inside the wheels that carry the
     robot while a lift moves."""

@@ -3,7 +3,8 @@ believes, and names what is wrong.
 
 It watches the robot's tilt (:mod:`stairbot.tilt`: the IMU's pitch, roll and
 their rates against ``[safety]``, and an IMU that is declared but missing or
-stale), and a stalled motor: one commanded to turn that does not (a wheel
+not a number; a stale one the controller holds on, as on a stale sensor),
+and a stalled motor: one commanded to turn that does not (a wheel
 against an obstacle, a jammed lift, a dead encoder).  Tipping on, or
 grinding on, helps nothing and may break something: the program ends with an
 error and every motor stops, lifts holding.

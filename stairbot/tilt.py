@@ -5,9 +5,16 @@ or roll is beyond the config's limit (``[safety] max_pitch_deg``,
 ``max_roll_deg``), or turning faster than ``max_rate_dps``: well before the
 robot tips over, and whatever the phase believes.  When in doubt it stops as
 well: a robot whose config declares an IMU (``[safety] imu = true``) and
-whose snapshot has none, or one older than ``imu_max_age_s``, or one that is
-not a number, cannot be watched.  A robot declared without an IMU is not
-watched at all, and :attr:`TiltWatch.watched` says so (the run tells it).
+whose snapshot has none, or one that is not a number, cannot be watched
+(:meth:`TiltWatch.check`: the program ends).  An IMU reading older than
+``imu_max_age_s`` cannot be watched either (:meth:`TiltWatch.stale`): the
+controller treats it as it treats a stale distance sensor -- every motor
+stops at once, the lifts hold, the timers stand, and the run goes on only
+when a fresh reading comes back within the sensor wait (the program ends
+otherwise).  One reply delayed on the wire then costs a pause of a tick or
+two, not the run; the robot never moves on an IMU reading older than the
+limit.  A robot declared without an IMU is not watched at all, and
+:attr:`TiltWatch.watched` says so (the run tells it).
 
 Pure Python, on the controller's clock (the snapshots' times).
 """
@@ -20,6 +27,7 @@ from stairbot.config import Safety
 from stairbot.hardware import Imu, Snapshot
 
 STOPPED = "every motor stopped, lifts holding"
+_INF = math.inf
 
 
 class TiltWatch:
@@ -43,7 +51,9 @@ class TiltWatch:
                 f"newer than {s.imu_max_age_s:g} s")
 
     def check(self, snap: Snapshot) -> str | None:
-        """A reason to stop the robot now, or None."""
+        """A reason to end the run and stop the robot now, or None.  An IMU
+        reading's age is not looked at here (:meth:`stale`); a stale reading
+        beyond a limit is still a reason: the robot was there."""
         s = self.safety
         if not s.imu:
             return None
@@ -51,7 +61,7 @@ class TiltWatch:
         if imu is not None and abs(imu.pitch_deg) <= s.max_pitch_deg \
                 and abs(imu.roll_deg) <= s.max_roll_deg \
                 and abs(imu.pitch_rate_dps) <= s.max_rate_dps \
-                and abs(imu.roll_rate_dps) <= s.max_rate_dps and imu.age_s <= s.imu_max_age_s:
+                and abs(imu.roll_rate_dps) <= s.max_rate_dps and -_INF < imu.age_s < _INF:
             return None  # every tick of a normal run: nothing more to look at (NaN fails it)
         if imu is None:
             return ("IMU missing: the robot config declares one ([safety] imu = true) but the "
@@ -60,9 +70,6 @@ class TiltWatch:
             return (f"IMU error: it reports pitch {imu.pitch_deg}°, roll {imu.roll_deg}°, "
                     f"rates {imu.pitch_rate_dps}/{imu.roll_rate_dps}°/s, age {imu.age_s} s: "
                     f"{STOPPED}")
-        if imu.age_s > s.imu_max_age_s:
-            return (f"IMU stale: its reading is {imu.age_s:.3f} s old (limit "
-                    f"{s.imu_max_age_s:g} s), so tilt cannot be watched: {STOPPED}")
         for name, value, limit, unit, sides in (
             ("pitch", imu.pitch_deg, s.max_pitch_deg, "°", ("nose up", "nose down")),
             ("roll", imu.roll_deg, s.max_roll_deg, "°", ("right side down", "left side down")),
@@ -75,6 +82,17 @@ class TiltWatch:
                 return (f"tilt: segment 2's {name} is {value:+.1f}{unit} ({side}), beyond the "
                         f"limit ±{limit:g}{unit}: {STOPPED}")
         return None
+
+
+    def stale(self, snap: Snapshot) -> str | None:
+        """Why tilt cannot be watched on this snapshot's IMU reading, older
+        than ``imu_max_age_s`` (a reason to hold, not to end: the module
+        header), or None.  A missing or broken IMU is :meth:`check`'s."""
+        s, imu = self.safety, snap.imu
+        if not s.imu or imu is None or not imu.age_s > s.imu_max_age_s:
+            return None
+        return (f"IMU stale (tilt cannot be watched): its reading is {imu.age_s:.3f} s old "
+                f"(limit {s.imu_max_age_s:g} s)")
 
 
 def _finite(imu: Imu) -> bool:

@@ -115,6 +115,7 @@ class Controller:
         self._timeout = phase_timeout_s(config)
         self._perception = Perception(config)
         self._supervisor = Supervisor(config)
+        self._tilt = self._supervisor.tilt
         self._sensor_since: float | None = None
         self._now_key: tuple[str, str | None] | None = None  # see _present
         self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
@@ -262,12 +263,14 @@ class Controller:
 
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
         """While a sensor the phase needs (``needed``) reads as ERROR (it reports
-        errors, or it is stale): every motor stops, the lifts hold, the timers
-        stand, for up to SENSOR_WAIT_S; then the program ends with the error.
-        True while holding."""
+        errors, or it is stale), or the IMU's reading is too old to watch tilt
+        by (:meth:`~stairbot.tilt.TiltWatch.stale`): every motor stops, the
+        lifts hold, the timers stand, for up to SENSOR_WAIT_S; then the program
+        ends with the error.  True while holding."""
         ctx = self._ctx
         errors = motion.sensor_errors(snap, needed)
-        if not errors:
+        imu = self._tilt.stale(snap)
+        if not errors and imu is None:
             if self._sensor_since is not None:
                 held = snap.time_s - self._sensor_since
                 self._shift_timers(held)
@@ -275,13 +278,15 @@ class Controller:
                 self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
                            f"{phase.label}", snap.time_s, {"phase": phase.value})
             return False
-        why = "; ".join(f"{s} {self._perception.why(s) or 'reports an error'}" for s in errors)
+        why = "; ".join([f"{s} {self._perception.why(s) or 'reports an error'}"
+                         for s in errors] + ([imu] if imu is not None else []))
         if self._sensor_since is None:
             self._sensor_since = snap.time_s
             ctx.pauses += 1
             self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
                        f"stopped, lifts holding, waiting up to {SENSOR_WAIT_S:g} s",
-                       snap.time_s, {"resume_phase": phase.value, "sensors": list(errors)})
+                       snap.time_s, {"resume_phase": phase.value, "sensors": list(errors),
+                                         "imu_stale": imu is not None})
             return True
         if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
             return True

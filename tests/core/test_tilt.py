@@ -1,7 +1,8 @@
 """The tilt watch: the supervisor stops the robot on a pitch, a roll or a rate
-beyond [safety]'s limits, on a declared IMU that is missing, stale or not a
-number, and says so; a robot declared without an IMU is never said to be
-watched."""
+beyond [safety]'s limits, on a declared IMU that is missing or not a number,
+and says so; a stale IMU reading holds the robot (every motor stopped) until
+a fresh one comes, for at most the sensor wait; a robot declared without an
+IMU is never said to be watched."""
 
 from __future__ import annotations
 
@@ -68,14 +69,27 @@ def test_at_the_limit_is_not_beyond_it() -> None:
 
 @pytest.mark.parametrize(("imu", "words"), [
     (None, "IMU missing"),
-    (Imu(0.0, 0.0, age_s=0.35), "IMU stale: its reading is 0.350 s old (limit 0.1 s)"),
     (Imu(math.nan, 0.0), "IMU error"),
     (Imu(0.0, 0.0, roll_rate_dps=math.inf), "IMU error"),
+    (Imu(0.0, 0.0, age_s=math.inf), "IMU error"),
 ])
 def test_a_declared_imu_missing_stale_or_broken_stops_the_robot(imu: Imu | None,
                                                                  words: str) -> None:
     reason = TiltWatch(SAFETY).check(snap(imu))
     assert reason is not None and words in reason and "stopped" in reason
+
+
+def test_a_stale_imu_reading_is_a_reason_to_hold_not_to_end() -> None:
+    watch, s = TiltWatch(SAFETY), SAFETY
+    old = snap(Imu(2.0, 0.0, age_s=0.35))
+    assert watch.check(old) is None
+    assert watch.stale(old) == ("IMU stale (tilt cannot be watched): its reading is 0.350 s "
+                                "old (limit 0.1 s)")
+    assert watch.stale(snap(Imu(2.0, 0.0, age_s=s.imu_max_age_s))) is None  # at the limit
+    assert watch.stale(snap(None)) is None  # missing: check's, an end
+    # beyond a limit, however old: the robot was there
+    assert "pitch is +16.0°" in str(watch.check(snap(Imu(16.0, 0.0, age_s=0.35))))
+    assert TiltWatch(without_imu().safety).stale(old) is None
 
 
 def test_without_a_declared_imu_nothing_is_watched_and_it_says_so() -> None:
@@ -120,6 +134,39 @@ def test_an_imu_that_stops_answering_stops_the_robot() -> None:
     robot.imu = None
     run(ctrl, robot)
     assert "IMU missing" in str(ctrl.result.error)
+    assert_stopped_for_good(ctrl, robot)
+
+
+def test_a_stale_imu_stops_every_motor_at_once_and_the_run_goes_on_when_it_is_fresh(
+        ) -> None:
+    ctrl, robot, events = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_DRIVE_SECOND)
+    assert any(v != 0.0 for v in ctrl.tick(robot.read()).values())  # it was moving
+    fresh, robot.imu = robot.imu, Imu(0.0, 0.0, age_s=0.12)
+    for _ in range(3):  # three ticks on a reading too old to watch tilt by
+        assert ctrl.tick(robot.read()) == dict.fromkeys(MotorId, 0.0)
+        robot.advance(TICK)
+    assert not ctrl.finished and ctrl.phase is Phase.ASCENT_DRIVE_SECOND
+    held = [e for e in events if e.kind is EventKind.PAUSE]
+    assert len(held) == 1 and "IMU stale (tilt cannot be watched)" in held[0].message
+    assert "all motors stopped, lifts holding" in held[0].message
+    assert held[0].data["imu_stale"] is True
+    robot.imu = fresh
+    run(ctrl, robot)
+    assert ctrl.result.outcome == "completed", ctrl.result.error
+    assert ctrl.result.pauses >= 1
+    assert any(e.kind is EventKind.RESUME and "sensors back" in e.message for e in events)
+
+
+def test_an_imu_stale_for_longer_than_the_sensor_wait_ends_the_run() -> None:
+    ctrl, robot, _ = start()
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_LIFT_FIRST)
+    robot.imu = Imu(0.0, 0.0, age_s=0.5)
+    sent = run(ctrl, robot, max_time=robot.t + 5.0)
+    assert all(v == 0.0 for speeds in sent for v in speeds.values())
+    assert ctrl.result.outcome == "error"
+    assert "IMU stale (tilt cannot be watched)" in str(ctrl.result.error)
+    assert "for 1 s in ascent" in str(ctrl.result.error)
     assert_stopped_for_good(ctrl, robot)
 
 
