@@ -8,8 +8,9 @@ For each run: ``stairbot fake-boards --can udp_multicast/GROUP --time-scale X``
 (real time, scaled: not lockstep), ``python -m can.logger -i udp_loopback -c
 GROUP -f run-N.log`` (stairbot registers its loopback bus with python-can as
 the interface ``udp_loopback``), then ``stairbot run --robot URL --json``.
-Prints one line a run -- outcome, steps, fell, wall time, what the link
-counted, frames the logger wrote and how many of them the shipped DBC
+Prints one line a run -- outcome, steps, fell, wall time, the holds (the
+robot stood, every motor stopped, for a stale sensor or IMU reading: a late
+reply), what the link counted, frames the logger wrote and how many of them the shipped DBC
 (stairbot/drivers/stairbot.dbc, via cantools with the frame id mask
 0x1FFC0000: a frame's id carries the host's session and seq below its base)
 cannot decode -- and the count
@@ -95,7 +96,8 @@ def one_run(n: int, scale: float, folder: Path) -> tuple[bool, str]:
     counts = " ".join(f"{k} {link[k]}" for k in keys if k in link)
     ok = r["outcome"] == "completed" and not r["fell"] and frames > 0 and unknown == 0
     return ok, (f"run {n:2}: {r['outcome']:9} up {r['steps_climbed']} down "
-                f"{r['steps_descended']} fell {r['fell']!s:5} {wall:5.1f} s  {counts}  "
+                f"{r['steps_descended']} fell {r['fell']!s:5} {wall:5.1f} s  "
+                f"holds {r.get('pauses', 0)}  {counts}  "
                 f"logged {frames} frames, {unknown} unknown to the DBC"
                 + (f"  error: {r['error']}" if r.get("error") else ""))
 
