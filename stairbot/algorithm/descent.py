@@ -25,6 +25,7 @@ from stairbot.algorithm.moves import (
 )
 from stairbot.algorithm.phase import (
     FAULT,
+    NO_MOTION,
     PhaseDef,
     Step,
     Tick,
@@ -65,7 +66,7 @@ def _back_off_enter(t: Tick, w: Work) -> None:
 
 _back_off_drive = reading_drive(-1, lambda _t: None,
                                 lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
-                                _backed_off, lambda t, _w: _edge_bound(t))
+                                _backed_off, lambda t, w: _edge_bound(t, w, refind=False))
 BACK_OFF = PhaseDef(
     P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW, _back_off_drive[1],
     enter=_back_off_enter, watches="front",
@@ -122,6 +123,15 @@ def edge_drop_m(cfg: RobotConfig) -> float:
     return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + cfg.min_step_rise_m / 2
 
 
+def edge_lag_s(cfg: RobotConfig) -> float:
+    """How long after the back pair crosses an edge perception reports the
+    drop: the sensor's latency, then the median's majority of the window,
+    one period each, the first of them half a period after the crossing on
+    average."""
+    return cfg.sensors.spec(True).latency_s \
+        + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
+
+
 def edge_sight_m(cfg: RobotConfig, speed_mps: float) -> float:
     """How far past an edge the back pair's sensors are when perception first
     reports the drop, backing at ``speed_mps``: the distance backed while
@@ -134,16 +144,29 @@ def edge_sight_m(cfg: RobotConfig, speed_mps: float) -> float:
     the drop 2.4 cm past the edge; backing edge_clearance_m from there, the
     sonar robot tipped back (the envelope sweep, case 925)."""
     spec = cfg.sensors.spec(True)
-    period = measurement_period(cfg, True)
-    lag_s = spec.latency_s + (window(cfg, True) // 2 + 0.5) * period
-    sight = abs(speed_mps) * lag_s
+    sight = abs(speed_mps) * edge_lag_s(cfg)
     if spec.first_echo:
         fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
         sight += edge_drop_m(cfg) * math.sin(math.radians(fov) / 2)
     return sight
 
 
-def _edge_bound(t: Tick) -> float | None:
+EDGE_GAP_TICKS = 2.5
+"""The edge watch missed a stretch when two of its ticks are further apart
+than this many control ticks."""
+REFIND_TICKS = 3
+"""Finding the floor again: ticks in a row the back pair must read it."""
+
+
+def _sees_drop(t: Tick) -> bool:
+    """The back pair reads past an edge: more than edge_drop_m, or nothing in range."""
+    cfg, drop = t.cfg, edge_drop_m(t.cfg)
+    return all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
+               or r.ok and r.distance_m > drop
+               for r in (t.snap.sensors[s] for s in BACK_SENSORS))
+
+
+def _edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
     """Descent 1's backing (backing off, and backing up to the edge) never
     passes edge_clearance_m beyond where the back pair saw the drop (more
     than half the lowest rise below BACK_CLEARANCE, or nothing in range):
@@ -151,13 +174,42 @@ def _edge_bound(t: Tick) -> float | None:
     and the robot tipped back where it was; and on a tread little longer
     than the robot, backing off the seed's approach turns already takes
     segment 3 past the edge (the envelope sweep: the reference robot tipped back
-    backing up to the edge after that)."""
+    backing up to the edge after that).
+
+    Where the pair crossed is worked out only from a crossing the watch saw
+    as it happened: the pair read the floor on a tick of this phase, then
+    the drop, with no stretch between missed.  Otherwise -- the pair already
+    past the edge when the phase began (it crossed as the back-off ended,
+    or while calibration turned), or a tick came late (a stalled host: the
+    robot ran on unwatched) -- where it crossed is not known: the back-off
+    ends where it is, and backing up to the edge first drives forward until
+    the pair reads the floor again (``refind``: :func:`_refind`).  Placed
+    at the tick that saw the drop, with the robot standing, the crossing
+    was put 0 mm behind the pair, and backing the whole clearance from
+    there tipped the robot back (``benchmarks/soak_host_stalls.py``, seed 19:
+    +15.8 deg)."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.edge_wheel is None:
-        backs = [t.snap.sensors[s] for s in BACK_SENSORS]
-        drop = edge_drop_m(cfg)
-        if all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
-               or r.ok and r.distance_m > drop for r in backs):
+        now = t.snap.time_s
+        if w.edge_watch_s is not None \
+                and now - w.edge_watch_s > EDGE_GAP_TICKS * cfg.algorithm.tick:
+            # a stretch unwatched: the floor read before it no longer counts,
+            # nor one read until perception's lag has passed
+            w.edge_floor_s = None
+            w.edge_blind_until = now + edge_lag_s(cfg) + measurement_period(cfg, True)
+        w.edge_watch_s = now
+        if not _sees_drop(t):
+            if w.edge_blind_until is None or now > w.edge_blind_until:
+                w.edge_floor_s = now
+        elif w.edge_floor_s is None:
+            if refind:
+                w.refind_from = motion.wheel_position(t.snap)
+                w.refind_floor = 0
+                t.say("SBR/SBL read past the edge, but they were not seen crossing it: "
+                      "driving forward until they read the floor again")
+                return None
+            return motion.wheel_position(t.snap)  # the back-off ends here
+        else:
             speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
             sight = edge_sight_m(cfg, speed * cfg.wheel_circumference)
             # where they crossed it: behind the robot's back (backing, the
@@ -177,13 +229,55 @@ def _edge_bound(t: Tick) -> float | None:
 # on the edge's corner, and lowered, segment 3 stayed up while the lift
 # pitched the robot (the envelope sweep, case 781 on ir).
 _to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD),
-                         lambda t, _w: _edge_bound(t), exact=True)
+                         lambda t, w: _edge_bound(t, w, refind=True), exact=True)
+
+
+def refind_max_m(cfg: RobotConfig) -> float:
+    """The farthest finding the floor again drives forward: back over the
+    whole clearance, what the pair's lag may have carried it past, and 2 cm."""
+    return edge_clearance_m(cfg) + edge_sight_m(cfg, cfg.wheel_speed_m_s) + 0.02
+
+
+def _refind(t: Tick, w: Work) -> Step:
+    """Drive forward until the back pair reads the floor again (REFIND_TICKS
+    ticks in a row, and at least as far as its lag carries the robot at full
+    speed), then back up to the edge, the watch seeing it cross."""
+    cfg = t.cfg
+    assert w.refind_from is not None
+    driven_m = (motion.wheel_position(t.snap) - w.refind_from) * cfg.wheel_circumference
+    w.refind_floor = 0 if _sees_drop(t) else w.refind_floor + 1
+    if w.refind_floor >= REFIND_TICKS and driven_m >= edge_sight_m(cfg, cfg.wheel_speed_m_s):
+        t.say(f"SBR/SBL read the floor again {driven_m * 1000:.0f} mm forward: backing up "
+              "to the edge")
+        w.refind_from, w.edge_blind_until = None, None
+        w.edge_watch_s = w.edge_floor_s = t.snap.time_s
+        return stay(NO_MOTION)
+    most = refind_max_m(cfg)
+    if driven_m >= most:
+        return fail(f"descent 1: SBR/SBL still read past the edge after driving "
+                    f"{driven_m * 1000:.0f} mm forward to find the floor again (at most "
+                    f"{most * 1000:.0f} mm): the edge of the step cannot be found")
+    return stay(motion.drive(cfg, 1, cfg.wheel_turns(most - driven_m)))
+
+
+def _to_edge_step(t: Tick, w: Work) -> Step:
+    if w.refind_from is None:
+        step = _to_edge[1](t, w)
+        if w.refind_from is None:
+            return step
+        # the watch found the pair past an edge it did not see crossed: this
+        # tick's step (which may have ended the backing) is not taken
+    return _refind(t, w)
+
+
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
-    checked_first(_edge_known, _to_edge[1]), enter=_to_edge[0], watches="front",
+    checked_first(_edge_known, _to_edge_step), enter=_to_edge[0], watches="front",
     to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
-                                "edge; or, not crossed yet, reads tab_length_to_edge[i]",
-        P.ERROR: "tab_length_to_edge[i] unknown; " + FAULT})
+                                "edge (driving forward first until they read the floor, "
+                                "if they were past it unseen); or, not crossed yet, reads "
+                                "tab_length_to_edge[i]",
+        P.ERROR: "tab_length_to_edge[i] unknown; the floor not found again; " + FAULT})
 
 
 # -- descent 2: lower segment 3 until the back sensors find the step below ------------------------

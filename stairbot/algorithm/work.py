@@ -73,6 +73,21 @@ class Work:
     rest of the lowering goes by turns to ``target_mtb``."""
     balanced: bool = False
     """The static-stability check has run (before a lift phase's first step)."""
+    edge_watch_s: float | None = None
+    """Descent 1's edge watch: the last tick it looked at the back pair."""
+    edge_floor_s: float | None = None
+    """The last tick the back pair read the floor while the watch looked (None:
+    not in this phase, or not since it missed a stretch): a crossing is
+    placed only after one."""
+    edge_blind_until: float | None = None
+    """After a stretch the watch missed (a tick that came late, a hold), what
+    perception says of the pair until then still comes from measurements
+    taken in it: a floor read before then does not count."""
+    refind_from: float | None = None
+    """Descent 1, backing up to the edge: the odometer where the robot began
+    driving forward to find the floor again (None: not doing that)."""
+    refind_floor: int = 0
+    """Ticks in a row the back pair has read the floor on that drive."""
 
     @classmethod
     def at_entry(cls, snap: Snapshot) -> Work:
