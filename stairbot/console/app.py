@@ -90,6 +90,8 @@ class StairbotConsole(App[None]):
 
     CSS_PATH = "console.tcss"
     TITLE = "stairbot console"
+    replaying = False
+    """A recording played back (console/replay_app.py), not a robot."""
     # The footer shows what an operator needs at once, and fits 80 columns;
     # ? (the help screen) and ctrl+p list every key.
     BINDINGS = [
@@ -155,6 +157,10 @@ class StairbotConsole(App[None]):
                 yield self.link
         yield Footer(compact=True)
 
+    def picture_note(self) -> str:
+        """What the picture says when there is no pose to draw."""
+        return ""
+
     def top_right(self) -> Widget:
         """What stands beside the banner: the emergency stop button."""
         return EStopButton(id="estop")
@@ -178,11 +184,17 @@ class StairbotConsole(App[None]):
             self._shown_key = None  # draw them now
 
     def on_mount(self) -> None:
-        self.lay_out_graphs()
         # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):
         # the robot stops first, then the console asks, as for Ctrl-C typed.
         with contextlib.suppress(ValueError):  # not the main thread: left as it is
             self._sigint = signal.signal(signal.SIGINT, self._on_sigint)
+        self.lay_out_graphs()
+        self.begin()
+
+    def begin(self) -> None:
+        """Once mounted: record if asked, redraw ten times a second, open the
+        robot and read it while idle.  (A subclass replaces this, not
+        ``on_mount``: Textual calls every class's ``on_mount``.)"""
         if self._record:
             self._start_recording(self._record)
         self.refresh_view()
@@ -215,8 +227,8 @@ class StairbotConsole(App[None]):
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
             per_turn = self.engine.config.motors.lift_travel_per_turn
             lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
-        scene, note = v.scene, ""
-        if v.wired and scene is None:
+        scene, note = v.scene, self.picture_note() if v.scene is None else ""
+        if v.wired and scene is None and not self.replaying:
             scenario = self.engine.scenario
             if snap is not None and v.stairs and scenario is not None:
                 scene = dead_reckon(snap, v.stairs, self.engine.config, scenario.start.distance)
@@ -224,11 +236,12 @@ class StairbotConsole(App[None]):
             else:
                 note = "no pose from a wired robot"
         picture.show(scene, v.stairs, lifts, note)
-        running = v.status.robot == "running"
+        running = v.status.robot in ("running", "replay")  # a replay: the recorded phase
         self.sensors.show(snap, age)
         self.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
         self.phase.show(v.phase, v.flow, v.context, v.phase_id)
-        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age)
+        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age,
+                       replay=self.replaying)
         if self.trends.display:
             self.trends.show(v.history, age)
         if v.events:
