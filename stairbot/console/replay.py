@@ -54,7 +54,8 @@ class ReplayPlayer:
         self.rewinds = 0
         """How many times the state was emptied to play again from the start
         (a seek back): the event list the screen shows must be emptied too."""
-        self.state = LiveState(url=self.robot_name, scenario=source.scenario,
+        self._part = 0  # the part (robot) the state was last named after
+        self.state = LiveState(url=self.robot_name, scenario=source.parts[0].scenario,
                                wall=self.now)
         self._ticks_done = 0  # ticks written into the state (the first ones)
         self._events_done = 0
@@ -64,8 +65,24 @@ class ReplayPlayer:
 
     @property
     def robot_name(self) -> str:
-        """What the recording says of its robot, never as a live one."""
-        return f"recorded on {self.source.url}" if self.source.url else "recorded"
+        """What the recording says of its robot (the part playing), never as a
+        live one."""
+        url = self.source.parts[self._part].url
+        return f"recorded on {url}" if url else "recorded"
+
+    def part_line(self) -> str:
+        """``recorded on sim://, default``, and for a recording of several
+        robots which one plays and where its own clock stands."""
+        parts, i = self.source.parts, self.source.part_at(self.position)
+        part = parts[i]
+        out = self.robot_name if i == self._part else (
+            f"recorded on {part.url}" if part.url else "recorded")
+        if part.scenario:
+            out += f", {part.scenario}"
+        if len(parts) > 1:
+            clock = self.position - part.start_s + (part.first_t or 0.0)
+            out += f" · robot {i + 1} of {len(parts)} (its clock {clock:.1f} s)"
+        return out
 
     def now(self) -> float:
         """The position, in the recording's robot time (the values' ages go by it)."""
@@ -121,11 +138,12 @@ class ReplayPlayer:
     def _reset(self) -> None:
         """An empty state, as before the recording's first tick."""
         self.rewinds += 1
-        src = self.source
-        wired = bool(src.url) and not src.url.startswith("sim://") \
-            or src.pose_topic == DeadReckonedPose.topic
+        self._part = 0
+        part = self.source.parts[0]
+        wired = bool(part.url) and not part.url.startswith("sim://") \
+            or part.pose_topic == DeadReckonedPose.topic
         self.state.clear_events()
-        self.state.set_robot(self.robot_name, src.scenario, not wired, src.stairs,
+        self.state.set_robot(self.robot_name, part.scenario, not wired, part.stairs,
                              wired=wired)
         self._ticks_done = self._events_done = 0
 
@@ -138,6 +156,11 @@ class ReplayPlayer:
         if done > self._ticks_done:
             first = max(self._ticks_done, src.tick_index(self.position - WINDOW_S))
             commanded, framed = None, None
+            last = src.ticks[done - 1].part
+            if last != self._part:  # another robot of the recording: its name
+                self._part = last
+                part = src.parts[last]
+                self.state.rename(self.robot_name, part.scenario, part.stairs)
             for tick in src.ticks[first:done]:
                 if tick.snapshot is not None:
                     state.on_read(tick.snapshot, at=tick.time_s)
@@ -146,7 +169,7 @@ class ReplayPlayer:
                     framed = tick
             state.on_command(commanded or {})
             if framed is not None:
-                scene = scene_of(framed, src.stairs, self.config)
+                scene = scene_of(framed, src.parts[framed.part].stairs, self.config)
                 if scene is not None:
                     state.on_scene(scene)
             self._ticks_done = done

@@ -114,7 +114,7 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
     )
 
     def __init__(self, player: ReplayPlayer, engine: ConsoleEngine) -> None:
-        super().__init__(engine, player.robot_name, player.source.scenario)
+        super().__init__(engine, player.robot_name, player.source.parts[0].scenario)
         self.player = player
         self._rewinds = player.rewinds
         self.title = f"stairbot replay · {player.source.path}"
@@ -154,9 +154,8 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
         and what the recording lacks."""
         src = self.player.source
         parts = [self.player.line(), src.path]
-        if src.url:
-            parts.append(f"recorded on {src.url}" + (f", {src.scenario}" if src.scenario
-                                                      else ""))
+        if src.kind == "mcap":
+            parts.append(self.player.part_line())
         if src.kind == "jsonl":
             parts.append("JSON lines: events only, no sensor or motor values")
         if not src.complete:

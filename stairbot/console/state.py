@@ -117,6 +117,12 @@ class LiveState:
             self._history.clear()
             self._bump()
 
+    def rename(self, url: str, scenario: str, stairs: tuple[tuple[float, float], ...]) -> None:
+        """Name another robot, keeping what was read (a replay's next part)."""
+        with self._lock:
+            self._url, self._scenario, self._stairs = url, scenario, stairs
+            self._bump()
+
     def set_status(self, *, robot: str | None = None, estopped: bool | None = None,
                    paused: bool | None = None, message: str | None = None,
                    severity: str | None = None, latch: str | None = None) -> None:

@@ -60,6 +60,10 @@ MCAP_SUFFIXES = (".mcap",)
 JSONL_SUFFIXES = (".jsonl", ".ndjson")
 ALLOWED = ("allowed: FILE.mcap (stairbot run --record FILE.mcap, or the console's w) "
            "or FILE.jsonl (a JSON-lines record)")
+PART_GAP_S = 0.001
+"""On the replay's timeline a robot's part starts this long after the one
+before ends (the time that passed between them is not recorded; the gap
+keeps the two apart: no time holds a tick of each)."""
 FLOOR_TOP_M = 0.0021
 """A block of the /scene stairs this low is the floor (drawn 2 mm thick)."""
 
@@ -85,16 +89,46 @@ class Tick:
     motor messages were lost (a file cut short inside the cycle)."""
 
     time_s: float
+    """On the replay's timeline (the robot's clock, shifted for a later part)."""
     snapshot: Snapshot | None
     commanded: dict[MotorId, float] | None
     """The speeds commanded (None: nothing was sent, or not recorded)."""
     frames: tuple[SegmentFrame, ...] = ()
     """Segments 1..3, front to back (empty: no pose recorded)."""
+    part: int = 0
+    """The robot it came from (:attr:`ReplaySource.parts`)."""
+
+
+@dataclass
+class Part:
+    """One robot of a recording.  A console records across robots (a reset,
+    another URL: each a ``/scene`` of its own), and each robot's clock is its
+    own: a reset simulation starts at 0 again.  The replay's timeline plays
+    the parts one after another (:data:`PART_GAP_S` apart): a part's robot
+    time ``t`` is at ``start_s + t - first_t`` on it (the first part: at
+    ``t`` itself)."""
+
+    url: str = ""
+    scenario: str = ""
+    pose_topic: str = ""
+    stairs: tuple[Point, ...] = ()
+    start_s: float = 0.0
+    first_t: float | None = None
+    """The robot time of its first message (None: none yet)."""
+    last_t: float = 0.0
+
+    def timeline(self, robot_s: float) -> float:
+        """Where robot time ``robot_s`` of this part is on the replay's timeline."""
+        return self.start_s + robot_s - (robot_s if self.first_t is None else self.first_t)
+
+    @property
+    def end_s(self) -> float:
+        return self.timeline(self.last_t)
 
 
 @dataclass
 class ReplaySource:
-    """Everything a replay plays, in time order."""
+    """Everything a replay plays, in time order on the replay's timeline."""
 
     path: str
     kind: str
@@ -105,10 +139,7 @@ class ReplaySource:
     """False: the file was cut short (read up to where it ends)."""
     config: RobotConfig | None
     """The robot config the recording was made with (None: not in it)."""
-    url: str = ""
-    scenario: str = ""
-    pose_topic: str = ""
-    stairs: tuple[Point, ...] = ()
+    parts: list[Part] = field(default_factory=lambda: [Part()])
     notes: list[str] = field(default_factory=list)
     """What could not be read, said once to the operator."""
 
@@ -131,6 +162,10 @@ class ReplaySource:
     def event_index(self, time_s: float) -> int:
         """How many events are at or before ``time_s``."""
         return bisect_right(_Times(self.events), time_s)
+
+    def part_at(self, time_s: float) -> int:
+        """The part playing at ``time_s`` on the timeline."""
+        return max(0, bisect_right([p.start_s for p in self.parts[1:]], time_s))
 
 
 class _Times(Sequence[float]):
@@ -165,7 +200,7 @@ def load_replay(path: str | os.PathLike[str]) -> ReplaySource:
         if not mcap:
             raise RecordingError(name, None, f"named .mcap but not an MCAP file (it does not "
                                  f"begin as one); {ALLOWED}")
-        return _load_mcap(name, data)
+        return _Loader(name).load(data)
     if mcap:
         raise RecordingError(name, None, "an MCAP file named as JSON lines; name it .mcap")
     rec = read_jsonl(name, data)
@@ -173,7 +208,7 @@ def load_replay(path: str | os.PathLike[str]) -> ReplaySource:
     return ReplaySource(name, "jsonl", [], events, rec.complete, None)
 
 
-def _event(raw: dict[str, Any]) -> Event:
+def _event(raw: dict[str, Any], shift: Callable[[float], float] = float) -> Event:
     kind_text = str(raw.get("kind"))
     message = str(raw.get("message", ""))
     try:
@@ -182,103 +217,133 @@ def _event(raw: dict[str, Any]) -> Event:
         kind, message = EventKind.INFO, f"({kind_text}) {message}"
     data = raw.get("data")
     phase = raw.get("phase")
-    return Event(float(raw["time_s"]), kind, message,
+    return Event(shift(float(raw["time_s"])), kind, message,
                  phase if isinstance(phase, str) else None,
                  data if isinstance(data, dict) else {})
 
 
 @dataclass
-class _Partial:
+class _TickParts:
     """The messages of one tick as they come (one log time)."""
 
     time_s: float
+    part: int
     sensors: dict[str, Any] | None = None
     motors: dict[str, Any] | None = None
     health: dict[str, float] = field(default_factory=dict)
     frames: tuple[SegmentFrame, ...] = ()
 
 
-def _load_mcap(name: str, data: bytes) -> ReplaySource:
-    partials: dict[int, _Partial] = {}
-    events: list[Event] = []
-    blocks: list[tuple[float, float, float]] = []
-    unreadable: dict[str, int] = {}
+class _Loader:
+    """An MCAP recording's messages, in file order, filed into ticks, events
+    and parts."""
 
-    def take(channel: Any, message: Any, decoder: Callable[[bytes], Any] | None,
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.parts = [Part()]
+        self.ticks: dict[tuple[int, int], _TickParts] = {}
+        self.events: list[Event] = []
+        self.unreadable: dict[str, int] = {}
+
+    def load(self, data: bytes) -> ReplaySource:
+        scan = scan_mcap(self.name, data, self.take)
+        ticks = [_tick(t, self.parts[t.part]) for _, t in sorted(self.ticks.items())]
+        source = ReplaySource(self.name, "mcap", ticks,
+                              sorted(self.events, key=lambda e: e.time_s), scan.complete, None,
+                              self.parts)
+        for topic, n in sorted(self.unreadable.items()):
+            source.notes.append(f"{n} unreadable message{'s' if n > 1 else ''} on {topic} "
+                                "skipped")
+        raw_config = scan.attachments.get("robot_config.json")
+        if raw_config is not None:
+            try:
+                source.config = recorded_config(raw_config, self.name)
+            except (RecordingError, ValueError, KeyError, TypeError, AttributeError) as exc:
+                source.notes.append(f"the recording's robot config cannot be read ({exc})")
+        else:
+            source.notes.append("the recording holds no robot config")
+        return source
+
+    def take(self, channel: Any, message: Any, decoder: Callable[[bytes], Any] | None,
              metadata: dict[str, dict[str, str]]) -> None:
         topic = channel.topic
         try:
-            _take(topic, message, decoder, metadata, partials, events, blocks)
+            self._take(topic, message, decoder, metadata)
         except (ValueError, KeyError, TypeError, AttributeError):
-            unreadable[topic] = unreadable.get(topic, 0) + 1
+            self.unreadable[topic] = self.unreadable.get(topic, 0) + 1
 
-    scan = scan_mcap(name, data, take)
-    source = ReplaySource(name, "mcap", [_tick(p) for _, p in sorted(partials.items())],
-                          sorted(events, key=lambda e: e.time_s), scan.complete, None)
-    robot = scan.metadata.get("robot", {})
-    source.url, source.scenario = robot.get("url", ""), robot.get("scenario", "")
-    source.pose_topic = robot.get("pose_topic", "")
-    for topic, n in sorted(unreadable.items()):
-        source.notes.append(f"{n} unreadable message{'s' if n > 1 else ''} on {topic} skipped")
-    raw_config = scan.attachments.get("robot_config.json")
-    if raw_config is not None:
-        try:
-            source.config = recorded_config(raw_config, name)
-        except (RecordingError, ValueError, KeyError, TypeError, AttributeError) as exc:
-            source.notes.append(f"the recording's robot config cannot be read ({exc})")
-    else:
-        source.notes.append("the recording holds no robot config")
-    source.stairs = _stairs(blocks)
-    return source
+    def _seen(self, robot_s: float) -> int:
+        """A message of the current part at ``robot_s``: the part's index."""
+        part = self.parts[-1]
+        if part.first_t is None:
+            part.first_t = part.last_t = robot_s
+            if len(self.parts) == 1:
+                part.start_s = robot_s  # the first part: the robot's own clock
+        part.last_t = max(part.last_t, robot_s)
+        return len(self.parts) - 1
 
+    def _take(self, topic: str, message: Any, decoder: Callable[[bytes], Any] | None,
+              metadata: dict[str, dict[str, str]]) -> None:
+        """File one message where the replay looks for it."""
+        if topic == topics.SCENE and decoder is not None:
+            self._scene(decoder(message.data), metadata.get("robot", {}))
+            return
+        if topic == topics.RECORD:
+            raw = json.loads(message.data)
+            self._seen(float(raw["time_s"]))
+            self.events.append(_event(raw, self.parts[-1].timeline))
+            return
+        if topic not in (topics.SENSORS, topics.MOTORS, topics.LINK, *POSE_TOPICS):
+            return
+        origin = int(metadata.get("stairbot", {}).get("time_origin_ns", "0"))
+        robot_s = (message.log_time - origin) / 1e9
+        index = self._seen(robot_s)
+        tick = self.ticks.get((index, message.log_time))
+        if tick is None:
+            tick = self.ticks[index, message.log_time] = _TickParts(robot_s, index)
+        if topic == topics.SENSORS:
+            tick.sensors = json.loads(message.data)
+            tick.time_s = float(tick.sensors["time_s"])
+        elif topic == topics.MOTORS:
+            tick.motors = json.loads(message.data)
+            tick.time_s = float(tick.motors["time_s"])
+        elif topic == topics.LINK:
+            health = json.loads(message.data).get("health") or {}
+            tick.health = {str(k): float(v) for k, v in health.items()
+                           if isinstance(v, int | float)}
+        elif decoder is not None:
+            frames = {}
+            for t in decoder(message.data).transforms:
+                if t.child_frame_id in SEGMENT_FRAMES:
+                    q = (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w)
+                    frames[t.child_frame_id] = SegmentFrame(t.translation.x, t.translation.z,
+                                                            pitch_of(q))
+            if all(f in frames for f in SEGMENT_FRAMES):
+                tick.frames = tuple(frames[f] for f in SEGMENT_FRAMES)
 
-def _take(topic: str, message: Any, decoder: Callable[[bytes], Any] | None,
-          metadata: dict[str, dict[str, str]], partials: dict[int, _Partial],
-          events: list[Event], blocks: list[tuple[float, float, float]]) -> None:
-    """File one message where the replay looks for it."""
-    if topic == topics.RECORD:
-        events.append(_event(json.loads(message.data)))
-        return
-    if topic == topics.SCENE and decoder is not None:
-        for entity in decoder(message.data).entities:
+    def _scene(self, update: Any, robot: dict[str, str]) -> None:
+        """A robot opened (``watch``): its stairs, and a part of its own once
+        the one before holds messages."""
+        part = self.parts[-1]
+        if part.first_t is not None:
+            part = Part(start_s=part.end_s + PART_GAP_S)
+            self.parts.append(part)
+        part.url, part.scenario = robot.get("url", ""), robot.get("scenario", "")
+        part.pose_topic = robot.get("pose_topic", "")
+        for entity in update.entities:
             if entity.id == "stairs":
-                blocks[:] = [(c.pose.position.x - c.size.x / 2, c.pose.position.x + c.size.x / 2,
-                              c.size.z) for c in entity.cubes]
-        return
-    if topic not in (topics.SENSORS, topics.MOTORS, topics.LINK, *POSE_TOPICS):
-        return
-    origin = int(metadata.get("stairbot", {}).get("time_origin_ns", "0"))
-    part = partials.get(message.log_time)
-    if part is None:
-        part = partials[message.log_time] = _Partial((message.log_time - origin) / 1e9)
-    if topic == topics.SENSORS:
-        part.sensors = json.loads(message.data)
-        part.time_s = float(part.sensors["time_s"])
-    elif topic == topics.MOTORS:
-        part.motors = json.loads(message.data)
-        part.time_s = float(part.motors["time_s"])
-    elif topic == topics.LINK:
-        health = json.loads(message.data).get("health") or {}
-        part.health = {str(k): float(v) for k, v in health.items()
-                       if isinstance(v, int | float)}
-    elif decoder is not None:
-        frames = {}
-        for t in decoder(message.data).transforms:
-            if t.child_frame_id in SEGMENT_FRAMES:
-                q = (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w)
-                frames[t.child_frame_id] = SegmentFrame(t.translation.x, t.translation.z,
-                                                        pitch_of(q))
-        if all(f in frames for f in SEGMENT_FRAMES):
-            part.frames = tuple(frames[f] for f in SEGMENT_FRAMES)
+                part.stairs = _stairs([(c.pose.position.x - c.size.x / 2,
+                                        c.pose.position.x + c.size.x / 2, c.size.z)
+                                       for c in entity.cubes])
 
 
-def _tick(part: _Partial) -> Tick:
+def _tick(parts: _TickParts, part: Part) -> Tick:
     snap: Snapshot | None = None
     commanded: dict[MotorId, float] | None = None
-    if part.sensors is not None or part.motors is not None:
-        sensors = _readings(part.sensors or {})
+    if parts.sensors is not None or parts.motors is not None:
+        sensors = _readings(parts.sensors or {})
         motors: dict[MotorId, MotorState] = {}
-        m = part.motors or {}
+        m = parts.motors or {}
         for motor in MotorId:
             entry = m.get(motor.value)
             if isinstance(entry, dict):
@@ -288,8 +353,9 @@ def _tick(part: _Partial) -> Tick:
             commanded = {motor: float(entry["command_tps"]) for motor in MotorId
                          if isinstance(entry := m.get(motor.value), dict)
                          and isinstance(entry.get("command_tps"), int | float)}
-        snap = Snapshot(part.time_s, sensors, motors, part.health, _imu(part.sensors or {}))
-    return Tick(part.time_s, snap, commanded, part.frames)
+        snap = Snapshot(parts.time_s, sensors, motors, parts.health,
+                        _imu(parts.sensors or {}))
+    return Tick(part.timeline(parts.time_s), snap, commanded, parts.frames, parts.part)
 
 
 def _readings(m: dict[str, Any]) -> dict[SensorId, SensorReading]:

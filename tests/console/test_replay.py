@@ -23,11 +23,14 @@ from stairbot.config import load_config
 from stairbot.console.freshness import STALE_S
 from stairbot.console.replay_app import ReplayConsole, build_replay_app
 from stairbot.console.widgets.motors import NAMES as MOTOR_NAMES
+from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.recording import read as read_module
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
-from stairbot.recording.replay_source import load_replay
+from stairbot.recording.pose import DeadReckonedPose
+from stairbot.recording.replay_source import PART_GAP_S, load_replay
+from stairbot.scenario import load_scenario
 
 
 class Clock:
@@ -326,6 +329,53 @@ def test_ages_are_the_recordings_a_gap_shows_stale(tmp_path: Path) -> None:
             await press(pilot, "right")  # 6 s: ticks again
             await until(pilot, lambda: "0.0 s ago" in str(app.sensors.border_title), "fresh")
             assert not app.sensors.has_class("-stale")
+    run(go)
+
+
+def _two_robots(path: Path) -> None:
+    """A console's recording across a reset: two robots, each clock from 0
+    (ticks 0..1 s, SFR 0.3 m and up; then 0..1 s again, SFR 0.5 m and up)."""
+    config, scenario = load_config(None), load_scenario(None)
+    record = McapRecord(path, config)
+    try:
+        for base in (0.3, 0.5):
+            record.watch(DeadReckonedPose(config, scenario), scenario, "sim://")
+            record.write(Event(0.0, EventKind.INFO, f"robot at {base}"))
+            for i in range(51):
+                snap = Snapshot(i * 0.02, {s: SensorReading(base + i / 1000) for s in SensorId},
+                                {m: MotorState(float(i)) for m in MotorId})
+                record.tick(snap, None)
+    finally:
+        record.close()
+
+
+def test_a_recording_of_two_robots_plays_one_after_the_other(tmp_path: Path) -> None:
+    """Finding: the second robot's ticks, at the same clock times as the
+    first's, were merged into them."""
+    path = tmp_path / "two.mcap"
+    _two_robots(path)
+    source = load_replay(path)
+    assert len(source.parts) == 2 and len(source.ticks) == 102
+    assert [t.time_s for t in source.ticks] == sorted(t.time_s for t in source.ticks)
+    assert source.end_s == pytest.approx(2.0 + PART_GAP_S)
+
+    async def go() -> None:
+        app = build_replay_app(source, clock=Clock(), playing=False)
+        async with app.run_test(size=(100, 40)) as pilot:
+            await press(pilot, "right")  # 1 s: the first robot's last tick
+            await until(pilot, lambda: "robot 1 of 2 (its clock 1.0 s)" in app.banner.plain,
+                        "the first robot")
+            assert "SFR 0.350 m" in shown(app.sensors)
+            app.player.seek(source.parts[1].start_s + 0.5)  # the second robot at 0.5 s
+            app.show_player()
+            assert "robot 2 of 2 (its clock 0.5 s)" in app.banner.plain
+            await until(pilot, lambda: "SFR 0.525 m" in shown(app.sensors), "the second robot")
+            snap = app.state.view().snapshot
+            assert snap is not None and snap.time_s == pytest.approx(0.5)
+            # the graphs start again with the second robot's clock
+            await until(pilot, lambda: len(app.trends.lines["SFR"].data or []) == 26,
+                        "the second robot's readings alone")
+            assert said(app) == ["robot at 0.3", "robot at 0.5"]
     run(go)
 
 
