@@ -236,24 +236,29 @@ class _TickParts:
 
 class _Loader:
     """An MCAP recording's messages, in file order, filed into ticks, events
-    and parts."""
+    and parts.  A tick's messages come one after another (the writer holds a
+    lock around them), so a tick is built as soon as the next one starts:
+    its JSON is not kept."""
 
     def __init__(self, name: str) -> None:
         self.name = name
         self.parts = [Part()]
-        self.ticks: dict[tuple[int, int], _TickParts] = {}
+        self.ticks: list[Tick] = []
         self.events: list[Event] = []
         self.unreadable: dict[str, int] = {}
+        self._open: tuple[tuple[int, int], _TickParts] | None = None
 
     def load(self, data: bytes) -> ReplaySource:
         scan = scan_mcap(self.name, data, self.take)
-        ticks = [_tick(t, self.parts[t.part]) for _, t in sorted(self.ticks.items())]
+        self._close()
+        ticks = sorted(self.ticks, key=lambda t: t.time_s)  # stable: file order at a tie
         source = ReplaySource(self.name, "mcap", ticks,
                               sorted(self.events, key=lambda e: e.time_s), scan.complete, None,
                               self.parts)
         for topic, n in sorted(self.unreadable.items()):
-            source.notes.append(f"{n} unreadable message{'s' if n > 1 else ''} on {topic} "
-                                "skipped")
+            what = "tick" if topic == "ticks" else "message"
+            source.notes.append(f"{n} unreadable {what}{'s' if n > 1 else ''}"
+                                + ("" if topic == "ticks" else f" on {topic}") + " skipped")
         raw_config = scan.attachments.get("robot_config.json")
         if raw_config is not None:
             try:
@@ -298,9 +303,11 @@ class _Loader:
         origin = int(metadata.get("stairbot", {}).get("time_origin_ns", "0"))
         robot_s = (message.log_time - origin) / 1e9
         index = self._seen(robot_s)
-        tick = self.ticks.get((index, message.log_time))
-        if tick is None:
-            tick = self.ticks[index, message.log_time] = _TickParts(robot_s, index)
+        key = (index, message.log_time)
+        if self._open is None or self._open[0] != key:
+            self._close()
+            self._open = (key, _TickParts(robot_s, index))
+        tick = self._open[1]
         if topic == topics.SENSORS:
             tick.sensors = json.loads(message.data)
             tick.time_s = float(tick.sensors["time_s"])
@@ -321,6 +328,18 @@ class _Loader:
             if all(f in frames for f in SEGMENT_FRAMES):
                 tick.frames = tuple(frames[f] for f in SEGMENT_FRAMES)
 
+    def _close(self) -> None:
+        """Build the tick whose messages have all come."""
+        if self._open is not None:
+            parts = self._open[1]
+            self._open = None
+            if parts.sensors is None and parts.motors is None and not parts.frames:
+                return  # nothing of it could be read (said as unreadable messages)
+            try:
+                self.ticks.append(_tick(parts, self.parts[parts.part]))
+            except (ValueError, KeyError, TypeError, AttributeError):
+                self.unreadable["ticks"] = self.unreadable.get("ticks", 0) + 1
+
     def _scene(self, update: Any, robot: dict[str, str]) -> None:
         """A robot opened (``watch``): its stairs, and a part of its own once
         the one before holds messages."""
@@ -337,6 +356,11 @@ class _Loader:
                                        for c in entity.cubes])
 
 
+_MOTORS = tuple((m, m.value) for m in MotorId)  # an enum member's .value is slow
+_SENSORS = tuple((s, s.value) for s in SensorId)
+_STATUS = {s.value: s for s in SensorStatus}
+
+
 def _tick(parts: _TickParts, part: Part) -> Tick:
     snap: Snapshot | None = None
     commanded: dict[MotorId, float] | None = None
@@ -344,14 +368,14 @@ def _tick(parts: _TickParts, part: Part) -> Tick:
         sensors = _readings(parts.sensors or {})
         motors: dict[MotorId, MotorState] = {}
         m = parts.motors or {}
-        for motor in MotorId:
-            entry = m.get(motor.value)
+        for motor, name in _MOTORS:
+            entry = m.get(name)
             if isinstance(entry, dict):
                 motors[motor] = MotorState(float(entry["turns"]), float(entry["speed_tps"]),
                                            entry.get("fault"))
         if m.get("sent"):
-            commanded = {motor: float(entry["command_tps"]) for motor in MotorId
-                         if isinstance(entry := m.get(motor.value), dict)
+            commanded = {motor: float(entry["command_tps"]) for motor, name in _MOTORS
+                         if isinstance(entry := m.get(name), dict)
                          and isinstance(entry.get("command_tps"), int | float)}
         snap = Snapshot(parts.time_s, sensors, motors, parts.health,
                         _imu(parts.sensors or {}))
@@ -360,10 +384,10 @@ def _tick(parts: _TickParts, part: Part) -> Tick:
 
 def _readings(m: dict[str, Any]) -> dict[SensorId, SensorReading]:
     out = {}
-    for sensor in SensorId:
-        r = m.get(sensor.value)
+    for sensor, name in _SENSORS:
+        r = m.get(name)
         if isinstance(r, dict):
-            out[sensor] = SensorReading(float(r["distance_m"]), SensorStatus(r["status"]),
+            out[sensor] = SensorReading(float(r["distance_m"]), _STATUS[r["status"]],
                                         float(r.get("age_s", 0.0)))
     return out
 

@@ -379,6 +379,41 @@ def test_a_recording_of_two_robots_plays_one_after_the_other(tmp_path: Path) -> 
     run(go)
 
 
+def test_messages_that_do_not_read_are_skipped_and_said(tmp_path: Path) -> None:
+    """A damaged message costs its tick, not the replay, and the banner says so."""
+    from mcap.writer import Writer
+
+    path = tmp_path / "damaged.mcap"
+    good = {"time_s": 0.0, "SFR": {"distance_m": 0.3, "status": "ok", "age_s": 0.0}}
+    with path.open("wb") as f:
+        writer = Writer(f)
+        writer.start()
+        writer.add_metadata("stairbot", {"time_origin_ns": "0"})
+        schema = writer.register_schema(name="stairbot.Sensors", encoding="jsonschema",
+                                        data=b"{}")
+        channel = writer.register_channel(topic=topics.SENSORS, message_encoding="json",
+                                          schema_id=schema)
+        bad_status = {**good, "time_s": 0.02, "SFR": {**good["SFR"], "status": "weird"}}
+        for i, data in enumerate((json.dumps(good).encode(), b"{not json",
+                                  json.dumps(bad_status).encode())):
+            writer.add_message(channel, log_time=i * 20_000_000, data=data,
+                               publish_time=i * 20_000_000)
+        writer.finish()
+    source = load_replay(path)
+    assert len(source.ticks) == 1
+    assert source.notes == ["1 unreadable message on /robot/sensors skipped",
+                            "1 unreadable tick skipped", "the recording holds no robot config"]
+
+    async def go() -> None:
+        app = build_replay_app(source, clock=Clock(), playing=False)
+        async with app.run_test(size=(80, 24)) as pilot:
+            await until(pilot, lambda: "REPLAY" in app.banner.plain, "the banner")
+            assert "1 unreadable message on /robot/sensors skipped" in app.banner.plain
+            assert "drawn with <default default_robot.toml>" in app.banner.plain
+            assert "SFR 0.300 m" in shown(app.sensors)
+    run(go)
+
+
 # -- bad input: one line, exit 2 (1 for a read the disk fails) ------------------------
 
 
