@@ -45,8 +45,8 @@ SEEK_SHORT_S = 1.0
 SEEK_LONG_S = 5.0
 
 REPLAY_HELP = f"""\
-REPLAY: a recording played back.  No robot is connected; nothing
-here moves or stops a robot.
+REPLAY: a recording played back.  No robot is connected:
+nothing here moves or stops a robot.
 
 KEYS
   p         play / pause (at the end: from the start again)
@@ -58,16 +58,17 @@ KEYS
   z         picture zoom
   q         quit (also Ctrl+Q, Ctrl-C)
   ?         this help          Ctrl+P  every action by name
-  space     the EMERGENCY STOP key of a live console: here it says
+  space     a live console's EMERGENCY STOP: here it says
             there is no robot to stop (the replay goes on)
-  s k c u r o x w f  say "replay: no robot"
+  s k c u r o x w f   say "replay: no robot"
 
 READING THE SCREEN
-  The banner: REPLAY, ▶ playing ⏸ paused ■ at the end, the speed,
-  the position t = 12.3 s / 85.0 s (the robot's clock), the file.
-  Every value is the recording's, drawn where the live console draws
-  it.  Ages are the recording's: a value recorded 2 s before the
-  position is 2 s old, STALE where the recording has a gap.
+  The banner: REPLAY, ▶ playing ⏸ paused ■ at the end, the
+  speed, the position t = 12.3 s / 85.0 s (the robot's clock),
+  the file.  Every value is the recording's, drawn where the
+  live console draws it.  Ages are the recording's: a value
+  recorded 2 s before the position is 2 s old, STALE where the
+  recording has a gap.
   A JSON-lines record holds events alone: no sensor, motor or
   picture, only the event list and the phases over time.
   Phase: steps climbed and treads are not recorded (—).

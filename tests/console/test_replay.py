@@ -10,6 +10,8 @@ import asyncio
 import errno
 import json
 import os
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -508,3 +510,13 @@ def test_help_answers_and_lists_replay(argv: list[str],
     out = capsys.readouterr().out
     assert ("usage: stairbot replay" in out and "FILE.mcap" in out) if argv[0] == "replay" \
         else "    replay " in out
+
+
+def test_without_the_mcap_reader_one_line_names_the_extra(recorded: dict[str, Path]) -> None:
+    probe = ("import sys; sys.modules['mcap'] = None\n"
+             "from stairbot.cli import main; sys.exit(main(sys.argv[1:]))")
+    proc = subprocess.run([sys.executable, "-c", probe, "replay", str(recorded["mcap"])],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr == ("stairbot: error: stairbot replay: needs mcap to read MCAP, which "
+                           "is not installed: pip install 'stairbot[replay]'\n")
