@@ -65,6 +65,9 @@ EXTERNAL: dict[str, tuple[str, str]] = {
     "sweep": ("stairbot.sweep.cli:main",
               "run many generated cases and judge each (stairbot sweep SPEC.toml; "
               "docs/envelope.md)"),
+    "replay": ("stairbot.console.replay_cli:main",
+               "play a recording (--record FILE.mcap, or JSON lines) in the console: "
+               "play/pause, speed, seek; no robot is connected"),
     "plot": ("stairbot.recording.cli:main",
              "draw a recording (--record FILE.mcap or JSON lines) over time as a PNG "
              "(needs the extra stairbot[plot])"),

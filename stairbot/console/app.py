@@ -26,6 +26,7 @@ from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
+from textual.widget import Widget
 from textual.widgets import Footer
 
 from stairbot.cli_journal import ResumePlan
@@ -51,11 +52,15 @@ from stairbot.console.widgets.motors import MotorPanel
 from stairbot.console.widgets.phase import PhasePanel
 from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
+from stairbot.console.widgets.trends import TrendsPanel
 from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 
 REFRESH_HZ = 10.0
+GRAPHS_ROWS = 36
+"""From this many rows the graphs show under the picture; on a smaller
+screen they take the picture's place while the operator wants them (g)."""
 LOOK_FIRST = ("Look at the robot first: it may stand part way up a step, and the next run "
               "starts from where it stands.")
 SPEED_ORDER = tuple(SPEEDS)
@@ -75,6 +80,7 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
                                 "the events as JSON lines (key: w)"),
     ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+    ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
     ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
 
@@ -84,6 +90,8 @@ class StairbotConsole(App[None]):
 
     CSS_PATH = "console.tcss"
     TITLE = "stairbot console"
+    replaying = False
+    """A recording played back (console/replay_app.py), not a robot."""
     # The footer shows what an operator needs at once, and fits 80 columns;
     # ? (the help screen) and ctrl+p list every key.
     BINDINGS = [
@@ -101,6 +109,7 @@ class StairbotConsole(App[None]):
         Binding("r", "reset", "reset", show=False),
         Binding("w", "record", "rec", show=False),
         Binding("z", "zoom", "zoom", show=False),
+        Binding("g", "graphs", "graphs", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
     ]
@@ -126,15 +135,20 @@ class StairbotConsole(App[None]):
         self.phase = PhasePanel(id="phase")
         self.link = LinkPanel(id="link")
         self.log_panel = EventLog(id="log")
+        self.trends = TrendsPanel(engine.config.motors.lift_travel_per_turn, id="trends")
+        self.graphs: bool | None = None
+        self._rows: int | None = None  # the screen's height, as the last resize said
+        """The operator's choice of graphs (g); None: by the screen's size."""
 
     # -- layout ------------------------------------------------------------------
     def compose(self) -> ComposeResult:
         with Horizontal(id="top"):
             yield self.banner
-            yield EStopButton(id="estop")
+            yield self.top_right()
         with Horizontal(id="main"):
             with Vertical(id="left"):
                 yield self.picture
+                yield self.trends
                 yield self.log_panel
             with Vertical(id="right"):
                 yield self.sensors
@@ -143,11 +157,44 @@ class StairbotConsole(App[None]):
                 yield self.link
         yield Footer(compact=True)
 
+    def picture_note(self) -> str:
+        """What the picture says when there is no pose to draw."""
+        return ""
+
+    def top_right(self) -> Widget:
+        """What stands beside the banner: the emergency stop button."""
+        return EStopButton(id="estop")
+
+    def on_resize(self, event: events.Resize) -> None:
+        self.lay_out_graphs(event.size.height)  # before the app's own size follows
+
+    def _tall(self, rows: int | None = None) -> bool:
+        return (self.size.height if rows is None else rows) >= GRAPHS_ROWS
+
+    def lay_out_graphs(self, rows: int | None = None) -> None:
+        """Show the graphs under the picture on a tall screen (``rows``: its
+        height, None: the app's); on a smaller one in the picture's place,
+        and only while the operator wants them."""
+        tall = self._tall(rows)
+        self._rows = rows if rows is not None else self.size.height
+        wanted = tall if self.graphs is None else self.graphs
+        self.trends.display = wanted
+        self.picture.display = tall or not wanted
+        if wanted:
+            self._shown_key = None  # draw them now
+
     def on_mount(self) -> None:
         # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):
         # the robot stops first, then the console asks, as for Ctrl-C typed.
         with contextlib.suppress(ValueError):  # not the main thread: left as it is
             self._sigint = signal.signal(signal.SIGINT, self._on_sigint)
+        self.lay_out_graphs()
+        self.begin()
+
+    def begin(self) -> None:
+        """Once mounted: record if asked, redraw ten times a second, open the
+        robot and read it while idle.  (A subclass replaces this, not
+        ``on_mount``: Textual calls every class's ``on_mount``.)"""
         if self._record:
             self._start_recording(self._record)
         self.refresh_view()
@@ -180,8 +227,8 @@ class StairbotConsole(App[None]):
         if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
             per_turn = self.engine.config.motors.lift_travel_per_turn
             lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
-        scene, note = v.scene, ""
-        if v.wired and scene is None:
+        scene, note = v.scene, self.picture_note() if v.scene is None else ""
+        if v.wired and scene is None and not self.replaying:
             scenario = self.engine.scenario
             if snap is not None and v.stairs and scenario is not None:
                 scene = dead_reckon(snap, v.stairs, self.engine.config, scenario.start.distance)
@@ -189,11 +236,14 @@ class StairbotConsole(App[None]):
             else:
                 note = "no pose from a wired robot"
         picture.show(scene, v.stairs, lifts, note)
-        running = v.status.robot == "running"
+        running = v.status.robot in ("running", "replay")  # a replay: the recorded phase
         self.sensors.show(snap, age)
         self.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
         self.phase.show(v.phase, v.flow, v.context, v.phase_id)
-        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age)
+        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age,
+                       replay=self.replaying)
+        if self.trends.display:
+            self.trends.show(v.history, age)
         if v.events:
             log = self.log_panel
             log.add(v.events)
@@ -483,6 +533,14 @@ class StairbotConsole(App[None]):
     def action_help(self) -> None:
         if not isinstance(self.screen, HelpScreen):
             self.push_screen(HelpScreen())
+
+    def action_graphs(self) -> None:
+        tall = self._tall(self._rows)
+        self.graphs = not (tall if self.graphs is None else self.graphs)
+        self.lay_out_graphs(self._rows)
+        where = "under the picture" if tall else "in place of the picture (g: the picture)"
+        self.say(f"graphs {'shown ' + where if self.graphs else 'hidden'}", keep=False)
+        self.refresh_view()
 
     def action_zoom(self) -> None:
         mode = self.picture.cycle_zoom()

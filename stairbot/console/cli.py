@@ -1,6 +1,8 @@
 """``stairbot console [--robot URL] [--scenario FILE|NAME] [--config FILE]
 [--record FILE] [--speed 1x|10x|max] [--serve [HOST:]PORT]``: the operator
-console, in this terminal or (``--serve``) in a browser.
+console, in this terminal or (``--serve``) in a browser.  ``stairbot console
+--replay FILE [--speed 1x|10x|max]`` plays a recording instead, as
+``stairbot replay FILE`` does (console/replay_cli.py).
 
 Bad input (config, scenario, an unknown URL scheme, an unwritable record file)
 is found before the screen opens and raises InputError, which ``stairbot``
@@ -30,7 +32,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="The operator console: watch and command the robot in a terminal.\n"
                     "Keys: space EMERGENCY STOP (everywhere), c clear it, s start, k calibrate\n"
                     "only, p pause/resume, x stop, r reset the simulation, u robot URL,\n"
-                    "o scenario, f simulation speed, w record, q quit; ctrl+p lists all.",
+                    "o scenario, f simulation speed, w record, g graphs, q quit; ctrl+p\n"
+                    "lists all.  --replay FILE plays a recording instead (stairbot replay).",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--robot", metavar="URL", default="sim://",
@@ -42,8 +45,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", metavar="FILE",
                    help="record to FILE: FILE.mcap as MCAP (every tick and event, for "
                         "Foxglove), any other name the event stream, one JSON object a line")
-    p.add_argument("--speed", choices=tuple(SPEEDS), default="1x",
-                   help="simulation speed: 1x real time (default), 10x, max")
+    p.add_argument("--speed", choices=tuple(SPEEDS), default=None,
+                   help="simulation speed: 1x real time (default), 10x, max; with "
+                        "--replay the replay's speed (max: the fastest, 50x)")
+    p.add_argument("--replay", metavar="FILE",
+                   help="play a recording (FILE.mcap, or FILE.jsonl: events alone) instead "
+                        "of opening a robot, as `stairbot replay FILE` does; no robot is "
+                        "connected")
     p.add_argument("--serve", metavar="[HOST:]PORT",
                    help="serve the console to a web browser at http://HOST:PORT/ instead of "
                         "opening it here (needs the extra stairbot[serve]); each browser tab "
@@ -81,6 +89,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the console until the operator quits; returns the exit code.
     Raises InputError (exit 2 in ``stairbot``) for bad input."""
     args = build_parser().parse_args(list(argv) if argv is not None else None)
+    if args.replay is not None:
+        return _replay(args)
+    if args.speed is None:
+        args.speed = "1x"
     bind = parse_bind(args.serve) if args.serve is not None else None
     config = load_config(args.config)
     load_scenario(args.scenario)  # a bad scenario fails here, not behind the screen
@@ -97,6 +109,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     # Textual sets 1 when the app ended on an unhandled error (the engine
     # stopped the robot on the way out): not the exit of a clean quit.
     return app.return_code or 0
+
+
+def _replay(args: argparse.Namespace) -> int:
+    """``--replay FILE``: the recording played; the options that open or
+    record a robot are refused (one line), not ignored."""
+    from stairbot.console.replay_cli import LIVE_SPEEDS, replay
+
+    given = [name for name, value in (("--robot", args.robot != "sim://"),
+                                      ("--scenario", args.scenario), ("--config", args.config),
+                                      ("--record", args.record), ("--serve", args.serve))
+             if value]
+    if given:
+        raise InputError("--replay", None, f"plays a recording: no robot is opened, so "
+                         f"{', '.join(given)} cannot be given with it")
+    return replay(args.replay, LIVE_SPEEDS[args.speed or "1x"])
 
 
 console_main = main

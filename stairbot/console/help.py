@@ -21,6 +21,9 @@ KEYS
   f       simulation speed        r  reset the simulation
   w       record events to a file (never over an existing one)
   z       picture zoom            ?  this help
+  g       graphs: pitch, distance sensors, lifts over the last
+          30 s of robot time (36 rows or more: under the picture;
+          fewer: in its place until g again)
   Ctrl+P  every action by name
 
 READING THE SCREEN
@@ -37,6 +40,8 @@ READING THE SCREEN
   middle, 3 back, coloured as in the picture).  With no run going,
   a lift's arrow is its end segment against segment 2.
   Phase: what the robot is doing, the seed's name for it beneath.
+  Graphs: each line scaled to its own range, written after it;
+  they stop when the readings stop, and dim with them when STALE.
   Events: the run's events and everything the console said.
 
   Escape or ? closes this help.
@@ -48,9 +53,13 @@ class HelpScreen(ModalScreen[None]):
 
     BINDINGS = [Binding("escape,question_mark,q", "close", "close")]
 
+    def __init__(self, text: str = HELP) -> None:
+        super().__init__()
+        self.text = text
+
     def compose(self) -> ComposeResult:
         with VerticalScroll(classes="dialog help"):
-            yield Static(HELP, markup=False)
+            yield Static(self.text, markup=False)
 
     def action_close(self) -> None:
         self.dismiss(None)

@@ -81,7 +81,7 @@ def served_argv(args: argparse.Namespace) -> list[str]:
     """The console each browser tab runs: this Python, the console's options as
     given (``--flag=value``, so a value starting with ``-`` stays a value)."""
     argv = [sys.executable, "-m", "stairbot", "console",
-            f"--robot={args.robot}", f"--speed={args.speed}"]
+            f"--robot={args.robot}", f"--speed={args.speed or '1x'}"]
     for flag in ("scenario", "config", "record"):
         value = getattr(args, flag)
         if value is not None:

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from stairbot.console.history import History, Row
 from stairbot.console.scene import SceneView
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, Snapshot
@@ -61,6 +62,8 @@ class StateView:
     speed: str
     recording: str | None
     events: tuple[tuple[int, Event], ...] = field(default=())
+    history: tuple[Row, ...] = field(default=())
+    """The last readings by robot time, for the graphs (console/history.py)."""
 
 
 class LiveState:
@@ -68,6 +71,8 @@ class LiveState:
 
     def __init__(self, *, url: str = "", scenario: str = "", simulated: bool = True,
                  wall: Callable[[], float] = time.monotonic) -> None:
+        """``wall``: the clock the values' ages go by (a replay passes its
+        position in the recording: the ages are the recording's)."""
         self._lock = threading.Lock()
         self._wall = wall
         self._read_at: float | None = None  # wall time of the last reading taken
@@ -92,6 +97,7 @@ class LiveState:
         self._recording: str | None = None
         self._events: deque[tuple[int, Event]] = deque(maxlen=LOG_LENGTH)
         self._event_seq = 0
+        self._history = History()
 
     # -- writers -----------------------------------------------------------------
     def _bump(self) -> None:
@@ -108,6 +114,13 @@ class LiveState:
             self._phase, self._flow, self._context = "—", "idle", {}
             self._phase_id = ""
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
+            self._history.clear()
+            self._bump()
+
+    def rename(self, url: str, scenario: str, stairs: tuple[tuple[float, float], ...]) -> None:
+        """Name another robot, keeping what was read (a replay's next part)."""
+        with self._lock:
+            self._url, self._scenario, self._stairs = url, scenario, stairs
             self._bump()
 
     def set_status(self, *, robot: str | None = None, estopped: bool | None = None,
@@ -127,11 +140,13 @@ class LiveState:
             )
             self._bump()
 
-    def on_read(self, snap: Snapshot) -> None:
+    def on_read(self, snap: Snapshot, at: float | None = None) -> None:
+        """``snap`` was read ``at`` on the ages' clock (None: now)."""
         with self._lock:
             self._snapshot = snap
-            self._read_at = self._wall()
+            self._read_at = self._wall() if at is None else at
             self._ticks += 1
+            self._history.add(snap)
             if snap.health:
                 self._health = dict(snap.health)
             self._bump()
@@ -162,6 +177,12 @@ class LiveState:
                 self._health.update(
                     {k: float(v) for k, v in event.data.items() if isinstance(v, int | float)}
                 )
+            self._bump()
+
+    def clear_events(self) -> None:
+        """Forget the event list (a replay sought back plays it again)."""
+        with self._lock:
+            self._events.clear()
             self._bump()
 
     def note(self, message: str, severity: str = "information") -> None:
@@ -218,4 +239,5 @@ class LiveState:
                 speed=self._speed,
                 recording=self._recording,
                 events=tuple(e for e in self._events if e[0] > events_after),
+                history=self._history.rows(),
             )

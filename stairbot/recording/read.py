@@ -75,19 +75,29 @@ class Recording:
 
 def read_recording(path: str | os.PathLike[str]) -> Recording:
     """Read the recording at ``path`` (see the module).  Raises RecordingError."""
+    data = recording_bytes(path)
+    name = shown(path)
+    if data.startswith(MCAP_MAGIC):
+        return _read_mcap(name, data)
+    return read_jsonl(name, data)
+
+
+def recording_bytes(path: str | os.PathLike[str]) -> bytes:
+    """The whole file at ``path``.  Raises RecordingError when it is not a
+    regular file that can be opened, or is empty (blank); OSError when the
+    read itself fails (a disk fault)."""
     fd = open_regular(path, RecordingError, "a recording")
     with os.fdopen(fd, "rb") as f:
         data = f.read()
-    name = shown(path)
     if not data.strip():
-        raise RecordingError(name, None, "empty; allowed: an MCAP or JSON-lines recording "
-                             "(stairbot run --record FILE.mcap or FILE.jsonl)")
-    if data.startswith(MCAP_MAGIC):
-        return _read_mcap(name, data)
-    return _read_jsonl(name, data)
+        raise RecordingError(shown(path), None, "empty; allowed: an MCAP or JSON-lines "
+                             "recording (stairbot run --record FILE.mcap or FILE.jsonl)")
+    return data
 
 
-def _read_jsonl(name: str, data: bytes) -> Recording:
+def read_jsonl(name: str, data: bytes) -> Recording:
+    """A JSON-lines record (``data``, named ``name`` in messages): its events,
+    up to a last line cut short.  Raises RecordingError."""
     events: list[dict[str, Any]] = []
     lines = data.split(b"\n")
     for number, line in enumerate(lines, 1):
@@ -115,7 +125,29 @@ def _records(data: bytes) -> Iterator[Any]:
     yield from StreamReader(io.BytesIO(data), record_size_limit=len(data)).records
 
 
-def _read_mcap(name: str, data: bytes) -> Recording:
+@dataclass
+class McapScan:
+    """What a scan of an MCAP file found besides its messages."""
+
+    metadata: dict[str, dict[str, str]]
+    attachments: dict[str, bytes]
+    counts: Counter[str]
+    """Messages read per topic."""
+    complete: bool
+    """The file ended as a finished file does (False: cut short, read up to its end)."""
+
+
+McapTake = Callable[[Any, Any, "Callable[[bytes], Any] | None", dict[str, dict[str, str]]],
+                    None]
+"""(channel, message, its protobuf decoder or None, the metadata so far):
+one message, handed over in the file's order."""
+
+
+def scan_mcap(name: str, data: bytes, take: McapTake) -> McapScan:
+    """Hand every message of the stairbot MCAP recording ``data`` (named
+    ``name`` in messages) to ``take``, in the file's order, up to where the
+    file ends or breaks off (see the module).  Raises RecordingError for a
+    file that is not a stairbot recording, or holds no message."""
     from mcap.exceptions import McapError
     from mcap.records import Attachment, Channel, Footer, Message, Metadata, Schema
     from mcap_protobuf.decoder import DecoderFactory
@@ -123,12 +155,7 @@ def _read_mcap(name: str, data: bytes) -> Recording:
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
     decoders: dict[int, Callable[[bytes], Any]] = {}
-    metadata: dict[str, dict[str, str]] = {}
-    attachments: dict[str, bytes] = {}
-    events: list[dict[str, Any]] = []
-    counts: Counter[str] = Counter()
-    tel = Telemetry()
-    complete = False
+    scan = McapScan({}, {}, Counter(), False)
     protobuf = DecoderFactory()
     try:
         for record in _records(data):
@@ -136,8 +163,8 @@ def _read_mcap(name: str, data: bytes) -> Recording:
                 channel = channels.get(record.channel_id)
                 if channel is None:
                     continue
-                counts[channel.topic] += 1
-                _take(tel, events, metadata, channel, record, decoders)
+                scan.counts[channel.topic] += 1
+                take(channel, record, decoders.get(channel.id), scan.metadata)
             elif isinstance(record, Schema):
                 schemas[record.id] = record
             elif isinstance(record, Channel):
@@ -148,20 +175,33 @@ def _read_mcap(name: str, data: bytes) -> Recording:
                     if decoder is not None:
                         decoders[record.id] = decoder
             elif isinstance(record, Metadata):
-                metadata[record.name] = dict(record.metadata)
+                scan.metadata[record.name] = dict(record.metadata)
             elif isinstance(record, Attachment):
-                attachments[record.name] = bytes(record.data)
+                scan.attachments[record.name] = bytes(record.data)
             elif isinstance(record, Footer):
-                complete = True
+                scan.complete = True
     except (McapError, struct.error, ValueError, EOFError, _zstd_error()):
-        complete = False  # cut short: what came before stands
-    if "stairbot" not in metadata:
+        scan.complete = False  # cut short: what came before stands
+    if "stairbot" not in scan.metadata:
         raise RecordingError(name, None, "an MCAP file, but not a stairbot recording (no "
                              "'stairbot' metadata); allowed: stairbot run --record FILE.mcap")
-    if not counts and not events:
+    if not scan.counts:
         raise RecordingError(name, None, "a stairbot recording that holds no messages (the run "
                              "recorded nothing before it ended)")
-    return Recording(name, "mcap", events, tel, counts, metadata, attachments, complete)
+    return scan
+
+
+def _read_mcap(name: str, data: bytes) -> Recording:
+    events: list[dict[str, Any]] = []
+    tel = Telemetry()
+
+    def take(channel: Any, message: Any, decoder: Callable[[bytes], Any] | None,
+             metadata: dict[str, dict[str, str]]) -> None:
+        _take(tel, events, metadata, channel, message, decoder)
+
+    scan = scan_mcap(name, data, take)
+    return Recording(name, "mcap", events, tel, scan.counts, scan.metadata, scan.attachments,
+                     scan.complete)
 
 
 def _zstd_error() -> type[Exception]:
@@ -172,7 +212,7 @@ def _zstd_error() -> type[Exception]:
 
 
 def _take(tel: Telemetry, events: list[dict[str, Any]], metadata: dict[str, dict[str, str]],
-          channel: Any, message: Any, decoders: dict[int, Callable[[bytes], Any]]) -> None:
+          channel: Any, message: Any, decoder: Callable[[bytes], Any] | None) -> None:
     """File one message's values where the plot looks for them."""
     topic = channel.topic
     if topic == topics.SENSORS:
@@ -192,11 +232,11 @@ def _take(tel: Telemetry, events: list[dict[str, Any]], metadata: dict[str, dict
                 tel.lift_m.setdefault(name, []).append(motor["extension_m"])
     elif topic == topics.RECORD:
         events.append(json.loads(message.data))
-    elif channel.id in decoders and topic in POSE_TOPICS:
+    elif decoder is not None and topic in POSE_TOPICS:
         origin = int(metadata.get("stairbot", {}).get("time_origin_ns", "0"))
         tel.pose_topic = topic
         tel.pose_time_s.append((message.log_time - origin) / 1e9)
-        for t in decoders[channel.id](message.data).transforms:
+        for t in decoder(message.data).transforms:
             if t.child_frame_id in SEGMENT_FRAMES:
                 tel.height_m.setdefault(t.child_frame_id, []).append(t.translation.z)
                 q = (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w)

@@ -59,22 +59,26 @@ class LinkPanel(Static):
         self.border_title = titled("link", None)
 
     def show(self, in_process: bool, time_s: float | None, speed: str,
-             health: Mapping[str, float], age_s: float | None = None) -> None:
+             health: Mapping[str, float], age_s: float | None = None,
+             replay: bool = False) -> None:
         """``in_process``: the simulation runs in the console (no link to show);
-        ``age_s``: wall seconds since the robot was last read (None: never)."""
+        ``age_s``: wall seconds since the robot was last read (None: never);
+        ``replay``: a recording played back, ``speed`` the replay's."""
         key = (in_process, None if time_s is None else round(time_s, 1), speed,
-               tuple(sorted(health.items())), age_key(age_s))
+               tuple(sorted(health.items())), age_key(age_s), replay)
         if key == self._last:
             return
         self._last = key
         self.set_class(is_stale(age_s), "-stale")
         if in_process:
-            self.border_title = titled("simulation", age_s)
+            self.border_title = titled("recorded simulation" if replay else "simulation",
+                                       age_s)
             out = Text("t ", "dim", no_wrap=True, overflow="ellipsis")
             out.append("—" if time_s is None else f"{time_s:7.1f} s")
-            out.append("  speed ", "dim")
+            out.append("  replay " if replay else "  speed ", "dim")
             out.append(SPEED_NAMES.get(speed, speed), "bold")
             self.update(out)
         else:
-            self.border_title = titled("link health", age_s)
+            self.border_title = titled("recorded link health" if replay else "link health",
+                                       age_s)
             self.update(Group(*health_text(health)))

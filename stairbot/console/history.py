@@ -1,0 +1,66 @@
+"""The last :data:`WINDOW_S` seconds of robot time of the values the graphs
+draw: the IMU's pitch, the four distance sensors, the two lifts' turn
+counters.  One row a reading, kept by the robot's clock: a reading no newer
+than the last (an idle robot read again while its clock stands) adds
+nothing, so when the readings stop, the graphs stop too."""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+from stairbot.hardware import MotorId, SensorId, SensorStatus, Snapshot
+
+WINDOW_S = 30.0
+"""Robot seconds the graphs look back."""
+
+SERIES: tuple[str, ...] = ("pitch", *(s.value for s in SensorId), MotorId.MTF.value,
+                           MotorId.MTB.value)
+"""The columns after the time: pitch (deg), SFR, SFL, SBR, SBL (m), MTF, MTB (turns)."""
+
+Row = tuple[float, ...]
+"""(time_s, then one value per :data:`SERIES`; nan: none at that reading)."""
+
+
+def row_of(snap: Snapshot) -> Row:
+    """The values the graphs keep of one reading (nan where there is none: no
+    IMU, a sensor in ERROR, whose distance means nothing, a motor not read)."""
+    values: list[float] = [snap.time_s, snap.imu.pitch_deg if snap.imu is not None else math.nan]
+    for sensor in SensorId:
+        r = snap.sensors.get(sensor)
+        values.append(math.nan if r is None or r.status is SensorStatus.ERROR
+                      else r.distance_m)
+    for motor in (MotorId.MTF, MotorId.MTB):
+        m = snap.motors.get(motor)
+        values.append(math.nan if m is None else m.turns)
+    return tuple(values)
+
+
+class History:
+    """Rows over the last ``window_s`` robot seconds (not thread-safe: the
+    live state holds its lock around every call)."""
+
+    def __init__(self, window_s: float = WINDOW_S) -> None:
+        self.window_s = window_s
+        self._rows: deque[Row] = deque()
+
+    def add(self, snap: Snapshot) -> None:
+        """Keep ``snap``'s values if it is newer than the last; a clock that
+        went back (another robot, a replay sought back) starts afresh."""
+        rows = self._rows
+        if rows:
+            last = rows[-1][0]
+            if snap.time_s == last:
+                return
+            if snap.time_s < last:
+                rows.clear()
+        rows.append(row_of(snap))
+        start = snap.time_s - self.window_s
+        while rows[0][0] < start:
+            rows.popleft()
+
+    def clear(self) -> None:
+        self._rows.clear()
+
+    def rows(self) -> tuple[Row, ...]:
+        return tuple(self._rows)

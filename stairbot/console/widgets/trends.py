@@ -1,0 +1,115 @@
+"""The graphs (key ``g``): the IMU's pitch, the four distance sensors and the
+two lifts over the last seconds of robot time, one Textual ``Sparkline``
+each, the latest value before it and the range drawn after it (each line
+scales to its own range: the range says how much a swing is).
+
+They advance with the robot's clock, not the wall's: when the readings stop,
+so do they, and once the readings are older than
+:data:`~stairbot.console.freshness.STALE_S` the panel is dimmed and its
+title says STALE, as every panel of robot values does."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Sparkline, Static
+
+from stairbot.console.freshness import age_key, is_stale, titled
+from stairbot.console.history import SERIES, Row
+from stairbot.console.widgets.sensors import NAMES as SENSOR_NAMES
+from stairbot.hardware import SensorId
+
+LABEL_WIDTH = 14  # "front R  0.204"
+RANGE_WIDTH = 12  # "0.041…1.300"
+
+
+def _signed(value: float, digits: int) -> str:
+    """``+1.5``, ``-0.2``, ``+0`` (never ``-0``: a value that rounds to 0)."""
+    shown = round(value, digits) + 0.0  # + 0.0 makes -0.0 plain 0.0
+    return f"{shown:+.{digits}f}"
+
+
+def _mean(values: Sequence[float]) -> float:
+    return sum(values) / len(values)
+
+
+def _label(name: str) -> str:
+    if name == "pitch":
+        return "pitch"
+    if name in SensorId.__members__:
+        return SENSOR_NAMES[SensorId(name)]
+    return name
+
+
+class TrendsPanel(Vertical):
+    """One line a series: ``name value``, its sparkline, ``low…high``."""
+
+    DEFAULT_CSS = """
+    TrendsPanel { height: auto; }
+    TrendsPanel > Horizontal { height: 1; }
+    TrendsPanel .trend-label { width: 14; }
+    TrendsPanel .trend-range { width: 12; padding-left: 1; color: $text-muted; }
+    TrendsPanel Sparkline { width: 1fr; }
+    """
+
+    def __init__(self, lift_m_per_turn: float, *, id: str | None = None) -> None:  # noqa: A002
+        super().__init__(id=id)
+        self.lift_m_per_turn = lift_m_per_turn
+        self._last: object = None
+        self.border_title = titled("graphs", None)
+        self.labels = {name: Static("", classes="trend-label", markup=False)
+                       for name in SERIES}
+        self.ranges = {name: Static("", classes="trend-range", markup=False)
+                       for name in SERIES}
+        self.lines = {name: Sparkline([], summary_function=_mean, id=f"trend-{name}")
+                      for name in SERIES}
+        self.plain: dict[str, str] = {}  # each line's label and range as shown, for tests
+
+    def compose(self) -> ComposeResult:
+        for name in SERIES:
+            with Horizontal():
+                yield self.labels[name]
+                yield self.lines[name]
+                yield self.ranges[name]
+
+    def show(self, rows: Sequence[Row], age_s: float | None) -> None:
+        """Draw ``rows`` (console/history.py); ``age_s``: how old the last
+        reading is (None: never read)."""
+        key = (rows[-1][0] if rows else None, len(rows), age_key(age_s))
+        if key == self._last:
+            return
+        self._last = key
+        span = rows[-1][0] - rows[0][0] if len(rows) > 1 else 0.0
+        self.border_title = titled(f"graphs · last {span:.0f} s", age_s)
+        self.set_class(is_stale(age_s), "-stale")
+        for i, name in enumerate(SERIES, start=1):
+            column = [r[i] for r in rows if not math.isnan(r[i])]
+            last = rows[-1][i] if rows else math.nan
+            label, low, high = self._texts(name, last, column)
+            self.labels[name].update(label)
+            self.ranges[name].update(Text(f"{low}…{high}" if column else ""))
+            self.plain[name] = f"{label.plain} | {low}…{high}" if column else label.plain
+            # one point would fill the line (the widget draws it full height): a
+            # line needs two to say anything
+            self.lines[name].data = column if len(column) > 1 else []
+
+    def _texts(self, name: str, last: float, column: list[float]) -> tuple[Text, str, str]:
+        out = Text(f"{_label(name):<8}", style="bold", no_wrap=True, overflow="ellipsis")
+        low = min(column) if column else math.nan
+        high = max(column) if column else math.nan
+        if name == "pitch":
+            value = "—" if math.isnan(last) else f"{_signed(last, 1)}°"
+            lo, hi = _signed(low, 1), f"{_signed(high, 1)}°"
+        elif name in SensorId.__members__:
+            value = "ERROR" if math.isnan(last) else f"{last:.3f}"
+            lo, hi = f"{low:.3f}", f"{high:.3f}"
+        else:  # a lift: turns as the extension, mm
+            mm = 1000 * self.lift_m_per_turn
+            value = "—" if math.isnan(last) else f"{_signed(last * mm, 0)}mm"
+            lo, hi = _signed(low * mm, 0), _signed(high * mm, 0)
+        out.append(value.rjust(LABEL_WIDTH - 8), "bold red" if value == "ERROR" else "")
+        return out, lo, hi
