@@ -28,8 +28,9 @@ def _figure(out: Text, label: str, value: float | None, unit: str = "",
 
 
 def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
-    """Two lines: frames per second and round-trip times; errors, lost and late
-    replies, retries (red when not zero)."""
+    """Two lines: frames per second and round-trip times; errors (stray
+    replies among them), lost and late replies, retries (red when not zero),
+    and duplicated replies when there were any (ignored, so not red)."""
     if not health:
         return Text("no link figures yet  ", "dim"), Text()
     rates = Text(no_wrap=True, overflow="ellipsis")
@@ -45,6 +46,8 @@ def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
                          ("late", health.get("late", 0.0)),
                          ("retries", health.get("retries", 0.0))):
         _figure(faults, label, value, bad=value > 0)
+    if health.get("duplicates", 0.0) > 0:
+        _figure(faults, "dup", health["duplicates"])
     return rates, faults
 
 

@@ -1,0 +1,19 @@
+"""The link panel's figures: every fault the driver counts is on screen."""
+
+from __future__ import annotations
+
+from stairbot.console.widgets.link import health_text
+
+
+def test_stray_replies_count_as_errors_and_duplicates_are_shown_when_there_are_any() -> None:
+    _, quiet = health_text({"frames_per_s": 500.0, "lost": 0.0})
+    assert "dup" not in quiet.plain
+    _, faults = health_text({"frames_per_s": 500.0, "stray": 2.0, "crc_errors": 1.0,
+                             "duplicates": 3.0, "late": 1.0})
+    text = faults.plain
+    assert "errors 3" in text and "late 1" in text and "dup 3" in text
+
+
+def test_no_figures_yet_says_so() -> None:
+    rates, _ = health_text({})
+    assert "no link figures yet" in rates.plain
