@@ -35,7 +35,6 @@ from stairbot.console.climb_gate import MidClimb
 from stairbot.console.freshness import age_key, age_words, is_stale
 from stairbot.console.help import HelpScreen
 from stairbot.console.modals import AskScreen, ChoiceScreen, ConfirmScreen
-from stairbot.console.reckon import dead_reckon
 from stairbot.console.runner_thread import (
     LATCH_HINT,
     MID_CLIMB_HINT,
@@ -56,6 +55,7 @@ from stairbot.console.widgets.trends import TrendsPanel
 from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
+from stairbot.reckon import dead_reckon
 
 REFRESH_HZ = 10.0
 GRAPHS_ROWS = 36

@@ -23,7 +23,6 @@ from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume
 from stairbot.config import RobotConfig
 from stairbot.console.climb_gate import MidClimb, after_run, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
-from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
@@ -36,6 +35,7 @@ from stairbot.resume import ResumeRefused
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
+from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
 
 if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
     from stairbot.recording.mcap_sink import McapRecord

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from stairbot.console.history import History, Row
-from stairbot.console.scene import SceneView
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, Snapshot
 from stairbot.runner import RunResult
+from stairbot.side_view import SceneView
 
 LOG_LENGTH = 1000
 NOTE_KINDS = {"information": EventKind.INFO, "warning": EventKind.WARNING,

@@ -12,9 +12,9 @@ import time
 from collections.abc import Callable
 from typing import Protocol
 
-from stairbot.console.scene import SceneView
 from stairbot.console.state import LiveState
 from stairbot.hardware import ZERO_SPEEDS, Clock, HasTruth, Robot, Snapshot, Speeds, Truth
+from stairbot.side_view import SceneView
 
 SCENE_PERIOD_S = 0.04  # wall seconds between pictures taken from the simulation
 

@@ -21,10 +21,10 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from stairbot.config import RobotConfig
-from stairbot.console.reckon import dead_reckon
-from stairbot.console.scene import stairs_from_scenario
 from stairbot.hardware import HasScene, Point, Snapshot
+from stairbot.reckon import dead_reckon
 from stairbot.scenario import Scenario
+from stairbot.side_view import stairs_from_scenario
 
 SEGMENT_FRAMES = ("segment1", "segment2", "segment3")
 """The frames of segments 1, 2 and 3 (front to back), children of ``world``."""
@@ -147,7 +147,7 @@ class SimulationPose:
 class DeadReckonedPose:
     """The host's estimate for a robot on a wire: the segments where the wheel
     and lift turn counters put them on the scenario's stairs
-    (:func:`stairbot.console.reckon.dead_reckon`).  Slip, yaw, the lateral
+    (:func:`stairbot.reckon.dead_reckon`).  Slip, yaw, the lateral
     position and a tipped robot are not in it."""
 
     topic = "/robot/estimated_pose"

@@ -31,7 +31,6 @@ from typing import Any
 
 from stairbot._schema import convert
 from stairbot.config import ConfigFile, RobotConfig
-from stairbot.console.scene import SceneView
 from stairbot.errors import StairbotError
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
@@ -55,6 +54,7 @@ from stairbot.recording.read import (
     recording_bytes,
     scan_mcap,
 )
+from stairbot.side_view import SceneView
 
 MCAP_SUFFIXES = (".mcap",)
 JSONL_SUFFIXES = (".jsonl", ".ndjson")

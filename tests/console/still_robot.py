@@ -9,7 +9,6 @@ from typing import Any
 
 from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
-from stairbot.console.scene import stairs_from_scenario
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
     Imu,
@@ -24,6 +23,7 @@ from stairbot.hardware import (
 )
 from stairbot.robots import RobotSession
 from stairbot.scenario import load_scenario
+from stairbot.side_view import stairs_from_scenario
 
 LIFT = 0.19  # segment 1 raised this far above segment 2, m
 

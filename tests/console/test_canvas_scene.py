@@ -6,9 +6,9 @@ from typing import Any
 
 from stairbot.config import load_config
 from stairbot.console.canvas import BrailleCanvas
-from stairbot.console.scene import SceneView, scene_view, stairs_from_scenario
 from stairbot.hardware import Scene
 from stairbot.scenario import load_scenario
+from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
 
 
 def test_dots_map_to_braille_bits() -> None:
@@ -112,7 +112,7 @@ def test_dead_reckoning_follows_the_simulated_climb() -> None:
     """The picture of a robot on a wire, from its counters alone, stays within
     5 cm (wheel slip adds up) and 2 cm in height of the simulation's truth
     over calibration and the first two steps."""
-    from stairbot.console.reckon import dead_reckon
+    from stairbot.reckon import dead_reckon
     from stairbot.robots import open_robot
     from stairbot.runner import RunControl, run
 

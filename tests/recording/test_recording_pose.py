@@ -8,7 +8,6 @@ import math
 import pytest
 
 from stairbot.config import load_config
-from stairbot.console.scene import stairs_from_scenario
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.recording.pose import (
     DeadReckonedPose,
@@ -19,6 +18,7 @@ from stairbot.recording.pose import (
     stair_blocks,
 )
 from stairbot.scenario import load_scenario
+from stairbot.side_view import stairs_from_scenario
 
 
 def rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]

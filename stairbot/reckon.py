@@ -17,8 +17,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from stairbot.config import RobotConfig
-from stairbot.console.scene import Point, SceneView
 from stairbot.hardware import WHEEL_MOTORS, MotorId, Snapshot
+from stairbot.side_view import Point, SceneView
 
 
 def ground_at(stairs: Sequence[Point], x: float) -> float:
