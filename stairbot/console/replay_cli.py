@@ -75,12 +75,13 @@ def check_reader(path: str) -> None:
 def replay(path: str, speed: float = 1.0, paused: bool = False) -> int:
     """Load ``path`` (bad input raises InputError), then play it until the
     operator quits; the exit code."""
-    from stairbot.recording.replay_source import ReplayReadError, load_replay
+    from stairbot.recording.read import RecordingReadError
+    from stairbot.recording.replay_source import load_replay
 
     check_reader(path)
     try:
         source = load_replay(path)
-    except ReplayReadError as exc:
+    except RecordingReadError as exc:
         print(f"stairbot: error: {exc}", file=sys.stderr)
         return EXIT_READ_FAULT
     from stairbot.console.replay_app import build_replay_app  # textual: once it opens

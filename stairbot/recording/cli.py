@@ -3,12 +3,14 @@ drawn over time as a PNG.
 
 Bad input -- a missing file, one that is not a recording, an empty one,
 an output that cannot be written, matplotlib not installed -- raises
-InputError, which ``stairbot`` turns into one line on stderr and exit 2.
+InputError, which ``stairbot`` turns into one line on stderr and exit 2; a
+read the disk fails is one line and exit 1.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -33,14 +35,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Write the PNG; returns 0.  Raises InputError for bad input, OutputError
-    when the disk refuses the PNG."""
+    """Write the PNG; returns 0, or 1 when the disk fails the recording's
+    read (one line).  Raises InputError for bad input, OutputError when the
+    disk refuses the PNG."""
     args = build_parser().parse_args(list(argv) if argv is not None else None)
     from stairbot.recording.plot import check_extra, render
-    from stairbot.recording.read import read_recording
+    from stairbot.recording.read import RecordingReadError, read_recording
 
     check_extra()
-    recording = read_recording(args.file)
+    try:
+        recording = read_recording(args.file)
+    except RecordingReadError as exc:
+        print(f"stairbot: error: {exc}", file=sys.stderr)
+        return 1
     out = Path(args.output) if args.output else Path(args.file).with_suffix(".png")
     png = render(recording)
     f = LineFile(out, "the plot")

@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from stairbot.errors import InputError
+from stairbot.errors import InputError, StairbotError
 from stairbot.files import open_regular, shown
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES, DeadReckonedPose, SimulationPose, pitch_of
@@ -82,13 +82,22 @@ def read_recording(path: str | os.PathLike[str]) -> Recording:
     return read_jsonl(name, data)
 
 
+class RecordingReadError(StairbotError):
+    """The disk failed while a recording was read (an I/O fault, not bad
+    input: exit 1).  One line naming the file."""
+
+
 def recording_bytes(path: str | os.PathLike[str]) -> bytes:
     """The whole file at ``path``.  Raises RecordingError when it is not a
-    regular file that can be opened, or is empty (blank); OSError when the
-    read itself fails (a disk fault)."""
+    regular file that can be opened, or is empty (blank); RecordingReadError
+    when the read itself fails (a disk fault)."""
     fd = open_regular(path, RecordingError, "a recording")
-    with os.fdopen(fd, "rb") as f:
-        data = f.read()
+    try:
+        with os.fdopen(fd, "rb") as f:
+            data = f.read()
+    except OSError as exc:
+        raise RecordingReadError(f"{shown(path)}: cannot read the recording: "
+                                 f"{exc.strerror or exc}") from None
     if not data.strip():
         raise RecordingError(shown(path), None, "empty; allowed: an MCAP or JSON-lines "
                              "recording (stairbot run --record FILE.mcap or FILE.jsonl)")

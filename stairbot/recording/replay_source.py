@@ -14,8 +14,9 @@ all flushed keeps what was.  A JSON-lines record holds events alone: no tick.
 
 Raises :class:`~stairbot.recording.read.RecordingError` (bad input: exit 2)
 for a file that is missing, not a regular file, empty, named for one kind
-and holding another or neither, and :class:`ReplayReadError` (exit 1) when
-the disk fails the read.
+and holding another or neither, and
+:class:`~stairbot.recording.read.RecordingReadError` (exit 1) when the disk
+fails the read.
 """
 
 from __future__ import annotations
@@ -31,7 +32,6 @@ from typing import Any
 
 from stairbot._schema import convert
 from stairbot.config import ConfigFile, RobotConfig
-from stairbot.errors import StairbotError
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
 from stairbot.hardware import (
@@ -66,11 +66,6 @@ before ends (the time that passed between them is not recorded; the gap
 keeps the two apart: no time holds a tick of each)."""
 FLOOR_TOP_M = 0.0021
 """A block of the /scene stairs this low is the floor (drawn 2 mm thick)."""
-
-
-class ReplayReadError(StairbotError):
-    """The disk failed while the recording was read (an I/O fault, not bad
-    input: exit 1).  One line naming the file."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -184,17 +179,13 @@ class _Times(Sequence[float]):
 def load_replay(path: str | os.PathLike[str]) -> ReplaySource:
     """The recording at ``path``, by its name: ``.mcap`` an MCAP recording,
     ``.jsonl`` (or ``.ndjson``) a JSON-lines record.  Raises RecordingError
-    for bad input, ReplayReadError when the read fails."""
+    for bad input, RecordingReadError when the read fails."""
     name = shown(path)
     suffix = PurePath(os.fspath(path)).suffix.lower()
     if suffix not in MCAP_SUFFIXES + JSONL_SUFFIXES:
         what = f"suffix {suffix!r}" if suffix else "no suffix"
         raise RecordingError(name, None, f"not a recording's name ({what}); {ALLOWED}")
-    try:
-        data = recording_bytes(path)
-    except OSError as exc:
-        raise ReplayReadError(f"{name}: cannot read the recording: "
-                              f"{exc.strerror or exc}") from None
+    data = recording_bytes(path)
     mcap = data.startswith(MCAP_MAGIC)
     if suffix in MCAP_SUFFIXES:
         if not mcap:
