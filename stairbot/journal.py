@@ -43,7 +43,7 @@ import uuid
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from stairbot.errors import InputError, OutputError
 from stairbot.files import LineFile, open_regular, refused, shown
@@ -239,11 +239,27 @@ def _records(data: bytes) -> list[dict[str, Any]]:
     return out
 
 
+def _count_resumes(f: BinaryIO, run_id: str) -> int:
+    """The resume records of ``run_id`` in the whole journal ``f``, read in
+    TAIL_BYTES pieces: each is one line as :meth:`JournalWriter.write` puts
+    it, beginning ``{"kind":"resume","run_id":RUN_ID``."""
+    mark = b'\n{"kind":"resume","run_id":' + json.dumps(run_id).encode()
+    f.seek(0)
+    count, carry = 0, b"\n"  # the file's first line begins at a line's start too
+    while piece := f.read(TAIL_BYTES):
+        block = carry + piece
+        count += block.count(mark)
+        carry = block[-(len(mark) - 1):]  # a mark split between two pieces
+    return count
+
+
 def read_journal(path: str | Path) -> JournalState:
     """The last run of the journal at ``path``.  JournalError (one line
     naming the file) when it is missing, not a regular file, or holds no run.
     A journal may be any size: only its last ``TAIL_BYTES`` (1 MiB) are read,
-    and its first ``MAX_LINE`` bytes when no run starts in them."""
+    and its first ``MAX_LINE`` bytes when no run starts in them; and in a
+    larger one, the resume records of its last run are counted through the
+    whole file (byte search, no JSON)."""
     p = Path(path)
     fd = open_regular(p, JournalError, "a journal")
     try:
@@ -255,10 +271,13 @@ def read_journal(path: str | Path) -> JournalState:
                 tail = tail[tail.find(b"\n") + 1:]  # the first line there may be cut
             records = _records(tail)
             starts = [r for r in records if r["kind"] == "start"]
+            resumes: int | None = None
             if not starts and size > TAIL_BYTES:  # a long run: find its start
                 f.seek(0)
                 head = f.read(MAX_LINE)
                 starts = [r for r in _records(head) if r["kind"] == "start"]
+            if starts and size > TAIL_BYTES:  # resumes further back than the tail
+                resumes = _count_resumes(f, starts[-1]["run_id"])
     except OSError as exc:
         raise JournalError(shown(p), None, f"cannot read the journal: {exc.strerror or exc}"
                            ) from None
@@ -276,5 +295,6 @@ def read_journal(path: str | Path) -> JournalState:
         context=ctx["context"] if ctx else None,
         context_time_s=ctx["time_s"] if ctx else None,
         end=ends[-1] if ends else None,
-        resumes=sum(1 for r in run if r["kind"] == "resume"),
+        resumes=resumes if resumes is not None else
+        sum(1 for r in run if r["kind"] == "resume"),
         boards=last.get("boards"))

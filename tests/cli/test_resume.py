@@ -204,3 +204,29 @@ def test_a_run_stopped_by_a_lost_link_can_be_resumed_one_that_failed_cannot(
         else:
             with pytest.raises(ResumeRefused, match="the last run ended"):
                 check(state, "serial://x", boards)
+
+
+def test_resumes_are_counted_through_a_journal_longer_than_its_tail(tmp_path: Path) -> None:
+    """read_journal reads a journal's last MiB; the resumes of a long run
+    before it are counted too (they used to be missed)."""
+    from stairbot.journal import TAIL_BYTES
+
+    path = tmp_path / "j.jsonl"
+    w = JournalWriter(path, fresh=True)
+    w.start(url="serial://x", config="c", config_sha256="0", scenario="s", mode="full",
+            boards=None, time_s=0.0)
+    run_id = w.run_id
+    for n in range(2):
+        w.resume(run_id, None, 1.0 + n)
+        w.tick(time_s=1.0 + n, phase="cal_check", estopped=False, command={}, boards=None,
+               context=lambda: {"phase": "cal_check"})
+    n = 0
+    while path.stat().st_size < 2 * TAIL_BYTES:  # a long run after the resumes
+        w.tick(time_s=3.0 + n * 0.02, phase="ascent_approach", estopped=False,
+               command={"MWF": 1.0}, boards=None, context=lambda: {"phase": "ascent_approach"})
+        n += 1
+    w.close()
+    state = read_journal(path)
+    assert state.start["run_id"] == run_id
+    assert state.resumes == 2
+    assert state.last["phase"] == "ascent_approach"
