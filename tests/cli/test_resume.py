@@ -18,6 +18,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from lockstep_boards import lockstep_boards
 
 from stairbot.journal import JournalWriter, read_journal
 from stairbot.resume import ResumeRefused, check, describe
@@ -37,17 +38,8 @@ def env(tmp_path: Path) -> dict[str, str]:
 @pytest.fixture
 def boards(env: dict[str, str], tmp_path: Path) -> Iterator[tuple[str, subprocess.Popen[str]]]:
     """Fake boards in lockstep in another process: (their URL, the process)."""
-    proc = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=tmp_path)
-    assert proc.stdout is not None
-    url = proc.stdout.readline().strip()
-    assert url.startswith("serial://") and url.endswith("?lockstep=1")
-    yield url, proc
-    proc.send_signal(signal.SIGINT)
-    try:
-        proc.wait(10)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
+    with lockstep_boards(tmp_path, env) as served:
+        yield served.url, served.proc
 
 
 def last_tick(journal: Path) -> dict[str, object]:

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from fake_boards import stairbot
+from lockstep_boards import stairbot
 from pilot import banner, press, ready, said, shown, until
 from still_robot import StillClock, StillRobot, make_still_app
 

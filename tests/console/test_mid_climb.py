@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 import pytest
-from fake_boards import fake_boards, stairbot
+from lockstep_boards import fake_boards, stairbot
 from pilot import SpyRobot, banner, press, ready, spied_open, until
 from textual.widgets import Label
 

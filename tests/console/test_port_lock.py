@@ -9,7 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from fake_boards import fake_boards, stairbot
+from lockstep_boards import fake_boards, stairbot
 from pilot import banner, said, until
 
 from stairbot.config import load_config

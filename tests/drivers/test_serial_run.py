@@ -4,12 +4,12 @@ ending exactly as sim:// does."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from lockstep_boards import lockstep_boards
 
 from stairbot.config import load_config
 from stairbot.robots import RobotOptions, open_robot
@@ -21,20 +21,10 @@ SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "
 
 @pytest.fixture
 def fake_boards_url(tmp_path: Path) -> Iterator[str]:
-    # cwd elsewhere: the installed package runs, not the source tree
-    proc = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial",
-                             "--lockstep"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=tmp_path)
-    assert proc.stdout is not None
-    url = proc.stdout.readline().strip()
-    try:
-        assert url.startswith("serial:///dev/") and url.endswith("?lockstep=1"), url
-        yield url
-    finally:
-        proc.terminate()
-        _, err = proc.communicate(timeout=10)
-        assert proc.returncode == 0, err
-        assert "frames in" in err  # the fake reports its own counters on SIGTERM
+    with lockstep_boards(tmp_path, stop=signal.SIGTERM) as boards:
+        yield boards.url
+    assert boards.returncode == 0, boards.stderr
+    assert "frames in" in boards.stderr  # the fake reports its own counters on SIGTERM
 
 
 def test_full_ascent_and_descent_over_a_pty_ends_as_sim_does(fake_boards_url: str) -> None:

@@ -1,0 +1,66 @@
+"""Fake boards in lockstep in a process of their own, on a pseudo-terminal
+(`stairbot fake-boards --serial --lockstep`): their world stands still while
+no host steps it, so a test on them is as fast as the machine and cannot
+flake on timing.  One helper for every test that needs them (a module of
+its own, not conftest.py)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+
+def stairbot(*args: str, env: dict[str, str] | None = None,
+             cwd: Path | None = None) -> subprocess.Popen[str]:
+    """``python -m stairbot ARGS``, its output piped, its input closed."""
+    return subprocess.Popen([sys.executable, "-m", "stairbot", *args], text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            stdin=subprocess.DEVNULL, env=env or dict(os.environ), cwd=cwd)
+
+
+@dataclass
+class Boards:
+    """Served boards: their URL and process; once stopped, what they said on
+    stderr and their exit status (None if they had to be killed)."""
+
+    url: str
+    proc: subprocess.Popen[str]
+    stderr: str = ""
+    returncode: int | None = None
+
+
+@contextmanager
+def lockstep_boards(cwd: Path, env: dict[str, str] | None = None,
+                    stop: signal.Signals = signal.SIGINT) -> Iterator[Boards]:
+    """Serve fake boards in lockstep until the block ends, then stop them
+    with ``stop`` (unless the block did), killing them after 10 s.  ``cwd``
+    elsewhere than the source tree: the installed package runs."""
+    proc = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=cwd)
+    assert proc.stdout is not None
+    boards = Boards(proc.stdout.readline().strip(), proc)
+    try:
+        assert boards.url.startswith("serial:///dev/") and boards.url.endswith(
+            "?lockstep=1"), boards.url
+        yield boards
+    finally:
+        if proc.poll() is None:
+            proc.send_signal(stop)
+        try:
+            _, boards.stderr = proc.communicate(timeout=10)
+            boards.returncode = proc.returncode
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+
+
+@contextmanager
+def fake_boards(cwd: Path) -> Iterator[str]:
+    """:func:`lockstep_boards`, yielding their URL alone."""
+    with lockstep_boards(cwd) as boards:
+        yield boards.url
