@@ -44,6 +44,7 @@ from stairbot import __version__
 from stairbot.config import RobotConfig
 from stairbot.errors import OutputError
 from stairbot.events import Event, EventKind
+from stairbot.files import shown
 from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, Snapshot, Speeds
 from stairbot.recording import messages, topics
 from stairbot.recording.pose import PoseSource
@@ -103,7 +104,7 @@ class McapRecord:
                                               writer_options=_options())
         except RuntimeError as exc:
             self._stream.close()
-            raise self._stream.failed or OutputError(str(self.path), WHAT, str(exc)) from None
+            raise self._stream.failed or OutputError(shown(self.path), WHAT, str(exc)) from None
         self._scene = SceneUpdateChannel(topics.SCENE, context=ctx)
         self._joints = JointStatesChannel(topics.JOINTS, context=ctx)
         self._motors = foxglove.Channel(topics.MOTORS, schema=topics.MOTORS_SCHEMA, context=ctx)
@@ -234,7 +235,7 @@ class McapRecord:
             fn(*args, **kwargs)
         except RuntimeError as exc:
             if self._stream.failed is None:  # not the disk: say what the SDK said
-                raise OutputError(str(self.path), WHAT, str(exc)) from None
+                raise OutputError(shown(self.path), WHAT, str(exc)) from None
         failed = self._stream.failed
         if failed is not None and not self._raised:
             self._raised = True
