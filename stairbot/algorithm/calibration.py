@@ -30,7 +30,7 @@ from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
-from stairbot.perception import pair_tolerance, settle_s, still_samples, still_tolerance
+from stairbot.perception import settle_s, still_samples, still_tolerance
 
 P = Phase
 FLOW = "calibration"
@@ -75,7 +75,7 @@ HEADING_TOLERANCE_RAD = math.radians(0.3)
 off than this (0.3 deg: 1.6 mm sideways over a 0.3 m climb)."""
 
 
-def _readings(t: Tick) -> tuple[float, float]:
+def readings(t: Tick) -> tuple[float, float]:
     sfr, sfl = motion.pair(t.snap)
     return sfr.distance_m, sfl.distance_m
 
@@ -96,7 +96,7 @@ def heading_off_rad(t: Tick, twist: float) -> float:
     return motion.turn_yaw_rad(t.cfg, motion.twist(t.snap) - twist)
 
 
-def _settled(t: Tick, w: Work) -> bool:
+def settled(t: Tick, w: Work) -> bool:
     """Standing still since ``w.still_since`` (set now if unset) for as long
     as the filter takes to stand for here (:func:`settle_s`)."""
     if w.still_since is None:
@@ -104,7 +104,7 @@ def _settled(t: Tick, w: Work) -> bool:
     return t.snap.time_s - w.still_since >= settle_s(t.cfg) - 1e-9  # (clocks round alike)
 
 
-def _measured_standing(t: Tick, w: Work, needed: int) -> bool:
+def measured_standing(t: Tick, w: Work, needed: int) -> bool:
     """True once ``needed`` ticks have been measured; until then, add this
     tick's SFL − SFR to ``w``'s sum when both read a distance.  A reading
     that is an error, a dropout or nothing ahead is no figure for the
@@ -127,7 +127,7 @@ TRIM = 0.2
 they are averaged."""
 
 
-def _mean_diff(t: Tick, w: Work) -> float:
+def mean_diff(t: Tick, w: Work) -> float:
     """The mean SFL − SFR measured standing, trimmed of its TRIM highest and
     lowest ticks; now's if no tick gave one.  Two outliers among an HC-SR04's
     last three measurements pass its median and stay for up to three ticks;
@@ -136,12 +136,12 @@ def _mean_diff(t: Tick, w: Work) -> float:
     cases 71 and 470 on sonar).  Trimmed, the mean of normal noise keeps
     about 90 % of its efficiency."""
     if not w.diffs:
-        sfr, sfl = _readings(t)
+        sfr, sfl = readings(t)
         return sfl - sfr
-    return _trimmed_mean(w.diffs)
+    return trimmed_mean(w.diffs)
 
 
-def _trimmed_mean(values: list[float]) -> float:
+def trimmed_mean(values: list[float]) -> float:
     ordered = sorted(values)
     k = int(len(ordered) * TRIM)
     kept = ordered[k:len(ordered) - k]
@@ -172,13 +172,13 @@ def _check(t: Tick, w: Work) -> Step:
     # called equal or not: one noisy reading must not choose the case; and
     # only once the filter has settled (a full window of measurements taken
     # standing here: not the first one or two, nor ones taken while moving).
-    if not _settled(t, w):
+    if not settled(t, w):
         return stay(NO_MOTION)
     # Checking a squaring turn: as long as it takes to know the difference to
     # within equal_tolerance, as the turn's own check does.
     needed = STILL_TICKS if ctx.squaring_turns == 0 else max(
         STILL_TICKS, still_samples(cfg, min(sfr.distance_m, sfl.distance_m)))
-    if not _measured_standing(t, w, needed):
+    if not measured_standing(t, w, needed):
         return stay(NO_MOTION)
     if ctx.squaring_turns > 0:
         return _verify(t, w)
@@ -202,7 +202,7 @@ def _check(t: Tick, w: Work) -> Step:
                   "square; closing in before squaring up",
                   SFR=sfr.distance_m, SFL=sfl.distance_m)
             return go(P.CAL_CLOSE_IN)
-    diff = _mean_diff(t, w)
+    diff = mean_diff(t, w)
     equal = abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)),
                                          min(sfr.distance_m, sfl.distance_m))
     if equal and ctx.purpose != "start":
@@ -214,7 +214,7 @@ def _check(t: Tick, w: Work) -> Step:
     # apart for one riser, are a side wall (the envelope sweep: 19 deg askew
     # near the open side of a flight, SFL read nothing, case 2W turned away
     # from the riser until it gave up).
-    wall = (not equal and abs(diff) > _one_riser(cfg)
+    wall = (not equal and abs(diff) > one_riser(cfg)
             and not motion.far(sfr, cfg) and not motion.far(sfl, cfg))
     ctx.calibration_case = "3" if equal else ("2W" if wall else "2")
     ctx.case_diff = diff
@@ -244,7 +244,7 @@ def _verify(t: Tick, w: Work) -> Step:
         return fail(f"calibration ({where(ctx, P.CAL_CHECK)}): squared up, but standing on "
                     f"all wheels SFR reads {sfr:.3f} m and SFL {sfl:.3f} m: at least one sees "
                     "nothing ahead where the riser should be")
-    diff = _mean_diff(t, w)
+    diff = mean_diff(t, w)
     if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
         t.say(f"square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
               f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)",
@@ -257,7 +257,7 @@ def _verify(t: Tick, w: Work) -> Step:
                     f"standing (SFR {sfr:.3f} m, SFL {sfl:.3f} m): the beams do not see one "
                     "flat riser alike (a riser too low for them, or its edge)")
     # SFL farther than SFR: turned left of square, turn right (and the other way).
-    yaw = -_askew_rad(cfg, diff)
+    yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
     ctx.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
     ctx.squaring_turns += 1
@@ -275,8 +275,8 @@ def _squared(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     if ctx.purpose == "start":
         if w.standing:
-            ctx.start_reading = (_trimmed_mean([r for r, _l in w.standing])
-                                 + _trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
+            ctx.start_reading = (trimmed_mean([r for r, _l in w.standing])
+                                 + trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
             ctx.start_wheel = motion.wheel_position(t.snap)
             t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m (their means "
                   f"over {len(w.standing)} ticks standing still)",
@@ -291,13 +291,13 @@ def _squared(t: Tick, w: Work) -> Step:
     return _after_calibration(t)
 
 
-def _askew_rad(cfg: RobotConfig, diff: float) -> float:
+def askew_rad(cfg: RobotConfig, diff: float) -> float:
     """How far the robot is turned left of square (radians) when both beams
     on one flat riser read SFL − SFR = ``diff``."""
     return math.atan(diff / (2 * max(cfg.sensors.front_lateral, 1e-6)))
 
 
-def _one_riser(cfg: RobotConfig) -> float:
+def one_riser(cfg: RobotConfig) -> float:
     """The largest SFL − SFR (either sign) both beams on one riser can read,
     the robot turned MAX_SQUARE_YAW_RAD from square to it."""
     return 2 * cfg.sensors.front_lateral * math.tan(MAX_SQUARE_YAW_RAD)
@@ -385,248 +385,6 @@ LIFT = PhaseDef(
         P.ERROR: FAULT})
 
 
-# -- turning ---------------------------------------------------------------------------
-def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
-    made = abs(t.snap.turns(MotorId.MWR) - t.ctx.turn_origin)
-    if motion.turn_yaw_rad(t.cfg, made) <= MAX_TURN_YAW_RAD:
-        return None
-    return fail(f"calibration ({where(t.ctx, phase)}) turned "
-                f"{math.degrees(MAX_TURN_YAW_RAD):.0f}° without finding SFR = SFL")
-
-
-def _turn_enter(t: Tick, w: Work) -> None:
-    r, l_ = motion.pair(t.snap)
-    sfr, sfl = r.distance_m, l_.distance_m
-    # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
-    w.turn_direction = 1 if sfl < sfr else -1
-    w.turn_diff = sfl - sfr
-    # Both beams on one riser, the difference says how far the robot is turned
-    # from square to it: the turn may make that and a margin, no more.
-    w.turn_from = t.snap.turns(MotorId.MWR)
-    if motion.far(r, t.cfg) or motion.far(l_, t.cfg):
-        # one beam off the flight's side: no figure, at most as askew as a
-        # calibration may stand
-        w.turn_limit_rad = MAX_SQUARE_YAW_RAD + TURN_MARGIN_RAD
-    else:
-        # the larger of what the standing mean the case was chosen on says and
-        # what the readings now say: one tick of a Sharp pair 0.36 m away read
-        # 1 deg askew where the mean had said 16 (ir envelope case 1452)
-        diff = max(abs(sfl - sfr), abs(t.ctx.case_diff or 0.0))
-        w.turn_limit_rad = _askew_rad(t.cfg, diff) + TURN_MARGIN_RAD
-
-
-def _turned_past_limit(t: Tick, w: Work) -> Step | None:
-    made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
-    if made <= w.turn_limit_rad:
-        return None
-    return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned {math.degrees(made):.0f}° "
-                f"without finding SFR = SFL, more than the "
-                f"{math.degrees(w.turn_limit_rad):.0f}° its first readings allow: "
-                "not squaring up to something other than the riser")
-
-
-def _turn(t: Tick, w: Work) -> Step:
-    cfg = t.cfg
-    sfr, sfl = _readings(t)
-    if w.checked:  # stopped at SFR = SFL: measuring standing still, once settled
-        if not _settled(t, w):
-            return stay(NO_MOTION)
-        # as long as it takes to know the difference to within equal_tolerance
-        if not _measured_standing(t, w, max(STILL_TICKS, still_samples(cfg, min(sfr, sfl)))):
-            return stay(NO_MOTION)
-        diff = _mean_diff(t, w)
-        if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
-            t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} readings "
-                  f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
-                  diff=diff)
-            t.ctx.squaring_turns += 1
-            return go(P.CAL_LOWER)
-        # Not square yet: turn on, slowly, the way the difference says.
-        direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
-        if direction != w.turn_direction:
-            w.turn_flips += 1
-            if w.turn_flips > MAX_TURN_FLIPS:
-                return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned back and forth "
-                            f"{MAX_TURN_FLIPS} times without finding SFR = SFL: standing, "
-                            f"SFL − SFR reads {diff * 1000:+.1f} mm (SFR {sfr:.3f} m, SFL "
-                            f"{sfl:.3f} m); a beam may be off the flight's side, or one "
-                            "sensor reading long or short")
-        w.checked, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
-        w.turn_direction = direction
-        w.turn_diff = diff
-    w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
-    # Turning left closes SFL - SFR from below, turning right from above: stop
-    # when the smoothed difference has reached zero (or, with readings that
-    # no longer change, has decayed to a twentieth of their resolution), then
-    # check it standing still.
-    remaining = -w.turn_direction * w.turn_diff
-    if remaining <= cfg.sensors.resolution / 20:
-        w.checked = True
-        return stay(NO_MOTION)
-    too_far = _turned_too_far(t, P.CAL_TURN) or _turned_past_limit(t, w)
-    if too_far is not None:
-        return too_far
-    slow = min(1.0, max(TURN_SLOW_FLOOR, remaining / (2 * cfg.algorithm.equal_tolerance)))
-    return stay(motion.turn(w.turn_direction, cfg, slow))
-
-
-TURN = PhaseDef(
-    P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, enter=_turn_enter,
-    to={P.CAL_LOWER: "SFR = SFL",
-        P.ERROR: "turned too far, or more than its first readings allow; " + FAULT})
-
-
-def _probe_enter(t: Tick, w: Work) -> None:
-    w.probe_sfr, w.probe_sfl = _readings(t)
-
-
-def _probe(t: Tick, w: Work) -> Step:
-    """Lifted, measure SFR and SFL standing still, then turn left and watch
-    how they change.  Both ends of the comparison are means: the start the
-    trimmed mean standing, now the mean of the last PROBE_TICKS ticks.  One
-    tick at each end let a square VL53L1X pair's noise look like a corner
-    ("SFR grew 12 mm, SFL shrank 4 mm" against a start reading 13 mm long):
-    case 3B turned 42 deg looking for the riser and the robot was stranded
-    (the envelope sweep, cases 1119 and 1967 on reference)."""
-    ctx, cfg = t.ctx, t.cfg
-    if not w.checked:
-        if not _settled(t, w) or not _measured_standing(t, w, STILL_TICKS):
-            return stay(NO_MOTION)
-        if not w.standing:  # no tick gave both: now's readings, as the seed
-            w.standing.append(_readings(t))
-        w.probe_sfr = _trimmed_mean([r for r, _l in w.standing])
-        w.probe_sfl = _trimmed_mean([l_ for _r, l_ in w.standing])
-        w.checked = True
-    r, l_ = motion.pair(t.snap)
-    both = r.ok and l_.ok and not motion.far(r, cfg) and not motion.far(l_, cfg)
-    if both:
-        w.probe_recent = [*w.probe_recent[-(PROBE_TICKS - 1):], (r.distance_m, l_.distance_m)]
-        sfr = sum(r_ for r_, _l in w.probe_recent) / len(w.probe_recent)
-        sfl = sum(l_ for _r, l_ in w.probe_recent) / len(w.probe_recent)
-    else:
-        # A beam off the riser (or past LENGTH_OF_INFINITY) is as large a
-        # change as there is: now's readings.  Waiting for five ticks that
-        # see something, an ideal robot 18 deg askew 0.97 m away turned on
-        # until both beams read nothing, and squared up to nothing (the
-        # envelope sweep, case 1004 on ideal).
-        sfr, sfl = _readings(t)
-    # a corner is decided on a full window of means only
-    window_full = both and len(w.probe_recent) >= PROBE_TICKS
-    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
-    d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
-    # Half a resolution step off the readings' grid: whole-millimetre readings
-    # that sum to the threshold exactly must not be decided by float rounding
-    # (the simulation's and the wire's last bits differ).
-    tol = cfg.algorithm.equal_tolerance + cfg.sensors.resolution / 4
-    # A corner only if the changes exceed the pair's noise at the distance
-    # (pair_tolerance), not equal_tolerance alone; a corner's look within the
-    # noise is probed further, not decided.
-    corner_tol = max(tol, pair_tolerance(cfg, (w.probe_sfr + w.probe_sfl) / 2.0))
-    cornerish = d_sfr > 0 and d_sfl < 0
-    unsure = abs(d_sfr) + abs(d_sfl) < 2 * tol or (
-        cornerish and (not window_full or d_sfr - d_sfl < corner_tol))
-    if unsure and motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
-        return stay(motion.turn(1, cfg))
-    corner = cornerish and d_sfr - d_sfl >= corner_tol
-    ctx.calibration_case = "3B" if corner else "3A"
-    data = {"case": ctx.calibration_case, "dSFR": d_sfr, "dSFL": d_sfl}
-    if corner:
-        t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
-              f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
-        return go(P.CAL_CORNER)
-    t.say(f"calibration case 3A: square to the riser (turning left, SFR changed "
-          f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
-    return go(P.CAL_TURN)
-
-
-PROBE = PhaseDef(
-    P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe,
-    to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
-        P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
-
-
-def _corner(t: Tick, w: Work) -> Step:
-    sfr, _sfl = _readings(t)
-    w.probe_sfr = max(w.probe_sfr, sfr)  # the largest SFR seen while turning
-    if sfr < w.probe_sfr - t.cfg.algorithm.equal_tolerance:
-        t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
-        return go(P.CAL_TURN)
-    too_far = _turned_too_far(t, P.CAL_CORNER)
-    if too_far is not None:
-        return too_far
-    return stay(motion.turn(1, t.cfg))
-
-
-CORNER = PhaseDef(
-    P.CAL_CORNER, "calibration case 3B — turn left until both readings shrink", FLOW, _corner,
-    enter=_probe_enter,
-    to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
-
-
-def _away_enter(t: Tick, w: Work) -> None:
-    sfr, sfl = _readings(t)
-    # The nearer beam sees a side wall: turn away from it (left when SFR is
-    # the nearer), the opposite of case 2's rule, until it sees the riser.
-    w.turn_direction = 1 if sfr < sfl else -1
-    w.turn_diff = sfl - sfr
-    w.turn_from = t.snap.turns(MotorId.MWR)
-
-
-def _away(t: Tick, w: Work) -> Step:
-    """Off the wall, the beam that saw it reads the riser: the pair flips
-    (the other sensor is now the nearer, the robot still askew the same way)
-    and the squaring turn goes on in the same direction.  Askew by less than
-    the pair can tell, it flips and flips back as the robot passes square."""
-    cfg = t.cfg
-    r, l_ = motion.pair(t.snap)
-    sfr, sfl = r.distance_m, l_.distance_m
-    first = w.turn_direction  # the sign of SFL − SFR at the start
-    w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
-    d = w.turn_diff
-    seen = not motion.far(r, cfg) and not motion.far(l_, cfg)
-    flipped = d * first < 0
-    w.checked = w.checked or flipped
-    off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance
-    passed_square = w.checked and not flipped and abs(d) <= _one_riser(cfg)
-    if seen and (off_wall or passed_square):
-        t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
-              "riser; squaring up", SFR=sfr, SFL=sfl)
-        return go(P.CAL_TURN)
-    made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
-    if made > MAX_AWAY_YAW_RAD:
-        return fail(f"calibration ({where(t.ctx, P.CAL_AWAY)}) turned "
-                    f"{math.degrees(MAX_AWAY_YAW_RAD):.0f}° away from the side wall and the "
-                    f"readings still do not fit one riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")
-    return stay(motion.turn(w.turn_direction, cfg))
-
-
-AWAY = PhaseDef(
-    P.CAL_AWAY, "calibration case 2W — turn away from the side wall until both see the riser",
-    FLOW, _away, enter=_away_enter,
-    to={P.CAL_TURN: "off the wall: the pair flipped (or flipped back, square)",
-        P.ERROR: "turned too far; " + FAULT})
-
-
-# -- turn back to a heading (descent 1 and 7) ------------------------------------------
-def _turn_to(t: Tick, w: Work) -> Step:
-    """Turn on segment 2's wheels until the odometer's heading is ctx.turn_to."""
-    assert t.ctx.turn_to is not None  # set by whoever lifted for this turn
-    remaining = t.ctx.turn_to - motion.twist(t.snap)
-    if abs(remaining) <= motion.WHEEL_DONE:
-        return go(P.CAL_LOWER)
-    too_far = _turned_too_far(t, P.CAL_TURN_TO)
-    if too_far is not None:
-        return too_far
-    slow = min(1.0, max(TURN_SLOW_FLOOR, abs(remaining) / motion.WHEEL_SLOW_ZONE))
-    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, slow))
-
-
-TURN_TO = PhaseDef(
-    P.CAL_TURN_TO, "calibration — turn by the odometer to a heading", FLOW,
-    _turn_to,
-    to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
-
-
 # -- lower segments 1 and 3 --------------------------------------------------------------
 def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
     ctx = t.ctx
@@ -658,4 +416,5 @@ LOWER = PhaseDef(
         P.DESCENT_FINISH: "lowered (descent 7, turned back to the floor's heading)",
         P.ERROR: FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, PROBE, CORNER, AWAY, TURN, TURN_TO, LOWER)
+PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, LOWER)
+"""This module's phases; the turns' are in :mod:`~stairbot.algorithm.turns`."""

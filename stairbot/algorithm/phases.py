@@ -91,7 +91,7 @@ _RECORDS: dict[Phase, PhaseDef] = {}
 
 
 def _records() -> dict[Phase, PhaseDef]:
-    # The records live with their flows (calibration.py, ascent.py...), which
+    # The records live with their flows (calibration.py, turns.py, ascent.py...), which
     # import this module: they are gathered on first use.
     if not _RECORDS:
         from stairbot.algorithm.table import PHASES
