@@ -30,3 +30,25 @@ def disk_fills(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, int]]:
 
     monkeypatch.setattr(files, "_write", write)
     yield left
+
+
+@pytest.fixture
+def recording_read_fails(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Reading a recording fails as a failing disk does: EIO from the read
+    (``stairbot plot`` and ``stairbot replay`` read a recording whole through
+    ``recording.read.recording_bytes``, which opens it with ``os.fdopen``)."""
+
+    class Failing:
+        def __init__(self, fd: int, mode: str) -> None:
+            os.close(fd)
+
+        def __enter__(self) -> Failing:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            pass
+
+        def read(self) -> bytes:
+            raise OSError(errno.EIO, "Input/output error")
+
+    monkeypatch.setattr(os, "fdopen", Failing)

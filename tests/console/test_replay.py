@@ -7,9 +7,7 @@ recording as the ``mcap`` package's own reader reads it."""
 from __future__ import annotations
 
 import asyncio
-import errno
 import json
-import os
 import subprocess
 import sys
 from collections.abc import Callable
@@ -27,7 +25,6 @@ from stairbot.console.replay_app import ReplayConsole, build_replay_app
 from stairbot.console.widgets.motors import NAMES as MOTOR_NAMES
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.recording import read as read_module
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.pose import DeadReckonedPose
@@ -464,22 +461,8 @@ def test_bad_input_is_one_line_and_exit_2(case: str, command: list[str], tmp_pat
 
 
 def test_a_read_the_disk_fails_is_one_line_and_exit_1(
-        recorded: dict[str, Path], monkeypatch: pytest.MonkeyPatch,
+        recorded: dict[str, Path], recording_read_fails: None,
         capsys: pytest.CaptureFixture[str]) -> None:
-    class Failing:
-        def __init__(self, fd: int, mode: str) -> None:
-            os.close(fd)
-
-        def __enter__(self) -> Failing:
-            return self
-
-        def __exit__(self, *exc: object) -> None:
-            pass
-
-        def read(self) -> bytes:
-            raise OSError(errno.EIO, "Input/output error")
-
-    monkeypatch.setattr(read_module.os, "fdopen", Failing)
     assert main(["replay", str(recorded["mcap"])]) == 1
     err = capsys.readouterr().err
     assert err == (f"stairbot: error: {recorded['mcap']}: cannot read the recording: "

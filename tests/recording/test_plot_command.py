@@ -4,7 +4,6 @@ exit 2, never a traceback."""
 
 from __future__ import annotations
 
-import os
 import struct
 import subprocess
 import sys
@@ -149,26 +148,8 @@ def test_an_mcap_recording_without_ticks_plots_its_events(
 
 
 def test_a_read_the_disk_fails_is_one_line_and_exit_1(
-        recordings: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        recordings: dict[str, Path], tmp_path: Path, recording_read_fails: None,
         capsys: pytest.CaptureFixture[str]) -> None:
-    import errno
-
-    from stairbot.recording import read as read_module
-
-    class Failing:
-        def __init__(self, fd: int, mode: str) -> None:
-            os.close(fd)
-
-        def __enter__(self) -> Failing:
-            return self
-
-        def __exit__(self, *exc: object) -> None:
-            pass
-
-        def read(self) -> bytes:
-            raise OSError(errno.EIO, "Input/output error")
-
-    monkeypatch.setattr(read_module.os, "fdopen", Failing)
     out = tmp_path / "x.png"
     assert main(["plot", str(recordings["mcap"]), "-o", str(out)]) == 1
     err = capsys.readouterr().err
