@@ -1,4 +1,8 @@
-"""The help screen (``?``): every key, and how to read the screen."""
+"""The help screen (``?``): every key, and how to read the screen.
+
+Its lines fit :data:`WIDTH` columns: the dialog's width (``.help`` in
+console.tcss, 72) less its border, padding and scroll bar; a longer one
+wraps at 80x24 into a line that reads as two."""
 
 from __future__ import annotations
 
@@ -8,11 +12,14 @@ from textual.containers import VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Static
 
+WIDTH = 64
+
 HELP = """\
 KEYS
-  space   EMERGENCY STOP: every motor stops at once, from any screen,
-          even over a prompt; latched until c
-  c       clear the emergency stop (asks first; look at the robot)
+  space   EMERGENCY STOP: every motor stops at once, from any
+          screen, even over a prompt; latched until c
+  c       clear the emergency stop (asks first: look at the
+          robot)
   s       start the full run      k  calibrate only
   p       pause / resume          x  stop the run
   q       quit (mid-run: the robot stops first, then it asks);
@@ -22,26 +29,28 @@ KEYS
   w       record events to a file (never over an existing one)
   z       picture zoom            ?  this help
   g       graphs: pitch, distance sensors, lifts over the last
-          30 s of robot time (36 rows or more: under the picture;
-          fewer: in its place until g again)
+          30 s of robot time (36 rows or more: under the
+          picture; fewer: in its place until g again)
   Ctrl+P  every action by name
 
 READING THE SCREEN
-  Banner: the state (READY, RUNNING, PAUSED, ENDED, FAULT), E-STOP
-  and who latched it (operator, or automatic: why), then what to
-  know now, whole.
+  Banner: the state (READY, RUNNING, PAUSED, ENDED, FAULT),
+  E-STOP and who latched it (operator, or automatic: why), then
+  what to know now, whole.
   Every panel says how old its values are; values not read for
   1.5 s are dimmed and marked STALE: they are not live.
   Sensors: front R/L look ahead (SFR, SFL), back R/L look down
-  (SBR, SBL); ok, out (of range: the value is the sensor's limit),
-  old (the sensor's own reading is stale), ERROR.
+  (SBR, SBL); ok, out (of range: the value is the sensor's
+  limit), old (the sensor's own reading is stale), ERROR.
   Motors: ▶ forward ◀ back; a lift shows the segment that moves:
   1▲ segment 1 rises, 2▼ segment 2 sinks (segments 1 front, 2
-  middle, 3 back, coloured as in the picture).  With no run going,
-  a lift's arrow is its end segment against segment 2.
-  Phase: what the robot is doing, the seed's name for it beneath.
+  middle, 3 back, coloured as in the picture).  With no run
+  going, a lift's arrow is its end segment against segment 2.
+  Phase: what the robot is doing, the seed's name for it
+  beneath.
   Graphs: each line scaled to its own range, written after it;
-  they stop when the readings stop, and dim with them when STALE.
+  they stop when the readings stop, and dim with them when
+  STALE.
   Events: the run's events and everything the console said.
 
   Escape or ? closes this help.

@@ -63,6 +63,27 @@ def test_help_screen_lists_every_key() -> None:
     asyncio.run(go())
 
 
+@pytest.mark.parametrize("which", ["console", "replay"])
+def test_no_help_line_wraps_at_80x24(which: str) -> None:
+    """Found: at 80x24 the help's longest lines wrapped ("...from any" and
+    "screen," on two lines), reading as two keys' worth of text."""
+    from stairbot.console.replay_app import REPLAY_HELP
+
+    text = REPLAY_HELP if which == "replay" else None
+
+    async def go() -> None:
+        app = make_still_app()
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            app.push_screen(HelpScreen(text) if text else HelpScreen())
+            await until(pilot, lambda: isinstance(app.screen, HelpScreen), "the help")
+            await pilot.pause(0.1)
+            static = app.screen.query_one(Static)
+            longest = max(len(line) for line in str(static.render()).splitlines())
+            assert longest <= static.content_region.width, (longest, static.content_region)
+    asyncio.run(go())
+
+
 @pytest.mark.parametrize("size", [(80, 24), (100, 24), (100, 30), (120, 40)])
 def test_nothing_an_operator_needs_is_cut(size: tuple[int, int]) -> None:
     """Findings: at 80 columns the banner's key text was cut (the e-stop button
