@@ -54,8 +54,11 @@ def first_row(screen: str) -> str:
 @needs_chromium
 def test_the_console_in_a_browser_draws_the_robot_climbing_and_the_estop_stops_it() -> None:
     with served_console("--speed", "10x") as (url, _), chromium_page(url) as page:
+        # the motors panel is drawn from the first reading, which may come a
+        # frame after the picture: wait for it too (a CI run read it empty)
         ready = wait_screen(page, lambda s: "READY" in first_row(s) and CAPTION.search(s)
-                            is not None, "the robot drawn on the stairs, ready")
+                            is not None and len(motor_speeds(s)) == 6,
+                            "the robot drawn on the stairs, ready, its motors read")
         assert "side view" in ready and BRAILLE.search(ready)  # the picture is there
         m = CAPTION.search(ready)
         assert m is not None and m.group(1, 2, 3) == ("0", "0", "0")
