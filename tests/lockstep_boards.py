@@ -6,10 +6,12 @@ its own, not conftest.py)."""
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -64,3 +66,33 @@ def fake_boards(cwd: Path) -> Iterator[str]:
     """:func:`lockstep_boards`, yielding their URL alone."""
     with lockstep_boards(cwd) as boards:
         yield boards.url
+
+
+def last_tick(journal: Path) -> dict[str, object]:
+    """The journal's last whole line (a run still writing may have begun the next)."""
+    whole = journal.read_text().rpartition("\n")[0]
+    return json.loads(whole.rpartition("\n")[2]) if whole else {}
+
+
+def kill_mid_lift(url: str, journal: Path, env: dict[str, str], cwd: Path,
+                  *args: str) -> dict[str, object]:
+    """``stairbot run --robot URL ARGS`` killed (-9) while segment 1 lifts
+    (ascent 3), watched through ``journal`` (where ARGS, or the default,
+    put it); the journal's last tick then."""
+    host = stairbot("run", "--robot", url, *args, "-q", env=env, cwd=cwd)
+    deadline = time.monotonic() + 120
+    try:
+        while time.monotonic() < deadline:
+            if journal.exists():
+                tick = last_tick(journal)
+                command = tick.get("command")
+                if (tick.get("phase") == "ascent_lift_first" and isinstance(command, dict)
+                        and command.get("MTF", 0) > 0):
+                    break
+            time.sleep(0.02)
+        else:
+            raise AssertionError("the run never reached ascent 3 lifting")
+    finally:
+        host.kill()  # SIGKILL: no finally, no close, no end record
+        host.wait()
+    return last_tick(journal)

@@ -13,12 +13,11 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from lockstep_boards import lockstep_boards
+from lockstep_boards import kill_mid_lift, last_tick, lockstep_boards
 
 from stairbot.journal import JournalWriter, read_journal
 from stairbot.resume import ResumeRefused, check, describe
@@ -42,40 +41,12 @@ def boards(env: dict[str, str], tmp_path: Path) -> Iterator[tuple[str, subproces
         yield served.url, served.proc
 
 
-def last_tick(journal: Path) -> dict[str, object]:
-    """The journal's last whole line (a run still writing may have begun the next)."""
-    whole = journal.read_text().rpartition("\n")[0]
-    return json.loads(whole.rpartition("\n")[2]) if whole else {}
-
-
-def kill_mid_lift(url: str, journal: Path, env: dict[str, str], cwd: Path) -> dict[str, object]:
-    """Start a run and kill -9 it while segment 1 lifts (ascent 3); the
-    journal's last tick then."""
-    host = stairbot("run", "--robot", url, "--journal", str(journal), "-q", env=env, cwd=cwd)
-    deadline = time.monotonic() + 120
-    try:
-        while time.monotonic() < deadline:
-            if journal.exists():
-                tick = last_tick(journal)
-                command = tick.get("command")
-                if (tick.get("phase") == "ascent_lift_first" and isinstance(command, dict)
-                        and command.get("MTF", 0) > 0):
-                    break
-            time.sleep(0.02)
-        else:
-            raise AssertionError("the run never reached ascent 3 lifting")
-    finally:
-        host.kill()  # SIGKILL: no finally, no close, no end record
-        host.wait()
-    return last_tick(journal)
-
-
 def test_kill_9_mid_lift_then_resume_with_confirmation_finishes_and_comes_home(
         boards: tuple[str, subprocess.Popen[str]], env: dict[str, str],
         tmp_path: Path) -> None:
     url, _ = boards
     journal = tmp_path / "run.jsonl"
-    killed = kill_mid_lift(url, journal, env, tmp_path)
+    killed = kill_mid_lift(url, journal, env, tmp_path, "--journal", str(journal))
     assert read_journal(journal).end is None
 
     # Without confirmation (no terminal, no --yes): one line, exit 2, nothing moved.
@@ -114,7 +85,7 @@ def test_a_resume_on_boards_that_restarted_is_refused(
         tmp_path: Path) -> None:
     url, proc = boards
     journal = tmp_path / "run.jsonl"
-    kill_mid_lift(url, journal, env, tmp_path)
+    kill_mid_lift(url, journal, env, tmp_path, "--journal", str(journal))
     proc.send_signal(signal.SIGINT)
     proc.wait(10)
     again = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=tmp_path)

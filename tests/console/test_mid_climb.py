@@ -10,11 +10,10 @@ from __future__ import annotations
 import asyncio
 import json
 import os
-import time
 from pathlib import Path
 
 import pytest
-from lockstep_boards import fake_boards, stairbot
+from lockstep_boards import fake_boards, kill_mid_lift, last_tick
 from pilot import SpyRobot, banner, press, ready, spied_open, until
 from textual.widgets import Label
 
@@ -69,30 +68,6 @@ def test_a_fresh_start_mid_climb_is_refused_and_reset_is_offered() -> None:
     asyncio.run(go())
 
 
-def kill_mid_lift(url: str, env: dict[str, str], cwd: Path) -> dict[str, object]:
-    """`stairbot run` on the boards, killed (-9) while segment 1 lifts; the
-    journal's last tick then (at its default place, as the console reads it)."""
-    journal = default_path(url)
-    assert journal is not None
-    host = stairbot("run", "--robot", url, "-q", env=env, cwd=cwd)
-    deadline = time.monotonic() + 120
-    try:
-        while time.monotonic() < deadline:
-            lines = journal.read_text().splitlines() if journal.exists() else []
-            tick = json.loads(lines[-1]) if lines else {}
-            command = tick.get("command")
-            if (tick.get("phase") == "ascent_lift_first" and isinstance(command, dict)
-                    and command.get("MTF", 0) > 0):
-                break
-            time.sleep(0.02)
-        else:
-            raise AssertionError("the run never reached ascent 3 lifting")
-    finally:
-        host.kill()
-        host.wait()
-    return json.loads(journal.read_text().splitlines()[-1])
-
-
 def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Finding: the console let a fresh run start on boards a crashed host had
@@ -102,9 +77,9 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
     with fake_boards(tmp_path) as url:
-        killed = kill_mid_lift(url, dict(os.environ), tmp_path)
         journal = default_path(url)
         assert journal is not None
+        killed = kill_mid_lift(url, journal, dict(os.environ), tmp_path)
 
         async def go() -> None:
             app = build_app(url=url)
@@ -130,7 +105,7 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
                 await until(pilot, lambda: len(app.screen_stack) == 1, "answered")
                 await pilot.pause(0.3)
                 assert not app.engine.running
-                assert json.loads(journal.read_text().splitlines()[-1]) == killed
+                assert last_tick(journal) == killed
                 await press(pilot, "s")
                 await until(pilot, lambda: isinstance(app.screen, ChoiceScreen), "again")
                 await press(pilot, "r")
