@@ -39,7 +39,7 @@ from stairbot.cli_show import (
     cmd_scenario_list,
 )
 from stairbot.config import RobotConfig, load_config
-from stairbot.errors import HardwareError, InputError, NoBoardError, OutputError
+from stairbot.errors import HardwareError, InputError, NoBoardError, OutputError, ReadFault
 from stairbot.events import Event, EventKind
 from stairbot.paths import unused_path
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
@@ -198,7 +198,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return func(args)
     except InputError as exc:
         return _input_error(exc)
-    except OutputError as exc:  # before the robot moved (a run's own ends in cmd_run)
+    except (OutputError, ReadFault) as exc:  # before the robot moved (a run's own: cmd_run)
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return EXIT_MISMATCH
     except KeyboardInterrupt:
@@ -229,7 +229,7 @@ def _external(name: str) -> Callable[[argparse.Namespace], int]:
             return func(list(args.rest))
         except InputError as exc:
             return _input_error(exc)
-        except OutputError as exc:  # a file the command writes: the disk refused it
+        except (OutputError, ReadFault) as exc:  # the disk refused a write or failed a read
             print(f"{PROG}: error: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
         except KeyboardInterrupt:

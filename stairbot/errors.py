@@ -46,6 +46,11 @@ class OutputError(StairbotError):
         super().__init__(f"{path}: cannot write {what}: {problem}")
 
 
+class ReadFault(StairbotError):
+    """The disk failed while a file was read (an I/O fault, not bad input):
+    the CLI exits 1 with the message, one line naming the file."""
+
+
 class HardwareError(StairbotError):
     """The robot (real or simulated) failed: the run stops in a safe state."""
 

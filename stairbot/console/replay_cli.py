@@ -14,13 +14,11 @@ a read the disk fails is one line and exit 1.
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 
 from stairbot.console.replay import SPEEDS
 from stairbot.errors import InputError
 
-EXIT_READ_FAULT = 1
 SPEED_WORDS = {f"{s:g}": s for s in SPEEDS} | {f"{s:g}x": s for s in SPEEDS}
 SPEED_WORDS_SHOWN = [f"{s:g}" for s in SPEEDS]
 LIVE_SPEEDS = {"1x": 1.0, "10x": 10.0, "max": SPEEDS[-1]}
@@ -75,15 +73,10 @@ def check_reader(path: str) -> None:
 def replay(path: str, speed: float = 1.0, paused: bool = False) -> int:
     """Load ``path`` (bad input raises InputError), then play it until the
     operator quits; the exit code."""
-    from stairbot.recording.read import RecordingReadError
     from stairbot.recording.replay_source import load_replay
 
     check_reader(path)
-    try:
-        source = load_replay(path)
-    except RecordingReadError as exc:
-        print(f"stairbot: error: {exc}", file=sys.stderr)
-        return EXIT_READ_FAULT
+    source = load_replay(path)  # a ReadFault: the CLI's one line and exit 1
     from stairbot.console.replay_app import build_replay_app  # textual: once it opens
 
     app = build_replay_app(source, speed=speed, playing=not paused)

@@ -10,7 +10,6 @@ read the disk fails is one line and exit 1.
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -35,19 +34,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Write the PNG; returns 0, or 1 when the disk fails the recording's
-    read (one line).  Raises InputError for bad input, OutputError when the
-    disk refuses the PNG."""
+    """Write the PNG; returns 0.  Raises InputError for bad input, a
+    ReadFault when the disk fails the recording's read, OutputError when it
+    refuses the PNG."""
     args = build_parser().parse_args(list(argv) if argv is not None else None)
     from stairbot.recording.plot import check_extra, render
-    from stairbot.recording.read import RecordingReadError, read_recording
+    from stairbot.recording.read import read_recording
 
     check_extra()
-    try:
-        recording = read_recording(args.file)
-    except RecordingReadError as exc:
-        print(f"stairbot: error: {exc}", file=sys.stderr)
-        return 1
+    recording = read_recording(args.file)
     out = Path(args.output) if args.output else Path(args.file).with_suffix(".png")
     png = render(recording)
     f = LineFile(out, "the plot")

@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from stairbot.errors import InputError, StairbotError
+from stairbot.errors import InputError, ReadFault
 from stairbot.files import open_regular, shown
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES, DeadReckonedPose, SimulationPose, pitch_of
@@ -82,9 +82,9 @@ def read_recording(path: str | os.PathLike[str]) -> Recording:
     return read_jsonl(name, data)
 
 
-class RecordingReadError(StairbotError):
-    """The disk failed while a recording was read (an I/O fault, not bad
-    input: exit 1).  One line naming the file."""
+class RecordingReadError(ReadFault):
+    """The disk failed while a recording was read (exit 1, as every
+    ReadFault).  One line naming the file."""
 
 
 def recording_bytes(path: str | os.PathLike[str]) -> bytes:
