@@ -16,6 +16,7 @@ from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import SERIES, History
+from stairbot.errors import LinkLostError
 from stairbot.hardware import (
     Imu,
     MotorId,
@@ -40,13 +41,17 @@ def snap(t: float, pitch: float, sfr: float = 0.3, mtf_turns: float = 0.0,
 
 
 class ScriptedRobot(StillRobot):
-    """Reads whatever the test last put in ``snap``."""
+    """Reads whatever the test last put in ``snap``; ``silent``: answers no
+    read (the console's idle poll then reads nothing)."""
 
     def __init__(self) -> None:
         super().__init__()
         self.snap = snap(0.0, 0.0)
+        self.silent = False
 
     def read(self) -> Snapshot:
+        if self.silent:
+            raise LinkLostError("link lost: no reply (the test's robot is silent)")
         return self.snap
 
 
@@ -144,6 +149,9 @@ def test_graphs_draw_the_readings_and_stop_and_dim_when_they_go_stale() -> None:
             assert len(app.trends.lines["SFL"].data or []) == 50
             assert len(app.trends.lines["pitch"].data or []) == 51
             # no reading for longer than STALE_S: stopped and dimmed, said STALE
+            # (the robot silent: an idle poll that read it again would make the
+            # values fresh, and did, once, on a loaded machine)
+            robot.silent = True
             ages[0] += STALE_S + 1
             await until(pilot, lambda: app.trends.has_class("-stale"), "the graphs dimmed")
             assert "STALE" in str(app.trends.border_title)
