@@ -179,6 +179,9 @@ class Truth:
     max_pitch_deg: float | None
     offset_m: float | None
     """Distance from the start pose."""
+    clear_of_stairs_m: float | None = None
+    """How far the robot's front face stands before the first riser (negative:
+    over the stairs): a descent from the top has reached the floor."""
 
 
 @runtime_checkable

@@ -128,11 +128,15 @@ class RunResult:
     """"link" when the run ended on a lost link, "hardware" on another
     failure the robot reported, "output" when the journal or the event
     record could not be written (a full disk); None otherwise."""
+    clear_of_stairs_m: float | None = None
+    """How far the robot's front face ended before the first riser (negative:
+    on the stairs), where the robot can tell (a simulation): a descent from
+    the top reached the floor."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
         for key in ("max_pitch_deg", "final_offset_m", "sim_time_s", "wall_time_s",
-                    "realtime_factor"):
+                    "realtime_factor", "clear_of_stairs_m"):
             if isinstance(out[key], float):
                 out[key] = round(out[key], 4)
         return out
@@ -245,6 +249,7 @@ def run(
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
         tilt_watched=ctl.config.safety.imu,
         fault=fault,
+        clear_of_stairs_m=truth.clear_of_stairs_m if truth is not None else None,
     )
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands

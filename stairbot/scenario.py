@@ -46,10 +46,19 @@ class Stairs(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 
 MAX_START_DISTANCE = 20.0
 """Farthest start before the first riser, m (the simulated floor runs 30 m back)."""
+TOP_LANDING_ROOM = 2.0
+"""Farthest start from the top edge, m, on the top (the simulated landing runs
+3 m past the last riser's top: the robot, 0.2-0.5 m long, stays on it)."""
 
 
 class Start(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    on: Literal["floor", "top"] = "floor"
+    """Where the robot starts: on the floor before the first riser, facing the
+    stairs; or on the top of the flight, facing away from it, to back down it
+    (continuous descent: a flight it has not climbed)."""
     distance: Annotated[float, msgspec.Meta(gt=0, le=MAX_START_DISTANCE)] = 0.5
+    """On the floor: the robot's front face to the first riser.  On the top:
+    its rear (segment 3's back face) to the top edge."""
     yaw_deg: Annotated[float, msgspec.Meta(ge=-80, le=80)] = 0.0
     lateral: Annotated[float, msgspec.Meta(ge=-10.0, le=10.0)] = 0.0
 
@@ -144,6 +153,20 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
                                 f"only an 'offset' fault takes an offset; an '{fault.kind}' "
                                 "fault makes the sensor report ERROR ('error') or stop "
                                 "measuring ('freeze'); leave offset out")
+    if data.start.on == "top":
+        if not steps:
+            raise ScenarioError(source, "start.on",
+                                "'top' needs at least one step to stand on the top of; "
+                                "allowed: 'floor', or 'top' with stairs.count >= 1")
+        if st.top == "wall":
+            raise ScenarioError(source, "start.on",
+                                "'top' needs the flight to end on a landing (stairs.top = "
+                                "'landing'): with a wall there is no top to stand on")
+        if data.start.distance > TOP_LANDING_ROOM:
+            raise ScenarioError(source, "start.distance",
+                                f"{data.start.distance} m from the top edge leaves the robot "
+                                f"off the landing; allowed with start.on = 'top': up to "
+                                f"{TOP_LANDING_ROOM} m")
     half = st.width / 2
     if abs(data.start.lateral) >= half:
         raise ScenarioError(source, "start.lateral",

@@ -61,8 +61,11 @@ class SceneView:
 def stairs_from_scenario(scenario: Scenario, robot_length: float) -> tuple[Point, ...]:
     """The side outline of a scenario's stairs: floor from behind the robot's
     start, each riser and tread, then a landing (or a wall too high to climb).
-    The first riser stands at x = 0; the robot's front starts at -distance."""
-    behind = scenario.start.distance + robot_length + 0.1
+    The first riser stands at x = 0; the robot's front starts at -distance,
+    or, on the top (``start.on = "top"``), its rear distance past the top
+    edge, and it ends on the floor behind the first riser."""
+    top = scenario.start.on == "top"
+    behind = 2 * robot_length + 0.4 if top else scenario.start.distance + robot_length + 0.1
     pts: list[Point] = [(-behind, 0.0), (0.0, 0.0)]
     x = y = 0.0
     for step in scenario.steps:
@@ -75,7 +78,11 @@ def stairs_from_scenario(scenario: Scenario, robot_length: float) -> tuple[Point
     elif scenario.top == "wall":
         pts.append((x, y + 0.6))
     else:
-        pts[-1] = (x + max(0.4, robot_length * 1.5), y)
+        room = max(0.4, robot_length * 1.5)
+        if top:  # past the top edge: the start, the robot, and a little
+            room = max(room, scenario.start.distance + robot_length + 0.1
+                       - scenario.steps[-1].tread)
+        pts[-1] = (x + room, y)
     return tuple(pts)
 
 

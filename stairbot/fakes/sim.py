@@ -166,7 +166,8 @@ class SimRobot:
         pitched, and how far segment 2 is from where it started."""
         w = self.world
         return Truth(fell=w.fell, fall_reason=w.fall_reason, pitch_deg=w.pitch_deg(),
-                     max_pitch_deg=w.max_pitch_deg, offset_m=self.offset_m())
+                     max_pitch_deg=w.max_pitch_deg, offset_m=self.offset_m(),
+                     clear_of_stairs_m=w.clear_of_stairs_m())
 
     def scene(self) -> Scene:
         """The stairs and the robot's pose, for drawing."""

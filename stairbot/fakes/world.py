@@ -40,6 +40,24 @@ CAT_ROBOT = 0b10
 ROBOT_GROUP = 1
 
 
+def top_edge(scenario: Scenario) -> tuple[float, float]:
+    """(x, y) of the top edge: where the last riser meets the last tread."""
+    x = sum(step.tread for step in scenario.steps[:-1])
+    return x, sum(step.rise for step in scenario.steps)
+
+
+def start_pose(scenario: Scenario, length: float) -> tuple[float, float]:
+    """Where the robot starts: x of its front face, and y of the surface it
+    stands on.  On the floor (``start.on = "floor"``) its front face is
+    ``start.distance`` before riser 1; on the top it faces away from the
+    flight, its rear ``start.distance`` past the top edge."""
+    start = scenario.start
+    if start.on == "top":
+        x, y = top_edge(scenario)
+        return x + start.distance + length, y
+    return -start.distance, 0.0
+
+
 class World:
     """The pymunk world: static stairs, the robot's bodies, joints and motors."""
 
@@ -71,7 +89,7 @@ class World:
                   config.masses.third_module)
         robot_filter = pymunk.ShapeFilter(group=ROBOT_GROUP, categories=CAT_ROBOT,
                                           mask=CAT_STAIRS)
-        front = -scenario.start.distance
+        front, base = start_pose(scenario, sum(self.lengths))
         self.segments: list[pymunk.Body] = []
         self.boxes: list[pymunk.Poly] = []
         self.wheels: list[tuple[pymunk.Body, pymunk.Body]] = []  # (rear, front)
@@ -81,7 +99,7 @@ class World:
         for length, mass in zip(self.lengths, masses, strict=True):
             body = pymunk.Body()
             # local frame: origin at the segment's centre on its axle line
-            body.position = (left - length / 2, r)
+            body.position = (left - length / 2, base + r)
             half, ch = length / 2, min(p.chamfer, length / 4, self.height / 4)
             # the chassis' bottom edges are chamfered, as a real one's would be
             box = pymunk.Poly(body, [(-half + ch, 0.0), (half - ch, 0.0), (half, ch),
@@ -262,6 +280,14 @@ class World:
         if self._pose_at != self._steps_done:
             self._fetch()
         return self._px[1]
+
+    def clear_of_stairs_m(self) -> float:
+        """How far segment 1's front face stands before riser 1 (x = 0), along
+        the flight; negative once it is over the stairs."""
+        if self._pose_at != self._steps_done:
+            self._fetch()
+        x, a = self._px[0], self._pa[0]
+        return -(x + math.cos(a) * self.lengths[0] / 2)
 
     def state(self) -> tuple[list[float], list[float], list[float], list[float], list[float]]:
         """What pose, wheel_turns and lift_offset tell one at a time, in one call:
