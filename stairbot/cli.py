@@ -121,6 +121,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--calibrate-only", action="store_true",
                    help="only square up to the first riser (calibration), then stop; "
                         "[expect] is not checked: exit 0 when calibration completes")
+    r.add_argument("--from-top", action="store_true",
+                   help="the robot stands on the top of a flight it has not climbed, "
+                        "facing away from it: back down it to the floor (continuous "
+                        "descent; a scenario with start.on = 'top' implies it)")
     r.add_argument("-q", "--quiet", action="store_true",
                    help="print no progress lines, only the summary (or the JSON)")
     r.add_argument("--journal", metavar="FILE",
@@ -320,7 +324,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale,
                            allow_latched=args.resume)
     path = journal_path(args.robot, args.journal)
-    mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.FULL
+    from_top = args.from_top or scenario.start.on == "top"
+    if args.calibrate_only and from_top:
+        print(f"{PROG}: error: --calibrate-only squares up to a riser ahead; a robot on the "
+              "top of a flight (--from-top, or start.on = 'top') has none: leave one out",
+              file=sys.stderr)
+        return EXIT_INPUT
+    mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.for_start(
+        "top" if from_top else "floor")
     with _record_file(unused_record(args.record), config) as record:
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
@@ -366,6 +377,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             verb = "resuming" if args.resume else "running"
             print(f"{verb} {scenario.name}{what} on {args.robot}"
                   + (", calibration only" if args.calibrate_only else "")
+                  + (", down from the top" if from_top else "")
                   + (f"; journal {path}" if journal is not None else ""),
                   file=progress, flush=True)
         control = RunControl()

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
 from stairbot.events import Event, discard
 from stairbot.robots import RobotOptions, open_robot
@@ -12,10 +13,11 @@ from stairbot.scenario import Scenario
 
 def run_sim(config: RobotConfig, scenario: Scenario,
             events: list[Event] | None = None) -> RunResult:
-    """``config``'s robot, simulated, on ``scenario``; its events go to
-    ``events`` if given."""
+    """``config``'s robot, simulated, on ``scenario`` (down from the top if it
+    starts there); its events go to ``events`` if given."""
     session = open_robot("sim://", config, RobotOptions(world=scenario))
     try:
-        return run(session, config, discard if events is None else events.append)
+        return run(session, config, discard if events is None else events.append,
+                   Mode.for_start(scenario.start.on))
     finally:
         session.close()

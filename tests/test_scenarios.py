@@ -38,6 +38,10 @@ PATHS: dict[str, tuple[set[str], set[str]]] = {
     "passing_disagreement": ({"paused"}, set()),
     "lasting_disagreement": ({"paused"}, set()),
     "floor_not_found": ({"descent_lower_third"}, {"descent_drive_second"}),
+    "top_descent": ({"descent_back_to_edge", "descent_lower_first", "descent_back_off"},
+                    {"ascent_approach", "descent_refuse", "descent_finish"}),
+    "top_deep_drop": ({"descent_lower_first", "descent_refuse"}, {"ascent_approach"}),
+    "top_no_edge": (set(), {"descent_lower_third", "ascent_approach"}),
 }
 
 

@@ -77,6 +77,12 @@ class Context:
     by the odometer to correct what the check standing on all wheels found);
     while above 0, the calibration's check verifies the last one."""
     steps_descended: int = 0
+    from_top: bool = False
+    """Continuous descent (:attr:`~stairbot.algorithm.phases.Mode.DESCEND`): the
+    program began on the top of a flight it did not climb.  Its steps are
+    counted from the top (number_of_steps stays 0); each step's
+    tab_length_to_edge is read where descent 1 leaves segment 3 over its
+    edge."""
     pauses: int = 0
     ascent_end: str | None = None
     """"top_reached" | "obstacle" | "step_limit" once the ascent has ended."""

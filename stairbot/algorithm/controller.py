@@ -104,6 +104,10 @@ class Controller:
         self._sink = sink
         if context is None:
             context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns)
+            if mode is Mode.DESCEND:  # on the top: no riser to square up to, the edge behind
+                context.from_top = True
+                context.purpose = "descent"
+                context.phase = Phase.DESCENT_BACK_TO_EDGE.value
         self._ctx = context
         self._started = context.phase_started_s is not None
         self._held: str | None = None

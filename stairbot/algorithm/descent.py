@@ -75,13 +75,29 @@ BACK_OFF = PhaseDef(
 
 
 def _edge_known(t: Tick, _w: Work) -> Step | None:
-    if _tab(t) is None:
+    if _tab(t) is None and not t.ctx.from_top:
         return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured; "
                     "the edge of the step cannot be found")
     return None
 
 
+def edge_search_m(t: Tick) -> float:
+    """Continuous descent: how far backing up to the edge looks for it before
+    taking what the robot stands on for the floor.  From the start on the top,
+    LENGTH_OF_INFINITY (the operator set the robot down near the edge); on a
+    step below, LENGTH_OF_A_ROBOT + SAFE_LENGTH past where the back-off and
+    calibration left it, so that a tread up to about twice the shortest the
+    robot enters, and the back-off's length, is a step, and a longer one
+    the floor (or a landing)."""
+    cfg = t.cfg
+    if t.ctx.steps_descended == 0:
+        return cfg.LENGTH_OF_INFINITY
+    return cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
+
+
 def _edge_fallback(t: Tick) -> float:
+    if t.ctx.from_top:
+        return t.cfg.wheel_turns(edge_search_m(t))
     # Descent 1 backed off to SAFE_DISTANCE_IN_FRONT_OF_STEP before calibrating.
     tab = _tab(t) or t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     return t.cfg.wheel_turns(max(0.0, tab - t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
@@ -228,7 +244,27 @@ def _edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
 # where segment 3 was lifted over the edge, it left segment 3's front wheels
 # on the edge's corner, and lowered, segment 3 stayed up while the lift
 # pitched the robot (the envelope sweep, case 781 on ir).
-_to_edge = reading_drive(-1, _tab, _edge_fallback, lambda _t, _w: go(P.DESCENT_LOWER_THIRD),
+def _at_edge(t: Tick, w: Work) -> Step:
+    """Backed up to the edge.  In a continuous descent, backing the whole
+    search without seeing an edge is the floor.  (Its tab_length_to_edge stay
+    unknown, and descent 3 and 5 go by the seed's turn counts: the front pair
+    looks back up at risers the robot did not climb, and a cone sees over a
+    low one as the robot backs away from it -- the descent sweep: on 0.08 m
+    risers SFR/SFL jumped 70 mm to the riser beyond, descent 5 ended at once,
+    and segment 1, lowered on the edge, pitched the robot 15 deg nose up.)"""
+    ctx = t.ctx
+    if not ctx.from_top or ctx.edge_wheel is not None:
+        return go(P.DESCENT_LOWER_THIRD)
+    searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
+    if ctx.steps_descended == 0:
+        return end("stopped", f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
+                              f"backing from the start (at most LENGTH_OF_INFINITY = "
+                              f"{t.cfg.LENGTH_OF_INFINITY} m): not on the top of a flight")
+    return end("completed", f"on the floor: no edge within {searched:.2f} m behind step "
+                            f"{ctx.steps_descended} from the top, the last descended")
+
+
+_to_edge = reading_drive(-1, _tab, _edge_fallback, _at_edge,
                          lambda t, w: _edge_bound(t, w, refind=True), exact=True)
 
 
@@ -253,6 +289,11 @@ def _refind(t: Tick, w: Work) -> Step:
         w.edge_watch_s = w.edge_floor_s = t.snap.time_s
         return stay(NO_MOTION)
     most = refind_max_m(cfg)
+    if driven_m >= most and t.ctx.from_top:
+        return end("stopped", f"refused: SBR/SBL read past an edge from the start of step "
+                              f"{t.ctx.steps_descended + 1} from the top, and still after "
+                              f"driving {driven_m * 1000:.0f} mm forward: the tread is shorter "
+                              "than the robot")
     if driven_m >= most:
         return fail(f"descent 1: SBR/SBL still read past the edge after driving "
                     f"{driven_m * 1000:.0f} mm forward to find the floor again (at most "
@@ -277,6 +318,9 @@ BACK_TO_EDGE = PhaseDef(
                                 "edge (driving forward first until they read the floor, "
                                 "if they were past it unseen); or, not crossed yet, reads "
                                 "tab_length_to_edge[i]",
+        P.DONE: "continuous descent: no edge within the search (edge_search_m): on the "
+                "floor; or, from the start, not on the top of a flight; or the floor not "
+                "found again: the tread is shorter than the robot (stopped)",
         P.ERROR: "tab_length_to_edge[i] unknown; the floor not found again; " + FAULT})
 
 
@@ -313,6 +357,54 @@ def _over_an_edge(t: Tick, _w: Work) -> Step | None:
     return None
 
 
+def lowerable_m(cfg: RobotConfig, mtb: float) -> float:
+    """How far segment 3 can go down from MTB's counter ``mtb``: to
+    -MAX_OF_VERTICAL_TURNS."""
+    return max(0.0, cfg.MAX_OF_VERTICAL_TURNS + mtb) * cfg.motors.lift_travel_per_turn
+
+
+def _deep_drop(t: Tick, w: Work) -> Step | None:
+    """Continuous descent: a drop below the edge deeper than segment 3 can be
+    lowered (SBR/SBL read the step below further than that past
+    BACK_CLEARANCE, or nothing within their range when the range is beyond
+    it) is refused before the lift moves.  (Descending steps it climbed, the
+    robot knows each drop is one it lifted.)"""
+    cfg = t.cfg
+    if not t.ctx.from_top:
+        return None
+    most = lowerable_m(cfg, w.entry_mtb)
+    backs = [t.snap.sensors[s] for s in BACK_SENSORS]
+    if all(r.ok for r in backs):
+        depth = min(r.distance_m for r in backs) - cfg.BACK_CLEARANCE
+        if depth > most + floor_tolerance(cfg):
+            return go(P.DESCENT_REFUSE, f"the drop below step {t.ctx.steps_descended + 1} from "
+                      f"the top is {depth:.3f} m (SBR/SBL), deeper than segment 3 can be "
+                      f"lowered ({most:.3f} m): refused")
+    elif all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
+             for r in backs):
+        reach = cfg.sensors.range(back=True)[1] - cfg.BACK_CLEARANCE
+        if reach > most:
+            return go(P.DESCENT_REFUSE, f"nothing within SBR/SBL's range below step "
+                      f"{t.ctx.steps_descended + 1} from the top: the drop is deeper than "
+                      f"{reach:.3f} m, more than segment 3 can be lowered ({most:.3f} m): "
+                      "refused")
+    return None
+
+
+def _floor_not_found(t: Tick, reading: float) -> Step:
+    """MTB's stroke ends before SBR/SBL read BACK_CLEARANCE: an error
+    descending a step climbed (a sensor reads wrong), refused in a
+    continuous descent (the drop is deeper than the lift)."""
+    cfg, ctx = t.cfg, t.ctx
+    if ctx.from_top:
+        return go(P.DESCENT_REFUSE, f"floor not found below step {ctx.steps_descended + 1} "
+                  f"from the top within MTB's stroke (-MAX_OF_VERTICAL_TURNS): SBR/SBL read "
+                  f"{reading:.3f} m: refused")
+    return fail(f"floor not found when descending step {t.descent_index + 1}: MTB reached "
+                f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL "
+                f"still read {reading:.3f} m")
+
+
 def _lower_third(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     reading = motion.mean_distance(t.snap, back=True)
@@ -322,6 +414,11 @@ def _lower_third(t: Tick, w: Work) -> Step:
         # turns, and no further (an unbiased finish, never a push on the floor).
         w.finishing = True
         w.target_mtb = t.snap.turns(MotorId.MTB) - cfg.lift_turns(max(0.0, to_go))
+        if w.target_mtb < -cfg.MAX_OF_VERTICAL_TURNS - motion.LIFT_DONE:
+            # the floor lies past the end of the stroke (the lift would never
+            # get there: a drop 5 mm deeper than the stroke waited out the
+            # phase's timeout)
+            return _floor_not_found(t, reading)
     if w.finishing:
         assert w.target_mtb is not None
         finish = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
@@ -335,9 +432,7 @@ def _lower_third(t: Tick, w: Work) -> Step:
     assert w.target_mtb is not None
     limit = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
     if limit is None:
-        return fail(f"floor not found when descending step {t.descent_index + 1}: MTB reached "
-                    f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL "
-                    f"still read {reading:.3f} m")
+        return _floor_not_found(t, reading)
     backs = [t.snap.sensors[s] for s in BACK_SENSORS]
     if all(r.ok for r in backs):
         speed = motion.approach(cfg.motors.lift_speed, cfg.lift_turns(to_go),
@@ -348,12 +443,48 @@ def _lower_third(t: Tick, w: Work) -> Step:
 
 LOWER_THIRD = PhaseDef(
     P.DESCENT_LOWER_THIRD, "descent 2 — lower segment 3", FLOW,
-    checked_first(_over_an_edge, _lower_third), enter=_lower_third_enter, watches="back",
-    carried_by=(1, 2),
+    checked_first(lambda t, w: _over_an_edge(t, w) or _deep_drop(t, w), _lower_third),
+    enter=_lower_third_enter, watches="back", carried_by=(1, 2),
     to={P.DESCENT_DRIVE_SECOND: "SBR/SBL read BACK_CLEARANCE: "
                                 "number_of_turns_for_step_height stored",
+        P.DESCENT_REFUSE: "continuous descent: SBR/SBL read a drop deeper than segment 3 "
+                          "can be lowered, or nothing in range; or the floor not found "
+                          "within MAX_OF_VERTICAL_TURNS",
         P.ERROR: "reads ≤ BACK_CLEARANCE at the start, or floor not found "
                  "within MAX_OF_VERTICAL_TURNS; " + FAULT})
+
+
+# -- descent 2, refused: segment 3 up again, and the robot back onto the step -------------------
+RETREAT_MARGIN_M = 0.03
+"""Refused, the robot drives forward this much more than it backed past where
+the back pair crossed the edge: segment 3 wholly on the step again."""
+
+
+def _refuse_enter(t: Tick, w: Work) -> None:
+    w.target_mtb = t.ctx.return_mtb  # where descent 2 began lowering
+
+
+def _refuse(t: Tick, w: Work) -> Step:
+    cfg = t.cfg
+    speeds = motion.lifts_to(cfg, t.snap, w.lift_targets())
+    if speeds is not None:
+        return stay(speeds)
+    here = motion.wheel_position(t.snap)
+    if w.target_wheel is None:
+        w.target_wheel = here + cfg.wheel_turns(edge_clearance_m(cfg) + RETREAT_MARGIN_M)
+    remaining = w.target_wheel - here
+    if remaining <= motion.WHEEL_DONE:
+        return end("stopped", f"refused the drop below step {t.ctx.steps_descended + 1} from "
+                              "the top: segment 3 raised again, the robot back on the step")
+    return stay(motion.drive(cfg, 1, remaining))
+
+
+REFUSE = PhaseDef(
+    P.DESCENT_REFUSE, "descent 2 — refused: raise segment 3, drive back onto the step", FLOW,
+    _refuse, enter=_refuse_enter, watches="front", carried_by=(1, 2),
+    to={P.DONE: "segment 3 raised to where descent 2 began, and driven forward "
+                "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step (stopped)",
+        P.ERROR: FAULT})
 
 
 # -- descent 3-6: segment by segment off the step ----------------------------------------------
@@ -389,6 +520,10 @@ DRIVE_FIRST = drive_phase(
 def _lowered_first(t: Tick, _w: Work) -> Step:
     ctx = t.ctx
     ctx.steps_descended += 1
+    if ctx.from_top:
+        t.say(f"step {ctx.steps_descended} from the top descended",
+              steps_descended=ctx.steps_descended)
+        return go(P.DESCENT_BACK_OFF)
     t.say(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
           f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
     if ctx.steps_descended < ctx.number_of_steps:
@@ -401,7 +536,7 @@ _lower1 = lift(lambda t, _w: {MotorId.MTF: -_h(t)}, _lowered_first)
 LOWER_FIRST = PhaseDef(
     P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], enter=_lower1[0],
     carried_by=(2, 3),
-    to={P.DESCENT_BACK_OFF: "turns made; steps remain",
+    to={P.DESCENT_BACK_OFF: "turns made; steps remain (a continuous descent: always)",
         P.DESCENT_FINISH: "turns made; all number_of_steps descended", P.ERROR: FAULT})
 
 
@@ -497,6 +632,6 @@ FINISH_FLOOR = PhaseDef(
     to={P.DONE: "turns made: where the program began", P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (
-    BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST, LOWER_FIRST,
-    FINISH, FINISH_FLOOR,
+    BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, REFUSE, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST,
+    LOWER_FIRST, FINISH, FINISH_FLOOR,
 )

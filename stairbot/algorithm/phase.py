@@ -85,8 +85,13 @@ class Tick:
 
     @property
     def descent_index(self) -> int:
-        """0-based index of the step being descended (into tab_length_to_edge)."""
-        return self.ctx.number_of_steps - self.ctx.steps_descended - 1
+        """0-based index of the step being descended (into tab_length_to_edge):
+        counted down from the top step climbed, or, in a continuous descent,
+        up from the top (the last entry serves every step past it)."""
+        ctx = self.ctx
+        if ctx.from_top:
+            return min(ctx.steps_descended, len(ctx.tab_length_to_edge) - 1)
+        return ctx.number_of_steps - ctx.steps_descended - 1
 
 
 def _no_entry(_t: Tick, _w: Work) -> None:
@@ -126,11 +131,19 @@ def where(ctx: Context, phase: Phase) -> str:
             return f"ascent 1, step {ctx.number_of_steps + 1}"
         if ctx.purpose in ("home", "floor"):
             return "descent 7"
-        return f"descent 1, step {ctx.number_of_steps - ctx.steps_descended}"
+        return f"descent 1, {_step_down(ctx)}"
     if flow == "ascent":
         counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
         return f"step {ctx.number_of_steps + (0 if counted else 1)}"
     if flow == "descent" and phase not in (Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR):
-        return f"step {ctx.number_of_steps - ctx.steps_descended}"
+        return _step_down(ctx)
     return ""
+
+
+def _step_down(ctx: Context) -> str:
+    """The step being descended: "step 3" (as climbed), or in a continuous
+    descent "step 2 from the top"."""
+    if ctx.from_top:
+        return f"step {ctx.steps_descended + 1} from the top"
+    return f"step {ctx.number_of_steps - ctx.steps_descended}"
 

@@ -25,6 +25,16 @@ class Mode(Enum):
 
     FULL = "full"
     CALIBRATE_ONLY = "calibrate_only"
+    DESCEND = "descend"
+    """Continuous descent: the robot stands on the top of a flight it has not
+    climbed, facing away from it, and backs down it step by step until the
+    floor."""
+
+    @classmethod
+    def for_start(cls, on: str) -> Mode:
+        """The whole program for a robot that starts ``on`` "floor" or "top"
+        (a scenario's ``start.on``)."""
+        return cls.DESCEND if on == "top" else cls.FULL
 
 
 class Phase(Enum):
@@ -53,6 +63,7 @@ class Phase(Enum):
     DESCENT_BACK_OFF = "descent_back_off"
     DESCENT_BACK_TO_EDGE = "descent_back_to_edge"
     DESCENT_LOWER_THIRD = "descent_lower_third"
+    DESCENT_REFUSE = "descent_refuse"
     DESCENT_DRIVE_SECOND = "descent_drive_second"
     DESCENT_LOWER_SECOND = "descent_lower_second"
     DESCENT_DRIVE_FIRST = "descent_drive_first"

@@ -65,7 +65,8 @@ class RunPlan:
 RunFn = Callable[[RobotSession, RobotConfig, EventSink, str, RunControl, OnTick, RunPlan],
                  RunResult]
 """(session, config, sink, mode, control, on_tick, plan) -> result: the run
-loop, ``mode`` "full" or "calibrate"."""
+loop, ``mode`` "full", "calibrate" or "descend" (a scenario that starts on
+the top)."""
 
 
 class EngineHooks(TypedDict, total=False):
@@ -95,7 +96,7 @@ def _default_run(session: RobotSession, config: RobotConfig, sink: EventSink,
 
 
 def _mode(mode: str) -> Mode:
-    return Mode.CALIBRATE_ONLY if mode == "calibrate" else Mode.FULL
+    return {"calibrate": Mode.CALIBRATE_ONLY, "descend": Mode.DESCEND}.get(mode, Mode.FULL)
 
 
 def describe_result(result: RunResult) -> tuple[str, str]:
@@ -308,6 +309,13 @@ class ConsoleEngine:
             return None
         if self._running.is_set():
             return None
+        if self.scenario is not None and self.scenario.start.on == "top":
+            if mode == "calibrate":
+                self.state.set_status(message="not started: calibration squares up to a riser "
+                                      "ahead; on the top of a flight there is none (s runs "
+                                      "the descent)", severity="warning")
+                return None
+            mode = "descend"
         try:
             plan = self._plan(mode, resume)
         except StairbotError as exc:
@@ -318,7 +326,8 @@ class ConsoleEngine:
                                self.session.simulated, self.session.sim)
         self.state.on_result(None)
         what = "resumed from the journal" if resume is not None else (
-            "calibrating only" if mode == "calibrate" else "full run")
+            "calibrating only" if mode == "calibrate" else
+            "descending from the top" if mode == "descend" else "full run")
         self.state.set_status(robot="running", paused=False, severity="info", message=what)
         self._controller = None
         self._last_flow, self._last_label = "", ""

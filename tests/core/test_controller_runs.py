@@ -57,7 +57,7 @@ def test_default_run_walks_every_phase_but_the_obstacle_and_corner(default_run) 
     # level rays square up from anywhere: no closing in, so nothing to retrace
     not_expected = {Phase.ASCENT_LOWER_OBSTACLE, Phase.CAL_CORNER, Phase.CAL_AWAY,
                     Phase.PAUSED, Phase.ERROR, Phase.CAL_CLOSE_IN, Phase.CAL_TURN_TO,
-                    Phase.DESCENT_FINISH_FLOOR}
+                    Phase.DESCENT_FINISH_FLOOR, Phase.DESCENT_REFUSE}
     assert seen == set(Phase) - not_expected
 
 
