@@ -274,6 +274,12 @@ class RobotConfig:
         return lift_at_sight + self.sensors.front_height
 
     @property
+    def max_drop_m(self) -> float:
+        """Deepest drop a continuous descent lowers segment 3 into: MTB's whole
+        stroke down, MAX_OF_VERTICAL_TURNS.  Deeper ones are refused."""
+        return self.MAX_OF_VERTICAL_TURNS * self.motors.lift_travel_per_turn
+
+    @property
     def min_step_rise_m(self) -> float:
         """Lowest rise it climbs: :meth:`min_rise_for` the shortest tread it
         enters.  Lower steps are refused."""
@@ -340,7 +346,7 @@ class RobotConfig:
         out["number_of_vertical_turns"] = self.initial_number_of_vertical_turns
         out["wheel_circumference_m"] = self.wheel_circumference
         for name in ("wheel_speed_m_s", "lift_speed_m_s", "max_step_rise_m", "min_tread_m",
-                     "min_step_rise_m"):
+                     "min_step_rise_m", "max_drop_m"):
             out[name] = float(getattr(self, name))
         if math.isfinite(self.square_range_m):  # a cone looking up, or a noisy pair
             out["square_range_m"] = self.square_range_m

@@ -139,6 +139,8 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     :func:`first_sight`) are outside.
     A tread counts where the robot must fit on it: every tread it climbs onto,
     but not the last one under a landing, which runs on into the landing."""
+    if scenario.start.on == "top":
+        return descent_zone(scenario, config, rules)
     steps = scenario.steps[:config.algorithm.max_steps]
     if not steps:
         return "inside", 0.0, math.inf
@@ -164,6 +166,35 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
         return "outside", max_rise, min_tread
     if (max_rise <= lr - rm and low >= rm and min_tread >= lt + tm
             and sight <= far - margin):
+        return "inside", max_rise, min_tread
+    return "band", max_rise, min_tread
+
+
+def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
+                 ) -> tuple[str, float, float]:
+    """A continuous descent's zone: every rise from the least drop the back
+    pair reads as one (:func:`~stairbot.algorithm.descent.edge_drop_m` less
+    BACK_CLEARANCE) to max_step_rise_m, and every tread it steps down onto (all
+    but the top one, which runs on into the landing it starts on) at least
+    min_tread_m, give or take the margins, is inside; a rise deeper than
+    max_drop_m (what segment 3 can be lowered), a lower rise than the pair
+    sees, or a tread shorter than LENGTH_OF_A_ROBOT, is outside (refused);
+    between, the band.  (The robot does not measure a tread before it steps
+    down onto it: one between LENGTH_OF_A_ROBOT and min_tread_m it may
+    descend or refuse.)"""
+    from stairbot.algorithm.descent import edge_drop_m  # the sweep runs the controller anyway
+
+    steps = scenario.steps
+    low = edge_drop_m(config) - config.BACK_CLEARANCE  # the least drop SBR/SBL read as one
+    max_rise = max(s.rise for s in steps)
+    min_rise = min(s.rise for s in steps)
+    min_tread = min((s.tread for s in steps[:-1]), default=math.inf)
+    rm, tm = rules.rise_margin_m, rules.tread_margin_m
+    if (max_rise > config.max_drop_m + rm or min_rise < low - rm
+            or min_tread < config.LENGTH_OF_A_ROBOT - tm):
+        return "outside", max_rise, min_tread
+    if (max_rise <= config.max_step_rise_m - rm and min_rise >= low + rm
+            and min_tread >= config.min_tread_m + tm):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread
 
@@ -216,6 +247,9 @@ def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) 
         "expected_steps": min(len(scenario.steps), config.algorithm.max_steps),
         "faults": len(scenario.faults), "home_m": spec.rules.home_m,
     }
+    if scenario.start.on == "top":
+        facts["from_top"] = True
+        facts["expected_steps"] = len(scenario.steps)
     return Case(index, values, scenario_text, config_text, facts)
 
 

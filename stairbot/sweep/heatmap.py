@@ -13,10 +13,10 @@ from rich.text import Text
 
 from stairbot.sweep.verdict import SEVERITY, VERDICTS
 
-COLOURS = {"climbed": "#2ca02c", "refused": "#1f77b4", "stranded": "#ffbf00",
-           "wrong": "#b03ab0", "unsafe": "#d62728", "error": "#000000"}
-LETTERS = {"climbed": "C", "refused": "R", "stranded": "S", "wrong": "W", "unsafe": "U",
-           "error": "E"}
+COLOURS = {"climbed": "#2ca02c", "descended": "#17becf", "refused": "#1f77b4",
+           "stranded": "#ffbf00", "wrong": "#b03ab0", "unsafe": "#d62728", "error": "#000000"}
+LETTERS = {"climbed": "C", "descended": "D", "refused": "R", "stranded": "S", "wrong": "W",
+           "unsafe": "U", "error": "E"}
 RISE_AXES, TREAD_AXES = ("stairs.rise", "max_rise_m"), ("stairs.tread", "min_tread_m")
 COMFORT = (0.59, 0.65)  # 2R + T, m: DIN 18065 / IBC / IRC comfort rule (docs/envelope.md)
 

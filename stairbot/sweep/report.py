@@ -24,8 +24,8 @@ from rich.table import Table
 from stairbot.sweep import heatmap
 from stairbot.sweep.verdict import SEVERITY, VERDICTS
 
-STYLE = {"climbed": "green", "refused": "blue", "stranded": "yellow", "wrong": "magenta",
-         "unsafe": "red", "error": "bold red"}
+STYLE = {"climbed": "green", "descended": "cyan", "refused": "blue", "stranded": "yellow",
+         "wrong": "magenta", "unsafe": "red", "error": "bold red"}
 
 
 def counts_of(records: list[dict[str, Any]]) -> Counter[str]:

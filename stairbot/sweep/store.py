@@ -175,6 +175,12 @@ def expect_for(facts: dict[str, Any]) -> dict[str, Any]:
     home = facts["home_m"]
     if facts.get("faults"):
         return {"max_final_offset_m": home}
+    if facts.get("from_top"):
+        if facts["zone"] == "inside":
+            return {"outcome": "completed", "steps_descended": facts["count"]}
+        if facts["zone"] == "outside":
+            return {"outcome": "stopped"}
+        return {}
     if facts["zone"] == "inside":
         n = facts["expected_steps"]
         return {"outcome": "completed", "steps_climbed": n, "steps_descended": n,

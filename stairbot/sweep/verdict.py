@@ -11,6 +11,10 @@ Zones (margins from the spec's ``[verdict]``, default 10 mm):
            (both front beams > LENGTH_OF_INFINITY + 20 mm: calibration case 1)
 * band:    neither: climbing and refusing are both right
 
+A case that starts on the top of the flight (``start.on = "top"``: continuous
+descent) is judged against the deepest drop the robot can lower instead:
+inside it descends, outside it refuses (see :func:`judge_descent`).
+
 Verdicts, first match wins:
 
 * ``error``    the program itself crashed (a traceback is kept)
@@ -29,9 +33,14 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-VERDICTS = ("climbed", "refused", "unsafe", "stranded", "wrong", "error")
-PASSING = ("climbed", "refused")
-SEVERITY = {"error": 5, "unsafe": 4, "wrong": 3, "stranded": 2, "refused": 0, "climbed": 0}
+VERDICTS = ("climbed", "descended", "refused", "unsafe", "stranded", "wrong", "error")
+PASSING = ("climbed", "descended", "refused")
+SEVERITY = {"error": 5, "unsafe": 4, "wrong": 3, "stranded": 2, "refused": 0, "climbed": 0,
+            "descended": 0}
+FLOOR_CLEAR_M = 0.0
+"""A continuous descent has reached the floor when the robot's front face
+stands at least this far before the first riser (the whole robot off the
+stairs)."""
 
 
 def judge(result: Mapping[str, Any], facts: Mapping[str, Any],
@@ -48,6 +57,8 @@ def judge(result: Mapping[str, Any], facts: Mapping[str, Any],
         return "unsafe", f"fell: {result.get('error') or 'pitch beyond the limit'}"
     if moving:
         return "unsafe", "left moving after the run: " + ", ".join(moving)
+    if facts.get("from_top"):
+        return judge_descent(result, facts)
     if up != down:
         return "stranded", f"ended on the stairs: climbed {up}, descended {down}"
     if offset is None or offset > home_m:
@@ -61,6 +72,36 @@ def judge(result: Mapping[str, Any], facts: Mapping[str, Any],
         why = result.get("error") or result.get("ascent_end") or result.get("outcome")
         return "wrong", f"refused inside the limits after {up} of {expected} step(s) ({why})"
     return "refused", f"refused after {up} of {expected} step(s), home"
+
+
+def judge_descent(result: Mapping[str, Any], facts: Mapping[str, Any]) -> tuple[str, str]:
+    """A continuous descent that did not fall and left nothing moving:
+
+    * ``descended`` completed, every step down, the whole robot on the floor:
+                    right inside and in the band
+    * ``refused``   stopped on the stairs (a drop deeper than it can lower):
+                    right outside and in the band, and wherever faults are injected
+    * ``wrong``     outside but descended, or inside but refused
+    * ``stranded``  any other end: an error on the stairs, or "the floor" found
+                    before the flight's end
+    """
+    down, count = int(result.get("steps_descended", 0)), int(facts.get("count", 0))
+    zone = str(facts.get("zone", "inside"))
+    clear = result.get("clear_of_stairs_m")
+    outcome = result.get("outcome")
+    if outcome == "completed" and down == count and clear is not None \
+            and clear >= FLOOR_CLEAR_M:
+        if zone == "outside":
+            return "wrong", f"descended {down} step(s) outside the limits"
+        return "descended", f"descended {down} step(s), {clear:.2f} m clear of the stairs"
+    why = result.get("error") or result.get("outcome")
+    if outcome == "stopped":
+        if zone == "inside" and not facts.get("faults"):
+            return "wrong", f"refused inside the limits after {down} of {count} step(s) ({why})"
+        return "refused", f"refused after {down} of {count} step(s), stopped on the stairs"
+    return "stranded", (f"ended after {down} of {count} step(s) down, "
+                        f"{clear if clear is None else round(clear, 3)} m clear of the "
+                        f"stairs ({why})")
 
 
 def passing(verdict: str) -> bool:

@@ -50,6 +50,7 @@ def run_case(case: Case) -> dict[str, Any]:
     wall0, cpu0 = time.perf_counter(), time.process_time()
     record: dict[str, Any] = {"case": case.index, "axes": case.axes, "facts": case.facts}
     try:
+        from stairbot.algorithm.phases import Mode
         from stairbot.config import load_config, parse_config
         from stairbot.robots import RobotOptions, open_robot
         from stairbot.runner import run
@@ -60,7 +61,7 @@ def run_case(case: Case) -> dict[str, Any]:
                   else parse_config(case.config_text, f"<case {case.index} config>"))
         session = open_robot("sim://", config, RobotOptions(world=scenario))
         try:
-            result = run(session, config)
+            result = run(session, config, mode=Mode.for_start(scenario.start.on))
             moving = _left_moving(session, config)
         finally:
             session.close()

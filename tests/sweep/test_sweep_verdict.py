@@ -38,6 +38,37 @@ def test_judge(res: dict[str, object], zone: str, faults: int, moving: tuple[str
     assert verdict == want, why
 
 
+TOP = {"zone": "inside", "count": 4, "expected_steps": 4, "faults": 0, "home_m": 0.05,
+       "from_top": True}
+
+
+def descent(outcome: str = "completed", down: int = 4, clear: float | None = 0.36,
+            fell: bool = False) -> dict[str, object]:
+    return {"outcome": outcome, "steps_climbed": 0, "steps_descended": down,
+            "final_offset_m": 1.5, "clear_of_stairs_m": clear, "fell": fell,
+            "ascent_end": None, "error": None}
+
+
+@pytest.mark.parametrize(("res", "zone", "faults", "moving", "want"), [
+    (descent(), "inside", 0, (), "descended"),
+    (descent(), "band", 0, (), "descended"),
+    (descent(), "outside", 0, (), "wrong"),
+    (descent(outcome="stopped", down=2, clear=-0.6), "outside", 0, (), "refused"),
+    (descent(outcome="stopped", down=2, clear=-0.6), "band", 0, (), "refused"),
+    (descent(outcome="stopped", down=2, clear=-0.6), "inside", 0, (), "wrong"),
+    (descent(outcome="stopped", down=2, clear=-0.6), "inside", 1, (), "refused"),
+    (descent(outcome="error", down=2, clear=-0.6), "outside", 0, (), "stranded"),
+    (descent(down=3, clear=-0.2), "inside", 0, (), "stranded"),  # "the floor" too soon
+    (descent(clear=None), "inside", 0, (), "stranded"),  # cannot tell where it is
+    (descent(outcome="fell", fell=True, down=1), "outside", 0, (), "unsafe"),
+    (descent(), "inside", 0, ("MWF",), "unsafe"),
+])
+def test_judge_a_descent_from_the_top(res: dict[str, object], zone: str, faults: int,
+                                      moving: tuple[str, ...], want: str) -> None:
+    verdict, why = judge(res, {**TOP, "zone": zone, "faults": faults}, moving)
+    assert verdict == want, why
+
+
 def test_a_case_that_crashes_is_an_error_with_its_traceback() -> None:
     rec = run_case(Case(7, {}, "[stairs]\ncount = -1\n", None, dict(FACTS)))
     assert rec["case"] == 7 and rec["verdict"] == "error" and rec["result"] is None
