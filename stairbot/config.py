@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -135,6 +136,11 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     # at most 1 kHz: what a host drives over a serial link or a CAN bus (and the
     # simulation's physics step, 1/600 s, must fit in a tick for time to move)
     tick: Annotated[float, msgspec.Meta(ge=0.001, le=0.5)]
+    narrow_steps: bool = False
+    """The seed's extension 3: climb treads down to LENGTH_OF_FIRST_MODULE +
+    LENGTH_OF_SECOND_MODULE (+ SAFE_LENGTH), segment 3 in the air over the
+    step below while segment 1 is lifted onto the next -- if segment 2's
+    wheels alone carry the robot then (:attr:`RobotConfig.narrow_steps_margin_m`)."""
 
 
 class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
@@ -323,9 +329,34 @@ class RobotConfig:
 
     @property
     def min_tread_m(self) -> float:
-        """Shortest tread it enters: LENGTH_OF_A_ROBOT + SAFE_LENGTH, measured at
-        the first sight over the riser as the reading less the approach's gap."""
+        """Shortest tread it enters, measured at the first sight over the riser
+        as the reading less the approach's gap: LENGTH_OF_A_ROBOT + SAFE_LENGTH;
+        with narrow steps (when :attr:`narrow_steps_safe`), LENGTH_OF_FIRST_MODULE
+        + LENGTH_OF_SECOND_MODULE + SAFE_LENGTH."""
+        if self.narrow_steps_safe:
+            return self.LENGTH_OF_FIRST_MODULE + self.LENGTH_OF_SECOND_MODULE + self.SAFE_LENGTH
         return self.LENGTH_OF_A_ROBOT + self.SAFE_LENGTH
+
+    @cached_property
+    def narrow_steps_margin_m(self) -> float:
+        """How far inside segment 2's wheels the centre of mass stays, level,
+        while segment 2 alone carries the robot with segment 3 at its height
+        (in the air over the step below) and segment 1 anywhere from down to
+        lifted its whole stroke: what narrow steps ask of the masses
+        (:mod:`stairbot.algorithm.stability`; negative: outside)."""
+        # the stability check builds on the config: imported here, not at the top
+        from stairbot.algorithm.stability import worst
+
+        return worst(self, (2,), (0.0, 0.0), (self.MAX_OF_VERTICAL_TURNS, 0.0)).margin
+
+    @property
+    def narrow_steps_safe(self) -> bool:
+        """``[algorithm] narrow_steps`` is set and the static-stability check
+        passes it: :attr:`narrow_steps_margin_m` at least ``[safety]
+        stability_margin``.  When it does not, the robot keeps the whole
+        length's min_tread_m (``config show`` says why)."""
+        return self.algorithm.narrow_steps and \
+            self.narrow_steps_margin_m >= self.safety.stability_margin
 
     @property
     def wheel_speed_m_s(self) -> float:
@@ -348,6 +379,8 @@ class RobotConfig:
         for name in ("wheel_speed_m_s", "lift_speed_m_s", "max_step_rise_m", "min_tread_m",
                      "min_step_rise_m", "max_drop_m"):
             out[name] = float(getattr(self, name))
+        if self.algorithm.narrow_steps:
+            out["narrow_steps_margin_m"] = self.narrow_steps_margin_m
         if math.isfinite(self.square_range_m):  # a cone looking up, or a noisy pair
             out["square_range_m"] = self.square_range_m
         return out

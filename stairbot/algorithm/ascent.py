@@ -32,6 +32,7 @@ from stairbot.algorithm.phase import (
 )
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
+from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId, SensorStatus
 
 P = Phase
@@ -217,9 +218,15 @@ LIFT_FIRST = PhaseDef(
         P.ERROR: FAULT})
 
 
+def narrow(cfg: RobotConfig, tread: float | None) -> bool:
+    """A tread the robot does not fit on: shorter than LENGTH_OF_A_ROBOT +
+    SAFE_LENGTH (climbed only with ``[algorithm] narrow_steps``: min_tread_m)."""
+    return tread is not None and tread < cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
+
+
 def _lifted_first(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
-    need = cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
+    need = cfg.min_tread_m
     # Measured over the second half of the lift, clear of the edge: at the
     # first sight over it the beam still grazes the step's own tread and
     # reads short.
@@ -231,9 +238,9 @@ def _lifted_first(t: Tick, w: Work) -> Step:
     if tread is not None and tread < need:
         ctx.ascent_end = "obstacle"
         t.say(f"the tread of step {ctx.number_of_steps + 1} is too short: {tread:.3f} m < "
-              f"LENGTH_OF_A_ROBOT + SAFE_LENGTH = {need:.3f} m; the ascent ends (obstacle)",
+              f"min_tread_m = {need:.3f} m; the ascent ends (obstacle)",
               ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than LENGTH_OF_A_ROBOT + SAFE_LENGTH")
+        return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than min_tread_m")
     lifted = t.snap.turns(MotorId.MTF) - ctx.return_mtf
     rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
         + cfg.sensors.front_height
@@ -247,6 +254,13 @@ def _lifted_first(t: Tick, w: Work) -> Step:
               f"{tread:.3f} m away); the ascent ends (obstacle)", ascent_end="obstacle")
         return go(P.ASCENT_LOWER_OBSTACLE, "rise too low for the tread the front cone measures")
     ctx.number_of_turns_for_step_height = lifted
+    if ctx.number_of_steps < len(ctx.tread_length):
+        ctx.tread_length[ctx.number_of_steps] = \
+            None if tread is None or tread == float("inf") else tread
+    if narrow(cfg, tread):
+        t.say(f"step {ctx.number_of_steps + 1} is narrow: tread {tread:.3f} m < "
+              f"LENGTH_OF_A_ROBOT + SAFE_LENGTH: segment 3 stays in the air over the step "
+              "below until segment 1 is on the next (narrow_steps)")
     _measure_next_step(t, w)
     t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
           f"(step {ctx.number_of_steps + 1})",
@@ -302,9 +316,9 @@ def _more_step(t: Tick, w: Work) -> Step:
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
     _more_step, enter=_more_enter, carried_by=(2, 3),
-    to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
+    to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ min_tread_m: "
                               "number_of_turns_for_step_height stored",
-        P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < LENGTH_OF_A_ROBOT + SAFE_LENGTH: "
+        P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < min_tread_m: "
                                  "tread too short; or a rise too low for the tread "
                                  "(min_rise_for)",
         P.ERROR: FAULT})
@@ -354,18 +368,35 @@ def _second_target(t: Tick) -> float | None:
 
 
 def _third_target(t: Tick) -> float | None:
+    """length_of_next_step − LENGTH_OF_A_ROBOT, or, on a narrow step (which
+    the robot does not fit on), no nearer the next riser than a tread of
+    min_tread_m would leave it (SAFE_LENGTH and the approach's gap): segment
+    3 stays in the air over the step below."""
     length = t.ctx.length_of_next_step
-    return None if length is None else length - t.cfg.LENGTH_OF_A_ROBOT
+    if length is None:
+        return None
+    cfg = t.cfg
+    return max(length - cfg.LENGTH_OF_A_ROBOT, cfg.SAFE_LENGTH + cfg.algorithm.approach_gap)
 
 
 def _h(t: Tick) -> float:
     return t.ctx.number_of_turns_for_step_height
 
 
-DRIVE_FIRST = drive_phase(
-    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, 1, _first_target,
-    lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, P.ASCENT_LIFT_SECOND,
-    "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns made)")
+def _driven_first(t: Tick, _w: Work) -> Step:
+    # segment 3, in the air over the step below if that is narrow, has rolled on with the
+    # robot onto the tread behind the riser just climbed: it carries again
+    t.ctx.third_in_air = False
+    return go(P.ASCENT_LIFT_SECOND)
+
+
+_drive1 = reading_drive(1, _first_target,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, _driven_first)
+DRIVE_FIRST = PhaseDef(
+    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, _drive1[1],
+    enter=_drive1[0], watches="front",
+    to={P.ASCENT_LIFT_SECOND: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns "
+                              "made)", P.ERROR: FAULT})
 
 LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
@@ -430,6 +461,7 @@ CHECK = PhaseDef(
 def _driven_third(t: Tick, w: Work) -> Step:
     t.ctx.purpose = "ascent"
     t.ctx.riser_wheel = None
+    t.ctx.third_in_air = narrow(t.cfg, t.ctx.tread_length[t.ctx.number_of_steps - 1])
     if w.target_reading is not None and not w.reading_lost and w.target_wheel is not None:
         # where the last readings put the riser: ascent 2 starts from it if
         # the sensors cannot read that near
@@ -442,8 +474,8 @@ _drive3 = reading_drive(1, _third_target,
 DRIVE_THIRD = PhaseDef(
     P.ASCENT_DRIVE_THIRD, "ascent 9 — drive segment 3 onto the step", FLOW, _drive3[1],
     enter=_drive3[0], watches="front",
-    to={P.CAL_CHECK: "reads length_of_next_step − LENGTH_OF_A_ROBOT (or turns made): "
-                     "next step, ascent 1",
+    to={P.CAL_CHECK: "reads length_of_next_step − LENGTH_OF_A_ROBOT, on a narrow step "
+                     "SAFE_LENGTH + approach_gap (or turns made): next step, ascent 1",
         P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (

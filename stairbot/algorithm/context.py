@@ -63,6 +63,15 @@ class Context:
     counter less MWL's (:func:`~stairbot.algorithm.motion.twist`).  Descent 7
     turns back to it before it backs the distance the first calibration
     closed in."""
+    tread_length: list[float | None] = field(default_factory=_empty_tab)
+    """Per step (0-based, as tab_length_to_edge): its tread as ascent 3
+    measured it (None: not measurable, the top).  One shorter than
+    LENGTH_OF_A_ROBOT + SAFE_LENGTH is a narrow step
+    (``[algorithm] narrow_steps``): the robot does not fit on it."""
+    third_in_air: bool = False
+    """Narrow steps: segment 3 hangs in the air over the step below (it did
+    not fit on the tread): it carries nothing, and the static-stability
+    check leaves it out."""
     climb_twist: list[float | None] = field(default_factory=_empty_tab)
     """Per step (0-based, as tab_length_to_edge): the heading by the odometer
     the robot climbed it with (where ascent 1's calibration left it).
@@ -175,7 +184,7 @@ class Context:
         return ctx
 
 
-_PER_STEP = ("tab_length_to_edge", "climb_twist")
+_PER_STEP = ("tab_length_to_edge", "climb_twist", "tread_length")
 """The context's lists with one entry per step (TAB_SIZE long)."""
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 from stairbot.algorithm import motion
+from stairbot.algorithm.ascent import narrow
 from stairbot.algorithm.calibration import HEADING_TOLERANCE_RAD, heading_off_rad
 from stairbot.algorithm.moves import (
     checked_first,
@@ -52,6 +53,14 @@ def _h(t: Tick) -> float:
     return t.ctx.number_of_turns_for_step_height
 
 
+def _narrow(t: Tick, index: int | None = None) -> bool:
+    """The tread of step ``index`` (default: the one being descended, which
+    the robot stands on) is narrow: the robot does not fit on it, and its
+    segment 3 hangs in the air over the step below (narrow_steps)."""
+    i = t.descent_index if index is None else index
+    return not t.ctx.from_top and 0 <= i and narrow(t.cfg, t.ctx.tread_length[i])
+
+
 # -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
 def _backed_off(t: Tick, _w: Work) -> Step:
     t.ctx.purpose = "descent"
@@ -64,14 +73,42 @@ def _back_off_enter(t: Tick, w: Work) -> None:
     _back_off_drive[0](t, w)
 
 
-_back_off_drive = reading_drive(-1, lambda _t: None,
-                                lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH,
-                                _backed_off, lambda t, w: _edge_bound(t, w, refind=False))
+def _back_off_target(t: Tick) -> float | None:
+    """None (the seed's turns), or, on a narrow step, tab_length_to_edge: the
+    robot does not fit on the tread, and backing off the seed's approach
+    turns would take segment 2's wheels over the edge.  Its segment 3 hangs
+    over the step below already; where segment 2's rear wheels stand on the
+    edge is where ascent 7 read the tab."""
+    return _tab(t) if _narrow(t) else None
+
+
+def _edge_or_tab(t: Tick, w: Work, refind: bool) -> float | None:
+    """The edge watch's bound (:func:`_edge_bound`); on a narrow step none:
+    the back pair is over the step below from the start (segment 3 in the
+    air), and the tab read on the way up places the robot."""
+    return None if _narrow(t) else _edge_bound(t, w, refind)
+
+
+def _back_off_turns(t: Tick) -> float:
+    """The seed's approach turns; on a narrow step, while the front pair
+    cannot read (descent 6 left it nearer the riser than it reads from),
+    the tab less the approach's gap, where descent 5 left segment 1's front
+    face: the seed's turns (0.1 m) took segment 2's rear wheels over the
+    edge, and the robot tipped back (the narrow sweep, case 16: +129 deg/s)."""
+    tab = _tab(t)
+    if _narrow(t) and tab is not None:
+        return t.cfg.wheel_turns(max(0.0, tab - t.cfg.algorithm.approach_gap))
+    return t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+
+
+_back_off_drive = reading_drive(-1, _back_off_target, _back_off_turns,
+                                _backed_off, lambda t, w: _edge_or_tab(t, w, refind=False))
 BACK_OFF = PhaseDef(
     P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW, _back_off_drive[1],
     enter=_back_off_enter, watches="front",
     to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
-                     "edge: calibrate (case 2)", P.ERROR: FAULT})
+                     "edge; on a narrow step, reads tab_length_to_edge[i]: calibrate "
+                     "(case 2)", P.ERROR: FAULT})
 
 
 def _edge_known(t: Tick, _w: Work) -> Step | None:
@@ -265,7 +302,7 @@ def _at_edge(t: Tick, w: Work) -> Step:
 
 
 _to_edge = reading_drive(-1, _tab, _edge_fallback, _at_edge,
-                         lambda t, w: _edge_bound(t, w, refind=True), exact=True)
+                         lambda t, w: _edge_or_tab(t, w, refind=True), exact=True)
 
 
 def refind_max_m(cfg: RobotConfig) -> float:
@@ -425,6 +462,7 @@ def _lower_third(t: Tick, w: Work) -> Step:
         if finish is not None:
             return stay({MotorId.MTB: finish})
         ctx.number_of_turns_for_step_height = ctx.return_mtb - t.snap.turns(MotorId.MTB)
+        ctx.third_in_air = False  # on the step below
         t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
               f"{ctx.number_of_turns_for_step_height:.2f} (step {t.descent_index + 1})",
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
@@ -510,11 +548,19 @@ LOWER_SECOND = lift_phase(
     P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW,
     lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)}, P.DESCENT_DRIVE_FIRST, (1, 3))
 
-DRIVE_FIRST = drive_phase(
-    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, -1,
-    _first_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
-    P.DESCENT_LOWER_FIRST, "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
-    "tab_length_to_edge[i] (or turns made)")
+def _driven_first(t: Tick, _w: Work) -> Step:
+    # on a narrow tread below, segment 3 has backed off its edge: in the air over the next
+    t.ctx.third_in_air = _narrow(t, t.descent_index - 1)
+    return go(P.DESCENT_LOWER_FIRST)
+
+
+_drive1 = reading_drive(-1, _first_target,
+                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, _driven_first)
+DRIVE_FIRST = PhaseDef(
+    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, _drive1[1],
+    enter=_drive1[0], watches="front",
+    to={P.DESCENT_LOWER_FIRST: "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
+                               "tab_length_to_edge[i] (or turns made)", P.ERROR: FAULT})
 
 
 def _lowered_first(t: Tick, _w: Work) -> Step:

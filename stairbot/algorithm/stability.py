@@ -130,6 +130,16 @@ def worst(cfg: RobotConfig, carried_by: tuple[int, ...], start: tuple[float, flo
                key=lambda b: b.margin)
 
 
+def carried_now(t: Tick, record: PhaseDef) -> tuple[int, ...]:
+    """The segments that carry the robot while ``record``'s lift moves: its
+    ``carried_by``, less segment 3 while it hangs in the air over the step
+    below (narrow steps: ``Context.third_in_air``)."""
+    carried = record.carried_by
+    if t.ctx.third_in_air and 3 in carried and len(carried) > 1:
+        return tuple(i for i in carried if i != 3)
+    return carried
+
+
 def before_lift(t: Tick, record: PhaseDef, w: Work) -> Step | None:
     """Once, before ``record``'s first step (a phase that moves a lift): the
     error that ends the program if the lift from the present counters to the
@@ -140,18 +150,19 @@ def before_lift(t: Tick, record: PhaseDef, w: Work) -> Step | None:
     if not record.carried_by:
         return None
     cfg, snap = t.cfg, t.snap
+    carried = carried_now(t, record)
     start = (snap.turns(MotorId.MTF), snap.turns(MotorId.MTB))
     targets = w.lift_targets()
     end = (targets.get(MotorId.MTF, start[0]), targets.get(MotorId.MTB, start[1]))
     imu = snap.imu
     pitch = imu.pitch_deg if cfg.safety.imu and imu is not None \
         and math.isfinite(imu.pitch_deg) else 0.0
-    b = worst(cfg, record.carried_by, start, end, pitch)
+    b = worst(cfg, carried, start, end, pitch)
     need = cfg.safety.stability_margin
     if b.margin >= need:
         return None
-    who = " and ".join(str(i) for i in record.carried_by)
-    plural = "s" if len(record.carried_by) > 1 else ""
+    who = " and ".join(str(i) for i in carried)
+    plural = "s" if len(carried) > 1 else ""
     side = "outside" if b.margin < 0 else "inside"
     return fail(
         f"{UNSTABLE}: {record.label} would leave the centre of mass {abs(b.margin) * 1000:.1f} mm "

@@ -1,0 +1,86 @@
+"""Narrow steps (issue 13, the seed's extension 3): a robot whose segment 2
+alone can carry it climbs treads shorter than itself, segment 3 in the air
+over the step below while segment 1 is lifted onto the next, and comes back
+down; a robot it cannot carry keeps its whole length's min_tread_m."""
+
+from __future__ import annotations
+
+import pytest
+import simrun
+
+from stairbot.algorithm.context import Context
+from stairbot.algorithm.phase import Tick
+from stairbot.algorithm.phases import Mode, Phase
+from stairbot.algorithm.stability import carried_now
+from stairbot.config import load_config, parse_config
+from stairbot.events import Event, EventKind
+from stairbot.scenario import load_scenario, parse_scenario
+
+HEAVY = load_config("heavy_middle")
+REFERENCE = load_config()
+FRONT_HEAVY = parse_config("extends = 'reference'\n[masses]\nfirst_module = 1.5\n"
+                           "second_module = 0.5\nthird_module = 0.3\n"
+                           "[algorithm]\nnarrow_steps = true\n", "front_heavy.toml")
+
+
+def test_min_tread_falls_to_the_first_two_segments_only_where_segment_2_carries_it() -> None:
+    g = HEAVY.geometry
+    assert HEAVY.narrow_steps_safe
+    assert HEAVY.min_tread_m == pytest.approx(
+        g.LENGTH_OF_FIRST_MODULE + g.LENGTH_OF_SECOND_MODULE + HEAVY.SAFE_LENGTH)
+    assert REFERENCE.min_tread_m == pytest.approx(
+        REFERENCE.LENGTH_OF_A_ROBOT + REFERENCE.SAFE_LENGTH)  # the flag is off
+    # asked for, but the front segment's weight would tip the robot off segment 2's wheels
+    assert FRONT_HEAVY.narrow_steps_margin_m < FRONT_HEAVY.safety.stability_margin
+    assert not FRONT_HEAVY.narrow_steps_safe
+    assert FRONT_HEAVY.min_tread_m == pytest.approx(REFERENCE.min_tread_m)
+
+
+def test_config_show_says_why_narrow_steps_are_refused(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from stairbot.cli import main
+
+    path = tmp_path / "front_heavy.toml"
+    path.write_text("extends = 'reference'\n[masses]\nfirst_module = 1.5\nsecond_module = 0.5\n"
+                    "third_module = 0.3\n[algorithm]\nnarrow_steps = true\n")
+    assert main(["config", "show", "--config", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "# narrow_steps refused" in out and "outside them" in out
+    assert main(["config", "show", "--config", "heavy_middle"]) == 0
+    out = capsys.readouterr().out
+    assert "min_tread_m" in out and "0.185" in out and "refused" not in out
+
+
+def test_segment_3_in_the_air_carries_nothing_in_the_stability_check() -> None:
+    ctx = Context()
+    record = Phase.ASCENT_LIFT_FIRST.record
+    tick = Tick(None, HEAVY, ctx, Mode.FULL, lambda *a, **k: None)  # type: ignore[arg-type]
+    assert carried_now(tick, record) == (2, 3)
+    ctx.third_in_air = True
+    assert carried_now(tick, record) == (2,)
+    # a lift carried by segment 3 alone with another is never left with none
+    assert carried_now(tick, Phase.ASCENT_LIFT_SECOND.record) == (1,)
+    assert carried_now(tick, Phase.CAL_LIFT.record) == (2,)
+
+
+def test_the_heavy_middle_robot_climbs_narrow_steps_and_comes_home() -> None:
+    events: list[Event] = []
+    result = simrun.run_sim(HEAVY, load_scenario("narrow_steps"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "top_reached", 3, 3), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m <= 0.05
+    assert result.max_pitch_deg is not None and result.max_pitch_deg < 8.0
+    narrow = [e for e in events if e.kind is EventKind.INFO and "is narrow" in e.message]
+    assert len(narrow) == 2  # steps 1 and 2; the top's tread runs into the landing
+
+
+def test_descending_a_narrow_step_backs_off_to_the_tab_not_the_seeds_turns() -> None:
+    """The narrow sweep's case 16 (0.182 m rise, 0.19 m tread): backing off
+    the seed's approach turns while the front pair could not read yet took
+    segment 2's rear wheels over the edge, and the robot tipped back
+    (+129 deg/s) starting down the last step."""
+    scenario = parse_scenario("[stairs]\ncount = 3\nrise = 0.182\ntread = 0.19\n"
+                              "[sensors]\nseed = 426094\n", "case16.toml")
+    result = simrun.run_sim(HEAVY, scenario)
+    assert (result.outcome, result.steps_climbed, result.steps_descended) == (
+        "completed", 3, 3), result.to_dict()
+    assert not result.fell
