@@ -339,6 +339,12 @@ def cmd_run(args: argparse.Namespace) -> int:
             if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(event.line(), file=progress, flush=True)
 
+        if args.from_top and args.robot.startswith("sim:") and scenario.start.on != "top":
+            print(f"{PROG}: error: --from-top: the simulated robot stands where "
+                  f"{scenario.source} puts it, on the floor; give a scenario with "
+                  "start.on = 'top' (it implies --from-top), e.g. --scenario top_descent",
+                  file=sys.stderr)
+            return EXIT_INPUT
         try:
             session = open_robot(args.robot, config, replace(options, world=scenario))
         except NoBoardError as exc:  # the URL was fine; the message names board and URL
@@ -457,6 +463,8 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
         f"  steps             climbed {d['steps_climbed']}, descended {d['steps_descended']}",
         f"  pauses            {d['pauses']}",
         f"  error             {d['error'] or 'none'}",
+        *([f"  ended             {d['reason']}"]
+          if d.get("reason") and not d.get("error") else []),
         f"  fell              {'yes' if d['fell'] else 'no'}"
         f" (max pitch {_fmt(d.get('max_pitch_deg'), ' deg', 1)})",
         f"  offset from start {_fmt(d.get('final_offset_m'), ' m')}",

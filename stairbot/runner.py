@@ -128,6 +128,8 @@ class RunResult:
     """"link" when the run ended on a lost link, "hardware" on another
     failure the robot reported, "output" when the journal or the event
     record could not be written (a full disk); None otherwise."""
+    reason: str | None = None
+    """Why the program ended, whatever the outcome (the controller's words)."""
     clear_of_stairs_m: float | None = None
     """How far the robot's front face ended before the first riser (negative:
     on the stairs), where the robot can tell (a simulation): a descent from
@@ -249,6 +251,7 @@ def run(
         realtime_factor=(sim_time / wall_time) if session.simulated and wall_time > 0 else None,
         tilt_watched=ctl.config.safety.imu,
         fault=fault,
+        reason=res.reason,
         clear_of_stairs_m=truth.clear_of_stairs_m if truth is not None else None,
     )
     if journal is not None:

@@ -162,6 +162,11 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
             raise ScenarioError(source, "start.on",
                                 "'top' needs the flight to end on a landing (stairs.top = "
                                 "'landing'): with a wall there is no top to stand on")
+        exp = data.expect
+        if exp is not None and (exp.steps_climbed or exp.ascent_end not in (None, "none")):
+            raise ScenarioError(source, "expect",
+                                "a robot that starts on the top climbs nothing: leave out "
+                                "steps_climbed (or 0) and ascent_end (or 'none')")
         if data.start.distance > TOP_LANDING_ROOM:
             raise ScenarioError(source, "start.distance",
                                 f"{data.start.distance} m from the top edge leaves the robot "

@@ -396,7 +396,8 @@ DRIVE_FIRST = PhaseDef(
     P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, _drive1[1],
     enter=_drive1[0], watches="front",
     to={P.ASCENT_LIFT_SECOND: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns "
-                              "made)", P.ERROR: FAULT})
+                              "made); from a narrow step, segment 3 on its tread again",
+        P.ERROR: FAULT})
 
 LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,

@@ -398,6 +398,9 @@ def _lowered(t: Tick, _w: Work) -> Step:
         return go(P.DESCENT_FINISH_FLOOR)
     if ctx.purpose == "floor":
         return go(P.DESCENT_FINISH)
+    if ctx.purpose == "edge":
+        ctx.purpose = "descent"
+        return go(P.DESCENT_BACK_TO_EDGE)
     # Check standing on all wheels, once the filter has settled there (the
     # check waits for it): a squaring turn (squaring_turns > 0), or descent
     # 1's turn back to the climb's heading (the seed's check).  Segment 1
@@ -414,6 +417,7 @@ LOWER = PhaseDef(
     to={P.CAL_CHECK: "lowered: check standing on all wheels",
         P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back to where the program began)",
         P.DESCENT_FINISH: "lowered (descent 7, turned back to the floor's heading)",
+        P.DESCENT_BACK_TO_EDGE: "lowered (continuous descent, turned square to the edge)",
         P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, LOWER)

@@ -47,7 +47,9 @@ class Context:
     purpose: str = "start"
     """What the calibration phases are doing: "start", "ascent", "descent", or
     "home" or "floor" (descent 7 lifts and lowers segments 1 and 3 to turn
-    back to the heading the program began with, or crossed the floor with)."""
+    back to the heading the program began with, or crossed the floor with),
+    or "edge" (a continuous descent turns square to the edge its back pair
+    found)."""
     calibration_case: str | None = None
     """The first calibration's case: "1", "2", "3A" or "3B"."""
     start_reading: float | None = None
@@ -126,6 +128,9 @@ class Context:
     backed while the reading came through:
     :func:`~stairbot.algorithm.descent.edge_sight_m`), backing
     off or backing up to it."""
+    edge_squared: bool = False
+    """Continuous descent: the robot turned square to this step's edge by
+    its back pair (once a step)."""
     turned_back: bool = False
     """Descent 1 has turned back to the climb's heading on this step (once)."""
     riser_wheel: float | None = None

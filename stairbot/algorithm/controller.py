@@ -399,12 +399,25 @@ class Controller:
 
 
 def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
-    """The sensors whose ERROR status ends the program in ``phase``."""
+    """The sensors whose ERROR status (errors, or stale) stands the robot in
+    ``phase``, and ends the program if it lasts."""
     if phase is _PAUSED and ctx.resume_phase is not None:
         phase = Phase(ctx.resume_phase)
     if phase.terminal:
         return ()
+    if ctx.from_top and phase.flow != "ascent":
+        return BACK_SENSORS  # a continuous descent steers by the back pair alone
+    if phase in _EDGE_WATCH:
+        return FRONT_SENSORS + BACK_SENSORS
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
+
+
+_EDGE_WATCH = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
+"""Descent 1's phases watch the back pair for the edge as they back: a back
+sensor that reports errors, or stops measuring, would hide it (the edge is
+where both read the drop), and backing from the top of a flight the robot
+went over the edge unseen and fell (the continuous descent's red team:
+SBR failing 0.5 s into the run)."""
 
 
 _PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick

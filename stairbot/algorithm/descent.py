@@ -34,6 +34,7 @@ from stairbot.algorithm.phase import (
     fail,
     go,
     stay,
+    where,
 )
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
@@ -62,14 +63,22 @@ def _narrow(t: Tick, index: int | None = None) -> bool:
 
 
 # -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
-def _backed_off(t: Tick, _w: Work) -> Step:
+def _backed_off(t: Tick, w: Work) -> Step:
     t.ctx.purpose = "descent"
+    if w.edge_stop is not None:
+        return fail(w.edge_stop)
+    if w.square_yaw is not None:
+        return _turn_square(t, w)
+    if t.ctx.from_top:
+        # squared up to the edge by the back pair instead (a riser too low for
+        # the front cone read as nothing ahead, and ended the program)
+        return go(P.DESCENT_BACK_TO_EDGE)
     return go(P.CAL_CHECK)
 
 
 def _back_off_enter(t: Tick, w: Work) -> None:
     t.ctx.edge_wheel = None  # a new step: its edge not seen yet, nor turned back
-    t.ctx.turned_back = False
+    t.ctx.turned_back = t.ctx.edge_squared = False
     _back_off_drive[0](t, w)
 
 
@@ -108,7 +117,13 @@ BACK_OFF = PhaseDef(
     enter=_back_off_enter, watches="front",
     to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
                      "edge; on a narrow step, reads tab_length_to_edge[i]: calibrate "
-                     "(case 2)", P.ERROR: FAULT})
+                     "(case 2)",
+        P.DESCENT_BACK_TO_EDGE: "continuous descent: the same, not calibrating (the back "
+                                "pair squares up at the edge)",
+        P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
+                    "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
+        P.ERROR: "one back sensor reads the drop and the other not within "
+                 "MAX_EDGE_YAW_RAD; " + FAULT})
 
 
 def _edge_known(t: Tick, _w: Work) -> Step | None:
@@ -170,10 +185,20 @@ def edge_doubt_m(cfg: RobotConfig) -> float:
     return cfg.wheel_speed_m_s * measurement_period(cfg, True)
 
 
-def edge_drop_m(cfg: RobotConfig) -> float:
+LOW_DROP_M = 0.015
+"""A continuous descent takes a drop this much past BACK_CLEARANCE (and its
+noise) for an edge: it has not climbed the flight, and a rise lower than
+half min_step_rise_m, unseen, was backed off wheels first (the red team:
+0.03-0.065 m rises tipped the robot back; 0.015 m is under a 32 mm wheel's
+radius)."""
+
+
+def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
     """The back pair reads "past the edge" beyond this: more than half the
-    lowest rise below BACK_CLEARANCE (and its noise)."""
-    return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + cfg.min_step_rise_m / 2
+    lowest rise below BACK_CLEARANCE (and its noise); in a continuous
+    descent, LOW_DROP_M more than BACK_CLEARANCE (and its noise)."""
+    low = LOW_DROP_M if from_top else cfg.min_step_rise_m / 2
+    return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + low
 
 
 def edge_lag_s(cfg: RobotConfig) -> float:
@@ -185,7 +210,7 @@ def edge_lag_s(cfg: RobotConfig) -> float:
         + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
 
 
-def edge_sight_m(cfg: RobotConfig, speed_mps: float) -> float:
+def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> float:
     """How far past an edge the back pair's sensors are when perception first
     reports the drop, backing at ``speed_mps``: the distance backed while
     the measurements came through (the sensor's latency, then the median's
@@ -200,7 +225,7 @@ def edge_sight_m(cfg: RobotConfig, speed_mps: float) -> float:
     sight = abs(speed_mps) * edge_lag_s(cfg)
     if spec.first_echo:
         fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
-        sight += edge_drop_m(cfg) * math.sin(math.radians(fov) / 2)
+        sight += edge_drop_m(cfg, from_top) * math.sin(math.radians(fov) / 2)
     return sight
 
 
@@ -211,12 +236,72 @@ REFIND_TICKS = 3
 """Finding the floor again: ticks in a row the back pair must read it."""
 
 
+def _drops(t: Tick) -> list[bool]:
+    """Each of SBR and SBL reads past an edge: more than edge_drop_m, or
+    nothing in range."""
+    cfg, drop = t.cfg, edge_drop_m(t.cfg, t.ctx.from_top)
+    return [r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
+            or r.ok and r.distance_m > drop
+            for r in (t.snap.sensors[s] for s in BACK_SENSORS)]
+
+
 def _sees_drop(t: Tick) -> bool:
-    """The back pair reads past an edge: more than edge_drop_m, or nothing in range."""
-    cfg, drop = t.cfg, edge_drop_m(t.cfg)
-    return all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
-               or r.ok and r.distance_m > drop
-               for r in (t.snap.sensors[s] for s in BACK_SENSORS))
+    """The back pair reads past an edge: both of them."""
+    return all(_drops(t))
+
+
+EDGE_SQUARE_RAD = math.radians(3.0)
+"""Continuous descent: turned further than this from square to the edge (by
+how far it backed between SBR and SBL reading the drop), the robot turns
+square before it backs on.  Set down 13 deg askew, it placed the edge where
+the second sensor crossed, backed the clearance, and segment 2's wheels on
+the first one's side went over (the red team: +15.5 deg, then a fall);
+the estimate's own error is about one measurement period's backing across
+the pair's spacing (3 deg for an HC-SR04 pair)."""
+MAX_EDGE_YAW_RAD = math.radians(25.0)
+"""One back sensor reads the drop and the other still the floor after the
+robot backed as far as this yaw across the pair's spacing: it stops."""
+
+
+def _square_to_edge(t: Tick, w: Work) -> str | None:
+    """Continuous descent: watch which back sensor reads the drop first; once
+    both do, the yaw to square up (``w.square_yaw``), if more than
+    EDGE_SQUARE_RAD and not squared at this edge yet; an error if the other
+    does not follow within MAX_EDGE_YAW_RAD.  Only on a crossing the watch
+    sees as it happens (``w.edge_floor_s``).  Returns the error that ends
+    the program, if any."""
+    ctx, cfg = t.ctx, t.cfg
+    if not ctx.from_top or ctx.edge_wheel is not None or w.edge_floor_s is None:
+        return None
+    right, left = _drops(t)
+    here = motion.wheel_position(t.snap)
+    if not right and not left:
+        w.edge_first_wheel = w.edge_first = None  # both on the floor: no crossing begun
+        return None
+    if right != left:
+        first = "SBR" if right else "SBL"
+        if w.edge_first_wheel is None or w.edge_first != first:
+            w.edge_first_wheel, w.edge_first = here, first
+        lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
+        most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
+        if lag > most:
+            other = "SBL" if right else "SBR"
+            return (f"descent 1: {first} reads the drop, {other} still the floor "
+                        f"after backing {lag * 1000:.0f} mm more (at most {most * 1000:.0f} mm: "
+                        f"{math.degrees(MAX_EDGE_YAW_RAD):.0f}° from square to the edge): "
+                        "turned too far from the edge, or the edge is not straight")
+        return None
+    if right and w.edge_first_wheel is not None and not ctx.edge_squared:
+        lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
+        yaw = math.atan2(lag, 2 * cfg.sensors.back_lateral)
+        if yaw > EDGE_SQUARE_RAD:
+            # SBR first: its side is further back, the robot turned right: turn left
+            w.square_yaw = yaw if w.edge_first == "SBR" else -yaw
+            t.say(f"{w.edge_first} read the drop {lag * 1000:.0f} mm before the other: "
+                  f"{math.degrees(yaw):.1f}° from square to the edge; turning "
+                  f"{'left' if w.square_yaw > 0 else 'right'} to square up",
+                  edge_yaw_deg=math.degrees(w.square_yaw))
+    return None
 
 
 def _edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
@@ -244,6 +329,12 @@ def _edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
     cfg, ctx = t.cfg, t.ctx
     if ctx.edge_wheel is None:
         now = t.snap.time_s
+        if w.square_yaw is None and w.edge_stop is None:
+            w.edge_stop = _square_to_edge(t, w)
+        if w.edge_stop is not None or w.square_yaw is not None:
+            # the step wrapper ends the program, or turns square first (the
+            # back-off ends here and turns)
+            return None if refind else motion.wheel_position(t.snap)
         if w.edge_watch_s is not None \
                 and now - w.edge_watch_s > EDGE_GAP_TICKS * cfg.algorithm.tick:
             # a stretch unwatched: the floor read before it no longer counts,
@@ -264,7 +355,7 @@ def _edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
             return motion.wheel_position(t.snap)  # the back-off ends here
         else:
             speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
-            sight = edge_sight_m(cfg, speed * cfg.wheel_circumference)
+            sight = edge_sight_m(cfg, speed * cfg.wheel_circumference, ctx.from_top)
             # where they crossed it: behind the robot's back (backing, the
             # odometer runs down), so the crossing was at a larger count
             ctx.edge_wheel = motion.wheel_position(t.snap) + cfg.wheel_turns(sight)
@@ -297,8 +388,9 @@ def _at_edge(t: Tick, w: Work) -> Step:
         return end("stopped", f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
                               f"backing from the start (at most LENGTH_OF_INFINITY = "
                               f"{t.cfg.LENGTH_OF_INFINITY} m): not on the top of a flight")
-    return end("completed", f"on the floor: no edge within {searched:.2f} m behind step "
-                            f"{ctx.steps_descended} from the top, the last descended")
+    return end("completed", f"on the floor, or a landing: no edge within {searched:.2f} m "
+                            f"behind step {ctx.steps_descended} from the top, the last "
+                            "descended")
 
 
 _to_edge = reading_drive(-1, _tab, _edge_fallback, _at_edge,
@@ -319,7 +411,8 @@ def _refind(t: Tick, w: Work) -> Step:
     assert w.refind_from is not None
     driven_m = (motion.wheel_position(t.snap) - w.refind_from) * cfg.wheel_circumference
     w.refind_floor = 0 if _sees_drop(t) else w.refind_floor + 1
-    if w.refind_floor >= REFIND_TICKS and driven_m >= edge_sight_m(cfg, cfg.wheel_speed_m_s):
+    if w.refind_floor >= REFIND_TICKS and driven_m >= edge_sight_m(cfg, cfg.wheel_speed_m_s,
+                                                                   t.ctx.from_top):
         t.say(f"SBR/SBL read the floor again {driven_m * 1000:.0f} mm forward: backing up "
               "to the edge")
         w.refind_from, w.edge_blind_until = None, None
@@ -341,11 +434,27 @@ def _refind(t: Tick, w: Work) -> Step:
 def _to_edge_step(t: Tick, w: Work) -> Step:
     if w.refind_from is None:
         step = _to_edge[1](t, w)
+        if w.edge_stop is not None:
+            return fail(w.edge_stop)
+        if w.square_yaw is not None:
+            return _turn_square(t, w)
         if w.refind_from is None:
             return step
         # the watch found the pair past an edge it did not see crossed: this
         # tick's step (which may have ended the backing) is not taken
     return _refind(t, w)
+
+
+def _turn_square(t: Tick, w: Work) -> Step:
+    """Lift segments 1 and 3 and turn on segment 2's wheels by the odometer
+    (calibration's turn to a heading), square to the edge; then back up to
+    it again, finding the floor first (the pair is past the edge now)."""
+    ctx = t.ctx
+    assert w.square_yaw is not None
+    ctx.edge_squared = True
+    ctx.turn_to = motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw)
+    ctx.purpose = "edge"
+    return go(P.CAL_LIFT, f"turning {math.degrees(w.square_yaw):+.1f}° square to the edge")
 
 
 BACK_TO_EDGE = PhaseDef(
@@ -354,11 +463,15 @@ BACK_TO_EDGE = PhaseDef(
     to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
                                 "edge (driving forward first until they read the floor, "
                                 "if they were past it unseen); or, not crossed yet, reads "
-                                "tab_length_to_edge[i]",
+                                "tab_length_to_edge[i]; on a narrow step, reads it (no "
+                                "edge watch)",
+        P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
+                    "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
         P.DONE: "continuous descent: no edge within the search (edge_search_m): on the "
                 "floor; or, from the start, not on the top of a flight; or the floor not "
                 "found again: the tread is shorter than the robot (stopped)",
-        P.ERROR: "tab_length_to_edge[i] unknown; the floor not found again; " + FAULT})
+        P.ERROR: "tab_length_to_edge[i] unknown; the floor not found again; one back "
+                 "sensor reads the drop and the other not within MAX_EDGE_YAW_RAD; " + FAULT})
 
 
 # -- descent 2: lower segment 3 until the back sensors find the step below ------------------------
@@ -394,6 +507,13 @@ def _over_an_edge(t: Tick, _w: Work) -> Step | None:
     return None
 
 
+def _refuse_because(t: Tick, why: str) -> Step:
+    """Refuse the drop below (``why`` is said, and kept for the end)."""
+    t.say(why)
+    t.ctx.end_reason = why
+    return go(P.DESCENT_REFUSE, why)
+
+
 def lowerable_m(cfg: RobotConfig, mtb: float) -> float:
     """How far segment 3 can go down from MTB's counter ``mtb``: to
     -MAX_OF_VERTICAL_TURNS."""
@@ -414,17 +534,17 @@ def _deep_drop(t: Tick, w: Work) -> Step | None:
     if all(r.ok for r in backs):
         depth = min(r.distance_m for r in backs) - cfg.BACK_CLEARANCE
         if depth > most + floor_tolerance(cfg):
-            return go(P.DESCENT_REFUSE, f"the drop below step {t.ctx.steps_descended + 1} from "
-                      f"the top is {depth:.3f} m (SBR/SBL), deeper than segment 3 can be "
-                      f"lowered ({most:.3f} m): refused")
+            return _refuse_because(t, f"the drop below step {t.ctx.steps_descended + 1} from "
+                                   f"the top is {depth:.3f} m (SBR/SBL), deeper than segment "
+                                   f"3 can be lowered ({most:.3f} m): refused")
     elif all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
              for r in backs):
         reach = cfg.sensors.range(back=True)[1] - cfg.BACK_CLEARANCE
         if reach > most:
-            return go(P.DESCENT_REFUSE, f"nothing within SBR/SBL's range below step "
-                      f"{t.ctx.steps_descended + 1} from the top: the drop is deeper than "
-                      f"{reach:.3f} m, more than segment 3 can be lowered ({most:.3f} m): "
-                      "refused")
+            return _refuse_because(t, f"nothing within SBR/SBL's range below step "
+                                   f"{t.ctx.steps_descended + 1} from the top: the drop is "
+                                   f"deeper than {reach:.3f} m, more than segment 3 can be "
+                                   f"lowered ({most:.3f} m): refused")
     return None
 
 
@@ -434,9 +554,9 @@ def _floor_not_found(t: Tick, reading: float) -> Step:
     continuous descent (the drop is deeper than the lift)."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.from_top:
-        return go(P.DESCENT_REFUSE, f"floor not found below step {ctx.steps_descended + 1} "
-                  f"from the top within MTB's stroke (-MAX_OF_VERTICAL_TURNS): SBR/SBL read "
-                  f"{reading:.3f} m: refused")
+        return _refuse_because(t, f"floor not found below step {ctx.steps_descended + 1} "
+                               f"from the top within MTB's stroke (-MAX_OF_VERTICAL_TURNS): "
+                               f"SBR/SBL read {reading:.3f} m: refused")
     return fail(f"floor not found when descending step {t.descent_index + 1}: MTB reached "
                 f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL "
                 f"still read {reading:.3f} m")
@@ -464,7 +584,7 @@ def _lower_third(t: Tick, w: Work) -> Step:
         ctx.number_of_turns_for_step_height = ctx.return_mtb - t.snap.turns(MotorId.MTB)
         ctx.third_in_air = False  # on the step below
         t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
-              f"{ctx.number_of_turns_for_step_height:.2f} (step {t.descent_index + 1})",
+              f"{ctx.number_of_turns_for_step_height:.2f} ({where(ctx, P.DESCENT_LOWER_THIRD)})",
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
         return go(P.DESCENT_DRIVE_SECOND)
     assert w.target_mtb is not None
@@ -512,14 +632,14 @@ def _refuse(t: Tick, w: Work) -> Step:
         w.target_wheel = here + cfg.wheel_turns(edge_clearance_m(cfg) + RETREAT_MARGIN_M)
     remaining = w.target_wheel - here
     if remaining <= motion.WHEEL_DONE:
-        return end("stopped", f"refused the drop below step {t.ctx.steps_descended + 1} from "
-                              "the top: segment 3 raised again, the robot back on the step")
+        why = t.ctx.end_reason or f"refused the drop below step {t.ctx.steps_descended + 1}"
+        return end("stopped", f"{why}; segment 3 raised again, the robot back on the step")
     return stay(motion.drive(cfg, 1, remaining))
 
 
 REFUSE = PhaseDef(
     P.DESCENT_REFUSE, "descent 2 — refused: raise segment 3, drive back onto the step", FLOW,
-    _refuse, enter=_refuse_enter, watches="front", carried_by=(1, 2),
+    _refuse, enter=_refuse_enter, carried_by=(1, 2),
     to={P.DONE: "segment 3 raised to where descent 2 began, and driven forward "
                 "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step (stopped)",
         P.ERROR: FAULT})
@@ -560,7 +680,8 @@ DRIVE_FIRST = PhaseDef(
     P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, _drive1[1],
     enter=_drive1[0], watches="front",
     to={P.DESCENT_LOWER_FIRST: "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
-                               "tab_length_to_edge[i] (or turns made)", P.ERROR: FAULT})
+                               "tab_length_to_edge[i] (or turns made); onto a narrow tread, "
+                               "segment 3 is in the air now", P.ERROR: FAULT})
 
 
 def _lowered_first(t: Tick, _w: Work) -> Step:

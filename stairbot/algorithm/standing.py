@@ -59,11 +59,21 @@ def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
 
 def watch(t: Tick, phase: PhaseDef) -> Step | None:
     """In an armed phase: the Step that pauses the robot when the watched pair
-    has disagreed long enough, else None."""
+    has disagreed long enough, else None.
+
+    A continuous descent steers by the back pair alone (it squares up to
+    each edge with it, and drives by turns): the front pair's rule is not
+    armed.  On the top the front pair faces nothing, or a landing's walls
+    (one beam on a side wall, the other open: the red team's runs ended
+    before they moved); below, risers the robot did not climb, which a cone
+    sees over when they are low, and, in a flight 0.3 m wide, a side wall
+    (ended on the stairs by a disagreement that steered nothing)."""
     if phase.watches is None:
         return None
     ctx = t.ctx
     back = phase.watches == "back"
+    if ctx.from_top and not back:
+        return None
     if not _disagree(t, back):
         ctx.disagree_ticks = 0
         return None

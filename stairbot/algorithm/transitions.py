@@ -97,10 +97,41 @@ def mermaid(flow: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+EXTENSIONS: Mapping[str, tuple[str, frozenset[Phase]]] = MappingProxyType({
+    "Continuous descent": ("continuous descent", frozenset({P.DESCENT_REFUSE})),
+    "Narrow steps": ("narrow", frozenset()),
+})
+"""The seed's extensions, each drawn as what it adds to the flows: the
+transitions whose condition names it, and every transition leaving a phase
+that is its own."""
+
+
+def mermaid_extension(title: str) -> str:
+    """The Mermaid flowchart of one of :data:`EXTENSIONS`.  Raises
+    ValueError for an unknown one."""
+    if title not in EXTENSIONS:
+        raise ValueError(f"unknown extension {title!r}; allowed: {', '.join(EXTENSIONS)}")
+    words, own = EXTENSIONS[title]
+    edges = [(src, dst, label) for src, nexts in TRANSITIONS.items()
+             for dst, label in nexts.items() if src in own or words in label.lower()]
+    nodes: list[Phase] = []
+    for src, dst, _ in edges:
+        for p in (src, dst):
+            if p not in nodes:
+                nodes.append(p)
+    lines = ["flowchart TD"]
+    lines += [_node(p) for p in nodes]
+    lines += [f'    {s.value} -->|"{label}"| {d.value}' for s, d, label in edges]
+    return "\n".join(lines) + "\n"
+
+
 def main() -> None:
-    """Print the three flowcharts as Markdown sections with Mermaid blocks."""
+    """Print the three flowcharts, then the extensions', as Markdown sections
+    with Mermaid blocks."""
     for flow in FLOWS:
         print(f"### {flow.capitalize()}\n\n```mermaid\n{mermaid(flow)}```\n")
+    for title in EXTENSIONS:
+        print(f"### {title}\n\n```mermaid\n{mermaid_extension(title)}```\n")
 
 
 if __name__ == "__main__":

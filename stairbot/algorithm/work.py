@@ -88,6 +88,17 @@ class Work:
     driving forward to find the floor again (None: not doing that)."""
     refind_floor: int = 0
     """Ticks in a row the back pair has read the floor on that drive."""
+    edge_first_wheel: float | None = None
+    edge_first: str | None = None
+    """Descent 1's edge watch: the odometer where one back sensor (named)
+    first read the drop while the other still read the floor."""
+    edge_stop: str | None = None
+    """Descent 1's edge watch found a reason to end the program (the step
+    wrapper ends it with this error)."""
+    square_yaw: float | None = None
+    """Continuous descent: the yaw (radians, + = turn left) that squares the
+    robot up to the edge, from how far it backed between its two back
+    sensors reading the drop: the step wrapper turns by it."""
 
     @classmethod
     def at_entry(cls, snap: Snapshot) -> Work:

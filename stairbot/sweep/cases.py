@@ -178,20 +178,22 @@ def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     but the top one, which runs on into the landing it starts on) at least
     min_tread_m, give or take the margins, is inside; a rise deeper than
     max_drop_m (what segment 3 can be lowered), a lower rise than the pair
-    sees, or a tread shorter than LENGTH_OF_A_ROBOT, is outside (refused);
-    between, the band.  (The robot does not measure a tread before it steps
-    down onto it: one between LENGTH_OF_A_ROBOT and min_tread_m it may
-    descend or refuse.)"""
+    sees, or a tread shorter than LENGTH_OF_FIRST_MODULE +
+    LENGTH_OF_SECOND_MODULE (segments 1 and 2 do not fit on it), is outside
+    (refused); between, the band.  (The robot does not measure a tread
+    before it steps down onto it: one shorter than min_tread_m it descends
+    while its back pair still reads the tread after the step, and refuses
+    once it reads past the next edge.)"""
     from stairbot.algorithm.descent import edge_drop_m  # the sweep runs the controller anyway
 
     steps = scenario.steps
-    low = edge_drop_m(config) - config.BACK_CLEARANCE  # the least drop SBR/SBL read as one
+    low = edge_drop_m(config, from_top=True) - config.BACK_CLEARANCE  # the least drop seen
     max_rise = max(s.rise for s in steps)
     min_rise = min(s.rise for s in steps)
     min_tread = min((s.tread for s in steps[:-1]), default=math.inf)
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
     if (max_rise > config.max_drop_m + rm or min_rise < low - rm
-            or min_tread < config.LENGTH_OF_A_ROBOT - tm):
+            or min_tread < config.LENGTH_OF_FIRST_MODULE + config.LENGTH_OF_SECOND_MODULE - tm):
         return "outside", max_rise, min_tread
     if (max_rise <= config.max_step_rise_m - rm and min_rise >= low + rm
             and min_tread >= config.min_tread_m + tm):

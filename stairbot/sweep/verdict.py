@@ -18,7 +18,8 @@ inside it descends, outside it refuses (see :func:`judge_descent`).
 Verdicts, first match wins:
 
 * ``error``    the program itself crashed (a traceback is kept)
-* ``unsafe``   the robot fell, or a lift or wheel was left moving
+* ``unsafe``   the robot fell (during the run, or in the 2 s the simulation
+               runs on after it), or a lift or wheel was left moving
 * ``stranded`` ended farther than ``home_m`` from the start, or on the stairs
                (climbed a different number of steps than it descended)
 * ``climbed``  completed, climbed and descended every step it should
@@ -53,6 +54,9 @@ def judge(result: Mapping[str, Any], facts: Mapping[str, Any],
     home_m = float(facts.get("home_m", 0.05))
     expected = int(facts.get("expected_steps", 0))
     zone = str(facts.get("zone", "inside"))
+    if result.get("fell_after"):
+        return "unsafe", (f"fell after the run ended ({result.get('fell_after')}), which "
+                          f"ended {result.get('outcome')}: {result.get('error') or ''}")
     if result.get("fell") or result.get("outcome") == "fell":
         return "unsafe", f"fell: {result.get('error') or 'pitch beyond the limit'}"
     if moving:
@@ -80,7 +84,8 @@ def judge_descent(result: Mapping[str, Any], facts: Mapping[str, Any]) -> tuple[
     * ``descended`` completed, every step down, the whole robot on the floor:
                     right inside and in the band
     * ``refused``   stopped on the stairs (a drop deeper than it can lower):
-                    right outside and in the band, and wherever faults are injected
+                    right outside and in the band; and, wherever faults are
+                    injected, stopped or ended with an error on the stairs
     * ``wrong``     outside but descended, or inside but refused
     * ``stranded``  any other end: an error on the stairs, or "the floor" found
                     before the flight's end
@@ -94,7 +99,10 @@ def judge_descent(result: Mapping[str, Any], facts: Mapping[str, Any]) -> tuple[
         if zone == "outside":
             return "wrong", f"descended {down} step(s) outside the limits"
         return "descended", f"descended {down} step(s), {clear:.2f} m clear of the stairs"
-    why = result.get("error") or result.get("outcome")
+    why = result.get("error") or result.get("reason") or result.get("outcome")
+    if facts.get("faults") and outcome in ("stopped", "error"):
+        # a sensor that fails part way down: the robot stops where it stands
+        return "refused", f"stopped after {down} of {count} step(s) on a sensor fault ({why})"
     if outcome == "stopped":
         if zone == "inside" and not facts.get("faults"):
             return "wrong", f"refused inside the limits after {down} of {count} step(s) ({why})"

@@ -27,10 +27,18 @@ simulated wheel settles with micro-motion (about 0.1 % of rated) after a stop.""
 SETTLE_TICKS = 5
 
 
+AFTER_S = 2.0
+"""How long the simulation runs on after the run ended, every motor stopped,
+to see the robot stay where it stopped: one that the tilt supervisor
+stopped past its support went on tipping, and fell half a second later,
+with the run already over and "fell: no" (the continuous descent's
+red team: a back sensor failing as the robot backed to the top edge)."""
+
+
 def _left_moving(session: Any, config: Any) -> list[str]:
     """The motors still turning five ticks after the run ended (a reading taken
     with no time passed would repeat the last snapshot, from before the stop).
-    A robot that fell cannot be read: its verdict is unsafe already."""
+    A robot that fell cannot be read: :func:`_fell_after` tells it."""
     from stairbot.errors import HardwareError
     from stairbot.hardware import MotorId
 
@@ -43,6 +51,20 @@ def _left_moving(session: Any, config: Any) -> list[str]:
         return []
     return sorted(str(m) for m, state in motors.items() if abs(state.speed_tps) > STILL * (
         config.motors.lift_speed if m in lifts else config.motors.wheel_speed))
+
+
+def _fell_after(session: Any, config: Any) -> str | None:
+    """Why the robot fell in the AFTER_S after the run (None: it stood)."""
+    from stairbot.errors import RobotFellError
+
+    tick = config.algorithm.tick
+    for _ in range(round(AFTER_S / tick)):
+        try:
+            session.robot.read()
+        except RobotFellError as exc:
+            return str(exc)
+        session.clock.advance(tick)
+    return None
 
 
 def run_case(case: Case) -> dict[str, Any]:
@@ -63,9 +85,12 @@ def run_case(case: Case) -> dict[str, Any]:
         try:
             result = run(session, config, mode=Mode.for_start(scenario.start.on))
             moving = _left_moving(session, config)
+            fell_after = None if result.fell else _fell_after(session, config)
         finally:
             session.close()
         data = result.to_dict()
+        if fell_after is not None:
+            data.update(fell=True, fell_after=fell_after)
         verdict, why = judge(data, case.facts, moving)
         record.update(verdict=verdict, why=why, result=data)
     except Exception as exc:  # noqa: BLE001 - any crash is this case's verdict

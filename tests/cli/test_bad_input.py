@@ -187,3 +187,18 @@ def test_a_binary_file_or_a_directory_exits_2(tmp_path: Path,
     folder.mkdir()
     assert main(["run", option, str(folder)]) == 2
     assert "folder.toml: cannot read" in one_error_line(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["run", "--from-top", "--calibrate-only", "--scenario", "top_descent"],
+     ["--calibrate-only", "top of a flight"]),
+    (["run", "--calibrate-only", "--scenario", "top_descent"],
+     ["--calibrate-only", "top of a flight"]),
+    (["run", "--from-top"], ["--from-top", "start.on = 'top'"]),
+])
+def test_from_the_top_with_what_cannot_go_with_it_exits_2(
+        argv: list[str], words: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(argv) == 2
+    line = one_error_line(capsys.readouterr().err)
+    for w in words:
+        assert w in line, line

@@ -149,3 +149,12 @@ def test_expectations_met_and_missed() -> None:
     assert expectation_mismatches(Expect(max_final_offset_m=0.005), RESULT)
     assert expectation_mismatches(Expect(error_contains="floor"),
                                   {**RESULT, "error": "Floor not found"}) == []
+
+
+def test_a_start_on_the_top_expects_no_climb() -> None:
+    for expect in ("steps_climbed = 2", "ascent_end = 'top_reached'"):
+        with pytest.raises(ScenarioError) as info:
+            parse_scenario(f"[start]\non = 'top'\n[expect]\n{expect}\n", "top.toml")
+        assert info.value.field == "expect" and "climbs nothing" in str(info.value)
+    parse_scenario("[start]\non = 'top'\n[expect]\nsteps_climbed = 0\nascent_end = 'none'\n",
+                   "top.toml")

@@ -88,3 +88,60 @@ def test_no_edge_within_reach_of_the_start_is_stopped_not_searched_for_ever() ->
     result = simrun.run_sim(CONFIG, scenario, events)
     assert (result.outcome, result.steps_descended) == ("stopped", 0)
     assert "not on the top of a flight" in end_of(events)
+
+
+@pytest.mark.parametrize("yaw", [13.0, -20.0])
+def test_set_down_askew_it_squares_up_to_the_edge_with_its_back_pair(yaw: float) -> None:
+    """Set down 13 deg askew, the robot placed the edge where the second back
+    sensor crossed it, backed the clearance and went over on the first one's
+    side (the red team: +15.5 deg, then a fall).  It now turns square by how
+    far it backed between the two reading the drop."""
+    scenario = parse_scenario(top("count = 3\nrise = 0.17\ntread = 0.28",
+                                  extra=f"yaw_deg = {yaw}\n"), "askew.toml")
+    events: list[Event] = []
+    result = simrun.run_sim(CONFIG, scenario, events)
+    assert (result.outcome, result.steps_descended, result.fell) == ("completed", 3, False)
+    squares = [e.message for e in events if "to square up" in e.message]
+    assert len(squares) >= 1
+    assert ("turning left" if yaw < 0 else "turning right") in squares[0]
+    assert result.max_pitch_deg is not None and result.max_pitch_deg < 5.0
+
+
+def test_too_far_askew_it_stops_at_the_edge() -> None:
+    scenario = parse_scenario(top("count = 3\nrise = 0.17\ntread = 0.28",
+                                  extra="yaw_deg = 32.0\n"), "askew.toml")
+    result = simrun.run_sim(CONFIG, scenario)
+    assert (result.outcome, result.steps_descended, result.fell) == ("error", 0, False)
+    assert "turned too far from the edge" in (result.error or "")
+
+
+@pytest.mark.parametrize("kind", ["error", "freeze"])
+def test_a_back_sensor_that_fails_backing_to_the_top_edge_stops_the_robot_before_it(
+        kind: str) -> None:
+    """SBR failing 0.5 s in hid the edge (the edge is where both read the
+    drop): the robot backed over it and fell after the tilt stop (the red
+    team).  The back pair is now needed in descent 1: the robot stands, then
+    ends, and stands where it stopped."""
+    scenario = parse_scenario(top("count = 5", extra=(
+        f"[[faults]]\nat = 0.5\nsensor = 'SBR'\nkind = '{kind}'\n")), "fault.toml")
+    session = open_robot("sim://", CONFIG, RobotOptions(world=scenario))
+    try:
+        result = run(session, CONFIG, mode=Mode.DESCEND)
+        for _ in range(100):  # two seconds on: it stays where it stopped
+            session.clock.advance(CONFIG.algorithm.tick)
+            session.robot.read()
+    finally:
+        session.close()
+    assert (result.outcome, result.steps_descended, result.fell) == ("error", 0, False)
+    assert "SBR" in (result.error or "") and "descent 1" in (result.error or "")
+    assert result.clear_of_stairs_m is not None and result.clear_of_stairs_m < -0.3
+
+
+@pytest.mark.parametrize("rise", [0.03, 0.05])
+def test_low_rises_are_seen_from_the_top(rise: float) -> None:
+    """Rises under half min_step_rise_m were not seen as edges and the robot
+    backed off them wheels first (the red team: 0.03-0.065 m tipped it)."""
+    scenario = parse_scenario(top(f"count = 4\nrise = {rise}\ntread = 0.3"), "low.toml")
+    result = simrun.run_sim(CONFIG, scenario)
+    assert (result.outcome, result.steps_descended, result.fell) == ("completed", 4, False)
+    assert result.clear_of_stairs_m is not None and result.clear_of_stairs_m > 0.1

@@ -62,6 +62,9 @@ def descent(outcome: str = "completed", down: int = 4, clear: float | None = 0.3
     (descent(clear=None), "inside", 0, (), "stranded"),  # cannot tell where it is
     (descent(outcome="fell", fell=True, down=1), "outside", 0, (), "unsafe"),
     (descent(), "inside", 0, ("MWF",), "unsafe"),
+    ({**descent(outcome="error", down=0, clear=-0.5), "fell": True,
+      "fell_after": "segment 1 pitched 38 deg"}, "inside", 1, (), "unsafe"),
+    (descent(outcome="error", down=1, clear=-0.5), "inside", 1, (), "refused"),  # a fault
 ])
 def test_judge_a_descent_from_the_top(res: dict[str, object], zone: str, faults: int,
                                       moving: tuple[str, ...], want: str) -> None:
@@ -73,3 +76,39 @@ def test_a_case_that_crashes_is_an_error_with_its_traceback() -> None:
     rec = run_case(Case(7, {}, "[stairs]\ncount = -1\n", None, dict(FACTS)))
     assert rec["case"] == 7 and rec["verdict"] == "error" and rec["result"] is None
     assert "Traceback" in rec["traceback"] and "ScenarioError" in rec["why"]
+
+
+def test_a_robot_that_falls_after_the_run_is_unsafe_whatever_the_run_said() -> None:
+    """The tilt supervisor stopped a robot already past its support: it went
+    on tipping and fell half a second after the run ended "fell: no"."""
+    from stairbot.errors import RobotFellError
+    from stairbot.sweep.worker import _fell_after
+
+    class Clock:
+        def __init__(self) -> None:
+            self.t = 0.0
+
+        def advance(self, dt: float) -> None:
+            self.t += dt
+
+    class Robot:
+        def __init__(self, clock: Clock, falls_at: float | None) -> None:
+            self.clock, self.falls_at = clock, falls_at
+
+        def read(self) -> None:
+            if self.falls_at is not None and self.clock.t >= self.falls_at:
+                raise RobotFellError("segment 1 pitched 38 deg")
+
+    class Session:
+        def __init__(self, falls_at: float | None) -> None:
+            self.clock = Clock()
+            self.robot = Robot(self.clock, falls_at)
+
+    from stairbot.config import load_config
+
+    cfg = load_config()
+    assert _fell_after(Session(0.5), cfg) == "segment 1 pitched 38 deg"
+    assert _fell_after(Session(None), cfg) is None
+    verdict, why = judge({**result(outcome="error", up=1, down=0), "fell": True,
+                          "fell_after": "segment 1 pitched 38 deg"}, FACTS)
+    assert verdict == "unsafe" and "after the run" in why
