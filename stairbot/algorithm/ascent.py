@@ -18,7 +18,6 @@ from stairbot.algorithm.moves import (
     drive_phase,
     lift,
     lift_phase,
-    reading_drive,
 )
 from stairbot.algorithm.phase import (
     FAULT,
@@ -390,14 +389,11 @@ def _driven_first(t: Tick, _w: Work) -> Step:
     return go(P.ASCENT_LIFT_SECOND)
 
 
-_drive1 = reading_drive(1, _first_target,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, _driven_first)
-DRIVE_FIRST = PhaseDef(
-    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, _drive1[1],
-    enter=_drive1[0], watches="front",
-    to={P.ASCENT_LIFT_SECOND: "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns "
-                              "made); from a narrow step, segment 3 on its tread again",
-        P.ERROR: FAULT})
+DRIVE_FIRST = drive_phase(
+    P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, 1, _first_target,
+    lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, P.ASCENT_LIFT_SECOND,
+    "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns made); from a narrow "
+    "step, segment 3 on its tread again", _driven_first)
 
 LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
@@ -470,14 +466,11 @@ def _driven_third(t: Tick, w: Work) -> Step:
     return go(P.CAL_CHECK)
 
 
-_drive3 = reading_drive(1, _third_target,
-                        lambda t: t.cfg.wheel_turns(t.cfg.LENGTH_OF_THIRD_MODULE), _driven_third)
-DRIVE_THIRD = PhaseDef(
-    P.ASCENT_DRIVE_THIRD, "ascent 9 — drive segment 3 onto the step", FLOW, _drive3[1],
-    enter=_drive3[0], watches="front",
-    to={P.CAL_CHECK: "reads length_of_next_step − LENGTH_OF_A_ROBOT, on a narrow step "
-                     "SAFE_LENGTH + approach_gap (or turns made): next step, ascent 1",
-        P.ERROR: FAULT})
+DRIVE_THIRD = drive_phase(
+    P.ASCENT_DRIVE_THIRD, "ascent 9 — drive segment 3 onto the step", FLOW, 1, _third_target,
+    lambda t: t.cfg.wheel_turns(t.cfg.LENGTH_OF_THIRD_MODULE), P.CAL_CHECK,
+    "reads length_of_next_step − LENGTH_OF_A_ROBOT, on a narrow step SAFE_LENGTH + "
+    "approach_gap (or turns made): next step, ascent 1", _driven_third)
 
 PHASES: tuple[PhaseDef, ...] = (
     APPROACH, APPROACH_TURNS, LIFT_FIRST, LIFT_FIRST_MORE, LOWER_OBSTACLE, DRIVE_FIRST,

@@ -674,14 +674,12 @@ def _driven_first(t: Tick, _w: Work) -> Step:
     return go(P.DESCENT_LOWER_FIRST)
 
 
-_drive1 = reading_drive(-1, _first_target,
-                        lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, _driven_first)
-DRIVE_FIRST = PhaseDef(
-    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, _drive1[1],
-    enter=_drive1[0], watches="front",
-    to={P.DESCENT_LOWER_FIRST: "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
-                               "tab_length_to_edge[i] (or turns made); onto a narrow tread, "
-                               "segment 3 is in the air now", P.ERROR: FAULT})
+DRIVE_FIRST = drive_phase(
+    P.DESCENT_DRIVE_FIRST, "descent 5 — drive segment 1 off the step", FLOW, -1,
+    _first_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
+    P.DESCENT_LOWER_FIRST, "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
+    "tab_length_to_edge[i] (or turns made); onto a narrow tread, segment 3 is in the air now",
+    _driven_first)
 
 
 def _lowered_first(t: Tick, _w: Work) -> Step:

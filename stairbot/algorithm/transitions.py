@@ -86,7 +86,13 @@ def mermaid(flow: str) -> str:
             resume = src is P.PAUSED and (dst.flow == flow or (pauses and dst is P.ERROR))
             if src.flow == flow or resume:
                 edges.append((src, dst, label))
-    nodes: list[Phase] = [p for p in Phase if p.flow == flow]
+    return _chart([p for p in Phase if p.flow == flow], edges)
+
+
+def _chart(nodes: list[Phase], edges: list[tuple[Phase, Phase, str]]) -> str:
+    """A Mermaid flowchart of ``nodes`` (and every phase the edges reach) and
+    ``edges`` (source, destination, condition)."""
+    nodes = list(nodes)
     for src, dst, _ in edges:
         for p in (src, dst):
             if p not in nodes:
@@ -114,15 +120,7 @@ def mermaid_extension(title: str) -> str:
     words, own = EXTENSIONS[title]
     edges = [(src, dst, label) for src, nexts in TRANSITIONS.items()
              for dst, label in nexts.items() if src in own or words in label.lower()]
-    nodes: list[Phase] = []
-    for src, dst, _ in edges:
-        for p in (src, dst):
-            if p not in nodes:
-                nodes.append(p)
-    lines = ["flowchart TD"]
-    lines += [_node(p) for p in nodes]
-    lines += [f'    {s.value} -->|"{label}"| {d.value}' for s, d, label in edges]
-    return "\n".join(lines) + "\n"
+    return _chart([], edges)
 
 
 def main() -> None:
