@@ -39,11 +39,14 @@ class Boards:
 
 @contextmanager
 def lockstep_boards(cwd: Path, env: dict[str, str] | None = None,
-                    stop: signal.Signals = signal.SIGINT) -> Iterator[Boards]:
-    """Serve fake boards in lockstep until the block ends, then stop them
-    with ``stop`` (unless the block did), killing them after 10 s.  ``cwd``
-    elsewhere than the source tree: the installed package runs."""
-    proc = stairbot("fake-boards", "--serial", "--lockstep", env=env, cwd=cwd)
+                    stop: signal.Signals = signal.SIGINT, *,
+                    scenario: str | None = None) -> Iterator[Boards]:
+    """Serve fake boards in lockstep (on ``scenario``, default the default
+    stairs) until the block ends, then stop them with ``stop`` (unless the
+    block did), killing them after 10 s.  ``cwd`` elsewhere than the source
+    tree: the installed package runs."""
+    more = () if scenario is None else ("--scenario", scenario)
+    proc = stairbot("fake-boards", "--serial", "--lockstep", *more, env=env, cwd=cwd)
     assert proc.stdout is not None
     boards = Boards(proc.stdout.readline().strip(), proc)
     try:
@@ -75,23 +78,26 @@ def last_tick(journal: Path) -> dict[str, object]:
 
 
 def kill_mid_lift(url: str, journal: Path, env: dict[str, str], cwd: Path,
-                  *args: str) -> dict[str, object]:
-    """``stairbot run --robot URL ARGS`` killed (-9) while segment 1 lifts
-    (ascent 3), watched through ``journal`` (where ARGS, or the default,
-    put it); the journal's last tick then."""
+                  *args: str, phase: str = "ascent_lift_first",
+                  lift: tuple[str, int] = ("MTF", 1)) -> dict[str, object]:
+    """``stairbot run --robot URL ARGS`` killed (-9) while a lift moves in
+    ``phase`` (default: segment 1 lifting, ascent 3; ``lift`` names the motor
+    and the sign of its speed), watched through ``journal`` (where ARGS, or
+    the default, put it); the journal's last tick then."""
     host = stairbot("run", "--robot", url, *args, "-q", env=env, cwd=cwd)
     deadline = time.monotonic() + 120
+    motor, sign = lift
     try:
         while time.monotonic() < deadline:
             if journal.exists():
                 tick = last_tick(journal)
                 command = tick.get("command")
-                if (tick.get("phase") == "ascent_lift_first" and isinstance(command, dict)
-                        and command.get("MTF", 0) > 0):
+                if (tick.get("phase") == phase and isinstance(command, dict)
+                        and sign * command.get(motor, 0) > 0):
                     break
             time.sleep(0.02)
         else:
-            raise AssertionError("the run never reached ascent 3 lifting")
+            raise AssertionError(f"the run never reached {phase} moving {motor}")
     finally:
         host.kill()  # SIGKILL: no finally, no close, no end record
         host.wait()

@@ -193,3 +193,25 @@ def test_resumes_are_counted_through_a_journal_longer_than_its_tail(tmp_path: Pa
     assert state.start["run_id"] == run_id
     assert state.resumes == 2
     assert state.last["phase"] == "ascent_approach"
+
+
+def test_a_descent_from_the_top_killed_mid_lift_resumes_down_to_the_floor(
+        env: dict[str, str], tmp_path: Path) -> None:
+    """The journal keeps the mode (descend) and the context (from the top):
+    killed while descent 2 lowers segment 3, the resumed run carries on down
+    the flight it never climbed, and stops on the floor."""
+    journal = tmp_path / "run.jsonl"
+    with lockstep_boards(tmp_path, env, scenario="top_descent") as served:
+        killed = kill_mid_lift(served.url, journal, env, tmp_path, "--scenario", "top_descent",
+                               "--journal", str(journal), phase="descent_lower_third",
+                               lift=("MTB", -1))
+        assert killed["phase"] == "descent_lower_third"
+        resumed = stairbot("run", "--robot", served.url, "--scenario", "top_descent",
+                           "--journal", str(journal), "--resume", "--yes", "--json",
+                           env=env, cwd=tmp_path)
+        out, err = resumed.communicate(timeout=600)
+    assert resumed.returncode == 0, err[-2000:]
+    result = json.loads(out)
+    assert (result["outcome"], result["steps_climbed"], result["steps_descended"],
+            result["fell"]) == ("completed", 0, 5, False)
+    assert "on the floor" in result["reason"]
