@@ -77,8 +77,8 @@ ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N
               "can://INTERFACE/CHANNEL?bitrate=N")
 SCENARIO_HELP = ("scenario TOML file, or the name of a shipped scenario (see "
                  "`stairbot scenario list`); default: five residential steps")
-CONFIG_HELP = ("robot config TOML file, or a shipped robot's name (reference, ideal, sonar, ir); "
-               "default: the reference robot")
+CONFIG_HELP = ("robot config TOML file, or a shipped robot's name (reference, ideal, sonar, ir, "
+               "heavy_middle); default: the reference robot")
 
 
 class _Formatter(argparse.RawDescriptionHelpFormatter):
@@ -379,6 +379,9 @@ def cmd_run(args: argparse.Namespace) -> int:
             session.close()
             raise
         if not args.quiet:
+            if config.narrow_steps_refusal is not None:
+                print(f"narrow_steps refused: {config.narrow_steps_refusal}; treads down to "
+                      f"min_tread_m = {config.min_tread_m:.3f} m only", file=progress)
             what = f" ({scenario.description})" if scenario.description else ""
             verb = "resuming" if args.resume else "running"
             print(f"{verb} {scenario.name}{what} on {args.robot}"

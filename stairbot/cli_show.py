@@ -46,14 +46,10 @@ def cmd_config_show(args: argparse.Namespace) -> int:
     width = max(len(k) for k in data["derived"])
     for key, value in data["derived"].items():
         print(f"{key:<{width}} = {value:<10g} # {_unit(key)}")
-    if cfg.algorithm.narrow_steps and not cfg.narrow_steps_safe:
-        margin = cfg.narrow_steps_margin_m
-        side = "inside" if margin >= 0 else "outside"
-        print(f"# narrow_steps refused: with segment 2's wheels alone carrying the robot, the "
-              f"centre of mass would stand {abs(margin) * 1000:.1f} mm {side} them, less "
-              "than [safety] "
-              f"stability_margin ({cfg.safety.stability_margin * 1000:g} mm): min_tread_m "
-              "stays LENGTH_OF_A_ROBOT + SAFE_LENGTH")
+    refusal = cfg.narrow_steps_refusal
+    if refusal is not None:
+        print(f"# narrow_steps refused: {refusal}: min_tread_m stays LENGTH_OF_A_ROBOT + "
+              "SAFE_LENGTH")
     return EXIT_OK
 
 

@@ -339,24 +339,50 @@ class RobotConfig:
 
     @cached_property
     def narrow_steps_margin_m(self) -> float:
-        """How far inside segment 2's wheels the centre of mass stays, level,
-        while segment 2 alone carries the robot with segment 3 at its height
-        (in the air over the step below) and segment 1 anywhere from down to
-        lifted its whole stroke: what narrow steps ask of the masses
-        (:mod:`stairbot.algorithm.stability`; negative: outside)."""
+        """How far inside segment 2's wheels the centre of mass stays while
+        segment 2 alone carries the robot, segment 3 at its height (in the air
+        over the step below) and segment 1 anywhere from down to lifted its
+        whole stroke, pitched either way as far as the supervisor lets it
+        (``[safety] max_pitch_deg``): what narrow steps ask of the masses
+        (:mod:`stairbot.algorithm.stability`; negative: outside).  Level,
+        any robot that calibrates passes (calibration's lift stands it on
+        segment 2's wheels too); pitched, segment 1 lifted high swings its
+        weight over them, and the lighter the end segments the less."""
         # the stability check builds on the config: imported here, not at the top
         from stairbot.algorithm.stability import worst
 
-        return worst(self, (2,), (0.0, 0.0), (self.MAX_OF_VERTICAL_TURNS, 0.0)).margin
+        top = (self.MAX_OF_VERTICAL_TURNS, 0.0)
+        return min(worst(self, (2,), (0.0, 0.0), top, pitch).margin
+                   for pitch in (-self.safety.max_pitch_deg, 0.0, self.safety.max_pitch_deg))
+
+    @property
+    def narrow_steps_refusal(self) -> str | None:
+        """Why ``[algorithm] narrow_steps`` is not safe for this robot, or None
+        (also None when it is not asked for)."""
+        if not self.algorithm.narrow_steps:
+            return None
+        margin, need = self.narrow_steps_margin_m, self.safety.stability_margin
+        if margin < need:
+            side = "inside" if margin >= 0 else "outside"
+            return (f"with segment 2's wheels alone carrying the robot, segment 1 lifted and "
+                    f"the robot pitched {self.safety.max_pitch_deg:g}°, the centre of mass "
+                    f"would stand {abs(margin) * 1000:.1f} mm {side} them, less than [safety] "
+                    f"stability_margin ({need * 1000:g} mm)")
+        near = self.SAFE_LENGTH + self.algorithm.approach_gap
+        reads_from = self.sensors.range(back=False)[0]
+        if reads_from > near:
+            return (f"on a narrow step the front pair stands SAFE_LENGTH + approach_gap "
+                    f"({near:.3f} m) from the next riser, nearer than it reads "
+                    f"({reads_from:.3f} m)")
+        return None
 
     @property
     def narrow_steps_safe(self) -> bool:
-        """``[algorithm] narrow_steps`` is set and the static-stability check
-        passes it: :attr:`narrow_steps_margin_m` at least ``[safety]
-        stability_margin``.  When it does not, the robot keeps the whole
-        length's min_tread_m (``config show`` says why)."""
-        return self.algorithm.narrow_steps and \
-            self.narrow_steps_margin_m >= self.safety.stability_margin
+        """``[algorithm] narrow_steps`` is set and nothing refuses it
+        (:attr:`narrow_steps_refusal`: the static-stability check, and the
+        front pair's range).  When refused, the robot keeps the whole
+        length's min_tread_m (``config show`` and ``run`` say why)."""
+        return self.algorithm.narrow_steps and self.narrow_steps_refusal is None
 
     @property
     def wheel_speed_m_s(self) -> float:
@@ -393,6 +419,8 @@ class RobotConfig:
         }
         out["geometry"]["LENGTH_OF_A_ROBOT"] = round(self.LENGTH_OF_A_ROBOT, 6)
         out["derived"] = {k: round(v, 6) for k, v in self.derived().items()}
+        if self.algorithm.narrow_steps:
+            out["narrow_steps_refused"] = self.narrow_steps_refusal  # None: it may
         out["source"] = self.source
         return out
 

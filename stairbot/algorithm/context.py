@@ -70,6 +70,10 @@ class Context:
     measured it (None: not measurable, the top).  One shorter than
     LENGTH_OF_A_ROBOT + SAFE_LENGTH is a narrow step
     (``[algorithm] narrow_steps``): the robot does not fit on it."""
+    narrow_edge_wheel: float | None = None
+    """Narrow steps: the odometer where the back pair crossed the edge of the
+    narrow tread the robot steps down onto (descent 5 and on): what bounds
+    descent 1's backing there, whatever the front pair reads."""
     third_in_air: bool = False
     """Narrow steps: segment 3 hangs in the air over the step below (it did
     not fit on the tread): it carries nothing, and the static-stability

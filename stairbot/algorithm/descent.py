@@ -92,10 +92,55 @@ def _back_off_target(t: Tick) -> float | None:
 
 
 def _edge_or_tab(t: Tick, w: Work, refind: bool) -> float | None:
-    """The edge watch's bound (:func:`_edge_bound`); on a narrow step none:
-    the back pair is over the step below from the start (segment 3 in the
-    air), and the tab read on the way up places the robot."""
-    return None if _narrow(t) else _edge_bound(t, w, refind)
+    """The edge watch's bound (:func:`_edge_bound`); on a narrow step, the
+    tab read on the way up places the robot (the back pair is over the step
+    below, segment 3 in the air), bounded by :func:`_narrow_bound`."""
+    if not _narrow(t):
+        return _edge_bound(t, w, refind)
+    limit = _narrow_bound(t, w, t.descent_index)
+    if limit is None or w.target_wheel is None:
+        return limit
+    # a limit, not where the drive ends (backing up to the edge is exact to its bound)
+    return max(limit, w.target_wheel)
+
+
+NARROW_AXLE_MARGIN_M = 0.004
+"""On a narrow step, descent 1 never backs segment 2's rear axle nearer the
+edge than this (the tab puts it 8.5 mm past it, as ascent 6 left it)."""
+
+
+def _narrow_bound(t: Tick, w: Work, index: int) -> float | None:
+    """Narrow steps: watch the back pair cross the edge of the narrow tread
+    of step ``index`` (floor, then the drop, as :func:`_edge_bound` does) and
+    keep where (``Context.narrow_edge_wheel``); once known, the odometer
+    count the backing never passes: segment 2's rear axle
+    NARROW_AXLE_MARGIN_M past that edge.  The front pair alone placed the
+    robot there, with 8.5 mm to spare: both of its sensors reading 20 mm
+    short (a common fault the standing rule cannot see) backed segment 2's
+    rear wheels off the edge, and the robot fell (the narrow steps' red
+    team)."""
+    cfg, ctx = t.cfg, t.ctx
+    if not _narrow(t, index):
+        return None
+    if ctx.narrow_edge_wheel is None:
+        if not _sees_drop(t):
+            w.edge_floor_s = t.snap.time_s
+        elif w.edge_floor_s is not None:
+            speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
+            sight = edge_sight_m(cfg, speed * cfg.wheel_circumference)
+            ctx.narrow_edge_wheel = motion.wheel_position(t.snap) + cfg.wheel_turns(sight)
+    if ctx.narrow_edge_wheel is None:
+        return None
+    g = cfg.geometry
+    reach = g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear + g.wheel_inset
+    return ctx.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M)
+
+
+def _narrow_tab_known(t: Tick, _w: Work) -> Step | None:
+    if _narrow(t) and _tab(t) is None:
+        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured on "
+                    "a narrow step: the robot cannot be placed on a tread it does not fit on")
+    return None
 
 
 def _back_off_turns(t: Tick) -> float:
@@ -113,7 +158,8 @@ def _back_off_turns(t: Tick) -> float:
 _back_off_drive = reading_drive(-1, _back_off_target, _back_off_turns,
                                 _backed_off, lambda t, w: _edge_or_tab(t, w, refind=False))
 BACK_OFF = PhaseDef(
-    P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW, _back_off_drive[1],
+    P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW,
+    checked_first(_narrow_tab_known, _back_off_drive[1]),
     enter=_back_off_enter, watches="front",
     to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
                      "edge; on a narrow step, reads tab_length_to_edge[i]: calibrate "
@@ -123,7 +169,7 @@ BACK_OFF = PhaseDef(
         P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
                     "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
         P.ERROR: "one back sensor reads the drop and the other not within "
-                 "MAX_EDGE_YAW_RAD; " + FAULT})
+                 "MAX_EDGE_YAW_RAD; a narrow step's tab_length_to_edge unknown; " + FAULT})
 
 
 def _edge_known(t: Tick, _w: Work) -> Step | None:
@@ -583,6 +629,7 @@ def _lower_third(t: Tick, w: Work) -> Step:
             return stay({MotorId.MTB: finish})
         ctx.number_of_turns_for_step_height = ctx.return_mtb - t.snap.turns(MotorId.MTB)
         ctx.third_in_air = False  # on the step below
+        ctx.narrow_edge_wheel = None  # the next edge's, if narrow, is watched for
         t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
               f"{ctx.number_of_turns_for_step_height:.2f} ({where(ctx, P.DESCENT_LOWER_THIRD)})",
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
@@ -668,6 +715,13 @@ LOWER_SECOND = lift_phase(
     P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW,
     lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)}, P.DESCENT_DRIVE_FIRST, (1, 3))
 
+def _first_bound(t: Tick, w: Work) -> float | None:
+    """Descent 5 onto a narrow tread: watch its edge (:func:`_narrow_bound`);
+    the drive's own target is not bounded."""
+    _narrow_bound(t, w, t.descent_index - 1)
+    return None
+
+
 def _driven_first(t: Tick, _w: Work) -> Step:
     # on a narrow tread below, segment 3 has backed off its edge: in the air over the next
     t.ctx.third_in_air = _narrow(t, t.descent_index - 1)
@@ -679,7 +733,7 @@ DRIVE_FIRST = drive_phase(
     _first_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
     P.DESCENT_LOWER_FIRST, "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
     "tab_length_to_edge[i] (or turns made); onto a narrow tread, segment 3 is in the air now",
-    _driven_first)
+    _driven_first, _first_bound)
 
 
 def _lowered_first(t: Tick, _w: Work) -> Step:

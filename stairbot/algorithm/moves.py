@@ -165,12 +165,14 @@ def checked_first(check: Callable[[Tick, Work], Step | None], step: StepFn) -> S
 def drive_phase(phase: Phase, label: str, flow: str, direction: int,
                 target: Callable[[Tick], float | None],
                 fallback_turns: Callable[[Tick], float], then: Phase, reaches: str,
-                done: Done | None = None) -> PhaseDef:
+                done: Done | None = None,
+                bound: Callable[[Tick, Work], float | None] | None = None) -> PhaseDef:
     """A :func:`reading_drive` phase that goes on to ``then`` when it ``reaches``
     its target (``done``, if given, records what the end tells first, and
-    returns the Step to ``then``); the front pair is watched."""
+    returns the Step to ``then``; ``bound`` as the drive's); the front pair is
+    watched."""
     enter, step = reading_drive(direction, target, fallback_turns,
-                                done or (lambda _t, _w: go(then)))
+                                done or (lambda _t, _w: go(then)), bound)
     return PhaseDef(phase, label, flow, step, enter=enter, watches="front",
                     to={then: reaches, Phase.ERROR: FAULT})
 

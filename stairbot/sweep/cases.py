@@ -176,7 +176,8 @@ def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     pair reads as one (:func:`~stairbot.algorithm.descent.edge_drop_m` less
     BACK_CLEARANCE) to max_step_rise_m, and every tread it steps down onto (all
     but the top one, which runs on into the landing it starts on) at least
-    min_tread_m, give or take the margins, is inside; a rise deeper than
+    LENGTH_OF_A_ROBOT + SAFE_LENGTH (narrow steps or not), give or take the
+    margins, is inside; a rise deeper than
     max_drop_m (what segment 3 can be lowered), a lower rise than the pair
     sees, or a tread shorter than LENGTH_OF_FIRST_MODULE +
     LENGTH_OF_SECOND_MODULE (segments 1 and 2 do not fit on it), is outside
@@ -195,8 +196,11 @@ def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     if (max_rise > config.max_drop_m + rm or min_rise < low - rm
             or min_tread < config.LENGTH_OF_FIRST_MODULE + config.LENGTH_OF_SECOND_MODULE - tm):
         return "outside", max_rise, min_tread
+    # the whole robot's tread, narrow steps or not: a continuous descent does
+    # not know a tread before it steps down onto it
+    whole = config.LENGTH_OF_A_ROBOT + config.SAFE_LENGTH
     if (max_rise <= config.max_step_rise_m - rm and min_rise >= low + rm
-            and min_tread >= config.min_tread_m + tm):
+            and min_tread >= whole + tm):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread
 

@@ -68,7 +68,7 @@ def run_parser() -> argparse.ArgumentParser:
     p.add_argument("--limit", metavar="N", type=_jobs, help="run only the first N cases")
     p.add_argument("--config", metavar="FILE|NAME",
                    help="run the cases on this robot config (a file, or a shipped robot: "
-                        "reference, ideal, sonar, ir) instead of the spec's")
+                        "reference, ideal, sonar, ir, heavy_middle) instead of the spec's")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress, no tables")
     _plot_options(p)
     return p

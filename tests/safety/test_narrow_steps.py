@@ -5,6 +5,8 @@ down; a robot it cannot carry keeps its whole length's min_tread_m."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
 import simrun
 
@@ -23,6 +25,13 @@ FRONT_HEAVY = parse_config("extends = 'reference'\n[masses]\nfirst_module = 1.5\
                            "[algorithm]\nnarrow_steps = true\n", "front_heavy.toml")
 
 
+def test_the_reference_robot_refuses_narrow_steps_and_comes_home() -> None:
+    result = simrun.run_sim(REFERENCE, load_scenario("narrow_steps"))
+    assert (result.outcome, result.ascent_end, result.steps_climbed) == (
+        "completed", "obstacle", 0), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m <= 0.05
+
+
 def test_min_tread_falls_to_the_first_two_segments_only_where_segment_2_carries_it() -> None:
     g = HEAVY.geometry
     assert HEAVY.narrow_steps_safe
@@ -34,6 +43,19 @@ def test_min_tread_falls_to_the_first_two_segments_only_where_segment_2_carries_
     assert FRONT_HEAVY.narrow_steps_margin_m < FRONT_HEAVY.safety.stability_margin
     assert not FRONT_HEAVY.narrow_steps_safe
     assert FRONT_HEAVY.min_tread_m == pytest.approx(REFERENCE.min_tread_m)
+    # the reference robot's masses, pitched to the tilt limit with segment 1 lifted high,
+    # leave 0.1 mm: a heavy middle is what narrow steps need
+    reference_asks = parse_config("extends = 'reference'\n[algorithm]\nnarrow_steps = true\n",
+                                  "reference_narrow.toml")
+    assert 0.0 < reference_asks.narrow_steps_margin_m < reference_asks.safety.stability_margin
+    assert "pitched 15°" in (reference_asks.narrow_steps_refusal or "")
+    assert HEAVY.narrow_steps_margin_m >= HEAVY.safety.stability_margin
+    # a front pair that cannot read as near as a narrow step leaves it to the next riser
+    ir_asks = parse_config("extends = 'ir'\n[masses]\nfirst_module = 0.3\n"
+                           "second_module = 2.0\nthird_module = 0.3\n"
+                           "[algorithm]\nnarrow_steps = true\n", "ir_narrow.toml")
+    assert "nearer than it reads" in (ir_asks.narrow_steps_refusal or "")
+    assert ir_asks.min_tread_m == pytest.approx(REFERENCE.min_tread_m)
 
 
 def test_config_show_says_why_narrow_steps_are_refused(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
@@ -45,6 +67,8 @@ def test_config_show_says_why_narrow_steps_are_refused(tmp_path, capsys) -> None
     assert main(["config", "show", "--config", str(path)]) == 0
     out = capsys.readouterr().out
     assert "# narrow_steps refused" in out and "outside them" in out
+    assert main(["config", "show", "--json", "--config", str(path)]) == 0
+    assert "outside them" in json.loads(capsys.readouterr().out)["narrow_steps_refused"]
     assert main(["config", "show", "--config", "heavy_middle"]) == 0
     out = capsys.readouterr().out
     assert "min_tread_m" in out and "0.185" in out and "refused" not in out
@@ -80,6 +104,23 @@ def test_descending_a_narrow_step_backs_off_to_the_tab_not_the_seeds_turns() -> 
     (+129 deg/s) starting down the last step."""
     scenario = parse_scenario("[stairs]\ncount = 3\nrise = 0.182\ntread = 0.19\n"
                               "[sensors]\nseed = 426094\n", "case16.toml")
+    result = simrun.run_sim(HEAVY, scenario)
+    assert (result.outcome, result.steps_climbed, result.steps_descended) == (
+        "completed", 3, 3), result.to_dict()
+    assert not result.fell
+
+
+@pytest.mark.parametrize("offset", [-0.02, -0.03])
+def test_a_front_pair_reading_short_does_not_back_segment_2_off_a_narrow_edge(
+        offset: float) -> None:
+    """Both front sensors 20-30 mm short from the descent on (a fault the
+    standing rule cannot see): backing to the tab took segment 2's rear
+    wheels off the narrow tread's edge and the robot fell (the narrow steps'
+    red team).  The back pair's crossing of that edge now bounds it."""
+    faults = "".join(f"[[faults]]\nat = 130.0\nsensor = '{s}'\nkind = 'offset'\n"
+                     f"offset = {offset}\n" for s in ("SFR", "SFL"))
+    scenario = parse_scenario("[stairs]\ncount = 3\nrise = 0.17\ntread = 0.19\n" + faults,
+                              "bias.toml")
     result = simrun.run_sim(HEAVY, scenario)
     assert (result.outcome, result.steps_climbed, result.steps_descended) == (
         "completed", 3, 3), result.to_dict()
