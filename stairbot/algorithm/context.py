@@ -130,7 +130,7 @@ class Context:
     """Descent 1: the odometer where the back pair crossed the edge of the
     step it stands on (where it read the drop, less how far the robot
     backed while the reading came through:
-    :func:`~stairbot.algorithm.descent.edge_sight_m`), backing
+    :func:`~stairbot.algorithm.edge.edge_sight_m`), backing
     off or backing up to it."""
     edge_squared: bool = False
     """Continuous descent: the robot turned square to this step's edge by
