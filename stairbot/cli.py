@@ -330,8 +330,14 @@ def cmd_run(args: argparse.Namespace) -> int:
               "top of a flight (--from-top, or start.on = 'top') has none: leave one out",
               file=sys.stderr)
         return EXIT_INPUT
-    mode = Mode.CALIBRATE_ONLY if args.calibrate_only else Mode.for_start(
-        "top" if from_top else "floor")
+    if args.from_top and args.robot.startswith("sim:") and scenario.start.on != "top":
+        print(f"{PROG}: error: --from-top: the simulated robot stands where "
+              f"{scenario.source} puts it, on the floor; give a scenario with "
+              "start.on = 'top' (it implies --from-top), e.g. --scenario top_descent",
+              file=sys.stderr)
+        return EXIT_INPUT
+    mode = Mode.CALIBRATE_ONLY if args.calibrate_only else \
+        Mode.DESCEND if from_top else Mode.FULL
     with _record_file(unused_record(args.record), config) as record:
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
@@ -339,12 +345,6 @@ def cmd_run(args: argparse.Namespace) -> int:
             if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(event.line(), file=progress, flush=True)
 
-        if args.from_top and args.robot.startswith("sim:") and scenario.start.on != "top":
-            print(f"{PROG}: error: --from-top: the simulated robot stands where "
-                  f"{scenario.source} puts it, on the floor; give a scenario with "
-                  "start.on = 'top' (it implies --from-top), e.g. --scenario top_descent",
-                  file=sys.stderr)
-            return EXIT_INPUT
         try:
             session = open_robot(args.robot, config, replace(options, world=scenario))
         except NoBoardError as exc:  # the URL was fine; the message names board and URL
