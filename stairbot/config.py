@@ -104,10 +104,31 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     """... of SBR/SBL, the same way."""
     back_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
     """Mounting tilt of SBR/SBL, degrees towards the front."""
+    side_model: SensorModelName | Literal["none"] = "none"
+    """The side pair SSR/SSL (quarter-turn landings, the seed's extension 1):
+    "none", the robot has none; else the kind of sensor they are."""
+    side_height: Length = 0.03
+    """Beam height of SSR/SSL above the wheels' contact line (they ride on
+    segment 3: lifting it raises them)."""
+    side_from_rear: Gap = 0.0375
+    """From the rear end of segment 3 to the side pair, along the robot."""
+    side_lateral: Gap = 0.09
+    """Each side sensor's face this far right/left of the centre line."""
+    side_min_range: Gap = 0.03
+    side_max_range: Length = 1.3
+
+    @property
+    def has_side_pair(self) -> bool:
+        """Whether the robot has SSR/SSL."""
+        return self.side_model != "none"
 
     def spec(self, back: bool) -> SensorSpec:
         """The datasheet of the front (or back) pair's kind of sensor."""
         return SPECS[self.back_model if back else self.front_model]
+
+    def side_spec(self) -> SensorSpec:
+        """The datasheet of the side pair's kind of sensor (``has_side_pair``)."""
+        return SPECS["ideal" if self.side_model == "none" else self.side_model]
 
     def range(self, back: bool) -> tuple[float, float]:
         """The pair's working range: the config's, within the sensor's own."""
@@ -141,6 +162,11 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     LENGTH_OF_SECOND_MODULE (+ SAFE_LENGTH), segment 3 in the air over the
     step below while segment 1 is lifted onto the next -- if segment 2's
     wheels alone carry the robot then (:attr:`RobotConfig.narrow_steps_margin_m`)."""
+    landings: bool = False
+    """The seed's extension 1: at the top of a flight that ends on a landing
+    with a wall ahead, look sideways with the side pair for the next flight,
+    turn 90 degrees towards it and climb on; the descent comes back the same
+    way.  Needs the side pair (``[sensors] side_model``)."""
 
 
 class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

@@ -33,6 +33,15 @@ def check_consistency(cfg: RobotConfig) -> None:
             f"{g.LENGTH_OF_A_ROBOT} m, but the segments add up to {cfg.LENGTH_OF_A_ROBOT:.4f} m; "
             "the robot is its three segments end to end (leave the key out to derive it)",
         )
+    if a.landings and not s.has_side_pair:
+        raise ConfigError(src, "algorithm.landings",
+                          "quarter-turn landings look sideways with the side pair SSR/SSL, "
+                          "and this robot has none; allowed: landings = false, or a "
+                          "[sensors] side_model (one of the sensor models) for the pair")
+    if s.has_side_pair and s.side_from_rear > g.LENGTH_OF_THIRD_MODULE:
+        raise ConfigError(src, "sensors.side_from_rear",
+                          f"{s.side_from_rear} m puts the side pair off segment 3 "
+                          f"({g.LENGTH_OF_THIRD_MODULE} m long); allowed: up to its length")
     for name in ("LENGTH_OF_FIRST_MODULE", "LENGTH_OF_SECOND_MODULE", "LENGTH_OF_THIRD_MODULE"):
         length = getattr(g, name)
         if 2 * g.wheel_inset > length or g.wheel_inset < g.wheel_radius:

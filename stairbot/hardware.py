@@ -1,7 +1,8 @@
 """The small hardware interface the controller talks to, and the clock.
 
 Everything the algorithm knows of the robot comes through :class:`Robot`:
-four distance sensors with a status each, six motors with a turn counter each.
+four distance sensors with a status each (six on a robot with the side pair),
+six motors with a turn counter each.
 Conventions (the same for the simulation, the drivers and the boards):
 
 * wheel motors (MWF, MWB, MWR, MWL): positive speed drives the robot forward
@@ -29,6 +30,8 @@ class SensorId(StrEnum):
     SFL = "SFL"  # segment 1, front left, looking forward
     SBR = "SBR"  # segment 3, back right, looking down
     SBL = "SBL"  # segment 3, back left, looking down
+    SSR = "SSR"  # segment 3, right side, looking right, parallel to the floor (optional)
+    SSL = "SSL"  # segment 3, left side, looking left, parallel to the floor (optional)
 
 
 class MotorId(StrEnum):
@@ -44,6 +47,12 @@ WHEEL_MOTORS: tuple[MotorId, ...] = (MotorId.MWF, MotorId.MWB, MotorId.MWR, Moto
 LIFT_MOTORS: tuple[MotorId, ...] = (MotorId.MTF, MotorId.MTB)
 FRONT_SENSORS: tuple[SensorId, ...] = (SensorId.SFR, SensorId.SFL)
 BACK_SENSORS: tuple[SensorId, ...] = (SensorId.SBR, SensorId.SBL)
+SIDE_SENSORS: tuple[SensorId, ...] = (SensorId.SSR, SensorId.SSL)
+"""The side pair, for quarter-turn landings (the seed's extension 1): only a
+robot whose config has one (``[sensors] side_model``) reads them; a snapshot
+of any other carries the four sensors without them."""
+BASE_SENSORS: tuple[SensorId, ...] = FRONT_SENSORS + BACK_SENSORS
+"""The four sensors every robot has."""
 
 
 class SensorStatus(StrEnum):

@@ -24,7 +24,7 @@ from stairbot.errors import ScenarioError
 Rise = Annotated[float, msgspec.Meta(ge=0.005, le=1.0)]
 Tread = Annotated[float, msgspec.Meta(ge=0.01, le=10.0)]
 Seconds = Annotated[float, msgspec.Meta(ge=0, le=86400.0)]
-SensorName = Literal["SFR", "SFL", "SBR", "SBL"]
+SensorName = Literal["SFR", "SFL", "SBR", "SBL", "SSR", "SSL"]
 Outcome = Literal["completed", "stopped", "error", "fell"]
 AscentEnd = Literal["top_reached", "obstacle", "step_limit"]
 
@@ -42,6 +42,33 @@ class Stairs(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     top: Literal["landing", "wall"] = "landing"
     width: Annotated[float, msgspec.Meta(ge=0.1, le=20.0)] = 1.0
     side_wall: Literal["none", "left", "right", "both"] = "none"
+
+
+class Landing(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
+    """A quarter-turn landing at the top of the flight, and the second flight
+    that leaves it to the left or right (the seed's extension 1)."""
+
+    depth: Annotated[float, msgspec.Meta(ge=0.1, le=10.0)] = 1.0
+    """From the top edge of the first flight to the wall ahead, m.  The landing
+    is as wide as the first flight (``stairs.width``); the second flight is
+    ``depth`` wide."""
+    turn: Literal["left", "right"] = "left"
+    """The side the second flight leaves the landing on; the other side, and
+    the far side, are walls."""
+    count: Annotated[int, msgspec.Meta(ge=0, le=40)] = 3
+    """Steps of the second flight; 0: a wall where it should be."""
+    rise: Rise | None = None
+    """Of the second flight's steps (default: the first flight's last step's)."""
+    tread: Tread | None = None
+
+
+@dataclass(frozen=True)
+class TurnLanding:
+    """A resolved :class:`Landing`: the second flight as a list of steps."""
+
+    depth: float
+    turn: str  # "left" | "right"
+    steps: tuple[Step, ...]
 
 
 MAX_START_DISTANCE = 20.0
@@ -97,6 +124,7 @@ class ScenarioFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     sensors: Sensors = msgspec.field(default_factory=Sensors)
     faults: list[Fault] = msgspec.field(default_factory=list)
     expect: Expect | None = None
+    landing: Landing | None = None
 
 
 @dataclass(frozen=True)
@@ -114,6 +142,9 @@ class Scenario:
     sensors: Sensors
     faults: tuple[Fault, ...]
     expect: Expect | None
+    landing: TurnLanding | None = None
+    """A quarter-turn landing at the top of the flight, or None: the flight
+    ends on a straight landing (``top``)."""
 
 
 DEFAULT_COUNT, DEFAULT_RISE, DEFAULT_TREAD = 5, 0.17, 0.28
@@ -172,6 +203,7 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
                                 f"{data.start.distance} m from the top edge leaves the robot "
                                 f"off the landing; allowed with start.on = 'top': up to "
                                 f"{TOP_LANDING_ROOM} m")
+    landing = _landing(data, steps, source)
     half = st.width / 2
     if abs(data.start.lateral) >= half:
         raise ScenarioError(source, "start.lateral",
@@ -189,7 +221,31 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
         sensors=data.sensors,
         faults=tuple(data.faults),
         expect=data.expect,
+        landing=landing,
     )
+
+
+def _landing(data: ScenarioFile, steps: tuple[Step, ...], source: str) -> TurnLanding | None:
+    """The scenario's quarter-turn landing, checked against its stairs."""
+    ld = data.landing
+    if ld is None:
+        return None
+    if not steps:
+        raise ScenarioError(source, "landing",
+                            "a landing needs a flight to stand at the top of; allowed: "
+                            "stairs.count >= 1, or leave [landing] out")
+    if data.stairs.top == "wall":
+        raise ScenarioError(source, "landing",
+                            "the flight ends in a wall (stairs.top = 'wall'), not on a "
+                            "landing; allowed: stairs.top = 'landing' with [landing]")
+    if data.start.on == "top":
+        raise ScenarioError(source, "landing",
+                            "a robot that starts on the top does not climb to a landing; "
+                            "allowed: start.on = 'floor' with [landing]")
+    last = steps[-1]
+    step = Step(last.rise if ld.rise is None else ld.rise,
+                last.tread if ld.tread is None else ld.tread)
+    return TurnLanding(ld.depth, ld.turn, tuple(step for _ in range(ld.count)))
 
 
 SHIPPED_DIR = "scenarios"
