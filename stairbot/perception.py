@@ -37,6 +37,7 @@ from stairbot.config import RobotConfig
 from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
+    SIDE_SENSORS,
     WHEEL_MOTORS,
     SensorId,
     SensorReading,
@@ -292,6 +293,20 @@ class Perception:
             for sid in ids:
                 self._tracks[sid] = _Track(not back, window(cfg, back), max_age(cfg, back),
                                            (lo + hi) / 2.0)
+        s = cfg.sensors
+        if s.has_side_pair:
+            # the side pair looks across the robot's path: driving does not move
+            # what it sees, so its medians are of the readings themselves (as
+            # the back pair's)
+            spec = s.side_spec()
+            period = max(spec.period_s, cfg.algorithm.tick)
+            age = spec.latency_s + STALE_PERIODS * period + cfg.algorithm.tick
+            lo = s.side_min_range if spec.min_range is None else max(s.side_min_range,
+                                                                      spec.min_range)
+            hi = s.side_max_range if spec.max_range is None else min(s.side_max_range,
+                                                                      spec.max_range)
+            for sid in SIDE_SENSORS:
+                self._tracks[sid] = _Track(False, WINDOW, age, (lo + hi) / 2.0)
         self._odometer: deque[tuple[float, float]] = deque(maxlen=ODOMETER_HISTORY)
         self._why: dict[SensorId, str] = {}
 

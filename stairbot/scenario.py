@@ -26,7 +26,8 @@ Tread = Annotated[float, msgspec.Meta(ge=0.01, le=10.0)]
 Seconds = Annotated[float, msgspec.Meta(ge=0, le=86400.0)]
 SensorName = Literal["SFR", "SFL", "SBR", "SBL", "SSR", "SSL"]
 Outcome = Literal["completed", "stopped", "error", "fell"]
-AscentEnd = Literal["top_reached", "obstacle", "step_limit"]
+AscentEnd = Literal["top_reached", "obstacle", "step_limit", "landing_closed",
+                    "landing_too_small"]
 
 
 class Step(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import statistics
 
-from stairbot.algorithm import motion
+from stairbot.algorithm import landing, motion
 from stairbot.algorithm.moves import (
     KEY_TICKS,
     drive_phase,
@@ -324,6 +324,9 @@ LIFT_FIRST_MORE = PhaseDef(
 
 
 def _lowered_obstacle(t: Tick, _w: Work) -> Step:
+    if landing.can_scan(t):
+        # a wall ahead at the top of a flight may be a landing's: look sideways first
+        return go(P.LANDING_SCAN)
     return go(P.DESCENT_BACK_OFF if t.ctx.number_of_steps > 0 else P.DESCENT_FINISH)
 
 
@@ -333,6 +336,8 @@ LOWER_OBSTACLE = PhaseDef(
     P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
     enter=_obstacle_enter, carried_by=(2, 3),
     to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
+        P.LANDING_SCAN: "lowered; number_of_steps > 0, [algorithm] landings and no landing "
+                        "scanned yet: look sideways for the next flight",
         P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
 
 

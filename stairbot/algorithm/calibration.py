@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import motion
+from stairbot.algorithm import landing, motion
 from stairbot.algorithm.moves import lift
 from stairbot.algorithm.phase import (
     FAULT,
@@ -69,6 +69,11 @@ MAX_SQUARING_TURNS = 4
 """A calibration that has turned this many times to square up (the squaring
 turn, then corrections by the odometer) and still does not read SFR = SFL
 standing on all wheels ends with an error."""
+LANDING_PURPOSES = ("landing", "landing_back")
+"""A landing's 90° turn onto the next flight, and back (:mod:`~stairbot.algorithm.landing`)."""
+LANDING_TURN_MARGIN_RAD = math.radians(15.0)
+"""A landing's turn may make this much more than 90° by the odometer before
+it ends with an error."""
 HEADING_TOLERANCE_RAD = math.radians(0.3)
 """Descent 1 turns back to the heading it climbed the step with, and descent
 7 to the one the program began with, when the odometer says it is further
@@ -401,6 +406,8 @@ def _lowered(t: Tick, _w: Work) -> Step:
     if ctx.purpose == "edge":
         ctx.purpose = "descent"
         return go(P.DESCENT_BACK_TO_EDGE)
+    if ctx.purpose in LANDING_PURPOSES:
+        return landing.turned(t)
     # Check standing on all wheels, once the filter has settled there (the
     # check waits for it): a squaring turn (squaring_turns > 0), or descent
     # 1's turn back to the climb's heading (the seed's check).  Segment 1
@@ -414,10 +421,12 @@ _lower_enter, _lower_step = lift(_lower_deltas, _lowered)
 LOWER = PhaseDef(
     P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, enter=_lower_enter,
     carried_by=(2,),
-    to={P.CAL_CHECK: "lowered: check standing on all wheels",
-        P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back to where the program began)",
+    to={P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back to where the program began)",
         P.DESCENT_FINISH: "lowered (descent 7, turned back to the floor's heading)",
         P.DESCENT_BACK_TO_EDGE: "lowered (continuous descent, turned square to the edge)",
+        P.CAL_CHECK: "lowered: check standing on all wheels; after a landing's turn, "
+                     "calibrate on the next flight's first riser (or, turned back, on the "
+                     "wall ahead: descent 1)",
         P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, LOWER)

@@ -148,6 +148,28 @@ class Context:
     the approach's last reading less what it drove after it (the sensors read
     "too near" there).  The tread is what they see past the riser less this."""
 
+    # -- quarter-turn landings ([algorithm] landings) -----------------------------
+    landing_seen: bool = False
+    """Landing 1 has scanned a landing (one a climb)."""
+    landing_right_m: float | None = None
+    landing_left_m: float | None = None
+    """How far what SSR (SSL) saw at the landing stands from the robot's centre
+    line, m (None: nothing in range)."""
+    landing_rise_m: list[float | None] = field(default_factory=lambda: [None, None])
+    """The height at which SSR (SSL) saw over it: the next flight's first
+    riser on the right (left), m; None: not seen over (a wall)."""
+    landing_open: list[int] = field(default_factory=list)
+    """The sides that open onto a flight: +1 left, -1 right."""
+    landing_depth_m: float | None = None
+    """The landing's depth, from the edge behind to the wall ahead, m."""
+    landing_side: int = 0
+    """The side the robot turned to: +1 left, -1 right (0: not turned)."""
+    landing_twist: float | None = None
+    """The heading (odometer twist) the robot came up the first flight with:
+    the way down turns back to it."""
+    landing_step: int | None = None
+    """0-based index of the next flight's first step (number_of_steps when the
+    robot turned onto it); None: no landing turned at."""
     # -- the present phase's own working state ----------------------------------------
     work: Work = field(default_factory=Work)
     """Made afresh when a phase is entered; no other phase reads it."""

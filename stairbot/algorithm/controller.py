@@ -33,6 +33,7 @@ from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
     LIFT_MOTORS,
+    SIDE_SENSORS,
     MotorId,
     SensorId,
     SensorStatus,
@@ -409,6 +410,8 @@ def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
         return BACK_SENSORS  # a continuous descent steers by the back pair alone
     if phase in _EDGE_WATCH:
         return FRONT_SENSORS + BACK_SENSORS
+    if phase is Phase.LANDING_SCAN:
+        return SIDE_SENSORS  # the scan looks sideways; nothing else moves
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import motion
+from stairbot.algorithm import landing, motion
 from stairbot.algorithm.ascent import narrow
 from stairbot.algorithm.calibration import HEADING_TOLERANCE_RAD, heading_off_rad
 from stairbot.algorithm.edge import (
@@ -458,6 +458,8 @@ def _lowered_first(t: Tick, _w: Work) -> Step:
         return go(P.DESCENT_BACK_OFF)
     t.say(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
           f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
+    if landing.returns_here(t):
+        return go(P.LANDING_RETURN)
     if ctx.steps_descended < ctx.number_of_steps:
         return go(P.DESCENT_BACK_OFF)
     ctx.turned_back = False  # descent 7 turns back to the floor's heading once
@@ -469,6 +471,8 @@ LOWER_FIRST = PhaseDef(
     P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], enter=_lower1[0],
     carried_by=(2, 3),
     to={P.DESCENT_BACK_OFF: "turns made; steps remain (a continuous descent: always)",
+        P.LANDING_RETURN: "turns made; down the first step of the flight after a landing's "
+                          "turn: back to where it turned",
         P.DESCENT_FINISH: "turns made; all number_of_steps descended", P.ERROR: FAULT})
 
 

@@ -131,10 +131,14 @@ def where(ctx: Context, phase: Phase) -> str:
             return f"ascent 1, step {ctx.number_of_steps + 1}"
         if ctx.purpose in ("home", "floor"):
             return "descent 7"
+        if ctx.purpose in ("landing", "landing_back"):
+            return f"the landing after step {ctx.landing_step or ctx.number_of_steps}"
         return f"descent 1, {_step_down(ctx)}"
     if flow == "ascent":
         counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
         return f"step {ctx.number_of_steps + (0 if counted else 1)}"
+    if flow == "landing":
+        return f"the landing after step {ctx.landing_step or ctx.number_of_steps}"
     if flow == "descent" and phase not in (Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR):
         return _step_down(ctx)
     return ""

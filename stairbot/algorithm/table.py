@@ -5,13 +5,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from stairbot.algorithm import ascent, calibration, descent, standing, turns
+from stairbot.algorithm import ascent, calibration, descent, landing, standing, turns
 from stairbot.algorithm.phase import PhaseDef
 from stairbot.algorithm.phases import Phase
 
 PHASES: Mapping[Phase, PhaseDef] = MappingProxyType(
     {d.phase: d for d in (*calibration.PHASES, *turns.PHASES, *ascent.PHASES, *descent.PHASES,
-                           *standing.PHASES)}
+                           *landing.PHASES, *standing.PHASES)}
 )
 """phase -> its record, for every Phase."""
 

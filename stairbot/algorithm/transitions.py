@@ -106,6 +106,8 @@ def _chart(nodes: list[Phase], edges: list[tuple[Phase, Phase, str]]) -> str:
 EXTENSIONS: Mapping[str, tuple[str, frozenset[Phase]]] = MappingProxyType({
     "Continuous descent": ("continuous descent", frozenset({P.DESCENT_REFUSE})),
     "Narrow steps": ("narrow", frozenset()),
+    "Quarter-turn landings": ("landing", frozenset(
+        {P.LANDING_SCAN, P.LANDING_SCAN_LOWER, P.LANDING_CENTRE, P.LANDING_RETURN})),
 })
 """The seed's extensions, each drawn as what it adds to the flows: the
 transitions whose condition names it, and every transition leaving a phase

@@ -11,6 +11,8 @@ import math
 from stairbot.algorithm import motion
 from stairbot.algorithm.calibration import (
     FLOW,
+    LANDING_PURPOSES,
+    LANDING_TURN_MARGIN_RAD,
     MAX_AWAY_YAW_RAD,
     MAX_SQUARE_YAW_RAD,
     MAX_TURN_FLIPS,
@@ -50,10 +52,13 @@ P = Phase
 # -- turning ---------------------------------------------------------------------------
 def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
     made = abs(t.snap.turns(MotorId.MWR) - t.ctx.turn_origin)
-    if motion.turn_yaw_rad(t.cfg, made) <= MAX_TURN_YAW_RAD:
+    limit = MAX_TURN_YAW_RAD
+    if t.ctx.purpose in LANDING_PURPOSES:
+        limit += LANDING_TURN_MARGIN_RAD  # a landing's turn is 90° by the odometer
+    if motion.turn_yaw_rad(t.cfg, made) <= limit:
         return None
     return fail(f"calibration ({where(t.ctx, phase)}) turned "
-                f"{math.degrees(MAX_TURN_YAW_RAD):.0f}° without finding SFR = SFL")
+                f"{math.degrees(limit):.0f}° without finding SFR = SFL")
 
 
 def _turn_enter(t: Tick, w: Work) -> None:

@@ -100,6 +100,12 @@ class Work:
     robot up to the edge, from how far it backed between its two back
     sensors reading the drop: the step wrapper turns by it."""
 
+    side_base: list[list[float]] = field(default_factory=lambda: [[], []])
+    """Landing 1: what SSR and SSL read over segment 3's first SCAN_BASE_M of lift."""
+    side_open: list[float | None] = field(default_factory=lambda: [None, None])
+    """Landing 1: how far segment 3 had lifted when SSR (SSL) saw over what it
+    saw: the next flight's first riser on that side (None: not seen over)."""
+
     @classmethod
     def at_entry(cls, snap: Snapshot) -> Work:
         """Fresh work for a phase entered at ``snap``."""

@@ -24,7 +24,7 @@ from stairbot.journal import read_journal
 from stairbot.resume import describe
 from stairbot.runner import RunResult
 
-CLIMB_FLOWS = ("ascent", "descent")
+CLIMB_FLOWS = ("ascent", "descent", "landing")
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from stairbot.errors import InputError
 from stairbot.recording.read import Recording
 
 FLOW_COLOURS = {"calibration": "#cfe2f3", "ascent": "#d9ead3", "descent": "#fce5cd",
+                "landing": "#ead1dc",
                 "end": "#eeeeee"}
 OTHER_FLOW = "#e6e6e6"
 SEGMENT_COLOURS = {"segment1": "#d55e00", "segment2": "#0072b2", "segment3": "#009e73"}

@@ -1,0 +1,340 @@
+"""Quarter-turn landings (the seed's extension 1): look sideways for the next
+flight, turn 90° towards it, climb on; on the way down, turn back.
+
+The seed turns one back sensor to look parallel to the floor; this robot
+has a side pair, SSR and SSL, on segment 3, looking right and left.  A
+landing shows itself as the seed's wall at the top: ascent 3 lifts segment
+1 its whole stroke in front of the wall ahead and still sees it (an
+obstacle).  With ``[algorithm] landings`` the robot then, before it turns
+back down:
+
+1. *scans* (landing 1): lifts segment 3 its whole stroke with the side pair
+   looking out.  A side whose reading jumps on by SIGHT_JUMP_M as the beam
+   rises over what it saw is the next flight's first riser; one that never
+   does is a wall.  The readings before the lift say how far the sides are.
+2. *decides*: no side open, the ascent ends as at a wall (``landing_closed``);
+   a landing too small for the robot to turn in (its turning circle,
+   TURN_ROOM_MARGIN clear of the walls, the riser and the edge behind), it
+   ends too (``landing_too_small``) -- both then descend home as from a wall.
+3. *centres* (landing 2): backs from the wall ahead to the landing's middle,
+   by the front pair, so that the turning circle clears the wall and the
+   edge behind it;
+4. *turns* 90° towards the open side by calibration's turn (segments 1 and 3
+   lifted, segment 2's wheels, by the odometer), and calibrates on the next
+   flight's first riser: the ascent goes on, counting steps on.
+
+The descent mirrors it: having come down the second flight's first step, the
+robot backs to where it turned (landing 3), turns back to the heading it
+came up with, and descends the first flight (descent 1's calibration on the
+wall ahead, then the edge its back pair finds).  One landing a climb.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+
+from stairbot.algorithm import motion
+from stairbot.algorithm.moves import lift, reading_drive
+from stairbot.algorithm.phase import FAULT, PhaseDef, Step, Tick, go
+from stairbot.algorithm.phases import Phase
+from stairbot.algorithm.work import Work
+from stairbot.config import RobotConfig
+from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
+
+P = Phase
+FLOW = "landing"
+
+TURN_ROOM_MARGIN = 0.03
+"""The robot turns on a landing only if its turning circle stays this far
+(m) from the walls, the next flight's riser and the edge behind it."""
+WHEEL_WIDTH = 0.01
+"""How far a wheel stands out past the track on each side, m: the robot's
+width is track_width plus twice this."""
+DEPTH_MARGIN = 0.01
+"""The landing's depth is taken this much less than ascent 3 measured it
+(its tread: the reading past the last riser), m."""
+SIDE_JUMP_M = 0.05
+"""A side sees over what it saw when it reads this much farther (or nothing
+in range): ascent 3's SIGHT_JUMP_M, for the same reason -- no tread is this
+short, and it is ten times the sensors' noise."""
+SCAN_BASE_M = 0.01
+"""The scan takes what each side sees from the readings of its first this
+much of segment 3's lift, m."""
+LEFT, RIGHT = 1, -1
+
+
+def half_width(cfg: RobotConfig) -> float:
+    """Half the robot's width, wheels included."""
+    return cfg.geometry.track_width / 2.0 + WHEEL_WIDTH
+
+
+def centre_to_front(cfg: RobotConfig) -> float:
+    """From segment 2's centre (where the robot turns) to segment 1's front face."""
+    g = cfg.geometry
+    return g.LENGTH_OF_FIRST_MODULE + g.LENGTH_OF_SECOND_MODULE / 2.0
+
+
+def turning_radius(cfg: RobotConfig) -> float:
+    """The farthest corner of the robot from segment 2's centre."""
+    g = cfg.geometry
+    reach = max(centre_to_front(cfg), g.LENGTH_OF_SECOND_MODULE / 2.0 + g.LENGTH_OF_THIRD_MODULE)
+    return math.hypot(reach, half_width(cfg))
+
+
+def turn_room_m(cfg: RobotConfig) -> float:
+    """How far every wall, riser and edge must be from the centre to turn."""
+    return turning_radius(cfg) + TURN_ROOM_MARGIN
+
+
+def can_scan(t: Tick) -> bool:
+    """A wall ahead at the top of a step, on a robot that turns on landings,
+    with no landing turned at yet: look sideways before turning back down."""
+    ctx, cfg = t.ctx, t.cfg
+    return (cfg.algorithm.landings and cfg.sensors.has_side_pair and ctx.number_of_steps > 0
+            and ctx.landing_step is None and not ctx.from_top)
+
+
+# -- landing 1: scan ---------------------------------------------------------------------
+def _side(reading: SensorReading) -> float | None:
+    """A side reading's distance, or None (nothing in range, or an error)."""
+    return reading.distance_m if reading.ok else None
+
+
+def _scan_enter(t: Tick, w: Work) -> None:
+    t.ctx.return_mtb = w.entry_mtb
+    _scan_lift[0](t, w)
+
+
+def _scan_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
+    return {MotorId.MTB: max(0.0, t.cfg.MAX_OF_VERTICAL_TURNS - w.entry_mtb)}
+
+
+def _scanned(t: Tick, w: Work) -> Step:
+    _sample(t, w)
+    return _record(t, w)
+
+
+_scan_lift = lift(_scan_deltas, _scanned)
+
+
+def _lifted_m(t: Tick, w: Work) -> float:
+    return (t.snap.turns(MotorId.MTB) - w.entry_mtb) * t.cfg.motors.lift_travel_per_turn
+
+
+def _sample(t: Tick, w: Work) -> None:
+    """Per side (SSR, SSL): the readings of the lift's first SCAN_BASE_M (what
+    the side sees), then the first height the reading jumps on past them."""
+    lifted = _lifted_m(t, w)
+    for i, sid in enumerate(SIDE_SENSORS):
+        reading = t.snap.sensors[sid]
+        d = _side(reading)
+        if lifted < SCAN_BASE_M:
+            if d is not None:
+                w.side_base[i].append(d)
+            continue
+        if w.side_open[i] is not None or not w.side_base[i]:
+            continue
+        base = statistics.median(w.side_base[i])
+        far = reading.status is SensorStatus.OUT_OF_RANGE and reading.distance_m > base
+        if far or (d is not None and d >= base + SIDE_JUMP_M):
+            w.side_open[i] = lifted
+            name = "right" if sid is SIDE_SENSORS[0] else "left"
+            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
+                  f"({base:.3f} m) with segment 3 lifted {lifted:.3f} m: the next flight",
+                  sensor=sid.value, base=base, lifted=lifted)
+
+
+def _scan(t: Tick, w: Work) -> Step:
+    _sample(t, w)
+    if all(o is not None for o in w.side_open):
+        return _record(t, w)  # both seen over: no need to lift on
+    return _scan_lift[1](t, w)
+
+
+def _record(t: Tick, w: Work) -> Step:
+    """What the scan found, kept in the context for the turn and the way back:
+    how far each side is from the centre line, which sides open onto a
+    flight, and its first riser's height (where the beam saw over it)."""
+    ctx, cfg = t.ctx, t.cfg
+    lat = cfg.sensors.side_lateral
+    bases = [statistics.median(b) if b else None for b in w.side_base]
+    ctx.landing_right_m = None if bases[0] is None else bases[0] + lat
+    ctx.landing_left_m = None if bases[1] is None else bases[1] + lat
+    ctx.landing_rise_m = [None if o is None else o + cfg.sensors.side_height
+                          for o in w.side_open]
+    ctx.landing_open = [s for i, s in ((0, RIGHT), (1, LEFT))
+                        if w.side_open[i] is not None and bases[i] is not None]
+    return go(P.LANDING_SCAN_LOWER)
+
+
+SCAN = PhaseDef(
+    P.LANDING_SCAN, "landing 1 — lift segment 3, looking sideways for the next flight", FLOW,
+    _scan, enter=_scan_enter, carried_by=(1, 2),
+    to={P.LANDING_SCAN_LOWER: "segment 3 at the top of its stroke, or both sides seen over",
+        P.ERROR: FAULT})
+
+
+# -- landing 1: lower, decide ------------------------------------------------------------------
+def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
+    return {MotorId.MTB: t.ctx.return_mtb - w.entry_mtb}
+
+
+def _decide(t: Tick, _w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    ctx.landing_seen = True
+    right, left = ctx.landing_right_m, ctx.landing_left_m
+    opened = ctx.landing_open
+    if not opened:
+        return _refuse(t, "landing_closed",
+                       "landing: no next flight to either side (SSR "
+                       f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
+                       "3's whole stroke does not see over)")
+    room = turn_room_m(cfg)
+    tread = ctx.tread_length[ctx.number_of_steps - 1]
+    if tread is None or not math.isfinite(tread):
+        return _refuse(t, "landing_too_small",
+                       "landing: its depth was not measured (the wall ahead beyond the "
+                       "front pair's range when the last step was climbed): no room to "
+                       "turn is known")
+    depth = tread - DEPTH_MARGIN
+    ctx.landing_depth_m = depth
+    short = [f"{name} {have:.3f} m" for name, have in
+             (("right", right), ("left", left), ("depth/2", depth / 2.0))
+             if have is None or have < room]
+    if short:
+        return _refuse(t, "landing_too_small",
+                       f"landing too small to turn in: the robot's turning circle needs "
+                       f"{room:.3f} m from its centre on every side (radius "
+                       f"{turning_radius(cfg):.3f} m + {TURN_ROOM_MARGIN} m), it has "
+                       + ", ".join(short))
+    side = LEFT if LEFT in opened else RIGHT
+    if len(opened) == 2:
+        # both open: the lower first riser (the side seen over first)
+        side = LEFT if (ctx.landing_rise_m[1] or 0.0) <= (ctx.landing_rise_m[0] or 0.0) \
+            else RIGHT
+    ctx.landing_side = side
+    t.say(f"landing: the next flight is to the {'left' if side == LEFT else 'right'}; "
+          f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
+          "centring to turn", side=side, depth=depth)
+    return go(P.LANDING_CENTRE)
+
+
+def _said(d: float | None) -> str:
+    return "nothing in range" if d is None else f"{d:.3f} m"
+
+
+def _refuse(t: Tick, why: str, message: str) -> Step:
+    t.ctx.ascent_end = why
+    t.say(message + "; the ascent ends, the descent begins", ascent_end=why)
+    return go(P.DESCENT_BACK_OFF)
+
+
+def _lowered(t: Tick, w: Work) -> Step:
+    return _decide(t, w)
+
+
+_scan_lower = lift(_lower_deltas, _lowered)
+SCAN_LOWER = PhaseDef(
+    P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
+    _scan_lower[1], enter=_scan_lower[0], carried_by=(1, 2),
+    to={P.LANDING_CENTRE: "lowered; a side seen over, and room to turn",
+        P.DESCENT_BACK_OFF: "lowered; no side seen over (landing_closed), or too little "
+                            "room to turn (landing_too_small): the descent begins",
+        P.ERROR: FAULT})
+
+
+# -- landing 2: centre, then turn --------------------------------------------------------------
+def _centre_target(t: Tick) -> float | None:
+    depth = t.ctx.landing_depth_m
+    assert depth is not None  # set by the decision
+    return depth / 2.0 - centre_to_front(t.cfg)
+
+
+def _centre_turns(t: Tick) -> float:
+    """Backing by turns, if the front pair cannot read the wall ahead: from
+    where ascent 2 left the front face (approach_gap from it)."""
+    target = _centre_target(t)
+    assert target is not None
+    return t.cfg.wheel_turns(max(0.0, target - t.cfg.algorithm.approach_gap))
+
+
+def _centred(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    ctx.landing_twist = motion.twist(t.snap)
+    yaw = ctx.landing_side * math.pi / 2.0
+    ctx.turn_to = ctx.landing_twist + motion.yaw_turns(t.cfg, yaw)
+    ctx.squaring_turns = 0
+    ctx.purpose = "landing"
+    return go(P.CAL_LIFT, f"centred on the landing: turning {math.degrees(yaw):+.0f}° "
+                          "towards the next flight")
+
+
+_centre = reading_drive(-1, _centre_target, _centre_turns, _centred)
+CENTRE = PhaseDef(
+    P.LANDING_CENTRE, "landing 2 — back to the landing's middle", FLOW, _centre[1],
+    enter=_centre[0], watches="front",
+    to={P.CAL_LIFT: "reads half the landing's depth less the front face's reach: lift "
+                    "to turn 90° towards the next flight",
+        P.ERROR: FAULT})
+
+
+def turned(t: Tick) -> Step:
+    """Calibration's lowering after a landing's turn: on up the next flight
+    (calibrate on its first riser), or down the first (calibrate on the wall
+    ahead, descent 1)."""
+    ctx = t.ctx
+    if ctx.purpose == "landing":
+        ctx.landing_step = ctx.number_of_steps
+        ctx.purpose = "ascent"
+        t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
+              landing_step=ctx.landing_step)
+    else:
+        ctx.purpose = "descent"
+        ctx.turned_back = False
+    return go(P.CAL_CHECK)
+
+
+# -- landing 3: back to where it turned, turn back ------------------------------------------
+def returns_here(t: Tick) -> bool:
+    """Just down the next flight's first step: back to the landing's turn."""
+    ctx = t.ctx
+    return (ctx.landing_step is not None and not ctx.from_top
+            and ctx.steps_descended < ctx.number_of_steps
+            and t.descent_index == ctx.landing_step - 1)
+
+
+def _return_target(t: Tick) -> float | None:
+    open_m = _open_m(t)
+    return None if open_m is None else open_m - centre_to_front(t.cfg)
+
+
+def _open_m(t: Tick) -> float | None:
+    ctx = t.ctx
+    return ctx.landing_left_m if ctx.landing_side == LEFT else ctx.landing_right_m
+
+
+def _return_turns(t: Tick) -> float:
+    target = _return_target(t)
+    return t.cfg.wheel_turns(max(0.0, (target or 0.0) - t.cfg.algorithm.approach_gap))
+
+
+def _returned(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    assert ctx.landing_twist is not None  # set before the turn
+    ctx.turn_to = ctx.landing_twist
+    ctx.squaring_turns = 0
+    ctx.purpose = "landing_back"
+    return go(P.CAL_LIFT, "back where it turned: turning back to the first flight")
+
+
+_return = reading_drive(-1, _return_target, _return_turns, _returned)
+RETURN = PhaseDef(
+    P.LANDING_RETURN, "landing 3 — back to where it turned", FLOW, _return[1],
+    enter=_return[0], watches="front",
+    to={P.CAL_LIFT: "reads where it turned: lift to turn back to the heading it came up "
+                    "the first flight with",
+        P.ERROR: FAULT})
+
+
+PHASES: tuple[PhaseDef, ...] = (SCAN, SCAN_LOWER, CENTRE, RETURN)
