@@ -111,7 +111,7 @@ EXTENSIONS: Mapping[str, tuple[str, frozenset[Phase]]] = MappingProxyType({
 })
 """The seed's extensions, each drawn as what it adds to the flows: the
 transitions whose condition names it, and every transition leaving a phase
-that is its own."""
+that is its own (and the standing rule's resume into one)."""
 
 
 def mermaid_extension(title: str) -> str:
@@ -121,7 +121,8 @@ def mermaid_extension(title: str) -> str:
         raise ValueError(f"unknown extension {title!r}; allowed: {', '.join(EXTENSIONS)}")
     words, own = EXTENSIONS[title]
     edges = [(src, dst, label) for src, nexts in TRANSITIONS.items()
-             for dst, label in nexts.items() if src in own or words in label.lower()]
+             for dst, label in nexts.items()
+             if src in own or words in label.lower() or (src is P.PAUSED and dst in own)]
     return _chart([], edges)
 
 
