@@ -134,6 +134,10 @@ class RunResult:
     """How far the robot's front face ended before the first riser (negative:
     on the stairs), where the robot can tell (a simulation): a descent from
     the top reached the floor."""
+    wall_contact: str | None = None
+    """The first wall (or riser) the robot's body touched, where the robot can
+    tell (a simulation's top view: a landing's walls as it turns); None:
+    none, or it cannot tell."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -253,6 +257,7 @@ def run(
         fault=fault,
         reason=res.reason,
         clear_of_stairs_m=truth.clear_of_stairs_m if truth is not None else None,
+        wall_contact=getattr(truth, "wall_contact", None),
     )
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands

@@ -200,6 +200,7 @@ def _lift_first(t: Tick, w: Work) -> Step:
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
         ctx.ascent_end = "obstacle"
+        ctx.wall_ahead = True
         allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
         t.say(f"step {ctx.number_of_steps + 1} too high: the front sensors did not see over "
               f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)",

@@ -149,6 +149,10 @@ class Context:
     "too near" there).  The tread is what they see past the riser less this."""
 
     # -- quarter-turn landings ([algorithm] landings) -----------------------------
+    wall_ahead: bool = False
+    """Ascent 3 lifted segment 1 its whole stroke and still saw what is ahead:
+    a wall (or a riser too high), not a tread too short or a rise too low.
+    Only a wall may be a landing's."""
     landing_seen: bool = False
     """Landing 1 has scanned a landing (one a climb)."""
     landing_right_m: float | None = None

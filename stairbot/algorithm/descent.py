@@ -403,13 +403,30 @@ REFUSE = PhaseDef(
 
 
 # -- descent 3-6: segment by segment off the step ----------------------------------------------
-def _second_target(t: Tick) -> float | None:
+FAR_TAB_M = 0.5
+"""Descent 3 and 5 drive by the seed's turn counts, as where the tab is not
+measurable, when the step's tab_length_to_edge is longer than this: the
+wall ahead is a landing's (a tread of 0.63 m or more), which the front pair
+reads from up to LENGTH_OF_INFINITY, where its noise is largest, while the
+back pair has just placed the edge behind (descent 1) exactly.  On a
+landing 1.0 m deep, descent 5 ended 6.5 mm short of its target 1.007 m
+(a VL53L1X pair: sigma 8 mm there), lowered segment 1's wheel onto the
+edge, and the robot tipped at 154 deg/s."""
+
+
+def _tab_to_drive(t: Tick) -> float | None:
+    """The tab descent 3 and 5 drive to, or None: by turns (FAR_TAB_M)."""
     tab = _tab(t)
+    return None if tab is None or tab > FAR_TAB_M else tab
+
+
+def _second_target(t: Tick) -> float | None:
+    tab = _tab_to_drive(t)
     return None if tab is None else t.cfg.LENGTH_OF_SECOND_MODULE + tab
 
 
 def _first_target(t: Tick) -> float | None:
-    tab = _tab(t)
+    tab = _tab_to_drive(t)
     if tab is None:
         return None
     return t.cfg.LENGTH_OF_FIRST_MODULE + t.cfg.LENGTH_OF_SECOND_MODULE + tab

@@ -52,8 +52,13 @@ WHEEL_WIDTH = 0.01
 """How far a wheel stands out past the track on each side, m: the robot's
 width is track_width plus twice this."""
 DEPTH_MARGIN = 0.01
-"""The landing's depth is taken this much less than ascent 3 measured it
-(its tread: the reading past the last riser), m."""
+"""The landing's depth is taken this much less than it was measured, m."""
+TAB_PAST_EDGE_M = 0.02
+"""Where ascent 7 read tab_length_to_edge, segment 1's front face stood
+LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE less about this past the
+edge (segment 2's rear wheels just onto the step: ascent 6 ends at
+length_of_next_step less the two, and a 0.28 m tread read tabs of 0.145 to
+0.150 m), m."""
 SIDE_JUMP_M = 0.05
 """A side sees over what it saw when it reads this much farther (or nothing
 in range): ascent 3's SIGHT_JUMP_M, for the same reason -- no tread is this
@@ -88,11 +93,13 @@ def turn_room_m(cfg: RobotConfig) -> float:
 
 
 def can_scan(t: Tick) -> bool:
-    """A wall ahead at the top of a step, on a robot that turns on landings,
-    with no landing turned at yet: look sideways before turning back down."""
+    """A wall ahead at the top of a step (too high to see over: a tread too
+    short to stand on is no landing to turn on), on a robot that turns on
+    landings, with no landing scanned yet: look sideways before turning
+    back down."""
     ctx, cfg = t.ctx, t.cfg
     return (cfg.algorithm.landings and cfg.sensors.has_side_pair and ctx.number_of_steps > 0
-            and ctx.landing_step is None and not ctx.from_top)
+            and ctx.wall_ahead and not ctx.landing_seen and not ctx.from_top)
 
 
 # -- landing 1: scan ---------------------------------------------------------------------
@@ -102,6 +109,7 @@ def _side(reading: SensorReading) -> float | None:
 
 
 def _scan_enter(t: Tick, w: Work) -> None:
+    t.ctx.landing_seen = True
     t.ctx.return_mtb = w.entry_mtb
     _scan_lift[0](t, w)
 
@@ -182,7 +190,6 @@ def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
 
 def _decide(t: Tick, _w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
-    ctx.landing_seen = True
     right, left = ctx.landing_right_m, ctx.landing_left_m
     opened = ctx.landing_open
     if not opened:
@@ -191,15 +198,14 @@ def _decide(t: Tick, _w: Work) -> Step:
                        f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
                        "3's whole stroke does not see over)")
     room = turn_room_m(cfg)
-    tread = ctx.tread_length[ctx.number_of_steps - 1]
-    if tread is None or not math.isfinite(tread):
+    depth = landing_depth(t)
+    if depth is None:
         return _refuse(t, "landing_too_small",
-                       "landing: its depth was not measured (the wall ahead beyond the "
-                       "front pair's range when the last step was climbed): no room to "
+                       "landing: its depth was not measured (neither the tread past the "
+                       "last riser nor tab_length_to_edge read the wall ahead): no room to "
                        "turn is known")
-    depth = tread - DEPTH_MARGIN
     ctx.landing_depth_m = depth
-    short = [f"{name} {have:.3f} m" for name, have in
+    short = [f"{name} {_said(have)}" for name, have in
              (("right", right), ("left", left), ("depth/2", depth / 2.0))
              if have is None or have < room]
     if short:
@@ -218,6 +224,24 @@ def _decide(t: Tick, _w: Work) -> Step:
           f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
           "centring to turn", side=side, depth=depth)
     return go(P.LANDING_CENTRE)
+
+
+def landing_depth(t: Tick) -> float | None:
+    """The landing's depth, from the edge behind to the wall ahead, less
+    DEPTH_MARGIN: the smaller of what ascent 3 measured for the last step's
+    tread (the reading past its riser: beyond LENGTH_OF_INFINITY not
+    measured) and what ascent 7's tab_length_to_edge puts it at
+    (TAB_PAST_EDGE_M); None if neither was measured."""
+    ctx, cfg = t.ctx, t.cfg
+    i = ctx.number_of_steps - 1
+    seen: list[float] = []
+    tread, tab = ctx.tread_length[i], ctx.tab_length_to_edge[i]
+    if tread is not None and math.isfinite(tread):
+        seen.append(tread)
+    if tab is not None:
+        seen.append(tab + cfg.LENGTH_OF_FIRST_MODULE + cfg.LENGTH_OF_SECOND_MODULE
+                    - TAB_PAST_EDGE_M)
+    return min(seen) - DEPTH_MARGIN if seen else None
 
 
 def _said(d: float | None) -> str:
@@ -290,8 +314,11 @@ def turned(t: Tick) -> Step:
         t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
               landing_step=ctx.landing_step)
     else:
+        # descent 1 of the first flight's top step, as its back-off would begin it:
+        # that step's edge not seen yet (the edge watch's mark is the last step's)
         ctx.purpose = "descent"
-        ctx.turned_back = False
+        ctx.edge_wheel = None
+        ctx.turned_back = ctx.edge_squared = False
     return go(P.CAL_CHECK)
 
 

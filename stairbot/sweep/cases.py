@@ -13,10 +13,12 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from importlib import resources
 from typing import Any
+
+import msgspec
 
 from stairbot._schema import _tokens
 from stairbot.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
@@ -141,6 +143,8 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     but not the last one under a landing, which runs on into the landing."""
     if scenario.start.on == "top":
         return descent_zone(scenario, config, rules)
+    if scenario.landing is not None:
+        return landing_zone(scenario, config, rules)
     steps = scenario.steps[:config.algorithm.max_steps]
     if not steps:
         return "inside", 0.0, math.inf
@@ -168,6 +172,78 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
             and sight <= far - margin):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread
+
+
+def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
+                 ) -> tuple[str, float, float]:
+    """Quarter-turn stairs' zone: each flight's as a flight of its own
+    (:func:`zone`: the first ends on the landing, the second on its top),
+    and the landing's.  The robot turns on the landing only if it has the
+    side pair and ``[algorithm] landings``, the second flight has steps, the
+    landing is not so deep that the wall ahead reads as the top (the front
+    pair's LENGTH_OF_INFINITY past the robot standing at the edge), and the
+    robot's turning room (:func:`~stairbot.algorithm.landing.turn_room_m`)
+    fits in half the landing's measured depth and on either side of where it
+    climbed (half the width, less start.lateral), give or take the tread
+    margin.  Where the landing refuses, the first flight's zone stands: the
+    robot climbs it, refuses the landing, comes home, and that is right
+    ("refused"); where it does not, both flights must be climbed."""
+    from stairbot.algorithm.landing import DEPTH_MARGIN, TAB_PAST_EDGE_M, turn_room_m
+
+    landing = scenario.landing
+    assert landing is not None
+    first = _first_flight_zone(scenario, config, rules)
+    if not landing.steps:
+        return first  # a wall where the second flight should be: the flight ends there
+    second = zone(replace(scenario, steps=landing.steps, landing=None,
+                          start=msgspec.structs.replace(scenario.start, distance=0.3)),
+                  config, rules)
+    tm = rules.tread_margin_m
+    room = turn_room_m(config)
+    depth = landing.depth - DEPTH_MARGIN
+    short = min(depth / 2.0 - room, scenario.width / 2.0 - abs(scenario.start.lateral) - room)
+    # ascent 8 reads the wall ahead from segment 1's front face, about
+    # LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE - TAB_PAST_EDGE_M past the edge
+    top = (config.LENGTH_OF_INFINITY + config.LENGTH_OF_FIRST_MODULE
+           + config.LENGTH_OF_SECOND_MODULE - TAB_PAST_EDGE_M - landing.depth)
+    sight = sight_margin(config)
+    turns = config.algorithm.landings and config.sensors.has_side_pair
+    max_rise, min_tread = max(first[1], second[1]), min(first[2], second[2])
+    steps = len(scenario.steps) + len(landing.steps)
+    if not turns or short < -tm or top < -sight:
+        # the landing refuses (or reads as the top): the first flight decides
+        return ("outside" if first[0] == "inside" else first[0]), max_rise, min_tread
+    zones = {first[0], second[0]}
+    if "outside" in zones:
+        return "outside", max_rise, min_tread
+    if zones == {"inside"} and short >= tm and top >= sight \
+            and steps <= config.algorithm.max_steps:
+        return "inside", max_rise, min_tread
+    return "band", max_rise, min_tread
+
+
+def _first_flight_zone(scenario: Scenario, config: RobotConfig, rules: Rules
+                       ) -> tuple[str, float, float]:
+    """The first flight's zone under a quarter-turn landing: its last tread is
+    the landing, which ascent 3 measures (and holds to min_rise_for, as any
+    tread: the robot cannot tell the landing's wall from a low riser beyond
+    a long tread) where the wall ahead is in the front pair's sight (nearer
+    than LENGTH_OF_INFINITY, give or take the sight margin), and does not
+    beyond it; between, either."""
+    landing = scenario.landing
+    assert landing is not None
+    last = scenario.steps[-1]
+    walled = replace(scenario, landing=None, top="wall",
+                     steps=(*scenario.steps[:-1], type(last)(last.rise, landing.depth)))
+    open_ = replace(scenario, landing=None)
+    reading = landing.depth + config.algorithm.approach_gap
+    sight, far = sight_margin(config), config.LENGTH_OF_INFINITY
+    if reading < far - sight:
+        return zone(walled, config, rules)
+    if reading > far + sight:
+        return zone(open_, config, rules)
+    a, b = zone(walled, config, rules), zone(open_, config, rules)
+    return a if a[0] == b[0] else ("band", a[1], min(a[2], b[2]))
 
 
 def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
@@ -256,6 +332,11 @@ def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) 
     if scenario.start.on == "top":
         facts["from_top"] = True
         facts["expected_steps"] = len(scenario.steps)
+    if scenario.landing is not None:
+        # all of both flights: the landing's zone says whether it turns
+        facts["expected_steps"] = min(len(scenario.steps) + len(scenario.landing.steps),
+                                      config.algorithm.max_steps)
+        facts["landing_turn"] = scenario.landing.turn
     return Case(index, values, scenario_text, config_text, facts)
 
 

@@ -19,7 +19,9 @@ Verdicts, first match wins:
 
 * ``error``    the program itself crashed (a traceback is kept)
 * ``unsafe``   the robot fell (during the run, or in the 2 s the simulation
-               runs on after it), or a lift or wheel was left moving
+               runs on after it), touched a wall it turned or drove into (a
+               landing's: the simulation's top view), or a lift or wheel was
+               left moving
 * ``stranded`` ended farther than ``home_m`` from the start, or on the stairs
                (climbed a different number of steps than it descended)
 * ``climbed``  completed, climbed and descended every step it should
@@ -61,6 +63,8 @@ def judge(result: Mapping[str, Any], facts: Mapping[str, Any],
         return "unsafe", f"fell: {result.get('error') or 'pitch beyond the limit'}"
     if moving:
         return "unsafe", "left moving after the run: " + ", ".join(moving)
+    if result.get("wall_contact"):
+        return "unsafe", f"touched a wall: {result.get('wall_contact')}"
     if facts.get("from_top"):
         return judge_descent(result, facts)
     if up != down:

@@ -1,0 +1,111 @@
+"""Quarter-turn landings (issue 13, the seed's extension 1): at a wall at the
+top of a flight the robot with the side pair looks sideways, turns 90°
+towards the next flight, climbs it, and comes back the same way; it refuses a
+landing too small to turn in, or with no next flight, and comes home; it
+never touches a wall."""
+
+from __future__ import annotations
+
+import pytest
+import simrun
+
+from stairbot.algorithm.phases import Phase
+from stairbot.config import load_config, parse_config
+from stairbot.errors import ConfigError
+from stairbot.events import Event, EventKind
+from stairbot.scenario import load_scenario, parse_scenario
+
+LANDINGS = load_config("landings")
+
+
+def phases(events: list[Event]) -> list[Phase]:
+    return [Phase(e.data["phase"]) for e in events if e.kind is EventKind.PHASE]
+
+
+def infos(events: list[Event]) -> list[str]:
+    return [e.message for e in events if e.kind is EventKind.INFO]
+
+
+def landing(depth: float = 1.0, turn: str = "left", count: int = 3, width: float = 1.0,
+            extra: str = "") -> str:
+    return (f"[stairs]\ncount = 3\nrise = 0.17\ntread = 0.28\nwidth = {width}\n"
+            f"[landing]\ndepth = {depth}\nturn = '{turn}'\ncount = {count}\n{extra}")
+
+
+@pytest.mark.parametrize("turn", ["left", "right"])
+def test_three_steps_a_quarter_turn_and_three_more_up_and_back_home(turn: str) -> None:
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, load_scenario(f"landing_{turn}"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "top_reached", 6, 6), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
+    assert result.wall_contact is None and not result.fell
+    told = infos(events)
+    assert any(m.startswith(f"landing: the next flight is to the {turn}") for m in told)
+    assert any(m.startswith("turned onto the next flight: its steps count on from 4")
+               for m in told)
+    seen = phases(events)
+    # scanned, centred and turned once; back where it turned once, on the way down
+    assert seen.count(Phase.LANDING_SCAN) == seen.count(Phase.LANDING_CENTRE) == 1
+    assert seen.count(Phase.LANDING_RETURN) == 1
+    assert seen.index(Phase.LANDING_RETURN) > seen.index(Phase.DESCENT_LOWER_THIRD)
+
+
+@pytest.mark.parametrize(("scenario", "end"), [("landing_too_small", "landing_too_small"),
+                                               ("landing_wall", "landing_closed")])
+def test_a_landing_it_cannot_turn_on_is_refused_and_the_robot_comes_home(
+        scenario: str, end: str) -> None:
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, load_scenario(scenario), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", end, 3, 3), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
+    assert result.wall_contact is None
+    seen = phases(events)
+    assert Phase.LANDING_SCAN in seen
+    assert Phase.LANDING_CENTRE not in seen  # it never turned
+    assert Phase.CAL_TURN_TO not in seen[:seen.index(Phase.DESCENT_BACK_OFF)]
+
+
+def test_a_landing_too_narrow_to_turn_in_is_refused() -> None:
+    """0.34 m wide: 0.17 m either side of the centre line, where the robot's
+    turning circle needs 0.174 m."""
+    scenario = parse_scenario(landing(width=0.34), "narrow.toml")
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, scenario, events)
+    assert (result.ascent_end, result.steps_climbed, result.steps_descended) == (
+        "landing_too_small", 3, 3), result.to_dict()
+    assert any(m.startswith("landing too small to turn in") and "right 0.1" in m
+               and "left 0.1" in m for m in infos(events))
+
+
+def test_a_tread_too_short_to_stand_on_is_no_landing_to_look_sideways_from() -> None:
+    """0.25 m to the wall ahead: ascent 3 refuses the tread (shorter than
+    min_tread_m) and the robot descends without scanning."""
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, parse_scenario(landing(depth=0.25), "short.toml"),
+                            events)
+    assert (result.ascent_end, result.steps_climbed, result.steps_descended) == (
+        "obstacle", 2, 2), result.to_dict()
+    assert Phase.LANDING_SCAN not in phases(events)
+
+
+def test_the_reference_robot_refuses_a_landing_as_a_wall_and_comes_home() -> None:
+    """No side pair: the landing's wall is the seed's obstacle.  Its tab (0.86 m,
+    read from far) is longer than FAR_TAB_M: descent 3 and 5 of that step go by
+    turns (by the reading, descent 5 ended 6.5 mm short and the robot tipped at
+    154 deg/s as segment 1 was lowered onto the edge)."""
+    events: list[Event] = []
+    result = simrun.run_sim(load_config(), load_scenario("landing_left"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "obstacle", 3, 3), result.to_dict()
+    assert not result.fell and result.final_offset_m is not None
+    assert result.final_offset_m < 0.05
+    assert Phase.LANDING_SCAN not in phases(events)
+
+
+def test_landings_need_the_side_pair() -> None:
+    with pytest.raises(ConfigError) as info:
+        parse_config('extends = "reference"\n[algorithm]\nlandings = true\n', "x.toml")
+    assert info.value.field == "algorithm.landings"
+    assert "side pair" in str(info.value)
