@@ -21,10 +21,11 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.link import Request
 
 SAME_SHORT_LIMIT = 8
-"""Attempts in a row that each lacked the same replies, after which a request
-is given up as a protocol error (``CanRequest.attempt_failed``): a board that
-leaves them out (its Ident said 6 sensor channels, it sends 4), not a lossy
-bus, which at 10 % of frames lost does that about once in 10**10 requests."""
+"""Attempts in a row that each ended in the same gap, after which a request is
+given up as a protocol error (``CanRequest.attempt_failed``): a board that
+leaves those replies out (its Ident said 6 sensor channels, it sends 4), not
+a lossy bus, which at 10 % of frames lost does that to fewer than one request
+in 10**10."""
 
 
 def expected_replies(board: int, msg: m.Message,
@@ -104,10 +105,14 @@ class CanRequest(Request):
         self.todo = deque(self._all_due())
 
     def attempt_failed(self) -> str | None:
-        """This attempt ended short (a gap, or the time ran out after some
-        replies came): after SAME_SHORT_LIMIT attempts in a row short of the
-        same replies, why the board will never send them; else None."""
-        lacked = tuple(self.skipped) + tuple(self.todo) if self.got else ()
+        """This attempt ended without its whole reply.  After SAME_SHORT_LIMIT
+        attempts in a row that each ended in the same gap -- the board's last
+        reply came, the same ones before it never did -- why the board will
+        never send them; else None.  Only a gap counts: CAN keeps a sender's
+        order, so a reply skipped before a later one was not sent (or lost),
+        never merely slow; an attempt that timed out with replies still to
+        come may have met a slow board, and starts the count afresh."""
+        lacked = tuple(self.skipped) if self.gap and not self.todo else ()
         before, count = self.short
         count = count + 1 if lacked and lacked == before else int(bool(lacked))
         self.short = (lacked, count)

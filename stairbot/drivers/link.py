@@ -91,7 +91,8 @@ class Request:
 
     def attempt_failed(self) -> str | None:
         """This attempt ended without the whole reply; why the board will never
-        send one (a wire that can tell: the CAN link), or None."""
+        send one (a wire that can tell: the CAN link, from the same replies
+        left out attempt after attempt), or None."""
         return None
 
 

@@ -20,7 +20,7 @@ from stairbot.config import RobotConfig, load_config, parse_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
-from stairbot.drivers.can_request import SAME_SHORT_LIMIT
+from stairbot.drivers.can_request import SAME_SHORT_LIMIT, CanRequest, Offer
 from stairbot.errors import BoardMismatchError, HardwareError, LinkLostError
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, SensorBoard, make_boards
@@ -247,3 +247,32 @@ def test_a_config_with_the_pair_refuses_fake_boards_without_it_by_url(kind: str)
         with pytest.raises(BoardMismatchError, match=r"side_model = \"vl53l0x\" gives the "
                            r"robot the side pair \(SSR, SSL\), but the sensor board offers 4"):
             open_robot(url, SIDE_CONFIG)
+
+
+def test_only_the_same_gap_attempt_after_attempt_counts_as_a_broken_board() -> None:
+    """A reply skipped before a later one was not sent (CAN keeps a sender's
+    order); a timeout with replies still owed may be a slow board: it counts
+    nothing.  A different gap starts the count afresh."""
+    req = CanRequest(int(m.Board.SENSOR), (m.ReadAll(),), True, 0.0, 1.0, channels=6)
+    status = m.Status(0x40, 0, 250, 0)
+    tel = [m.SensorTelemetry(c, 0, 500, 1, 0) for c in range(6)]
+    imu = [m.ImuTelemetry(a, 0, 0, 0, 0) for a in range(2)]
+
+    def attempt(*replies: m.Message) -> str | None:
+        req.expect()
+        for r in replies:
+            assert req.offer(r, 0) is Offer.TAKEN
+        return req.attempt_failed()
+
+    without_side = (status, *tel[:4], *imu)
+    for _ in range(SAME_SHORT_LIMIT - 1):
+        assert attempt(*without_side) is None
+    assert attempt(status, *tel[:3]) is None  # timed out, replies owed: a slow board?
+    for _ in range(SAME_SHORT_LIMIT - 1):
+        assert attempt(*without_side) is None
+    assert attempt(status, *tel[:4], tel[5], *imu) is None  # another gap: afresh
+    for _ in range(SAME_SHORT_LIMIT - 1):
+        assert attempt(*without_side) is None
+    why = attempt(*without_side)
+    assert why is not None and "without SensorTelemetry channel 4, SensorTelemetry channel 5" \
+        in why
