@@ -10,10 +10,10 @@ such line.
 Four lines (five), a bracket joining each pair to its verdict: two lines
 fewer than a verdict line per pair, which an 80x24 screen needs for the
 panels below (the side pair's one line takes the row the link panel has to
-spare there).  The title says when the values were read; stale ones are dimmed and
-marked (:mod:`stairbot.console.freshness`), and a sensor whose own
-measurement is older than that says ``old`` instead of ``ok`` -- the side
-pair's as every other's.
+spare there).  The title says when the values were read; stale ones are
+dimmed and marked (:mod:`stairbot.console.freshness`), and a sensor whose
+own measurement is older than that says ``old`` instead of ``ok`` -- the
+side pair's as every other's.
 """
 
 from __future__ import annotations
