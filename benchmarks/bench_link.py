@@ -36,15 +36,16 @@ BAUD = 1_000_000
 BITS_PER_BYTE = 10  # 8N1
 
 
-def cycle_bytes() -> tuple[int, int]:
-    """(host -> boards, boards -> host) bytes on the wire per cycle."""
+def cycle_bytes(sensors: int = 4) -> tuple[int, int]:
+    """(host -> boards, boards -> host) bytes on the wire per cycle, for a
+    sensor board of ``sensors`` channels (6: the side pair)."""
     status = m.Status(0, 0, 250, 0)
     s = 0x5A  # a host session (a zero would cost COBS a byte)
     tx = [Frame(1, 1, (m.ReadAll(),), session=s), Frame(2, 2, (m.ReadAll(),), session=s),
           Frame(1, 3, u.speeds_to_wire({}), session=s)]
     rx = [Frame(1, 1, (status, *(m.MotorTelemetry(c, 1, 0, 1000, 123456) for c in range(6))),
                 True, s),
-          Frame(2, 2, (status, *(m.SensorTelemetry(c, 0, 500, 7, 12) for c in range(4)),
+          Frame(2, 2, (status, *(m.SensorTelemetry(c, 0, 500, 7, 12) for c in range(sensors)),
                        *(m.ImuTelemetry(a, 0, -250, 15, 3) for a in m.IMU_AXES)), True, s),
           Frame(1, 3, (m.Ack(0x20, 0), m.Ack(0x21, 0)), True, s)]
     return sum(len(encode_frame(f)) for f in tx), sum(len(encode_frame(f)) for f in rx)
@@ -107,6 +108,10 @@ def bench_serial(cycles: int) -> None:
         print(f"  wire at 1 Mbaud 8N1: {tx} B out + {rx} B in per cycle -> "
               f"{1 / (max(tx, rx) * bits):.0f} cycles/s full duplex, "
               f"{1 / ((tx + rx) * bits):.0f} cycles/s half duplex (RS-485)")
+        tx, rx = cycle_bytes(sensors=6)
+        print(f"  the same with the side pair (6 sensor channels): {tx} B out + {rx} B in "
+              f"-> {1 / (max(tx, rx) * bits):.0f} cycles/s full duplex, "
+              f"{1 / ((tx + rx) * bits):.0f} half duplex")
         session.close()
     finally:
         proc.terminate()

@@ -48,15 +48,16 @@ LOAD_LIMIT = 0.20
 WARMUP = 100  # cycles before the measured ones
 
 
-def cycle_frames() -> list[tuple[str, int, int]]:
+def cycle_frames(sensors: int = 4) -> list[tuple[str, int, int]]:
     """(frame name, data bytes, count) of every frame one control cycle puts on
-    the bus, both ways, taken from the DBC."""
+    the bus, both ways, taken from the DBC; ``sensors``: the sensor board's
+    channels (6: the side pair)."""
     w = wire()
     sent = [(15, m.ReadAll()), (1, m.SetWheelSpeeds(0, 0, 0, 0)),
             (1, m.SetLiftSpeeds(0, 0)),
             (1, m.Status(0, 0, 250, 0)), (2, m.Status(0, 0, 250, 0)),
             *((1, m.MotorTelemetry(c, 1, 0, 0, 0)) for c in range(6)),
-            *((2, m.SensorTelemetry(c, 0, 0, 0, 0)) for c in range(4)),
+            *((2, m.SensorTelemetry(c, 0, 0, 0, 0)) for c in range(sensors)),
             *((2, m.ImuTelemetry(a, 0, 0, 0, 0)) for a in m.IMU_AXES),
             (1, m.Ack(0x20, 0)), (1, m.Ack(0x21, 0))]
     counts: dict[str, list[int]] = {}
@@ -135,6 +136,12 @@ def bus_budget(tick_s: float) -> None:
     step = frame_bits(4) * 2  # lockstep only: StepTo + StepDone (simulation)
     print(f"  (lockstep simulation adds StepTo + StepDone: {step} bits, "
           f"{(bits + step) / tick_s / BITRATE:.1%})")
+    side = cycle_frames(sensors=6)
+    side_bits = sum(frame_bits(size) * n for _, size, n in side)
+    print(f"  with the side pair (6 sensor channels): {sum(n for _, _, n in side)} frames, "
+          f"{side_bits} bits, {side_bits / tick_s / BITRATE:.1%} "
+          f"({(side_bits + step) / tick_s / BITRATE:.1%} in lockstep), the bus allows "
+          f"{BITRATE / side_bits:.0f} cycles/s")
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -77,6 +77,12 @@ class PortBusyError(HardwareError):
     on a port at a time).  One line naming the port and who holds it."""
 
 
+class BoardMismatchError(HardwareError):
+    """The boards lack what the robot config says the robot has (the side
+    pair SSR/SSL): a run would miss readings it counts on.  One line naming
+    the URL, the config file and key, and what the board offers."""
+
+
 class RobotFellError(HardwareError):
     """The simulated world detected instability: pitch beyond the limit, a fall."""
 

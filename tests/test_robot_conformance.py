@@ -35,6 +35,7 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
 from stairbot.hardware import (
+    BASE_SENSORS,
     LIFT_MOTORS,
     WHEEL_MOTORS,
     HasScene,
@@ -225,7 +226,7 @@ def test_is_a_robot_and_starts_unlatched(rig: Rig) -> None:
 
 def test_read_gives_every_sensor_and_every_motor(rig: Rig) -> None:
     snap = rig.robot.read()
-    assert set(snap.sensors) == set(SensorId) and len(SensorId) == 4
+    assert set(snap.sensors) == set(BASE_SENSORS) and len(BASE_SENSORS) == 4  # no side pair
     assert set(snap.motors) == set(MotorId) and len(MotorId) == 6
     assert all(isinstance(r, SensorReading) for r in snap.sensors.values())
     assert all(isinstance(s, MotorState) for s in snap.motors.values())
@@ -282,7 +283,7 @@ def test_read_goes_on_while_latched(rig: Rig) -> None:
     rig.robot.command(FORWARD)
     rig.wait(0.5)
     b = rig.robot.read()
-    assert set(b.sensors) == set(SensorId) and set(b.motors) == set(MotorId)
+    assert set(b.sensors) == set(BASE_SENSORS) and set(b.motors) == set(MotorId)
     assert wheels_moved(a, b) < STILL
 
 
@@ -388,7 +389,8 @@ def carried(imu: Imu | None) -> Imu | None:
 def assert_as_reported(got: Snapshot, own: Snapshot) -> None:
     """``got`` (read through the robot) holds the ages and the IMU of ``own``
     (the simulated robot's snapshot of the same instant)."""
-    for sid in SensorId:
+    assert set(got.sensors) == set(own.sensors)
+    for sid in own.sensors:
         want = min(AGE_MAX_S, own.sensors[sid].age_s)
         assert near(got.sensors[sid].age_s, want, AGE_S), (sid, got.sensors[sid], want)
     want_imu = carried(own.imu)

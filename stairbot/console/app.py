@@ -130,12 +130,15 @@ class StairbotConsole(App[None]):
         # screen is on top (app.query_one looks only at the top screen).
         self.banner = Banner(id="banner")  # the line that says how things stand
         self.picture = StairsPicture(id="picture")
-        self.sensors = SensorPanel(engine.config.algorithm.equal_tolerance, id="sensors")
+        side_pair = engine.config.sensors.has_side_pair
+        self.sensors = SensorPanel(engine.config.algorithm.equal_tolerance, side_pair=side_pair,
+                                   id="sensors")
         self.motors = MotorPanel(id="motors")
         self.phase = PhasePanel(id="phase")
         self.link = LinkPanel(id="link")
         self.log_panel = EventLog(id="log")
-        self.trends = TrendsPanel(engine.config.motors.lift_travel_per_turn, id="trends")
+        self.trends = TrendsPanel(engine.config.motors.lift_travel_per_turn,
+                                  side_pair=side_pair, id="trends")
         self.graphs: bool | None = None
         self._rows: int | None = None  # the screen's height, as the last resize said
         """The operator's choice of graphs (g); None: by the screen's size."""

@@ -40,8 +40,10 @@ READING THE SCREEN
   Every panel says how old its values are; values not read for
   1.5 s are dimmed and marked STALE: they are not live.
   Sensors: front R/L look ahead (SFR, SFL), back R/L look down
-  (SBR, SBL); ok, out (of range: the value is the sensor's
-  limit), old (the sensor's own reading is stale), ERROR.
+  (SBR, SBL); side R/L look right and left (SSR, SSL), on a
+  robot with the side pair only; ok, out (of range: the value
+  is the sensor's limit), old (the sensor's own reading is
+  stale), ERROR, none (no reading of it).
   Motors: ▶ forward ◀ back; a lift shows the segment that moves:
   1▲ segment 1 rises, 2▼ segment 2 sinks (segments 1 front, 2
   middle, 3 back, coloured as in the picture).  With no run

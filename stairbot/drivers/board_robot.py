@@ -3,7 +3,8 @@
 :class:`BoardRobot` implements the Robot protocol on a
 :class:`~stairbot.drivers.link.BoardLink` (the serial link, the CAN link):
 ``read()`` is one ReadAll to each board (both in flight at once; the replies
-become the snapshot in ``telemetry.py``), ``command()``
+become the snapshot in ``telemetry.py``: the four base sensors, and the side
+pair SSR/SSL on a robot whose config has one), ``command()``
 one SetWheelSpeeds + SetLiftSpeeds whose Ack is collected on the next call,
 the handshake identifies the boards and sets their watchdogs, a keepalive
 thread feeds them while the robot stands idle, and link health goes into
@@ -26,6 +27,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Concatenate, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
+from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
@@ -33,9 +35,9 @@ from stairbot.drivers.handshake import LATCHES, open_board
 from stairbot.drivers.health import HealthReport
 from stairbot.drivers.link import BoardLink, Reply, Request
 from stairbot.drivers.telemetry import K, T, V
-from stairbot.errors import HardwareError, LinkLostError
+from stairbot.errors import BoardMismatchError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import Clock, Imu, MotorId, Snapshot
+from stairbot.hardware import Clock, Imu, MotorId, SensorId, SensorReading, Snapshot
 from stairbot.robots import RobotSession
 
 # The emergency stop (docs/protocol.md, "Emergency stop"): each press puts
@@ -69,7 +71,11 @@ class BoardRobot:
     ``watchdog_ms`` is the boards' watchdog in wall-clock ms (0: off); boards
     paced at ``time_scale`` times real time are sent that many times it, and
     the robot's clock (a WallClock unless ``clock`` is given) runs as fast.
-    ``monotonic`` is the wall clock the keepalive goes by."""
+    ``monotonic`` is the wall clock the keepalive goes by.  ``side_pair``
+    names where the robot config gives the robot the side pair (SSR, SSL;
+    ``wanted_side_pair``), None when it has none: the sensor board must then
+    have it (BoardMismatchError when opening), and every snapshot carries six
+    readings; otherwise four, whatever the board sends."""
 
     LOCKSTEP = False  # what the boards' LOCKSTEP flag must say (fakes.lockstep: True)
     estop_any_thread = True  # estop() does not wait for the lock (the console relies on it)
@@ -79,9 +85,10 @@ class BoardRobot:
                  time_scale: float = 1.0, clock: Clock | None = None,
                  sink: EventSink = discard, keepalive: bool = True,
                  monotonic: Callable[[], float] = time.monotonic,
-                 allow_latched: bool = False) -> None:
+                 allow_latched: bool = False, side_pair: str | None = None) -> None:
         self.link = link
         self.url = url
+        self.side_pair = side_pair
         self.sink = sink
         self.clock: Clock = clock or WallClock(
             monotonic=lambda: monotonic() * time_scale, sleep=lambda s: time.sleep(s / time_scale))
@@ -118,7 +125,8 @@ class BoardRobot:
         for board in m.Board:
             self.idents[board], status = open_board(
                 self.link, self.url, board, lockstep=self.LOCKSTEP,
-                watchdog_ms=self.board_watchdog_ms, allow_latched=allow_latched)
+                watchdog_ms=self.board_watchdog_ms, allow_latched=allow_latched,
+                side_pair=self.side_pair)
             if status is not None:
                 self.status[board] = status
                 if status.flags & LATCHES:
@@ -167,9 +175,7 @@ class BoardRobot:
         transit = max(0.0, now - sent)
         motors = self._read_all(m.Board.MOTOR, fm.messages, m.MotorTelemetry,
                                 m.MOTOR_CHANNELS, u.state_from_wire)
-        sensors = self._read_all(m.Board.SENSOR, fs.messages, m.SensorTelemetry,
-                                 m.SENSOR_CHANNELS,
-                                 lambda t: u.reading_from_wire(t, transit))
+        sensors = self._read_sensors(fs.messages, transit)
         imu = self._read_imu(fs.messages, transit, now)
         health = self.health()
         self.report.maybe_event(health, now, self.sink)
@@ -362,6 +368,8 @@ class BoardRobot:
         except LinkLostError as exc:
             self._lost(str(exc))
             raise  # unreachable: _lost raises
+        except HardwareError as exc:  # a board that broke the protocol
+            raise HardwareError(f"{self.url}: {exc}") from None
 
     def _lost(self, reason: str, boards_stopped: bool = False) -> None:
         """Report the lost link (a LINK event, the first time only: the stop,
@@ -420,11 +428,28 @@ class BoardRobot:
         """A ReadAll reply -- Status, then one ``kind`` telemetry per channel --
         as ``{ids[channel]: convert(telemetry)}``, after checking the Status.
         HardwareError when the reply is not that."""
+        self._check_reply_status(board, msgs)
+        return telemetry.channels(board, msgs[1:], kind, ids, convert)
+
+    def _read_sensors(self, msgs: tuple[Any, ...], transit_s: float
+                      ) -> dict[SensorId, SensorReading]:
+        """The sensor board's ReadAll reply as readings, after checking its
+        Status: the base four, and the side pair on a robot that has one
+        (``telemetry.sensors_of``).  HardwareError when the reply is not that;
+        BoardMismatchError (naming this URL) when the side pair lacks."""
+        self._check_reply_status(m.Board.SENSOR, msgs)
+        try:
+            return telemetry.sensors_of(msgs[1:], lambda t: u.reading_from_wire(t, transit_s),
+                                        self.side_pair)
+        except BoardMismatchError as exc:
+            raise BoardMismatchError(f"{self.url}: {exc}") from None
+
+    def _check_reply_status(self, board: m.Board, msgs: tuple[Any, ...]) -> None:
+        """HardwareError unless a ReadAll reply starts with a Status; check it."""
         if not msgs or not isinstance(msgs[0], m.Status):
             raise HardwareError(f"the {board.name.lower()} board answered ReadAll with "
                                 f"{msgs!r}")
         self._check_status(board, msgs[0])
-        return telemetry.channels(board, msgs[1:], kind, ids, convert)
 
     def _read_imu(self, msgs: tuple[Any, ...], transit_s: float, now: float) -> Imu | None:
         """The IMU of the sensor board's ReadAll reply (None unless it is
@@ -441,21 +466,33 @@ class BoardRobot:
         return got.imu
 
 
+def wanted_side_pair(config: RobotConfig) -> str | None:
+    """Where ``config`` gives the robot the side pair, for messages
+    (``robot.toml: [sensors] side_model = "ir"``); None when it has none."""
+    if not config.sensors.has_side_pair:
+        return None
+    return f'{config.source}: [sensors] side_model = "{config.sensors.side_model}"'
+
+
 def open_board_session(link: BoardLink, url: str, *, watchdog_ms: int, lockstep: bool,
-                       time_scale: float, allow_latched: bool = False) -> RobotSession:
+                       time_scale: float, allow_latched: bool = False,
+                       side_pair: str | None = None) -> RobotSession:
     """The session of the boards on ``link`` (closed again if they cannot be
     opened).  Fake boards in lockstep (``lockstep``) are opened by
     ``stairbot.fakes.lockstep``: their clock steps their world.  Boards that
-    hold a latch raise LatchedError unless ``allow_latched``."""
+    hold a latch raise LatchedError unless ``allow_latched``; a sensor board
+    without the side pair ``side_pair`` names (``wanted_side_pair``) raises
+    BoardMismatchError."""
     robot: BoardRobot
     try:
         if lockstep:
             from stairbot.fakes.lockstep import LockstepRobot  # the simulation's own part
 
-            robot = LockstepRobot(link, url, watchdog_ms, allow_latched=allow_latched)
+            robot = LockstepRobot(link, url, watchdog_ms, allow_latched=allow_latched,
+                                  side_pair=side_pair)
         else:
             robot = BoardRobot(link, url, watchdog_ms, time_scale=time_scale,
-                               allow_latched=allow_latched)
+                               allow_latched=allow_latched, side_pair=side_pair)
     except BaseException:
         link.close()
         raise

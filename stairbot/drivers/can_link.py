@@ -15,7 +15,8 @@ CAN's own (docs/protocol.md, "CAN"):
   (``ANSWER``: Identify -> Ident; Heartbeat, GetStatus, SetWatchdog, EStop,
   Clear -> Status; GetMotor/GetSensor/GetImu -> one telemetry frame; commands
   -> Ack; ReadAll -> Status + one telemetry frame per channel and per IMU axis,
-  ``messages.READ_ALL_REPLY``), telemetry by its channel.  An Ack naming the
+  ``messages.read_all_reply``: as many sensor channels as the board's Ident
+  said, ``set_channels``), telemetry by its channel.  An Ack naming the
   message's type answers any of them (a refusal).
 * A retry of an idempotent request is the same frame again (same seq): a
   board answers it from its cache without acting twice.  A second copy of a
@@ -86,13 +87,22 @@ class CanLink(RequestLink[CanRequest]):
         self._past: OrderedDict[tuple[int, int], bool] = OrderedDict()  # -> answered?
         self._held: list[CanRequest] = []
         self.old_idents: dict[int, m.Ident] = {}  # boards heard speaking protocol 3.x
+        self.channels: dict[int, int] = {}  # board -> its channels, from its Ident
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[m.Message, ...], idempotent: bool,
              now: float) -> CanRequest:
-        req = CanRequest(board, messages, idempotent, now, now + self.timeout_s)
+        req = CanRequest(board, messages, idempotent, now, now + self.timeout_s,
+                         channels=self.channels.get(board))
         req.expect()
         return req
+
+    def set_channels(self, board: int, channels: int) -> None:
+        """``board`` answers ReadAll with ``channels`` telemetry frames (its
+        Ident says; the handshake tells): a sensor board with the side pair
+        sends 6 SensorTelemetry, one without 4."""
+        with self._mutex:
+            self.channels[board] = channels
 
     def _next_seq(self) -> int:
         """A seq no waiting request's frame has; its past is forgotten."""
@@ -128,7 +138,7 @@ class CanLink(RequestLink[CanRequest]):
             self.send(board, msg, seq)
 
     def _frames(self, requests: Sequence[CanRequest]) -> Iterator[tuple[int, m.Message, int]]:
-        boards = set(m.READ_ALL_REPLY)
+        boards = {int(b) for b in m.Board}
         i = 0
         while i < len(requests):
             group = requests[i:i + len(boards)]

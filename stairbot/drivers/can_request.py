@@ -4,7 +4,8 @@ sends it and hands it the replies whose session and seq are its own).
 A request is one frame per message, each with a seq of its own; a board
 answers each frame with the replies its message declares (``ANSWER``;
 ReadAll: Status + one telemetry frame per channel and IMU axis,
-``messages.READ_ALL_REPLY``), back to back and in order.  Within one frame's
+``messages.read_all_reply``: as many sensor channels as the board's Ident
+said), back to back and in order.  Within one frame's
 replies a reply is matched by kind and, for telemetry, by channel or axis.
 """
 
@@ -19,11 +20,20 @@ from typing import NamedTuple
 from stairbot.drivers import messages as m
 from stairbot.drivers.link import Request
 
+SAME_SHORT_LIMIT = 8
+"""Attempts in a row that each ended in the same gap, after which a request is
+given up as a protocol error (``CanRequest.attempt_failed``): a board that
+leaves those replies out (its Ident said 6 sensor channels, it sends 4), not
+a lossy bus, which at 10 % of frames lost does that to fewer than one request
+in 10**10."""
 
-def expected_replies(board: int, msg: m.Message) -> list[type[m.Message]]:
-    """The reply messages, in order, a board sends for ``msg`` when it obeys."""
+
+def expected_replies(board: int, msg: m.Message,
+                     channels: int | None = None) -> list[type[m.Message]]:
+    """The reply messages, in order, a board sends for ``msg`` when it obeys;
+    ``channels``: how many the board's Ident says it has (None: its base)."""
     if isinstance(msg, m.ReadAll):
-        return list(m.READ_ALL_REPLY.get(board, (m.Status,)))
+        return list(m.read_all_reply(board, channels))
     return [m.MESSAGES.get(msg.ANSWER, m.Ack)]
 
 
@@ -34,6 +44,10 @@ def _key(msg: m.Message) -> int | None:
     if isinstance(msg, m.ImuTelemetry):
         return msg.axis
     return None
+
+
+# What a telemetry reply's key is, for messages (else a channel).
+_KEY_NAME: dict[type[m.Message], str] = {m.ImuTelemetry: "axis"}
 
 
 class Due(NamedTuple):
@@ -73,23 +87,49 @@ class CanRequest(Request):
     request cannot complete, and the link sends it again as soon as the last
     reply has come, without waiting for the timeout."""
 
+    channels: int | None = None  # the board's, from its Ident (None: its base)
     seqs: tuple[int, ...] = ()
     got: list[m.Message] = field(default_factory=list)
     todo: deque[Due] = field(default_factory=deque)
     taken: list[Due] = field(default_factory=list)
     gap: bool = False
+    skipped: list[Due] = field(default_factory=list)  # this attempt's, lost in a gap
+    short: tuple[tuple[Due, ...], int] = ((), 0)  # replies lacked, attempts in a row
 
     def expect(self) -> None:
         """(Re)start waiting for every reply."""
         self.got = []
         self.taken = []
         self.gap = False
+        self.skipped = []
         self.todo = deque(self._all_due())
+
+    def attempt_failed(self) -> str | None:
+        """This attempt ended without its whole reply.  After SAME_SHORT_LIMIT
+        attempts in a row that each ended in the same gap -- the board's last
+        reply came, the same ones before it never did -- why the board will
+        never send them; else None.  Only a gap counts: CAN keeps a sender's
+        order, so a reply skipped before a later one was not sent (or lost),
+        never merely slow; an attempt that timed out with replies still to
+        come may have met a slow board, and starts the count afresh."""
+        lacked = tuple(self.skipped) if self.gap and not self.todo else ()
+        before, count = self.short
+        count = count + 1 if lacked and lacked == before else int(bool(lacked))
+        self.short = (lacked, count)
+        if count < SAME_SHORT_LIMIT:
+            return None
+        names = "+".join(type(x).__name__ for x in self.messages)
+        what = ", ".join(due.kind.__name__ + ("" if due.key is None else
+                                              f" {_KEY_NAME.get(due.kind, 'channel')} {due.key}")
+                         for due in lacked)
+        told = "" if self.channels is None else f" (its Ident said {self.channels} channels)"
+        return (f"it answered {names} {count} times in a row without {what}{told}, though "
+                "it answered each time")
 
     def _all_due(self) -> Iterator[Due]:
         for i, msg in enumerate(self.messages):
             seen: dict[type[m.Message], int] = {}
-            for kind in expected_replies(self.board, msg):
+            for kind in expected_replies(self.board, msg, self.channels):
                 n = seen.get(kind, 0)
                 seen[kind] = n + 1
                 keyed = kind in (m.MotorTelemetry, m.SensorTelemetry, m.ImuTelemetry)
@@ -114,7 +154,7 @@ class CanRequest(Request):
         if pos:
             self.gap = True
             for _ in range(pos):
-                self.todo.popleft()
+                self.skipped.append(self.todo.popleft())
         first = self.todo[0]
         if isinstance(msg, m.Ack):
             # An Ack answers the message whole: nothing else comes for it.

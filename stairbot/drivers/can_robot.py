@@ -76,7 +76,7 @@ import can
 import can.util
 
 from stairbot.config import RobotConfig
-from stairbot.drivers.board_robot import open_board_session
+from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import CanFrameLog, check_can_log
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
@@ -243,4 +243,5 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=options.time_scale or opts["time_scale"],
-                              allow_latched=options.allow_latched)
+                              allow_latched=options.allow_latched,
+                              side_pair=wanted_side_pair(config))

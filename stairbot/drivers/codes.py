@@ -14,8 +14,15 @@ from stairbot.hardware import MotorId, SensorId
 # version; Ident keeps its layout in every version so that it can tell.
 # 3.0: the serial frame header has a length byte, flagged by address bit 4
 # (serial_wire.py); CAN frames are unchanged.
+# 4.0: CAN ids are 29 bits and carry the host's session and a seq (can_wire.py).
+# 4.1: sensor channels 4 and 5, the side pair SSR and SSL (quarter-turn
+# landings).  A sensor board with them says 6 channels in its Ident and sends
+# 6 SensorTelemetry in its ReadAll reply; one without says 4 and sends 4, as
+# before.  A 4.0 host reads channels 0-3 of either (on CAN it counts the two
+# side frames it did not expect as stray); a 4.1 host reads a 4.0 board as one
+# without the side pair.
 PROTOCOL_MAJOR = 4
-PROTOCOL_MINOR = 0
+PROTOCOL_MINOR = 1
 MAX_PAYLOAD = 8
 INT16_MAX = 32767
 INT16_NONE = -32768  # never sent in an IMU field: a board's "no number" (NaN)
@@ -37,7 +44,14 @@ BROADCAST = 0x0F
 MOTOR_CHANNELS: tuple[MotorId, ...] = (
     MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL, MotorId.MTF, MotorId.MTB,
 )
-SENSOR_CHANNELS: tuple[SensorId, ...] = (SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL)
+SENSOR_CHANNELS: tuple[SensorId, ...] = (
+    SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL, SensorId.SSR, SensorId.SSL,
+)
+"""Every sensor channel a sensor board may have, in channel order."""
+BASE_SENSOR_CHANNELS = 4
+"""Channels 0-3 (SFR, SFL, SBR, SBL): every sensor board has them."""
+SIDE_SENSOR_CHANNELS: tuple[int, ...] = (4, 5)
+"""SSR and SSL, the side pair: a sensor board has both or neither (4.1)."""
 LIFT_CHANNELS: frozenset[int] = frozenset({4, 5})
 ALL_MOTORS_MASK = 0x3F
 

@@ -8,15 +8,19 @@ it does not answer) or whose
 lockstep does not match the URL, or that holds a latch (its emergency stop,
 or a watchdog that tripped: an earlier host stopped mid-run, crashed or was
 cut off) -- opening never clears one, the operator does (``stairbot clear``)
--- then sets its watchdog.  ``board_robot`` does this for both boards when it
-opens.
+-- then sets its watchdog.  A sensor board must say 4 channels, or 6 with the
+side pair (SSR, SSL; protocol 4.1); one without the side pair is refused when
+the robot config has it (BoardMismatchError), before any run could miss its
+readings.  ``board_robot`` does this for both boards when it opens.
 """
 
 from __future__ import annotations
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.link import BoardLink, ProbesOldBoards
+from stairbot.drivers.link import BoardLink, CountsReplies, ProbesOldBoards
+from stairbot.drivers.telemetry import BASE_NAMES, SIDE_NAMES
 from stairbot.errors import (
+    BoardMismatchError,
     HardwareError,
     LatchedError,
     LinkLostError,
@@ -36,6 +40,30 @@ def check_version(url: str, board: m.Board, ident: m.Ident) -> None:
             "(docs/protocol.md): update the board's firmware or the host")
 
 
+WITH_SIDE_PAIR = max(m.SIDE_SENSOR_CHANNELS) + 1  # 6: the channels of a board with it
+
+
+def check_sensor_channels(url: str, ident: m.Ident, side_pair: str | None) -> None:
+    """HardwareError unless the sensor board's Ident says 4 channels (SFR, SFL,
+    SBR, SBL) or 6 (the side pair SSR, SSL too; a later minor version may
+    add more, which this host does not read); BoardMismatchError when it has
+    no side pair and ``side_pair`` says the robot config has one (``side_pair``:
+    where the config says so, for the message; None: the robot has none)."""
+    n = ident.channels
+    if n < m.BASE_SENSOR_CHANNELS or m.BASE_SENSOR_CHANNELS < n < WITH_SIDE_PAIR:
+        raise HardwareError(
+            f"{url}: the sensor board says it has {n} channel(s); allowed: "
+            f"{m.BASE_SENSOR_CHANNELS} ({BASE_NAMES}) or {WITH_SIDE_PAIR} (with the side "
+            f"pair {SIDE_NAMES}, protocol 4.1): a board has both side sensors or neither "
+            "(docs/protocol.md, section 1)")
+    if side_pair is not None and n < WITH_SIDE_PAIR:
+        raise BoardMismatchError(
+            f"{url}: {side_pair} gives the robot the side pair ({SIDE_NAMES}), but the sensor "
+            f"board offers {n} channels ({BASE_NAMES}) and no side pair (protocol "
+            f"{ident.protocol_major}.{ident.protocol_minor}); fit a sensor board with "
+            f"channels 4-5 ({SIDE_NAMES}), or set [sensors] side_model = \"none\"")
+
+
 LATCHES = m.StatusFlag.ESTOP | m.StatusFlag.WATCHDOG
 
 
@@ -51,12 +79,14 @@ def latch_names(flags: int) -> str:
 
 
 def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
-               watchdog_ms: int, allow_latched: bool = False
+               watchdog_ms: int, allow_latched: bool = False, side_pair: str | None = None
                ) -> tuple[m.Ident, m.Status | None]:
     """Identify ``board`` and set it up; its Ident and the Status after set-up.
     Raises NoBoardError (no answer), ProtocolVersionError, RobotUrlError (a
     lockstep mismatch), LatchedError (a latch, unless ``allow_latched``: the
-    clear command) or HardwareError (an answer that is not Ident + Status)."""
+    clear command), BoardMismatchError (a sensor board without the side pair
+    that ``side_pair`` names: see ``check_sensor_channels``) or HardwareError
+    (an answer that is not Ident + Status, a sensor board's channel count)."""
     n = link.retries + 1
     tries = f"{n} {'try' if n == 1 else 'tries'} of {link.timeout_s * 1e3:.0f} ms"
     name = board.name.lower()
@@ -77,6 +107,10 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
     if not isinstance(ident, m.Ident) or not isinstance(status, m.Status):
         raise HardwareError(f"{url}: the {name} board gave an unexpected "
                             f"answer to Identify: {reply.messages}")
+    if board == m.Board.SENSOR:
+        check_sensor_channels(url, ident, side_pair)
+        if isinstance(link, CountsReplies):  # the motor board's six are the protocol's
+            link.set_channels(board, ident.channels)
     board_lockstep = bool(status.flags & m.StatusFlag.LOCKSTEP)
     if board_lockstep != lockstep:
         hint = ("add ?lockstep=1 to the URL" if board_lockstep

@@ -22,7 +22,10 @@ Rules (docs/protocol.md, "Requests and replies"):
 * :meth:`RequestLink.wait` raises LinkLostError when a waited-for request got
   no reply after its retries and its board has not answered anything for
   ``grace_s``; until then the request is sent again (a query) -- ordinary
-  line noise, a lost frame here and there, is ridden out.  ``max_lost``
+  line noise, a lost frame here and there, is ridden out.  A board that
+  answers every attempt but never wholly (``Request.attempt_failed``: on CAN
+  the same replies left out, attempt after attempt) is alive but will never
+  complete it: HardwareError, at once, rather than retries without end.  ``max_lost``
   commands in a row (in the order they were sent) that went unanswered mean
   the link is lost too, again once the board has been silent for ``grace_s``.
 * :meth:`RequestLink.urgent` (the emergency stop) may be called from any
@@ -46,7 +49,7 @@ from typing import Generic, Protocol, TypeVar, cast, runtime_checkable
 
 from stairbot.drivers.codes import Board
 from stairbot.drivers.records import Ident, Message, RawMessage
-from stairbot.errors import LinkLostError
+from stairbot.errors import HardwareError, LinkLostError
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,6 +77,9 @@ class Request:
     reply: Reply | None = None
     failed: bool = False
     urgent: bool = False  # sent by urgent(): resent and given up by its sender
+    broken: str | None = None
+    """Why the board's answers can never complete this request (it leaves the
+    same replies out every time: a protocol error); never sent again."""
 
     @property
     def done(self) -> bool:
@@ -82,6 +88,12 @@ class Request:
     def progress(self) -> str:
         """What a wire adds to "did not answer" (the CAN link: replies that came)."""
         return ""
+
+    def attempt_failed(self) -> str | None:
+        """This attempt ended without the whole reply; why the board will never
+        send one (a wire that can tell: the CAN link, from the same replies
+        left out attempt after attempt), or None."""
+        return None
 
 
 @dataclass
@@ -221,6 +233,18 @@ class ProbesOldBoards(Protocol):
 
     def probe_old_ident(self, board: int) -> Ident | None:
         """The Ident an older board sends when asked the old way; None if none."""
+        ...
+
+
+@runtime_checkable
+class CountsReplies(Protocol):
+    """A link that counts a ReadAll reply's telemetry before it comes, and so
+    must be told how many channels each board has (its Ident): the CAN link,
+    where each telemetry message is a frame of its own and a reply is whole
+    when every frame has come.  (On the serial link a reply is one frame.)"""
+
+    def set_channels(self, board: int, channels: int) -> None:
+        """``board`` answers ReadAll with ``channels`` telemetry messages."""
         ...
 
 
@@ -376,7 +400,8 @@ class RequestLink(ABC, Generic[R]):
                 if now < req.deadline or req.urgent or not self._on_wire(req):
                     continue
                 self.stats.timeouts += 1
-                if req.idempotent and req.attempts <= self.retries:
+                req.broken = req.broken or req.attempt_failed()
+                if req.idempotent and req.attempts <= self.retries and req.broken is None:
                     req.attempts += 1
                     self.stats.retries += 1
                     req.sent_at, req.deadline = now, now + self.timeout_s
@@ -428,7 +453,8 @@ class RequestLink(ABC, Generic[R]):
     def _revive(self, req: R) -> bool:
         """Send a query that got no reply again, as a fresh request, while its
         board is within its grace period; False once it is beyond it."""
-        if not req.idempotent or self.silent_s(req.board) >= self.grace_s:
+        if (not req.idempotent or req.broken is not None
+                or self.silent_s(req.board) >= self.grace_s):
             return False
         with self._mutex:
             self.stats.revived += 1
@@ -461,6 +487,8 @@ class RequestLink(ABC, Generic[R]):
                     names = "+".join(type(x).__name__ for x in req.messages)
                     who = (f"the {Board(req.board).name.lower()} board"
                            if req.board in Board._value2member_map_ else f"board {req.board}")
+                    if req.broken is not None:
+                        raise HardwareError(f"{who} broke the protocol: {req.broken}")
                     attempts = req.attempts + req.revived * (self.retries + 1)
                     silent = max(self.silent_s(req.board), attempts * self.timeout_s)
                     raise LinkLostError(

@@ -1,7 +1,8 @@
 """The boards' messages, independent of the wire that carries them, and their codec.
 
 Two boards sit on the robot: the motor board (MWF, MWB, MWR, MWL, MTF, MTB)
-and the sensor board (SFR, SFL, SBR, SBL).  The host talks to each with small
+and the sensor board (SFR, SFL, SBR, SBL, and on a robot with the side pair
+SSR, SSL).  The host talks to each with small
 messages: a one-byte type code and a fixed payload of at most 8 bytes, so the
 same model maps onto a serial frame (``serial_wire``) and onto one CAN data
 frame each (the CAN driver's DBC).  ``docs/protocol.md`` is the reference a
@@ -34,6 +35,7 @@ from stairbot.drivers.codes import (
     AGE_MAX_MS,
     ALL_MOTORS_MASK,
     ANGLE_MAX_CDEG,
+    BASE_SENSOR_CHANNELS,
     BROADCAST,
     IMU_AXES,
     INT16_MAX,
@@ -45,6 +47,7 @@ from stairbot.drivers.codes import (
     PROTOCOL_MAJOR,
     PROTOCOL_MINOR,
     SENSOR_CHANNELS,
+    SIDE_SENSOR_CHANNELS,
     AckResult,
     Board,
     ClearMask,
@@ -97,12 +100,24 @@ MESSAGES: dict[int, type[Message]] = {
 _STRUCTS: dict[int, struct.Struct] = {t: struct.Struct(c.FORMAT) for t, c in MESSAGES.items()}
 assert all(s.size <= MAX_PAYLOAD for s in _STRUCTS.values())
 
-# What a board obeying ReadAll sends, in order (docs/protocol.md, section 3).
+
+def read_all_reply(board: int, channels: int | None = None) -> tuple[type[Message], ...]:
+    """What a board obeying ReadAll sends, in order (docs/protocol.md, section
+    3): its Status, one telemetry message per channel, and on the sensor board
+    one ImuTelemetry per IMU axis.  ``channels``: how many its Ident says it
+    has (a sensor board 4, or 6 with the side pair); None: the board's base
+    (6 motors, 4 sensors).  A board of no known address answers with its Status."""
+    if board == Board.MOTOR:
+        return (Status, *(MotorTelemetry,) * (channels or len(MOTOR_CHANNELS)))
+    if board == Board.SENSOR:
+        return (Status, *(SensorTelemetry,) * (channels or BASE_SENSOR_CHANNELS),
+                *(ImuTelemetry,) * len(IMU_AXES))
+    return (Status,)
+
+
 READ_ALL_REPLY: dict[int, tuple[type[Message], ...]] = {
-    int(Board.MOTOR): (Status, *(MotorTelemetry,) * len(MOTOR_CHANNELS)),
-    int(Board.SENSOR): (Status, *(SensorTelemetry,) * len(SENSOR_CHANNELS),
-                        *(ImuTelemetry,) * len(IMU_AXES)),
-}
+    int(b): read_all_reply(b) for b in Board}
+"""Each board's ReadAll reply without the side pair (``read_all_reply``)."""
 
 
 def payload_size(type_code: int) -> int:
@@ -138,13 +153,14 @@ def decode(type_code: int, payload: bytes) -> Message:
 
 
 __all__ = [
-    "AGE_MAX_MS", "ALL_MOTORS_MASK", "ANGLE_MAX_CDEG", "BROADCAST", "IMU_AXES", "INT16_MAX",
-    "INT16_NONE", "INT32_MAX", "LIFT_CHANNELS", "MAX_PAYLOAD", "MESSAGES", "MOTOR_CHANNELS",
-    "PROTOCOL_MAJOR", "PROTOCOL_MINOR", "READ_ALL_REPLY", "SENSOR_CHANNELS", "Ack",
-    "AckResult", "Board", "Brake", "Clear", "ClearMask", "CodecError", "EStop", "GetImu",
-    "GetMotor", "GetSensor", "GetStatus", "GetTruth", "Heartbeat", "Ident", "Identify",
-    "ImuAxis", "ImuCode", "ImuTelemetry", "Message", "MotorFault", "MotorMode",
-    "MotorTelemetry", "Move", "RawMessage", "ReadAll", "Run", "SensorCode", "SensorTelemetry",
-    "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds", "Status", "StatusFlag", "StepDone",
-    "StepTo", "Stop", "TelemetryValueError", "Truth", "decode", "encode", "payload_size",
+    "AGE_MAX_MS", "ALL_MOTORS_MASK", "ANGLE_MAX_CDEG", "BASE_SENSOR_CHANNELS", "BROADCAST",
+    "IMU_AXES", "INT16_MAX", "INT16_NONE", "INT32_MAX", "LIFT_CHANNELS", "MAX_PAYLOAD",
+    "MESSAGES", "MOTOR_CHANNELS", "PROTOCOL_MAJOR", "PROTOCOL_MINOR", "READ_ALL_REPLY",
+    "SENSOR_CHANNELS", "SIDE_SENSOR_CHANNELS", "Ack", "AckResult", "Board", "Brake", "Clear",
+    "ClearMask", "CodecError", "EStop", "GetImu", "GetMotor", "GetSensor", "GetStatus",
+    "GetTruth", "Heartbeat", "Ident", "Identify", "ImuAxis", "ImuCode", "ImuTelemetry",
+    "Message", "MotorFault", "MotorMode", "MotorTelemetry", "Move", "RawMessage", "ReadAll",
+    "Run", "SensorCode", "SensorTelemetry", "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds",
+    "Status", "StatusFlag", "StepDone", "StepTo", "Stop", "TelemetryValueError", "Truth",
+    "decode", "encode", "payload_size", "read_all_reply",
 ]

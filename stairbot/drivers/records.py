@@ -137,8 +137,9 @@ class Clear(Message):
 @dataclass(frozen=True, slots=True)
 class ReadAll(Message):
     """Ask for every channel at once.  Reply: Status, then one MotorTelemetry
-    per motor (motor board), or one SensorTelemetry per sensor and one
-    ImuTelemetry per IMU axis (sensor board): ``messages.READ_ALL_REPLY``."""
+    per motor (motor board), or one SensorTelemetry per sensor (4, or 6 with
+    the side pair) and one ImuTelemetry per IMU axis (sensor board):
+    ``messages.read_all_reply``."""
 
     TYPE = 0x10
     ANSWER = STATUS
@@ -242,6 +243,11 @@ class Brake(Message):
 
 @dataclass(frozen=True, slots=True)
 class Ident(Message):
+    """Who a board is: its address, the protocol it speaks, how many channels
+    it has (the motor board 6; the sensor board 4, or 6 with the side pair
+    SSR/SSL: that many SensorTelemetry in its ReadAll reply), its firmware
+    and serial number.  Its layout is the same in every protocol version."""
+
     TYPE = 0x81
     FORMAT = "<BBBBHH"
     REPLY = True

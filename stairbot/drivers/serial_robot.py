@@ -51,7 +51,7 @@ from urllib.parse import urlencode
 import serial
 
 from stairbot.config import RobotConfig
-from stairbot.drivers.board_robot import open_board_session
+from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.port_lock import PortLock, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
@@ -160,7 +160,8 @@ def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> R
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=options.time_scale or opts["time_scale"],
-                              allow_latched=options.allow_latched)
+                              allow_latched=options.allow_latched,
+                              side_pair=wanted_side_pair(config))
 
 
 __all__ = ["DEFAULTS", "open_channel", "open_serial_robot", "parse_serial_url",

@@ -26,12 +26,16 @@ class BoardWorld:
     sensor noise draws are the same as a ``sim://`` run's), and its clock.
 
     In lockstep the world advances only on :meth:`step_to`; otherwise the
-    server calls :meth:`advance` as wall time passes."""
+    server calls :meth:`advance` as wall time passes.  ``side_pair``: the
+    robot has the side pair SSR/SSL (its config's ``[sensors] side_model``),
+    so the sensor board has six channels."""
 
-    def __init__(self, robot: Robot, clock: Clock, lockstep: bool = False) -> None:
+    def __init__(self, robot: Robot, clock: Clock, lockstep: bool = False,
+                 side_pair: bool = False) -> None:
         self.robot = robot
         self.clock = clock
         self.lockstep = lockstep
+        self.side_pair = side_pair
         self.failure: str | None = None
         self._snap: Snapshot | None = None
         self._snap_time = -1.0

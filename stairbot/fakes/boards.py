@@ -249,17 +249,23 @@ class MotorBoard(Board):
 
 
 class SensorBoard(Board):
-    """Four distance sensors, channels in ``messages.SENSOR_CHANNELS`` order,
-    and the IMU (``messages.IMU_AXES``), as the world's snapshot holds them:
-    each reading's age and the IMU's (None: no IMU fitted, ABSENT) grow by the
-    time from the snapshot to the reply, as a real board's count would."""
+    """Four distance sensors -- six when the world's robot has the side pair
+    (``BoardWorld.side_pair``: channels 4 SSR and 5 SSL, protocol 4.1) --
+    channels in ``messages.SENSOR_CHANNELS`` order, and the IMU
+    (``messages.IMU_AXES``), as the world's snapshot holds them: each reading's
+    age and the IMU's (None: no IMU fitted, ABSENT) grow by the time from the
+    snapshot to the reply, as a real board's count would.  A channel the
+    snapshot lacks (a side sensor the simulation does not model) is sent as
+    a sensor that has never measured: ERROR, age saturated."""
 
     BOARD = m.Board.SENSOR
-    CHANNELS = len(m.SENSOR_CHANNELS)
+    CHANNELS = m.BASE_SENSOR_CHANNELS
     NEW_SAMPLE_S = 1e-6  # measurement times closer than this are one measurement
 
     def __init__(self, world: BoardWorld, serial: int = 2) -> None:
         super().__init__(world, serial)
+        if world.side_pair:
+            self.CHANNELS = max(m.SIDE_SENSOR_CHANNELS) + 1
         self._sample = [0] * self.CHANNELS
         self._sample_time: list[float | None] = [None] * self.CHANNELS
 
@@ -272,7 +278,10 @@ class SensorBoard(Board):
         if snap is None:
             return m.SensorTelemetry(ch, int(m.SensorCode.ERROR), 0, self._sample[ch],
                                      m.AGE_MAX_MS)
-        r = snap.sensors[m.SENSOR_CHANNELS[ch]]
+        r = snap.sensors.get(m.SENSOR_CHANNELS[ch])
+        if r is None:  # never measured (docs/protocol.md, section 3: "Ages")
+            return m.SensorTelemetry(ch, int(m.SensorCode.ERROR), 0, self._sample[ch],
+                                     m.AGE_MAX_MS)
         measured = snap.time_s - r.age_s  # a repeated value keeps its measurement time
         last = self._sample_time[ch]
         if last is None or not abs(measured - last) < self.NEW_SAMPLE_S:

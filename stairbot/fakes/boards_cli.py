@@ -75,7 +75,8 @@ def make_world(config: RobotConfig, scenario: Scenario, lockstep: bool) -> Board
     """The simulated robot behind the fake boards (never paced by its clock:
     the server paces it)."""
     robot = SimRobot(config, scenario)
-    return BoardWorld(robot, SimClock(robot, None), lockstep=lockstep)
+    return BoardWorld(robot, SimClock(robot, None), lockstep=lockstep,
+                      side_pair=config.sensors.has_side_pair)
 
 
 def faults_from(args: argparse.Namespace) -> WireFaults:

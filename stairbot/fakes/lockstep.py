@@ -60,10 +60,11 @@ class LockstepRobot(BoardRobot):
     PIPELINED_STEP = True  # False: each advance() waits for its StepDone
 
     def __init__(self, link: BoardLink, url: str, watchdog_ms: int = 250,
-                 sink: EventSink = discard, allow_latched: bool = False) -> None:
+                 sink: EventSink = discard, allow_latched: bool = False,
+                 side_pair: str | None = None) -> None:
         self._step: Request | None = None
         super().__init__(link, url, watchdog_ms, clock=LockstepClock(self), sink=sink,
-                         keepalive=False, allow_latched=allow_latched)
+                         keepalive=False, allow_latched=allow_latched, side_pair=side_pair)
         # The world may have run before this host opened it (a resumed run):
         # the clock starts where the world stands (StepTo 0 steps nothing).
         (done,) = self._wait([self._request(m.Board.MOTOR, [m.StepTo(0)])])

@@ -9,6 +9,9 @@ Left: the 3-D scene (the stairs and the segments on their frames, which
 the pose topic moves, followed from segment 2) over the event log.
 Right: the phase and each sensor's status over time, the IMU's pitch, the
 lifts' extensions, the sensors' distances, and the link's latest health.
+One layout serves every robot: it names the side pair SSR/SSL too, whose
+series stay empty in a recording of a robot without it (the recording has
+no such field, so nothing is drawn).
 """
 
 from __future__ import annotations

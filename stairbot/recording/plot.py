@@ -1,7 +1,8 @@
 """A recording drawn over time as a PNG (``stairbot plot``; matplotlib, the
 optional extra ``stairbot[plot]``): the phases as bands, the pitch, the
 segments' heights, the lifts' extensions and the distance sensors'
-readings with their status.  A JSON-lines record holds events alone, so
+readings with their status (the side pair's in a panel of its own, drawn
+only when the recording has it).  A JSON-lines record holds events alone, so
 its plot has the phases and the events, and says so."""
 
 from __future__ import annotations
@@ -20,7 +21,9 @@ FLOW_COLOURS = {"calibration": "#cfe2f3", "ascent": "#d9ead3", "descent": "#fce5
                 "end": "#eeeeee"}
 OTHER_FLOW = "#e6e6e6"
 SEGMENT_COLOURS = {"segment1": "#d55e00", "segment2": "#0072b2", "segment3": "#009e73"}
-SENSOR_COLOURS = {"SFR": "#d55e00", "SFL": "#e69f00", "SBR": "#0072b2", "SBL": "#56b4e9"}
+SENSOR_COLOURS = {"SFR": "#d55e00", "SFL": "#e69f00", "SBR": "#0072b2", "SBL": "#56b4e9",
+                  "SSR": "#009e73", "SSL": "#cc79a7"}
+SIDE_PAIR = ("SSR", "SSL")
 STATUS_MARKS = {"out_of_range": "x", "error": "o"}
 """How a reading that is not ok is marked (in the sensor's colour)."""
 EVENT_LINES = {"error": "#d62728", "pause": "#ff7f0e", "warning": "#ff7f0e", "link": "#9467bd"}
@@ -93,7 +96,8 @@ def render(rec: Recording, *, width_in: float = 12.0, dpi: int = 100) -> bytes:
     end = _end_time(rec)
     bands = phase_bands(rec.events, end)
     telemetry = bool(rec.telemetry.time_s or rec.telemetry.pose_time_s)
-    ratios = [0.5, 1, 1, 1, 1, 1] if telemetry else [0.5, 1]
+    side = telemetry and any(name in rec.telemetry.distance_m for name in SIDE_PAIR)
+    ratios = [0.5, 1, 1, 1, 1, 1, *([1] if side else [])] if telemetry else [0.5, 1]
     fig, axes = plt.subplots(len(ratios), 1, sharex=True, figsize=(width_in, 2.2 * sum(ratios)),
                              dpi=dpi, gridspec_kw={"height_ratios": ratios})
     _phase_strip(axes[0], bands)
@@ -103,6 +107,8 @@ def render(rec: Recording, *, width_in: float = 12.0, dpi: int = 100) -> bytes:
         _lifts(axes[3], rec)
         _sensors(axes[4], rec, ("SFR", "SFL"), "front sensors")
         _sensors(axes[5], rec, ("SBR", "SBL"), "back sensors")
+        if side:
+            _sensors(axes[6], rec, SIDE_PAIR, "side sensors")
     else:
         _events_only(axes[1], rec)
     for ax in axes[1:]:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, SensorStatus
+from stairbot.hardware import BASE_SENSORS, LIFT_MOTORS, SIDE_SENSORS, MotorId, SensorStatus
 
 SCENE = "/scene"
 """foxglove.SceneUpdate: the stairs (frame ``world``) and each segment with its
@@ -27,7 +27,8 @@ as revolute joints (rad, rad/s), the lifts as prismatic ones (m, m/s)."""
 MOTORS = "/robot/motors"
 """JSON: each motor's turn counter, speed, the speed commanded and any fault."""
 SENSORS = "/robot/sensors"
-"""JSON: each distance sensor's reading, status and age; the IMU."""
+"""JSON: each distance sensor's reading, status and age (SFR, SFL, SBR, SBL;
+SSR and SSL only on a robot with the side pair); the IMU."""
 LINK = "/robot/link"
 """JSON: the link's health figures the robot reports each tick (empty for a
 simulation in this process: it has no link)."""
@@ -69,11 +70,18 @@ _IMU = {"oneOf": [{"type": "null"}, _object({
     "age_s": {"type": "number", "description": "how long before time_s it was measured"},
 }, "the sensor board's inertial unit")]}
 
+_SIDE_READING = {**_READING, "description": "one distance reading of the side pair: only on "
+                 "a robot that has it (the config's [sensors] side_model)"}
+
 SENSORS_SCHEMA: dict[str, Any] = {
     "title": "stairbot.Sensors",
-    **_object({"time_s": _TIME, **{s.value: _READING for s in SensorId}, "imu": _IMU},
-              "every sensor as the host read it at one tick (raw: before perception)"),
+    **_object({"time_s": _TIME, **{s.value: _READING for s in BASE_SENSORS},
+               **{s.value: _SIDE_READING for s in SIDE_SENSORS}, "imu": _IMU},
+              "every sensor as the host read it at one tick (raw: before perception)",
+              required=["time_s", *(s.value for s in BASE_SENSORS), "imu"]),
 }
+"""SSR and SSL are optional: a recording of a robot without the side pair
+(and every recording made before it existed) has the four base sensors alone."""
 
 _MOTOR = {
     "turns": {"type": "number", "description": "the motor's turn counter"},

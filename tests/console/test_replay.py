@@ -24,7 +24,7 @@ from stairbot.console.freshness import STALE_S
 from stairbot.console.replay_app import ReplayConsole, build_replay_app
 from stairbot.console.widgets.motors import NAMES as MOTOR_NAMES
 from stairbot.events import Event, EventKind
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.pose import DeadReckonedPose
@@ -102,8 +102,9 @@ def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[st
             s, m = at(sensors, 3.0), at(motors, 3.0)
             assert s["time_s"] == 3.0
             screen = shown(app.sensors)
-            for sensor in SensorId:
+            for sensor in BASE_SENSORS:
                 assert f"{sensor.value} {s[sensor.value]['distance_m']:5.3f} m" in screen
+            assert "side" not in screen and "SSR" not in screen  # a robot without the pair
             lines = shown(app.motors).splitlines()
             for motor in MotorId:
                 line = next(li for li in lines if f"{MOTOR_NAMES[motor]:<12} {motor.value}" in li)
@@ -305,7 +306,7 @@ def _gap_recording(path: Path) -> None:
     try:
         for i in [*range(51), *range(275, 301)]:
             t = i * 0.02
-            snap = Snapshot(t, {s: SensorReading(0.3 + i / 1000) for s in SensorId},
+            snap = Snapshot(t, {s: SensorReading(0.3 + i / 1000) for s in BASE_SENSORS},
                             {m: MotorState(float(i)) for m in MotorId})
             record.tick(snap, None)
     finally:
@@ -341,7 +342,7 @@ def _two_robots(path: Path) -> None:
             record.watch(DeadReckonedPose(config, scenario), scenario, "sim://")
             record.write(Event(0.0, EventKind.INFO, f"robot at {base}"))
             for i in range(51):
-                snap = Snapshot(i * 0.02, {s: SensorReading(base + i / 1000) for s in SensorId},
+                snap = Snapshot(i * 0.02, {s: SensorReading(base + i / 1000) for s in BASE_SENSORS},
                                 {m: MotorState(float(i)) for m in MotorId})
                 record.tick(snap, None)
     finally:

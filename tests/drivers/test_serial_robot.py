@@ -34,7 +34,7 @@ from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
-from stairbot.hardware import HasTruth, MotorId, SensorId
+from stairbot.hardware import BASE_SENSORS, HasTruth, MotorId, SensorId
 from stairbot.robots import RobotSession, open_robot
 from stairbot.runner import run
 from stairbot.scenario import Scenario, load_scenario
@@ -82,7 +82,7 @@ def test_read_command_and_lockstep_clock(fake: Fake) -> None:
     try:
         assert session.simulated
         snap = session.robot.read()
-        assert set(snap.sensors) == set(SensorId) and set(snap.motors) == set(MotorId)
+        assert set(snap.sensors) == set(BASE_SENSORS) and set(snap.motors) == set(MotorId)
         assert snap.sensors[SensorId.SFR].distance_m == pytest.approx(
             SCENARIO.start.distance, abs=0.01)
         for _ in range(25):

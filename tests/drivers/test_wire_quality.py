@@ -7,112 +7,29 @@ world whose snapshot the test sets."""
 
 from __future__ import annotations
 
-import contextlib
 import itertools
-import socket
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable
 from dataclasses import replace
 
 import can
 import pytest
 from cobs import cobs
+from scripted_boards import WIRES, Boards, Scripted, ScriptedClock, link_to, wired
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot, open_board_session
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_wire import wire
-from stairbot.drivers.link import BoardLink
-from stairbot.drivers.serial_link import SerialLink
 from stairbot.drivers.serial_wire import FrameReader, crc16
 from stairbot.errors import ProtocolVersionError
-from stairbot.events import Event, EventKind
+from stairbot.events import EventKind
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, SensorBoard, make_boards
-from stairbot.fakes.can_boards import CanBoardServer, InlineBus
-from stairbot.fakes.lockstep import LockstepRobot
-from stairbot.fakes.serial_boards import InlineChannel, SerialBoardServer
-from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import BASE_SENSORS, Imu, SensorId
 
-WIRES = ("serial", "can")
 _channels = itertools.count()
-AGES = dict(zip(SensorId, (0.0123, 0.2, 1.5, 100.0), strict=True))  # the last saturates
+AGES = dict(zip(BASE_SENSORS, (0.0123, 0.2, 1.5, 100.0), strict=True))  # the last saturates
 IMU = Imu(5.234, -0.756, 1.52, -0.24, 0.0031)
-
-
-class Scripted:
-    """The robot behind the fake boards: the snapshot the test sets, at the
-    world's time."""
-
-    def __init__(self) -> None:
-        self.t = 0.0
-        self.ages: Mapping[SensorId, float] = dict.fromkeys(SensorId, 0.0)
-        self.imu: Imu | None = None
-
-    def read(self) -> Snapshot:
-        return Snapshot(self.t, {s: SensorReading(0.5, age_s=self.ages[s]) for s in SensorId},
-                        {k: MotorState(0.0) for k in MotorId}, imu=self.imu)
-
-    def command(self, speeds: Mapping[MotorId, float]) -> None:
-        pass
-
-    def stop_all(self) -> None:
-        pass
-
-
-class ScriptedClock:
-    def __init__(self, robot: Scripted) -> None:
-        self.robot = robot
-
-    def now(self) -> float:
-        return self.robot.t
-
-    def advance(self, dt: float) -> None:
-        self.robot.t += dt
-
-
-Boards = Callable[[BoardWorld], dict[int, Board]]
-
-
-@contextlib.contextmanager
-def link_to(kind: str, world: BoardWorld, boards: dict[int, Board]) -> Iterator[BoardLink]:
-    """A host link to ``boards`` served inline on ``kind`` (serial: a socket
-    pair; can: a fresh python-can virtual channel)."""
-    if kind == "serial":
-        host, end = socket.socketpair()
-        server = SerialBoardServer(end.fileno(), world, boards)
-        link: BoardLink = SerialLink(InlineChannel(host.detach(), server), timeout_s=0.5)
-        try:
-            yield link
-        finally:
-            with contextlib.suppress(OSError):  # closed already by the robot that used it
-                link.close()
-            end.close()
-    else:
-        channel = f"quality-{next(_channels)}"
-        can_server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world, boards)
-        link = CanLink(InlineBus(can.Bus(interface="virtual", channel=channel), can_server),
-                       timeout_s=0.5, retries=0)
-        try:
-            yield link
-        finally:
-            link.close()
-            can_server.bus.shutdown()
-
-
-@contextlib.contextmanager
-def wired(kind: str, boards: Boards = make_boards
-          ) -> Iterator[tuple[LockstepRobot, Scripted, list[Event]]]:
-    """Fake boards in lockstep over a Scripted world; the host's robot, the
-    world's robot and the events the host told."""
-    robot = Scripted()
-    world = BoardWorld(robot, ScriptedClock(robot), lockstep=True)
-    events: list[Event] = []
-    with link_to(kind, world, boards(world)) as link:
-        host = LockstepRobot(link, f"{kind}://inline?lockstep=1", sink=events.append)
-        try:
-            yield host, robot, events
-        finally:
-            host.close()
 
 
 def near(a: float, b: float, resolution: float) -> bool:
@@ -125,7 +42,8 @@ def test_ages_and_imu_arrive_to_the_wires_resolution(kind: str) -> None:
         robot.ages, robot.imu = AGES, IMU
         host.clock.advance(0.02)
         snap = host.read()
-        assert [snap.sensors[s].age_s for s in SensorId] == [0.012, 0.2, 1.5, 65.535]
+        assert [snap.sensors[s].age_s for s in BASE_SENSORS] == [0.012, 0.2, 1.5, 65.535]
+        assert set(snap.sensors) == set(BASE_SENSORS)  # this robot has no side pair
         assert snap.imu is not None
         assert near(snap.imu.pitch_deg, IMU.pitch_deg, 0.01)
         assert near(snap.imu.roll_deg, IMU.roll_deg, 0.01)
@@ -263,7 +181,7 @@ def test_an_imu_value_the_protocol_forbids_reads_as_no_imu(
         for _ in range(3):
             snap = host.read()
             assert snap.imu is None
-            assert set(snap.sensors) == set(SensorId)  # the distances still count
+            assert set(snap.sensors) == set(BASE_SENSORS)  # the distances still count
             host.clock.advance(0.02)
         diag = host.diagnostics()["imu"]
         assert isinstance(diag, dict) and diag["state"] == "invalid" and diag["rejected"] == 3

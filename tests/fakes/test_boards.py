@@ -13,6 +13,8 @@ from stairbot.errors import RobotFellError
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import MotorBoard, SensorBoard, make_boards
 from stairbot.hardware import (
+    BASE_SENSORS,
+    SIDE_SENSORS,
     Imu,
     MotorId,
     MotorState,
@@ -25,10 +27,12 @@ from stairbot.hardware import (
 
 class StubRobot:
     """Turns integrate the commanded speeds; ``fail`` makes read() raise;
-    ``ages`` (per sensor) and ``imu`` are what the snapshot reports."""
+    ``ages`` (per sensor) and ``imu`` are what the snapshot reports, for
+    ``sensors`` (every SensorId unless told)."""
 
-    def __init__(self) -> None:
+    def __init__(self, sensors: tuple[SensorId, ...] = tuple(SensorId)) -> None:
         self.t = 0.0
+        self.sensors = sensors
         self.speeds = {mid: 0.0 for mid in MotorId}
         self.turns = {mid: 0.0 for mid in MotorId}
         self.reads = 0
@@ -42,7 +46,7 @@ class StubRobot:
             raise RobotFellError("pitch beyond 35 degrees")
         self.reads += 1
         return Snapshot(self.t, {s: SensorReading(0.5 + i / 10, age_s=self.ages[s])
-                                 for i, s in enumerate(SensorId)},
+                                 for i, s in enumerate(SensorId) if s in self.sensors},
                         {k: MotorState(v, self.speeds[k]) for k, v in self.turns.items()},
                         imu=self.imu)
 
@@ -231,7 +235,7 @@ def test_a_repeated_reading_keeps_its_sample_number(rig: tuple) -> None:
 
 def test_the_sensor_board_serves_each_readings_age_and_the_imu(rig: tuple) -> None:
     robot, world, motor, sensor = rig
-    robot.ages = dict(zip(SensorId, (0.0123, 0.2, 1.5, 100.0), strict=True))
+    robot.ages = {**robot.ages, **dict(zip(BASE_SENSORS, (0.0123, 0.2, 1.5, 100.0), strict=True))}
     robot.imu = Imu(5.234, -0.756, 1.52, -0.24, 0.0031)
     replies = sensor.handle([m.ReadAll()])
     assert [r.age_ms for r in replies[1:5]] == [12, 200, 1500, m.AGE_MAX_MS]  # saturated
@@ -286,3 +290,48 @@ def test_the_pacer_keeps_the_world_up_with_the_wall_clock_one_step_at_a_time(
     while pacer.step() == 0.0:
         pass
     assert motor.watchdog_tripped  # the boards are polled between steps
+
+
+# -- the side pair (protocol 4.1) ---------------------------------------------------
+
+def side_rig(sensors: tuple[SensorId, ...]) -> tuple[StubRobot, SensorBoard]:
+    """A sensor board whose world's robot has the side pair; its snapshot
+    holds ``sensors``."""
+    robot = StubRobot(sensors)
+    world = BoardWorld(robot, StubClock(robot), lockstep=True, side_pair=True)
+    sensor = make_boards(world)[2]
+    assert isinstance(sensor, SensorBoard)
+    return robot, sensor
+
+
+def test_a_sensor_board_with_the_side_pair_has_six_channels() -> None:
+    _, sensor = side_rig(tuple(SensorId))
+    (ident,) = sensor.handle([m.Identify()])
+    assert ident == m.Ident(2, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, 6, 0x0100, 2)
+    assert (m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR) == (4, 1)
+    replies = sensor.handle([m.ReadAll()])
+    assert tuple(type(r) for r in replies) == m.read_all_reply(m.Board.SENSOR, 6)
+    tel = [r for r in replies if isinstance(r, m.SensorTelemetry)]
+    assert [(t.channel, t.distance_mm) for t in tel] == [(c, 500 + 100 * c) for c in range(6)]
+    assert sensor.handle([m.GetSensor(5)]) == [tel[5]]  # SSL
+    assert sensor.handle([m.GetSensor(6)]) == [m.Ack(m.GetSensor.TYPE, m.AckResult.BAD_CHANNEL)]
+
+
+def test_a_sensor_board_without_it_has_four_whatever_the_world_reads(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    assert set(SIDE_SENSORS) <= set(robot.sensors)  # the stub reads them; the board has none
+    assert sensor.handle([m.Identify()])[0].channels == 4
+    replies = sensor.handle([m.ReadAll()])
+    assert [r.channel for r in replies if isinstance(r, m.SensorTelemetry)] == [0, 1, 2, 3]
+    assert sensor.handle([m.GetSensor(4)]) == [m.Ack(m.GetSensor.TYPE, m.AckResult.BAD_CHANNEL)]
+
+
+def test_a_side_sensor_the_world_does_not_read_goes_as_never_measured() -> None:
+    """A simulation that does not model the side pair yet: the board invents
+    no distance; it says ERROR with the age saturated (docs/protocol.md, "Ages")."""
+    _, sensor = side_rig(BASE_SENSORS)
+    replies = sensor.handle([m.ReadAll()])
+    tel = [r for r in replies if isinstance(r, m.SensorTelemetry)]
+    assert [t.channel for t in tel] == [0, 1, 2, 3, 4, 5]
+    assert tel[4] == m.SensorTelemetry(4, m.SensorCode.ERROR, 0, 0, m.AGE_MAX_MS)
+    assert tel[5] == m.SensorTelemetry(5, m.SensorCode.ERROR, 0, 0, m.AGE_MAX_MS)

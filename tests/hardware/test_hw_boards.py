@@ -9,9 +9,10 @@ import time
 
 import pytest
 
+from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
-from stairbot.hardware import ZERO_SPEEDS, MotorId, SensorId
+from stairbot.hardware import BASE_SENSORS, SIDE_SENSORS, ZERO_SPEEDS, MotorId
 
 pytestmark = pytest.mark.hardware
 
@@ -32,10 +33,13 @@ def test_both_boards_answer_with_their_identity(boards: BoardRobot) -> None:
     assert not boards.latched, f"the boards hold latches: {boards.latched} (stairbot clear)"
 
 
-def test_a_read_has_every_motor_and_sensor_and_fresh_ages(boards: BoardRobot) -> None:
+def test_a_read_has_every_motor_and_sensor_and_fresh_ages(boards: BoardRobot,
+                                                          hw_config: RobotConfig) -> None:
+    """Every sensor the robot has: the side pair too when its config has it."""
     snap = boards.read()
     assert set(snap.motors) == set(MotorId)
-    assert set(snap.sensors) == set(SensorId)
+    side = SIDE_SENSORS if hw_config.sensors.has_side_pair else ()
+    assert set(snap.sensors) == set(BASE_SENSORS + side)
     for sid, reading in snap.sensors.items():
         assert 0 <= reading.age_s < 0.5, (sid, reading)
     if snap.imu is not None:

@@ -11,7 +11,7 @@ import pytest
 from stairbot.config import load_config
 from stairbot.errors import InputError
 from stairbot.events import Event, EventKind
-from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import BASE_SENSORS, Imu, MotorId, MotorState, SensorReading, Snapshot
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import FLUSH_PERIOD_S, FLUSH_TICKS, McapRecord
 from stairbot.recording.read import read_recording
@@ -30,7 +30,7 @@ class Wall:
 
 def snap(i: int) -> Snapshot:
     return Snapshot(time_s=i * 0.02,
-                    sensors={s: SensorReading(0.5) for s in SensorId},
+                    sensors={s: SensorReading(0.5) for s in BASE_SENSORS},
                     motors={m: MotorState(turns=i * 0.01) for m in MotorId},
                     imu=Imu(pitch_deg=0.0, roll_deg=0.0))
 

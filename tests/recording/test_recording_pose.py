@@ -8,7 +8,7 @@ import math
 import pytest
 
 from stairbot.config import load_config
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
 from stairbot.recording.pose import (
     DeadReckonedPose,
     SegmentPose,
@@ -96,7 +96,7 @@ def test_the_dead_reckoned_pose_follows_the_counters() -> None:
         motors = {m: MotorState(turns=wheel_turns) for m in MotorId}
         motors[MotorId.MTF] = MotorState(turns=lift_m / config.motors.lift_travel_per_turn)
         motors[MotorId.MTB] = MotorState(turns=0.0)
-        return Snapshot(0.0, {s: SensorReading(0.3) for s in SensorId}, motors)
+        return Snapshot(0.0, {s: SensorReading(0.3) for s in BASE_SENSORS}, motors)
 
     start = source.poses(at(0.0, 0.0))
     r = config.geometry.wheel_radius

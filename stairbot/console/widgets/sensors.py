@@ -1,13 +1,19 @@
-"""The four distance sensors: value and status, and whether each pair that
-must agree (front right/left, back right/left) agrees within
-``equal_tolerance``.  Operator words first (``front R``), the seed's names
-(SFR...) beside them, dimmer.
+"""The distance sensors: value and status, and whether each pair that must
+agree (front right/left, back right/left) agrees within ``equal_tolerance``.
+Operator words first (``front R``), the seed's names (SFR...) beside them,
+dimmer.  On a robot with the side pair (its config's ``[sensors]
+side_model``, or a reading that carries SSR/SSL) one line more, ``side``:
+SSR (right) and SSL (left) beside each other, values in metres; they look
+opposite ways, so no verdict joins them.  A robot without the pair shows no
+such line.
 
-Four lines, a bracket joining each pair to its verdict: two lines fewer than a
-verdict line per pair, which an 80x24 screen needs for the panels below.  The
-title says when the values were read; stale ones are dimmed and marked
-(:mod:`stairbot.console.freshness`), and a sensor whose own measurement is
-older than that says ``old`` instead of ``ok``.
+Four lines (five), a bracket joining each pair to its verdict: two lines
+fewer than a verdict line per pair, which an 80x24 screen needs for the
+panels below (the side pair's one line takes the row the link panel has to
+spare there).  The title says when the values were read; stale ones are
+dimmed and marked (:mod:`stairbot.console.freshness`), and a sensor whose
+own measurement is older than that says ``old`` instead of ``ok`` -- the
+side pair's as every other's.
 """
 
 from __future__ import annotations
@@ -16,31 +22,54 @@ from rich.text import Text
 from textual.widgets import Static
 
 from stairbot.console.freshness import STALE_S, age_key, is_stale, titled
-from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
+from stairbot.hardware import SIDE_SENSORS, SensorId, SensorReading, SensorStatus, Snapshot
 
 PAIRS = ((SensorId.SFR, SensorId.SFL), (SensorId.SBR, SensorId.SBL))
 NAMES = {SensorId.SFR: "front R", SensorId.SFL: "front L", SensorId.SBR: "back R",
-         SensorId.SBL: "back L"}
+         SensorId.SBL: "back L", SensorId.SSR: "side R", SensorId.SSL: "side L"}
 READING_WIDTH = 25  # "front R SFR 0.265 m ERROR"
+
+
+def _value(line: Text, r: SensorReading | None, unit: str = " m") -> None:
+    """A reading's value and status word: ``0.265 m ok``, ``out`` (of range:
+    the value is the sensor's limit), ``old`` (not measured for STALE_S),
+    ``ERROR``, ``none`` (no reading of it)."""
+    blank = " " * len(unit)
+    if r is None:
+        line.append(f"  —  {blank} none", "dim")
+    elif r.status is SensorStatus.ERROR:
+        line.append(f"  —  {blank} ", "dim")
+        line.append("ERROR", "bold red")
+    else:
+        line.append(f"{r.distance_m:5.3f}{unit} ")
+        if r.age_s > STALE_S:  # the sensor has not measured for that long
+            line.append("old", "bold yellow")
+        elif r.status is SensorStatus.OUT_OF_RANGE:
+            line.append("out", "yellow")
+        else:
+            line.append("ok", "green")
 
 
 def _reading(sensor: SensorId, r: SensorReading | None) -> Text:
     line = Text(f"{NAMES[sensor]:<7} ", style="bold")
     line.append(f"{sensor.value} ", "dim")
-    if r is None:
-        line.append("   —    none", "dim")
-    elif r.status is SensorStatus.ERROR:
-        line.append("   —    ", "dim")
-        line.append("ERROR", "bold red")
-    else:
-        line.append(f"{r.distance_m:5.3f} m ")
-        if r.age_s > STALE_S:  # the sensor has not measured for that long
-            line.append("old", "bold yellow")
-        elif r.status is SensorStatus.OUT_OF_RANGE:
-            line.append("out", "yellow")  # of range: the value is the sensor's limit
-        else:
-            line.append("ok", "green")
+    _value(line, r)
     line.pad_right(READING_WIDTH - line.cell_len)
+    return line
+
+
+SIDE_CELL = 15  # "SSR 0.620 ERROR"
+
+
+def _side_line(sensors: dict[SensorId, SensorReading]) -> Text:
+    """The side pair on one line: ``side  SSR 0.620 ok     SSL 1.300 out``."""
+    line = Text("side  ", style="bold")
+    for sensor in SIDE_SENSORS:
+        cell = Text(f"{sensor.value} ", "dim")
+        _value(cell, sensors.get(sensor), unit="")
+        cell.pad_right(SIDE_CELL - cell.cell_len + 2)
+        line.append_text(cell)
+    line.rstrip()
     return line
 
 
@@ -61,13 +90,18 @@ def pair_verdict(a: SensorReading | None, b: SensorReading | None,
 
 
 class SensorPanel(Static):
-    """Four sensor lines; each pair bracketed with its verdict."""
+    """Four sensor lines, each pair bracketed with its verdict; the side
+    pair's line after them on a robot that has it."""
 
     DEFAULT_CSS = "SensorPanel { height: auto; }"
 
-    def __init__(self, tolerance: float, *, id: str | None = None) -> None:  # noqa: A002
+    def __init__(self, tolerance: float, *, side_pair: bool = False,
+                 id: str | None = None) -> None:  # noqa: A002
+        """``side_pair``: the robot has SSR/SSL (its config says so); their
+        line shows then, and whenever a reading carries them."""
         super().__init__(id=id)
         self.tolerance = tolerance
+        self.side_pair = side_pair
         self._last: object = ()
         self.border_title = titled("sensors", None)
 
@@ -88,4 +122,6 @@ class SensorPanel(Static):
                 line.append(bracket, "dim")
                 line.append_text(verdict)
                 lines.append(line)
+        if self.side_pair or any(s in sensors for s in SIDE_SENSORS):
+            lines.append(_side_line(sensors))
         self.update(Text("\n").join(lines))

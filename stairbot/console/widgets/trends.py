@@ -1,5 +1,6 @@
-"""The graphs (key ``g``): the IMU's pitch, the four distance sensors and the
-two lifts over the last seconds of robot time, one Textual ``Sparkline``
+"""The graphs (key ``g``): the IMU's pitch, the distance sensors (the side
+pair too, on a robot that has it) and the two lifts over the last seconds
+of robot time, one Textual ``Sparkline``
 each, the latest value before it and the range drawn after it (each line
 scales to its own range: the range says how much a swing is).
 
@@ -19,7 +20,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Sparkline, Static
 
 from stairbot.console.freshness import age_key, is_stale, titled
-from stairbot.console.history import SERIES, Row
+from stairbot.console.history import NOT_CARRIED, Row, column, series
 from stairbot.console.widgets.sensors import NAMES as SENSOR_NAMES
 from stairbot.hardware import SensorId
 
@@ -56,21 +57,25 @@ class TrendsPanel(Vertical):
     TrendsPanel Sparkline { width: 1fr; }
     """
 
-    def __init__(self, lift_m_per_turn: float, *, id: str | None = None) -> None:  # noqa: A002
+    def __init__(self, lift_m_per_turn: float, *, side_pair: bool = False,
+                 id: str | None = None) -> None:  # noqa: A002
+        """``side_pair``: the robot has SSR/SSL (its config's ``[sensors]
+        side_model``): a line each for them too."""
         super().__init__(id=id)
         self.lift_m_per_turn = lift_m_per_turn
+        self.series = series(side_pair)
         self._last: object = None
         self.border_title = titled("graphs", None)
         self.labels = {name: Static("", classes="trend-label", markup=False)
-                       for name in SERIES}
+                       for name in self.series}
         self.ranges = {name: Static("", classes="trend-range", markup=False)
-                       for name in SERIES}
+                       for name in self.series}
         self.lines = {name: Sparkline([], summary_function=_mean, id=f"trend-{name}")
-                      for name in SERIES}
+                      for name in self.series}
         self.plain: dict[str, str] = {}  # each line's label and range as shown, for tests
 
     def compose(self) -> ComposeResult:
-        for name in SERIES:
+        for name in self.series:
             with Horizontal():
                 yield self.labels[name]
                 yield self.lines[name]
@@ -86,26 +91,28 @@ class TrendsPanel(Vertical):
         span = rows[-1][0] - rows[0][0] if len(rows) > 1 else 0.0
         self.border_title = titled(f"graphs · last {span:.0f} s", age_s)
         self.set_class(is_stale(age_s), "-stale")
-        for i, name in enumerate(SERIES, start=1):
-            column = [r[i] for r in rows if not math.isnan(r[i])]
+        for name in self.series:
+            i = column(name)
+            values = [r[i] for r in rows if math.isfinite(r[i])]
             last = rows[-1][i] if rows else math.nan
-            label, low, high = self._texts(name, last, column)
+            label, low, high = self._texts(name, last, values)
             self.labels[name].update(label)
-            self.ranges[name].update(Text(f"{low}…{high}" if column else ""))
-            self.plain[name] = f"{label.plain} | {low}…{high}" if column else label.plain
+            self.ranges[name].update(Text(f"{low}…{high}" if values else ""))
+            self.plain[name] = f"{label.plain} | {low}…{high}" if values else label.plain
             # one point would fill the line (the widget draws it full height): a
             # line needs two to say anything
-            self.lines[name].data = column if len(column) > 1 else []
+            self.lines[name].data = values if len(values) > 1 else []
 
-    def _texts(self, name: str, last: float, column: list[float]) -> tuple[Text, str, str]:
+    def _texts(self, name: str, last: float, values: list[float]) -> tuple[Text, str, str]:
         out = Text(f"{_label(name):<8}", style="bold", no_wrap=True, overflow="ellipsis")
-        low = min(column) if column else math.nan
-        high = max(column) if column else math.nan
+        low = min(values) if values else math.nan
+        high = max(values) if values else math.nan
         if name == "pitch":
             value = "—" if math.isnan(last) else f"{_signed(last, 1)}°"
             lo, hi = _signed(low, 1), f"{_signed(high, 1)}°"
         elif name in SensorId.__members__:
-            value = "ERROR" if math.isnan(last) else f"{last:.3f}"
+            value = ("—" if last == NOT_CARRIED  # no such reading (a side sensor not read)
+                     else "ERROR" if math.isnan(last) else f"{last:.3f}")
             lo, hi = f"{low:.3f}", f"{high:.3f}"
         else:  # a lift: turns as the extension, mm
             mm = 1000 * self.lift_m_per_turn
