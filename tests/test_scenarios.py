@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import pytest
 import simrun
-from awaiting import LANDING_SCENARIOS, LANDING_SCENARIOS_REASON
 
 from stairbot.config import RobotConfig, load_config
 from stairbot.events import Event, EventKind
@@ -34,6 +33,10 @@ PATHS: dict[str, tuple[set[str], set[str]]] = {
     "calibration_case3b_corner": ({"cal_probe", "cal_corner", "cal_turn"}, set()),
     "side_wall_square": ({"cal_away", "cal_turn"}, {"cal_probe", "cal_corner"}),
     "wall_at_top": ({"ascent_lower_obstacle"}, set()),
+    "landing_left": ({"landing_scan", "landing_centre", "landing_return"}, set()),
+    "landing_right": ({"landing_scan", "landing_centre", "landing_return"}, set()),
+    "landing_too_small": ({"landing_scan"}, {"landing_centre"}),
+    "landing_wall": ({"landing_scan"}, {"landing_centre"}),
     "step_too_high": ({"ascent_lower_obstacle"}, {"ascent_drive_first"}),
     "tread_too_short": ({"ascent_lower_obstacle"}, {"ascent_drive_first"}),
     "passing_disagreement": ({"paused"}, set()),
@@ -58,13 +61,13 @@ def assert_one_phase_entry_a_tick(events: list[Event]) -> None:
     assert not twice, f"more than one phase entered at t = {twice}"
 
 
-ROBOT_FOR = {"narrow_steps": load_config("heavy_middle")}
+ROBOT_FOR = {"narrow_steps": load_config("heavy_middle"),
+             **{name: load_config("landings") for name in (
+                 "landing_left", "landing_right", "landing_too_small", "landing_wall")}}
 """A scenario written for another robot than the reference one."""
 
 
-@pytest.mark.parametrize("name", [
-    pytest.param(name, marks=pytest.mark.skip(reason=LANDING_SCENARIOS_REASON))
-    if name in LANDING_SCENARIOS else name for name in shipped()])
+@pytest.mark.parametrize("name", shipped())
 def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
     scenario = load_scenario(name)
     result, events = run_sim(scenario, ROBOT_FOR.get(name, CONFIG))

@@ -50,7 +50,8 @@ view stops the robot's centre line at the faces it holds, not its corners
 not at the faces it does not hold (side walls, flight 2 in flight 1's
 frame); nothing stops the robot there -- the sweeps judge it by
 ``Truth.wall_contact``.  Flight 1's risers are not watched: the robot climbs
-them.
+them; nor are flight 2's in flight 2's frame while the robot stands within
+CLIMB_YAW of its axis (climbing them, not turning).
 
 Limits: in a frame's side view the stairs reach sideways without end (a robot
 driven sideways off the landing over flight 1's top edge, in flight 2's
@@ -80,6 +81,12 @@ CONTACT_DEPTH = 0.003
 view lets a wheel or a chassis rest against a riser or a wall (its contact
 slop and the stairs' rounding: 1.5 mm), and a robot a degree or two off square
 reaches that much further at its corners."""
+CLIMB_YAW = math.radians(20.0)
+"""In flight 2's frame, its risers are the side view's, as flight 1's are in
+flight 1's: the robot climbs them, resting against each (a corner a degree
+or two off square reaches past CONTACT_DEPTH).  The footprint check watches
+them there only while the robot is turned more than this from flight 2's
+axis: turning on the landing."""
 CONTACT_TOLERANCE = 0.002
 """A riser's top must stand this far above a segment's underside for a
 contact (a wheel resting on the tread beside it is not one), m."""
@@ -247,8 +254,10 @@ class Stairwell:
         d = CONTACT_DEPTH  # the footprint less this all round: reaching in further
         front, rear, hw = l2 / 2 + l1 - d, -(l2 / 2 + l3) + d, width / 2 - d
         reach = max(front, -rear) + hw  # no face further than this from the centre
+        climbing = self.flight == 2 and abs(yaw - self.sign * math.pi / 2) < CLIMB_YAW
         near = [w for w in self._watched if w[1] - reach <= x <= w[2] + reach
-                and w[3] - reach <= y <= w[4] + reach]
+                and w[3] - reach <= y <= w[4] + reach
+                and not (climbing and w[0].kind == "riser2")]
         if not near:
             return None
         c, s = math.cos(yaw), math.sin(yaw)

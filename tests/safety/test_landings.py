@@ -69,14 +69,15 @@ def test_a_landing_it_cannot_turn_on_is_refused_and_the_robot_comes_home(
 
 def test_a_landing_too_narrow_to_turn_in_is_refused() -> None:
     """0.34 m wide: 0.17 m either side of the centre line, where the robot's
-    turning circle needs 0.174 m."""
-    scenario = parse_scenario(landing(width=0.34), "narrow.toml")
+    turning circle needs 0.174 m (0.40 m deep: room enough that way)."""
+    scenario = parse_scenario(landing(width=0.34, depth=0.40), "narrow.toml")
     events: list[Event] = []
     result = simrun.run_sim(LANDINGS, scenario, events)
     assert (result.ascent_end, result.steps_climbed, result.steps_descended) == (
         "landing_too_small", 3, 3), result.to_dict()
-    assert any(m.startswith("landing too small to turn in") and "right 0.1" in m
-               and "left 0.1" in m for m in infos(events))
+    # (wherever the climb left it across the landing, one side is short of room)
+    assert any(m.startswith("landing too small to turn in") and
+               ("right 0.1" in m or "left 0.1" in m) for m in infos(events))
 
 
 def test_a_tread_too_short_to_stand_on_is_no_landing_to_look_sideways_from() -> None:
