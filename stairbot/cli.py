@@ -471,6 +471,7 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
         f"  fell              {'yes' if d['fell'] else 'no'}"
         f" (max pitch {_fmt(d.get('max_pitch_deg'), ' deg', 1)})",
         f"  offset from start {_fmt(d.get('final_offset_m'), ' m')}",
+        *([f"  touched a wall    {d['wall_contact']}"] if d.get("wall_contact") else []),
         "  tilt              " + ("watched (IMU)" if d.get("tilt_watched")
                                   else "NOT watched: the robot config declares no IMU"),
         f"  time              {_fmt(d['sim_time_s'], ' s', 2)} robot time, "

@@ -435,6 +435,13 @@ class RobotConfig:
             out["narrow_steps_margin_m"] = self.narrow_steps_margin_m
         if math.isfinite(self.square_range_m):  # a cone looking up, or a noisy pair
             out["square_range_m"] = self.square_range_m
+        if self.algorithm.landings:
+            # the controller's own figures (it refuses a landing with less room)
+            from stairbot.algorithm.landing import DEPTH_MARGIN, turn_room_m
+
+            room = turn_room_m(self)
+            out["landing_turn_room_m"] = room
+            out["min_landing_m"] = 2.0 * room + DEPTH_MARGIN
         return out
 
     def to_dict(self) -> dict[str, Any]:
