@@ -174,6 +174,12 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     return "band", max_rise, min_tread
 
 
+LATERAL_DRIFT_M = 0.05
+"""How far across the flight a climb may carry the robot from where it
+started: calibration squares up within its tolerance (a degree or so), and
+1.3 degrees over three steps and the landing's approach moved it 45 mm."""
+
+
 def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
                  ) -> tuple[str, float, float]:
     """Quarter-turn stairs' zone: each flight's as a flight of its own
@@ -201,7 +207,10 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     tm = rules.tread_margin_m
     room = turn_room_m(config)
     depth = landing.depth - DEPTH_MARGIN
-    short = min(depth / 2.0 - room, scenario.width / 2.0 - abs(scenario.start.lateral) - room)
+    # where the robot stands across the landing: start.lateral, and what
+    # calibration's residual yaw adds over the flight (LATERAL_DRIFT_M)
+    centred = scenario.width / 2.0 - room
+    drifted = centred - abs(scenario.start.lateral) - LATERAL_DRIFT_M
     # ascent 8 reads the wall ahead from segment 1's front face, about
     # LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE - TAB_PAST_EDGE_M past the edge
     top = (config.LENGTH_OF_INFINITY + config.LENGTH_OF_FIRST_MODULE
@@ -210,9 +219,10 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     turns = config.algorithm.landings and config.sensors.has_side_pair
     max_rise, min_tread = max(first[1], second[1]), min(first[2], second[2])
     steps = len(scenario.steps) + len(landing.steps)
-    if not turns or short < -tm or top < -sight:
+    if not turns or min(depth / 2.0 - room, centred) < -tm or top < -sight:
         # the landing refuses (or reads as the top): the first flight decides
         return ("outside" if first[0] == "inside" else first[0]), max_rise, min_tread
+    short = min(depth / 2.0 - room, drifted)
     zones = {first[0], second[0]}
     if "outside" in zones:
         return "outside", max_rise, min_tread
