@@ -328,6 +328,9 @@ def _lowered_obstacle(t: Tick, _w: Work) -> Step:
     if landing.can_scan(t):
         # a wall ahead at the top of a flight may be a landing's: look sideways first
         return go(P.LANDING_SCAN)
+    if landing.turned_here(t):
+        # the next flight's first step refused: back where it turned, and turn back
+        return go(P.LANDING_RETURN)
     return go(P.DESCENT_BACK_OFF if t.ctx.number_of_steps > 0 else P.DESCENT_FINISH)
 
 
@@ -339,6 +342,8 @@ LOWER_OBSTACLE = PhaseDef(
     to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
         P.LANDING_SCAN: "lowered; number_of_steps > 0, [algorithm] landings and no landing "
                         "scanned yet: look sideways for the next flight",
+        P.LANDING_RETURN: "lowered; the first step after a landing's turn: back to where it "
+                          "turned",
         P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
 
 

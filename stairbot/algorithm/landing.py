@@ -36,11 +36,12 @@ import statistics
 
 from stairbot.algorithm import motion
 from stairbot.algorithm.moves import lift, reading_drive
-from stairbot.algorithm.phase import FAULT, PhaseDef, Step, Tick, go
+from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
+from stairbot.perception import WINDOW
 
 P = Phase
 FLOW = "landing"
@@ -63,6 +64,12 @@ SIDE_JUMP_M = 0.05
 """A side sees over what it saw when it reads this much farther (or nothing
 in range): ascent 3's SIGHT_JUMP_M, for the same reason -- no tread is this
 short, and it is ten times the sensors' noise."""
+SCAN_CONFIRM_TICKS = 5
+"""Lifting, a side has been seen over once its reading has stayed past what
+it saw this many ticks in a row (then the lift may stop early)."""
+SCAN_TOP_TICKS = 15
+"""Standing at the top of the scan, the ticks each side is read over: open
+if past what it saw on most of them."""
 SCAN_BASE_M = 0.01
 """The scan takes what each side sees from the readings of its first this
 much of segment 3's lift, m."""
@@ -111,53 +118,77 @@ def _side(reading: SensorReading) -> float | None:
 def _scan_enter(t: Tick, w: Work) -> None:
     t.ctx.landing_seen = True
     t.ctx.return_mtb = w.entry_mtb
-    _scan_lift[0](t, w)
+    w.target_mtb = max(w.entry_mtb, t.cfg.MAX_OF_VERTICAL_TURNS)
 
 
-def _scan_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
-    return {MotorId.MTB: max(0.0, t.cfg.MAX_OF_VERTICAL_TURNS - w.entry_mtb)}
-
-
-def _scanned(t: Tick, w: Work) -> Step:
-    _sample(t, w)
-    return _record(t, w)
-
-
-_scan_lift = lift(_scan_deltas, _scanned)
+def _settled(t: Tick, w: Work) -> bool:
+    """Standing still since ``w.still_since`` (set now if unset) for as long as
+    the side pair's filter takes to stand for here: its latency and a full
+    window of its measurements."""
+    if w.still_since is None:
+        w.still_since = t.snap.time_s
+    spec = t.cfg.sensors.side_spec()
+    settle = spec.latency_s + WINDOW * max(spec.period_s, t.cfg.algorithm.tick)
+    return t.snap.time_s - w.still_since >= settle - 1e-9
 
 
 def _lifted_m(t: Tick, w: Work) -> float:
     return (t.snap.turns(MotorId.MTB) - w.entry_mtb) * t.cfg.motors.lift_travel_per_turn
 
 
+def _jumped(reading: SensorReading, base: float) -> bool:
+    """The side reads on past what it saw (by SIDE_JUMP_M, or nothing in range)."""
+    if reading.status is SensorStatus.OUT_OF_RANGE:
+        return reading.distance_m > base
+    return reading.ok and reading.distance_m >= base + SIDE_JUMP_M
+
+
 def _sample(t: Tick, w: Work) -> None:
-    """Per side (SSR, SSL): the readings of the lift's first SCAN_BASE_M (what
-    the side sees), then the first height the reading jumps on past them."""
+    """Lifting, per side (SSR, SSL): the readings of the lift's first
+    SCAN_BASE_M (what the side sees), then the height from which the reading
+    has stayed past them SCAN_CONFIRM_TICKS ticks in a row (where the beam
+    saw over what it saw: a hint of the riser's height)."""
     lifted = _lifted_m(t, w)
     for i, sid in enumerate(SIDE_SENSORS):
         reading = t.snap.sensors[sid]
-        d = _side(reading)
         if lifted < SCAN_BASE_M:
+            d = _side(reading)
             if d is not None:
                 w.side_base[i].append(d)
             continue
-        if w.side_open[i] is not None or not w.side_base[i]:
+        if not w.side_base[i] or w.side_run[i] >= SCAN_CONFIRM_TICKS:
             continue
-        base = statistics.median(w.side_base[i])
-        far = reading.status is SensorStatus.OUT_OF_RANGE and reading.distance_m > base
-        if far or (d is not None and d >= base + SIDE_JUMP_M):
-            w.side_open[i] = lifted
-            name = "right" if sid is SIDE_SENSORS[0] else "left"
-            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
-                  f"({base:.3f} m) with segment 3 lifted {lifted:.3f} m: the next flight",
-                  sensor=sid.value, base=base, lifted=lifted)
+        if _jumped(reading, statistics.median(w.side_base[i])):
+            if w.side_run[i] == 0:
+                w.side_open[i] = lifted
+            w.side_run[i] += 1
+        else:
+            w.side_run[i], w.side_open[i] = 0, None
 
 
 def _scan(t: Tick, w: Work) -> Step:
-    _sample(t, w)
-    if all(o is not None for o in w.side_open):
-        return _record(t, w)  # both seen over: no need to lift on
-    return _scan_lift[1](t, w)
+    """Lift segment 3 to the top of its stroke (or until both sides have been
+    seen over), then, standing, read both sides SCAN_TOP_TICKS ticks once
+    the filter has settled: a side is open only if what it reads standing
+    there lies past what it saw below.  A stray measurement while lifting
+    (1 % outliers) took a wall for a flight: the robot turned to it."""
+    if not w.checked:
+        _sample(t, w)
+        speeds = motion.lifts_to(t.cfg, t.snap, w.lift_targets())
+        if speeds is not None and min(w.side_run) < SCAN_CONFIRM_TICKS:
+            return stay(speeds)
+        w.checked = True
+    if not _settled(t, w):
+        return stay(NO_MOTION)
+    for i, sid in enumerate(SIDE_SENSORS):
+        reading = t.snap.sensors[sid]
+        if not w.side_base[i]:
+            continue
+        w.side_top[i] += 1 if _jumped(reading, statistics.median(w.side_base[i])) else 0
+    w.diff_skipped += 1  # ticks measured standing at the top
+    if w.diff_skipped < SCAN_TOP_TICKS:
+        return stay(NO_MOTION)
+    return _record(t, w)
 
 
 def _record(t: Tick, w: Work) -> Step:
@@ -169,17 +200,28 @@ def _record(t: Tick, w: Work) -> Step:
     bases = [statistics.median(b) if b else None for b in w.side_base]
     ctx.landing_right_m = None if bases[0] is None else bases[0] + lat
     ctx.landing_left_m = None if bases[1] is None else bases[1] + lat
-    ctx.landing_rise_m = [None if o is None else o + cfg.sensors.side_height
-                          for o in w.side_open]
-    ctx.landing_open = [s for i, s in ((0, RIGHT), (1, LEFT))
-                        if w.side_open[i] is not None and bases[i] is not None]
+    # open: past what it saw on most of the ticks standing at the top
+    opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS for i in (0, 1)]
+    lifted = _lifted_m(t, w)
+    seen_at = [lifted if o is None else o for o in w.side_open]
+    ctx.landing_rise_m = [seen_at[i] + cfg.sensors.side_height if opened[i] else None
+                          for i in (0, 1)]
+    ctx.landing_open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
+    for i, sid in enumerate(SIDE_SENSORS):
+        if opened[i]:
+            name = "right" if i == 0 else "left"
+            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
+                  f"({bases[i]:.3f} m) with segment 3 lifted "
+                  f"{(ctx.landing_rise_m[i] or 0.0) - cfg.sensors.side_height:.3f} m, and "
+                  f"standing at the top: the next flight", sensor=sid.value, base=bases[i])
     return go(P.LANDING_SCAN_LOWER)
 
 
 SCAN = PhaseDef(
     P.LANDING_SCAN, "landing 1 — lift segment 3, looking sideways for the next flight", FLOW,
     _scan, enter=_scan_enter, carried_by=(1, 2),
-    to={P.LANDING_SCAN_LOWER: "segment 3 at the top of its stroke, or both sides seen over",
+    to={P.LANDING_SCAN_LOWER: "segment 3 at the top of its stroke (or both sides seen over), "
+                              "read standing there",
         P.ERROR: FAULT})
 
 
@@ -323,6 +365,13 @@ def turned(t: Tick) -> Step:
 
 
 # -- landing 3: back to where it turned, turn back ------------------------------------------
+def turned_here(t: Tick) -> bool:
+    """Turned onto the next flight, and refusing its first step: the way down
+    begins with the turn back."""
+    ctx = t.ctx
+    return ctx.landing_step is not None and ctx.number_of_steps == ctx.landing_step
+
+
 def returns_here(t: Tick) -> bool:
     """Just down the next flight's first step: back to the landing's turn."""
     ctx = t.ctx
@@ -359,8 +408,9 @@ _return = reading_drive(-1, _return_target, _return_turns, _returned)
 RETURN = PhaseDef(
     P.LANDING_RETURN, "landing 3 — back to where it turned", FLOW, _return[1],
     enter=_return[0], watches="front",
-    to={P.CAL_LIFT: "reads where it turned: lift to turn back to the heading it came up "
-                    "the first flight with",
+    to={P.CAL_LIFT: "reads where it turned (down the next flight's first step, or having "
+                    "refused it): lift to turn back to the heading it came up the first "
+                    "flight with",
         P.ERROR: FAULT})
 
 

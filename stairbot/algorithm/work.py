@@ -103,8 +103,12 @@ class Work:
     side_base: list[list[float]] = field(default_factory=lambda: [[], []])
     """Landing 1: what SSR and SSL read over segment 3's first SCAN_BASE_M of lift."""
     side_open: list[float | None] = field(default_factory=lambda: [None, None])
-    """Landing 1: how far segment 3 had lifted when SSR (SSL) saw over what it
-    saw: the next flight's first riser on that side (None: not seen over)."""
+    """Landing 1: how far segment 3 had lifted when SSR (SSL) began reading
+    past what it saw (None: not, or not for long)."""
+    side_run: list[int] = field(default_factory=lambda: [0, 0])
+    """Landing 1: ticks in a row SSR (SSL) has read past what it saw."""
+    side_top: list[int] = field(default_factory=lambda: [0, 0])
+    """Landing 1: ticks standing at the top on which SSR (SSL) read past it."""
 
     @classmethod
     def at_entry(cls, snap: Snapshot) -> Work:

@@ -110,3 +110,37 @@ def test_landings_need_the_side_pair() -> None:
         parse_config('extends = "reference"\n[algorithm]\nlandings = true\n', "x.toml")
     assert info.value.field == "algorithm.landings"
     assert "side pair" in str(info.value)
+
+
+def test_a_stray_side_reading_while_lifting_is_no_flight() -> None:
+    """The landings sweep, case 197: with 1 % outliers, SSL read past the wall
+    on its left for a moment as segment 3 rose; taken for the next flight,
+    the robot turned left to a wall, and touched it.  A side is open only if
+    it reads past what it saw standing at the top of the lift."""
+    scenario = parse_scenario(landing(depth=0.4, turn="right", extra=(
+        "[start]\nyaw_deg = 7.218421\nlateral = -0.011017\n"
+        "[sensors]\nseed = 138644\noutliers = 0.01\n")), "case197.toml")
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, scenario, events)
+    assert (result.steps_climbed, result.steps_descended, result.wall_contact) == (
+        6, 6, None), result.to_dict()
+    assert any(m.startswith("landing: the next flight is to the right") for m in infos(events))
+
+
+def test_the_next_flights_first_step_refused_it_turns_back_before_it_descends() -> None:
+    """A second flight whose first riser (0.215 m) the side pair sees over
+    (0.24 m up) but ascent 3 cannot climb (max_step_rise_m 0.202 m): an
+    obstacle after the turn.  The robot backs to where it turned, turns back,
+    and descends the first flight home -- not backwards off the landing's
+    side."""
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, parse_scenario(
+        landing(extra="rise = 0.215\n"), "high.toml"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "obstacle", 3, 3), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
+    seen = phases(events)
+    # the landing's wall, then the next flight's first riser
+    obstacles = [i for i, p in enumerate(seen) if p is Phase.ASCENT_LOWER_OBSTACLE]
+    assert [seen[i + 1] for i in obstacles] == [Phase.LANDING_SCAN, Phase.LANDING_RETURN]
+    assert result.wall_contact is None
