@@ -187,10 +187,29 @@ class Truth:
     pitch_deg: float | None
     max_pitch_deg: float | None
     offset_m: float | None
-    """Distance from the start pose."""
+    """Distance of segment 2's centre from where it started, seen from above
+    (in flight 1's frame)."""
     clear_of_stairs_m: float | None = None
     """How far the robot's front face stands before the first riser (negative:
     over the stairs): a descent from the top has reached the floor."""
+    wall_contact: str | None = None
+    """The first time the robot's footprint seen from above (its three segments
+    end to end, ``track_width`` + 2 cm wide) overlapped a wall, or a riser
+    standing higher than the segment's underside, that the side view does not
+    hold (side walls; a quarter-turn landing's walls and second flight): which
+    segment, what and when.  None: never, or a robot that cannot tell.  The
+    simulation lets the robot through; a sweep should judge it unsafe."""
+    flight: int = 1
+    """The flight whose frame the side view (``Scene``) is in: 1, or 2 while the
+    robot stands turned more than 45 degrees towards a quarter-turn landing's
+    second flight, or on it."""
+    flight1_x_m: float | None = None
+    """Segment 2's centre in flight 1's frame, seen from above: along flight 1,
+    from its first riser (+ = towards the risers), whatever ``flight``."""
+    flight1_y_m: float | None = None
+    """... across flight 1, from its centre line (+ = left)."""
+    flight1_yaw_deg: float | None = None
+    """The robot's heading from straight up flight 1, degrees (+ = turned left)."""
 
 
 @runtime_checkable

@@ -12,7 +12,12 @@ Modules:
   lead-screw lifts, friction, and the instability checks (pitch beyond the
   limit, a segment falling, every wheel off every support);
 * :mod:`~stairbot.fakes.plan` -- the top view: yaw, lateral position, side
-  walls and the corner geometry the front beams see;
+  walls (the whole length or part of it) and the corner geometry the front
+  beams see;
+* :mod:`~stairbot.fakes.landing` -- the stairwell seen from above as vertical
+  faces (side walls, a quarter-turn landing's walls, the second flight's
+  risers) for the side pair and the footprint check; flight 1's and flight
+  2's frames and the switch between them at 45 degrees on the landing;
 * :mod:`~stairbot.fakes.sensors` -- what every sensor shares: its seeded
   noise generator and the scenario's faults;
 * :mod:`~stairbot.fakes.sensor_model`, :mod:`~stairbot.fakes.sensor_presets`,
@@ -21,9 +26,9 @@ Modules:
   incidence loss), their datasheet presets, and the cones' ray casts
   (docs/sensors.md);
 * :mod:`~stairbot.fakes.sim_sensors` -- the sensor board: the four distance
-  sensors through their models (each reading with its age) and the IMU in
-  segment 2 (pitch and pitch rate of its body; roll 0: a side view cannot
-  roll);
+  sensors (six with the side pair SSR/SSL) through their models (each
+  reading with its age) and the IMU in segment 2 (pitch and pitch rate of
+  its body; roll 0: a side view cannot roll);
 * :mod:`~stairbot.fakes.sim` -- :class:`SimRobot` (the Robot protocol),
   :class:`SimClock` (the Clock protocol: advancing it steps the physics,
   optionally paced to the wall clock) and the ``sim://`` factory.
@@ -37,7 +42,12 @@ What is modelled and what is not:
 * segment 2's right and left wheels share one side-view wheel pair running at
   their mean; their difference turns the robot about segment 2's centre, and
   only while segments 1 and 3 are lifted clear of the ground;
-* side walls bound the beams, not the robot's body;
+* side walls bound the beams, not the robot's body: a footprint check
+  records the first time the body reaches into a wall, or a riser the side
+  view does not hold (``Truth.wall_contact``), and lets it through;
+* on a quarter-turn landing the side view is flight 1's until the robot has
+  turned past 45 degrees towards the second flight, then flight 2's
+  (:mod:`~stairbot.fakes.landing`);
 * lifts are stiff lead screws: they move at the commanded speed up to their
   force limit, hold when stopped, and never coast;
 * the same config, scenario (seed) and command sequence give the same run,

@@ -65,7 +65,9 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
     mounts = [(hits, y_fwd + lat * mount_c, lat * mount_s)
               for hits, lat in zip(out, laterals, strict=True)]
     if plan.left_wall or plan.right_wall:
-        _front_walls(plan, side_view, turned, rays, mounts, ahead)
+        x_fwd = plan.x + forward * mount_c  # the mounts' top-view x, for walls over part of x
+        _front_walls(plan, side_view, turned, rays, mounts, ahead,
+                     [x_fwd - lat * mount_s for lat in laterals])
         return out
     for i_up, i_across, weight in rays:  # no side wall: a beam meets a riser or nothing
         hit_dx, c, s, nx, ny, slant = side_view[i_up]
@@ -84,14 +86,17 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
 def _front_walls(plan: Plan, side_view: list[tuple[float | None, float, float, float, float,
                                                    float]],
                  turned: list[tuple[float, float]], rays: tuple[tuple[int, int, float], ...],
-                 mounts: list[tuple[list[Hit], float, float]], ahead: float) -> None:
+                 mounts: list[tuple[list[Hit], float, float]], ahead: float,
+                 xs: list[float]) -> None:
     """The top view of :func:`front_hits` beside side walls: each beam meets
-    the nearer of the riser and the wall it turns towards."""
+    the nearer of the riser and the wall it turns towards, where that wall
+    stands (``xs``: the mounts' top-view x)."""
     half, left_wall, right_wall = plan.width / 2, plan.left_wall, plan.right_wall
+    wall_at, (left_all, right_all) = plan.wall_at, plan.whole_length()
     for i_up, i_across, weight in rays:
         hit_dx, c, s, nx, ny, slant = side_view[i_up]
         cos_psi, sin_psi = turned[i_across]
-        for hits, y_m, side in mounts:
+        for (hits, y_m, side), x_m in zip(mounts, xs, strict=True):
             best: float | None = None
             if hit_dx is not None and cos_psi > 1e-9:
                 dx = hit_dx + ahead + side
@@ -101,8 +106,12 @@ def _front_walls(plan: Plan, side_view: list[tuple[float | None, float, float, f
             if sin_psi > 1e-9:
                 if left_wall:
                     wall = max(0.0, (half - y_m) / sin_psi)
+                    if not left_all and not wall_at(True, x_m + wall * cos_psi):
+                        wall = None
             elif sin_psi < -1e-9 and right_wall:
                 wall = max(0.0, (-half - y_m) / sin_psi)
+                if not right_all and not wall_at(False, x_m + wall * cos_psi):
+                    wall = None
             if wall is not None and (best is None or wall * slant < best):
                 hits.append((wall * slant, abs(c * sin_psi), weight))
             elif best is not None:

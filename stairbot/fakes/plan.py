@@ -8,12 +8,23 @@ width; side walls, where the scenario puts them, are planes y = +-width/2 that
 run the whole length of the stairwell.  A front beam that leaves the flight's
 width before it reaches what the side view says it hits meets that side wall,
 or nothing where there is no wall.
+
+A wall may also stand over part of the length only (``walls``: ranges of x
+per side; a quarter-turn landing's, :mod:`stairbot.fakes.landing`): a beam
+meets it only where it crosses the wall's plane within one of them, which
+needs the top-view x of segment 2's centre (``x``, the side view's).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+Range = tuple[float, float]
+"""From x to x (lo <= hi): where along the flight a wall stands."""
+WHOLE_LENGTH: tuple[Range, ...] = ((-math.inf, math.inf),)
+Walls = tuple[tuple[Range, ...], tuple[Range, ...]]
+"""Where the left wall stands along x, and where the right one does (empty: none)."""
 
 
 @dataclass
@@ -24,17 +35,53 @@ class Plan:
     side_wall: str  # "none" | "left" | "right" | "both"
     y: float = 0.0
     yaw: float = 0.0  # radians, + = left
+    x: float = 0.0
+    """Top-view x of segment 2's centre (the side view's); only walls over part
+    of the length need it."""
+    walls: Walls | None = None
+    """Where the walls stand along x, left and right; None: as ``side_wall``
+    says, the whole length."""
+    _left: tuple[Range, ...] = field(init=False, repr=False, default=())
+    _right: tuple[Range, ...] = field(init=False, repr=False, default=())
+    _left_all: bool = field(init=False, repr=False, default=False)
+    _right_all: bool = field(init=False, repr=False, default=False)
+
+    def __post_init__(self) -> None:
+        self.set_walls(self.walls)
+
+    def set_walls(self, walls: Walls | None) -> None:
+        """Put the walls where ``walls`` says (None: as ``side_wall`` says)."""
+        self.walls = walls
+        if walls is None:
+            walls = (WHOLE_LENGTH if self.side_wall in ("left", "both") else (),
+                     WHOLE_LENGTH if self.side_wall in ("right", "both") else ())
+        self._left, self._right = walls
+        self._left_all = walls[0] == WHOLE_LENGTH
+        self._right_all = walls[1] == WHOLE_LENGTH
 
     @property
     def left_wall(self) -> bool:
-        return self.side_wall in ("left", "both")
+        """Whether a left wall stands anywhere."""
+        return bool(self._left)
 
     @property
     def right_wall(self) -> bool:
-        return self.side_wall in ("right", "both")
+        """Whether a right wall stands anywhere."""
+        return bool(self._right)
+
+    def whole_length(self) -> tuple[bool, bool]:
+        """Whether the left wall, and the right one, stand the whole length."""
+        return self._left_all, self._right_all
+
+    def wall_at(self, left: bool, x: float) -> bool:
+        """Whether the left (or right) wall stands at ``x``."""
+        if self._left_all if left else self._right_all:
+            return True
+        return any(lo <= x <= hi for lo, hi in (self._left if left else self._right))
 
     def move(self, dx: float) -> None:
         """The robot advanced ``dx`` along x (towards the risers) on its heading."""
+        self.x += dx
         self.y += dx * math.tan(self.yaw)
 
     def turn(self, dyaw: float) -> None:
@@ -87,13 +134,19 @@ class Plan:
                 y_hit = y_m + dx * s / c
                 if abs(y_hit) <= self.width / 2:
                     best = dx / c * slant
-        # the side wall the beam turns towards, if there is one
+        # the side wall the beam turns towards, if there is one where it crosses its plane
         wall: float | None = None
         if s > 1e-9:
-            if self.left_wall:
+            if self._left:
                 wall = max(0.0, (self.width / 2 - y_m) / s)
-        elif s < -1e-9 and self.right_wall:
+                if not self._left_all and not self.wall_at(
+                        True, self.x + forward * mc - lateral * ms + wall * c):
+                    wall = None
+        elif s < -1e-9 and self._right:
             wall = max(0.0, (-(self.width / 2) - y_m) / s)
+            if not self._right_all and not self.wall_at(
+                    False, self.x + forward * mc - lateral * ms + wall * c):
+                wall = None
         if wall is not None and (best is None or wall * slant < best):
             return wall * slant, True
         return None if best is None else (best, False)

@@ -21,6 +21,13 @@ from the lifts' actual offsets (encoders), not from the commands; the one
 exception is the differential part of MWR/MWL, which the side view cannot roll:
 it integrates the commanded difference (the wheels spin whether or not the
 robot turns).
+
+Quarter-turn landings (:mod:`stairbot.fakes.landing`): once per advance the
+robot, turned past 45 degrees on the landing, may move to the other flight's
+frame (the side view rebuilt, the bodies shifted along x, the top view
+re-framed: counters and readings carry on); and its footprint is checked
+against the walls and risers that only the top view has (``truth()``'s
+``wall_contact``).  ``truth()`` tells the frame and the pose in flight 1's frame.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ from urllib.parse import urlsplit
 
 from stairbot.config import RobotConfig
 from stairbot.errors import RobotFellError, RobotUrlError
+from stairbot.fakes.landing import FOOTPRINT_MARGIN, Stairwell
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sim_sensors import SimImu, SimSensors
 from stairbot.fakes.world import World, WorldParams
@@ -65,10 +73,15 @@ class SimRobot:
         self.config = config
         self.scenario = scenario
         self.world = World(config, scenario, params)
+        self.well = Stairwell(scenario)
         self.plan = Plan(scenario.width, scenario.side_wall, y=scenario.start.lateral,
-                         yaw=math.radians(scenario.start.yaw_deg))
+                         yaw=math.radians(scenario.start.yaw_deg), x=self.world.centre_x(),
+                         walls=self.well.walls(1))
         self._start_y = self.plan.y
-        self.board = SimSensors(config, scenario, self.world, self.plan)
+        self.board = SimSensors(config, scenario, self.world, self.plan, self.well)
+        self._footprint_width = config.geometry.track_width + FOOTPRINT_MARGIN
+        self.wall_contact: str | None = None
+        """The first contact of the footprint with a wall (see Truth.wall_contact)."""
         self._imu = SimImu(self.world)
         m = config.motors
         self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
@@ -143,13 +156,14 @@ class SimRobot:
 
     def diagnostics(self) -> dict[str, object]:
         """The simulation's pose, for a person reading it (a run's fell, pitch
-        and offset come from :meth:`truth`)."""
+        and offset come from :meth:`truth`): in flight 1's frame."""
         w = self.world
+        x, y, yaw = self.flight1_pose()
         return {
             "sim_time_s": w.time,
-            "yaw_deg": math.degrees(self.plan.yaw),
-            "lateral_m": self.plan.y,
-            "x_m": w.centre_x(),
+            "yaw_deg": math.degrees(yaw),
+            "lateral_m": y,
+            "x_m": x,
             "lift_front_m": w.lift_offset(0),
             "lift_back_m": w.lift_offset(1),
         }
@@ -163,11 +177,16 @@ class SimRobot:
     # -- capabilities: HasTruth, HasScene -------------------------------------------
     def truth(self) -> Truth:
         """Whether the robot fell (and why), its pitch now and the most it
-        pitched, and how far segment 2 is from where it started."""
+        pitched, how far segment 2 is from where it started, how far it stands
+        before the stairs, its first contact with a wall, the frame it is in
+        and its pose in flight 1's frame."""
         w = self.world
+        x, y, yaw = self.flight1_pose()
         return Truth(fell=w.fell, fall_reason=w.fall_reason, pitch_deg=w.pitch_deg(),
                      max_pitch_deg=w.max_pitch_deg, offset_m=self.offset_m(),
-                     clear_of_stairs_m=w.clear_of_stairs_m())
+                     clear_of_stairs_m=self.clear_of_stairs_m(),
+                     wall_contact=self.wall_contact, flight=self.well.flight,
+                     flight1_x_m=x, flight1_y_m=y, flight1_yaw_deg=math.degrees(yaw))
 
     def scene(self) -> Scene:
         """The stairs and the robot's pose, for drawing."""
@@ -216,11 +235,42 @@ class SimRobot:
             turns = lifts[i] / per_turn
             lift_tps[i] = (turns - lift_turns[i]) / elapsed
             lift_turns[i] = turns
+        well = self.well
+        if well.turns and well.switch(w, self.plan):
+            self._apply(self._speeds)  # the share of travel along the new frame's axis
+        if self.wall_contact is None and well.watches():
+            self._watch_walls()
+
+    def _watch_walls(self) -> None:
+        """Record the footprint's first contact with a wall the side view does
+        not hold (fakes/landing.py, Stairwell.contact)."""
+        x, y, yaw = self.flight1_pose()
+        met = self.well.contact(self.world, x, y, yaw, self._footprint_width)
+        if met is not None:
+            segment, what = met
+            self.wall_contact = f"segment {segment + 1} against {what} at {self.world.time:.2f} s"
+
+    def flight1_pose(self) -> tuple[float, float, float]:
+        """Segment 2's centre and the heading (radians) in flight 1's frame."""
+        return self.well.in_flight1(self.world.centre_x(), self.plan.y, self.plan.yaw)
 
     def offset_m(self) -> float:
-        """Top-view distance of segment 2's centre from where it started."""
-        return math.hypot(self.world.centre_x() - self.world.start_x,
-                          self.plan.y - self._start_y)
+        """Top-view distance of segment 2's centre from where it started (in
+        flight 1's frame)."""
+        x, y, _yaw = self.flight1_pose()
+        return math.hypot(x - self.world.start_x, y - self._start_y)
+
+    def clear_of_stairs_m(self) -> float:
+        """How far segment 1's front face stands before riser 1, along flight 1
+        (negative: over the stairs).  In flight 2's frame: segment 2's centre in
+        flight 1's frame plus the front face's distance ahead of it along the
+        robot, as flight 1's side view counts it (continuous across the switch)."""
+        w = self.world
+        clear = w.clear_of_stairs_m()
+        if self.well.flight == 1:
+            return clear
+        ahead = -clear - w.centre_x()
+        return -(self.flight1_pose()[0] + ahead)
 
     # -- internals -------------------------------------------------------------------
     def _apply(self, speeds: dict[MotorId, float]) -> None:

@@ -1,11 +1,20 @@
-"""The simulated robot's sensor board: four distance sensors and the IMU.
+"""The simulated robot's sensor board: four distance sensors (six with the
+side pair) and the IMU.
 
 :class:`SimSensors` reads SFR/SFL (segment 1's front face, looking forward)
 and SBR/SBL (under segment 3, looking down) from the pymunk side view
 (:mod:`stairbot.fakes.world`) and the top view (:mod:`stairbot.fakes.plan`)
 through the sensor models (:mod:`stairbot.fakes.sensor_model`, one preset per
 pair from the config's ``[sensors] front_model`` / ``back_model``; the cones'
-rays are cast by :mod:`stairbot.fakes.beams`).  A reading's ``age_s`` is its
+rays are cast by :mod:`stairbot.fakes.beams`).  A robot with the side pair
+(``[sensors] side_model``) also reads SSR/SSL: one level ray each from
+segment 3 (``side_from_rear`` from its rear, ``side_height`` above its wheels'
+contact line: lifting segment 3 raises them), square to the heading, to the
+right and to the left, cast against the stairwell's faces in flight 1's frame
+(:meth:`stairbot.fakes.landing.Stairwell.side_hit`: side walls, a landing's
+walls, the second flight's risers), through the side model (its noise,
+timing, faults; its incidence and weak-signal limits on the one ray).  A
+reading's ``age_s`` is its
 model's: how long before the read the published measurement was taken (a
 model with a period or a latency); the ``ideal`` preset measures at every
 read, so its readings are 0 s old and shared, not copied.
@@ -22,14 +31,16 @@ import math
 
 from stairbot.config import RobotConfig
 from stairbot.fakes.beams import down_fans, front_hits, total_weight
+from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.plan import Plan
-from stairbot.fakes.sensor_model import ModelSensor, combine
-from stairbot.fakes.sensor_presets import model_for
+from stairbot.fakes.sensor_model import Hit, ModelSensor, combine
+from stairbot.fakes.sensor_presets import model_for, preset
 from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.scenario import Scenario
 
 _SFR, _SFL, _SBR, _SBL = SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL  # bound once
+_SSR, _SSL = SensorId.SSR, SensorId.SSL
 
 IMU_SEGMENT = 1
 """The IMU rides in segment 2 (index 1 in the world)."""
@@ -61,10 +72,12 @@ class SimImu:
 
 
 class SimSensors:
-    """SFR, SFL, SBR and SBL on the simulated robot (see the module docstring)."""
+    """SFR, SFL, SBR and SBL on the simulated robot, and SSR and SSL on one with
+    the side pair (see the module docstring).  ``well``: the stairwell and the
+    frame the world is in (the side pair's, built from ``scenario`` if not given)."""
 
     def __init__(self, config: RobotConfig, scenario: Scenario, world: World,
-                 plan: Plan) -> None:
+                 plan: Plan, well: Stairwell | None = None) -> None:
         self.config = config
         self.world = world
         self.plan = plan
@@ -102,12 +115,62 @@ class SimSensors:
                             s.back_height - r,
                             self.sensors[SensorId.SBR].max_range * 1.05)
         self._front_laterals = (-s.front_lateral, s.front_lateral)  # SFR, SFL
+        self.well = well if well is not None else Stairwell(scenario)
+        self.side_model = preset(s.side_model) if s.has_side_pair else None
+        self._side: tuple[ModelSensor, ModelSensor] | None = None
+        if self.side_model is not None:
+            for sid in (_SSR, _SSL):
+                self.sensors[sid] = ModelSensor(sid, self.side_model, s.side_min_range,
+                                                s.side_max_range, s.resolution, n.noise,
+                                                n.seed, scenario.faults, n.outliers)
+            self._side = (self.sensors[_SSR], self.sensors[_SSL])
+            self._side_mount = (-world.lengths[2] / 2 + s.side_from_rear, s.side_height - r,
+                                self.sensors[_SSR].max_range * 1.05)
 
     def read(self, t: float) -> dict[SensorId, SensorReading]:
         """Every distance sensor's published reading at ``t``, with its age."""
         sfr, sfl = self._front_readings(t)
         sbr, sbl = self._back_readings(t)
-        return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl}
+        if self._side is None:
+            return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl}
+        ssr, ssl = self._side_readings(t, self._side)
+        return {_SFR: sfr, _SFL: sfl, _SBR: sbr, _SBL: sbl, _SSR: ssr, _SSL: ssl}
+
+    def _side_readings(self, t: float, pair: tuple[ModelSensor, ModelSensor]
+                       ) -> tuple[SensorReading, SensorReading]:
+        """What SSR and SSL publish at ``t``: one ray each, cast when a
+        measurement is due."""
+        right, left = pair
+        due_r, due_l = right.due(t), left.due(t)
+        if due_r or due_l:
+            model = self.side_model
+            assert model is not None
+            seen_r, seen_l = self.side_seen()
+            for sensor, due, seen in ((right, due_r, seen_r), (left, due_l, seen_l)):
+                if due:
+                    hits: list[Hit] = [] if seen is None else [(seen[0], seen[1], 1.0)]
+                    sensor.sample(combine(model, hits, 1.0), t)
+        return right.published(t), left.published(t)
+
+    def side_seen(self) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
+        """What SSR's and SSL's beams meet now, before the sensor's model: the
+        distance and the cosine of the incidence, each (None: nothing within
+        reach).  Needs the side pair."""
+        px, py, pa, _turns, _lifts = self.world.state()
+        lx, ly, reach = self._side_mount
+        a3 = pa[2]
+        c, s = math.cos(a3), math.sin(a3)
+        mx, z = px[2] + c * lx - s * ly, py[2] + s * lx + c * ly
+        well, plan = self.well, self.plan
+        x, y, yaw = well.in_flight1(px[1], plan.y, plan.yaw)
+        # the pair's point on the centre line, `behind` along the robot from segment 2's centre
+        behind = mx - px[1]
+        cy, sy = math.cos(yaw), math.sin(yaw)
+        bx, by = x + behind * cy, y + behind * sy
+        lat = self.config.sensors.side_lateral
+        right = well.side_hit(bx + lat * sy, by - lat * cy, z, sy, -cy, reach)
+        left = well.side_hit(bx - lat * sy, by + lat * cy, z, -sy, cy, reach)
+        return right, left
 
     def _front_readings(self, t: float) -> tuple[SensorReading, SensorReading]:
         """What SFR and SFL publish at ``t``: one ray each for a single-ray model,

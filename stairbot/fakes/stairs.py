@@ -5,6 +5,10 @@ back.  Each step rises by its ``rise`` and runs its ``tread``.  After the last
 riser the top is a ``LANDING`` metres long flat landing with nothing beyond
 (``top = "landing"``) or, at the end of the last tread, a wall
 ``WALL_HEIGHT`` high (``top = "wall"``).  No steps: open floor far ahead.
+With a quarter-turn landing (``scenario.landing``) the top is that landing,
+``depth`` long from the last riser, and its far wall, ``WALL_HEIGHT`` high:
+the side view of flight 1's frame (:mod:`stairbot.fakes.landing` has the
+rest of the stairwell, and flight 2's frame).
 
 The distance sensors cast their rays here rather than through pymunk's query
 API: the outline is monotonic in x, so a ray meets its first surface among the
@@ -38,9 +42,16 @@ def stairs_outline(scenario: Scenario) -> list[Point]:
     x = y = 0.0
     pts.append((x, y))
     last = len(scenario.steps) - 1
+    landing = scenario.landing
     for i, step in enumerate(scenario.steps):
         y += step.rise
         pts.append((x, y))
+        if i == last and landing is not None:
+            # a quarter-turn landing: its far wall stands ``depth`` past the top edge
+            # (the second flight leaves it sideways: fakes/landing.py)
+            pts.append((x + landing.depth, y))
+            pts.append((x + landing.depth, y + WALL_HEIGHT))
+            break
         x += step.tread
         if i == last:
             if scenario.top == "wall":

@@ -73,13 +73,8 @@ class World:
         space.collision_slop = p.collision_slop
         self.time = 0.0
         self._steps_done = 0
-        self.outline = stairs_outline(scenario)
-        self.profile = StairsProfile(self.outline, p.stairs_radius)
-        for a, b in zip(self.outline, self.outline[1:], strict=False):
-            seg = pymunk.Segment(space.static_body, a, b, p.stairs_radius)
-            seg.friction = p.stairs_friction
-            seg.filter = pymunk.ShapeFilter(categories=CAT_STAIRS)
-            space.add(seg)
+        self._stairs: list[pymunk.Segment] = []
+        self.set_stairs(stairs_outline(scenario))
 
         self.lengths = (g.LENGTH_OF_FIRST_MODULE, g.LENGTH_OF_SECOND_MODULE,
                         g.LENGTH_OF_THIRD_MODULE)
@@ -178,6 +173,31 @@ class World:
         self._fetch()
         self._check_y, self._check_t = list(self._py), 0.0
         self.start_x = self._px[1]
+
+    # -- the stairs, and a change of frame ---------------------------------------------
+    def set_stairs(self, outline: list[tuple[float, float]]) -> None:
+        """Make ``outline`` the stairs: the static segments the wheels roll on,
+        ``outline`` and ``profile`` (the sensors' rays).  Between steps only."""
+        p = self.params
+        if self._stairs:
+            self.space.remove(*self._stairs)
+        self.outline = outline
+        self.profile = StairsProfile(outline, p.stairs_radius)
+        self._stairs = []
+        for a, b in zip(outline, outline[1:], strict=False):
+            seg = pymunk.Segment(self.space.static_body, a, b, p.stairs_radius)
+            seg.friction = p.stairs_friction
+            seg.filter = pymunk.ShapeFilter(categories=CAT_STAIRS)
+            self._stairs.append(seg)
+        self.space.add(*self._stairs)
+
+    def shift(self, dx: float) -> None:
+        """Move every body of the robot ``dx`` along x, velocities, angles and
+        joints as they are (a change of frame: fakes/landing.py).  Between steps only."""
+        for body in (*self.segments, *self.all_wheels):
+            x, y = body.position
+            body.position = (x + dx, y)
+        self._pose_at = -1
 
     # -- actuators ------------------------------------------------------------------
     def set_wheel_speed(self, segment: int, turns_per_s: float) -> None:
@@ -436,6 +456,11 @@ class World:
                 if self.ray((c.x + dx * 0.7, c.y), (c.x + dx * 0.7, c.y - r - clearance)):
                     return False
         return True
+
+    def underside(self, segment: int) -> float:
+        """Height of a segment's lowest point: the bottom of its lower wheel."""
+        rear, front = self.wheels[segment]
+        return min(rear.position.y, front.position.y) - self.radius
 
     def segment_corners(self, segment: int) -> list[tuple[float, float]]:
         """The segment chassis' outline in world metres (a closed polygon, CCW)."""

@@ -165,9 +165,10 @@ def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Pat
 
 
 @pytest.mark.parametrize(("text", "words"), [
-    ('extends = "lidar-bot"\n',
-     "no such file, nor a shipped robot; shipped: heavy_middle, ideal, ir, reference, sonar"),
-    ("extends = 3\n", "must be a shipped robot's name (heavy_middle, ideal, ir, reference, sonar)"),
+    ('extends = "lidar-bot"\n', "no such file, nor a shipped robot; shipped: "
+     "heavy_middle, ideal, ir, landings, reference, sonar"),
+    ("extends = 3\n", "must be a shipped robot's name "
+     "(heavy_middle, ideal, ir, landings, reference, sonar)"),
     ('extends = "loop.toml"\n', "extends itself"),
 ])
 def test_bad_extends_is_one_clear_error(tmp_path: Path, text: str, words: str) -> None:
