@@ -234,9 +234,8 @@ class StairbotConsole(App[None]):
         picture = self.picture
         age = v.read_age_s
         # never markup: the URL may hold brackets; with a landing, the frame it is in
-        on_landing = v.plan is not None and v.plan.landing and v.top is not None
-        title = Text(f"side view, flight {v.top.flight} · " if on_landing and v.top
-                     else "side view · ")
+        framed = v.top.flight if v.top is not None and v.plan and v.plan.landing else None
+        title = Text("side view · " if framed is None else f"side view, flight {framed} · ")
         title.append(age_words(age), "bold red" if is_stale(age) else "dim")
         title.append(f" · {v.url} · {v.scenario}")
         picture.border_title = title
@@ -293,10 +292,12 @@ class StairbotConsole(App[None]):
         top.border_title = title
         top.set_class(stale, "-stale")
         top.show(None if note else v.plan, None if note else v.top, self._shape, note, stale)
-        contact = v.top.wall_contact if v.top is not None else None
+        if v.top is None:
+            return
+        contact = v.top.wall_contact
         if contact and contact != self._contact_said:
             self.say(f"wall contact: {contact} (t: the top view)", "warning", timeout=10)
-        self._contact_said = contact
+        self._contact_said = contact  # a new robot's pose has none: the next is told
 
     # -- workers -------------------------------------------------------------------
     @work(thread=True, group="robot", exclusive=True, exit_on_error=False)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -18,10 +19,14 @@ from stairbot.config import load_config
 from stairbot.console.app import COMMANDS, StairbotConsole, build_app
 from stairbot.console.help import HELP, WIDTH
 from stairbot.console.replay_app import REPLAY_HELP, ReplayConsole
+from stairbot.console.state import LiveState
+from stairbot.console.watch import watch
 from stairbot.console.widgets.top_view import CONTACT_LINE_STYLE
 from stairbot.errors import LinkLostError
 from stairbot.hardware import Snapshot, Truth
 from stairbot.robots import RobotSession
+from stairbot.scenario import load_scenario
+from stairbot.top_view import TopPose, plan_of
 
 BRAILLE = {chr(c) for c in range(0x2801, 0x2900)}
 README = Path(__file__).parents[2] / "stairbot" / "console" / "README.md"
@@ -189,3 +194,29 @@ def test_a_pose_no_longer_taken_is_shown_stale() -> None:
             assert "STALE 5.0 s" in title(app.top_view)
             assert caption(app).startswith("STALE ")
     asyncio.run(go())
+
+
+def test_the_pose_keeps_its_own_age_and_a_pose_that_fails_is_dropped() -> None:
+    wall = [10.0]
+    state = LiveState(wall=lambda: wall[0])
+    plan = plan_of(load_scenario("landing_left"))
+    state.set_robot("sim://", "landing_left", True, plan=plan)
+    assert state.view().plan is plan and state.view().top is None
+    state.on_top(TopPose(0.1, 0.0, 0.0))
+    wall[0] += 2.0
+    v = state.view()
+    assert v.top == TopPose(0.1, 0.0, 0.0) and v.top_age_s == 2.0
+    state.set_robot("sim://", "default", True)  # another robot: nothing of the last
+    assert state.view().plan is None and state.view().top is None
+
+    state.set_robot("sim://", "landing_left", True, plan=plan)
+    state.on_top(TopPose(0.1, 0.0, 0.0))
+
+    def broken() -> TopPose | None:
+        raise RuntimeError("no truth today")
+
+    robot = watch(StillRobot(), state, threading.RLock(), top=broken)  # type: ignore[arg-type]
+    robot.read()
+    v = state.view()
+    assert v.top is None and v.top_age_s is None  # never the last pose as live
+    assert "no top view: no truth today" in v.status.message

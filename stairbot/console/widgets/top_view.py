@@ -166,7 +166,7 @@ class TopViewPicture(Widget):
         if self._stale:
             out.append("STALE ", "bold red")
         if pose is None:
-            out.append("no pose yet", "italic")
+            out.append("no pose", "italic")
         else:
             out.append(f"x {pose.x:+.2f} y {pose.y:+.2f} m  yaw {pose.yaw_deg:+.0f}°")
             out.append(f"  flight {pose.flight}", "bold" if pose.flight != 1 else "")
