@@ -51,11 +51,13 @@ from stairbot.console.widgets.motors import MotorPanel
 from stairbot.console.widgets.phase import PhasePanel
 from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
+from stairbot.console.widgets.top_view import TopViewPicture
 from stairbot.console.widgets.trends import TrendsPanel
 from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 from stairbot.reckon import dead_reckon
+from stairbot.top_view import RobotShape
 
 REFRESH_HZ = 10.0
 GRAPHS_ROWS = 36
@@ -80,6 +82,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
                                 "the events as JSON lines (key: w)"),
     ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+    ("top_view", "Top view / side view", "The stairwell and the robot seen from above, or "
+                                         "the side view again (key: t)"),
     ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
     ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
@@ -109,6 +113,7 @@ class StairbotConsole(App[None]):
         Binding("r", "reset", "reset", show=False),
         Binding("w", "record", "rec", show=False),
         Binding("z", "zoom", "zoom", show=False),
+        Binding("t", "top_view", "top view", show=False),
         Binding("g", "graphs", "graphs", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
@@ -130,6 +135,11 @@ class StairbotConsole(App[None]):
         # screen is on top (app.query_one looks only at the top screen).
         self.banner = Banner(id="banner")  # the line that says how things stand
         self.picture = StairsPicture(id="picture")
+        self.top_view = TopViewPicture(id="topview")
+        self.top_shown = False
+        """The picture shows the top view (t), not the side view."""
+        self._shape = RobotShape.of(engine.config)
+        self._contact_said: str | None = None  # the wall contact told the operator
         side_pair = engine.config.sensors.has_side_pair
         self.sensors = SensorPanel(engine.config.algorithm.equal_tolerance, side_pair=side_pair,
                                    id="sensors")
@@ -151,6 +161,7 @@ class StairbotConsole(App[None]):
         with Horizontal(id="main"):
             with Vertical(id="left"):
                 yield self.picture
+                yield self.top_view
                 yield self.trends
                 yield self.log_panel
             with Vertical(id="right"):
@@ -182,7 +193,9 @@ class StairbotConsole(App[None]):
         self._rows = rows if rows is not None else self.size.height
         wanted = tall if self.graphs is None else self.graphs
         self.trends.display = wanted
-        self.picture.display = tall or not wanted
+        picture = tall or not wanted
+        self.picture.display = picture and not self.top_shown
+        self.top_view.display = picture and self.top_shown
         if wanted:
             self._shown_key = None  # draw them now
 
@@ -210,7 +223,7 @@ class StairbotConsole(App[None]):
         """Copy the live state and update every panel that changed (the ages
         of the values shown change with the wall clock alone)."""
         view = self.state.view(events_after=self._shown_event)
-        key = (view.version, age_key(view.read_age_s))
+        key = (view.version, age_key(view.read_age_s), age_key(view.top_age_s))
         if key == self._shown_key:
             return
         self._shown_key = key
@@ -220,7 +233,9 @@ class StairbotConsole(App[None]):
         self.banner.show(v.url, v.scenario, v.status, v.recording)
         picture = self.picture
         age = v.read_age_s
-        title = Text("side view · ")  # never markup: the URL may hold brackets
+        # never markup: the URL may hold brackets; with a landing, the frame it is in
+        framed = v.top.flight if v.top is not None and v.plan and v.plan.landing else None
+        title = Text("side view · " if framed is None else f"side view, flight {framed} · ")
         title.append(age_words(age), "bold red" if is_stale(age) else "dim")
         title.append(f" · {v.url} · {v.scenario}")
         picture.border_title = title
@@ -239,6 +254,7 @@ class StairbotConsole(App[None]):
             else:
                 note = "no pose from a wired robot"
         picture.show(scene, v.stairs, lifts, note)
+        self._show_top(v)
         running = v.status.robot in ("running", "replay")  # a replay: the recorded phase
         self.sensors.show(snap, age)
         self.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
@@ -251,6 +267,37 @@ class StairbotConsole(App[None]):
             log = self.log_panel
             log.add(v.events)
             self._shown_event = log.last_seq
+
+    def top_note(self, v: StateView) -> str:
+        """Why the top view has nothing to draw ("": it has)."""
+        if v.wired:
+            return "no top view: a robot on a wire tells no pose seen from above"
+        if v.plan is None:
+            if v.status.robot in ("no robot", "connecting"):
+                return "no robot open"
+            return "no top view: this robot tells no pose seen from above"
+        return ""
+
+    def _show_top(self, v: StateView) -> None:
+        """The top view, and a wall contact told once in the event list (the
+        side view cannot show it)."""
+        top, age, note = self.top_view, v.top_age_s, self.top_note(v)
+        stale = not note and is_stale(age)
+        title = Text("top view · ")
+        if note:
+            title.append("none", "dim")
+        else:
+            title.append(age_words(age), "bold red" if stale else "dim")
+        title.append(f" · {v.url} · {v.scenario}")
+        top.border_title = title
+        top.set_class(stale, "-stale")
+        top.show(None if note else v.plan, None if note else v.top, self._shape, note, stale)
+        if v.top is None:
+            return
+        contact = v.top.wall_contact
+        if contact and contact != self._contact_said:
+            self.say(f"wall contact: {contact} (t: the top view)", "warning", timeout=10)
+        self._contact_said = contact  # a new robot's pose has none: the next is told
 
     # -- workers -------------------------------------------------------------------
     @work(thread=True, group="robot", exclusive=True, exit_on_error=False)
@@ -546,9 +593,27 @@ class StairbotConsole(App[None]):
         self.refresh_view()
 
     def action_zoom(self) -> None:
+        if self.top_shown:
+            mode = self.top_view.cycle_zoom()
+            names = {"auto": "auto zoom", "flight": "the whole stairwell",
+                     "robot": "following the robot"}
+            self.say(f"top view: {names[mode]}", keep=False)
+            return
         mode = self.picture.cycle_zoom()
         names = {"auto": "auto zoom", "flight": "whole flight", "robot": "following the robot"}
         self.say(f"picture: {names[mode]}", keep=False)
+
+    def action_top_view(self) -> None:
+        """The picture between the side view and the top view; on a small screen
+        it also comes back in the graphs' place."""
+        self.top_shown = not self.top_shown
+        if not self._tall(self._rows) and self.graphs:
+            self.graphs = False
+        self.lay_out_graphs(self._rows)
+        self.say("picture: top view (t: the side view)" if self.top_shown
+                 else "picture: side view (t: the top view)", keep=False)
+        self._shown_key = None
+        self.refresh_view()
 
     def get_system_commands(self, screen: Screen) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)

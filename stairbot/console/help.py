@@ -28,6 +28,8 @@ KEYS
   f       simulation speed        r  reset the simulation
   w       record events to a file (never over an existing one)
   z       picture zoom            ?  this help
+  t       top view: the stairwell and the robot seen from above,
+          in the side view's place (t again: the side view)
   g       graphs: pitch, distance sensors, lifts over the last
           30 s of robot time (36 rows or more: under the
           picture; fewer: in its place until g again)
@@ -50,6 +52,12 @@ READING THE SCREEN
   going, a lift's arrow is its end segment against segment 2.
   Phase: what the robot is doing, the seed's name for it
   beneath.
+  Top view (t): flight 1 runs right as in the side view, its
+  left side up; risers grey, walls white, a landing's second
+  flight beyond it; the robot's footprint (segments coloured as
+  in the picture), a white tick at its nose.  A wall contact is
+  red, under it and on the wall: the simulation lets the robot
+  through a wall the side view does not hold.  Simulation only.
   Graphs: each line scaled to its own range, written after it;
   they stop when the readings stop, and dim with them when
   STALE.

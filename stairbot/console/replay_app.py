@@ -30,6 +30,7 @@ from stairbot.console.app import REFRESH_HZ, StairbotConsole
 from stairbot.console.help import HelpScreen
 from stairbot.console.replay import ReplayPlayer, speed_name
 from stairbot.console.runner_thread import ConsoleEngine
+from stairbot.console.state import StateView
 from stairbot.console.widgets.estop import ESTOP_KEY
 from stairbot.recording.replay_source import ReplaySource
 
@@ -56,6 +57,8 @@ KEYS
   Home End  the start / the end
   g         graphs (pitch, distance sensors, lifts; last 30 s)
   z         picture zoom
+  t         top view: a recording holds no pose seen from
+            above, so it says so (t again: the side view)
   q         quit (also Ctrl+Q, Ctrl-C)
   ?         this help          Ctrl+P  every action by name
   space     a live console's EMERGENCY STOP: here it says
@@ -99,6 +102,7 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
         Binding("question_mark", "help", "help", key_display="?"),
         Binding("g", "graphs", "graphs", show=False),
         Binding("z", "zoom", "zoom", show=False),
+        Binding("t", "top_view", "top view", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "quit", show=False, priority=True),
         *(Binding(key, f"no_robot('{key}')", NO_ROBOT, show=False) for key in KEY_WORDS),
@@ -111,6 +115,7 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
         ("seek_to('end')", "To the end", "On to the recording's end (key: End)"),
         ("graphs", "Graphs", "Pitch, distance sensors and lifts over 30 s (key: g)"),
         ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+        ("top_view", "Top view / side view", "The top view: not in a recording (key: t)"),
         ("help", "Help", "Every key, and how to read the screen (key: ?)"),
     )
 
@@ -127,6 +132,13 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
         if self.player.source.kind == "jsonl":
             return "no picture: a JSON-lines record holds events alone"
         return "no pose recorded yet" if self.player.source.ticks else "no pose recorded"
+
+    def top_note(self, v: StateView) -> str:
+        # What is recorded is the side view's pose, in the frame the simulation
+        # was in (a landing's second flight switches it) and without the frame:
+        # drawn in flight 1's frame it could be wrong, so it is not drawn.
+        return ("no top view: a recording holds no pose seen from above (in flight 1's "
+                "frame)")
 
     def begin(self) -> None:
         """Once mounted: play, drawing ten times a second.  No robot is opened

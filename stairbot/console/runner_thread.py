@@ -27,7 +27,7 @@ from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
-from stairbot.hardware import HasScene, ReportsEvents, Snapshot
+from stairbot.hardware import HasScene, HasTruth, ReportsEvents, Snapshot
 from stairbot.journal import JournalWriter
 from stairbot.paths import unused_path
 from stairbot.recording.record import JsonLinesRecord, RecordsTicks, is_mcap
@@ -36,6 +36,7 @@ from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
 from stairbot.scenario import Scenario, load_scenario
 from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
+from stairbot.top_view import TopPlan, TopPose, plan_of, top_pose
 
 if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
     from stairbot.recording.mcap_sink import McapRecord
@@ -219,15 +220,25 @@ class ConsoleEngine:
         if isinstance(sim, HasScene):
             def scene_fn() -> SceneView:
                 return scene_view(sim.scene())
+        # the top view: a simulation that tells its truth tells its pose seen from above
+        top_fn: Callable[[], TopPose | None] | None = None
+        plan: TopPlan | None = None
+        if isinstance(sim, HasTruth):
+            truthful = sim  # bound for the closure, narrowed
+
+            def top_fn() -> TopPose | None:
+                return top_pose(truthful.truth())
+            plan = plan_of(scenario)
         if isinstance(session.robot, ReportsEvents):  # LINK events: the log and the record
             session.robot.attach_sink(self._sink)
-        self.robot = watch(session.robot, self.state, self._lock, scene_fn, self._wall)
+        self.robot = watch(session.robot, self.state, self._lock, scene_fn, self._wall, top_fn)
         if self.latched:  # the latch outlives the robot it was pressed on
             self.robot.estop()
         self.clock = PacedClock(session.clock, self._lock, self._wall, self._sleep)
         self.clock.set_scale(SPEEDS[self._speed] if sim is not None else None)
         stairs = stairs_from_scenario(scenario, self.config.LENGTH_OF_A_ROBOT)
-        self.state.set_robot(url, scenario.name, session.simulated, stairs, wired=sim is None)
+        self.state.set_robot(url, scenario.name, session.simulated, stairs, wired=sim is None,
+                             plan=plan)
         self._recording_safely(self._watch_recording)
         try:
             self.robot.read()  # first readings and picture, before any motion

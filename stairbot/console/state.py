@@ -18,6 +18,7 @@ from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, Snapshot
 from stairbot.runner import RunResult
 from stairbot.side_view import SceneView
+from stairbot.top_view import TopPlan, TopPose
 
 LOG_LENGTH = 1000
 NOTE_KINDS = {"information": EventKind.INFO, "warning": EventKind.WARNING,
@@ -64,6 +65,13 @@ class StateView:
     events: tuple[tuple[int, Event], ...] = field(default=())
     history: tuple[Row, ...] = field(default=())
     """The last readings by robot time, for the graphs (console/history.py)."""
+    plan: TopPlan | None = None
+    """The stairwell seen from above, for the top view; None: this robot tells
+    no pose seen from above (a robot on a wire, a replay)."""
+    top: TopPose | None = None
+    """The robot seen from above, as last taken (None: none yet)."""
+    top_age_s: float | None = None
+    """Wall seconds since ``top`` was taken (None: never)."""
 
 
 class LiveState:
@@ -90,6 +98,9 @@ class LiveState:
         self._flow = "idle"
         self._context: dict[str, Any] = {}
         self._scene: SceneView | None = None
+        self._plan: TopPlan | None = None
+        self._top: TopPose | None = None
+        self._top_at: float | None = None
         self._stairs: tuple[tuple[float, float], ...] = ()
         self._health: dict[str, float] = {}
         self._result: RunResult | None = None
@@ -104,9 +115,12 @@ class LiveState:
         self._version += 1
 
     def set_robot(self, url: str, scenario: str, simulated: bool,
-                  stairs: tuple[tuple[float, float], ...] = (), wired: bool = False) -> None:
-        """A new robot was opened: forget the previous one's readings."""
+                  stairs: tuple[tuple[float, float], ...] = (), wired: bool = False,
+                  plan: TopPlan | None = None) -> None:
+        """A new robot was opened: forget the previous one's readings.  ``plan``:
+        its stairwell seen from above, when it tells its pose seen from above."""
         with self._lock:
+            self._plan, self._top, self._top_at = plan, None, None
             self._url, self._scenario, self._simulated = url, scenario, simulated
             self._wired = wired
             self._snapshot, self._commands, self._ticks = None, {}, 0
@@ -167,6 +181,14 @@ class LiveState:
     def on_scene(self, scene: SceneView) -> None:
         with self._lock:
             self._scene = scene
+            self._bump()
+
+    def on_top(self, pose: TopPose | None, at: float | None = None) -> None:
+        """The robot seen from above, taken ``at`` on the ages' clock (None: now);
+        ``pose`` None: it can no longer be taken (the view shows none)."""
+        with self._lock:
+            self._top = pose
+            self._top_at = None if pose is None else (self._wall() if at is None else at)
             self._bump()
 
     def on_event(self, event: Event) -> None:
@@ -240,4 +262,7 @@ class LiveState:
                 recording=self._recording,
                 events=tuple(e for e in self._events if e[0] > events_after),
                 history=self._history.rows(),
+                plan=self._plan,
+                top=self._top,
+                top_age_s=None if self._top_at is None else self._wall() - self._top_at,
             )

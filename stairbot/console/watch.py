@@ -15,6 +15,7 @@ from typing import Protocol
 from stairbot.console.state import LiveState
 from stairbot.hardware import ZERO_SPEEDS, Clock, HasTruth, Robot, Snapshot, Speeds, Truth
 from stairbot.side_view import SceneView
+from stairbot.top_view import TopPose
 
 SCENE_PERIOD_S = 0.04  # wall seconds between pictures taken from the simulation
 
@@ -26,11 +27,13 @@ class WatchedRobot:
 
     def __init__(self, inner: Robot, state: LiveState, lock: threading.RLock,
                  scene: Callable[[], SceneView] | None = None,
-                 wall: Callable[[], float] = time.monotonic) -> None:
+                 wall: Callable[[], float] = time.monotonic,
+                 top: Callable[[], TopPose | None] | None = None) -> None:
         self.inner = inner
         self._state = state
         self._lock = lock
         self._scene = scene
+        self._top = top
         self._wall = wall
         self._last_scene = -1.0
         self._estop = threading.Event()
@@ -56,16 +59,25 @@ class WatchedRobot:
 
     def _maybe_scene(self, force: bool = False) -> None:
         now = self._wall()
-        if self._scene is None or (not force and now - self._last_scene < SCENE_PERIOD_S):
+        if ((self._scene is None and self._top is None)
+                or (not force and now - self._last_scene < SCENE_PERIOD_S)):
             return
         self._last_scene = now
-        try:
-            scene = self._scene()
-        except Exception as exc:  # noqa: BLE001 - a picture must never stop the robot
-            self._scene = None
-            self._state.set_status(message=f"no picture: {exc}", severity="warning")
-            return
-        self._state.on_scene(scene)
+        if self._scene is not None:
+            try:
+                scene = self._scene()
+            except Exception as exc:  # noqa: BLE001 - a picture must never stop the robot
+                self._scene = None
+                self._state.set_status(message=f"no picture: {exc}", severity="warning")
+            else:
+                self._state.on_scene(scene)
+        if self._top is not None:
+            try:
+                pose = self._top()
+            except Exception as exc:  # noqa: BLE001 - nor must the top view
+                self._top, pose = None, None
+                self._state.set_status(message=f"no top view: {exc}", severity="warning")
+            self._state.on_top(pose)  # None: no pose to show, never the last one as live
 
     def refresh_scene(self) -> None:
         """Take a picture now (under the lock)."""
@@ -166,10 +178,13 @@ class WatchedTruthRobot(WatchedRobot):
 
 def watch(inner: Robot, state: LiveState, lock: threading.RLock,
           scene: Callable[[], SceneView] | None = None,
-          wall: Callable[[], float] = time.monotonic) -> WatchedRobot:
-    """The robot watched, with the capabilities it has (truth passes through)."""
+          wall: Callable[[], float] = time.monotonic,
+          top: Callable[[], TopPose | None] | None = None) -> WatchedRobot:
+    """The robot watched, with the capabilities it has (truth passes through);
+    ``scene`` and ``top`` take the side view and the pose seen from above
+    after a read (at most every SCENE_PERIOD_S of wall time)."""
     cls = WatchedTruthRobot if isinstance(inner, HasTruth) else WatchedRobot
-    return cls(inner, state, lock, scene, wall)
+    return cls(inner, state, lock, scene, wall, top)
 
 
 class PacedClock:

@@ -244,6 +244,20 @@ def test_seek_keys_go_to_the_right_time_and_back_replays_the_events(
     run(go)
 
 
+def test_t_in_a_replay_shows_no_top_view_and_says_why(recorded: dict[str, Path]) -> None:
+    """The recording holds the side view's pose in the frame the simulation was
+    in, not which frame: nothing is drawn from above rather than something wrong."""
+    async def go() -> None:
+        app = replay_app(recorded["mcap"], Clock(), playing=False)
+        async with app.run_test(size=(80, 24)) as pilot:
+            await press(pilot, "right", "t")
+            assert app.top_view.display and not app.picture.display
+            text = app.top_view.render().plain
+            assert not any(0x2800 < ord(ch) < 0x2900 for ch in text)
+            assert "a recording holds no pose seen from above" in " ".join(text.split())
+    run(go)
+
+
 def test_graphs_in_a_replay_draw_the_recorded_window(recorded: dict[str, Path]) -> None:
     sensors = messages(recorded["mcap"], topics.SENSORS)
 
