@@ -79,7 +79,7 @@ class SimRobot:
                          walls=self.well.walls(1))
         self._start_y = self.plan.y
         self.board = SimSensors(config, scenario, self.world, self.plan, self.well)
-        self._footprint_width = config.geometry.track_width + FOOTPRINT_MARGIN
+        self.well.footprint(self.world.lengths, config.geometry.track_width + FOOTPRINT_MARGIN)
         self.wall_contact: str | None = None
         """The first contact of the footprint with a wall (see Truth.wall_contact)."""
         self._imu = SimImu(self.world)
@@ -245,7 +245,7 @@ class SimRobot:
         """Record the footprint's first contact with a wall the side view does
         not hold (fakes/landing.py, Stairwell.contact)."""
         x, y, yaw = self.flight1_pose()
-        met = self.well.contact(self.world, x, y, yaw, self._footprint_width)
+        met = self.well.contact(self.world, x, y, yaw)
         if met is not None:
             segment, what = met
             self.wall_contact = f"segment {segment + 1} against {what} at {self.world.time:.2f} s"
