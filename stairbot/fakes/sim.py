@@ -25,9 +25,9 @@ robot turns).
 Quarter-turn landings (:mod:`stairbot.fakes.landing`): once per advance the
 robot, turned past 45 degrees on the landing, may move to the other flight's
 frame (the side view rebuilt, the bodies shifted along x, the top view
-re-framed: counters and readings carry on); and its footprint is checked
-against the walls and risers that only the top view has (``truth()``'s
-``wall_contact``).  ``truth()`` tells the frame and the pose in flight 1's frame.
+re-framed: counters and readings carry on); and its footprint seen from
+above is checked against the walls and the second flight's risers, which the
+side view's physics does not stop it at (``truth()``'s ``wall_contact``).  ``truth()`` tells the frame and the pose in flight 1's frame.
 """
 
 from __future__ import annotations
@@ -242,8 +242,8 @@ class SimRobot:
             self._watch_walls()
 
     def _watch_walls(self) -> None:
-        """Record the footprint's first contact with a wall the side view does
-        not hold (fakes/landing.py, Stairwell.contact)."""
+        """Record the footprint's first contact with a wall or a riser of a
+        landing's second flight (fakes/landing.py, Stairwell.contact)."""
         x, y, yaw = self.flight1_pose()
         met = self.well.contact(self.world, x, y, yaw)
         if met is not None:
