@@ -27,7 +27,8 @@ robot, turned past 45 degrees on the landing, may move to the other flight's
 frame (the side view rebuilt, the bodies shifted along x, the top view
 re-framed: counters and readings carry on); and its footprint seen from
 above is checked against the walls and the second flight's risers, which the
-side view's physics does not stop it at (``truth()``'s ``wall_contact``).  ``truth()`` tells the frame and the pose in flight 1's frame.
+side view's physics does not stop it at (``truth()``'s ``wall_contact``).
+``truth()`` tells the frame and the pose in flight 1's frame.
 """
 
 from __future__ import annotations
