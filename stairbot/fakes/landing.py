@@ -261,10 +261,17 @@ class Stairwell:
             return None
         front, rear, hw, mid_front, mid_rear = self._footprint
         c, s = math.cos(yaw), math.sin(yaw)
+        # the footprint's box seen from above: a face outside it is not met
+        fc, rc, fs, rs = front * c, rear * c, front * s, rear * s
+        wx, wy = hw * abs(s), hw * abs(c)
+        x_lo, x_hi = x + min(fc, rc) - wx, x + max(fc, rc) + wx
+        y_lo, y_hi = y + min(fs, rs) - wy, y + max(fs, rs) + wy
         # each segment's stretch along the robot, front to back
         stretches = ((mid_front, front), (mid_rear, mid_front), (rear, mid_rear))
         undersides: list[float | None] = [None, None, None]
         for face, ax, bx, ay, by in self._watched:
+            if bx < x_lo or ax > x_hi or by < y_lo or ay > y_hi:
+                continue
             # the face's ends in the robot's frame (u along it, v to its left)
             u0, v0 = (ax - x) * c + (ay - y) * s, -(ax - x) * s + (ay - y) * c
             u1, v1 = (bx - x) * c + (by - y) * s, -(bx - x) * s + (by - y) * c
