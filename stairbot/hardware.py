@@ -194,11 +194,14 @@ class Truth:
     over the stairs): a descent from the top has reached the floor."""
     wall_contact: str | None = None
     """The first time the robot's footprint seen from above (its three segments
-    end to end, ``track_width`` + 2 cm wide) overlapped a wall, or a riser
-    standing higher than the segment's underside, that the side view does not
-    hold (side walls; a quarter-turn landing's walls and second flight): which
-    segment, what and when.  None: never, or a robot that cannot tell.  The
-    simulation lets the robot through; a sweep should judge it unsafe."""
+    end to end, ``track_width`` + 2 cm wide) reached more than 3 mm into a wall
+    (side walls, a wall at the top, a quarter-turn landing's walls) or into a
+    riser of a landing's second flight standing higher than the segment's
+    underside there: which segment, what and when, e.g. "segment 1 against the
+    landing's far wall at 212.40 s".  None: never, or a robot that cannot tell.
+    The simulation's physics holds only the robot's centre line against the
+    stairs of its side view, so it lets the robot through; a sweep should judge
+    a contact unsafe."""
     flight: int = 1
     """The flight whose frame the side view (``Scene``) is in: 1, or 2 while the
     robot stands turned more than 45 degrees towards a quarter-turn landing's

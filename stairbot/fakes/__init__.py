@@ -42,9 +42,10 @@ What is modelled and what is not:
 * segment 2's right and left wheels share one side-view wheel pair running at
   their mean; their difference turns the robot about segment 2's centre, and
   only while segments 1 and 3 are lifted clear of the ground;
-* side walls bound the beams, not the robot's body: a footprint check
-  records the first time the body reaches into a wall, or a riser the side
-  view does not hold (``Truth.wall_contact``), and lets it through;
+* side walls bound the beams, not the robot's body, and the side view's
+  physics holds only the robot's centre line: a footprint check seen from
+  above records the first time the body reaches into a wall, or into a riser
+  of a landing's second flight (``Truth.wall_contact``), and lets it through;
 * on a quarter-turn landing the side view is flight 1's until the robot has
   turned past 45 degrees towards the second flight, then flight 2's
   (:mod:`~stairbot.fakes.landing`);

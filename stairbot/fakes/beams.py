@@ -93,10 +93,11 @@ def _front_walls(plan: Plan, side_view: list[tuple[float | None, float, float, f
     stands (``xs``: the mounts' top-view x)."""
     half, left_wall, right_wall = plan.width / 2, plan.left_wall, plan.right_wall
     wall_at, (left_all, right_all) = plan.wall_at, plan.whole_length()
+    placed = [(hits, y_m, side, x_m) for (hits, y_m, side), x_m in zip(mounts, xs, strict=True)]
     for i_up, i_across, weight in rays:
         hit_dx, c, s, nx, ny, slant = side_view[i_up]
         cos_psi, sin_psi = turned[i_across]
-        for (hits, y_m, side), x_m in zip(mounts, xs, strict=True):
+        for hits, y_m, side, x_m in placed:
             best: float | None = None
             if hit_dx is not None and cos_psi > 1e-9:
                 dx = hit_dx + ahead + side

@@ -42,7 +42,7 @@ down flight 2) switches back.  A landing without a second flight never
 switches.
 
 The footprint check (:meth:`Stairwell.contact`) watches every wall and
-flight 2's risers, in either frame: a segment of the footprint seen from
+flight 2's risers (but see below): a segment of the footprint seen from
 above reaching more than ``CONTACT_DEPTH`` into one that stands higher than
 the segment's underside (its wheels' lowest point) is a contact.  The side
 view stops the robot's centre line at the faces it holds, not its corners
@@ -136,6 +136,8 @@ class Stairwell:
                          if f.across == "y"]
         # the faces the footprint check watches, with their extent seen from above
         self._watched = tuple((f, *_box(f)) for f in self.faces if f.kind != "riser")
+        self._footprint = (0.0, 0.0, 0.0, 0.0, 0.0)  # see footprint()
+        self._near: tuple[tuple[float, float, float, float], ...] = ()
 
     # -- frames -----------------------------------------------------------------------
     def in_flight1(self, x: float, y: float, yaw: float) -> tuple[float, float, float]:
@@ -242,29 +244,45 @@ class Stairwell:
         """Whether there is anything for the footprint check to watch."""
         return bool(self._watched)
 
-    def contact(self, world: World, x: float, y: float, yaw: float, width: float
-                ) -> tuple[int, str] | None:
-        """The first segment (index, front to back) whose footprint reaches more
-        than ``CONTACT_DEPTH`` into a wall or a riser of flight 2 standing higher
-        than the segment's underside, and that face's name; None: none.  ``x``,
-        ``y``, ``yaw``: segment 2's centre and the heading in flight 1's frame;
-        the footprint is the three segments end to end along the heading,
-        ``width`` wide."""
-        l1, l2, l3 = world.lengths
+    def footprint(self, lengths: tuple[float, float, float], width: float) -> None:
+        """Set the robot's footprint for :meth:`contact`: its segments' lengths
+        (front to back) end to end, ``width`` wide."""
+        l1, l2, l3 = lengths
         d = CONTACT_DEPTH  # the footprint less this all round: reaching in further
         front, rear, hw = l2 / 2 + l1 - d, -(l2 / 2 + l3) + d, width / 2 - d
-        reach = max(front, -rear) + hw  # no face further than this from the centre
-        climbing = self.flight == 2 and abs(yaw - self.sign * math.pi / 2) < CLIMB_YAW
-        near = [w for w in self._watched if w[1] - reach <= x <= w[2] + reach
-                and w[3] - reach <= y <= w[4] + reach
-                and not (climbing and w[0].kind == "riser2")]
-        if not near:
+        self._footprint = (front, rear, hw, l2 / 2, -l2 / 2)
+        reach = max(front, -rear) + hw  # no face further than this from segment 2's centre
+        self._near = tuple((ax - reach, bx + reach, ay - reach, by + reach)
+                           for _f, ax, bx, ay, by in self._watched)
+
+    def contact(self, world: World, x: float, y: float, yaw: float) -> tuple[int, str] | None:
+        """The first segment (index, front to back) whose footprint
+        (:meth:`footprint`) reaches more than ``CONTACT_DEPTH`` into a wall or a
+        riser of flight 2 standing higher than the segment's underside, and that
+        face's name; None: none.  ``x``, ``y``, ``yaw``: segment 2's centre and
+        the heading in flight 1's frame."""
+        for x_lo, x_hi, y_lo, y_hi in self._near:  # every tick: the short way out first
+            if x_lo <= x <= x_hi and y_lo <= y <= y_hi:
+                break
+        else:
             return None
+        front, rear, hw, mid_front, mid_rear = self._footprint
         c, s = math.cos(yaw), math.sin(yaw)
+        # the footprint's box seen from above: a face outside it is not met
+        fc, rc, fs, rs = front * c, rear * c, front * s, rear * s
+        wx, wy = hw * abs(s), hw * abs(c)
+        x_lo, x_hi = x + min(fc, rc) - wx, x + max(fc, rc) + wx
+        y_lo, y_hi = y + min(fs, rs) - wy, y + max(fs, rs) + wy
         # each segment's stretch along the robot, front to back
-        stretches = ((l2 / 2, front), (-l2 / 2, l2 / 2), (rear, -l2 / 2))
+        stretches = ((mid_front, front), (mid_rear, mid_front), (rear, mid_rear))
         undersides: list[float | None] = [None, None, None]
-        for face, ax, bx, ay, by in near:
+        # flight 2's risers are the side view's while the robot climbs them
+        climbing = self.flight == 2 and abs(yaw - self.sign * math.pi / 2) < CLIMB_YAW
+        for face, ax, bx, ay, by in self._watched:
+            if bx < x_lo or ax > x_hi or by < y_lo or ay > y_hi:
+                continue
+            if climbing and face.kind == "riser2":
+                continue
             # the face's ends in the robot's frame (u along it, v to its left)
             u0, v0 = (ax - x) * c + (ay - y) * s, -(ax - x) * s + (ay - y) * c
             u1, v1 = (bx - x) * c + (by - y) * s, -(bx - x) * s + (by - y) * c

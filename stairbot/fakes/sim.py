@@ -25,9 +25,10 @@ robot turns).
 Quarter-turn landings (:mod:`stairbot.fakes.landing`): once per advance the
 robot, turned past 45 degrees on the landing, may move to the other flight's
 frame (the side view rebuilt, the bodies shifted along x, the top view
-re-framed: counters and readings carry on); and its footprint is checked
-against the walls and risers that only the top view has (``truth()``'s
-``wall_contact``).  ``truth()`` tells the frame and the pose in flight 1's frame.
+re-framed: counters and readings carry on); and its footprint seen from
+above is checked against the walls and the second flight's risers, which the
+side view's physics does not stop it at (``truth()``'s ``wall_contact``).
+``truth()`` tells the frame and the pose in flight 1's frame.
 """
 
 from __future__ import annotations
@@ -79,7 +80,7 @@ class SimRobot:
                          walls=self.well.walls(1))
         self._start_y = self.plan.y
         self.board = SimSensors(config, scenario, self.world, self.plan, self.well)
-        self._footprint_width = config.geometry.track_width + FOOTPRINT_MARGIN
+        self.well.footprint(self.world.lengths, config.geometry.track_width + FOOTPRINT_MARGIN)
         self.wall_contact: str | None = None
         """The first contact of the footprint with a wall (see Truth.wall_contact)."""
         self._imu = SimImu(self.world)
@@ -242,10 +243,10 @@ class SimRobot:
             self._watch_walls()
 
     def _watch_walls(self) -> None:
-        """Record the footprint's first contact with a wall the side view does
-        not hold (fakes/landing.py, Stairwell.contact)."""
+        """Record the footprint's first contact with a wall or a riser of a
+        landing's second flight (fakes/landing.py, Stairwell.contact)."""
         x, y, yaw = self.flight1_pose()
-        met = self.well.contact(self.world, x, y, yaw, self._footprint_width)
+        met = self.well.contact(self.world, x, y, yaw)
         if met is not None:
             segment, what = met
             self.wall_contact = f"segment {segment + 1} against {what} at {self.world.time:.2f} s"

@@ -322,10 +322,10 @@ def test_standing_into_flight_2s_first_riser_is_a_contact_above_it_none() -> Non
     assert contact is not None and contact.startswith("segment 1 against riser 1 of flight 2")
     well, w = r.well, r.world
     x, y, yaw = r.flight1_pose()
-    assert well.contact(w, x, y - 0.01, yaw, r._footprint_width) is None  # 2 mm short
+    assert well.contact(w, x, y - 0.01, yaw) is None  # 2 mm short
     for body in (*w.segments, *w.all_wheels):  # the whole robot above the riser's top
         body.position = (body.position.x, body.position.y + 0.18)
-    assert well.contact(w, x, y, yaw, r._footprint_width) is None
+    assert well.contact(w, x, y, yaw) is None
 
 
 def test_stairs_without_walls_are_not_watched() -> None:
