@@ -306,7 +306,7 @@ def test_on_flight_2_turned_past_45_degrees_stays_in_flight_2s_frame() -> None:
 
 
 def test_turning_on_a_landing_too_small_touches_the_far_wall() -> None:
-    r, c = robot(load_scenario("landing_too_small"))
+    r, c = robot(landing(depth=0.25))
     place(r, c, X1 + 0.125)  # 1.25 cm from the far wall and from the top edge
     lift_ends(r, c)
     assert r.truth().wall_contact is None
