@@ -243,6 +243,12 @@ class Scene:
     yaw_deg: float
     lateral_m: float
     fell: bool
+    flight2: tuple[float, int] | None = None
+    """None: the side view is along the stairs' first flight.  On a
+    quarter-turn landing's second flight (the side view along it), ``(x_mid,
+    sign)``: a pose (x, y, yaw) of this view is (x_mid − sign·y, sign·x, yaw +
+    sign·90°) in the first flight's frame (sign +1: the second flight leaves
+    to the left)."""
 
 
 @runtime_checkable

@@ -201,6 +201,7 @@ class SimRobot:
             yaw_deg=math.degrees(self.plan.yaw),
             lateral_m=self.plan.y,
             fell=w.fell,
+            flight2=(self.well.x_mid, self.well.sign) if self.well.flight == 2 else None,
         )
 
     # -- simulation ----------------------------------------------------------------

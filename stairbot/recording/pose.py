@@ -80,7 +80,10 @@ def segment_poses(outlines: Sequence[Sequence[Point]], yaw: float = 0.0,
     metres left of the flight's centre line (the simulation's top view)."""
     sides = [side_pose(o) for o in outlines]
     x2 = sides[1][0] if len(sides) > 1 else 0.0
-    return tuple(SegmentPose(x, lateral + (x - x2) * math.tan(yaw), z, pitch, yaw)
+    # the side view lays the robot along its axis: a segment (x - x2) ahead of
+    # segment 2's centre stands that far along the heading, seen from above
+    c, s = math.cos(yaw), math.sin(yaw)
+    return tuple(SegmentPose(x2 + (x - x2) * c, lateral + (x - x2) * s, z, pitch, yaw)
                  for x, z, pitch in sides)
 
 
@@ -140,8 +143,16 @@ class SimulationPose:
         return self._sim.scene().stairs
 
     def poses(self, snap: Snapshot) -> tuple[SegmentPose, ...]:
+        """In the first flight's frame, whichever frame the simulation's side
+        view is in (a quarter-turn landing's second flight: its own), so
+        that the recording's stairs (the first flight's) stay under it."""
         scene = self._sim.scene()
-        return segment_poses(scene.segments, math.radians(scene.yaw_deg), scene.lateral_m)
+        poses = segment_poses(scene.segments, math.radians(scene.yaw_deg), scene.lateral_m)
+        if scene.flight2 is None:
+            return poses
+        x_mid, sign = scene.flight2
+        return tuple(SegmentPose(x_mid - sign * p.y, sign * p.x, p.z, p.pitch,
+                                 p.yaw + sign * math.pi / 2) for p in poses)
 
 
 class DeadReckonedPose:

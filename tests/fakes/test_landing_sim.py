@@ -356,3 +356,27 @@ def test_without_a_landing_the_truth_is_flight_1s_side_view() -> None:
         1, w.centre_x(), r.plan.y, pytest.approx(10.0))
     assert t.clear_of_stairs_m == w.clear_of_stairs_m()
     assert t.offset_m == math.hypot(w.centre_x() - w.start_x, r.plan.y - 0.1)
+
+
+@pytest.mark.parametrize("turn", ["left", "right"])
+def test_a_recording_poses_the_robot_in_flight_1s_frame_whichever_frame_the_side_view_is_in(
+        turn: str) -> None:
+    """The recording's stairs are flight 1's (written once, at the start): its
+    pose of the segments stays in flight 1's frame after the switch, or the
+    robot on flight 2 would be drawn where flight 2's frame put it."""
+    from stairbot.recording.pose import SimulationPose
+
+    r, c = robot(landing(turn))
+    place(r, c, X1 + 0.45, lateral=0.05)
+    s = 1 if turn == "left" else -1
+    before = SimulationPose(r).poses(r.read())
+    r.plan.turn(s * math.radians(45.5))
+    turned = SimulationPose(r).poses(r.read())
+    assert r.well.switch(r.world, r.plan) and r.scene().flight2 is not None
+    after = SimulationPose(r).poses(r.read())
+    for a, b in zip(turned, after, strict=True):
+        assert (b.x, b.y, b.z, b.pitch, b.yaw) == pytest.approx(
+            (a.x, a.y, a.z, a.pitch, a.yaw), abs=1e-6)
+    x, y, _yaw = r.flight1_pose()
+    assert (after[1].x, after[1].y) == pytest.approx((x, y), abs=1e-6)
+    assert before[1].yaw == 0.0 and after[1].yaw == pytest.approx(s * math.radians(45.5))

@@ -69,9 +69,10 @@ def test_segments_off_the_centre_line_follow_the_yaw() -> None:
     box = [(-0.04, 0.0), (0.04, 0.0), (0.04, 0.05), (-0.04, 0.05)]
     outlines = [[(x + dx, y) for x, y in box] for dx in (0.1, 0.0, -0.1)]
     poses = segment_poses(outlines, yaw=math.radians(10), lateral=0.05)
-    assert [p.x for p in poses] == pytest.approx([0.1, 0.0, -0.1])
-    assert [p.y for p in poses] == pytest.approx(
-        [0.05 + 0.1 * math.tan(math.radians(10)), 0.05, 0.05 - 0.1 * math.tan(math.radians(10))])
+    # 0.1 m ahead of segment 2's centre along the heading, seen from above
+    c, s = math.cos(math.radians(10)), math.sin(math.radians(10))
+    assert [p.x for p in poses] == pytest.approx([0.1 * c, 0.0, -0.1 * c])
+    assert [p.y for p in poses] == pytest.approx([0.05 + 0.1 * s, 0.05, 0.05 - 0.1 * s])
     assert all(p.z == pytest.approx(0.0) and p.pitch == 0.0 for p in poses)
 
 
