@@ -40,12 +40,15 @@ class Boards:
 @contextmanager
 def lockstep_boards(cwd: Path, env: dict[str, str] | None = None,
                     stop: signal.Signals = signal.SIGINT, *,
-                    scenario: str | None = None) -> Iterator[Boards]:
+                    scenario: str | None = None,
+                    config: str | None = None) -> Iterator[Boards]:
     """Serve fake boards in lockstep (on ``scenario``, default the default
-    stairs) until the block ends, then stop them with ``stop`` (unless the
-    block did), killing them after 10 s.  ``cwd`` elsewhere than the source
-    tree: the installed package runs."""
-    more = () if scenario is None else ("--scenario", scenario)
+    stairs; for ``config``, default the reference robot) until the block
+    ends, then stop them with ``stop`` (unless the block did), killing them
+    after 10 s.  ``cwd`` elsewhere than the source tree: the installed
+    package runs."""
+    more = (*(() if scenario is None else ("--scenario", scenario)),
+            *(() if config is None else ("--config", config)))
     proc = stairbot("fake-boards", "--serial", "--lockstep", *more, env=env, cwd=cwd)
     assert proc.stdout is not None
     boards = Boards(proc.stdout.readline().strip(), proc)

@@ -215,3 +215,26 @@ def test_a_descent_from_the_top_killed_mid_lift_resumes_down_to_the_floor(
     assert (result["outcome"], result["steps_climbed"], result["steps_descended"],
             result["fell"]) == ("completed", 0, 5, False)
     assert "on the floor" in result["reason"]
+
+
+def test_a_climb_killed_mid_scan_on_a_landing_resumes_turns_and_comes_home(
+        env: dict[str, str], tmp_path: Path) -> None:
+    """The journal keeps the landing's scan (its working state) and what the
+    robot learnt of the landing: killed while landing 1 lifts segment 3
+    looking sideways, on boards with the side pair, the resumed run finishes
+    the scan, turns onto the second flight, climbs it and comes home."""
+    journal = tmp_path / "run.jsonl"
+    args = ("--scenario", "landing_left", "--config", "landings")
+    with lockstep_boards(tmp_path, env, scenario="landing_left", config="landings") as served:
+        killed = kill_mid_lift(served.url, journal, env, tmp_path, *args,
+                               "--journal", str(journal), phase="landing_scan",
+                               lift=("MTB", 1))
+        assert killed["phase"] == "landing_scan"
+        resumed = stairbot("run", "--robot", served.url, *args, "--journal", str(journal),
+                           "--resume", "--yes", "--json", env=env, cwd=tmp_path)
+        out, err = resumed.communicate(timeout=600)
+    assert resumed.returncode == 0, err[-2000:]
+    result = json.loads(out)
+    assert (result["outcome"], result["steps_climbed"], result["steps_descended"],
+            result["fell"]) == ("completed", 6, 6, False), result
+    assert "the next flight is to the left" in err
