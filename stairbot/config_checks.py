@@ -38,6 +38,14 @@ def check_consistency(cfg: RobotConfig) -> None:
                           "quarter-turn landings look sideways with the side pair SSR/SSL, "
                           "and this robot has none; allowed: landings = false, or a "
                           "[sensors] side_model (one of the sensor models) for the pair")
+    if s.has_side_pair and s.side_min_range >= s.side_max_range:
+        raise ConfigError(src, "sensors.side_min_range", "must be below side_max_range")
+    if s.has_side_pair and s.side_height >= cfg.min_step_rise_m:
+        raise ConfigError(src, "sensors.side_height",
+                          f"{s.side_height} m: the side pair's beams must start below the "
+                          f"lowest riser the robot climbs (min_step_rise_m, "
+                          f"{cfg.min_step_rise_m:.3f} m), or they read past a landing's next "
+                          "flight's first riser to the ones beyond; allowed: less than that")
     if s.has_side_pair and s.side_from_rear > g.LENGTH_OF_THIRD_MODULE:
         raise ConfigError(src, "sensors.side_from_rear",
                           f"{s.side_from_rear} m puts the side pair off segment 3 "

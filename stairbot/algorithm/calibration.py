@@ -92,6 +92,7 @@ def _after_calibration(t: Tick) -> Step:
     if ctx.number_of_steps < len(ctx.climb_twist):
         # the heading this step is climbed with: descent 1 comes back to it
         ctx.climb_twist[ctx.number_of_steps] = motion.twist(t.snap)
+    landing.after_calibration(t)
     return go(P.ASCENT_APPROACH)
 
 

@@ -171,6 +171,9 @@ class Context:
     landing_twist: float | None = None
     """The heading (odometer twist) the robot came up the first flight with:
     the way down turns back to it."""
+    landing_riser_m: float | None = None
+    """What SFR/SFL read on the next flight's first riser, squared up where the
+    robot turned: landing 3 backs to it."""
     landing_step: int | None = None
     """0-based index of the next flight's first step (number_of_steps when the
     robot turned onto it); None: no landing turned at."""

@@ -33,7 +33,6 @@ from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
     LIFT_MOTORS,
-    SIDE_SENSORS,
     MotorId,
     SensorId,
     SensorStatus,
@@ -411,7 +410,11 @@ def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     if phase in _EDGE_WATCH:
         return FRONT_SENSORS + BACK_SENSORS
     if phase is Phase.LANDING_SCAN:
-        return SIDE_SENSORS  # the scan looks sideways; nothing else moves
+        # The scan moves segment 3 alone, and steers nothing: a side pair that
+        # reads no distance there is no flight (the landing is refused, the
+        # robot goes home), not a reason to stop on the landing (the red team:
+        # a 3 s SSR error ended the program there).
+        return ()
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
 

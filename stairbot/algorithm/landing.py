@@ -200,10 +200,16 @@ def _record(t: Tick, w: Work) -> Step:
     bases = [statistics.median(b) if b else None for b in w.side_base]
     ctx.landing_right_m = None if bases[0] is None else bases[0] + lat
     ctx.landing_left_m = None if bases[1] is None else bases[1] + lat
-    # open: past what it saw on most of the ticks standing at the top
-    opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS for i in (0, 1)]
+    # open: past what it saw on most of the ticks standing at the top, and
+    # seen over no lower than the lowest riser it climbs (the beam below that
+    # met something it then lost: a fault, not a flight -- a side sensor reading
+    # 1 m long from 10 mm up was taken for the flight, and the robot turned to a
+    # wall: the red team)
     lifted = _lifted_m(t, w)
     seen_at = [lifted if o is None else o for o in w.side_open]
+    low = cfg.min_step_rise_m - cfg.sensors.side_height - SCAN_BASE_M
+    opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS
+              and seen_at[i] >= low for i in (0, 1)]
     ctx.landing_rise_m = [seen_at[i] + cfg.sensors.side_height if opened[i] else None
                           for i in (0, 1)]
     ctx.landing_open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
@@ -364,6 +370,19 @@ def turned(t: Tick) -> Step:
     return go(P.CAL_CHECK)
 
 
+def after_calibration(t: Tick) -> None:
+    """Squared up on the next flight's first riser, standing where it turned:
+    what the front pair reads there is where the way down turns back
+    (``landing_riser_m``)."""
+    ctx = t.ctx
+    if ctx.landing_step is None or ctx.number_of_steps != ctx.landing_step \
+            or ctx.landing_riser_m is not None or not motion.measurable(t.snap, t.cfg):
+        return
+    ctx.landing_riser_m = motion.mean_distance(t.snap)
+    t.say(f"where it turned: SFR/SFL read {ctx.landing_riser_m:.3f} m to the next flight's "
+          "first riser", landing_riser_m=ctx.landing_riser_m)
+
+
 # -- landing 3: back to where it turned, turn back ------------------------------------------
 def turned_here(t: Tick) -> bool:
     """Turned onto the next flight, and refusing its first step: the way down
@@ -381,6 +400,14 @@ def returns_here(t: Tick) -> bool:
 
 
 def _return_target(t: Tick) -> float | None:
+    """What the front pair read on the next flight's first riser where the
+    robot turned (squared up there); if it could not read it, what the side
+    pair said of that side, less the front face's reach.  (The side pair's
+    reading alone: a side sensor reading 0.3 m long sent the robot back to
+    the wrong place on a landing 0.6 m wide, and it turned back into a wall:
+    the red team.)"""
+    if t.ctx.landing_riser_m is not None:
+        return t.ctx.landing_riser_m
     open_m = _open_m(t)
     return None if open_m is None else open_m - centre_to_front(t.cfg)
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 
 from stairbot.config import RobotConfig
+from stairbot.errors import ScenarioError
 from stairbot.fakes.beams import down_fans, front_hits, total_weight
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.plan import Plan
@@ -82,6 +83,13 @@ class SimSensors:
         self.world = world
         self.plan = plan
         s, n = config.sensors, scenario.sensors
+        if not s.has_side_pair:
+            for i, fault in enumerate(scenario.faults):
+                if fault.sensor in ("SSR", "SSL"):
+                    raise ScenarioError(scenario.source, f"faults[{i}].sensor",
+                                        f"{fault.sensor}, but the robot config has no side pair "
+                                        "([sensors] side_model): the fault would do nothing; "
+                                        "allowed: SFR, SFL, SBR, SBL, or a robot with the pair")
         self.front_model, self.back_model = model_for(s, back=False), model_for(s, back=True)
         self.sensors = {
             sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults,

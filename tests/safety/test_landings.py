@@ -11,7 +11,7 @@ import simrun
 
 from stairbot.algorithm.phases import Phase
 from stairbot.config import load_config, parse_config
-from stairbot.errors import ConfigError
+from stairbot.errors import ConfigError, ScenarioError
 from stairbot.events import Event, EventKind
 from stairbot.scenario import load_scenario, parse_scenario
 
@@ -144,3 +144,55 @@ def test_the_next_flights_first_step_refused_it_turns_back_before_it_descends() 
     obstacles = [i for i, p in enumerate(seen) if p is Phase.ASCENT_LOWER_OBSTACLE]
     assert [seen[i + 1] for i in obstacles] == [Phase.LANDING_SCAN, Phase.LANDING_RETURN]
     assert result.wall_contact is None
+
+
+FAULTS = "[[faults]]\nat = {at}\nsensor = 'SSR'\nkind = '{kind}'\n{more}"
+
+
+@pytest.mark.parametrize(("width", "turn", "fault", "end", "steps"), [
+    # SSR 0.3 m long from the scan on, a flight 0.6 m wide between walls: the way
+    # down backed to where the side pair said the turn was, turned back into a wall
+    (0.6, "right", FAULTS.format(at=141, kind="offset", more="offset = 0.3\n"),
+     "top_reached", 6),
+    # SSR (the wall's side) 1 m long from 10 mm up: read past its range at the
+    # top, it was taken for the flight; the robot turned to the wall
+    (1.0, "left", FAULTS.format(at=141, kind="offset", more="offset = 1.0\n"),
+     "top_reached", 6),
+    # SSR failing for 3 s during the scan ended the program on the landing
+    (1.0, "left", FAULTS.format(at=145, kind="error", more="duration = 3.0\n"),
+     "top_reached", 6),
+    # the open side's sensor failing for good during the scan: no flight seen, home
+    (1.0, "right", FAULTS.format(at=145, kind="error", more=""), "landing_closed", 3),
+])
+def test_a_side_sensor_that_fails_or_reads_wrong_during_the_scan_is_no_reason_to_stop(
+        width: float, turn: str, fault: str, end: str, steps: int) -> None:
+    """The red team's faults on SSR around the scan (130-160 s robot time):
+    the robot climbs on to the flight the other sensor saw, or refuses the
+    landing, and comes home; it never turns to a wall, nor stops on the
+    landing."""
+    walls = "side_wall = 'both'\n" if width < 1.0 else ""
+    scenario = parse_scenario(landing(width=width, turn=turn, extra=fault).replace(
+        "[landing]", walls + "[landing]"), "fault.toml")
+    result = simrun.run_sim(LANDINGS, scenario)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", end, steps, steps), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
+    assert result.wall_contact is None and not result.fell
+
+
+@pytest.mark.parametrize(("key", "value", "says"), [
+    ("side_height", "0.5", "lowest riser the robot climbs"),
+    ("side_min_range", "1.5", "must be below side_max_range")])
+def test_a_side_pair_that_cannot_tell_a_flight_is_refused(key: str, value: str,
+                                                          says: str) -> None:
+    with pytest.raises(ConfigError) as info:
+        parse_config(f'extends = "landings"\n[sensors]\n{key} = {value}\n', "x.toml")
+    assert info.value.field == f"sensors.{key}" and says in str(info.value)
+
+
+def test_a_fault_on_a_side_sensor_the_robot_does_not_have_is_refused() -> None:
+    scenario = parse_scenario("[stairs]\ncount = 2\n[[faults]]\nat = 1.0\nsensor = 'SSL'\n"
+                              "kind = 'error'\n", "f.toml")
+    with pytest.raises(ScenarioError) as info:
+        simrun.run_sim(load_config(), scenario)
+    assert info.value.field == "faults[0].sensor" and "no side pair" in str(info.value)
