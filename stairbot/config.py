@@ -132,15 +132,23 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 
     def range(self, back: bool) -> tuple[float, float]:
         """The pair's working range: the config's, within the sensor's own."""
-        spec = self.spec(back)
         lo, hi = ((self.back_min_range, self.back_max_range) if back
                   else (self.front_min_range, self.front_max_range))
-        return (lo if spec.min_range is None else max(lo, spec.min_range),
-                hi if spec.max_range is None else min(hi, spec.max_range))
+        return _within(self.spec(back), lo, hi)
+
+    def side_range(self) -> tuple[float, float]:
+        """The side pair's working range, as :meth:`range`."""
+        return _within(self.side_spec(), self.side_min_range, self.side_max_range)
 
     def sigma(self, back: bool, distance_m: float) -> float:
         """The stated sigma of one reading of the pair at ``distance_m``."""
         return self.spec(back).sigma(distance_m, self.noise)
+
+
+def _within(spec: SensorSpec, lo: float, hi: float) -> tuple[float, float]:
+    """The range ``lo`` to ``hi`` within the sensor's own."""
+    return (lo if spec.min_range is None else max(lo, spec.min_range),
+            hi if spec.max_range is None else min(hi, spec.max_range))
 
 
 class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

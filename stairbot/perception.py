@@ -44,6 +44,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.sensor_specs import SensorSpec
 
 WINDOW = 5
 """Measurements a sensor's median spans, whatever its period.  Five, not
@@ -78,7 +79,7 @@ _STATUS_OK = SensorStatus.OK
 
 def measurement_period(cfg: RobotConfig, back: bool) -> float:
     """How often the pair gives a new measurement: its period, or every tick."""
-    return max(cfg.sensors.spec(back).period_s, cfg.algorithm.tick)
+    return _period(cfg, cfg.sensors.spec(back))
 
 
 def window(cfg: RobotConfig, back: bool) -> int:
@@ -88,15 +89,31 @@ def window(cfg: RobotConfig, back: bool) -> int:
 
 def max_age(cfg: RobotConfig, back: bool) -> float:
     """The oldest a measurement of the pair may be and still be used."""
-    spec = cfg.sensors.spec(back)
-    return spec.latency_s + STALE_PERIODS * measurement_period(cfg, back) + cfg.algorithm.tick
+    return _max_age(cfg, cfg.sensors.spec(back))
 
 
 def settle_s(cfg: RobotConfig, back: bool = False) -> float:
     """How long the pair's filtered readings take to stand for where the robot
     stands now, once it stops: its latency and a full window of measurements.
     Measurements to average standing still start after it."""
-    return cfg.sensors.spec(back).latency_s + window(cfg, back) * measurement_period(cfg, back)
+    return _settle_s(cfg, cfg.sensors.spec(back))
+
+
+def side_settle_s(cfg: RobotConfig) -> float:
+    """:func:`settle_s` of the side pair (``[sensors] side_model``)."""
+    return _settle_s(cfg, cfg.sensors.side_spec())
+
+
+def _period(cfg: RobotConfig, spec: SensorSpec) -> float:
+    return max(spec.period_s, cfg.algorithm.tick)
+
+
+def _max_age(cfg: RobotConfig, spec: SensorSpec) -> float:
+    return spec.latency_s + STALE_PERIODS * _period(cfg, spec) + cfg.algorithm.tick
+
+
+def _settle_s(cfg: RobotConfig, spec: SensorSpec) -> float:
+    return spec.latency_s + WINDOW * _period(cfg, spec)
 
 
 def median_sigma(cfg: RobotConfig, back: bool, distance_m: float) -> float:
@@ -298,13 +315,8 @@ class Perception:
             # the side pair looks across the robot's path: driving does not move
             # what it sees, so its medians are of the readings themselves (as
             # the back pair's)
-            spec = s.side_spec()
-            period = max(spec.period_s, cfg.algorithm.tick)
-            age = spec.latency_s + STALE_PERIODS * period + cfg.algorithm.tick
-            lo = s.side_min_range if spec.min_range is None else max(s.side_min_range,
-                                                                      spec.min_range)
-            hi = s.side_max_range if spec.max_range is None else min(s.side_max_range,
-                                                                      spec.max_range)
+            age = _max_age(cfg, s.side_spec())
+            lo, hi = s.side_range()
             for sid in SIDE_SENSORS:
                 self._tracks[sid] = _Track(False, WINDOW, age, (lo + hi) / 2.0)
         self._odometer: deque[tuple[float, float]] = deque(maxlen=ODOMETER_HISTORY)

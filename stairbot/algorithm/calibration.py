@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from stairbot.algorithm import landing, motion
-from stairbot.algorithm.moves import lift
+from stairbot.algorithm.moves import lift, stood
 from stairbot.algorithm.phase import (
     FAULT,
     NO_MOTION,
@@ -105,9 +105,7 @@ def heading_off_rad(t: Tick, twist: float) -> float:
 def settled(t: Tick, w: Work) -> bool:
     """Standing still since ``w.still_since`` (set now if unset) for as long
     as the filter takes to stand for here (:func:`settle_s`)."""
-    if w.still_since is None:
-        w.still_since = t.snap.time_s
-    return t.snap.time_s - w.still_since >= settle_s(t.cfg) - 1e-9  # (clocks round alike)
+    return stood(t, w, settle_s(t.cfg))
 
 
 def measured_standing(t: Tick, w: Work, needed: int) -> bool:

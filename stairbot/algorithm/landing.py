@@ -9,9 +9,10 @@ obstacle).  With ``[algorithm] landings`` the robot then, before it turns
 back down:
 
 1. *scans* (landing 1): lifts segment 3 its whole stroke with the side pair
-   looking out.  A side whose reading jumps on by SIGHT_JUMP_M as the beam
-   rises over what it saw is the next flight's first riser; one that never
-   does is a wall.  The readings before the lift say how far the sides are.
+   looking out.  A side that, standing at the top, reads on past what it
+   saw below by SIDE_JUMP_M, having first done so no lower than the lowest
+   riser the robot climbs, is the next flight's first riser; any other is a
+   wall.  The readings before the lift say how far the sides are.
 2. *decides*: no side open, the ascent ends as at a wall (``landing_closed``);
    a landing too small for the robot to turn in (its turning circle,
    TURN_ROOM_MARGIN clear of the walls, the riser and the edge behind), it
@@ -35,13 +36,13 @@ import math
 import statistics
 
 from stairbot.algorithm import motion
-from stairbot.algorithm.moves import lift, reading_drive
+from stairbot.algorithm.moves import lift, reading_drive, stood
 from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
 from stairbot.config import RobotConfig
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
-from stairbot.perception import WINDOW
+from stairbot.perception import side_settle_s
 
 P = Phase
 FLOW = "landing"
@@ -121,17 +122,6 @@ def _scan_enter(t: Tick, w: Work) -> None:
     w.target_mtb = max(w.entry_mtb, t.cfg.MAX_OF_VERTICAL_TURNS)
 
 
-def _settled(t: Tick, w: Work) -> bool:
-    """Standing still since ``w.still_since`` (set now if unset) for as long as
-    the side pair's filter takes to stand for here: its latency and a full
-    window of its measurements."""
-    if w.still_since is None:
-        w.still_since = t.snap.time_s
-    spec = t.cfg.sensors.side_spec()
-    settle = spec.latency_s + WINDOW * max(spec.period_s, t.cfg.algorithm.tick)
-    return t.snap.time_s - w.still_since >= settle - 1e-9
-
-
 def _lifted_m(t: Tick, w: Work) -> float:
     return (t.snap.turns(MotorId.MTB) - w.entry_mtb) * t.cfg.motors.lift_travel_per_turn
 
@@ -178,15 +168,15 @@ def _scan(t: Tick, w: Work) -> Step:
         if speeds is not None and min(w.side_run) < SCAN_CONFIRM_TICKS:
             return stay(speeds)
         w.checked = True
-    if not _settled(t, w):
+    if not stood(t, w, side_settle_s(t.cfg)):
         return stay(NO_MOTION)
     for i, sid in enumerate(SIDE_SENSORS):
         reading = t.snap.sensors[sid]
         if not w.side_base[i]:
             continue
         w.side_top[i] += 1 if _jumped(reading, statistics.median(w.side_base[i])) else 0
-    w.diff_skipped += 1  # ticks measured standing at the top
-    if w.diff_skipped < SCAN_TOP_TICKS:
+    w.side_ticks += 1
+    if w.side_ticks < SCAN_TOP_TICKS:
         return stay(NO_MOTION)
     return _record(t, w)
 
@@ -217,8 +207,7 @@ def _record(t: Tick, w: Work) -> Step:
         if opened[i]:
             name = "right" if i == 0 else "left"
             t.say(f"landing: {sid.value} sees over what it saw on the {name} "
-                  f"({bases[i]:.3f} m) with segment 3 lifted "
-                  f"{(ctx.landing_rise_m[i] or 0.0) - cfg.sensors.side_height:.3f} m, and "
+                  f"({bases[i]:.3f} m) with segment 3 lifted {seen_at[i]:.3f} m, and "
                   f"standing at the top: the next flight", sensor=sid.value, base=bases[i])
     return go(P.LANDING_SCAN_LOWER)
 
@@ -302,11 +291,7 @@ def _refuse(t: Tick, why: str, message: str) -> Step:
     return go(P.DESCENT_BACK_OFF)
 
 
-def _lowered(t: Tick, w: Work) -> Step:
-    return _decide(t, w)
-
-
-_scan_lower = lift(_lower_deltas, _lowered)
+_scan_lower = lift(_lower_deltas, _decide)
 SCAN_LOWER = PhaseDef(
     P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
     _scan_lower[1], enter=_scan_lower[0], carried_by=(1, 2),

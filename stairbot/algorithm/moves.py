@@ -146,6 +146,14 @@ def lift(deltas: Callable[[Tick, Work], dict[MotorId, float]],
     return enter, step
 
 
+def stood(t: Tick, w: Work, seconds: float) -> bool:
+    """Standing still since ``w.still_since`` (set now if unset) for
+    ``seconds`` (a filter's settling time)."""
+    if w.still_since is None:
+        w.still_since = t.snap.time_s
+    return t.snap.time_s - w.still_since >= seconds - 1e-9  # (clocks round alike)
+
+
 def checked_first(check: Callable[[Tick, Work], Step | None], step: StepFn) -> StepFn:
     """``step``, with ``check`` run once before its first tick: a phase whose
     entry condition does not hold ends there (``check`` returns that Step)

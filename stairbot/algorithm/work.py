@@ -109,6 +109,8 @@ class Work:
     """Landing 1: ticks in a row SSR (SSL) has read past what it saw."""
     side_top: list[int] = field(default_factory=lambda: [0, 0])
     """Landing 1: ticks standing at the top on which SSR (SSL) read past it."""
+    side_ticks: int = 0
+    """Landing 1: ticks read standing at the top."""
 
     @classmethod
     def at_entry(cls, snap: Snapshot) -> Work:
