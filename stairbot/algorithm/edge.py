@@ -148,14 +148,16 @@ robot backed as far as this yaw across the pair's spacing: it stops."""
 
 
 def square_to_edge(t: Tick, w: Work) -> str | None:
-    """Continuous descent: watch which back sensor reads the drop first; once
-    both do, the yaw to square up (``w.square_yaw``), if more than
-    EDGE_SQUARE_RAD and not squared at this edge yet; an error if the other
-    does not follow within MAX_EDGE_YAW_RAD.  Only on a crossing the watch
-    sees as it happens (``w.edge_floor_s``).  Returns the error that ends
-    the program, if any."""
+    """Watch which back sensor reads the drop first, and where
+    (``w.edge_first_wheel``: :func:`_crossed` places the crossing between
+    the two).  In a continuous descent, once both do, the yaw to square up
+    (``w.square_yaw``), if more than EDGE_SQUARE_RAD and not squared at
+    this edge yet; an error if the other does not follow within
+    MAX_EDGE_YAW_RAD.  Only on a crossing the watch sees as it happens
+    (``w.edge_floor_s``).  Returns the error that ends the program, if
+    any."""
     ctx, cfg = t.ctx, t.cfg
-    if not ctx.from_top or ctx.edge_wheel is not None or w.edge_floor_s is None:
+    if ctx.edge_wheel is not None or w.edge_floor_s is None:
         return None
     right, left = drops(t)
     here = motion.wheel_position(t.snap)
@@ -166,6 +168,8 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
         first = "SBR" if right else "SBL"
         if w.edge_first_wheel is None or w.edge_first != first:
             w.edge_first_wheel, w.edge_first = here, first
+        if not ctx.from_top:
+            return None
         lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
         most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
         if lag > most:
@@ -175,7 +179,7 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
                         f"{math.degrees(MAX_EDGE_YAW_RAD):.0f}° from square to the edge): "
                         "turned too far from the edge, or the edge is not straight")
         return None
-    if right and w.edge_first_wheel is not None and not ctx.edge_squared:
+    if right and w.edge_first_wheel is not None and ctx.from_top and not ctx.edge_squared:
         lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
         yaw = math.atan2(lag, 2 * cfg.sensors.back_lateral)
         if yaw > EDGE_SQUARE_RAD:
@@ -223,7 +227,7 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
                 and now - w.edge_watch_s > EDGE_GAP_TICKS * cfg.algorithm.tick:
             # a stretch unwatched: the floor read before it no longer counts,
             # nor one read until perception's lag has passed
-            w.edge_floor_s = None
+            w.edge_floor_s = w.edge_first_wheel = w.edge_first = None
             w.edge_blind_until = now + edge_lag_s(cfg) + measurement_period(cfg, True)
         w.edge_watch_s = now
         if not sees_drop(t):
@@ -238,7 +242,7 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
                 return None
             return motion.wheel_position(t.snap)  # the back-off ends here
         else:
-            ctx.edge_wheel, sight = _crossed(t)
+            ctx.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
             more = max(0.0, edge_clearance_m(cfg) - sight)
             t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m, "
                   f"about {sight * 1000:.0f} mm past it): backing at most {more:.3f} m more")
@@ -247,15 +251,26 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
     return ctx.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
 
 
-def _crossed(t: Tick) -> tuple[float, float]:
+def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
     """Where the back pair crossed the edge whose drop it reads now for the
     first time, on the odometer, and how far past it the pair is
     (:func:`edge_sight_m` at the wheels' speed): behind the robot's back
-    (backing, the odometer runs down), so at a larger count."""
+    (backing, the odometer runs down), so at a larger count.  If one sensor
+    read the drop first (at ``first_wheel``), the crossing is placed
+    half-way between the two: where the robot's centre line crossed, the
+    pair being mounted either side of it.  Placed where the second sensor
+    read it, a pair reading the drop 12 mm apart (a VL53L0X cone straddling
+    the edge, a stray measurement in its median, 2.3 deg off square) put it
+    7 mm past the pair when it was about 13 mm, and backing the rest of the
+    clearance the robot tipped back (the landings sweep, case 99)."""
     cfg = t.cfg
     speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
     sight = edge_sight_m(cfg, speed * cfg.wheel_circumference, t.ctx.from_top)
-    return motion.wheel_position(t.snap) + cfg.wheel_turns(sight), sight
+    here = motion.wheel_position(t.snap)
+    if first_wheel is not None:
+        half = (first_wheel - here) / 2
+        return here + half + cfg.wheel_turns(sight), sight + half * cfg.wheel_circumference
+    return here + cfg.wheel_turns(sight), sight
 
 
 NARROW_AXLE_MARGIN_M = 0.004
@@ -305,7 +320,7 @@ def refind(t: Tick, w: Work) -> Step:
                                                                    t.ctx.from_top):
         t.say(f"SBR/SBL read the floor again {driven_m * 1000:.0f} mm forward: backing up "
               "to the edge")
-        w.refind_from, w.edge_blind_until = None, None
+        w.refind_from = w.edge_blind_until = w.edge_first_wheel = w.edge_first = None
         w.edge_watch_s = w.edge_floor_s = t.snap.time_s
         return stay(NO_MOTION)
     most = refind_max_m(cfg)
