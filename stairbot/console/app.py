@@ -31,13 +31,11 @@ from textual.widgets import Footer
 
 from stairbot.cli_journal import ResumePlan
 from stairbot.config import RobotConfig, load_config
-from stairbot.console.climb_gate import MidClimb
+from stairbot.console import motion_gate
 from stairbot.console.freshness import age_key, age_words, is_stale
 from stairbot.console.help import HelpScreen
-from stairbot.console.modals import AskScreen, ChoiceScreen, ConfirmScreen
+from stairbot.console.modals import AskScreen
 from stairbot.console.runner_thread import (
-    LATCH_HINT,
-    MID_CLIMB_HINT,
     SPEEDS,
     ConsoleEngine,
     EngineHooks,
@@ -63,8 +61,6 @@ REFRESH_HZ = 10.0
 GRAPHS_ROWS = 36
 """From this many rows the graphs show under the picture; on a smaller
 screen they take the picture's place while the operator wants them (g)."""
-LOOK_FIRST = ("Look at the robot first: it may stand part way up a step, and the next run "
-              "starts from where it stands.")
 SPEED_ORDER = tuple(SPEEDS)
 
 # (action, palette title, palette help) for every operator action.
@@ -129,7 +125,8 @@ class StairbotConsole(App[None]):
         self._record = record
         self._shown_key: object = None
         self._shown_event = 0
-        self._asking_quit = False
+        self.asking_quit = False
+        """The console asks whether to quit (mid-run)."""
         self._sigint: Any = None  # the SIGINT handler before ours
         # The panels, kept here: refresh_view must reach them while a modal
         # screen is on top (app.query_one looks only at the top screen).
@@ -364,145 +361,15 @@ class StairbotConsole(App[None]):
         self.refresh_view()
 
     def action_clear_estop(self) -> None:
-        """Clear the emergency stop -- the console's latch, or the latches of
-        boards refused for holding one -- once the operator confirms."""
-        pending = self.engine.latched_boards
-        if pending is not None and self.engine.session is None:
-            url, scenario, why = pending
-            question = (f"{why}\n\n{LOOK_FIRST}\nClear the latches the boards hold?")
-
-            def clear_boards(yes: bool | None) -> None:
-                if yes:
-                    self.open_robot(url, scenario, clear_latches=True)
-                else:
-                    self.say("not cleared: the boards keep their latches")
-
-            self.push_screen(ConfirmScreen(question, yes="Yes, clear (y)"), clear_boards)
-            return
-        if not self.engine.estop_set:
-            self.say("the emergency stop is not set")
-            return
-
-        def clear(yes: bool | None) -> None:
-            if not yes:
-                self.say("not cleared: the emergency stop stays latched")
-            elif not self.engine.clear_estop():
-                self.say("the emergency stop is not set")
-            self.refresh_view()
-
-        then = "p resumes the run" if self.engine.running else "s starts a run"
-        self.push_screen(ConfirmScreen(
-            f"Clear the EMERGENCY STOP?\n{LOOK_FIRST}\nClearing moves nothing: {then}.",
-            yes="Yes, clear (y)"), clear)
+        """Clear the emergency stop once the operator confirms
+        (:func:`~stairbot.console.motion_gate.clear_estop`)."""
+        motion_gate.clear_estop(self)
 
     def action_start(self, mode: str) -> None:
-        if self.engine.estop_set:
-            self.state.set_status(message=LATCH_HINT, severity="error")
-            self.say(LATCH_HINT, "error")
-            return
-        if self.engine.running:
-            self.say("a run is already going on", severity="warning")
-            return
-        if self.engine.session is None:
-            self.say("no robot open: choose one with u", severity="error")
-            return
-        if self.engine.mid_climb is not None:
-            self._mid_climb(mode, self.engine.mid_climb)
-            return
-        what = "Start calibration" if mode == "calibrate" else "Start the full run"
-        self._after_consent(what, lambda: self.run_program(mode))
-
-    def _mid_climb(self, mode: str, gate: MidClimb) -> None:
-        """The robot may stand part way up: no fresh start from there.  Offer
-        what is safe -- resume (boards: the journal's run, checked first),
-        reset (the simulation), or the operator's word that it is back at
-        the start -- and move nothing until one is chosen and confirmed."""
-        wired = not self.engine.in_process
-        lines = "\n".join(gate.lines)
-        question = (f"The robot may stand part way up the stairs:\n{lines}\n\n"
-                    "A new run would square up and drive at the riser from there: not "
-                    "started.  " + ("Resume carries on the journal's run, after checks"
-                                    if wired else "Reset puts the simulated robot at the start")
-                    + "; or say the robot is back at the start.")
-        first = ("r", "Resume (r)") if wired else ("r", "Reset (r)")
-
-        def chosen(key: str | None) -> None:
-            if key == "r":
-                if wired:
-                    self._resume(mode)
-                else:
-                    self.action_reset()
-            elif key == "b":
-                self.push_screen(ConfirmScreen(
-                    "Start a new run from where the robot stands?\nOnly if it stands on the "
-                    "floor before the first step: a new run squares up, then drives at the "
-                    "stairs.", yes="Yes, it is at the start (y)"), back)
-            else:
-                self.say("nothing moved")
-
-        def back(yes: bool | None) -> None:
-            if yes:
-                self.engine.back_at_start()
-                self.action_start(mode)
-            else:
-                self.say("nothing moved")
-
-        self.state.set_status(message=MID_CLIMB_HINT, severity="error")
-        self.push_screen(ChoiceScreen(question, [first, ("b", "Back at start (b)")]), chosen)
-
-    def _resume(self, mode: str) -> None:
-        """Check the journal's run against the boards, show where the robot
-        believes it is, and carry it on once the operator confirms."""
-        try:
-            plan = self.engine.plan_resume()
-        except StairbotError as exc:
-            message = f"cannot resume: {exc}"
-            self.state.set_status(message=message, severity="error")
-            self.say(message, "error", timeout=10)
-            return
-
-        def answered(yes: bool | None) -> None:
-            if yes:
-                self.run_program(mode, plan)
-            else:
-                self.say("not resumed: nothing moved")
-
-        lines = "\n".join(plan.lines)
-        self.push_screen(ConfirmScreen(
-            f"Resume on {plan.state.start.get('url')}:\n{lines}\n\nLook at the robot: does "
-            "it stand where these lines say?  Resume and let it move?  Space stops every "
-            "motor.", yes="Yes, resume (y)"), answered)
+        motion_gate.start(self, mode)
 
     def action_pause(self) -> None:
-        if not self.engine.running:
-            self.say("no run is going on")
-        elif self.state.view().status.paused:
-            self._after_consent("Resume motion", self.engine.resume)
-        else:
-            self.engine.pause()
-        self.refresh_view()
-
-    def _after_consent(self, what: str, go: Callable[[], object]) -> None:
-        """Do ``go`` now for the in-process simulation; for a robot on a wire ask
-        first.  Fake boards are asked about too: that they are simulated is only
-        their own word (a status flag), which is no ground for moving unasked."""
-        session = self.engine.session
-        if session is None or self.engine.in_process:
-            go()
-            return
-        boards = ("Boards on a wire that report a simulated world (fake boards)."
-                  if session.simulated else "REAL boards on a wire.")
-
-        def answered(yes: bool | None) -> None:
-            if yes:
-                go()
-                self.refresh_view()
-            else:
-                self.say("nothing moved")
-
-        self.push_screen(ConfirmScreen(
-            f"{what} on {session.url}?\n{boards}\n"
-            "The motors will move. Space stops every motor."), answered)
+        motion_gate.pause(self)
 
     def action_stop_run(self) -> None:
         if self.engine.running:
@@ -633,31 +500,9 @@ class StairbotConsole(App[None]):
 
     # -- quitting ------------------------------------------------------------------
     def action_quit_console(self, key: str = "q") -> None:
-        """Quit; mid-run the robot stops first (the emergency stop, latched),
-        then the console asks: the answer may take a while, and the robot must
-        not drive on meanwhile."""
-        if not self.engine.running:
-            self.exit()
-            return
-        if not self.engine.latched:
-            self.engine.estop(f"{key} pressed mid-run")
-            self.refresh_view()
-        if self._asking_quit:
-            return
-        self._asking_quit = True
-
-        def answered(yes: bool | None) -> None:
-            self._asking_quit = False
-            if yes:
-                self.exit()  # on_unmount ends the run and releases the robot
-            else:
-                self.say("not quitting: the run is held, EMERGENCY STOP latched "
-                         "(c clears it, then p resumes)", "warning")
-
-        self.push_screen(ConfirmScreen(
-            "The robot is stopped: EMERGENCY STOP latched (every motor stopped, the lifts "
-            "hold).\nQuit the console? The run ends; the robot stays where it stands, "
-            "latched.", yes="Yes, quit (y)", no="No, stay (n)"), answered)
+        """Quit; mid-run the robot stops first, then the console asks
+        (:func:`~stairbot.console.motion_gate.quit_console`)."""
+        motion_gate.quit_console(self, key)
 
     def _on_sigint(self, _sig: int, _frame: FrameType | None) -> None:
         def stop_then_ask() -> None:
