@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import statistics
 
-from stairbot.algorithm import landing, motion
+from stairbot.algorithm import landing, long_tread, motion
 from stairbot.algorithm.moves import (
     KEY_TICKS,
     drive_phase,
@@ -244,7 +244,8 @@ def _lifted_first(t: Tick, w: Work) -> Step:
     lifted = t.snap.turns(MotorId.MTF) - ctx.return_mtf
     rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
         + cfg.sensors.front_height
-    if tread is not None and tread != float("inf") and rise < cfg.min_rise_for(tread):
+    if tread is not None and tread != float("inf") and rise < cfg.min_rise_for(tread) \
+            and not _held(t, w, tread):
         # A cone looking up sees over the next riser (as high as this one, we
         # assume) this far away: the readings mix what lies beyond it.
         ctx.ascent_end = "obstacle"
@@ -266,6 +267,29 @@ def _lifted_first(t: Tick, w: Work) -> Step:
           f"(step {ctx.number_of_steps + 1})",
           number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
     return go(P.ASCENT_DRIVE_FIRST)
+
+
+def _held(t: Tick, w: Work, tread: float) -> bool:
+    """A tread past FAR_TREAD_M whose rise is below min_rise_for: whether the
+    pair's readings held as segment 1 rose (a wall, or a riser the cone
+    sees whole: climbed), said either way
+    (:mod:`~stairbot.algorithm.long_tread`)."""
+    if not long_tread.far(tread):
+        return False
+    reading = tread + _gap(t)
+    held, moved = long_tread.steady(t, w, reading)
+    limit = long_tread.steady_m(t, reading)
+    lift_mm = t.ctx.number_of_vertical_turns * t.cfg.motors.lift_travel_per_turn * 1000
+    if moved is None:
+        t.say(f"step {t.ctx.number_of_steps + 1}: too few readings past the riser over the "
+              f"last {lift_mm:.0f} mm of lift to tell whether they held")
+    else:
+        t.say(f"step {t.ctx.number_of_steps + 1}: the front pair's readings of the riser "
+              f"{reading:.3f} m ahead moved {moved * 1000:.0f} mm as segment 1 rose "
+              f"{lift_mm:.0f} mm ({'within' if held else 'more than'} {limit * 1000:.0f} mm): "
+              + ("a wall, or a riser the whole cone sees" if held
+                 else "the cone sees over it"), tread_moved=moved)
+    return held
 
 
 def _sample_sight(t: Tick, w: Work) -> None:
@@ -310,6 +334,7 @@ _more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_verti
 
 def _more_step(t: Tick, w: Work) -> Step:
     _sample_sight(t, w)
+    long_tread.sample(t, w, _gap(t) + SIGHT_JUMP_M)
     return _lift_more(t, w)
 
 
@@ -320,7 +345,8 @@ LIFT_FIRST_MORE = PhaseDef(
                               "number_of_turns_for_step_height stored",
         P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < min_tread_m: "
                                  "tread too short; or a rise too low for the tread "
-                                 "(min_rise_for)",
+                                 "(min_rise_for; past FAR_TREAD_M, only if the readings "
+                                 "grew as segment 1 rose)",
         P.ERROR: FAULT})
 
 
@@ -357,7 +383,10 @@ def _measure_next_step(t: Tick, w: Work) -> None:
     medians = _sight_medians(t, w)
     if motion.measurable(t.snap, t.cfg) and None not in medians:
         ctx.length_of_next_step = sum(m for m in medians if m is not None) / 2.0
-        t.say(f"length_of_next_step = {ctx.length_of_next_step:.3f} m",
+        far = long_tread.far(ctx.length_of_next_step)
+        t.say(f"length_of_next_step = {ctx.length_of_next_step:.3f} m"
+              + (f" (past FAR_TREAD_M = {long_tread.FAR_TREAD_M} m: the drives onto the step "
+                 "go by turns)" if far else ""),
               length_of_next_step=ctx.length_of_next_step)
         return
     ctx.length_of_next_step = None
@@ -366,12 +395,12 @@ def _measure_next_step(t: Tick, w: Work) -> None:
 
 
 def _first_target(t: Tick) -> float | None:
-    length = t.ctx.length_of_next_step
+    length = long_tread.near_length(t)
     return None if length is None else length - t.cfg.LENGTH_OF_FIRST_MODULE
 
 
 def _second_target(t: Tick) -> float | None:
-    length = t.ctx.length_of_next_step
+    length = long_tread.near_length(t)
     if length is None:
         return None
     return length - t.cfg.LENGTH_OF_FIRST_MODULE - t.cfg.LENGTH_OF_SECOND_MODULE
@@ -381,8 +410,9 @@ def _third_target(t: Tick) -> float | None:
     """length_of_next_step − LENGTH_OF_A_ROBOT, or, on a narrow step (which
     the robot does not fit on), no nearer the next riser than a tread of
     min_tread_m would leave it (SAFE_LENGTH and the approach's gap): segment
-    3 stays in the air over the step below."""
-    length = t.ctx.length_of_next_step
+    3 stays in the air over the step below.  None (by turns) past
+    FAR_TREAD_M, as for ascent 4 and 6."""
+    length = long_tread.near_length(t)
     if length is None:
         return None
     cfg = t.cfg
@@ -442,7 +472,12 @@ LIFT_THIRD = PhaseDef(
 
 
 # -- ascent 8-9: the top, or the next step ------------------------------------------------------
-def _check(t: Tick, _w: Work) -> Step:
+TAB_WAIT_S = 1.0
+"""Ascent 8: how long the robot stands for a tab ascent 7 found not
+measurable while the pair does not read "nothing ahead" either."""
+
+
+def _check(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
@@ -450,6 +485,9 @@ def _check(t: Tick, _w: Work) -> Step:
         t.say(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
               "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
         return go(P.DESCENT_LOWER_THIRD)
+    tab = _tab_again(t, w)
+    if tab is not None:
+        return tab
     if ctx.number_of_steps >= cfg.algorithm.max_steps:
         ctx.ascent_end = "step_limit"
         t.say(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
@@ -458,10 +496,43 @@ def _check(t: Tick, _w: Work) -> Step:
     return go(P.ASCENT_DRIVE_THIRD)
 
 
+def _tab_again(t: Tick, w: Work) -> Step | None:
+    """Ascent 7 found no tab (one sensor at least read nothing ahead) and
+    the pair does not read "nothing ahead" now: a riser about
+    LENGTH_OF_INFINITY away, which one beam reaches and the other not.  The
+    descent of this step needs the tab: stand up to TAB_WAIT_S for the pair
+    to read it (kept), or both nothing (the top); still neither, the riser
+    is taken for out of sight and this for the top.  (Going on, the ir robot,
+    LENGTH_OF_INFINITY 0.75 m, climbed onto a 0.9 m tread, met a wall, and
+    on the way down descent 1 stopped: no tab to find the edge by -- the
+    long-treads sweep.)  None: go on."""
+    ctx, cfg = t.ctx, t.cfg
+    i = ctx.number_of_steps - 1
+    if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:
+        return None
+    if motion.measurable(t.snap, cfg):
+        ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
+        t.say(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m (read standing at "
+              "ascent 8: ascent 7 read nothing ahead)", index=i,
+              tab_length_to_edge=ctx.tab_length_to_edge[i])
+        return None
+    if w.still_since is None:
+        w.still_since = t.snap.time_s
+    if t.snap.time_s - w.still_since < TAB_WAIT_S:
+        return stay(NO_MOTION)
+    sfr, sfl = motion.pair(t.snap)
+    ctx.ascent_end = "top_reached"
+    t.say(f"top taken after {ctx.number_of_steps} steps: SFR/SFL read {sfr.distance_m:.3f}/"
+          f"{sfl.distance_m:.3f} m for {TAB_WAIT_S:g} s, one past LENGTH_OF_INFINITY (a riser "
+          "about that far: out of sight); the descent begins", ascent_end="top_reached")
+    return go(P.DESCENT_LOWER_THIRD)
+
+
 CHECK = PhaseDef(
     P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, watches="front",
     to={P.DESCENT_LOWER_THIRD: "reads ≥ LENGTH_OF_INFINITY (top reached) "
-                               "or number_of_steps = max_steps",
+                               "or number_of_steps = max_steps; or the tab not measured "
+                               "and not read standing TAB_WAIT_S (the top)",
         P.ASCENT_DRIVE_THIRD: "otherwise",
         P.ERROR: FAULT})
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import landing, motion
+from stairbot.algorithm import landing, long_tread, motion
 from stairbot.algorithm.ascent import narrow
 from stairbot.algorithm.calibration import HEADING_TOLERANCE_RAD, heading_off_rad
 from stairbot.algorithm.edge import (
@@ -414,10 +414,30 @@ landing 1.0 m deep, descent 5 ended 6.5 mm short of its target 1.007 m
 edge, and the robot tipped at 154 deg/s."""
 
 
+TAB_SIGMA_MAX_M = 0.0065
+"""Descent 3 and 5 drive by turns, too, where the front pair's stated sigma
+at the tab is more than this: the tab is one reading, and where descent 3
+ends is as far off as it.  The sweeps pass with sigmas up to 6 mm (the ir
+robot's Sharp pair at 0.25 m, the longest tabs of the envelope; a VL53L1X
+pair at 0.5 m, 5.5 mm); at 0.34 m the Sharp pair's (7.8 mm) ended descent 3
+17 mm short, and lowering segment 2 onto the edge pitched the robot to the
+tilt stop (the long-treads sweep, case 60 on ir)."""
+
+
 def _tab_to_drive(t: Tick) -> float | None:
-    """The tab descent 3 and 5 drive to, or None: by turns (FAR_TAB_M)."""
+    """The tab descent 3 and 5 drive to, or None: by turns (FAR_TAB_M; or a
+    tread past FAR_TREAD_M, which the ascent drove onto by turns: its tab,
+    0.35 to 0.45 m on treads of 0.5 to 0.6 m, read with the cone over a
+    riser lower than min_rise_for, jumped 22-27 mm as the robot backed, and
+    descent 3 or 5 ended short enough to pitch segment 2 to the tilt stop:
+    the long-treads sweep, six cases on the reference robot)."""
     tab = _tab(t)
-    return None if tab is None or tab > FAR_TAB_M else tab
+    i = t.descent_index
+    tread = t.ctx.tread_length[i] if 0 <= i < len(t.ctx.tread_length) else None
+    if tab is None or tab > FAR_TAB_M or long_tread.far(tread) \
+            or t.cfg.sensors.sigma(False, tab) > TAB_SIGMA_MAX_M:
+        return None
+    return tab
 
 
 def _second_target(t: Tick) -> float | None:

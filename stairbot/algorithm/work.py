@@ -55,6 +55,9 @@ class Work:
     """Ascent 3's lift past the sight-over: SFR's and SFL's readings of the
     next riser over its second half (the tread is measured on their medians,
     not on one noisy reading)."""
+    rise_rows: list[list[float]] = field(default_factory=lambda: [[], []])
+    """Ascent 3's lift past the sight-over: SFR's and SFL's readings past the
+    riser, in the order segment 1 rose (:mod:`stairbot.algorithm.long_tread`)."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
     diffs: list[float] = field(default_factory=list)

@@ -23,7 +23,14 @@ import msgspec
 from stairbot._schema import _tokens
 from stairbot.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
 from stairbot.errors import ConfigError, ScenarioError
-from stairbot.scenario import DEFAULT_COUNT, DEFAULT_RISE, DEFAULT_TREAD, Scenario, parse_scenario
+from stairbot.scenario import (
+    DEFAULT_COUNT,
+    DEFAULT_RISE,
+    DEFAULT_TREAD,
+    Scenario,
+    Step,
+    parse_scenario,
+)
 from stairbot.sweep import tomlw
 from stairbot.sweep.spec import VIRTUAL, Axis, Rules, Spec, SpecError, case_rng
 
@@ -140,7 +147,10 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     or take the margins; stairs out of sight at the start (see
     :func:`first_sight`) are outside.
     A tread counts where the robot must fit on it: every tread it climbs onto,
-    but not the last one under a landing, which runs on into the landing."""
+    but not the last one under a landing, which runs on into the landing.
+    A tread so long that the next riser is out of the front pair's sight at
+    ascent 8 ends the flight for the robot, as stairs out of sight at the
+    start do (:func:`_riser_seen_m`)."""
     if scenario.start.on == "top":
         return descent_zone(scenario, config, rules)
     if scenario.landing is not None:
@@ -159,19 +169,63 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     # before it, and each measured tread's own riser what the robot asks of it
     # (it takes the next riser to be as high: ascent 3)
     measured = [i for i in range(len(steps)) if not (i == last and scenario.top == "landing")]
-    low = min([min_rise - lo]
-              + [steps[i + 1].rise - config.min_rise_for(steps[i].tread)
-                 for i in range(len(steps) - 1)]
-              + [steps[i].rise - config.min_rise_for(steps[i].tread) for i in measured])
+    near_low, far_low = _cone_clearances(scenario, steps, measured, config, tm)
+    low = min([min_rise - lo] + near_low)
     sight, margin = first_sight(scenario, config), sight_margin(config)
+    sight = max([sight] + [_riser_seen_m(s.tread, config) for s in steps[:-1]])
     far = config.LENGTH_OF_INFINITY
     if (max_rise > lr + rm or low < -rm or min_tread < lt - tm
             or sight > far + margin):
         return "outside", max_rise, min_tread
-    if (max_rise <= lr - rm and low >= rm and min_tread >= lt + tm
-            and sight <= far - margin):
+    if (max_rise <= lr - rm and low >= rm and min(far_low, default=rm) >= rm
+            and min_tread >= lt + tm and sight <= far - margin):
         return "inside", max_rise, min_tread
     return "band", max_rise, min_tread
+
+
+def _riser_seen_m(tread: float, config: RobotConfig) -> float:
+    """What the front pair reads of the next riser at ascent 8 on a tread
+    ``tread`` long: from segment 1's front face, about LENGTH_OF_FIRST_MODULE
+    + LENGTH_OF_SECOND_MODULE - TAB_PAST_EDGE_M past the edge.  Past
+    LENGTH_OF_INFINITY (give or take the sight margin) the robot takes that
+    step for the top: like stairs out of sight at the start, the rest is
+    outside."""
+    from stairbot.algorithm.landing import TAB_PAST_EDGE_M
+
+    return tread - (config.LENGTH_OF_FIRST_MODULE + config.LENGTH_OF_SECOND_MODULE
+                    - TAB_PAST_EDGE_M)
+
+
+def _cone_clearances(scenario: Scenario, steps: tuple[Step, ...] | list[Step],
+                     measured: list[int], config: RobotConfig, tm: float
+                     ) -> tuple[list[float], list[float]]:
+    """How far each riser clears what the front cone needs, split by the
+    rule that holds it: ([the rule's own, which refuses], [the readings',
+    for a tread past FAR_TREAD_M]).  A tread the robot measures up to
+    FAR_TREAD_M (the reading, tread + approach_gap, give or take the tread
+    margin) holds the riser it climbs, and the next, to min_rise_for it;
+    past it the robot climbs a riser lower than that if its readings held
+    as segment 1 rose (:mod:`stairbot.algorithm.long_tread`): the next
+    riser lower than min_rise_for, climbing and refusing are both right (a
+    wall is higher than any: no bound).  Within the margin of FAR_TREAD_M,
+    either rule may hold: the readings'."""
+    from stairbot.algorithm.long_tread import FAR_TREAD_M  # the sweep runs the controller anyway
+
+    near: list[float] = []
+    far: list[float] = []
+    gap = config.algorithm.approach_gap
+    for i in range(len(steps)):
+        tread = steps[i].tread
+        need = config.min_rise_for(tread)
+        ahead = [steps[i + 1].rise - need] if i + 1 < len(steps) else []
+        own = [steps[i].rise - need] if i in measured else []
+        if tread + gap <= FAR_TREAD_M - tm:
+            near.extend(ahead + own)
+        elif tread + gap <= FAR_TREAD_M + tm:
+            far.extend(ahead + own)  # either rule
+        else:
+            far.extend(ahead)  # a wall ahead (the last step under top = "wall"): no bound
+    return near, far
 
 
 LATERAL_DRIFT_M = 0.05

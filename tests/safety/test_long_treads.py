@@ -1,0 +1,61 @@
+"""Long treads (stairbot.algorithm.long_tread): past FAR_TREAD_M the robot
+climbs a riser lower than the front cone's rule asks when its readings held
+as segment 1 rose, refuses it when they grew, and drives onto and off such a
+tread by turns."""
+
+from __future__ import annotations
+
+import simrun
+
+from stairbot.config import load_config
+from stairbot.events import Event, EventKind
+from stairbot.scenario import parse_scenario
+
+REFERENCE = load_config("reference")
+
+
+def flight(rise: float, tread: float, top: str = "landing", seed: int = 1) -> str:
+    return (f"[stairs]\ncount = 3\nrise = {rise}\ntread = {tread}\ntop = '{top}'\n"
+            f"[start]\ndistance = 0.5\n[sensors]\nseed = {seed}\n")
+
+
+def infos(events: list[Event]) -> list[str]:
+    return [e.message for e in events if e.kind is EventKind.INFO]
+
+
+def test_a_long_tread_before_a_riser_the_whole_cone_sees_is_climbed_by_turns() -> None:
+    """0.17 m risers 0.7 m apart: min_rise_for(0.7) is 0.24 m, which refused
+    them before; the readings hold, and the drives go by turns."""
+    events: list[Event] = []
+    result = simrun.run_sim(REFERENCE, parse_scenario(flight(0.17, 0.7), "<t>"), events)
+    assert (result.outcome, result.steps_climbed, result.steps_descended) == \
+        ("completed", 3, 3), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
+    assert not result.fell
+    told = infos(events)
+    assert sum("a wall, or a riser the whole cone sees" in m for m in told) == 2
+    assert sum("the drives onto the step go by turns" in m for m in told) == 2
+
+
+def test_a_long_tread_before_a_riser_the_cone_sees_over_is_refused() -> None:
+    """0.14 m risers 0.6 m apart: the top of the cone takes in what lies
+    beyond, the reading is 38 mm long, and it grows as segment 1 rises."""
+    for seed in (1, 2):
+        events: list[Event] = []
+        scenario = parse_scenario(flight(0.14, 0.6, seed=seed), "<t>")
+        result = simrun.run_sim(REFERENCE, scenario, events)
+        assert (result.outcome, result.ascent_end, result.steps_climbed) == \
+            ("completed", "obstacle", 0), result.to_dict()
+        assert any("the cone sees over it" in m for m in infos(events))
+
+
+def test_a_landing_as_deep_as_most_homes_is_climbed_onto_and_left_by_turns() -> None:
+    """A 0.9 m landing before a wall on the reference robot (no side pair):
+    it climbs onto it, refuses the wall, and comes home."""
+    events: list[Event] = []
+    text = ("[stairs]\nsteps = [{rise = 0.17, tread = 0.28}, {rise = 0.17, tread = 0.28}, "
+            "{rise = 0.17, tread = 0.9}]\ntop = 'wall'\n[start]\ndistance = 0.5\n")
+    result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "obstacle", 3, 3), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
