@@ -500,12 +500,14 @@ def _tab_again(t: Tick, w: Work) -> Step | None:
     """Ascent 7 found no tab (one sensor at least read nothing ahead) and
     the pair does not read "nothing ahead" now: a riser about
     LENGTH_OF_INFINITY away, which one beam reaches and the other not.  The
-    descent of this step needs the tab: stand up to TAB_WAIT_S for the pair
-    to read it (kept), or both nothing (the top); still neither, the riser
-    is taken for out of sight and this for the top.  (Going on, the ir robot,
-    LENGTH_OF_INFINITY 0.75 m, climbed onto a 0.9 m tread, met a wall, and
-    on the way down descent 1 stopped: no tab to find the edge by -- the
-    long-treads sweep.)  None: go on."""
+    descent of this step reads it: stand up to TAB_WAIT_S for the pair to
+    read it (kept), or both nothing (the top); still neither, go on, and
+    descent 1 finds this step's edge by the back pair alone.  (Without the
+    tab, the ir robot, LENGTH_OF_INFINITY 0.75 m, climbed onto a 0.9 m
+    tread, met a wall, and on the way down descent 1 stopped -- the
+    long-treads sweep; taking the top there instead, a robot whose SFL read
+    30 mm long, askew at the flight's side, came down the step it stood on
+    and tipped back.)  None: go on."""
     ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps - 1
     if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:
@@ -521,18 +523,16 @@ def _tab_again(t: Tick, w: Work) -> Step | None:
     if t.snap.time_s - w.still_since < TAB_WAIT_S:
         return stay(NO_MOTION)
     sfr, sfl = motion.pair(t.snap)
-    ctx.ascent_end = "top_reached"
-    t.say(f"top taken after {ctx.number_of_steps} steps: SFR/SFL read {sfr.distance_m:.3f}/"
-          f"{sfl.distance_m:.3f} m for {TAB_WAIT_S:g} s, one past LENGTH_OF_INFINITY (a riser "
-          "about that far: out of sight); the descent begins", ascent_end="top_reached")
-    return go(P.DESCENT_LOWER_THIRD)
+    t.say(f"tab_length_to_edge[{i}] not measured: SFR/SFL read {sfr.distance_m:.3f}/"
+          f"{sfl.distance_m:.3f} m for {TAB_WAIT_S:g} s, not both a riser nor both nothing "
+          "ahead; going on (the descent of this step finds its edge by the back pair alone)")
+    return None  # the phase goes on this tick
 
 
 CHECK = PhaseDef(
     P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, watches="front",
     to={P.DESCENT_LOWER_THIRD: "reads ≥ LENGTH_OF_INFINITY (top reached) "
-                               "or number_of_steps = max_steps; or the tab not measured "
-                               "and not read standing TAB_WAIT_S (the top)",
+                               "or number_of_steps = max_steps",
         P.ASCENT_DRIVE_THIRD: "otherwise",
         P.ERROR: FAULT})
 

@@ -145,13 +145,6 @@ BACK_OFF = PhaseDef(
                  "MAX_EDGE_YAW_RAD; a narrow step's tab_length_to_edge unknown; " + FAULT})
 
 
-def _edge_known(t: Tick, _w: Work) -> Step | None:
-    if _tab(t) is None and not t.ctx.from_top:
-        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured; "
-                    "the edge of the step cannot be found")
-    return None
-
-
 def edge_search_m(t: Tick) -> float:
     """Continuous descent: how far backing up to the edge looks for it before
     taking what the robot stands on for the floor.  From the start on the top,
@@ -166,9 +159,30 @@ def edge_search_m(t: Tick) -> float:
     return cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
 
 
+def _edge_by_watch(t: Tick) -> bool:
+    """Backing up to the edge goes by the back pair's edge watch alone: in a
+    continuous descent, and on a climbed step whose tab_length_to_edge was
+    not measured (the riser ahead about LENGTH_OF_INFINITY away, which one
+    beam reached and the other not: ascent 7 read nothing, ascent 8 read a
+    riser, and the robot went on -- the ir robot on a 0.9 m tread, the
+    long-treads sweep).  Not on a narrow step, whose tab places the robot."""
+    return t.ctx.from_top or (_tab(t) is None and not _narrow(t))
+
+
+def unmeasured_search_m(t: Tick) -> float:
+    """A climbed step whose tab was not measured: how far backing up to the
+    edge looks for it, the tread as ascent 3 measured it (the robot stands
+    on it), or LENGTH_OF_INFINITY."""
+    i = t.descent_index
+    tread = t.ctx.tread_length[i] if 0 <= i < len(t.ctx.tread_length) else None
+    return tread if tread is not None and math.isfinite(tread) else t.cfg.LENGTH_OF_INFINITY
+
+
 def _edge_fallback(t: Tick) -> float:
     if t.ctx.from_top:
         return t.cfg.wheel_turns(edge_search_m(t))
+    if _edge_by_watch(t):
+        return t.cfg.wheel_turns(unmeasured_search_m(t))
     # Descent 1 backed off to SAFE_DISTANCE_IN_FRONT_OF_STEP before calibrating.
     tab = _tab(t) or t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     return t.cfg.wheel_turns(max(0.0, tab - t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
@@ -188,9 +202,13 @@ def _at_edge(t: Tick, w: Work) -> Step:
     risers SFR/SFL jumped 70 mm to the riser beyond, descent 5 ended at once,
     and segment 1, lowered on the edge, pitched the robot 15 deg nose up.)"""
     ctx = t.ctx
+    searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
+    if not ctx.from_top and ctx.edge_wheel is None and _edge_by_watch(t):
+        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured, and "
+                    f"SBR/SBL saw no edge backing {searched:.2f} m (the tread measured, or "
+                    "LENGTH_OF_INFINITY): the edge of the step cannot be found")
     if not ctx.from_top or ctx.edge_wheel is not None:
         return go(P.DESCENT_LOWER_THIRD)
-    searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
     if ctx.steps_descended == 0:
         return end("stopped", f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
                               f"backing from the start (at most LENGTH_OF_INFINITY = "
@@ -232,7 +250,7 @@ def _turn_square(t: Tick, w: Work) -> Step:
 
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
-    checked_first(_edge_known, _to_edge_step), enter=_to_edge[0], watches="front",
+    _to_edge_step, enter=_to_edge[0], watches="front",
     to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
                                 "edge (driving forward first until they read the floor, "
                                 "if they were past it unseen); or, not crossed yet, reads "
@@ -243,7 +261,8 @@ BACK_TO_EDGE = PhaseDef(
         P.DONE: "continuous descent: no edge within the search (edge_search_m): on the "
                 "floor; or, from the start, not on the top of a flight; or the floor not "
                 "found again: the tread is shorter than the robot (stopped)",
-        P.ERROR: "tab_length_to_edge[i] unknown; the floor not found again; one back "
+        P.ERROR: "tab_length_to_edge[i] unknown and no edge seen within the tread; the floor "
+                 "not found again; one back "
                  "sensor reads the drop and the other not within MAX_EDGE_YAW_RAD; " + FAULT})
 
 

@@ -21,12 +21,16 @@ from __future__ import annotations
 
 import statistics
 
-from stairbot.algorithm import motion
+from stairbot.algorithm import long_tread, motion
 from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
 from stairbot.perception import standing_tolerance
 
+BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
+                           Phase.ASCENT_DRIVE_SECOND, Phase.ASCENT_LIFT_THIRD})
+"""Ascent 4 to 7: onto a step the robot drives by turns (long_tread.near_length
+None), the front pair's rule is not armed."""
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after
 the wait, before the program ends with an error)."""
@@ -67,12 +71,20 @@ def watch(t: Tick, phase: PhaseDef) -> Step | None:
     (one beam on a side wall, the other open: the red team's runs ended
     before they moved); below, risers the robot did not climb, which a cone
     sees over when they are low, and, in a flight 0.3 m wide, a side wall
-    (ended on the stairs by a disagreement that steered nothing)."""
+    (ended on the stairs by a disagreement that steered nothing).  Nor is it
+    armed in ascent 4 to 7 of a step the robot drives onto by turns (nothing
+    ahead, or a tread past FAR_TREAD_M): the front pair steers nothing
+    there, and pitched 5 deg nose down in ascent 5 on the top step of a
+    0.55 m wide second flight, it read the floor ahead at a graze and a side
+    wall (0.49 / 0.47 m), and the rule ended the program (the landings
+    sweep's deeper landings)."""
     if phase.watches is None:
         return None
     ctx = t.ctx
     back = phase.watches == "back"
     if ctx.from_top and not back:
+        return None
+    if not back and phase.phase in BY_TURNS_ONTO and long_tread.near_length(t) is None:
         return None
     if not _disagree(t, back):
         ctx.disagree_ticks = 0

@@ -59,3 +59,22 @@ def test_a_landing_as_deep_as_most_homes_is_climbed_onto_and_left_by_turns() -> 
     assert (result.outcome, result.ascent_end, result.steps_climbed,
             result.steps_descended) == ("completed", "obstacle", 3, 3), result.to_dict()
     assert result.final_offset_m is not None and result.final_offset_m < 0.05
+
+
+def test_a_tab_ascent_7_missed_is_found_by_the_back_pair_on_the_way_down() -> None:
+    """SFR reads past LENGTH_OF_INFINITY over ascent 7 and 8 of step 1 (as
+    the ir robot's beam did with a riser 0.75 m away): the tab is not
+    measured, ascent 8 waits TAB_WAIT_S for it and goes on, and descent 1
+    finds step 1's edge by the back pair alone (it stopped with "the edge of
+    the step cannot be found" before)."""
+    text = ("[stairs]\ncount = 2\nrise = 0.17\ntread = 0.28\n"
+            "[[faults]]\nat = 46.0\nsensor = 'SFR'\nkind = 'offset'\noffset = 1.5\n"
+            "duration = 3.5\n")
+    events: list[Event] = []
+    result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"), events)
+    assert (result.outcome, result.steps_climbed, result.steps_descended) == \
+        ("completed", 2, 2), result.to_dict()
+    assert result.final_offset_m is not None and result.final_offset_m < 0.05
+    told = infos(events)
+    assert any(m.startswith("tab_length_to_edge[0] not measured: SFR/SFL read") for m in told)
+    assert any(m.startswith("SBR/SBL see the edge") for m in told)
