@@ -150,12 +150,16 @@ robot backed as far as this yaw across the pair's spacing: it stops."""
 def square_to_edge(t: Tick, w: Work) -> str | None:
     """Watch which back sensor reads the drop first, and where
     (``w.edge_first_wheel``: :func:`_crossed` places the crossing between
-    the two).  In a continuous descent, once both do, the yaw to square up
-    (``w.square_yaw``), if more than EDGE_SQUARE_RAD and not squared at
-    this edge yet; an error if the other does not follow within
-    MAX_EDGE_YAW_RAD.  Only on a crossing the watch sees as it happens
-    (``w.edge_floor_s``).  Returns the error that ends the program, if
-    any."""
+    the two); an error if the other does not follow within
+    MAX_EDGE_YAW_RAD.  In a continuous descent, once both do, the yaw to
+    square up (``w.square_yaw``), if more than EDGE_SQUARE_RAD and not
+    squared at this edge yet.  Only on a crossing the watch sees as it
+    happens (``w.edge_floor_s``).  Returns the error that ends the program,
+    if any.  (On a climbed step the robot is square to the edge after
+    calibration: SBL reading 0.1 m long took a drop 0.2 m before SBR's, the
+    crossing half-way put it that far past, and the robot, stopped short,
+    tipped nose down lowering segment 3 -- the red team, on a 0.7 m
+    tread.)"""
     ctx, cfg = t.ctx, t.cfg
     if ctx.edge_wheel is not None or w.edge_floor_s is None:
         return None
@@ -168,8 +172,6 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
         first = "SBR" if right else "SBL"
         if w.edge_first_wheel is None or w.edge_first != first:
             w.edge_first_wheel, w.edge_first = here, first
-        if not ctx.from_top:
-            return None
         lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
         most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
         if lag > most:
@@ -177,9 +179,12 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
             return (f"descent 1: {first} reads the drop, {other} still the floor "
                         f"after backing {lag * 1000:.0f} mm more (at most {most * 1000:.0f} mm: "
                         f"{math.degrees(MAX_EDGE_YAW_RAD):.0f}° from square to the edge): "
-                        "turned too far from the edge, or the edge is not straight")
+                        "turned too far from the edge, the edge not straight, or a back "
+                        "sensor reading wrong")
         return None
-    if right and w.edge_first_wheel is not None and ctx.from_top and not ctx.edge_squared:
+    if not ctx.from_top:
+        return None
+    if right and w.edge_first_wheel is not None and not ctx.edge_squared:
         lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
         yaw = math.atan2(lag, 2 * cfg.sensors.back_lateral)
         if yaw > EDGE_SQUARE_RAD:

@@ -28,9 +28,12 @@ from stairbot.algorithm.work import Work
 from stairbot.perception import standing_tolerance
 
 BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
-                           Phase.ASCENT_DRIVE_SECOND, Phase.ASCENT_LIFT_THIRD})
-"""Ascent 4 to 7: onto a step the robot drives by turns (long_tread.near_length
-None), the front pair's rule is not armed."""
+                           Phase.ASCENT_DRIVE_SECOND})
+"""Ascent 4 to 6: onto a step the robot drives by turns (long_tread.near_length
+None), the front pair's rule is not armed.  It is in ascent 7, where the pair
+reads the tab: unarmed there, SFL reading 0.13 m short was not seen, the tab
+was stored 65 mm short, and descent 1 later stopped segment 3 short of the
+edge (the red team)."""
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after
 the wait, before the program ends with an error)."""
@@ -72,12 +75,12 @@ def watch(t: Tick, phase: PhaseDef) -> Step | None:
     before they moved); below, risers the robot did not climb, which a cone
     sees over when they are low, and, in a flight 0.3 m wide, a side wall
     (ended on the stairs by a disagreement that steered nothing).  Nor is it
-    armed in ascent 4 to 7 of a step the robot drives onto by turns (nothing
+    armed in ascent 4 to 6 of a step the robot drives onto by turns (nothing
     ahead, or a tread past FAR_TREAD_M): the front pair steers nothing
     there, and pitched 5 deg nose down in ascent 5 on the top step of a
     0.55 m wide second flight, it read the floor ahead at a graze and a side
     wall (0.49 / 0.47 m), and the rule ended the program (the landings
-    sweep's deeper landings)."""
+    sweep's deeper landings); ascent 7 reads the tab, and is armed."""
     if phase.watches is None:
         return None
     ctx = t.ctx

@@ -78,3 +78,38 @@ def test_a_tab_ascent_7_missed_is_found_by_the_back_pair_on_the_way_down() -> No
     told = infos(events)
     assert any(m.startswith("tab_length_to_edge[0] not measured: SFR/SFL read") for m in told)
     assert any(m.startswith("SBR/SBL see the edge") for m in told)
+
+
+RED_FLIGHT = ("[stairs]\nsteps = [{rise = 0.17, tread = 0.28}, {rise = 0.17, tread = 0.7}, "
+              "{rise = 0.14, tread = 0.28}, {rise = 0.17, tread = 0.28}]\ntop = 'landing'\n"
+              "[sensors]\nseed = 6\n")
+
+
+def test_a_front_sensor_reading_short_while_the_tab_of_a_long_tread_is_read_stops_the_robot(
+        ) -> None:
+    """The red team: SFL 0.13 m short through ascent 7 of the 0.7 m step.
+    With the standing rule off there (the drives go by turns), the tab was
+    stored 65 mm short and descent 1 stopped segment 3 short of the edge:
+    tilt stop nose down two steps higher.  Ascent 7 reads the tab, and the
+    rule is armed in it."""
+    text = RED_FLIGHT + ("[[faults]]\nat = 71.5\nsensor = 'SFL'\nkind = 'offset'\n"
+                         "offset = -0.13\nduration = 9\n")
+    result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"))
+    assert result.outcome == "error" and not result.fell, result.to_dict()
+    assert "still disagree" in str(result.error) and "ascent 7" in str(result.error)
+    assert result.steps_climbed == 1
+
+
+def test_a_back_sensor_reading_the_drop_far_before_the_other_stops_the_robot_on_the_tread(
+        ) -> None:
+    """The red team: SBL 0.1 m long as the robot backs up to the 0.7 m
+    step's edge reads a drop 0.2 m before SBR; placed half-way between the
+    two, the crossing left the robot short of the edge and it tipped nose
+    down lowering segment 3.  More than MAX_EDGE_YAW_RAD's worth apart, the
+    robot stops where it stands."""
+    text = RED_FLIGHT + ("[[faults]]\nat = 204.3\nsensor = 'SBL'\nkind = 'offset'\n"
+                         "offset = 0.1\nduration = 6\n")
+    result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"))
+    assert result.outcome == "error" and not result.fell, result.to_dict()
+    assert "SBL reads the drop, SBR still the floor" in str(result.error)
+    assert result.max_pitch_deg is not None and result.max_pitch_deg < 8.0
