@@ -263,7 +263,12 @@ def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
     (backing, the odometer runs down), so at a larger count.  If one sensor
     read the drop first (at ``first_wheel``), the crossing is placed
     half-way between the two: where the robot's centre line crossed, the
-    pair being mounted either side of it.  Placed where the second sensor
+    pair being mounted either side of it -- less what one measurement
+    period's backing explains (:func:`edge_doubt_m`: the two sensors measure
+    at their own times; counted in full, an HC-SR04 pair reading the drop
+    12 mm apart stopped segment 3's front wheels on the corner, and the
+    sonar robot tipped nose down lowering it: the envelope sweep, case
+    1464).  Placed where the second sensor
     read it, a pair reading the drop 12 mm apart (a VL53L0X cone straddling
     the edge, a stray measurement in its median, 2.3 deg off square) put it
     7 mm past the pair when it was about 13 mm, and backing the rest of the
@@ -273,8 +278,10 @@ def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
     sight = edge_sight_m(cfg, speed * cfg.wheel_circumference, t.ctx.from_top)
     here = motion.wheel_position(t.snap)
     if first_wheel is not None:
-        half = (first_wheel - here) / 2
-        return here + half + cfg.wheel_turns(sight), sight + half * cfg.wheel_circumference
+        # what one measurement period's backing explains is the sensors'
+        # timing, not where they crossed (edge_doubt_m covers it)
+        apart = max(0.0, (first_wheel - here) * cfg.wheel_circumference - edge_doubt_m(cfg))
+        return here + cfg.wheel_turns(sight + apart / 2), sight + apart / 2
     return here + cfg.wheel_turns(sight), sight
 
 
