@@ -293,14 +293,17 @@ def _held(t: Tick, w: Work, tread: float) -> bool:
 
 
 def _sample_sight(t: Tick, w: Work) -> None:
-    """Over the second half of the lift past the sight-over, keep each front
-    reading that still sees past the riser in ``w.sights``."""
-    if t.snap.turns(MotorId.MTF) - w.entry_mtf < t.ctx.number_of_vertical_turns / 2.0:
-        return
+    """Over the lift past the sight-over, keep each front reading that still
+    sees past the riser in ``w.rise_rows`` (the long tread's rule), and over
+    its second half in ``w.sights`` too."""
+    second_half = (t.snap.turns(MotorId.MTF) - w.entry_mtf
+                   >= t.ctx.number_of_vertical_turns / 2.0)
     gap, cfg = _gap(t), t.cfg
     for i, r in enumerate(motion.pair(t.snap)):
         if r.ok and not motion.far(r, cfg) and r.distance_m >= gap + SIGHT_JUMP_M:
-            w.sights[i].append(r.distance_m)
+            w.rise_rows[i].append(r.distance_m)
+            if second_half:
+                w.sights[i].append(r.distance_m)
 
 
 def _sight_medians(t: Tick, w: Work) -> list[float | None]:
@@ -334,7 +337,6 @@ _more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_verti
 
 def _more_step(t: Tick, w: Work) -> Step:
     _sample_sight(t, w)
-    long_tread.sample(t, w, _gap(t) + SIGHT_JUMP_M)
     return _lift_more(t, w)
 
 

@@ -55,6 +55,13 @@ def _tab(t: Tick) -> float | None:
     return t.ctx.tab_length_to_edge[t.descent_index]
 
 
+def _tread(t: Tick) -> float | None:
+    """The tread ascent 3 measured for the step being descended (None: not
+    measured, or not climbed)."""
+    i = t.descent_index
+    return t.ctx.tread_length[i] if 0 <= i < len(t.ctx.tread_length) else None
+
+
 def _h(t: Tick) -> float:
     return t.ctx.number_of_turns_for_step_height
 
@@ -173,8 +180,7 @@ def unmeasured_search_m(t: Tick) -> float:
     """A climbed step whose tab was not measured: how far backing up to the
     edge looks for it, the tread as ascent 3 measured it (the robot stands
     on it), or LENGTH_OF_INFINITY."""
-    i = t.descent_index
-    tread = t.ctx.tread_length[i] if 0 <= i < len(t.ctx.tread_length) else None
+    tread = _tread(t)
     return tread if tread is not None and math.isfinite(tread) else t.cfg.LENGTH_OF_INFINITY
 
 
@@ -451,9 +457,7 @@ def _tab_to_drive(t: Tick) -> float | None:
     descent 3 or 5 ended short enough to pitch segment 2 to the tilt stop:
     the long-treads sweep, six cases on the reference robot)."""
     tab = _tab(t)
-    i = t.descent_index
-    tread = t.ctx.tread_length[i] if 0 <= i < len(t.ctx.tread_length) else None
-    if tab is None or tab > FAR_TAB_M or long_tread.far(tread) \
+    if tab is None or tab > FAR_TAB_M or long_tread.far(_tread(t)) \
             or t.cfg.sensors.sigma(False, tab) > TAB_SIGMA_MAX_M:
         return None
     return tab

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import statistics
 
-from stairbot.algorithm import motion
 from stairbot.algorithm.phase import Tick
 from stairbot.algorithm.work import Work
 
@@ -60,14 +59,6 @@ def near_length(t: Tick) -> float | None:
     return None if length is None or far(length) else length
 
 
-def sample(t: Tick, w: Work, sees_past: float) -> None:
-    """Keep each front reading of ascent 3's lift that sees past the riser
-    (at least ``sees_past``), in the order segment 1 rose."""
-    for i, r in enumerate(motion.pair(t.snap)):
-        if r.ok and not motion.far(r, t.cfg) and r.distance_m >= sees_past:
-            w.rise_rows[i].append(r.distance_m)
-
-
 def growth(w: Work) -> float | None:
     """How much the pair's readings moved over the lift: the larger of SFR's
     and SFL's last-third median less its first-third median, in magnitude;
@@ -91,4 +82,4 @@ def steady(t: Tick, w: Work, distance_m: float) -> tuple[bool, float | None]:
     """Whether the pair's readings of a riser ``distance_m`` away held over
     the lift, and by how much they moved (None: too few readings)."""
     grew = growth(w)
-    return grew is not None and abs(grew) <= steady_m(t, distance_m), grew
+    return grew is not None and grew <= steady_m(t, distance_m), grew

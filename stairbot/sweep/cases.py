@@ -248,7 +248,7 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     margin.  Where the landing refuses, the first flight's zone stands: the
     robot climbs it, refuses the landing, comes home, and that is right
     ("refused"); where it does not, both flights must be climbed."""
-    from stairbot.algorithm.landing import DEPTH_MARGIN, TAB_PAST_EDGE_M, turn_room_m
+    from stairbot.algorithm.landing import DEPTH_MARGIN, turn_room_m
 
     landing = scenario.landing
     assert landing is not None
@@ -265,10 +265,8 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     # calibration's residual yaw adds over the flight (LATERAL_DRIFT_M)
     centred = scenario.width / 2.0 - room
     drifted = centred - abs(scenario.start.lateral) - LATERAL_DRIFT_M
-    # ascent 8 reads the wall ahead from segment 1's front face, about
-    # LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE - TAB_PAST_EDGE_M past the edge
-    top = (config.LENGTH_OF_INFINITY + config.LENGTH_OF_FIRST_MODULE
-           + config.LENGTH_OF_SECOND_MODULE - TAB_PAST_EDGE_M - landing.depth)
+    # how far inside LENGTH_OF_INFINITY ascent 8 reads the wall ahead
+    top = config.LENGTH_OF_INFINITY - _riser_seen_m(landing.depth, config)
     sight = sight_margin(config)
     turns = config.algorithm.landings and config.sensors.has_side_pair
     max_rise, min_tread = max(first[1], second[1]), min(first[2], second[2])
