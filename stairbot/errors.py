@@ -77,6 +77,12 @@ class PortBusyError(HardwareError):
     on a port at a time).  One line naming the port and who holds it."""
 
 
+class BoardOwnedError(HardwareError):
+    """Another host holds a board's lease (docs/protocol.md, section 3: one
+    host owns the robot): nothing was sent that it refuses.  One line naming
+    the URL, the board and the holder's session."""
+
+
 class BoardMismatchError(HardwareError):
     """The boards lack what the robot config says the robot has (the side
     pair SSR/SSL): a run would miss readings it counts on.  One line naming

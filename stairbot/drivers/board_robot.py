@@ -6,8 +6,9 @@
 become the snapshot in ``telemetry.py``: the four base sensors, and the side
 pair SSR/SSL on a robot whose config has one), ``command()``
 one SetWheelSpeeds + SetLiftSpeeds whose Ack is collected on the next call,
-the handshake identifies the boards and sets their watchdogs, a keepalive
-thread feeds them while the robot stands idle, and link health goes into
+the handshake identifies the boards, takes their leases (one host owns the
+robot: docs/protocol.md, section 3) and sets their watchdogs, a keepalive
+thread feeds them and renews the leases while the robot stands idle, and link health goes into
 ``Snapshot.health``, ``diagnostics()`` and LINK events (``attach_sink``).  A
 lost link raises LinkLostError; a board that never answers while opening,
 NoBoardError.
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import secrets
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -31,11 +33,11 @@ from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
-from stairbot.drivers.handshake import LATCHES, open_board
+from stairbot.drivers.handshake import LATCHES, open_board, release_board
 from stairbot.drivers.health import HealthReport
 from stairbot.drivers.link import BoardLink, Reply, Request
 from stairbot.drivers.telemetry import K, T, V
-from stairbot.errors import BoardMismatchError, HardwareError, LinkLostError
+from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import Clock, Imu, MotorId, SensorId, SensorReading, Snapshot
 from stairbot.robots import RobotSession
@@ -94,6 +96,9 @@ class BoardRobot:
             monotonic=lambda: monotonic() * time_scale, sleep=lambda s: time.sleep(s / time_scale))
         self.idents: dict[int, m.Ident] = {}
         self.status: dict[int, m.Status] = {}
+        self.boots: dict[int, int] = {}  # board -> boot id (its Owner reply)
+        self.nonce = secrets.randbits(32)  # tells this host's leases from another's
+        self._time_scale = time_scale
         self.imu_read = telemetry.ImuRead(None, "unknown")  # the IMU as last read
         self.imu_rejected = 0  # replies whose IMU broke the protocol
         self.report = HealthReport(link.stats, monotonic)
@@ -107,15 +112,22 @@ class BoardRobot:
         # Fake boards paced at X times real time count the watchdog in their
         # simulated time: X times the wall time the host has to feed it.
         self.board_watchdog_ms = min(65535, round(watchdog_ms * time_scale))
+        self.lease_ms = m.LEASE_MS  # in wall-clock ms, as the watchdog
         self._lock = threading.RLock()
         self.latched: dict[int, int] = {}  # board -> latch flags found when opening
-        self._handshake(allow_latched)
+        try:
+            self._handshake(allow_latched)
+        except BaseException:
+            for board in self.boots:  # the leases taken so far
+                release_board(self.link, m.Board(board), self.nonce)
+            raise
         # A robot opened and left idle (a console before its run starts) must
-        # not trip the boards' watchdogs: a daemon thread sends Heartbeats to
-        # any board the host has not addressed for a quarter of the timeout.
+        # neither trip the boards' watchdogs nor let its leases lapse: a daemon
+        # thread sends Heartbeats to any board the host has not addressed for
+        # a quarter of the shorter of the two.
         self._stop = threading.Event()
         self._keepalive: threading.Thread | None = None
-        if watchdog_ms and keepalive:
+        if keepalive:
             self._keepalive = threading.Thread(target=self._keep_alive, daemon=True,
                                                name=f"{link.wire} robot keepalive")
             self._keepalive.start()
@@ -123,10 +135,12 @@ class BoardRobot:
     # -- setting up ------------------------------------------------------------
     def _handshake(self, allow_latched: bool) -> None:
         for board in m.Board:
-            self.idents[board], status = open_board(
+            self.idents[board], status, owner = open_board(
                 self.link, self.url, board, lockstep=self.LOCKSTEP,
-                watchdog_ms=self.board_watchdog_ms, allow_latched=allow_latched,
-                side_pair=self.side_pair)
+                watchdog_ms=self.board_watchdog_ms, nonce=self.nonce,
+                lease_ms=self.board_lease_ms, wait_s=self._wait_board_s,
+                allow_latched=allow_latched, side_pair=self.side_pair)
+            self.boots[board] = owner.boot
             if status is not None:
                 self.status[board] = status
                 if status.flags & LATCHES:
@@ -135,13 +149,30 @@ class BoardRobot:
                     self._estopped = True  # this host holds the latch it found
             self._last_tx[board] = self._monotonic()
 
+    @property
+    def board_lease_ms(self) -> int:
+        """The lease asked of the boards, in their ms (time-scaled as the watchdog)."""
+        return max(1, min(65535, round(self.lease_ms * self._time_scale)))
+
+    def _wait_board_s(self, seconds: float) -> None:
+        """Sleep ``seconds`` of the boards' clock."""
+        time.sleep(seconds / self._time_scale)
+
+    @property
+    def feed_s(self) -> float:
+        """How often, in wall seconds, a board must hear from this host to
+        keep both its watchdog fed and its lease: a quarter of the shorter."""
+        return min(self.watchdog_ms or self.lease_ms, self.lease_ms) / 4000
+
     def identity(self) -> dict[str, dict[str, int]]:
-        """Each board's serial number and uptime (ms, from its last Status):
-        what a journal keeps, and what tells a resumed run whether these are
-        the same boards, still running since (their counters still valid)."""
+        """Each board's serial number, uptime (ms, from its last Status) and
+        boot id (drawn by the board at power-up): what a journal keeps, and
+        what tells a resumed run whether these are the same boards, still
+        running since (their counters still valid)."""
         return {m.Board(b).name.lower(): {
                     "serial": ident.serial,
-                    "uptime_ms": self.status[b].uptime_ms if b in self.status else -1}
+                    "uptime_ms": self.status[b].uptime_ms if b in self.status else -1,
+                    "boot": self.boots.get(b, 0)}
                 for b, ident in self.idents.items()}
 
     @property
@@ -275,10 +306,22 @@ class BoardRobot:
     @locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
         """Clear latches (e-stop, watchdog, faults) on both boards; the host's
-        e-stop latch once both boards confirm.  LinkLostError if they do not."""
-        self._wait(self._broadcast(m.Clear(mask)))
+        e-stop latch once both boards confirm.  LinkLostError if they do not;
+        BoardOwnedError if a board refuses (another host took its lease)."""
+        for reply in self._wait(self._broadcast(m.Clear(mask))):
+            self._check_owned(reply, "Clear")
         if mask & m.ClearMask.ESTOP:
             self._estopped = False
+
+    def _check_owned(self, reply: Reply, what: str) -> None:
+        """BoardOwnedError when a board answered ``what`` with Ack(NOT_OWNER)."""
+        for msg in reply.messages:
+            if isinstance(msg, m.Ack) and msg.result == m.AckResult.NOT_OWNER:
+                raise BoardOwnedError(
+                    f"{self.url}: the {m.Board(reply.board).name.lower()} board refused "
+                    f"{what}: this host no longer holds its lease (another host took it, "
+                    "or this one fell silent for longer than the lease); one host owns "
+                    "the robot")
 
     @property
     def estopped(self) -> bool:
@@ -287,13 +330,11 @@ class BoardRobot:
 
     @locked
     def heartbeat(self) -> None:
-        """Feed the watchdog of a board that was sent nothing for a quarter of
-        its timeout (the control loop's own frames normally do this)."""
-        if not self.watchdog_ms:
-            return
+        """Feed the watchdog and renew the lease of a board that was sent
+        nothing for ``feed_s`` (the control loop's own frames normally do this)."""
         now = self._monotonic()
         for board in m.Board:
-            if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:
+            if now - self._last_tx.get(board, 0.0) > self.feed_s:
                 self._commands.append(self._request(board, [m.Heartbeat()]))
 
     @locked
@@ -306,7 +347,7 @@ class BoardRobot:
                         "rejected": self.imu_rejected}}
 
     def _keep_alive(self) -> None:
-        period = self.watchdog_ms / 4000
+        period = self.feed_s
         while not self._stop.wait(period):
             try:
                 with self._lock:
@@ -325,15 +366,19 @@ class BoardRobot:
 
     @locked
     def _close(self) -> None:
-        """Stop every motor; once both boards confirm, switch their watchdogs
-        off: a watchdog still armed after a close trips, and its latch then
-        tells the next host that this one stopped without closing."""
+        """Stop every motor; once both boards confirm, switch off the
+        watchdogs this host set and give its leases up: a watchdog still armed
+        after a close trips, and its latch then tells the next host that this
+        one stopped without closing.  A board whose lease another host holds
+        refuses both (this host set nothing there that it may undo)."""
         if self._closed:
             return
         with contextlib.suppress(Exception):
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
             if self.watchdog_ms:
                 self._wait(self._broadcast(m.SetWatchdog(0)))
+        for board in self.boots:
+            release_board(self.link, m.Board(board), self.nonce)
         self._closed = True
         self.link.close()
 
@@ -396,14 +441,19 @@ class BoardRobot:
         except LinkLostError as exc:  # the wire itself failed
             self._lost(str(exc))
         still = []
+        done_now = []
         for p in self._commands:
             if p.reply is not None:
+                done_now.append(p)
                 for msg in p.reply.messages:
                     if isinstance(msg, m.Ack) and msg.result != m.AckResult.OK:
                         self.report.refused += 1
             elif not p.failed:
                 still.append(p)
         self._commands = still
+        for p in done_now:
+            if p.reply is not None:
+                self._check_owned(p.reply, "a command")
 
     def _check_status(self, board: m.Board, status: m.Status) -> None:
         self.status[board] = status

@@ -56,6 +56,12 @@ URL gives one: then any host on that network can send frames to the boards
 or the host (make them stop, or move).  Use a different ``port=`` to keep two
 buses on one group apart.
 
+One stairbot host on a bus at a time on this machine: opening takes a lock
+per interface and channel (``port_lock.py``; a second host is refused with
+one PortBusyError line naming the process that holds it), released when the
+bus shuts down.  Hosts on other machines are kept off by the boards' lease
+(docs/protocol.md, "One host owns the boards").
+
 Examples::
 
     can://virtual/bus0
@@ -79,6 +85,7 @@ from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import CanFrameLog, check_can_log
+from stairbot.drivers.port_lock import PortLock, take_port_lock
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
@@ -223,6 +230,19 @@ def open_bus(spec: CanUrl) -> can.BusABC:
         raise RobotUrlError(spec.url, None, f"cannot open CAN bus {where}: {detail}") from exc
 
 
+def lock_bus(spec: CanUrl) -> PortLock:
+    """This machine's lock on the bus ``spec`` names (``port_lock.py``): one
+    stairbot host on a bus at a time.  PortBusyError names the holder;
+    RobotUrlError when the lock file cannot be made."""
+    cfg = resolve_bus_config(spec)
+    where = f"{cfg.get('interface')}/{cfg.get('channel') if cfg.get('channel') is not None else ''}"
+    try:
+        return take_port_lock(f"can:{where}", f"CAN bus {where}")
+    except OSError as exc:
+        raise RobotUrlError(spec.url, None, f"cannot lock CAN bus {where}: "
+                            f"{exc.strerror or exc}") from None
+
+
 def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> RobotSession:
     """Open ``can://INTERFACE/CHANNEL?...``: both boards on one bus, driven by
     ``board_robot.BoardRobot`` over a :class:`CanLink` (an emergency stop is
@@ -232,7 +252,21 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     answers."""
     spec = parse_can_url(url)
     opts = spec.options
-    bus = open_bus(spec)
+    lock = lock_bus(spec)
+    try:
+        bus = open_bus(spec)
+    except BaseException:
+        lock.release()
+        raise
+    shutdown = bus.shutdown
+
+    def shutdown_and_unlock() -> None:
+        try:
+            shutdown()
+        finally:
+            lock.release()
+
+    bus.shutdown = shutdown_and_unlock  # type: ignore[method-assign]
     try:
         log = CanFrameLog(url, spec.log) if spec.log else None
     except RobotUrlError:

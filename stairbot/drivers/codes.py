@@ -21,8 +21,14 @@ from stairbot.hardware import MotorId, SensorId
 # before.  A 4.0 host reads channels 0-3 of either (on CAN it counts the two
 # side frames it did not expect as stray); a 4.1 host reads a 4.0 board as one
 # without the side pair.
-PROTOCOL_MAJOR = 4
-PROTOCOL_MINOR = 1
+# 5.0: one host owns the boards.  A host takes a board with Claim (a lease of
+# its session, renewed by every frame it sends); while the lease is live the
+# board refuses another session's motion commands, SetWatchdog, Clear and
+# StepTo (Ack NOT_OWNER), and only the owner's frames feed the watchdog.
+# Claim's reply, Owner, names the holder and carries the board's boot id.
+# SetWatchdog(0) is refused while a motor may move.
+PROTOCOL_MAJOR = 5
+PROTOCOL_MINOR = 0
 MAX_PAYLOAD = 8
 INT16_MAX = 32767
 INT16_NONE = -32768  # never sent in an IMU field: a board's "no number" (NaN)
@@ -113,6 +119,20 @@ class StatusFlag(IntFlag):
     LOCKSTEP = 0x80  # a fake board whose physics advances only on StepTo
 
 
+class ClaimResult(IntEnum):
+    """Owner.result: what became of a Claim."""
+
+    GRANTED = 0  # the lease is the claiming host's (taken or renewed)
+    HELD = 1  # another host's lease is live: nothing changed
+    RELEASED = 2  # the claiming host gave its lease up (lease_ms 0)
+    FREE = 3  # lease_ms 0 from a host that held none: nothing changed
+
+
+LEASE_MS = 1000
+"""The lease a host claims unless told otherwise (ms of the board's clock);
+a board keeps a lease at least as long as its watchdog timeout."""
+
+
 class ClearMask(IntFlag):
     ESTOP = 0x01
     WATCHDOG = 0x02
@@ -129,3 +149,4 @@ class AckResult(IntEnum):
     UNKNOWN_TYPE = 5
     BAD_LENGTH = 6
     NOT_SUPPORTED = 7  # e.g. StepTo on a real board
+    NOT_OWNER = 8  # refused: another host's lease is live, or this host holds none

@@ -8,7 +8,10 @@ it does not answer) or whose
 lockstep does not match the URL, or that holds a latch (its emergency stop,
 or a watchdog that tripped: an earlier host stopped mid-run, crashed or was
 cut off) -- opening never clears one, the operator does (``stairbot clear``)
--- then sets its watchdog.  A sensor board must say 4 channels, or 6 with the
+-- then sets its watchdog.  Before the latch check it takes the board's lease
+(Claim, protocol 5.0): a board another host holds is refused with one
+BoardOwnedError line naming that host's session; a lease about to lapse (its
+holder gone silent) is waited out once and taken.  A sensor board must say 4 channels, or 6 with the
 side pair (SSR, SSL; protocol 4.1); one without the side pair is refused when
 the robot config has it (BoardMismatchError), before any run could miss its
 readings.  ``board_robot`` does this for both boards when it opens.
@@ -16,11 +19,15 @@ readings.  ``board_robot`` does this for both boards when it opens.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable
+
 from stairbot.drivers import messages as m
 from stairbot.drivers.link import BoardLink, CountsReplies, ProbesOldBoards
 from stairbot.drivers.telemetry import BASE_NAMES, SIDE_NAMES
 from stairbot.errors import (
     BoardMismatchError,
+    BoardOwnedError,
     HardwareError,
     LatchedError,
     LinkLostError,
@@ -78,15 +85,63 @@ def latch_names(flags: int) -> str:
     return " and ".join(names)
 
 
+LEASE_WAIT_MAX_S = 3.0
+"""The longest lease left (board seconds) that opening waits out for a
+holder that may be gone; a longer one is refused at once."""
+
+
+def claim_board(link: BoardLink, url: str, board: m.Board, *, nonce: int, lease_ms: int,
+                wait_s: Callable[[float], None]) -> m.Owner:
+    """Take ``board``'s lease for this link's session (``nonce``: this host's).
+    A lease held by another host is waited out once (``wait_s`` sleeps board
+    seconds) when it has at most LEASE_WAIT_MAX_S left: a holder still alive
+    renews it meanwhile and is refused then.  Raises BoardOwnedError (one line
+    naming the holder's session), NoBoardError (no answer) or HardwareError
+    (an answer that is not Owner)."""
+    name = board.name.lower()
+    holder = 0
+    for attempt in (1, 2):
+        try:
+            reply = link.exchange(board, [m.Claim(lease_ms, nonce)])
+        except LinkLostError:
+            raise NoBoardError(url, name, f"the {name} board did not answer Claim on the "
+                               f"{link.wire}") from None
+        owner = reply.messages[0] if reply.messages else None
+        if not isinstance(owner, m.Owner):
+            raise HardwareError(f"{url}: the {name} board gave an unexpected answer to "
+                                f"Claim: {reply.messages}")
+        if owner.result == m.ClaimResult.GRANTED:
+            return owner
+        holder, left = owner.session, owner.lease_cs / 100
+        if attempt == 2 or left > LEASE_WAIT_MAX_S:
+            break
+        wait_s(left + 0.05)
+    raise BoardOwnedError(
+        f"{url}: the {name} board is held by another host (session {holder}; its "
+        "lease runs on while that host keeps sending): close that host first, one host "
+        "owns the robot")
+
+
+def release_board(link: BoardLink, board: m.Board, nonce: int) -> None:
+    """Give ``board``'s lease up (Claim with lease 0); what it answers is
+    not waited for beyond the link's own timeout, and nothing is raised."""
+    with contextlib.suppress(Exception):  # a lease not given up lapses on its own
+        link.exchange(board, [m.Claim(0, nonce)])
+
+
 def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
-               watchdog_ms: int, allow_latched: bool = False, side_pair: str | None = None
-               ) -> tuple[m.Ident, m.Status | None]:
-    """Identify ``board`` and set it up; its Ident and the Status after set-up.
+               watchdog_ms: int, nonce: int, lease_ms: int,
+               wait_s: Callable[[float], None], allow_latched: bool = False,
+               side_pair: str | None = None
+               ) -> tuple[m.Ident, m.Status | None, m.Owner]:
+    """Identify ``board``, take its lease (``claim_board``) and set it up;
+    its Ident, the Status after set-up and the Owner reply (the boot id).
     Raises NoBoardError (no answer), ProtocolVersionError, RobotUrlError (a
-    lockstep mismatch), LatchedError (a latch, unless ``allow_latched``: the
-    clear command), BoardMismatchError (a sensor board without the side pair
-    that ``side_pair`` names: see ``check_sensor_channels``) or HardwareError
-    (an answer that is not Ident + Status, a sensor board's channel count)."""
+    lockstep mismatch), BoardOwnedError (another host holds it), LatchedError
+    (a latch, unless ``allow_latched``: the clear command), BoardMismatchError
+    (a sensor board without the side pair that ``side_pair`` names: see
+    ``check_sensor_channels``) or HardwareError (an answer that is not Ident +
+    Status, a sensor board's channel count)."""
     n = link.retries + 1
     tries = f"{n} {'try' if n == 1 else 'tries'} of {link.timeout_s * 1e3:.0f} ms"
     name = board.name.lower()
@@ -117,6 +172,8 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
                 else "start the fake boards with --lockstep")
         state = "run" if board_lockstep else "do not run"
         raise RobotUrlError(url, "lockstep", f"the boards {state} in lockstep; {hint}")
+    owner = claim_board(link, url, board, nonce=nonce, lease_ms=lease_ms,
+                        wait_s=wait_s)
     if status.flags & LATCHES and not allow_latched:
         raise LatchedError(
             f"{url}: the {name} board has {latch_names(status.flags)}; opening never "
@@ -132,4 +189,8 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
                 raise NoBoardError(url, name, f"the {name} board did not answer "
                                    f"SetWatchdog on the {link.wire} ({tries})") from None
     last = reply.messages[-1] if reply.messages else None
-    return ident, last if isinstance(last, m.Status) else None
+    if isinstance(last, m.Ack) and last.result == m.AckResult.NOT_OWNER:
+        raise BoardOwnedError(f"{url}: the {name} board refused SetWatchdog: another host "
+                              "took its lease; one host owns the robot")
+    return ident, last if isinstance(last, m.Status) else None, owner
+

@@ -41,6 +41,7 @@ from stairbot.drivers.codes import (
     INT16_MAX,
     INT16_NONE,
     INT32_MAX,
+    LEASE_MS,
     LIFT_CHANNELS,
     MAX_PAYLOAD,
     MOTOR_CHANNELS,
@@ -50,6 +51,7 @@ from stairbot.drivers.codes import (
     SIDE_SENSOR_CHANNELS,
     AckResult,
     Board,
+    ClaimResult,
     ClearMask,
     ImuAxis,
     ImuCode,
@@ -61,6 +63,7 @@ from stairbot.drivers.codes import (
 from stairbot.drivers.records import (
     Ack,
     Brake,
+    Claim,
     Clear,
     CodecError,
     EStop,
@@ -75,6 +78,7 @@ from stairbot.drivers.records import (
     Message,
     MotorTelemetry,
     Move,
+    Owner,
     RawMessage,
     ReadAll,
     Run,
@@ -94,7 +98,7 @@ MESSAGES: dict[int, type[Message]] = {
         Identify, Heartbeat, GetStatus, SetWatchdog, EStop, Clear, ReadAll, GetMotor,
         GetSensor, GetImu, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, StepTo,
         GetTruth, Ident, Status, MotorTelemetry, SensorTelemetry, ImuTelemetry, Ack, StepDone,
-        Truth,
+        Truth, Claim, Owner,
     )
 }
 _STRUCTS: dict[int, struct.Struct] = {t: struct.Struct(c.FORMAT) for t, c in MESSAGES.items()}
@@ -154,13 +158,14 @@ def decode(type_code: int, payload: bytes) -> Message:
 
 __all__ = [
     "AGE_MAX_MS", "ALL_MOTORS_MASK", "ANGLE_MAX_CDEG", "BASE_SENSOR_CHANNELS", "BROADCAST",
-    "IMU_AXES", "INT16_MAX", "INT16_NONE", "INT32_MAX", "LIFT_CHANNELS", "MAX_PAYLOAD",
-    "MESSAGES", "MOTOR_CHANNELS", "PROTOCOL_MAJOR", "PROTOCOL_MINOR", "READ_ALL_REPLY",
-    "SENSOR_CHANNELS", "SIDE_SENSOR_CHANNELS", "Ack", "AckResult", "Board", "Brake", "Clear",
-    "ClearMask", "CodecError", "EStop", "GetImu", "GetMotor", "GetSensor", "GetStatus",
-    "GetTruth", "Heartbeat", "Ident", "Identify", "ImuAxis", "ImuCode", "ImuTelemetry",
-    "Message", "MotorFault", "MotorMode", "MotorTelemetry", "Move", "RawMessage", "ReadAll",
-    "Run", "SensorCode", "SensorTelemetry", "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds",
-    "Status", "StatusFlag", "StepDone", "StepTo", "Stop", "TelemetryValueError", "Truth",
-    "decode", "encode", "payload_size", "read_all_reply",
+    "IMU_AXES", "INT16_MAX", "INT16_NONE", "INT32_MAX", "LEASE_MS", "LIFT_CHANNELS",
+    "MAX_PAYLOAD", "MESSAGES", "MOTOR_CHANNELS", "PROTOCOL_MAJOR", "PROTOCOL_MINOR",
+    "READ_ALL_REPLY", "SENSOR_CHANNELS", "SIDE_SENSOR_CHANNELS", "Ack", "AckResult", "Board",
+    "Brake", "Claim", "ClaimResult", "Clear", "ClearMask", "CodecError", "EStop", "GetImu",
+    "GetMotor", "GetSensor", "GetStatus", "GetTruth", "Heartbeat", "Ident", "Identify",
+    "ImuAxis", "ImuCode", "ImuTelemetry", "Message", "MotorFault", "MotorMode",
+    "MotorTelemetry", "Move", "Owner", "RawMessage", "ReadAll", "Run", "SensorCode",
+    "SensorTelemetry", "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds", "Status", "StatusFlag",
+    "StepDone", "StepTo", "Stop", "TelemetryValueError", "Truth", "decode", "encode",
+    "payload_size", "read_all_reply",
 ]

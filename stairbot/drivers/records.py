@@ -20,7 +20,7 @@ from stairbot.drivers.codes import ALL_MOTORS_MASK, ClearMask
 from stairbot.errors import StairbotError
 
 # The type codes of the replies a host's message is answered with (ANSWER).
-IDENT, STATUS, ACK = 0x81, 0x82, 0xA0
+IDENT, STATUS, OWNER, ACK = 0x81, 0x82, 0x83, 0xA0
 MOTOR_TELEMETRY, SENSOR_TELEMETRY, IMU_TELEMETRY = 0x90, 0x91, 0x92
 
 
@@ -132,6 +132,21 @@ class Clear(Message):
     ANSWER = STATUS
     FORMAT = "<B"
     mask: int = int(ClearMask.ALL)
+
+
+@dataclass(frozen=True, slots=True)
+class Claim(Message):
+    """Take, renew or (``lease_ms`` 0) give up this host's lease of the
+    board.  ``nonce`` is drawn by the host when it opens the link, so that a
+    host whose session number happens to equal the holder's cannot take its
+    lease.  Sending it again has the same effect.  Reply: Owner."""
+
+    TYPE = 0x07
+    ANSWER = OWNER
+    FORMAT = "<HI"
+    IDEMPOTENT = True
+    lease_ms: int
+    nonce: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -271,6 +286,23 @@ class Status(Message):
     fault: int
     watchdog_ms: int
     uptime_ms: int
+
+
+@dataclass(frozen=True, slots=True)
+class Owner(Message):
+    """Answer to Claim: what became of it (ClaimResult), the session that
+    holds the lease now (0: none), how long it lasts from now without another
+    frame from its holder (in 10 ms, saturating at 2.55 s), and the board's
+    boot id: a number the board draws at power-up, so that a host can tell
+    a board that restarted (its counters begun again) from one that ran on."""
+
+    TYPE = 0x83
+    FORMAT = "<BHBI"
+    REPLY = True
+    result: int
+    session: int
+    lease_cs: int
+    boot: int
 
 
 @dataclass(frozen=True, slots=True)

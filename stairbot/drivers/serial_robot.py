@@ -53,7 +53,7 @@ import serial
 from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.frame_log import SerialFrameLog
-from stairbot.drivers.port_lock import PortLock, take_port_lock
+from stairbot.drivers.port_lock import PortLock, serial_lock_key, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
@@ -118,15 +118,16 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     line naming who holds it, when another stairbot has it open.
     RobotUrlError in one line when it cannot open."""
     lock: PortLock | None = None
-    if "://" not in port:  # a device: one host at a time
+    key = serial_lock_key(port)
+    if key is not None:  # one host at a time, however the URL spells the port
         try:
-            lock = take_port_lock(port)
+            lock = take_port_lock(key, f"serial port {port}")
         except OSError as exc:
             raise RobotUrlError(url, None, f"cannot lock port {port}: "
                                 f"{exc.strerror or exc}") from None
+    exclusive = {"exclusive": True} if key is not None and key.startswith("/") else {}
     try:
-        ser = serial.serial_for_url(port, baudrate=baud, timeout=0,
-                                    **({"exclusive": True} if lock is not None else {}))
+        ser = serial.serial_for_url(port, baudrate=baud, timeout=0, **exclusive)
     except Exception as exc:  # noqa: BLE001 - pyserial's URL handlers raise anything
         if lock is not None:
             lock.release()

@@ -2,20 +2,26 @@
 
 :class:`MotorBoard` and :class:`SensorBoard` answer the messages of
 ``stairbot.drivers.messages`` as docs/protocol.md says a real board must:
-per-board watchdog (no valid host frame for ``watchdog_ms`` -> every motor
-stops, lifts hold, a fault latches until an explicit Clear), latched emergency
-stop, fault latch, Move by turns; the motor board also answers the
-simulation's StepTo and GetTruth.  Both are backed by one
+one host's lease (Claim: while it is live, only its holder may command
+motion, set the watchdog, clear or step the world, and only its frames feed
+the watchdog), per-board watchdog (no frame from the lease's holder for
+``watchdog_ms`` -> every motor stops, lifts hold, a fault latches until an
+explicit Clear), latched emergency stop (anyone may stop the robot), fault
+latch, Move by turns; the motor board also answers the simulation's StepTo
+and GetTruth.  Both are backed by one
 :class:`~stairbot.fakes.board_world.BoardWorld` (``board_world.py``).
 
 A transport (``serial_boards``, the CAN fake) feeds each valid host frame to
-``board.handle(messages)`` and sends back what it returns; it calls
-``board.poll()`` whenever time may have passed.
+``board.handle(messages, session)`` with the host session the frame carries
+and sends back what it returns; it calls ``board.poll()`` whenever time may
+have passed.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import secrets
+import time
+from collections.abc import Callable, Sequence
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
@@ -23,6 +29,11 @@ from stairbot.fakes.board_world import BoardWorld
 
 FIRMWARE_VERSION = 0x0100
 DEFAULT_WATCHDOG_MS = 250
+
+# What only the holder of a live lease may send; anyone may query, stop or
+# brake (Stop, Brake) and latch the emergency stop.
+OWNED: tuple[type[m.Message], ...] = (
+    m.SetWatchdog, m.Clear, m.SetWheelSpeeds, m.SetLiftSpeeds, m.Run, m.Move, m.StepTo)
 
 
 class Board:
@@ -38,9 +49,20 @@ class Board:
         self.estop = False
         self.watchdog_tripped = False
         self.fault = m.MotorFault.NONE
-        self._last_feed: float | None = None  # the watchdog arms on the first host frame
+        self._last_feed: float | None = None  # the watchdog arms when a lease is granted
         self._start = world.now()
         self.handled = 0
+        self.boot = secrets.randbits(32) or 1  # drawn at power-up (Owner.boot)
+        # The lease: the holder's session and nonce, the lease it asked for,
+        # and when its last frame came (on the lease clock).  In lockstep the
+        # world's time stands still while the host is away, so the lease is
+        # counted in wall time there; otherwise on the board's own clock.
+        self.owner: int | None = None
+        self.owner_nonce = 0
+        self.lease_ms = 0
+        self._owner_seen = 0.0
+        self._lease_clock: Callable[[], float] = (time.monotonic if world.lockstep
+                                                  else world.now)
 
     # -- status ----------------------------------------------------------------
     def flags(self) -> int:
@@ -87,11 +109,49 @@ class Board:
     def halt(self) -> None:
         """Stop every motor this board drives (nothing on the sensor board)."""
 
+    # -- the lease ---------------------------------------------------------------
+    def _lease_left_s(self) -> float:
+        """How long the lease lasts without another frame from its holder
+        (0 when there is none); at least as long as the watchdog."""
+        if self.owner is None:
+            return 0.0
+        span = max(self.lease_ms, self.watchdog_ms) / 1000
+        return max(0.0, span - (self._lease_clock() - self._owner_seen))
+
+    def owns(self, session: int) -> bool:
+        """Whether ``session`` holds a live lease of this board."""
+        return self.owner == session and self._lease_left_s() > 0
+
+    def _owner(self, result: m.ClaimResult) -> m.Owner:
+        left = self._lease_left_s()
+        return m.Owner(int(result), self.owner if left > 0 and self.owner else 0,
+                       min(255, round(left * 100)), self.boot)
+
+    def _claim(self, msg: m.Claim, session: int) -> m.Owner:
+        live = self._lease_left_s() > 0
+        if live and (self.owner, self.owner_nonce) != (session, msg.nonce):
+            return self._owner(m.ClaimResult.HELD)
+        if msg.lease_ms == 0:
+            if not live:
+                return self._owner(m.ClaimResult.FREE)
+            self.owner = None
+            return self._owner(m.ClaimResult.RELEASED)
+        self.owner, self.owner_nonce, self.lease_ms = session, msg.nonce, msg.lease_ms
+        self._owner_seen = self._lease_clock()
+        self._last_feed = self.world.now()  # the watchdog is armed from now on
+        return self._owner(m.ClaimResult.GRANTED)
+
     # -- messages --------------------------------------------------------------
-    def handle(self, msgs: Sequence[m.Message | m.RawMessage]) -> list[m.Message]:
-        """The replies to one valid host frame, in order; feeds the watchdog."""
+    def handle(self, msgs: Sequence[m.Message | m.RawMessage], session: int
+               ) -> list[m.Message]:
+        """The replies to one valid host frame of host session ``session``,
+        in order.  A frame of the lease's holder renews the lease and feeds
+        the watchdog; another session's commands that need the lease are
+        answered Ack(NOT_OWNER) and not executed."""
         self.poll()  # a frame that comes too late does not un-trip the watchdog
-        self._last_feed = self.world.now()
+        if self.owns(session):
+            self._last_feed = self.world.now()
+            self._owner_seen = self._lease_clock()
         self.handled += 1
         out: list[m.Message] = []
         for msg in msgs:
@@ -99,9 +159,17 @@ class Board:
                 out.append(m.Ack(msg.type_code, m.AckResult.UNKNOWN_TYPE))
             elif msg.REPLY:
                 out.append(m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED))
+            elif isinstance(msg, m.Claim):
+                out.append(self._claim(msg, session))
+            elif isinstance(msg, OWNED) and not self.owns(session):
+                out.append(m.Ack(msg.TYPE, m.AckResult.NOT_OWNER))
             else:
                 out.extend(self.answer(msg))
         return out
+
+    def may_move(self) -> bool:
+        """Whether a motor of this board may be moving (none on the sensor board)."""
+        return False
 
     def answer(self, msg: m.Message) -> list[m.Message]:
         if isinstance(msg, m.Identify):
@@ -110,6 +178,8 @@ class Board:
         if isinstance(msg, m.Heartbeat | m.GetStatus):
             return [self.status()]
         if isinstance(msg, m.SetWatchdog):
+            if msg.timeout_ms == 0 and self.may_move():
+                return [m.Ack(msg.TYPE, m.AckResult.BAD_VALUE)]  # stop the motors first
             self.watchdog_ms = msg.timeout_ms
             return [self.status()]
         if isinstance(msg, m.EStop):
@@ -148,6 +218,9 @@ class MotorBoard(Board):
 
     def halt(self) -> None:
         self._set({ch: 0.0 for ch in range(self.CHANNELS)}, m.MotorMode.HOLD)
+
+    def may_move(self) -> bool:
+        return any(mode in (m.MotorMode.RUN, m.MotorMode.MOVE) for mode in self.modes)
 
     def telemetry(self, ch: int) -> m.MotorTelemetry:
         snap = self.world.snapshot()

@@ -172,10 +172,10 @@ class CanBoardServer:
         last = self._last.get(address)
         if last is not None and last[0] == key:
             self.stats.duplicates += 1
-            board.handle([])  # feeds the watchdog, executes nothing
+            board.handle([], frame.session)  # feeds the watchdog, executes nothing
             replies = last[1]
         else:
-            replies = board.handle([frame.message])
+            replies = board.handle([frame.message], frame.session)
             self._last[address] = (key, replies)
         if self._silent(address):
             return

@@ -159,7 +159,7 @@ class _DeadBoard:
     def __init__(self, board: Board) -> None:
         self.board = board
 
-    def handle(self, msgs: Any) -> list[m.Message]:
+    def handle(self, msgs: Any, session: int) -> list[m.Message]:
         return []
 
     def __getattr__(self, name: str) -> Any:

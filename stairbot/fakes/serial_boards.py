@@ -200,10 +200,10 @@ class SerialBoardServer:
         last = self._last.get(frame.board)
         if last is not None and last[0] == frame:
             self.stats.duplicates += 1
-            board.handle([])  # feeds the watchdog, executes nothing
+            board.handle([], frame.session)  # feeds the watchdog, executes nothing
             wire = last[1]
         else:
-            replies: list[Message] = board.handle(frame.messages)
+            replies: list[Message] = board.handle(frame.messages, frame.session)
             wire = self._reply_frame(frame, replies)
             self._last[frame.board] = (frame, wire)
         if not self._silent(frame.board):

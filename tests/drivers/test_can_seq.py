@@ -10,6 +10,7 @@ from __future__ import annotations
 import itertools
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import resources
@@ -222,6 +223,7 @@ def test_a_new_session_reusing_a_seq_is_executed_and_the_same_session_is_not(rig
     host's seq; the same frame again in one session is a copy, not executed."""
     motor = rig.boards[MOTOR]
     motor.estop = True
+    rig.link.exchange(MOTOR, [m.Claim(m.LEASE_MS, 1)])
     rig.link._seq = 41  # the next frame's seq: 42
     rig.link.exchange(MOTOR, [m.Clear(m.ClearMask.ESTOP)])
     assert not motor.estop
@@ -233,6 +235,8 @@ def test_a_new_session_reusing_a_seq_is_executed_and_the_same_session_is_not(rig
     # a new host (another session) whose seq is 42 too: executed
     newcomer = CanLink(rig.link.bus, timeout_s=0.01, retries=1,
                        session=rig.link.session % 1023 + 1)
+    rig.link.exchange(MOTOR, [m.Claim(0, 1)])  # the first host leaves
+    newcomer.exchange(MOTOR, [m.Claim(m.LEASE_MS, 2)])
     newcomer._seq = 41
     newcomer.exchange(MOTOR, [m.Clear(m.ClearMask.ESTOP)])
     assert not motor.estop and rig.server.stats.duplicates == 1
@@ -279,7 +283,7 @@ def test_a_protocol_3_can_board_is_refused_with_one_line() -> None:
     try:
         with pytest.raises(ProtocolVersionError) as info:
             open_board(link, "can://virtual/old", m.Board.MOTOR, lockstep=False,
-                       watchdog_ms=250)
+                       watchdog_ms=250, nonce=1, lease_ms=m.LEASE_MS, wait_s=time.sleep)
         assert str(info.value) == (
             "can://virtual/old: the motor board speaks protocol 3.0; this host speaks "
             f"{m.PROTOCOL_MAJOR}.x (docs/protocol.md): update the board's firmware or the host")
@@ -287,7 +291,7 @@ def test_a_protocol_3_can_board_is_refused_with_one_line() -> None:
         # a board that answers neither way is still "no board"
         with pytest.raises(NoBoardError, match="no sensor board answered"):
             open_board(link, "can://virtual/old", m.Board.SENSOR, lockstep=False,
-                       watchdog_ms=250)
+                       watchdog_ms=250, nonce=1, lease_ms=m.LEASE_MS, wait_s=time.sleep)
     finally:
         link.close()
 

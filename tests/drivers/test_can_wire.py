@@ -158,7 +158,7 @@ def test_captured_traffic_is_decoded_by_cantools(tmp_path: Path) -> None:
     host = InlineBus(can.Bus(interface="virtual", channel="capture"), server)
     link = CanLink(host, timeout_s=1.0)
     for board in m.Board:
-        link.exchange(board, [m.Identify(), m.ReadAll()])
+        link.exchange(board, [m.Identify(), m.Claim(m.LEASE_MS, 1), m.ReadAll()])
     link.exchange(1, [m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.StepTo(20000)])
     log = tmp_path / "capture.asc"
     with can.ASCWriter(str(log)) as writer:
@@ -176,8 +176,8 @@ def test_captured_traffic_is_decoded_by_cantools(tmp_path: Path) -> None:
         found.decode(frame.data)  # raises if it cannot
     assert names.count("MotorTelemetry_Motor") == 6
     assert names.count("SensorTelemetry_Sensor") == 4
-    assert {"Ident_Motor", "Ident_Sensor", "StepTo_Motor", "StepDone_Motor",
-            "SetWheelSpeeds_Motor", "Ack_Motor"} <= set(names)
+    assert {"Ident_Motor", "Ident_Sensor", "Claim_Motor", "Owner_Sensor", "StepTo_Motor",
+            "StepDone_Motor", "SetWheelSpeeds_Motor", "Ack_Motor"} <= set(names)
     for bus in (spy, host):
         bus.shutdown()
     server.bus.shutdown()

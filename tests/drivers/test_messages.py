@@ -153,10 +153,10 @@ def test_a_speed_that_is_not_a_number_is_sent_as_stop() -> None:
     assert lifts == m.SetLiftSpeeds(0, 0)
 
 
-def test_only_queries_and_step_to_are_idempotent() -> None:
+def test_only_queries_step_to_and_claim_are_idempotent() -> None:
     idempotent = {c.__name__ for c in m.MESSAGES.values() if c.IDEMPOTENT}
     assert idempotent == {"Identify", "Heartbeat", "GetStatus", "ReadAll", "GetMotor",
-                          "GetSensor", "GetImu", "StepTo", "GetTruth"}
+                          "GetSensor", "GetImu", "StepTo", "GetTruth", "Claim"}
 
 
 def test_every_host_message_declares_a_reply_a_board_sends() -> None:

@@ -87,7 +87,8 @@ def test_a_host_with_the_pair_refuses_a_board_without_it_while_opening(kind: str
     assert str(info.value) == (
         f'{kind}://x: side.toml: [sensors] side_model = "vl53l0x" gives the robot the side '
         "pair (SSR, SSL), but the sensor board offers 4 channels (SFR, SFL, SBR, SBL) and no "
-        "side pair (protocol 4.1); fit a sensor board with channels 4-5 (SSR, SSL), or set "
+        f"side pair (protocol {m.PROTOCOL_MAJOR}.{m.PROTOCOL_MINOR}); fit a sensor board with "
+        "channels 4-5 (SSR, SSL), or set "
         '[sensors] side_model = "none"')
     assert isinstance(info.value, HardwareError)  # exit 1, as every robot that cannot open
 
@@ -179,11 +180,11 @@ def test_a_can_board_that_leaves_out_frames_its_ident_promised_is_an_error_not_a
         "though it answered each time")
 
 
-def test_a_protocol_4_0_sensor_board_reads_as_one_without_the_pair() -> None:
+def test_a_minor_0_sensor_board_reads_as_one_without_the_pair() -> None:
     class Minor0(SensorBoard):
         def answer(self, msg: m.Message) -> list[m.Message]:
             if isinstance(msg, m.Identify):
-                return [m.Ident(self.BOARD, 4, 0, 4, 0x0100, self.serial)]
+                return [m.Ident(self.BOARD, m.PROTOCOL_MAJOR, 0, 4, 0x0100, self.serial)]
             return super().answer(msg)
 
     def boards(world: BoardWorld) -> dict[int, Board]:

@@ -24,6 +24,8 @@ from stairbot.hardware import (
     Truth,
 )
 
+HOST, NONCE = 0x2A, 7  # the session and nonce of the host these tests play
+
 
 class StubRobot:
     """Turns integrate the commanded speeds; ``fail`` makes read() raise;
@@ -88,6 +90,9 @@ def rig() -> tuple[StubRobot, BoardWorld, MotorBoard, SensorBoard]:
     boards = make_boards(world)
     motor, sensor = boards[1], boards[2]
     assert isinstance(motor, MotorBoard) and isinstance(sensor, SensorBoard)
+    for board in (motor, sensor):
+        (owner,) = board.handle([m.Claim(m.LEASE_MS, NONCE)], HOST)
+        assert owner.result == m.ClaimResult.GRANTED
     return robot, world, motor, sensor
 
 
@@ -99,9 +104,9 @@ def step(motor: MotorBoard, world: BoardWorld, seconds: float) -> None:
 
 def test_identify_and_read_all(rig: tuple) -> None:
     robot, world, motor, sensor = rig
-    (ident,) = motor.handle([m.Identify()])
+    (ident,) = motor.handle([m.Identify()], HOST)
     assert ident == m.Ident(1, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, 6, 0x0100, 1)
-    replies = sensor.handle([m.ReadAll()])
+    replies = sensor.handle([m.ReadAll()], HOST)
     assert isinstance(replies[0], m.Status)
     assert replies[0].flags & m.StatusFlag.SIMULATED and replies[0].flags & m.StatusFlag.LOCKSTEP
     assert tuple(type(r) for r in replies) == m.READ_ALL_REPLY[m.Board.SENSOR]
@@ -109,17 +114,17 @@ def test_identify_and_read_all(rig: tuple) -> None:
     assert [r.age_ms for r in replies[1:5]] == [0, 0, 0, 0]
     assert replies[5:] == [m.ImuTelemetry(0, m.ImuCode.ABSENT, 0, 0, 0),  # no IMU fitted
                            m.ImuTelemetry(1, m.ImuCode.ABSENT, 0, 0, 0)]
-    motor.handle([m.ReadAll()])
+    motor.handle([m.ReadAll()], HOST)
     assert robot.reads == 1  # both boards share one read per instant
 
 
 def test_speeds_reach_the_robot_and_telemetry_follows(rig: tuple) -> None:
     robot, world, motor, _ = rig
-    acks = motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(-2000, 0)])
+    acks = motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(-2000, 0)], HOST)
     assert acks == [m.Ack(0x20, 0), m.Ack(0x21, 0)]
     assert robot.speeds[MotorId.MWF] == 1.0 and robot.speeds[MotorId.MTF] == -2.0
-    motor.handle([m.StepTo(200_000)])  # within the 250 ms watchdog
-    tel = motor.handle([m.ReadAll()])[1:]
+    motor.handle([m.StepTo(200_000)], HOST)  # within the 250 ms watchdog
+    tel = motor.handle([m.ReadAll()], HOST)[1:]
     assert tel[0] == m.MotorTelemetry(0, m.MotorMode.RUN, 0, 1000, 200)
     assert tel[4] == m.MotorTelemetry(4, m.MotorMode.RUN, 0, -2000, -400)
     assert tel[5].mode == m.MotorMode.IDLE
@@ -127,123 +132,124 @@ def test_speeds_reach_the_robot_and_telemetry_follows(rig: tuple) -> None:
 
 def test_watchdog_trips_stops_every_motor_and_latches_until_cleared(rig: tuple) -> None:
     robot, world, motor, sensor = rig
-    motor.handle([m.SetWatchdog(100), m.SetWheelSpeeds(500, 500, 500, 500)])
+    motor.handle([m.SetWatchdog(100), m.SetWheelSpeeds(500, 500, 500, 500)], HOST)
     step(motor, world, 0.05)
     assert not motor.watchdog_tripped
     step(motor, world, 0.2)  # 250 ms without a host frame
     assert motor.watchdog_tripped and sensor.watchdog_tripped is False  # sensor never armed
     assert all(v == 0.0 for v in robot.speeds.values())
-    status = motor.handle([m.GetStatus()])[0]
+    status = motor.handle([m.GetStatus()], HOST)[0]
     assert status.flags & m.StatusFlag.WATCHDOG and status.fault == m.MotorFault.WATCHDOG
     # frames alone do not reset it; motion is refused until a Clear
-    assert motor.handle([m.SetWheelSpeeds(500, 0, 0, 0)]) == [m.Ack(0x20, m.AckResult.WATCHDOG)]
+    assert motor.handle([m.SetWheelSpeeds(500, 0, 0, 0)], HOST) == [
+        m.Ack(0x20, m.AckResult.WATCHDOG)]
     assert robot.speeds[MotorId.MWF] == 0.0
-    assert motor.handle([m.ReadAll()])[1].mode == m.MotorMode.HOLD
-    motor.handle([m.Clear(m.ClearMask.WATCHDOG)])
-    assert motor.handle([m.SetWheelSpeeds(500, 0, 0, 0)]) == [m.Ack(0x20, m.AckResult.OK)]
+    assert motor.handle([m.ReadAll()], HOST)[1].mode == m.MotorMode.HOLD
+    motor.handle([m.Clear(m.ClearMask.WATCHDOG)], HOST)
+    assert motor.handle([m.SetWheelSpeeds(500, 0, 0, 0)], HOST) == [m.Ack(0x20, m.AckResult.OK)]
     assert robot.speeds[MotorId.MWF] == 0.5
 
 
 def test_watchdog_zero_disables_it(rig: tuple) -> None:
     _, world, motor, _ = rig
-    motor.handle([m.SetWatchdog(0)])
+    motor.handle([m.SetWatchdog(0)], HOST)
     step(motor, world, 10.0)
     assert not motor.watchdog_tripped
 
 
 def test_estop_latches_until_an_explicit_clear(rig: tuple) -> None:
     robot, _, motor, _ = rig
-    motor.handle([m.SetLiftSpeeds(10000, 10000)])
-    status = motor.handle([m.EStop()])[0]
+    motor.handle([m.SetLiftSpeeds(10000, 10000)], HOST)
+    status = motor.handle([m.EStop()], HOST)[0]
     assert status.flags & m.StatusFlag.ESTOP and status.fault == m.MotorFault.ESTOP
     assert all(v == 0.0 for v in robot.speeds.values())
-    assert motor.handle([m.Run(4, 100)]) == [m.Ack(0x22, m.AckResult.ESTOP)]
-    assert motor.handle([m.Move(0, 100, 100)]) == [m.Ack(0x23, m.AckResult.ESTOP)]
-    motor.handle([m.Clear(m.ClearMask.WATCHDOG)])  # the wrong latch: still stopped
-    assert motor.handle([m.Run(4, 100)]) == [m.Ack(0x22, m.AckResult.ESTOP)]
-    status = motor.handle([m.Clear(m.ClearMask.ESTOP)])[0]
+    assert motor.handle([m.Run(4, 100)], HOST) == [m.Ack(0x22, m.AckResult.ESTOP)]
+    assert motor.handle([m.Move(0, 100, 100)], HOST) == [m.Ack(0x23, m.AckResult.ESTOP)]
+    motor.handle([m.Clear(m.ClearMask.WATCHDOG)], HOST)  # the wrong latch: still stopped
+    assert motor.handle([m.Run(4, 100)], HOST) == [m.Ack(0x22, m.AckResult.ESTOP)]
+    status = motor.handle([m.Clear(m.ClearMask.ESTOP)], HOST)[0]
     assert not status.flags & m.StatusFlag.ESTOP
-    assert motor.handle([m.Run(4, 100)]) == [m.Ack(0x22, m.AckResult.OK)]
+    assert motor.handle([m.Run(4, 100)], HOST) == [m.Ack(0x22, m.AckResult.OK)]
 
 
 def test_move_stops_after_the_turns(rig: tuple) -> None:
     robot, world, motor, _ = rig
-    assert motor.handle([m.Move(5, -1500, 1000)]) == [m.Ack(0x23, 0)]
+    assert motor.handle([m.Move(5, -1500, 1000)], HOST) == [m.Ack(0x23, 0)]
     assert robot.speeds[MotorId.MTB] == -1.0
     for _ in range(10):
-        motor.handle([m.StepTo(round(world.now() * 1e6) + 200_000)])
+        motor.handle([m.StepTo(round(world.now() * 1e6) + 200_000)], HOST)
     assert robot.speeds[MotorId.MTB] == 0.0
-    tel = motor.handle([m.GetMotor(5)])[0]
+    tel = motor.handle([m.GetMotor(5)], HOST)[0]
     assert tel.mode == m.MotorMode.IDLE and tel.turns_mt == -1600  # stopped at the next poll
 
 
 def test_stop_and_brake(rig: tuple) -> None:
     robot, _, motor, _ = rig
-    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(1000, 1000)])
-    motor.handle([m.Brake(0b010001)])  # MWF and MTF
-    tel = motor.handle([m.ReadAll()])[1:]
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(1000, 1000)], HOST)
+    motor.handle([m.Brake(0b010001)], HOST)  # MWF and MTF
+    tel = motor.handle([m.ReadAll()], HOST)[1:]
     assert tel[0].mode == m.MotorMode.BRAKE and tel[4].mode == m.MotorMode.IDLE
     assert robot.speeds[MotorId.MWF] == 0.0 and robot.speeds[MotorId.MWB] == 1.0
-    motor.handle([m.Stop()])
+    motor.handle([m.Stop()], HOST)
     assert all(v == 0.0 for v in robot.speeds.values())
 
 
 def test_refusals_and_unknown_messages(rig: tuple) -> None:
     robot, _, motor, sensor = rig
-    assert motor.handle([m.GetMotor(6)]) == [m.Ack(0x11, m.AckResult.BAD_CHANNEL)]
-    assert motor.handle([m.Move(1, 10, 0)]) == [m.Ack(0x23, m.AckResult.BAD_VALUE)]
-    assert motor.handle([m.Stop(0x40)]) == [m.Ack(0x24, m.AckResult.BAD_CHANNEL)]
-    assert motor.handle([RawMessage(0x33, b"")]) == [m.Ack(0x33, m.AckResult.UNKNOWN_TYPE)]
-    assert sensor.handle([m.SetLiftSpeeds(1, 1)]) == [m.Ack(0x21, m.AckResult.NOT_SUPPORTED)]
-    assert sensor.handle([m.GetSensor(4)]) == [m.Ack(0x12, m.AckResult.BAD_CHANNEL)]
-    assert motor.handle([m.Ack(0, 0)]) == [m.Ack(0xA0, m.AckResult.NOT_SUPPORTED)]
+    assert motor.handle([m.GetMotor(6)], HOST) == [m.Ack(0x11, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([m.Move(1, 10, 0)], HOST) == [m.Ack(0x23, m.AckResult.BAD_VALUE)]
+    assert motor.handle([m.Stop(0x40)], HOST) == [m.Ack(0x24, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([RawMessage(0x33, b"")], HOST) == [m.Ack(0x33, m.AckResult.UNKNOWN_TYPE)]
+    assert sensor.handle([m.SetLiftSpeeds(1, 1)], HOST) == [m.Ack(0x21, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([m.GetSensor(4)], HOST) == [m.Ack(0x12, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([m.Ack(0, 0)], HOST) == [m.Ack(0xA0, m.AckResult.NOT_SUPPORTED)]
     assert robot.speeds[MotorId.MTF] == 0.0
 
 
 def test_step_to_is_idempotent_and_lockstep_only(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     # the simulation's messages are the motor board's (docs/protocol.md, section 2)
-    assert sensor.handle([m.StepTo(20_000)]) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
-    assert sensor.handle([m.GetTruth()]) == [m.Ack(0x7D, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([m.StepTo(20_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([m.GetTruth()], HOST) == [m.Ack(0x7D, m.AckResult.NOT_SUPPORTED)]
     assert robot.t == 0.0
-    assert motor.handle([m.StepTo(20_000)]) == [m.StepDone(20_000)]
-    assert motor.handle([m.StepTo(20_000)]) == [m.StepDone(20_000)]
-    assert motor.handle([m.StepTo(10_000)]) == [m.StepDone(20_000)]
+    assert motor.handle([m.StepTo(20_000)], HOST) == [m.StepDone(20_000)]
+    assert motor.handle([m.StepTo(20_000)], HOST) == [m.StepDone(20_000)]
+    assert motor.handle([m.StepTo(10_000)], HOST) == [m.StepDone(20_000)]
     assert robot.t == pytest.approx(0.02)
     world.lockstep = False
-    assert motor.handle([m.StepTo(40_000)]) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    assert motor.handle([m.StepTo(40_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
 
 
 def test_sensor_sample_counter_advances_with_new_measurements(rig: tuple) -> None:
     _, world, motor, sensor = rig
-    a = sensor.handle([m.GetSensor(0)])[0].sample
-    assert sensor.handle([m.GetSensor(1)])[0].sample == a
-    motor.handle([m.StepTo(20_000)])
-    assert sensor.handle([m.GetSensor(0)])[0].sample == (a + 1) & 0xFFFF
+    a = sensor.handle([m.GetSensor(0)], HOST)[0].sample
+    assert sensor.handle([m.GetSensor(1)], HOST)[0].sample == a
+    motor.handle([m.StepTo(20_000)], HOST)
+    assert sensor.handle([m.GetSensor(0)], HOST)[0].sample == (a + 1) & 0xFFFF
 
 
 def test_a_repeated_reading_keeps_its_sample_number(rig: tuple) -> None:
     """A sensor that has not measured again (its age grew by the step) keeps
     its sample number; one that measured anew advances."""
     robot, world, motor, sensor = rig
-    sfr, sfl = (sensor.handle([m.GetSensor(ch)])[0].sample for ch in (0, 1))
+    sfr, sfl = (sensor.handle([m.GetSensor(ch)], HOST)[0].sample for ch in (0, 1))
     robot.ages[SensorId.SFR] = 0.02  # the same measurement, 20 ms older
-    motor.handle([m.StepTo(20_000)])
-    assert sensor.handle([m.GetSensor(0)])[0] == m.SensorTelemetry(0, 0, 500, sfr, 20)
-    assert sensor.handle([m.GetSensor(1)])[0].sample == (sfl + 1) & 0xFFFF
+    motor.handle([m.StepTo(20_000)], HOST)
+    assert sensor.handle([m.GetSensor(0)], HOST)[0] == m.SensorTelemetry(0, 0, 500, sfr, 20)
+    assert sensor.handle([m.GetSensor(1)], HOST)[0].sample == (sfl + 1) & 0xFFFF
 
 
 def test_the_sensor_board_serves_each_readings_age_and_the_imu(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     robot.ages = {**robot.ages, **dict(zip(BASE_SENSORS, (0.0123, 0.2, 1.5, 100.0), strict=True))}
     robot.imu = Imu(5.234, -0.756, 1.52, -0.24, 0.0031)
-    replies = sensor.handle([m.ReadAll()])
+    replies = sensor.handle([m.ReadAll()], HOST)
     assert [r.age_ms for r in replies[1:5]] == [12, 200, 1500, m.AGE_MAX_MS]  # saturated
     assert replies[5:] == [m.ImuTelemetry(0, m.ImuCode.OK, 523, 15, 3),
                            m.ImuTelemetry(1, m.ImuCode.OK, -76, -2, 3)]
-    assert sensor.handle([m.GetImu(1)]) == [m.ImuTelemetry(1, m.ImuCode.OK, -76, -2, 3)]
-    assert sensor.handle([m.GetImu(2)]) == [m.Ack(m.GetImu.TYPE, m.AckResult.BAD_CHANNEL)]
-    assert motor.handle([m.GetImu(0)]) == [m.Ack(m.GetImu.TYPE, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([m.GetImu(1)], HOST) == [m.ImuTelemetry(1, m.ImuCode.OK, -76, -2, 3)]
+    assert sensor.handle([m.GetImu(2)], HOST) == [m.Ack(m.GetImu.TYPE, m.AckResult.BAD_CHANNEL)]
+    assert motor.handle([m.GetImu(0)], HOST) == [m.Ack(m.GetImu.TYPE, m.AckResult.NOT_SUPPORTED)]
 
 
 @pytest.mark.parametrize(("imu", "pitch", "roll"), [
@@ -259,16 +265,16 @@ def test_an_imu_value_the_wire_cannot_carry_goes_as_error_or_saturates(
         rig: tuple, imu: Imu, pitch: m.ImuTelemetry, roll: m.ImuTelemetry) -> None:
     robot, world, motor, sensor = rig
     robot.imu = imu
-    assert sensor.handle([m.ReadAll()])[5:] == [pitch, roll]
+    assert sensor.handle([m.ReadAll()], HOST)[5:] == [pitch, roll]
 
 
 def test_a_failed_world_is_a_latched_simulation_fault(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     robot.fail = True
-    motor.handle([m.StepTo(20_000)])
-    status = sensor.handle([m.ReadAll()])[0]
+    motor.handle([m.StepTo(20_000)], HOST)
+    status = sensor.handle([m.ReadAll()], HOST)[0]
     assert status.fault == m.MotorFault.SIMULATION and status.flags & m.StatusFlag.FAULT
-    truth = motor.handle([m.GetTruth()])[0]
+    truth = motor.handle([m.GetTruth()], HOST)[0]
     assert truth == m.Truth(1, 325, 12)
 
 
@@ -285,7 +291,7 @@ def test_the_pacer_keeps_the_world_up_with_the_wall_clock_one_step_at_a_time(
     waits = [pacer.step() for _ in range(5)]
     assert waits[:4] == [0.0] * 4 and waits[4] > 0.0
     assert robot.t == pytest.approx(0.02)
-    motor.handle([m.SetWatchdog(10)])
+    motor.handle([m.SetWatchdog(10)], HOST)
     wall[0] += 0.002
     while pacer.step() == 0.0:
         pass
@@ -306,32 +312,104 @@ def side_rig(sensors: tuple[SensorId, ...]) -> tuple[StubRobot, SensorBoard]:
 
 def test_a_sensor_board_with_the_side_pair_has_six_channels() -> None:
     _, sensor = side_rig(tuple(SensorId))
-    (ident,) = sensor.handle([m.Identify()])
+    (ident,) = sensor.handle([m.Identify()], HOST)
     assert ident == m.Ident(2, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, 6, 0x0100, 2)
-    assert (m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR) == (4, 1)
-    replies = sensor.handle([m.ReadAll()])
+    assert (m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR) >= (4, 1)  # the side pair came in 4.1
+    replies = sensor.handle([m.ReadAll()], HOST)
     assert tuple(type(r) for r in replies) == m.read_all_reply(m.Board.SENSOR, 6)
     tel = [r for r in replies if isinstance(r, m.SensorTelemetry)]
     assert [(t.channel, t.distance_mm) for t in tel] == [(c, 500 + 100 * c) for c in range(6)]
-    assert sensor.handle([m.GetSensor(5)]) == [tel[5]]  # SSL
-    assert sensor.handle([m.GetSensor(6)]) == [m.Ack(m.GetSensor.TYPE, m.AckResult.BAD_CHANNEL)]
+    assert sensor.handle([m.GetSensor(5)], HOST) == [tel[5]]  # SSL
+    assert sensor.handle([m.GetSensor(6)], HOST) == [
+        m.Ack(m.GetSensor.TYPE, m.AckResult.BAD_CHANNEL)]
 
 
 def test_a_sensor_board_without_it_has_four_whatever_the_world_reads(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     assert set(SIDE_SENSORS) <= set(robot.sensors)  # the stub reads them; the board has none
-    assert sensor.handle([m.Identify()])[0].channels == 4
-    replies = sensor.handle([m.ReadAll()])
+    assert sensor.handle([m.Identify()], HOST)[0].channels == 4
+    replies = sensor.handle([m.ReadAll()], HOST)
     assert [r.channel for r in replies if isinstance(r, m.SensorTelemetry)] == [0, 1, 2, 3]
-    assert sensor.handle([m.GetSensor(4)]) == [m.Ack(m.GetSensor.TYPE, m.AckResult.BAD_CHANNEL)]
+    assert sensor.handle([m.GetSensor(4)], HOST) == [
+        m.Ack(m.GetSensor.TYPE, m.AckResult.BAD_CHANNEL)]
 
 
 def test_a_side_sensor_the_world_does_not_read_goes_as_never_measured() -> None:
     """A simulation that does not model the side pair yet: the board invents
     no distance; it says ERROR with the age saturated (docs/protocol.md, "Ages")."""
     _, sensor = side_rig(BASE_SENSORS)
-    replies = sensor.handle([m.ReadAll()])
+    replies = sensor.handle([m.ReadAll()], HOST)
     tel = [r for r in replies if isinstance(r, m.SensorTelemetry)]
     assert [t.channel for t in tel] == [0, 1, 2, 3, 4, 5]
     assert tel[4] == m.SensorTelemetry(4, m.SensorCode.ERROR, 0, 0, m.AGE_MAX_MS)
     assert tel[5] == m.SensorTelemetry(5, m.SensorCode.ERROR, 0, 0, m.AGE_MAX_MS)
+
+
+# -- one host owns the boards (protocol 5.0) ----------------------------------------
+
+OTHER = 0x15  # a second host's session
+
+
+def test_a_second_host_cannot_command_set_the_watchdog_clear_or_step(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    (held,) = motor.handle([m.Claim(m.LEASE_MS, 99)], OTHER)
+    assert (held.result, held.session, held.boot) == (m.ClaimResult.HELD, HOST, motor.boot)
+    for msg in (m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(500, 0),
+                m.Run(0, 100), m.Move(0, 100, 100), m.SetWatchdog(0), m.Clear(),
+                m.StepTo(round(world.now() * 1e6) + 20_000)):
+        assert motor.handle([msg], OTHER) == [m.Ack(msg.TYPE, m.AckResult.NOT_OWNER)]
+    assert sensor.handle([m.SetWatchdog(0)], OTHER) == [
+        m.Ack(m.SetWatchdog.TYPE, m.AckResult.NOT_OWNER)]
+    assert motor.watchdog_ms == sensor.watchdog_ms == 250
+    assert robot.speeds[MotorId.MWF] == 0.0
+    # queries are answered; stopping is anyone's right
+    assert isinstance(motor.handle([m.GetStatus()], OTHER)[0], m.Status)
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
+    assert motor.handle([m.Stop(m.ALL_MOTORS_MASK)], OTHER) == [m.Ack(m.Stop.TYPE, 0)]
+    assert robot.speeds[MotorId.MWF] == 0.0
+    assert motor.handle([m.EStop()], OTHER)[0].flags & m.StatusFlag.ESTOP
+
+
+def test_a_second_host_does_not_feed_the_owners_watchdog(rig: tuple) -> None:
+    robot, world, motor, sensor = rig
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
+    for _ in range(10):  # the other host talks every 50 ms; the owner is silent
+        step(motor, world, 0.05)
+        motor.handle([m.Heartbeat(), m.ReadAll()], OTHER)
+    assert motor.watchdog_tripped and robot.speeds[MotorId.MWF] == 0.0
+
+
+def test_the_same_session_with_another_nonce_is_another_host(rig: tuple) -> None:
+    _, _, motor, _ = rig
+    (held,) = motor.handle([m.Claim(m.LEASE_MS, NONCE + 1)], HOST)
+    assert held.result == m.ClaimResult.HELD
+    (again,) = motor.handle([m.Claim(m.LEASE_MS, NONCE)], HOST)
+    assert again.result == m.ClaimResult.GRANTED
+
+
+def test_the_watchdog_cannot_be_switched_off_while_a_motor_runs(rig: tuple) -> None:
+    _, _, motor, _ = rig
+    motor.handle([m.SetLiftSpeeds(500, 0)], HOST)
+    assert motor.handle([m.SetWatchdog(0)], HOST) == [
+        m.Ack(m.SetWatchdog.TYPE, m.AckResult.BAD_VALUE)]
+    motor.handle([m.Stop(m.ALL_MOTORS_MASK)], HOST)
+    assert motor.handle([m.SetWatchdog(0)], HOST)[0].watchdog_ms == 0
+
+
+def test_a_lease_released_or_lapsed_can_be_taken(rig: tuple,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    _, _, motor, sensor = rig
+    (gone,) = motor.handle([m.Claim(0, NONCE)], HOST)
+    assert (gone.result, gone.session) == (m.ClaimResult.RELEASED, 0)
+    assert motor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)[0].result == m.ClaimResult.GRANTED
+    # The sensor board's holder falls silent: its lease (lockstep: wall time)
+    # lapses after the longer of the lease and the watchdog.
+    clock = [1000.0]
+    monkeypatch.setattr(sensor, "_lease_clock", lambda: clock[0])
+    sensor.handle([m.Claim(m.LEASE_MS, NONCE)], HOST)
+    clock[0] += m.LEASE_MS / 1000 - 0.01
+    (held,) = sensor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)
+    assert held.result == m.ClaimResult.HELD and held.lease_cs == 1
+    clock[0] += 0.02
+    assert sensor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)[0].result == m.ClaimResult.GRANTED
+    assert sensor.handle([m.Clear()], HOST) == [m.Ack(m.Clear.TYPE, m.AckResult.NOT_OWNER)]

@@ -87,8 +87,16 @@ def test_arbitrary_messages_in_valid_frames_never_crash_a_board(
         assert frame.session == 0x5A
 
 
+def claim(srv: SerialBoardServer, r: int, session: int, lease_ms: int = m.LEASE_MS) -> None:
+    """Take (or with ``lease_ms`` 0 give up) the motor board's lease for ``session``."""
+    srv.receive(encode_frame(Frame(1, 200, (m.Claim(lease_ms, session),), session=session)))
+    (reply,) = FrameReader().feed(drain(r))
+    assert isinstance(reply.messages[0], m.Owner)
+
+
 def test_a_repeated_frame_is_answered_again_but_executed_once(server: tuple) -> None:
     srv, r = server
+    claim(srv, r, 0)  # the session of the frames below
     move = encode_frame(Frame(1, 5, (m.Move(0, 1000, 1000),)))
     srv.receive(move)
     first = drain(r)
@@ -105,7 +113,11 @@ def test_the_same_seq_and_bytes_of_another_session_are_executed(server: tuple) -
     srv, r = server
     robot = srv.world.robot
     assert isinstance(robot, StubRobot)
+    claim(srv, r, 1)
     for session in (1, 1, 2):
+        if session == 2:  # the first host leaves; the next takes the boards
+            claim(srv, r, 1, lease_ms=0)
+            claim(srv, r, 2)
         srv.receive(encode_frame(Frame(1, 5, (m.Move(0, 1000, 1000),), session=session)))
         (reply,) = FrameReader().feed(drain(r))
         assert reply.session == session and reply.seq == 5
