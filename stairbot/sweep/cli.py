@@ -89,13 +89,12 @@ def cmd_check(argv: list[str]) -> int:
                 description="Validate a spec: build and check every case, run none.")
     p.add_argument("spec", metavar="SPEC.toml")
     args = p.parse_args(argv)
-    from stairbot.sweep.cases import check_spec
+    from stairbot.sweep.cases import iter_cases
     from stairbot.sweep.spec import load_spec
 
-    spec = load_spec(args.spec)
-    cases = check_spec(spec)
-    zones = counts_of([{"verdict": c.facts["zone"]} for c in cases])
-    print(f"ok  {args.spec}: {len(cases)} case(s) ({spec.grid_size} grid point(s) x "
+    spec = load_spec(args.spec)  # refuses a spec of too many cases before building any
+    zones = counts_of([{"verdict": c.facts["zone"]} for c in iter_cases(spec)])
+    print(f"ok  {args.spec}: {spec.total} case(s) ({spec.grid_size} grid point(s) x "
           f"{spec.samples_per_point}); inside {zones['inside']}, band {zones['band']}, "
           f"outside {zones['outside']}; hash {spec.hash[:12]}")
     return EXIT_OK
@@ -111,9 +110,7 @@ def cmd_sweep(argv: list[str]) -> int:
     spec = load_spec(args.spec)
     if args.config is not None:
         spec = with_config(spec, args.config)
-    cases = check_spec(spec)  # a bad spec never starts work
-    if args.limit is not None:
-        cases = cases[:args.limit]
+    cases = check_spec(spec, args.limit)  # a bad spec never starts work
     jobs = args.jobs or default_jobs()
     folder = args.out or Path(f"sweep-{spec.name}-{spec.hash[:8]}")
     store = ResultStore(folder, spec, args.resume)
