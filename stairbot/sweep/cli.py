@@ -24,6 +24,7 @@ from stairbot.errors import OutputError
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.spec import SpecError
 from stairbot.sweep.verdict import passing
+from stairbot.text import printable
 
 EXIT_OK, EXIT_FAILURES, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -94,8 +95,8 @@ def cmd_check(argv: list[str]) -> int:
 
     spec = load_spec(args.spec)  # refuses a spec of too many cases before building any
     zones = counts_of([{"verdict": c.facts["zone"]} for c in iter_cases(spec)])
-    print(f"ok  {args.spec}: {spec.total} case(s) ({spec.grid_size} grid point(s) x "
-          f"{spec.samples_per_point}); inside {zones['inside']}, band {zones['band']}, "
+    print(f"ok  {printable(args.spec)}: {spec.total} case(s) ({spec.grid_size} grid point(s) "
+          f"x {spec.samples_per_point}); inside {zones['inside']}, band {zones['band']}, "
           f"outside {zones['outside']}; hash {spec.hash[:12]}")
     return EXIT_OK
 
@@ -118,7 +119,7 @@ def cmd_sweep(argv: list[str]) -> int:
     try:
         with open_executor(jobs, args.dask) as (executor, label):
             view = ProgressView(len(cases), counts_of(store.records),
-                                f"{spec.name} on {label}", args.quiet)
+                                printable(f"{spec.name} on {label}"), args.quiet)
             try:
                 out = run_cases(cases, store, executor, view.update, jobs)
             finally:
@@ -135,14 +136,14 @@ def cmd_sweep(argv: list[str]) -> int:
         print_summary(records, meta, console, spec.report.worst)
         png = draw(records, meta, folder, console, args.x, args.y, args.png, not args.no_png)
         if png is not None:
-            print(f"heat map: {png}")
+            print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     rate = f"{out.ran / out.wall_s * 60:.0f} cases/min" if out.wall_s > 0 and out.ran else "-"
     state = "interrupted; rerun with --resume" if out.interrupted else (
         f"{failing} not passing" if failing else "all passing")
-    print(f"sweep {spec.name}: {len(records)}/{len(cases)} case(s) in {folder} "
-          f"({out.ran} run now in {out.wall_s:.1f} s, {rate}; {state}): "
-          f"{counts_line(counts_of(records))}", flush=True)
+    print(printable(f"sweep {spec.name}: {len(records)}/{len(cases)} case(s) in {folder} "
+                    f"({out.ran} run now in {out.wall_s:.1f} s, {rate}; {state}): "
+                    f"{counts_line(counts_of(records))}"), flush=True)
     if out.interrupted:
         return EXIT_INTERRUPTED
     return EXIT_FAILURES if failing else EXIT_OK
@@ -165,8 +166,8 @@ def cmd_report(argv: list[str]) -> int:
                   args.worst if args.worst is not None else int(meta["report"]["worst"]))
     png = draw(records, meta, args.results, console, args.x, args.y, args.png, not args.no_png)
     if png is not None:
-        print(f"heat map: {png}")
+        print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
-    print(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
-          f"{counts_line(counts_of(records))}", file=sys.stdout)
+    print(printable(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
+                    f"{counts_line(counts_of(records))}"), file=sys.stdout)
     return EXIT_FAILURES if failing else EXIT_OK

@@ -47,6 +47,7 @@ from stairbot.config import ConfigFile, config_table
 from stairbot.errors import ConfigError, InputError
 from stairbot.scenario import ScenarioFile
 from stairbot.sweep import tomlw
+from stairbot.text import check_line, printable
 
 
 class SpecError(InputError):
@@ -338,6 +339,11 @@ def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
     :func:`stairbot.sweep.cases.check_spec`.  Raises SpecError."""
     raw = load_toml(text, source, SpecError)
     data = convert(raw, SpecFile, source, SpecError)
+    check_line(data.sweep.name, source, "sweep.name", SpecError)
+    check_line(data.sweep.description, source, "sweep.description", SpecError)
+    if data.sweep.name is not None and ("/" in data.sweep.name or "\\" in data.sweep.name):
+        raise SpecError(source, "sweep.name", f"{data.sweep.name!r} names the results folder; "
+                        "allowed: a name without / or \\")
     axes = [parse_axis(source, p, v) for p, v in _flatten(data.axes)]
     seen = [a.path for a in axes]
     for path in seen:
@@ -354,8 +360,8 @@ def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
                                "default_scenario.toml", "scenarios")
     config_text = None if s.config is None else _config_text(spec_dir, s.config, source)
     v = data.verdict
-    spec = Spec(source=source, name=s.name or Path(source).stem, description=s.description,
-                seed=s.seed, samples=s.cases, axes=tuple(axes),
+    spec = Spec(source=source, name=s.name or printable(Path(source).stem),
+                description=s.description, seed=s.seed, samples=s.cases, axes=tuple(axes),
                 rules=Rules(v.rise_margin_m, v.tread_margin_m, v.home_m),
                 scenario_text=scenario_text, config_text=config_text, report=data.report,
                 raw=raw)
