@@ -40,11 +40,6 @@ def printable(text: object) -> str:
     return _CONTROL.sub(_escape, str(text))
 
 
-def has_control(text: str) -> bool:
-    """Whether ``text`` holds a character :func:`printable` escapes."""
-    return _CONTROL.search(text) is not None
-
-
 def check_line(value: str | None, source: str, field: str,
                error: type[InputError]) -> None:
     """Refuse a name or description that holds a control character: raises
