@@ -49,6 +49,7 @@ from stairbot.scenario import (
     expectation_mismatches,
     load_scenario,
 )
+from stairbot.text import printable
 
 EXIT_MISMATCH, EXIT_INTERRUPTED = 1, 130
 
@@ -276,7 +277,8 @@ def unused_record(path: str | None) -> str | None:
     except FileExistsError as exc:
         raise InputError(path, None, f"cannot write the record: {exc}") from None
     if chosen != path:
-        print(f"{PROG}: {path} exists (not overwritten): recording to {chosen}",
+        print(f"{PROG}: {printable(path)} exists (not overwritten): recording to "
+              f"{printable(chosen)}",
               file=sys.stderr, flush=True)
     return chosen
 
@@ -332,7 +334,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_INPUT
     if args.from_top and args.robot.startswith("sim:") and scenario.start.on != "top":
         print(f"{PROG}: error: --from-top: the simulated robot stands where "
-              f"{scenario.source} puts it, on the floor; give a scenario with "
+              f"{printable(scenario.source)} puts it, on the floor; give a scenario with "
               "start.on = 'top' (it implies --from-top), e.g. --scenario top_descent",
               file=sys.stderr)
         return EXIT_INPUT
@@ -343,7 +345,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             if record is not None:  # OutputError (a full disk) ends the run
                 record.write(event)
             if not args.quiet and event.kind is not EventKind.SUMMARY:
-                print(event.line(), file=progress, flush=True)
+                print(printable(event.line()), file=progress, flush=True)
 
         try:
             session = open_robot(args.robot, config, replace(options, world=scenario))
@@ -351,7 +353,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"{PROG}: error: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
         except HardwareError as exc:
-            print(f"{PROG}: error: cannot open {args.robot}: {exc}", file=sys.stderr)
+            print(f"{PROG}: error: cannot open {printable(args.robot)}: {exc}",
+                  file=sys.stderr)
             return EXIT_MISMATCH
         controller = journal = None
         tap = None
@@ -384,11 +387,11 @@ def cmd_run(args: argparse.Namespace) -> int:
                       f"min_tread_m = {config.min_tread_m:.3f} m only", file=progress)
             what = f" ({scenario.description})" if scenario.description else ""
             verb = "resuming" if args.resume else "running"
-            print(f"{verb} {scenario.name}{what} on {args.robot}"
-                  + (", calibration only" if args.calibrate_only else "")
-                  + (", down from the top" if from_top else "")
-                  + (f"; journal {path}" if journal is not None else ""),
-                  file=progress, flush=True)
+            line = (f"{verb} {scenario.name}{what} on {args.robot}"
+                    + (", calibration only" if args.calibrate_only else "")
+                    + (", down from the top" if from_top else "")
+                    + (f"; journal {path}" if journal is not None else ""))
+            print(printable(line), file=progress, flush=True)
         control = RunControl()
         link: object = None
         try:
@@ -434,8 +437,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"{PROG}: interrupted: emergency stop latched, every motor stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
     if mismatches:
-        print(f"{PROG}: the run did not end as {scenario.source} expects: "
-              + "; ".join(mismatches), file=sys.stderr)
+        print(f"{PROG}: the run did not end as {printable(scenario.source)} expects: "
+              + printable("; ".join(mismatches)), file=sys.stderr)
         return EXIT_MISMATCH
     return EXIT_OK
 
@@ -482,4 +485,4 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
                                     if mismatches[0].startswith("interrupted")
                                     else "NO: " + "; ".join(mismatches)),
     ]
-    print("\n".join(lines), flush=True)
+    print("\n".join(printable(line) for line in lines), flush=True)

@@ -26,6 +26,7 @@ from stairbot.journal import JournalState, JournalWriter, digest, read_journal
 from stairbot.resume import ResumeRefused, check, describe, restored_context
 from stairbot.robots import RobotSession
 from stairbot.runner import board_identity
+from stairbot.text import printable
 
 
 class NotConfirmed(ResumeRefused):
@@ -142,7 +143,7 @@ def resume(path: Path | None, url: str, session: RobotSession, config: RobotConf
     otherwise; nothing has moved then."""
     plan = plan_resume(path, url, session, config)
     for line in plan.lines:
-        print(f"resume: {line}", file=out)
+        print(f"resume: {printable(line)}", file=out)
     out.flush()
     question = ("Look at the robot: does it stand where the lines above say?  Resume and "
                 "let it move? [y/N] ")

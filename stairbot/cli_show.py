@@ -10,6 +10,7 @@ import sys
 from stairbot.config import load_config
 from stairbot.errors import InputError
 from stairbot.scenario import Scenario, load_scenario, shipped_scenarios
+from stairbot.text import printable
 
 PROG = "stairbot"
 EXIT_OK, EXIT_INPUT = 0, 2
@@ -34,7 +35,7 @@ def cmd_config_show(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(data, indent=2, sort_keys=True))
         return EXIT_OK
-    print(f"# robot config from {data['source']}")
+    print(f"# robot config from {printable(data['source'])}")
     for section in ("geometry", "masses", "motors", "sensors", "algorithm", "safety"):
         print(f"\n[{section}]")
         for key, value in data[section].items():
@@ -77,7 +78,7 @@ def cmd_scenario_check(args: argparse.Namespace) -> int:
             print(f"{PROG}: error: {exc}", file=sys.stderr)
             bad += 1
             continue
-        print(f"ok  {name}: {_describe(s)}")
+        print(f"ok  {printable(name)}: {_describe(s)}")
     return EXIT_INPUT if bad else EXIT_OK
 
 
@@ -87,5 +88,5 @@ def cmd_scenario_list(_args: argparse.Namespace) -> int:
     width = max((len(n) for n in names), default=0)
     for name in names:
         s = load_scenario(name)
-        print(f"{name:<{width}}  {s.description}")
+        print(printable(f"{name:<{width}}  {s.description}"))
     return EXIT_OK

@@ -21,6 +21,7 @@ import msgspec
 from stairbot._schema import convert, load_toml, read_named, shipped
 from stairbot.config_checks import check_consistency
 from stairbot.errors import ConfigError
+from stairbot.files import shown
 from stairbot.sensor_specs import SPECS, SensorSpec
 
 # Physical bounds: generous around any robot of this kind (the reference robot
@@ -484,21 +485,45 @@ REFERENCE = "reference"
 """The shipped reference robot's name (``extends = "reference"``, ``--config reference``)."""
 
 
-def _extended(raw: dict[str, Any], source: str, seen: tuple[str, ...]) -> dict[str, Any]:
+MAX_EXTENDS = 8
+"""The most configs one config stands on through ``extends`` (the one it
+names, the one that one names, and so on): a deeper chain is refused, and so
+is a loop."""
+
+
+def _extended(raw: dict[str, Any], source: str, chain: tuple[str, ...]) -> dict[str, Any]:
     """``raw`` laid over the config it names in ``extends`` (a shipped robot, or
-    a file beside it): its tables key by key, anything else replaced."""
+    a file beside it), and that one over its own: tables key by key, anything
+    else replaced.  ``chain`` holds the sources that extend this one, the
+    first one loaded first.  Raises ConfigError on a loop (naming its files)
+    or on a chain of more than :data:`MAX_EXTENDS`."""
+    chain = (*chain, source)
     base = raw.pop("extends", None)
     if base is None:
         return raw
     if not isinstance(base, str) or not base:
         raise ConfigError(source, "extends", "must be a shipped robot's name ("
                           + ", ".join(shipped_configs()) + ") or a config file's path")
-    if base in seen or len(seen) >= 5:
-        raise ConfigError(source, "extends", f"{base!r} extends itself (through "
-                          + " -> ".join(seen) + "); allowed: a chain without loops")
     text, base_source = _config_text(base, Path(source).parent if Path(source).exists() else None)
-    base_raw = _extended(load_toml(text, base_source, ConfigError), base_source, (*seen, base))
+    ids = [_identity(s) for s in chain]
+    if _identity(base_source) in ids:
+        loop = (*chain[ids.index(_identity(base_source)):], base_source)
+        raise ConfigError(source, "extends", f"{base!r} makes a loop: "
+                          + " -> ".join(shown(s) for s in loop)
+                          + "; allowed: a chain without loops")
+    if len(chain) > MAX_EXTENDS:
+        raise ConfigError(source, "extends", f"{base!r}: the chain of extends from "
+                          f"{shown(chain[0])} goes deeper than {MAX_EXTENDS} configs; "
+                          f"allowed: a config stands on at most {MAX_EXTENDS} others")
+    base_raw = _extended(load_toml(text, base_source, ConfigError), base_source, chain)
     return _merged(base_raw, raw)
+
+
+def _identity(source: str) -> str:
+    """What tells two configs of a chain apart: a file's resolved path (one
+    file by two spellings is one), else the source's name (``<robot ir>``)."""
+    path = Path(source)
+    return str(path.resolve()) if path.is_file() else source
 
 
 def _merged(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:

@@ -2,9 +2,18 @@
 
 from __future__ import annotations
 
+from stairbot.text import printable
+
 
 class StairbotError(Exception):
-    """Root of every error stairbot raises on purpose."""
+    """Root of every error stairbot raises on purpose.
+
+    Its message (``str()``) has every control character escaped
+    (:func:`stairbot.text.printable`): it names files, fields and values from
+    outside, and is printed to a terminal."""
+
+    def __str__(self) -> str:
+        return printable(super().__str__())
 
 
 class InputError(StairbotError):

@@ -18,6 +18,7 @@ import msgspec
 
 from stairbot._schema import convert, load_toml, read_named, shipped
 from stairbot.errors import ScenarioError
+from stairbot.text import check_line, printable
 
 # Bounds that keep the simulated world sane (docs/scenarios.md): a riser from
 # 5 mm to 1 m, a tread from 1 cm to 10 m, a flight from 0.1 to 20 m wide.
@@ -160,6 +161,8 @@ def parse_scenario(text: str, source: str) -> Scenario:
 
 
 def _resolve(data: ScenarioFile, source: str) -> Scenario:
+    check_line(data.name, source, "name", ScenarioError)
+    check_line(data.description, source, "description", ScenarioError)
     st = data.stairs
     if st.steps is not None:
         if st.count is not None or st.rise is not None or st.tread is not None:
@@ -212,7 +215,7 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
                             f"allowed: between -{half} and {half} m (half the width)")
     return Scenario(
         source=source,
-        name=data.name or Path(source).stem,
+        name=data.name or printable(Path(source).stem),  # a name holds no control character
         description=data.description or "",
         steps=steps,
         top=st.top,

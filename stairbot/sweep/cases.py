@@ -3,9 +3,11 @@ the spec overrides the robot), built and validated by the same loaders that
 ``stairbot run --scenario/--config`` use, so what a sweep runs is what a person
 reproduces from the files it writes.
 
-:func:`check_spec` builds every case before any runs: a value the loaders
-refuse (and the edges of every distribution) stops the sweep with a SpecError
-naming the axis.
+:func:`check_spec` builds every case (or the first ``limit``) before any
+runs, one at a time: a value the loaders refuse (and the edges of every
+distribution) stops the sweep with a SpecError naming the axis.  How many
+cases a spec makes is counted from its axes (:attr:`Spec.total`), without
+building any.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from functools import cache
 from importlib import resources
@@ -427,15 +430,25 @@ def _blame(spec: Spec, field_: str | None, prefix: str, problem: str, where: str
                      f"{full or 'the document'}: {problem}")
 
 
-def check_spec(spec: Spec) -> list[Case]:
-    """Every case of the spec, built and validated, after the edges of each
-    distribution are checked.  Raises SpecError (nothing has run)."""
+def iter_cases(spec: Spec, limit: int | None = None) -> Iterator[Case]:
+    """The spec's cases in index order, the first ``limit`` of them (all when
+    None), each built and validated only when asked for; the edges of each
+    distribution are checked before the first.  Raises SpecError at the first
+    case the loaders refuse."""
     if spec.total == 0:
         raise SpecError(spec.source, "axes", "the axes give no cases")
     for axis in spec.axes:
         if axis.sampled:
             _check_edges(spec, axis)
-    return [build_case(spec, i) for i in range(spec.total)]
+    for index in range(spec.total if limit is None else min(limit, spec.total)):
+        yield build_case(spec, index)
+
+
+def check_spec(spec: Spec, limit: int | None = None) -> list[Case]:
+    """The spec's first ``limit`` cases (every case when None), built and
+    validated, after the edges of each distribution are checked.  Raises
+    SpecError (nothing has run)."""
+    return list(iter_cases(spec, limit))
 
 
 def _check_edges(spec: Spec, axis: Axis) -> None:

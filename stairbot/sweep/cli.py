@@ -24,6 +24,7 @@ from stairbot.errors import OutputError
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.spec import SpecError
 from stairbot.sweep.verdict import passing
+from stairbot.text import printable
 
 EXIT_OK, EXIT_FAILURES, EXIT_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -89,14 +90,13 @@ def cmd_check(argv: list[str]) -> int:
                 description="Validate a spec: build and check every case, run none.")
     p.add_argument("spec", metavar="SPEC.toml")
     args = p.parse_args(argv)
-    from stairbot.sweep.cases import check_spec
+    from stairbot.sweep.cases import iter_cases
     from stairbot.sweep.spec import load_spec
 
-    spec = load_spec(args.spec)
-    cases = check_spec(spec)
-    zones = counts_of([{"verdict": c.facts["zone"]} for c in cases])
-    print(f"ok  {args.spec}: {len(cases)} case(s) ({spec.grid_size} grid point(s) x "
-          f"{spec.samples_per_point}); inside {zones['inside']}, band {zones['band']}, "
+    spec = load_spec(args.spec)  # refuses a spec of too many cases before building any
+    zones = counts_of([{"verdict": c.facts["zone"]} for c in iter_cases(spec)])
+    print(f"ok  {printable(args.spec)}: {spec.total} case(s) ({spec.grid_size} grid point(s) "
+          f"x {spec.samples_per_point}); inside {zones['inside']}, band {zones['band']}, "
           f"outside {zones['outside']}; hash {spec.hash[:12]}")
     return EXIT_OK
 
@@ -111,9 +111,7 @@ def cmd_sweep(argv: list[str]) -> int:
     spec = load_spec(args.spec)
     if args.config is not None:
         spec = with_config(spec, args.config)
-    cases = check_spec(spec)  # a bad spec never starts work
-    if args.limit is not None:
-        cases = cases[:args.limit]
+    cases = check_spec(spec, args.limit)  # a bad spec never starts work
     jobs = args.jobs or default_jobs()
     folder = args.out or Path(f"sweep-{spec.name}-{spec.hash[:8]}")
     store = ResultStore(folder, spec, args.resume)
@@ -121,7 +119,7 @@ def cmd_sweep(argv: list[str]) -> int:
     try:
         with open_executor(jobs, args.dask) as (executor, label):
             view = ProgressView(len(cases), counts_of(store.records),
-                                f"{spec.name} on {label}", args.quiet)
+                                printable(f"{spec.name} on {label}"), args.quiet)
             try:
                 out = run_cases(cases, store, executor, view.update, jobs)
             finally:
@@ -138,14 +136,14 @@ def cmd_sweep(argv: list[str]) -> int:
         print_summary(records, meta, console, spec.report.worst)
         png = draw(records, meta, folder, console, args.x, args.y, args.png, not args.no_png)
         if png is not None:
-            print(f"heat map: {png}")
+            print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     rate = f"{out.ran / out.wall_s * 60:.0f} cases/min" if out.wall_s > 0 and out.ran else "-"
     state = "interrupted; rerun with --resume" if out.interrupted else (
         f"{failing} not passing" if failing else "all passing")
-    print(f"sweep {spec.name}: {len(records)}/{len(cases)} case(s) in {folder} "
-          f"({out.ran} run now in {out.wall_s:.1f} s, {rate}; {state}): "
-          f"{counts_line(counts_of(records))}", flush=True)
+    print(printable(f"sweep {spec.name}: {len(records)}/{len(cases)} case(s) in {folder} "
+                    f"({out.ran} run now in {out.wall_s:.1f} s, {rate}; {state}): "
+                    f"{counts_line(counts_of(records))}"), flush=True)
     if out.interrupted:
         return EXIT_INTERRUPTED
     return EXIT_FAILURES if failing else EXIT_OK
@@ -168,8 +166,8 @@ def cmd_report(argv: list[str]) -> int:
                   args.worst if args.worst is not None else int(meta["report"]["worst"]))
     png = draw(records, meta, args.results, console, args.x, args.y, args.png, not args.no_png)
     if png is not None:
-        print(f"heat map: {png}")
+        print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
-    print(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
-          f"{counts_line(counts_of(records))}", file=sys.stdout)
+    print(printable(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
+                    f"{counts_line(counts_of(records))}"), file=sys.stdout)
     return EXIT_FAILURES if failing else EXIT_OK

@@ -12,6 +12,7 @@ from typing import Any
 from rich.text import Text
 
 from stairbot.sweep.verdict import SEVERITY, VERDICTS
+from stairbot.text import printable
 
 COLOURS = {"climbed": "#2ca02c", "descended": "#17becf", "refused": "#1f77b4",
            "stranded": "#ffbf00", "wrong": "#b03ab0", "unsafe": "#d62728", "error": "#000000"}
@@ -60,7 +61,7 @@ def binning(values: list[Any], bins: int) -> Binning:
     numeric = bool(distinct) and all(isinstance(v, int | float) and not isinstance(v, bool)
                                      for v in distinct)
     if not numeric:
-        return Binning([str(v) for v in distinct], None, distinct)
+        return Binning([printable(v) for v in distinct], None, distinct)
     if len(distinct) <= 40:
         mids = [(a + b) / 2 for a, b in zip(distinct, distinct[1:], strict=False)]
         half = (distinct[1] - distinct[0]) / 2 if len(distinct) > 1 else 0.5
@@ -120,9 +121,10 @@ def terminal(grid: Grid) -> Text:
     colour (count of non-passing cases when more than one); ◀ and ▲ mark the
     row and column holding a limit."""
     out = Text()
+    x_name, y_name = printable(grid.x), printable(grid.y)
     ylim, xlim = _limit_for(grid.y, grid.limits), _limit_for(grid.x, grid.limits)
-    lw = max([len(s) for s in grid.by.labels] + [len(grid.y)])
-    out.append(f"{grid.y:>{lw}}\n", style="bold")
+    lw = max([len(s) for s in grid.by.labels] + [len(y_name)])
+    out.append(f"{y_name:>{lw}}\n", style="bold")
     for i in reversed(range(len(grid.by.labels))):
         out.append(f"{grid.by.labels[i]:>{lw}} ")
         for cell in grid.cells[i]:
@@ -146,7 +148,7 @@ def terminal(grid: Grid) -> Text:
     for k in range(max((len(lab) for lab in labels), default=0)):  # column labels, vertical
         out.append(" " * (lw + 1) + "".join(f" {lab[k] if k < len(lab) else ' '} "
                                             for lab in labels) + "\n")
-    out.append(" " * (lw + 1) + f"{grid.x}" + (f"  (▲ {xlim[0]} {xlim[1]:.3f})" if xlim else "")
+    out.append(" " * (lw + 1) + x_name + (f"  (▲ {xlim[0]} {xlim[1]:.3f})" if xlim else "")
                + "\n")
     for v in VERDICTS:
         out.append(f" {LETTERS[v]} ", style=f"bold white on {COLOURS[v]}")

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -23,9 +24,17 @@ from rich.table import Table
 
 from stairbot.sweep import heatmap
 from stairbot.sweep.verdict import SEVERITY, VERDICTS
+from stairbot.text import printable
 
 STYLE = {"climbed": "green", "descended": "cyan", "refused": "blue", "stranded": "yellow",
          "wrong": "magenta", "unsafe": "red", "error": "bold red"}
+
+
+def plain(value: object) -> str:
+    """Text from a spec or a results folder as Rich prints it: control
+    characters escaped (:func:`~stairbot.text.printable`), brackets taken
+    as themselves rather than as markup."""
+    return escape(printable(value))
 
 
 def counts_of(records: list[dict[str, Any]]) -> Counter[str]:
@@ -56,13 +65,13 @@ class ProgressView:
                 TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                 TextColumn("{task.fields[counts]}"), TimeElapsedColumn(), TextColumn("eta"),
                 TimeRemainingColumn(), console=self.err, transient=False)
-            self.task = self.progress.add_task(label, total=total,
+            self.task = self.progress.add_task(plain(label), total=total,
                                                completed=self.start_done,
                                                counts=counts_line(self.counts, True))
             self.progress.start()
         elif not quiet:
-            print(f"{label}: {total} cases, {self.start_done} already done", file=sys.stderr,
-                  flush=True)
+            print(f"{printable(label)}: {total} cases, {self.start_done} already done",
+                  file=sys.stderr, flush=True)
 
     def update(self, record: dict[str, Any]) -> None:
         self.counts[str(record.get("verdict"))] += 1
@@ -103,8 +112,8 @@ def worst_cases(records: list[dict[str, Any]], n: int) -> list[dict[str, Any]]:
 def print_summary(records: list[dict[str, Any]], meta: dict[str, Any], console: Console,
                   worst: int) -> None:
     counts = counts_of(records)
-    table = Table(title=f"sweep {meta.get('name')}: {len(records)} of {meta.get('total')} "
-                        "case(s)", title_justify="left")
+    table = Table(title=plain(f"sweep {meta.get('name')}: {len(records)} of "
+                              f"{meta.get('total')} case(s)"), title_justify="left")
     table.add_column("verdict")
     table.add_column("cases", justify="right")
     table.add_column("share", justify="right")
@@ -121,8 +130,8 @@ def print_summary(records: list[dict[str, Any]], meta: dict[str, Any], console: 
         wt.add_column(col, overflow="fold")
     for r in bad:
         axes = ", ".join(f"{k.split('.')[-1]}={_short(v)}" for k, v in r.get("axes", {}).items())
-        wt.add_row(str(r["case"]), f"[{STYLE[r['verdict']]}]{r['verdict']}[/]", axes,
-                   str(r.get("why", ""))[:90], str(r.get("reproduce", "")))
+        wt.add_row(plain(r["case"]), f"[{STYLE[r['verdict']]}]{r['verdict']}[/]", plain(axes),
+                   plain(str(r.get("why", ""))[:90]), plain(r.get("reproduce", "")))
     console.print(wt)
 
 

@@ -24,6 +24,7 @@ A spec is a TOML file (docs/envelope.md)::
     x = "stairs.tread"
     y = "stairs.rise"
 
+A spec makes at most :data:`MAX_CASES` cases, counted from its axes.
 Everything wrong with a spec raises :class:`SpecError` (exit 2, one line).
 """
 
@@ -46,6 +47,7 @@ from stairbot.config import ConfigFile, config_table
 from stairbot.errors import ConfigError, InputError
 from stairbot.scenario import ScenarioFile
 from stairbot.sweep import tomlw
+from stairbot.text import check_line, printable
 
 
 class SpecError(InputError):
@@ -60,6 +62,10 @@ VIRTUAL = {
     "stairs.tread_jitter": "each step's tread varies uniformly by up to this much, m",
 }
 NORMAL_SIGMAS = 4.0  # a normal axis must be valid this many deviations either side
+MAX_CASES = 100_000
+"""The most cases a spec may make (grid points times samples), counted from
+its axes before any case is built: more would take days to run even on a
+cluster, and hours only to build and check (docs/envelope.md)."""
 
 
 class SweepTable(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
@@ -272,9 +278,11 @@ def parse_axis(src: str, path: str, value: Any) -> Axis:
         if step <= 0 or stop < start:
             raise SpecError(src, f"{where}.range", f"{arg!r} is an empty range; allowed: "
                             "[start, stop, step] with step > 0 and stop >= start")
-        n = int(math.floor((stop - start) / step + 1e-9)) + 1
-        if n > 100_000:
-            raise SpecError(src, f"{where}.range", f"{n} values; allowed: at most 100000")
+        span = (stop - start) / step  # inf when the step is tiny beside the range
+        if not span < MAX_CASES:
+            raise SpecError(src, f"{where}.range", f"{arg!r} gives more than {MAX_CASES} "
+                            f"values; allowed: at most {MAX_CASES}")
+        n = int(math.floor(span + 1e-9)) + 1
         ints = all(isinstance(v, int) for v in arg)
         vals = [int(start + k * step) if ints else round(start + k * step, 10) for k in range(n)]
         return Axis(path, "range", tuple(vals))
@@ -331,6 +339,11 @@ def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
     :func:`stairbot.sweep.cases.check_spec`.  Raises SpecError."""
     raw = load_toml(text, source, SpecError)
     data = convert(raw, SpecFile, source, SpecError)
+    check_line(data.sweep.name, source, "sweep.name", SpecError)
+    check_line(data.sweep.description, source, "sweep.description", SpecError)
+    if data.sweep.name is not None and ("/" in data.sweep.name or "\\" in data.sweep.name):
+        raise SpecError(source, "sweep.name", f"{data.sweep.name!r} names the results folder; "
+                        "allowed: a name without / or \\")
     axes = [parse_axis(source, p, v) for p, v in _flatten(data.axes)]
     seen = [a.path for a in axes]
     for path in seen:
@@ -347,11 +360,27 @@ def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
                                "default_scenario.toml", "scenarios")
     config_text = None if s.config is None else _config_text(spec_dir, s.config, source)
     v = data.verdict
-    return Spec(source=source, name=s.name or Path(source).stem, description=s.description,
-                seed=s.seed, samples=s.cases, axes=tuple(axes),
+    spec = Spec(source=source, name=s.name or printable(Path(source).stem),
+                description=s.description, seed=s.seed, samples=s.cases, axes=tuple(axes),
                 rules=Rules(v.rise_margin_m, v.tread_margin_m, v.home_m),
                 scenario_text=scenario_text, config_text=config_text, report=data.report,
                 raw=raw)
+    _check_size(spec)
+    return spec
+
+
+def _check_size(spec: Spec) -> None:
+    """Refuse a spec of more than MAX_CASES cases (counted, none built)."""
+    if spec.total <= MAX_CASES:
+        return
+    if spec.samples_per_point > 1:
+        fields = "axes, sweep.cases"
+        count = (f"{spec.grid_size} grid point(s) x {spec.samples} case(s) each = "
+                 f"{spec.total} cases")
+    else:
+        fields, count = "axes", f"{spec.grid_size} grid points"
+    raise SpecError(spec.source, fields, f"{count}; allowed: at most {MAX_CASES} cases in "
+                    "a sweep (fewer grid values, or fewer samples per point)")
 
 
 DERIVED = ("max_rise_m", "min_tread_m", "count")

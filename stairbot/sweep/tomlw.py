@@ -30,7 +30,8 @@ def value(v: Any) -> str:
             raise ValueError(f"{v} cannot be written to TOML")
         return repr(v)
     if isinstance(v, str):
-        return json.dumps(v, ensure_ascii=False)
+        # JSON leaves DEL as it is; TOML wants it escaped, as every control but tab
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
     if isinstance(v, list | tuple):
         return "[" + ", ".join(value(x) for x in v) + "]"
     if isinstance(v, dict):

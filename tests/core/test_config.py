@@ -169,7 +169,7 @@ def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Pat
      "heavy_middle, ideal, ir, landings, reference, sonar"),
     ("extends = 3\n", "must be a shipped robot's name "
      "(heavy_middle, ideal, ir, landings, reference, sonar)"),
-    ('extends = "loop.toml"\n', "extends itself"),
+    ('extends = "loop.toml"\n', "makes a loop"),
 ])
 def test_bad_extends_is_one_clear_error(tmp_path: Path, text: str, words: str) -> None:
     path = tmp_path / "loop.toml"
