@@ -92,8 +92,8 @@ def test_a_second_host_is_refused_and_a_killed_host_leaves_every_motor_stopped_a
             # A second stairbot on this machine: refused at once, naming the first.
             spellings = [url] + ([url.replace("serial://", "serial://spy://", 1)]
                                  if wire == "serial" else [])
-            for spelling in spellings:
-                second = stairbot("clear", "--robot", spelling, "--yes", env=env)
+            for command, spelling in [("run", url), *(("clear", s) for s in spellings)]:
+                second = stairbot(command, "--robot", spelling, "--yes", env=env)
                 _, err = second.communicate(timeout=30)
                 assert second.returncode == 1, err
                 assert err.count("\n") == 1 and "in use by another stairbot (pid " \
