@@ -377,8 +377,9 @@ class BoardRobot:
             self._wait([self._request(m.Board.MOTOR, [m.Stop(m.ALL_MOTORS_MASK)])])
             if self.watchdog_ms:
                 self._wait(self._broadcast(m.SetWatchdog(0)))
-        for board in self.boots:
-            release_board(self.link, m.Board(board), self.nonce)
+        if not self._link_lost:  # a lease on a lost link lapses by itself
+            for board in self.boots:
+                release_board(self.link, m.Board(board), self.nonce)
         self._closed = True
         self.link.close()
 
