@@ -199,8 +199,9 @@ class Context:
 
         Raises InputError naming the key when a key is unknown, a value has
         the wrong type, a number is not finite or beyond :data:`MAX_ABS`, a
-        per-step list is not :data:`TAB_SIZE` long, a count of steps is
-        beyond it, or ``phase`` (or ``resume_phase``) names no phase.
+        per-step list is not :data:`TAB_SIZE` long, the steps climbed are
+        beyond it, more steps were descended than climbed, or ``phase`` (or
+        ``resume_phase``) names no phase.
         """
         if not isinstance(data, dict):
             raise InputError(source, None, "a context must be a table")
@@ -217,14 +218,18 @@ class Context:
             if value is not None and not 0 <= value <= TAB_SIZE:
                 raise InputError(source, key, f"{value} is out of range; allowed: 0 to "
                                  f"{TAB_SIZE} (the steps a context has room for)")
+        most = MAX_ABS if ctx.from_top else ctx.number_of_steps  # from the top: not climbed
+        if not 0 <= ctx.steps_descended <= most:
+            raise InputError(source, "steps_descended", f"{ctx.steps_descended} is out of "
+                             f"range; allowed: 0 to {most:g} (number_of_steps)")
         return ctx
 
 
 _PER_STEP = ("tab_length_to_edge", "climb_twist", "tread_length")
 """The context's lists with one entry per step (TAB_SIZE long)."""
 
-_STEP_COUNTS = ("number_of_steps", "steps_descended", "landing_step")
-"""Counts (or indices) of steps: each indexes the per-step lists."""
+_STEP_COUNTS = ("number_of_steps", "landing_step")
+"""Counts (or indices) of steps climbed: each indexes the per-step lists."""
 
 MAX_ABS = 1e9
 """The largest magnitude a number in a context may have (counters in turns,

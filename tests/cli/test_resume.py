@@ -169,10 +169,11 @@ def test_a_run_stopped_by_a_lost_link_can_be_resumed_one_that_failed_cannot(
                 check(state, "serial://x", boards)
 
 
-def test_resumes_are_counted_through_a_journal_longer_than_its_tail(tmp_path: Path) -> None:
-    """read_journal reads a journal's last MiB; the resumes of a long run
-    before it are counted too (they used to be missed)."""
-    from stairbot.journal import TAIL_BYTES
+def test_resumes_are_counted_through_a_journal_longer_than_a_read_piece(
+        tmp_path: Path) -> None:
+    """read_journal reads a journal whole, a piece at a time: the resumes of
+    a long run in its first piece are counted too."""
+    from stairbot.journal_read import CHUNK
 
     path = tmp_path / "j.jsonl"
     w = JournalWriter(path, fresh=True)
@@ -184,7 +185,7 @@ def test_resumes_are_counted_through_a_journal_longer_than_its_tail(tmp_path: Pa
         w.tick(time_s=1.0 + n, phase="cal_check", estopped=False, command={}, boards=None,
                context=lambda: {"phase": "cal_check"})
     n = 0
-    while path.stat().st_size < 2 * TAIL_BYTES:  # a long run after the resumes
+    while path.stat().st_size < 2 * CHUNK:  # a long run after the resumes
         w.tick(time_s=3.0 + n * 0.02, phase="ascent_approach", estopped=False,
                command={"MWF": 1.0}, boards=None, context=lambda: {"phase": "ascent_approach"})
         n += 1

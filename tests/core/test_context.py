@@ -113,3 +113,9 @@ def test_from_dict_refuses_numbers_out_of_bounds_and_unknown_phases(
     with pytest.raises(InputError) as err:
         Context.from_dict(data, "j")
     assert str(err.value).startswith(f"j: {problem}")
+
+
+def test_steps_descended_are_bounded_by_those_climbed_unless_from_the_top() -> None:
+    with pytest.raises(InputError, match="steps_descended: 3 is out of range; allowed: 0 to 2"):
+        Context.from_dict({"number_of_steps": 2, "steps_descended": 3})
+    assert Context.from_dict({"from_top": True, "steps_descended": 35}).steps_descended == 35
