@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import stat
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -103,10 +104,13 @@ def _last_record(path: Path) -> dict[str, object] | None:
 
 def unfinished(path: Path) -> str | None:
     """What a new run at ``path`` would lose: None when there is no journal
-    there, or its run ended (its last line an end that is not resumable),
-    or ran in the simulation; else a few words on the run (where it stopped,
-    or why its journal cannot be read)."""
-    if not path.exists():
+    there (or no regular file: it is not read), or its run ended (its last
+    line an end that is not resumable), or ran in the simulation; else a few
+    words on the run (where it stopped, or why its journal cannot be read)."""
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None  # nothing there, or not a journal (the writer says why)
+    except (OSError, ValueError):
         return None
     last = _last_record(path)
     if last is not None and last.get("kind") == "end" and not last.get("resumable"):

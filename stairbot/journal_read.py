@@ -286,7 +286,7 @@ def read_journal(path: str | Path) -> JournalState:
                     raise JournalError(where, line, f"more than {MAX_LINE} bytes: not a "
                                        "journal's line")
                 try:
-                    rec = json.loads(raw, parse_constant=_no_constant)
+                    rec = json.loads(raw)
                 except (ValueError, RecursionError):
                     raise JournalError(where, line, "not a JSON object (damaged, or a line "
                                        "cut short before others were added)") from None

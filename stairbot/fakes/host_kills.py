@@ -30,7 +30,7 @@ from pathlib import Path
 
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
-from stairbot.cli_journal import start_journal
+from stairbot.cli_journal import default_path, start_journal
 from stairbot.config import RobotConfig, load_config
 from stairbot.errors import HardwareError
 from stairbot.fakes.boards import make_boards
@@ -46,6 +46,7 @@ from stairbot.fakes.fault_matrix import (
     resume_watched,
 )
 from stairbot.hardware import Snapshot
+from stairbot.journal import mark_path
 from stairbot.runner import run
 from stairbot.scenario import parse_scenario
 
@@ -75,9 +76,11 @@ class Killed:
 
 
 @contextlib.contextmanager
-def killed_host(wire: str, journal: Path, tick: int) -> Iterator[Killed]:
+def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
     """Fake boards on ``wire`` running the flight with a journal at
-    ``journal``, the host killed after tick ``tick``, the world run on
+    ``journal`` (None: where a run on them keeps it by default,
+    :func:`~stairbot.cli_journal.default_path`), the host killed after tick
+    ``tick``, the world run on
     :data:`HOST_DEAD_S` and the boards listening again; closed when the
     block ends.  AssertionError when the run ends before that tick."""
     config = load_config()
@@ -86,6 +89,8 @@ def killed_host(wire: str, journal: Path, tick: int) -> Iterator[Killed]:
     real = make_boards(world)
     boards = _Boards(wire, world, real, config)
     try:
+        journal = journal or default_path(boards.url)
+        assert journal is not None
         session = boards.open()
         writer = start_journal(journal, boards.url, session, config, scenario.name, Mode.FULL)
         assert writer is not None
@@ -116,12 +121,20 @@ def killed_host(wire: str, journal: Path, tick: int) -> Iterator[Killed]:
 
 
 @cache
+def recorded(wire: str) -> tuple[tuple[str, ...], bytes, bytes]:
+    """A run of the flight with no fault on ``wire`` (once a process): each
+    tick's phase, and its journal's and its mark's bytes."""
+    with tempfile.TemporaryDirectory() as tmp:
+        journal = Path(tmp) / "journal.jsonl"
+        phases = record_run(wire, journal)
+        return tuple(phases), journal.read_bytes(), mark_path(journal).read_bytes()
+
+
 def phase_ticks(wire: str) -> dict[str, tuple[int, int]]:
     """Each phase's first visit in a run of the flight with no fault on
     ``wire``: its first and last tick (0-based, counted from the run's
     start)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        return _spans(record_run(wire, Path(tmp) / "journal.jsonl"))
+    return _spans(list(recorded(wire)[0]))
 
 
 def record_run(wire: str, journal: Path) -> list[str]:
