@@ -401,6 +401,10 @@ def cmd_run(args: argparse.Namespace) -> int:
             session.close()
             print(f"{PROG}: error: cannot resume: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
+        except HardwareError as exc:  # the boards did not confirm the resume's Clear
+            session.close()
+            print(f"{PROG}: error: cannot resume: {exc}", file=sys.stderr)
+            return EXIT_MISMATCH
         except BaseException:
             session.close()
             raise
