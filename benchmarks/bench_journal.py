@@ -16,6 +16,7 @@ that disk makes it cost (on tmpfs, nothing).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import statistics
 import sys
@@ -26,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from stairbot.config import load_config
-from stairbot.journal import JournalWriter
+from stairbot.journal import JournalWriter, mark_path
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import run
 from stairbot.scenario import load_scenario
@@ -69,6 +70,8 @@ def measure(folder: Path, ticks: list[dict[str, Any]],
         return times, os.path.getsize(name), w.syncs, time.perf_counter() - t0
     finally:
         os.unlink(name)
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(mark_path(name))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -2,7 +2,9 @@
 table of docs/reliability.md: one row a fault, one column a phase, one
 letter a cell -- C completed, S stopped safe (lifts holding, a reason, a
 resumable journal), R resumed (the host killed, a new host finished the
-run), X UNSAFE (listed below the table with what was wrong).
+run), F refused (the host killed, the new host refused to resume before
+any Clear, the boards still latched), X UNSAFE (listed below the table with
+what was wrong).
 
     python benchmarks/fault_matrix.py [-j 4] [--wire can|serial] [--fault NAME] [--phase NAME]
 
@@ -20,7 +22,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 from stairbot.fakes.fault_matrix import FAULTS, PHASES, WIRES, Cell, run_cell
 
-LETTER = {"completed": "C", "stopped": "S", "resumed": "R", "UNSAFE": "X"}
+LETTER = {"completed": "C", "stopped": "S", "resumed": "R", "refused": "F", "UNSAFE": "X"}
 
 
 def _one(args: tuple[str, str, str, int]) -> Cell:

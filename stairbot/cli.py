@@ -138,6 +138,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "believes it is, and asks before anything moves")
     r.add_argument("--yes", action="store_true",
                    help="with --resume: resume without asking (you have looked at the robot)")
+    r.add_argument("--discard-journal", action="store_true",
+                   help="start a new run although the journal holds one that did not finish "
+                        "(you have checked the robot stands at a start position again); the "
+                        "old journal is kept, renamed beside it (JOURNAL.discarded.jsonl)")
     r.set_defaults(func=cmd_run)
 
     c = sub.add_parser("config", help="show the robot config and what follows from it",
@@ -316,7 +320,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     config, scenario = _load_inputs(args)
     # Imported here: the runner pulls in the controller, which `config show` needs not.
     from stairbot.algorithm.phases import Mode
-    from stairbot.cli_journal import NotConfirmed, journal_path, start_journal
+    from stairbot.cli_journal import (
+        NotConfirmed,
+        journal_path,
+        set_aside,
+        start_journal,
+        unfinished,
+    )
     from stairbot.cli_journal import resume as resume_run
     from stairbot.resume import ResumeRefused
     from stairbot.robots import RobotOptions, open_robot
@@ -340,6 +350,22 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_INPUT
     mode = Mode.CALIBRATE_ONLY if args.calibrate_only else \
         Mode.DESCEND if from_top else Mode.FULL
+    if args.resume and args.discard_journal:
+        print(f"{PROG}: error: --resume carries the journal's run on, --discard-journal sets "
+              "it aside: leave one out", file=sys.stderr)
+        return EXIT_INPUT
+    left = None if args.resume or path is None else unfinished(path)
+    if left is not None and path is not None:  # a new run would write over an unfinished one
+        if not args.discard_journal:
+            print(f"{PROG}: error: {path} holds {left}: carry it on with `{PROG} run --robot "
+                  f"{args.robot} --resume`; or, once the robot stands at a start position "
+                  f"again, `{PROG} clear --robot {args.robot}` (if the boards hold latches) "
+                  "and run again with --discard-journal (the journal is kept, renamed)",
+                  file=sys.stderr)
+            return EXIT_INPUT
+        aside = set_aside(path)
+        print(f"{PROG}: the journal of the run that did not finish is kept as {aside}",
+              file=sys.stderr, flush=True)
     with _record_file(unused_record(args.record), config) as record:
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
@@ -375,6 +401,10 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"{PROG}: error: {exc}", file=sys.stderr)
             return EXIT_INPUT
         except ResumeRefused as exc:
+            session.close()
+            print(f"{PROG}: error: cannot resume: {exc}", file=sys.stderr)
+            return EXIT_MISMATCH
+        except HardwareError as exc:  # the boards did not confirm the resume's Clear
             session.close()
             print(f"{PROG}: error: cannot resume: {exc}", file=sys.stderr)
             return EXIT_MISMATCH

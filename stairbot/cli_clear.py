@@ -7,6 +7,9 @@ coming while it was armed: the host crashed, hung or lost the wire mid-run).
 Opening the boards never clears a latch: ``stairbot run`` and the console
 refuse boards that hold one, naming this command.  The operator looks at the
 robot first -- it may stand half way up a step -- and then confirms.
+Clearing leaves the run journal as it is: a run a killed host left
+unfinished can still be carried on (``stairbot run --resume``), and this
+command says so when the robot's journal holds one.
 
 Exit 0: nothing latched, or cleared; 1: the boards could not be reached or
 did not confirm the clear; 2: bad input, or no confirmation.
@@ -51,6 +54,17 @@ def ask(prompt: str) -> bool:
         return False
 
 
+def _say_unfinished(url: str) -> None:
+    """Say so when the robot's journal holds a run that did not finish."""
+    from stairbot.cli_journal import default_path, unfinished
+
+    path = default_path(url)
+    left = None if path is None else unfinished(path)
+    if left is not None:
+        print(f"{url}: the journal {path} holds {left}; clearing keeps it: "
+              f"`{PROG} run --robot {url} --resume` carries it on")
+
+
 def main(argv: list[str], confirm: Callable[[str], bool] = ask) -> int:
     args = build_parser().parse_args(argv)
     if not args.robot.startswith(("serial://", "can://")):
@@ -71,6 +85,7 @@ def main(argv: list[str], confirm: Callable[[str], bool] = ask) -> int:
         for board, flags in sorted(robot.latched.items()):
             print(f"{args.robot}: the {m.Board(board).name.lower()} board has "
                   f"{latch_names(flags)}")
+        _say_unfinished(args.robot)
         question = ("Look at the robot first: it may stand part way up a step, and the next "
                     "run starts from where it stands.  Clear these latches? [y/N] ")
         if not args.yes and not confirm(question):

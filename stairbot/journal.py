@@ -13,48 +13,66 @@ program's writes -- took 0.2 ms a tick at the median and up to 4 ms here,
 longer than a tick of a simulation at x20).  A power loss may then cost the
 ticks since the last fsync finished: the one in flight, rarely more.
 
-* ``{"kind": "start", "run_id", "url", "config", "config_sha256",
-  "scenario", "mode", "boards", "time_s"}`` -- a run began
-  (``boards``: each board's serial number and uptime, or null in the
-  simulation);
-* ``{"kind": "tick", "run_id", "n", "time_s", "phase", "estopped",
-  "command", "boards", "context"?}`` -- after each tick's command:
-  ``command`` the speeds sent (turns/s), ``context`` the controller's whole
-  context (:meth:`Context.to_dict`), written when the phase changes and
-  otherwise every ``CONTEXT_EVERY`` ticks (it is about 2 kB; the phases'
-  motion targets in it are absolute counter values, so a context a few
-  ticks old carries on as well);
-* ``{"kind": "resume", "run_id", "time_s", "boards"}`` -- a resumed run
-  carries on here;
-* ``{"kind": "end", "run_id", "outcome", "error", "time_s"}`` -- the run
-  ended (a run with an end has nothing to resume).
+Every record carries ``seq`` (its line's number, from 0) and ``prev`` (the
+:func:`line_hash` of the line before; "" on the first): a line lost, added
+or changed in the middle breaks the chain.  Beside the journal, its mark
+(:func:`mark_path`, ``JOURNAL.synced``) says which line was the last made
+durable, and that line's hash; the fsync thread rewrites it (and fsyncs it)
+after each fsync of the journal.  A journal whose lines end before its mark's
+was cut short after it was written -- not by a killed host, which leaves
+every line it wrote, nor by a power loss, which costs only lines after the
+mark -- and is not resumed (:mod:`stairbot.journal_read` checks all this).
 
-A line cut short by a power loss is the last one, and is ignored when read.
-Pure Python, standard library only: part of the core.
+* ``{"kind": "start", "seq", "prev", "run_id", "format", "url", "config",
+  "config_sha256", "scenario", "mode", "boards", "time_s"}`` -- a run began
+  (``format``: :data:`FORMAT`; ``boards``: each board's identity --
+  serial number, uptime, and boot id where the boards give one -- or null
+  in the simulation);
+* ``{"kind": "tick", "seq", "prev", "run_id", "n", "time_s", "phase",
+  "estopped", "command", "boards", "context"?}`` -- after each tick's
+  command: ``command`` the speeds sent (turns/s), ``context`` the
+  controller's whole context (:meth:`Context.to_dict`), written when the
+  phase changes and otherwise every ``CONTEXT_EVERY`` ticks (it is about
+  2 kB; the phases' motion targets in it are absolute counter values, so a
+  context a few ticks old carries on as well);
+* ``{"kind": "resume", "seq", "prev", "run_id", "time_s", "boards"}`` -- a
+  resumed run carries on here;
+* ``{"kind": "end", "seq", "prev", "run_id", "outcome", "error", "time_s",
+  "resumable"?}`` -- the run ended (a run with an end that is not
+  resumable has nothing to resume).
+
+A file holds one run: a new run starts it anew, a resumed one appends.  A
+line cut short by a power loss can only be the last; a resume drops it
+before it appends.  Pure Python, standard library only: part of the core.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import threading
 import uuid
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any
 
-from stairbot.errors import InputError, OutputError
-from stairbot.files import LineFile, open_regular, refused, shown
+from stairbot.errors import OutputError
+from stairbot.files import LineFile, refused, shown
+from stairbot.journal_read import (
+    FORMAT,
+    MAX_LINE,
+    JournalError,
+    JournalState,
+    Tail,
+    line_hash,
+    mark_path,
+    read_journal,
+)
 
 CONTEXT_EVERY = 25  # ticks: half a second at the 20 ms tick
-MAX_LINE = 1 << 20  # a journal line longer than this is not one of ours
-TAIL_BYTES = 1 << 20  # how much of a journal's end is read to resume from
-
-
-class JournalError(InputError):
-    """A journal that cannot be written or read: names the file and why."""
+MARK_BYTES = 256  # the mark's one line, padded: each rewrite covers the last
 
 
 def digest(data: Any) -> str:
@@ -67,22 +85,38 @@ def digest(data: Any) -> str:
 class JournalWriter:
     """Appends records to a journal, each written whole before it returns and
     made durable (fsync) before it returns or, a tick, by its fsync thread
-    (see the module docstring).  ``fresh`` starts the file anew (a new run);
-    otherwise records are added (a resumed run).  ``sync=False`` (no fsync at
-    all) is for measuring what fsync costs."""
+    (see the module docstring), the mark rewritten after each fsync.
+    ``fresh`` starts the file anew (a new run); otherwise records are added
+    after ``tail`` (a resumed run; whatever follows it -- a line cut short --
+    is dropped first).  ``sync=False`` (no fsync at all, the mark written on
+    close) is for measuring what fsync costs."""
 
-    def __init__(self, path: str | Path, *, fresh: bool, sync: bool = True) -> None:
+    def __init__(self, path: str | Path, *, fresh: bool, sync: bool = True,
+                 tail: Tail | None = None) -> None:
         self.path = Path(path)
         self.sync = sync
+        if not fresh and tail is None:
+            raise ValueError("appending to a journal takes the tail its chain ends at")
+
+        def cannot(exc: OSError) -> JournalError:
+            return JournalError(shown(self.path), None,
+                                f"cannot write the journal: {exc.strerror or exc}")
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
-            raise JournalError(shown(self.path), None,
-                               f"cannot write the journal: {exc.strerror or exc}") from None
+            raise cannot(exc) from None
         # fsync is this class's own (see the module docstring)
         self._file = LineFile(self.path, "the journal", fresh=fresh, regular=True,
                               error=JournalError)
-        if sync:  # the file's name is durable too
+        try:
+            if tail is not None and os.fstat(self._file.fileno()).st_size > tail.size:
+                os.truncate(self.path, tail.size)  # a line cut short by a power loss
+            self._mark = os.open(mark_path(self.path), os.O_WRONLY | os.O_CREAT
+                                 | (os.O_TRUNC if fresh else 0), 0o644)
+        except OSError as exc:
+            self._file.close()
+            raise cannot(exc) from None
+        if sync:  # the files' names are durable too
             try:
                 dir_fd = os.open(self.path.parent, os.O_RDONLY)
                 try:
@@ -90,14 +124,18 @@ class JournalWriter:
                 finally:
                     os.close(dir_fd)
             except OSError as exc:
-                self._file.close()
-                raise JournalError(shown(self.path), None,
-                                   f"cannot write the journal: {exc.strerror or exc}") from None
+                self._close_files()
+                raise cannot(exc) from None
         self.run_id = ""
         self._ticks = 0
         self._phase: str | None = None
-        # lines written, lines known durable; the fsync thread's state
+        # the chain: the next line's seq, the last line's hash
+        self._seq, self._prev = (0, "") if tail is None else (tail.seq + 1, tail.hash)
+        # lines written, lines known durable, the last line written (seq, hash)
+        # and the last known durable; the fsync thread's state
         self._written = self._synced = 0
+        self._last: tuple[int, str] | None = None
+        self._marked: tuple[int, str] | None = None
         self.syncs = 0  # fsyncs done (one covers every line written before it)
         self._closing = False
         self._told = False  # the caller has had the OutputError
@@ -114,21 +152,29 @@ class JournalWriter:
         return self._file.failed
 
     def write(self, record: Mapping[str, Any], durable: bool = True) -> None:
-        """One record, whole; durable (fsync'ed) before it returns, or with
-        ``durable=False`` by the fsync thread as soon as it can.  OutputError
-        (once) when the disk refuses it or refused an earlier fsync; after
-        that the journal is silent."""
+        """One record, whole, chained (``seq`` and ``prev`` put after its
+        ``kind``); durable (fsync'ed, the mark rewritten) before it returns,
+        or with ``durable=False`` by the fsync thread as soon as it can.
+        OutputError (once) when the disk refuses it or refused an earlier
+        fsync; after that the journal is silent."""
         if self._failed_now():
             return
+        chained = {"kind": record["kind"], "seq": self._seq, "prev": self._prev,
+                   **{k: v for k, v in record.items() if k != "kind"}}
+        line = json.dumps(chained, separators=(",", ":"), allow_nan=False).encode("utf-8")
         try:
-            self._file.write(json.dumps(record, separators=(",", ":"), allow_nan=False) + "\n")
+            self._file.write(line + b"\n")
         except OutputError:
             self._told = True
             raise
+        last = (self._seq, line_hash(line))
+        self._seq, self._prev = self._seq + 1, last[1]
         if self._syncer is None:
+            self._last = last
             return
         with self._cv:
             self._written += 1
+            self._last = last
             self._cv.notify_all()
             if durable:
                 self._cv.wait_for(lambda: self._synced >= self._written
@@ -145,16 +191,28 @@ class JournalWriter:
             raise error
         return True
 
+    def _write_mark(self, last: tuple[int, str]) -> None:
+        """The mark: ``last`` (seq, hash) is the journal's last durable line."""
+        text = json.dumps({"run_id": self.run_id, "seq": last[0], "hash": last[1]},
+                          separators=(",", ":"))
+        data = text.ljust(MARK_BYTES - 1).encode("utf-8") + b"\n"
+        os.pwrite(self._mark, data, 0)
+        self._marked = last
+
     def _sync_loop(self) -> None:
-        """fsync whatever has been written, back to back, until closed."""
+        """fsync whatever has been written, then the mark, back to back,
+        until closed."""
         while True:
             with self._cv:
                 self._cv.wait_for(lambda: self._synced < self._written or self._closing)
                 if self._synced >= self._written:
                     return  # closing, and everything is durable
-                target = self._written
+                target, last = self._written, self._last
             try:
                 os.fsync(self._file.fileno())
+                if last is not None:
+                    self._write_mark(last)
+                    os.fsync(self._mark)
             except OSError as exc:
                 with self._cv:
                     self._file.failed = refused(self.path, "the journal", exc)
@@ -168,9 +226,9 @@ class JournalWriter:
     def start(self, *, url: str, config: str, config_sha256: str, scenario: str, mode: str,
               boards: Any, time_s: float, run_id: str | None = None) -> None:
         self.run_id = run_id or uuid.uuid4().hex
-        self.write({"kind": "start", "run_id": self.run_id, "url": url, "config": config,
-                    "config_sha256": config_sha256, "scenario": scenario, "mode": mode,
-                    "boards": boards, "time_s": time_s})
+        self.write({"kind": "start", "run_id": self.run_id, "format": FORMAT, "url": url,
+                    "config": config, "config_sha256": config_sha256, "scenario": scenario,
+                    "mode": mode, "boards": boards, "time_s": time_s})
 
     def resume(self, run_id: str, boards: Any, time_s: float) -> None:
         self.run_id = run_id
@@ -201,100 +259,23 @@ class JournalWriter:
         self.write(record)
 
     def close(self) -> None:
-        """Every line durable (the fsync thread finishes), then the file closed."""
+        """Every line durable (the fsync thread finishes), the mark saying
+        so, then the files closed."""
         if self._syncer is not None:
             with self._cv:
                 self._closing = True
                 self._cv.notify_all()
             self._syncer.join()
+        elif self._last is not None and self._file.failed is None:
+            with contextlib.suppress(OSError):  # without fsync nothing was promised
+                self._write_mark(self._last)
+        self._close_files()
+
+    def _close_files(self) -> None:
         self._file.close()
+        if self._mark >= 0:
+            os.close(self._mark)
+            self._mark = -1
 
-
-@dataclass
-class JournalState:
-    """What a journal says of its last run: its start record, the last tick
-    and the last context written, and its end (None: the run did not end)."""
-
-    path: str
-    start: dict[str, Any]
-    last: dict[str, Any]
-    context: dict[str, Any] | None
-    context_time_s: float | None
-    end: dict[str, Any] | None
-    resumes: int = 0
-    boards: Any = field(default=None)
-
-
-def _records(data: bytes) -> list[dict[str, Any]]:
-    out = []
-    for raw in data.split(b"\n"):
-        if not raw.strip():
-            continue
-        try:
-            rec = json.loads(raw)
-        except (ValueError, RecursionError):
-            continue  # a line cut short by a power loss (the last), or a torn head
-        if isinstance(rec, dict) and isinstance(rec.get("kind"), str):
-            out.append(rec)
-    return out
-
-
-def _count_resumes(f: BinaryIO, run_id: str) -> int:
-    """The resume records of ``run_id`` in the whole journal ``f``, read in
-    TAIL_BYTES pieces: each is one line as :meth:`JournalWriter.write` puts
-    it, beginning ``{"kind":"resume","run_id":RUN_ID``."""
-    mark = b'\n{"kind":"resume","run_id":' + json.dumps(run_id).encode()
-    f.seek(0)
-    count, carry = 0, b"\n"  # the file's first line begins at a line's start too
-    while piece := f.read(TAIL_BYTES):
-        block = carry + piece
-        count += block.count(mark)
-        carry = block[-(len(mark) - 1):]  # a mark split between two pieces
-    return count
-
-
-def read_journal(path: str | Path) -> JournalState:
-    """The last run of the journal at ``path``.  JournalError (one line
-    naming the file) when it is missing, not a regular file, or holds no run.
-    A journal may be any size: only its last ``TAIL_BYTES`` (1 MiB) are read,
-    and its first ``MAX_LINE`` bytes when no run starts in them; and in a
-    larger one, the resume records of its last run are counted through the
-    whole file (byte search, no JSON)."""
-    p = Path(path)
-    fd = open_regular(p, JournalError, "a journal")
-    try:
-        with os.fdopen(fd, "rb") as f:
-            size = os.fstat(f.fileno()).st_size
-            f.seek(max(0, size - TAIL_BYTES))
-            tail = f.read(TAIL_BYTES)
-            if size > TAIL_BYTES:
-                tail = tail[tail.find(b"\n") + 1:]  # the first line there may be cut
-            records = _records(tail)
-            starts = [r for r in records if r["kind"] == "start"]
-            resumes: int | None = None
-            if not starts and size > TAIL_BYTES:  # a long run: find its start
-                f.seek(0)
-                head = f.read(MAX_LINE)
-                starts = [r for r in _records(head) if r["kind"] == "start"]
-            if starts and size > TAIL_BYTES:  # resumes further back than the tail
-                resumes = _count_resumes(f, starts[-1]["run_id"])
-    except OSError as exc:
-        raise JournalError(shown(p), None, f"cannot read the journal: {exc.strerror or exc}"
-                           ) from None
-    if not starts:
-        raise JournalError(str(p), None, "holds no run (no start record)")
-    start = starts[-1]
-    run = [r for r in records if r.get("run_id") == start["run_id"]]
-    ticks = [r for r in run if r["kind"] == "tick"]
-    with_context = [r for r in ticks if isinstance(r.get("context"), dict)]
-    ends = [r for r in run if r["kind"] == "end"]
-    last = ticks[-1] if ticks else start
-    ctx = with_context[-1] if with_context else None
-    return JournalState(
-        path=str(p), start=start, last=last,
-        context=ctx["context"] if ctx else None,
-        context_time_s=ctx["time_s"] if ctx else None,
-        end=ends[-1] if ends else None,
-        resumes=resumes if resumes is not None else
-        sum(1 for r in run if r["kind"] == "resume"),
-        boards=last.get("boards"))
+__all__ = ["CONTEXT_EVERY", "FORMAT", "MAX_LINE", "JournalError", "JournalState",
+           "JournalWriter", "Tail", "digest", "line_hash", "mark_path", "read_journal"]

@@ -1,16 +1,25 @@
 """Carrying on a run that a host left unfinished (``stairbot run --resume``).
 
-What the journal (:mod:`stairbot.journal`) says of the last run is checked
-against the boards as they are now, before anything moves:
+The journal (:mod:`stairbot.journal`) has been read and checked whole
+(:func:`~stairbot.journal_read.read_journal`); what it says of the run is
+checked here against the boards as they are now and the robot's config,
+before anything moves -- before the boards' latches are cleared:
 
 * a run that ended (completed, refused, stopped or failed, with its end
   record) has nothing to resume;
-* the boards must be the journal's (the same serial numbers) and must have
-  run on since (uptime no lower than the journal's last): a board that
-  restarted began its turn counters again at 0, and the robot's position by
-  them -- what every phase's motion targets are -- is lost;
 * the simulation (``sim://``) cannot be resumed: its world ended with the
-  host that ran it.
+  host that ran it;
+* the robot's URL must be the journal's (the same scheme and port, or
+  interface and channel; its options may differ);
+* the boards must be the journal's (the same boards by name and serial
+  number), still running since: the same boot id where the boards give one
+  (a journal with a boot id for boards that give none, or the other way
+  round, is of another firmware or host version and is refused), and an
+  uptime no lower than the journal's last -- a board that restarted began
+  its turn counters again at 0, and the robot's position by them, what
+  every phase's motion targets are, is lost;
+* the context restores (:meth:`Context.from_dict`) and its steps climbed are
+  within the config's ``max_steps``.
 
 :func:`describe` says where the robot believes it is, for the operator to
 compare with what they see; only after their confirmation does the run go
@@ -27,17 +36,30 @@ from typing import Any
 
 from stairbot.algorithm.context import Context
 from stairbot.algorithm.phases import BY_VALUE
-from stairbot.errors import StairbotError
-from stairbot.journal import JournalState
+from stairbot.errors import InputError, StairbotError
+from stairbot.journal import JournalError, JournalState
 
 
 class ResumeRefused(StairbotError):
     """The journal's run cannot be carried on (one line says why)."""
 
 
+def same_robot_url(a: str, b: str) -> bool:
+    """Whether two robot URLs name the same boards: the same scheme and port
+    (``serial:///dev/ttyUSB0``) or interface and channel (``can://socketcan/can0``);
+    their options (``?baud=...``) may differ."""
+    return _where(a) == _where(b)
+
+
+def _where(url: str) -> str:
+    return url.split("?", 1)[0].split("#", 1)[0].rstrip("/")
+
+
 def check(state: JournalState, url: str, boards: dict[str, dict[str, int]] | None) -> None:
     """ResumeRefused unless the journal's run can go on on the boards at ``url``
-    (``boards``: their identity now, None for the simulation)."""
+    (``boards``: their identity now, None for the simulation).  Checks, in
+    order: the run did not end, it is not a simulation, the journal has a
+    context, the boards are the journal's and did not restart, the URL."""
     where = state.path
     if state.end is not None and not state.end.get("resumable"):
         raise ResumeRefused(f"{where}: the last run ended ({state.end.get('outcome')}"
@@ -50,20 +72,45 @@ def check(state: JournalState, url: str, boards: dict[str, dict[str, int]] | Non
         raise ResumeRefused(f"{where}: the run stopped before its first tick was written: "
                             "start a new run")
     was = state.boards if isinstance(state.boards, dict) else {}
+    if set(was) != set(boards):
+        raise ResumeRefused(f"{url}: the boards are {', '.join(sorted(boards)) or 'none'}, "
+                            f"the journal's were {', '.join(sorted(was)) or 'none'}: not the "
+                            f"robot of {where}")
     for name, now in sorted(boards.items()):
-        then = was.get(name)
-        if not isinstance(then, dict):
-            raise ResumeRefused(f"{where}: the journal does not know the {name} board")
-        if then.get("serial") != now["serial"]:
-            raise ResumeRefused(
-                f"{url}: the {name} board is serial {now['serial']}, the journal's was "
-                f"{then.get('serial')}: not the robot of {where}")
-        if now["uptime_ms"] < int(then.get("uptime_ms", 0)):
-            raise ResumeRefused(
-                f"{url}: the {name} board restarted since the journal's last tick (up "
-                f"{now['uptime_ms'] / 1000:.1f} s, then {int(then['uptime_ms']) / 1000:.1f} s): "
-                "its turn counters began again at 0, so the robot's position by them is "
-                "lost; bring the robot to the floor by hand and start a new run")
+        _same_board(name, was[name], now, url, where)
+    then_url = str(state.start.get("url"))
+    if not same_robot_url(then_url, url):
+        raise ResumeRefused(f"{url}: the journal's run was on {then_url}, not on "
+                            f"{_where(url)}: resume it on {then_url} (or pass the journal "
+                            "of this robot)")
+
+
+def _same_board(name: str, then: dict[str, int], now: dict[str, int], url: str,
+                where: str) -> None:
+    """ResumeRefused unless the ``name`` board is the journal's, running since."""
+    lost = ("its turn counters began again at 0, so the robot's position by them is "
+            "lost; bring the robot to the floor by hand and start a new run")
+    if then.get("serial") != now.get("serial"):
+        raise ResumeRefused(
+            f"{url}: the {name} board is serial {now.get('serial')}, the journal's was "
+            f"{then.get('serial')}: not the robot of {where}")
+    if ("boot" in then) != ("boot" in now):
+        has, lacks = ("the journal", "the board") if "boot" in then else \
+            ("the board", "the journal")
+        raise ResumeRefused(
+            f"{url}: {has} gives the {name} board's boot id and {lacks} does not: the "
+            f"journal {where} is of another firmware or host version, and whether the board "
+            "restarted since cannot be told; bring the robot to the floor by hand and "
+            "start a new run")
+    if "boot" in then and then["boot"] != now["boot"]:
+        raise ResumeRefused(
+            f"{url}: the {name} board restarted since the journal (boot id {then['boot']}, "
+            f"then {now['boot']}): {lost}")
+    if now["uptime_ms"] < int(then.get("uptime_ms", 0)):
+        raise ResumeRefused(
+            f"{url}: the {name} board restarted since the journal's last tick (up "
+            f"{now['uptime_ms'] / 1000:.1f} s, then {int(then['uptime_ms']) / 1000:.1f} s): "
+            f"{lost}")
 
 
 def describe(state: JournalState) -> list[str]:
@@ -96,9 +143,13 @@ def describe(state: JournalState) -> list[str]:
 _TIMES = ("phase_started_s", "pause_started_s")
 
 
-def restored_context(state: JournalState, now_s: float) -> Context:
+def restored_context(state: JournalState, now_s: float, max_steps: int | None = None
+                     ) -> Context:
     """The journal's last context, its timers moved on by the time between the
-    journal's last tick and ``now_s`` (the robot's clock now)."""
+    journal's last tick and ``now_s`` (the robot's clock now).  ResumeRefused
+    when there is none; JournalError (naming the file and the field) when it
+    does not restore, or its steps climbed are more than ``max_steps`` (the
+    config's)."""
     if state.context is None:
         raise ResumeRefused(f"{state.path}: no context to resume from")
     data: dict[str, Any] = copy.deepcopy(state.context)
@@ -109,4 +160,12 @@ def restored_context(state: JournalState, now_s: float) -> Context:
     work = data.get("work")
     if isinstance(work, dict) and isinstance(work.get("still_since"), int | float):
         work["still_since"] = float(work["still_since"]) + shift
-    return Context.from_dict(data, state.path)
+    try:
+        ctx = Context.from_dict(data, "the context")
+    except InputError as exc:
+        raise JournalError(state.path, f"the last context: {exc.field}", exc.problem) from None
+    if max_steps is not None and ctx.number_of_steps > max_steps:
+        raise JournalError(state.path, "the last context: number_of_steps",
+                           f"{ctx.number_of_steps} is out of range; allowed: 0 to the "
+                           f"config's max_steps, {max_steps}")
+    return ctx

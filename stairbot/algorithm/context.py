@@ -10,9 +10,12 @@ exactly where it stopped.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, fields
-from typing import Any
+import math
+import types
+from dataclasses import asdict, dataclass, field, fields, is_dataclass
+from typing import Any, Union, get_args, get_origin, get_type_hints
 
+from stairbot.algorithm.phases import BY_VALUE
 from stairbot.algorithm.work import Work
 from stairbot.errors import InputError
 
@@ -189,69 +192,122 @@ class Context:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], source: str = "<context>") -> Context:
-        """Restore a context saved with :meth:`to_dict`.
+        """Restore a context saved with :meth:`to_dict` (and sent through JSON):
+        every value as its field declares it -- a tuple from the list JSON
+        made of it, a float from an int -- so that ``from_dict(to_dict())``
+        equals the original.
 
-        Raises InputError naming the key when a key is unknown or a value has
-        the wrong type.
+        Raises InputError naming the key when a key is unknown, a value has
+        the wrong type, a number is not finite or beyond :data:`MAX_ABS`, a
+        per-step list is not :data:`TAB_SIZE` long, the steps climbed are
+        beyond it, more steps were descended than climbed, or ``phase`` (or
+        ``resume_phase``) names no phase.
         """
-        known = {f.name: f for f in fields(cls)}
-        kwargs: dict[str, Any] = {}
-        for key, value in data.items():
-            if key not in known:
-                raise InputError(source, key, "unknown key; allowed: " + ", ".join(known))
-            kwargs[key] = value
+        if not isinstance(data, dict):
+            raise InputError(source, None, "a context must be a table")
+        ctx = cls(**_values(cls, data, source, ""))
         for key in _PER_STEP:
-            tab = kwargs.get(key)
-            if tab is None:
-                continue
-            if not isinstance(tab, list) or len(tab) != TAB_SIZE or not all(
-                v is None or isinstance(v, int | float) for v in tab
-            ):
+            if len(getattr(ctx, key)) != TAB_SIZE:
                 raise InputError(source, key, f"must be a list of {TAB_SIZE} numbers or nulls")
-            kwargs[key] = [None if v is None else float(v) for v in tab]
-        work = kwargs.get("work")
-        if work is not None:
-            kwargs["work"] = _work_from(work, source)
-        ctx = cls(**kwargs)
-        for name, f in known.items():
-            value = getattr(ctx, name)
-            if name in _PER_STEP or name == "work":
-                continue
-            if not _type_ok(value, str(f.type)):
-                raise InputError(source, name, f"{value!r} is not of type {f.type}")
+        for key in ("phase", "resume_phase"):
+            value = getattr(ctx, key)
+            if value is not None and value not in BY_VALUE:
+                raise InputError(source, key, f"{value!r} is not a phase")
+        for key in _STEP_COUNTS:
+            value = getattr(ctx, key)
+            if value is not None and not 0 <= value <= TAB_SIZE:
+                raise InputError(source, key, f"{value} is out of range; allowed: 0 to "
+                                 f"{TAB_SIZE} (the steps a context has room for)")
+        most = MAX_ABS if ctx.from_top else ctx.number_of_steps  # from the top: not climbed
+        if not 0 <= ctx.steps_descended <= most:
+            raise InputError(source, "steps_descended", f"{ctx.steps_descended} is out of "
+                             f"range; allowed: 0 to {most:g} (number_of_steps)")
         return ctx
 
 
 _PER_STEP = ("tab_length_to_edge", "climb_twist", "tread_length")
 """The context's lists with one entry per step (TAB_SIZE long)."""
 
+_STEP_COUNTS = ("number_of_steps", "landing_step")
+"""Counts (or indices) of steps climbed: each indexes the per-step lists."""
 
-def _work_from(data: object, source: str) -> Work:
-    if not isinstance(data, dict):
-        raise InputError(source, "work", "must be a table of the phase's working state")
-    known = {f.name: f for f in fields(Work)}
+MAX_ABS = 1e9
+"""The largest magnitude a number in a context may have (counters in turns,
+times in seconds, lengths in metres: an hour at a motor's top speed is a few
+million turns)."""
+
+
+def _values(cls: type, data: dict[str, Any], source: str, prefix: str) -> dict[str, Any]:
+    """``data``'s values for the dataclass ``cls``, each restored to its
+    field's declared type (InputError naming ``prefix`` + the key)."""
+    hints = _hints(cls)
+    out: dict[str, Any] = {}
     for key, value in data.items():
-        if key not in known:
-            raise InputError(source, f"work.{key}", "unknown key; allowed: " + ", ".join(known))
-        if not _type_ok(value, str(known[key].type)):
-            raise InputError(source, f"work.{key}", f"{value!r} is not of type {known[key].type}")
-    return Work(**data)
+        if key not in hints:
+            raise InputError(source, prefix + key,
+                             "unknown key; allowed: " + ", ".join(hints))
+        out[key] = _restore(value, hints[key], source, prefix + key)
+    return out
 
 
-def _type_ok(value: object, annotation: str) -> bool:
-    if annotation.startswith("list["):
-        return isinstance(value, list) and all(_type_ok(v, annotation[5:-1]) for v in value)
-    allowed: list[type] = []
-    if "None" in annotation:
-        allowed.append(type(None))
-    if "float" in annotation:
-        allowed += [float, int]
-    if "int" in annotation:
-        allowed.append(int)
-    if "str" in annotation:
-        allowed.append(str)
-    if "bool" in annotation:
-        allowed = [bool]
-    if isinstance(value, bool) and bool not in allowed:
-        return False
-    return isinstance(value, tuple(allowed))
+_HINTS: dict[type, dict[str, Any]] = {}
+
+
+def _hints(cls: type) -> dict[str, Any]:
+    if cls not in _HINTS:
+        names = {f.name for f in fields(cls)}
+        _HINTS[cls] = {k: v for k, v in get_type_hints(cls).items() if k in names}
+    return _HINTS[cls]
+
+
+def _restore(value: object, tp: Any, source: str, key: str, shown: str = "") -> Any:
+    """``value`` (as JSON gave it) as a value of the type ``tp`` (named
+    ``shown`` in messages, default its own name); InputError when it is not
+    one."""
+    def wrong(why: str = "") -> InputError:
+        return InputError(source, key, why or f"{value!r} is not of type {shown or _name(tp)}")
+
+    args = get_args(tp)
+    if isinstance(tp, types.UnionType) or get_origin(tp) is Union:
+        if value is None and type(None) in args:
+            return None
+        others = [a for a in args if a is not type(None)]
+        if len(others) != 1:
+            raise wrong()
+        return _restore(value, others[0], source, key, shown or _name(tp))
+    origin = get_origin(tp)
+    if origin is list:
+        if not isinstance(value, list):
+            raise wrong()
+        return [_restore(v, args[0], source, f"{key}[{i}]") for i, v in enumerate(value)]
+    if origin is tuple:
+        if not isinstance(value, list | tuple) or len(value) != len(args):
+            raise wrong()
+        return tuple(_restore(v, a, source, f"{key}[{i}]")
+                     for i, (v, a) in enumerate(zip(value, args, strict=True)))
+    if isinstance(tp, type) and is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise wrong(f"must be a table of {tp.__name__}'s fields")
+        return tp(**_values(tp, value, source, key + "."))
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise wrong()
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise wrong()
+        return value
+    if tp in (int, float):
+        if isinstance(value, bool) or not isinstance(value, int | float) or (
+                tp is int and not isinstance(value, int)):
+            raise wrong()
+        if not math.isfinite(value) or abs(value) > MAX_ABS:
+            raise wrong(f"{value!r} is out of range; allowed: a finite number of at most "
+                        f"{MAX_ABS:g} in magnitude")
+        return tp(value)
+    raise wrong()  # a field of a type this function does not know
+
+
+def _name(tp: Any) -> str:
+    return tp.__name__ if isinstance(tp, type) and not get_args(tp) else str(tp).replace(
+        "NoneType", "None")

@@ -23,7 +23,9 @@ A cell is **safe** (:func:`run_cell`) when the run
   at once, and -- the host gone, the world run on for :data:`AFTER_S` --
   every motor stopped and the lifts holding (their turns unchanged), with a
   journal that ends resumable (a lost link) so ``--resume`` can carry on;
-* for the host killed: the resumed run completed and never fell.
+* for the host killed: the resumed run completed and never fell (a resume
+  refused before any Clear, the boards still latched, is "refused": safe,
+  but not what the matrix expects).
 
 ``benchmarks/fault_matrix.py`` runs every cell and prints the table of
 docs/reliability.md; tests/safety/test_fault_matrix.py runs a subset in CI.
@@ -50,7 +52,7 @@ from stairbot.cli_journal import resume, start_journal
 from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
-from stairbot.errors import HardwareError
+from stairbot.errors import HardwareError, InputError
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -59,6 +61,7 @@ from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import Snapshot
 from stairbot.journal import read_journal
+from stairbot.resume import ResumeRefused
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunResult, run
 from stairbot.scenario import parse_scenario
@@ -133,8 +136,9 @@ WIRES = ("can", "serial")
 @dataclass
 class Cell:
     """One cell's run: ``verdict`` is "completed", "stopped", "resumed" (the
-    host killed, the new host finished) or "UNSAFE"; ``reason`` the run's
-    error, or what made it unsafe."""
+    host killed, the new host finished), "refused" (the host killed, the new
+    host refused to resume before touching the boards) or "UNSAFE";
+    ``reason`` the run's error, or what made it unsafe."""
 
     fault: str
     phase: str
@@ -332,10 +336,54 @@ def _resumed(cell: Cell, boards: _Boards, config: RobotConfig, journal: Path) ->
     """The host was killed: the world runs on, then a new host resumes."""
     _run_on(boards.world, boards.boards, HOST_DEAD_S)
     boards.deaf(False)
+    taken = resume_watched(boards, config, journal)
+    cell.verdict, cell.reason = taken.verdict, taken.reason
+    return cell
+
+
+@dataclass
+class Resumption:
+    """What a new host made of a killed one's journal: ``verdict`` "resumed"
+    (the run completed, never fell), "refused" (one line, ``reason``, before
+    any Clear: the boards still hold their latches) or "UNSAFE" (refused
+    after the latches were cleared, or a resumed run that did not
+    complete); ``cleared``: whether the host sent the boards a Clear."""
+
+    verdict: str
+    reason: str
+    cleared: bool
+    latched: bool
+
+
+def latched(boards: _Boards) -> bool:
+    """Whether a fake board holds a latch (its e-stop or its tripped watchdog)."""
+    return any(b.estop or b.watchdog_tripped for b in boards.boards.values())
+
+
+def resume_watched(boards: _Boards, config: RobotConfig, journal: Path,
+                   url: str | None = None) -> Resumption:
+    """``stairbot run --resume --yes`` on ``boards`` (at ``url``, default
+    theirs) from ``journal``, in this process, watching for the Clear."""
     session = boards.open(allow_latched=True)
+    cleared = False
+    clear = session.robot.clear
+
+    def watched(*args: Any) -> None:
+        nonlocal cleared
+        cleared = True
+        clear(*args)
+
+    session.robot.clear = watched  # type: ignore[method-assign]
     try:
-        resumed = resume(journal, boards.url, session, config, lambda _e: None, yes=True,
-                         out=io.StringIO())
+        try:
+            resumed = resume(journal, url or boards.url, session, config, lambda _e: None,
+                             yes=True, out=io.StringIO())
+        except (ResumeRefused, InputError) as exc:
+            held = latched(boards)
+            safe = not cleared and held and "\n" not in str(exc)
+            return Resumption("refused" if safe else "UNSAFE",
+                              str(exc) if safe else f"refused after a Clear, or not in one "
+                              f"line, or the latches gone: {exc}", cleared, held)
         try:
             result = run(session, config, controller=resumed.controller,
                          journal=resumed.journal)
@@ -345,10 +393,9 @@ def _resumed(cell: Cell, boards: _Boards, config: RobotConfig, journal: Path) ->
         with contextlib.suppress(HardwareError):
             session.close()
     if result.outcome == "completed" and not result.fell:
-        cell.verdict, cell.reason = "resumed", ""
-    else:
-        cell.reason = f"the resumed run ended {result.outcome}: {result.error}"
-    return cell
+        return Resumption("resumed", "", cleared, latched(boards))
+    return Resumption("UNSAFE", f"the resumed run ended {result.outcome}: {result.error}",
+                      cleared, latched(boards))
 
 
 def cells(wires: tuple[str, ...] = WIRES) -> Iterator[tuple[str, str, str]]:

@@ -169,10 +169,11 @@ def test_a_run_stopped_by_a_lost_link_can_be_resumed_one_that_failed_cannot(
                 check(state, "serial://x", boards)
 
 
-def test_resumes_are_counted_through_a_journal_longer_than_its_tail(tmp_path: Path) -> None:
-    """read_journal reads a journal's last MiB; the resumes of a long run
-    before it are counted too (they used to be missed)."""
-    from stairbot.journal import TAIL_BYTES
+def test_resumes_are_counted_through_a_journal_longer_than_a_read_piece(
+        tmp_path: Path) -> None:
+    """read_journal reads a journal whole, a piece at a time: the resumes of
+    a long run in its first piece are counted too."""
+    from stairbot.journal_read import CHUNK
 
     path = tmp_path / "j.jsonl"
     w = JournalWriter(path, fresh=True)
@@ -184,7 +185,7 @@ def test_resumes_are_counted_through_a_journal_longer_than_its_tail(tmp_path: Pa
         w.tick(time_s=1.0 + n, phase="cal_check", estopped=False, command={}, boards=None,
                context=lambda: {"phase": "cal_check"})
     n = 0
-    while path.stat().st_size < 2 * TAIL_BYTES:  # a long run after the resumes
+    while path.stat().st_size < 2 * CHUNK:  # a long run after the resumes
         w.tick(time_s=3.0 + n * 0.02, phase="ascent_approach", estopped=False,
                command={"MWF": 1.0}, boards=None, context=lambda: {"phase": "ascent_approach"})
         n += 1
@@ -238,3 +239,30 @@ def test_a_climb_killed_mid_scan_on_a_landing_resumes_turns_and_comes_home(
     assert (result["outcome"], result["steps_climbed"], result["steps_descended"],
             result["fell"]) == ("completed", 6, 6, False), result
     assert "the next flight is to the left" in err
+
+
+def test_a_resume_drops_a_line_cut_short_and_carries_the_chain_on(tmp_path: Path) -> None:
+    """A power loss cut the last line: the resumed run's writer drops it
+    before it appends, and the journal reads back whole, chained."""
+    from stairbot.journal import mark_path
+
+    path = tmp_path / "j.jsonl"
+    w = JournalWriter(path, fresh=True)
+    w.start(url="serial://x", config="c", config_sha256="0", scenario="s", mode="full",
+            boards=None, time_s=0.0)
+    w.tick(time_s=0.02, phase="cal_check", estopped=False, command={}, boards=None,
+           context=lambda: {"phase": "cal_check"})
+    w.close()
+    with open(path, "ab") as f:
+        f.write(b'{"kind":"tick","seq":2,"pr')  # the power went here
+    state = read_journal(path)
+    assert state.tail is not None and state.tail.seq == 1
+    w = JournalWriter(path, fresh=False, tail=state.tail)
+    w.resume(state.start["run_id"], None, 5.0)
+    w.tick(time_s=5.0, phase="cal_check", estopped=False, command={}, boards=None,
+           context=lambda: {"phase": "cal_check"})
+    w.close()
+    again = read_journal(path)
+    assert again.resumes == 1 and again.last["time_s"] == 5.0
+    assert b'"pr{' not in path.read_bytes()
+    assert json.loads(mark_path(path).read_bytes())["seq"] == 3

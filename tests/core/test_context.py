@@ -70,3 +70,52 @@ def test_a_restored_controller_continues_like_the_original() -> None:
     assert sent_a == sent_b
     assert ctrl_a.result == restored.result
     assert restored.result.outcome == "completed"
+
+
+def test_the_phases_lists_of_pairs_come_back_as_pairs() -> None:
+    """JSON makes a list of a tuple: from_dict restores the declared type
+    (the calibration check's ``standing``, the probe's ``probe_recent``)."""
+    ctx = Context(work=Work(standing=[(0.3, 0.31)], probe_recent=[(0.5, 0.52), (0.5, 0.53)]))
+    back = Context.from_dict(json.loads(json.dumps(ctx.to_dict())))
+    assert back == ctx
+    assert back.work.standing == [(0.3, 0.31)] and isinstance(back.work.standing[0], tuple)
+
+
+def test_every_field_round_trips_through_json() -> None:
+    """Each field set to a value unlike its default comes back equal, of its type."""
+    ctx = Context(
+        length_of_next_step=0.3, number_of_vertical_turns=1.5, number_of_steps=2,
+        phase="ascent_check", purpose="ascent", calibration_case="3B", start_reading=0.2,
+        home_twist=0.1, third_in_air=True, squaring_turns=1, steps_descended=1,
+        pause_diffs=[0.01, 0.02], disagree_ticks=3, landing_rise_m=[0.17, None],
+        landing_open=[1, -1], landing_step=2, resume_phase="cal_turn",
+        work=Work(entry_wheel=3.0, turn_direction=-1, probe_recent=[(0.1, 0.2)],
+                  first_keys=[1.0], sights=[[0.2], [0.3, 0.4]], side_open=[0.05, None],
+                  side_run=[1, 2], standing=[(0.3, 0.3)], edge_first="SBR"))
+    ctx.tab_length_to_edge[1] = 0.14
+    ctx.climb_twist[0] = -0.02
+    back = Context.from_dict(json.loads(json.dumps(ctx.to_dict())))
+    assert back == ctx
+    assert type(back.work.entry_wheel) is float and type(back.number_of_steps) is int
+
+
+@pytest.mark.parametrize(("data", "problem"), [
+    ({"number_of_steps": 10**9}, "number_of_steps: 1000000000 is out of range; allowed: 0 to 20"),
+    ({"number_of_steps": 1e9}, "number_of_steps: 1000000000.0 is not of type int"),
+    ({"phase_started_s": float("nan")}, "phase_started_s: nan is out of range"),
+    ({"work": {"target_mtf": float("inf")}}, "work.target_mtf: inf is out of range"),
+    ({"phase": "ascent_fly"}, "phase: 'ascent_fly' is not a phase"),
+    ({"work": {"standing": [[0.3]]}}, "work.standing[0]: [0.3] is not of type tuple"),
+    ({"landing_step": -1}, "landing_step: -1 is out of range"),
+])
+def test_from_dict_refuses_numbers_out_of_bounds_and_unknown_phases(
+        data: dict[str, object], problem: str) -> None:
+    with pytest.raises(InputError) as err:
+        Context.from_dict(data, "j")
+    assert str(err.value).startswith(f"j: {problem}")
+
+
+def test_steps_descended_are_bounded_by_those_climbed_unless_from_the_top() -> None:
+    with pytest.raises(InputError, match="steps_descended: 3 is out of range; allowed: 0 to 2"):
+        Context.from_dict({"number_of_steps": 2, "steps_descended": 3})
+    assert Context.from_dict({"from_top": True, "steps_descended": 35}).steps_descended == 35

@@ -1,0 +1,56 @@
+"""The host killed anywhere in a run can be resumed: the context restores at
+every tick of one recorded run's journal (in this process, no boards), and
+a few real kills -- inside phases whose working state holds the pairs JSON
+turns into lists -- are resumed to the end on both wires.  Every phase at
+three points on both wires: ``python benchmarks/host_kills.py``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from stairbot.config import load_config
+from stairbot.fakes.host_kills import kill_tick, recorded, run_kill
+from stairbot.journal import JournalState, mark_path, read_journal
+from stairbot.resume import check, restored_context
+
+
+def test_the_context_restores_at_every_tick_of_a_whole_run(tmp_path: Path) -> None:
+    journal = tmp_path / "journal.jsonl"
+    phases, data, mark = recorded("can")
+    journal.write_bytes(data)
+    mark_path(journal).write_bytes(mark)
+    whole = read_journal(journal)  # every line checked
+    assert whole.end is not None and whole.end["outcome"] == "completed"
+    records = [json.loads(line) for line in journal.read_bytes().splitlines()]
+    start, max_steps = records[0], load_config().algorithm.max_steps
+    context: dict[str, object] | None = None
+    restored = pairs = 0
+    for rec in records:
+        if rec["kind"] != "tick":
+            continue
+        if "context" in rec:
+            context = rec
+        assert context is not None
+        state = JournalState(str(journal), start, rec, context["context"],  # type: ignore[arg-type]
+                             float(context["time_s"]), None,  # type: ignore[arg-type]
+                             boards=rec["boards"])
+        check(state, start["url"], rec["boards"])  # as if the host died after this tick
+        ctx = restored_context(state, rec["time_s"] + 1.0, max_steps)
+        assert ctx.phase == context["context"]["phase"]  # type: ignore[index]
+        pairs += bool(ctx.work.standing or ctx.work.probe_recent)
+        restored += 1
+    assert restored == len(phases)
+    assert pairs > 0  # the ticks that could not be resumed before
+
+
+@pytest.mark.parametrize(("wire", "phase", "point"), [
+    ("can", "cal_check", "last"), ("serial", "cal_probe", "middle"),
+])
+def test_a_host_killed_inside_a_phase_is_resumed_to_the_end(
+        wire: str, phase: str, point: str) -> None:
+    assert kill_tick(wire, phase, point) > kill_tick(wire, phase, "first")
+    cell = run_kill(wire, phase, point)
+    assert cell.verdict == "resumed", cell.reason
