@@ -121,19 +121,30 @@ def test_boards_that_restarted_since_the_journal_are_refused_by_their_boot_id(
                 "then 8)", "bring the robot to the floor by hand")
 
 
+def without_boot(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The boards' identity without a boot id (a robot driver that has none)."""
+    identity = BoardRobot.identity
+
+    def bootless(self: BoardRobot) -> dict[str, dict[str, int]]:
+        return {name: {k: v for k, v in ident.items() if k != "boot"}
+                for name, ident in identity(self).items()}
+
+    monkeypatch.setattr(BoardRobot, "identity", bootless)
+
+
 @pytest.mark.parametrize("side", ["journal", "boards"])
 def test_a_boot_id_on_one_side_only_is_refused(
         side: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
     if side == "journal":
-        with_boot(monkeypatch, {"motor": 7, "sensor": 9})
+        without_boot(monkeypatch)
     with killed_host("serial", None, KILL_TICK) as k:
         if side == "journal":
             monkeypatch.undo()
             monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
         else:
-            with_boot(monkeypatch, {"motor": 7, "sensor": 9})
+            without_boot(monkeypatch)
         code, err = resume(capsys, k)
         refused(code, err, k, 1, "boot id", "another firmware or host version")
 
