@@ -52,8 +52,10 @@ class LockstepClock:
 
 class LockstepRobot(BoardRobot):
     """Both fake boards in lockstep over one link: see the module docstring.
-    Its watchdog counts simulated time, which stands still between ticks, so
-    no keepalive runs."""
+    Its watchdog counts simulated time, which stands still between ticks, but
+    the boards count its lease in wall time: the keepalive renews the lease of
+    a robot left idle (a console before its run, a resume that checks its
+    journal, an operator asked to confirm)."""
 
     LOCKSTEP = True
     HOLD_COMMANDS = True
@@ -64,7 +66,7 @@ class LockstepRobot(BoardRobot):
                  side_pair: str | None = None) -> None:
         self._step: Request | None = None
         super().__init__(link, url, watchdog_ms, clock=LockstepClock(self), sink=sink,
-                         keepalive=False, allow_latched=allow_latched, side_pair=side_pair)
+                         allow_latched=allow_latched, side_pair=side_pair)
         # The world may have run before this host opened it (a resumed run):
         # the clock starts where the world stands (StepTo 0 steps nothing).
         (done,) = self._wait([self._request(m.Board.MOTOR, [m.StepTo(0)])])
@@ -72,6 +74,12 @@ class LockstepRobot(BoardRobot):
         step = done.messages[0]
         if isinstance(step, m.StepDone) and isinstance(self.clock, LockstepClock):
             self.clock.start_at(step.time_us)
+
+    @property
+    def feed_s(self) -> float:
+        """The lease alone sets the keepalive's pace: the watchdog counts the
+        world's time, which stands still while the robot is idle."""
+        return self.lease_ms / 4000
 
     @locked
     def step_to(self, time_us: int) -> None:
