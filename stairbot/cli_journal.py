@@ -30,6 +30,7 @@ from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
 from stairbot.config import RobotConfig
 from stairbot.events import EventSink
+from stairbot.hardware import HasAttitude, Imu
 from stairbot.journal import (
     MAX_LINE,
     JournalError,
@@ -190,12 +191,38 @@ def plan_resume(path: Path | None, url: str, session: RobotSession,
                             f"{state.start.get('config')}")
     context = restored_context(state, float(state.last["time_s"]),
                                config.algorithm.max_steps)
+    if isinstance(robot, HasAttitude):
+        check_attitude(url, robot.attitude(), config)
     lines = describe(state)
     latched = getattr(robot, "latched", {})
     if latched:
         lines.append(f"the boards hold latches ({len(latched)} board(s)); resuming "
                      "clears them")
     return ResumePlan(path, state, lines, context)
+
+
+def check_attitude(url: str, imu: Imu | None, config: RobotConfig) -> None:
+    """ResumeRefused when the IMU reads the robot pitched or rolled beyond the
+    config's limits ([safety] max_pitch_deg, max_roll_deg): it tipped, or
+    fell, while no host watched it, and where the journal left it no longer
+    says where it is; or when its reading is older than the tilt watch
+    allows ([safety] imu_max_age_s): what it says is not the robot now.  No
+    IMU at all: nothing to check."""
+    if imu is None:
+        return
+    s = config.safety
+    if imu.age_s > s.imu_max_age_s:
+        raise ResumeRefused(
+            f"{url}: the IMU's reading is {imu.age_s:.2f} s old (limit {s.imu_max_age_s:g} "
+            "s): whether the robot tipped since the host stopped cannot be told; look at "
+            "the robot, bring it to the floor by hand and start a new run")
+    for name, value, limit in (("pitch", imu.pitch_deg, s.max_pitch_deg),
+                               ("roll", imu.roll_deg, s.max_roll_deg)):
+        if abs(value) > limit:
+            raise ResumeRefused(
+                f"{url}: the IMU reads {name} {value:+.1f}° (limit ±{limit:g}°): the robot "
+                "tipped since the host stopped; bring it to the floor by hand and start a "
+                "new run")
 
 
 def carry_on(plan: ResumePlan, session: RobotSession, config: RobotConfig,

@@ -224,6 +224,16 @@ class HasTruth(Protocol):
         ...
 
 
+@runtime_checkable
+class HasAttitude(Protocol):
+    """A robot that can read its IMU outside a run, whatever its latches (the
+    boards): what a resume looks at before it clears anything."""
+
+    def attitude(self) -> Imu | None:
+        """The IMU now; None when the robot has none, or it has no valid reading."""
+        ...
+
+
 Point = tuple[float, float]
 
 

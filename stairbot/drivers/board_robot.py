@@ -217,6 +217,15 @@ class BoardRobot:
         return self._wait(reads)
 
     @locked
+    def attitude(self) -> Imu | None:
+        """The sensor board's IMU now (one ReadAll to it), read whatever the
+        boards' latches: ``read()`` stops at a tripped watchdog, and a resume
+        must know whether the robot tipped while no host watched it."""
+        sent = self.clock.now()
+        (reply,) = self._wait([self._request(m.Board.SENSOR, [m.ReadAll()])])
+        return telemetry.imu_of(reply.messages, max(0.0, self.clock.now() - sent)).imu
+
+    @locked
     def command(self, speeds: Mapping[MotorId, float]) -> None:
         """Send every motor's speed in one frame; its Ack is checked later.
         While the e-stop is latched every speed sent is 0."""

@@ -19,6 +19,7 @@ from stairbot.cli import main
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.fakes.fault_matrix import SCENARIO, resume_watched
 from stairbot.fakes.host_kills import Killed, killed_host
+from stairbot.hardware import Imu
 from stairbot.journal import line_hash, mark_path, read_journal
 
 Records = list[dict[str, Any]]
@@ -269,3 +270,18 @@ def test_discarding_the_journal_keeps_it_renamed(
     assert code == 1 and "latch" in err[-1]  # the boards still hold theirs: nothing moved
     assert killed.latched()
     assert read_journal(aside).start["url"] == url
+
+
+# -- the robot itself ---------------------------------------------------------------
+
+@pytest.mark.parametrize(("imu", "words"), [
+    (Imu(31.0, 0.5, 0.0, 0.0, 0.01), ("the IMU reads pitch +31.0°", "tipped")),
+    (Imu(0.5, -22.0, 0.0, 0.0, 0.01), ("the IMU reads roll -22.0°", "tipped")),
+    (Imu(0.1, 0.0, 0.0, 0.0, 1.0), ("the IMU's reading is 1.00 s old", "cannot be told")),
+])
+def test_a_robot_that_tipped_while_no_host_watched_is_not_resumed(
+        imu: Imu, words: tuple[str, ...], killed: Killed, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(BoardRobot, "attitude", lambda self: imu)
+    code, err = resume(capsys, killed)
+    refused(code, err, killed, 1, *words)
