@@ -39,7 +39,14 @@ from stairbot.cli_show import (
     cmd_scenario_list,
 )
 from stairbot.config import RobotConfig, load_config
-from stairbot.errors import HardwareError, InputError, NoBoardError, OutputError, ReadFault
+from stairbot.errors import (
+    HardwareError,
+    InputError,
+    LatchedError,
+    NoBoardError,
+    OutputError,
+    ReadFault,
+)
 from stairbot.events import Event, EventKind
 from stairbot.paths import unused_path
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
@@ -355,7 +362,12 @@ def cmd_run(args: argparse.Namespace) -> int:
               "it aside: leave one out", file=sys.stderr)
         return EXIT_INPUT
     left = None if args.resume or path is None else unfinished(path)
-    if left is not None and path is not None:  # a new run would write over an unfinished one
+
+    def keep_unfinished() -> int | None:
+        """A new run would write over the journal's unfinished run: refused
+        (EXIT_INPUT) unless --discard-journal, which sets it aside."""
+        if left is None or path is None:
+            return None
         if not args.discard_journal:
             print(f"{PROG}: error: {path} holds {left}: carry it on with `{PROG} run --robot "
                   f"{args.robot} --resume`; or, once the robot stands at a start position "
@@ -366,6 +378,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         aside = set_aside(path)
         print(f"{PROG}: the journal of the run that did not finish is kept as {aside}",
               file=sys.stderr, flush=True)
+        return None
+
     with _record_file(unused_record(args.record), config) as record:
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
@@ -373,15 +387,28 @@ def cmd_run(args: argparse.Namespace) -> int:
             if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(printable(event.line()), file=progress, flush=True)
 
+        # The robot is opened before the journal is looked at: a journal whose
+        # run another stairbot is driving now is in use, not unfinished.
         try:
             session = open_robot(args.robot, config, replace(options, world=scenario))
         except NoBoardError as exc:  # the URL was fine; the message names board and URL
             print(f"{PROG}: error: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
+        except LatchedError as exc:  # after a host that stopped mid-run: --resume first
+            kept = keep_unfinished()
+            if kept is not None:
+                return kept
+            print(f"{PROG}: error: cannot open {printable(args.robot)}: {exc}",
+                  file=sys.stderr)
+            return EXIT_MISMATCH
         except HardwareError as exc:
             print(f"{PROG}: error: cannot open {printable(args.robot)}: {exc}",
                   file=sys.stderr)
             return EXIT_MISMATCH
+        kept = keep_unfinished()
+        if kept is not None:
+            session.close()
+            return kept
         controller = journal = None
         tap = None
         try:
