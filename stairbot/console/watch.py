@@ -13,7 +13,16 @@ from collections.abc import Callable
 from typing import Protocol
 
 from stairbot.console.state import LiveState
-from stairbot.hardware import ZERO_SPEEDS, Clock, HasTruth, Robot, Snapshot, Speeds, Truth
+from stairbot.hardware import (
+    ZERO_SPEEDS,
+    Clock,
+    EstopsFromAnyThread,
+    HasTruth,
+    Robot,
+    Snapshot,
+    Speeds,
+    Truth,
+)
 from stairbot.side_view import SceneView
 from stairbot.top_view import TopPose
 
@@ -106,10 +115,10 @@ class WatchedRobot:
         so even if the lock is busy for a moment no further motion is
         commanded, and the run thread's own call then reaches the robot.
         Never raises.  A robot whose ``estop()`` is made for any thread
-        (``estop_any_thread``: the boards' driver) is called at once, without
+        (EstopsFromAnyThread: the boards' driver) is called at once, without
         the lock, which a read retrying on a lossy wire may hold."""
         self._estop.set()
-        if getattr(type(self.inner), "estop_any_thread", False):
+        if isinstance(self.inner, EstopsFromAnyThread):
             if not self._estop_sent:
                 self._send_estop()
             return
