@@ -19,7 +19,6 @@ import hashlib
 import json
 import os
 import stat
-import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +27,7 @@ from typing import TextIO
 from stairbot.algorithm.context import Context
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
+from stairbot.cli_show import ask
 from stairbot.config import RobotConfig
 from stairbot.events import EventSink
 from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
@@ -147,16 +147,6 @@ class Resumed:
     controller: Controller
     journal: JournalWriter
     state: JournalState
-
-
-def ask(prompt: str) -> bool:
-    """The operator's answer on the terminal (no terminal: no)."""
-    if not sys.stdin.isatty():
-        return False
-    try:
-        return input(prompt).strip().lower() in ("y", "yes")
-    except EOFError:
-        return False
 
 
 @dataclass
