@@ -39,6 +39,7 @@ class WatchedRobot:
                  wall: Callable[[], float] = time.monotonic,
                  top: Callable[[], TopPose | None] | None = None) -> None:
         self.inner = inner
+        self._estop_unlocked = isinstance(inner, EstopsFromAnyThread)  # asked once, not per press
         self._state = state
         self._lock = lock
         self._scene = scene
@@ -118,7 +119,7 @@ class WatchedRobot:
         (EstopsFromAnyThread: the boards' driver) is called at once, without
         the lock, which a read retrying on a lossy wire may hold."""
         self._estop.set()
-        if isinstance(self.inner, EstopsFromAnyThread):
+        if self._estop_unlocked:
             if not self._estop_sent:
                 self._send_estop()
             return
