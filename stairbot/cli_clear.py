@@ -21,7 +21,7 @@ import argparse
 import sys
 from collections.abc import Callable
 
-from stairbot.cli_show import EXIT_INPUT, EXIT_OK, PROG
+from stairbot.cli_show import EXIT_INPUT, EXIT_OK, PROG, ask
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
@@ -42,16 +42,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="clear without asking (you have looked at the robot); without it "
                         "the command asks on the terminal, and refuses when there is none")
     return p
-
-
-def ask(prompt: str) -> bool:
-    """The operator's answer on the terminal (no terminal: no)."""
-    if not sys.stdin.isatty():
-        return False
-    try:
-        return input(prompt).strip().lower() in ("y", "yes")
-    except EOFError:
-        return False
 
 
 def _say_unfinished(url: str) -> None:

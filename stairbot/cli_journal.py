@@ -19,8 +19,7 @@ import hashlib
 import json
 import os
 import stat
-import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
@@ -28,9 +27,10 @@ from typing import TextIO
 from stairbot.algorithm.context import Context
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
+from stairbot.cli_show import ask
 from stairbot.config import RobotConfig
 from stairbot.events import EventSink
-from stairbot.hardware import HasAttitude, Imu
+from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
 from stairbot.journal import (
     MAX_LINE,
     JournalError,
@@ -149,16 +149,6 @@ class Resumed:
     state: JournalState
 
 
-def ask(prompt: str) -> bool:
-    """The operator's answer on the terminal (no terminal: no)."""
-    if not sys.stdin.isatty():
-        return False
-    try:
-        return input(prompt).strip().lower() in ("y", "yes")
-    except EOFError:
-        return False
-
-
 @dataclass
 class ResumePlan:
     """A run the journal says can go on, checked against the boards; nothing
@@ -194,11 +184,17 @@ def plan_resume(path: Path | None, url: str, session: RobotSession,
     if isinstance(robot, HasAttitude):
         check_attitude(url, robot.attitude(), config)
     lines = describe(state)
-    latched = getattr(robot, "latched", {})
+    latched = _latches(robot)
     if latched:
         lines.append(f"the boards hold latches ({len(latched)} board(s)); resuming "
                      "clears them")
     return ResumePlan(path, state, lines, context)
+
+
+def _latches(robot: Robot) -> Mapping[int, int]:
+    """The latches the robot's boards held when the host opened them (none
+    for a robot without boards)."""
+    return robot.latched if isinstance(robot, HoldsLatches) else {}
 
 
 def check_attitude(url: str, imu: Imu | None, config: RobotConfig) -> None:
@@ -239,7 +235,7 @@ def carry_on(plan: ResumePlan, session: RobotSession, config: RobotConfig,
     writer = JournalWriter(plan.path, fresh=False, tail=state.tail)
     try:
         writer.resume(str(state.start["run_id"]), board_identity(robot), now)
-        if getattr(robot, "latched", {}) or robot.estopped:
+        if _latches(robot) or robot.estopped:
             robot.clear()
     except BaseException:
         writer.close()

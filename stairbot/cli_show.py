@@ -1,5 +1,6 @@
 """The ``stairbot`` commands that show inputs: ``config show``, ``scenario
-check``, ``scenario list`` (the parser and the run are in :mod:`stairbot.cli`)."""
+check``, ``scenario list`` (the parser and the run are in :mod:`stairbot.cli`);
+and what every command shares: its name, the exit codes, and :func:`ask`."""
 
 from __future__ import annotations
 
@@ -14,6 +15,16 @@ from stairbot.text import printable
 
 PROG = "stairbot"
 EXIT_OK, EXIT_INPUT = 0, 2
+
+
+def ask(prompt: str) -> bool:
+    """The operator's answer on the terminal (no terminal: no)."""
+    if not sys.stdin.isatty():
+        return False
+    try:
+        return input(prompt).strip().lower() in ("y", "yes")
+    except EOFError:
+        return False
 
 
 # -- config show ---------------------------------------------------------------------

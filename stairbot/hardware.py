@@ -20,7 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 from types import MappingProxyType
-from typing import Protocol, runtime_checkable
+from typing import Literal, Protocol, runtime_checkable
 
 from stairbot.events import EventSink
 
@@ -232,6 +232,38 @@ class HasAttitude(Protocol):
     def attitude(self) -> Imu | None:
         """The IMU now; None when the robot has none, or it has no valid reading."""
         ...
+
+
+@runtime_checkable
+class HasIdentity(Protocol):
+    """A robot that can say which boards it is (serial://, can://, and the
+    console's watched robot around any robot): what a journal keeps and a
+    resume compares."""
+
+    def identity(self) -> dict[str, dict[str, int]] | None:
+        """Each board's serial number, uptime (ms) and boot id, by board name;
+        None for a robot that has no boards."""
+        ...
+
+
+@runtime_checkable
+class HoldsLatches(Protocol):
+    """A robot whose boards keep their latches from one host to the next
+    (serial://, can://): a resume says it clears them, and clears them."""
+
+    @property
+    def latched(self) -> Mapping[int, int]:
+        """The latch flags each board held when the host opened it, by board."""
+        ...
+
+
+@runtime_checkable
+class EstopsFromAnyThread(Protocol):
+    """A robot whose ``estop()`` may be called from any thread at any moment,
+    without waiting for a lock a read may hold (the boards' driver, whose
+    reads retry on a lossy wire): the console's e-stop key calls it at once."""
+
+    estop_any_thread: Literal[True]
 
 
 Point = tuple[float, float]

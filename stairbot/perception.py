@@ -48,11 +48,10 @@ from stairbot.sensor_specs import SensorSpec
 
 WINDOW = 5
 """Measurements a sensor's median spans, whatever its period.  Five, not
-three: with the median of three that a slow sensor's 0.1 s used to allow,
-two stray measurements in a row passed it -- an HC-SR04 pair (1 % outliers,
-a measurement every 60 ms) about three times a run, a VL53L1X pair often
-enough to pause 3 of 20 noisy runs twice (the standing rule) and to set
-reading drives' targets centimetres off (sonar envelope cases 601, 808)."""
+three: two stray measurements in a row pass a median of three -- for an
+HC-SR04 pair (1 % outliers, a measurement every 60 ms) about three times a
+run, for a VL53L1X pair often enough to pause the standing rule -- and set
+reading drives' targets centimetres off."""
 CONFIRM = 3
 """Measurements in a row that must agree before the kind seen changes."""
 STALE_PERIODS = 3.0

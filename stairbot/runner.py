@@ -13,7 +13,7 @@ import contextlib
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
@@ -23,8 +23,8 @@ from stairbot.config import RobotConfig
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
+    HasIdentity,
     HasTruth,
-    MotorId,
     ReportsEvents,
     Robot,
     Snapshot,
@@ -257,7 +257,7 @@ def run(
         fault=fault,
         reason=res.reason,
         clear_of_stairs_m=truth.clear_of_stairs_m if truth is not None else None,
-        wall_contact=getattr(truth, "wall_contact", None),
+        wall_contact=truth.wall_contact if truth is not None else None,
     )
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands
@@ -271,12 +271,11 @@ def run(
 
 def board_identity(robot: Robot) -> dict[str, dict[str, int]] | None:
     """The boards' serial numbers and uptimes (a robot on a wire), else None."""
-    identity = getattr(robot, "identity", None)
-    return identity() if callable(identity) else None
+    return robot.identity() if isinstance(robot, HasIdentity) else None
 
 
 def _journal_tick(journal: JournalWriter, ctl: Controller, robot: Robot, snap: Snapshot,
-                  speeds: Mapping[MotorId, float]) -> None:
+                  speeds: Speeds) -> None:
     journal.tick(time_s=snap.time_s, phase=ctl.context.phase, estopped=robot.estopped,
                  command={m.name: float(v) for m, v in speeds.items()},
                  boards=board_identity(robot), context=ctl.context.to_dict)

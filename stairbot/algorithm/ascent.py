@@ -81,11 +81,10 @@ def _riser_ahead(t: Tick, w: Work) -> float:
     """How far the riser is: the median over the last RISER_KEYS ticks of
     the mean reading plus the odometer (``ctx.riser_wheel``), less the
     odometer now; the reading itself until KEY_TICKS ticks have measured it.
-    Two outliers among an HC-SR04's last three measurements pass its median:
-    one tick's SFR read 0.057 m for 0.100 m, the approach took the pair's
-    mean, 0.081 m, for its start, and stopped 3.2 cm from the riser where it
-    reckoned 1 cm (envelope case 261 on sonar: lifting segment 3 from there
-    tipped the robot nose up)."""
+    Many ticks, not one: two outliers among an HC-SR04's last three
+    measurements pass its median, one tick's reading can be centimetres
+    short, and an approach that takes it for its start stops that far from
+    the riser, where lifting segment 3 tips the robot nose up."""
     cfg, ctx = t.cfg, t.ctx
     reading = motion.mean_distance(t.snap)
     here = motion.wheel_position(t.snap)
@@ -309,12 +308,11 @@ def _sample_sight(t: Tick, w: Work) -> None:
 def _sight_medians(t: Tick, w: Work) -> list[float | None]:
     """SFR's and SFL's readings past the riser: each one's median over the
     lift's second half where it has them, else its reading now; None for a
-    sensor that reads nothing ahead now.  The median, not the
-    mean: two stray HC-SR04 measurements in a row passed perception's median
-    of three and held SFR at 0.627 m for the lift's last 12 ticks; their mean
-    made length_of_next_step 2 cm long, segment 2 stopped 2 cm short of the
-    edge and lifting segment 3 pitched the robot 15 deg nose up (the envelope
-    sweep, case 601 on sonar)."""
+    sensor that reads nothing ahead now.  The median, not the mean: stray
+    measurements that pass perception's median can hold a reading
+    centimetres off for many ticks of the lift; in a mean they make
+    length_of_next_step that much long, segment 2 stops short of the edge,
+    and lifting segment 3 pitches the robot nose up."""
     out: list[float | None] = []
     for i, r in enumerate(motion.pair(t.snap)):
         sights = w.sights[i]
@@ -380,7 +378,7 @@ def _measure_next_step(t: Tick, w: Work) -> None:
     """Ascent 4's "store the reading in length_of_next_step", on the pair's
     medians over ascent 3's last lift (:func:`_sight_medians`) rather than one
     reading: a Sharp's single reading at 0.35 m is 8 mm off one time in
-    five, and segment 2 stopped that short of the edge (case 816 on ir)."""
+    five, and segment 2 would stop that short of the edge."""
     ctx = t.ctx
     medians = _sight_medians(t, w)
     if motion.measurable(t.snap, t.cfg) and None not in medians:
@@ -504,12 +502,11 @@ def _tab_again(t: Tick, w: Work) -> Step | None:
     LENGTH_OF_INFINITY away, which one beam reaches and the other not.  The
     descent of this step reads it: stand up to TAB_WAIT_S for the pair to
     read it (kept), or both nothing (the top); still neither, go on, and
-    descent 1 finds this step's edge by the back pair alone.  (Without the
-    tab, the ir robot, LENGTH_OF_INFINITY 0.75 m, climbed onto a 0.9 m
-    tread, met a wall, and on the way down descent 1 stopped -- the
-    long-treads sweep; taking the top there instead, a robot whose SFL read
-    30 mm long, askew at the flight's side, came down the step it stood on
-    and tipped back.)  None: go on."""
+    descent 1 finds this step's edge by the back pair alone.  The wait gives
+    descent 1 a tab to back to where one can be read.  The split reading is
+    not taken for the top: one sensor reading a little long, the robot askew
+    at the flight's side, would then end the ascent, and coming down the
+    step it stands on from there tips the robot back.  None: go on."""
     ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps - 1
     if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:

@@ -112,9 +112,9 @@ def measured_standing(t: Tick, w: Work, needed: int) -> bool:
     """True once ``needed`` ticks have been measured; until then, add this
     tick's SFL − SFR to ``w``'s sum when both read a distance.  A reading
     that is an error, a dropout or nothing ahead is no figure for the
-    difference: one HC-SR04 dropout (1.3 m) among 25 ticks moved their mean
-    by 46 mm, and a robot squared up within 6 mm turned 45 deg away from a
-    side wall that was not there (the envelope sweep, case 151 on sonar)."""
+    difference: one HC-SR04 dropout (1.3 m) among 25 ticks moves their mean
+    by centimetres, enough for a square robot to take the riser for a side
+    wall and turn away from it."""
     if len(w.diffs) + w.diff_skipped >= needed:
         return True
     r, l_ = motion.pair(t.snap)
@@ -135,10 +135,9 @@ def mean_diff(t: Tick, w: Work) -> float:
     """The mean SFL − SFR measured standing, trimmed of its TRIM highest and
     lowest ticks; now's if no tick gave one.  Two outliers among an HC-SR04's
     last three measurements pass its median and stay for up to three ticks;
-    in a plain mean one moved it by centimetres, and a square robot took the
-    riser for a side wall (case 2W) and turned 45° away from it (envelope
-    cases 71 and 470 on sonar).  Trimmed, the mean of normal noise keeps
-    about 90 % of its efficiency."""
+    in a plain mean they move it by centimetres, enough for a square robot
+    to take the riser for a side wall (case 2W) and turn away from it.
+    Trimmed, the mean of normal noise keeps about 90 % of its efficiency."""
     if not w.diffs:
         sfr, sfl = readings(t)
         return sfl - sfr
@@ -215,9 +214,8 @@ def _check(t: Tick, w: Work) -> Step:
     # One beam reading nothing ahead is off the flight's open side (a side
     # wall would be seen): the other sees the riser, and case 2's rule turns
     # the right way.  Only two readings that both see something, too far
-    # apart for one riser, are a side wall (the envelope sweep: 19 deg askew
-    # near the open side of a flight, SFL read nothing, case 2W turned away
-    # from the riser until it gave up).
+    # apart for one riser, are a side wall: taking the open side for one,
+    # case 2W would turn away from the riser the other beam sees.
     wall = (not equal and abs(diff) > one_riser(cfg)
             and not motion.far(sfr, cfg) and not motion.far(sfl, cfg))
     ctx.calibration_case = "3" if equal else ("2W" if wall else "2")
@@ -236,8 +234,8 @@ def _verify(t: Tick, w: Work) -> Step:
     """Check a squaring turn standing on all wheels.  The turn ended on the
     readings taken with segments 1 and 3 lifted, their sensors a clearance
     higher: a cone tilted up then sees more of what lies over a low riser,
-    and read equal 17 deg askew on the reference robot (the envelope sweep: the
-    standing rule then ended the approach).  Not equal here, the robot turns
+    and may read equal well askew (17 deg on the reference robot), which
+    the standing rule would then stop in the approach.  Not equal here, the robot turns
     by the odometer as far as the difference says (a flat riser, both beams
     on it), and checks again."""
     ctx, cfg = t.ctx, t.cfg

@@ -412,8 +412,7 @@ def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     if phase is Phase.LANDING_SCAN:
         # The scan moves segment 3 alone, and steers nothing: a side pair that
         # reads no distance there is no flight (the landing is refused, the
-        # robot goes home), not a reason to stop on the landing (the red team:
-        # a 3 s SSR error ended the program there).
+        # robot goes home), not a reason to end the program on the landing.
         return ()
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
@@ -422,8 +421,7 @@ _EDGE_WATCH = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
 """Descent 1's phases watch the back pair for the edge as they back: a back
 sensor that reports errors, or stops measuring, would hide it (the edge is
 where both read the drop), and backing from the top of a flight the robot
-went over the edge unseen and fell (the continuous descent's red team:
-SBR failing 0.5 s into the run)."""
+would go over the edge unseen."""
 
 
 _PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick

@@ -82,8 +82,9 @@ def _backed_off(t: Tick, w: Work) -> Step:
     if w.square_yaw is not None:
         return _turn_square(t, w)
     if t.ctx.from_top:
-        # squared up to the edge by the back pair instead (a riser too low for
-        # the front cone read as nothing ahead, and ended the program)
+        # squared up to the edge by the back pair instead: the front pair
+        # faces risers the robot did not climb, and one too low for its cone
+        # reads as nothing ahead, which calibration takes for case 1
         return go(P.DESCENT_BACK_TO_EDGE)
     return go(P.CAL_CHECK)
 
@@ -127,8 +128,8 @@ def _back_off_turns(t: Tick) -> float:
     """The seed's approach turns; on a narrow step, while the front pair
     cannot read (descent 6 left it nearer the riser than it reads from),
     the tab less the approach's gap, where descent 5 left segment 1's front
-    face: the seed's turns (0.1 m) took segment 2's rear wheels over the
-    edge, and the robot tipped back (the narrow sweep, case 16: +129 deg/s)."""
+    face: on a tread shorter than the robot the seed's turns (0.1 m) take
+    segment 2's rear wheels over the edge, and the robot tips back."""
     tab = _tab(t)
     if _narrow(t) and tab is not None:
         return t.cfg.wheel_turns(max(0.0, tab - t.cfg.algorithm.approach_gap))
@@ -171,8 +172,8 @@ def _edge_by_watch(t: Tick) -> bool:
     continuous descent, and on a climbed step whose tab_length_to_edge was
     not measured (the riser ahead about LENGTH_OF_INFINITY away, which one
     beam reached and the other not: ascent 7 read nothing, ascent 8 read a
-    riser, and the robot went on -- the ir robot on a 0.9 m tread, the
-    long-treads sweep).  Not on a narrow step, whose tab places the robot."""
+    riser, and the robot went on).  Not on a narrow step, whose tab places
+    the robot."""
     return t.ctx.from_top or (_tab(t) is None and not _narrow(t))
 
 
@@ -195,18 +196,18 @@ def _edge_fallback(t: Tick) -> float:
 
 
 # Once the back pair has crossed the edge, the backing ends edge_clearance_m
-# past it, wherever tab_length_to_edge would stop it: read on the way up
-# where segment 3 was lifted over the edge, it left segment 3's front wheels
-# on the edge's corner, and lowered, segment 3 stayed up while the lift
-# pitched the robot (the envelope sweep, case 781 on ir).
+# past it, wherever tab_length_to_edge would stop it: the tab, read on the
+# way up where segment 3 was lifted over the edge, can leave segment 3's
+# front wheels on the edge's corner, and lowered there segment 3 stays up
+# while the lift pitches the robot.
 def _at_edge(t: Tick, w: Work) -> Step:
     """Backed up to the edge.  In a continuous descent, backing the whole
     search without seeing an edge is the floor.  (Its tab_length_to_edge stay
     unknown, and descent 3 and 5 go by the seed's turn counts: the front pair
     looks back up at risers the robot did not climb, and a cone sees over a
-    low one as the robot backs away from it -- the descent sweep: on 0.08 m
-    risers SFR/SFL jumped 70 mm to the riser beyond, descent 5 ended at once,
-    and segment 1, lowered on the edge, pitched the robot 15 deg nose up.)"""
+    low one as the robot backs away from it, so its reading jumps to the
+    riser beyond; a drive by it would end at once, and segment 1, lowered on
+    the edge, would pitch the robot nose up.)"""
     ctx = t.ctx
     searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
     if not ctx.from_top and ctx.edge_wheel is None and _edge_by_watch(t):
@@ -433,29 +434,30 @@ FAR_TAB_M = 0.5
 measurable, when the step's tab_length_to_edge is longer than this: the
 wall ahead is a landing's (a tread of 0.63 m or more), which the front pair
 reads from up to LENGTH_OF_INFINITY, where its noise is largest, while the
-back pair has just placed the edge behind (descent 1) exactly.  On a
-landing 1.0 m deep, descent 5 ended 6.5 mm short of its target 1.007 m
-(a VL53L1X pair: sigma 8 mm there), lowered segment 1's wheel onto the
-edge, and the robot tipped at 154 deg/s."""
+back pair has just placed the edge behind (descent 1) exactly.  A
+VL53L1X pair's sigma at 1 m is about 8 mm: a drive to a tab that far ends
+that much short, lowers segment 1's wheel onto the edge, and tips the
+robot."""
 
 
 TAB_SIGMA_MAX_M = 0.0065
 """Descent 3 and 5 drive by turns, too, where the front pair's stated sigma
 at the tab is more than this: the tab is one reading, and where descent 3
-ends is as far off as it.  The sweeps pass with sigmas up to 6 mm (the ir
-robot's Sharp pair at 0.25 m, the longest tabs of the envelope; a VL53L1X
-pair at 0.5 m, 5.5 mm); at 0.34 m the Sharp pair's (7.8 mm) ended descent 3
-17 mm short, and lowering segment 2 onto the edge pitched the robot to the
-tilt stop (the long-treads sweep, case 60 on ir)."""
+ends is as far off as it.  The threshold sits between the sigmas the
+drives to a tab handle (up to 6 mm: the ir robot's Sharp pair at 0.25 m,
+the longest tabs of the envelope; a VL53L1X pair at 0.5 m, 5.5 mm) and
+those that end descent 3 short enough for segment 2, lowered onto the
+edge, to pitch the robot to the tilt stop (the Sharp pair at 0.34 m,
+7.8 mm)."""
 
 
 def _tab_to_drive(t: Tick) -> float | None:
     """The tab descent 3 and 5 drive to, or None: by turns (FAR_TAB_M; or a
     tread past FAR_TREAD_M, which the ascent drove onto by turns: its tab,
     0.35 to 0.45 m on treads of 0.5 to 0.6 m, read with the cone over a
-    riser lower than min_rise_for, jumped 22-27 mm as the robot backed, and
-    descent 3 or 5 ended short enough to pitch segment 2 to the tilt stop:
-    the long-treads sweep, six cases on the reference robot)."""
+    riser lower than min_rise_for, jumps 22-27 mm as the robot backs, and
+    descent 3 or 5 would end short enough to pitch segment 2 to the tilt
+    stop)."""
     tab = _tab(t)
     if tab is None or tab > FAR_TAB_M or long_tread.far(_tread(t)) \
             or t.cfg.sensors.sigma(False, tab) > TAB_SIGMA_MAX_M:
@@ -548,8 +550,9 @@ def _finish_turns(t: Tick) -> float:
     """How far descent 7 backs while the front pair cannot measure: by the
     odometer if no step was climbed; else from the riser (approach_gap
     away) to the start reading -- not the seed's
-    NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, which a pair that reads from
-    10 cm (a Sharp) had not yet measured within, and stopped 0.4 m short."""
+    NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, within which a pair that reads
+    only from 10 cm (a Sharp) may not yet measure, which would stop the
+    robot 0.4 m short."""
     ctx, cfg = t.ctx, t.cfg
     if _on_the_floor_all_along(t):
         assert ctx.start_wheel is not None
@@ -588,8 +591,8 @@ def _floor_heading(t: Tick, _w: Work) -> Step | None:
     (climb_twist[0]), if the odometer says it is further off than
     HEADING_TOLERANCE_RAD.  Descent 1 squared up to the first riser again, and
     a start squared up far away within a noisy pair's tolerance may differ
-    from that by degrees: backing 0.7 m on the squarer heading put the ir
-    robot 5.7 cm to the side of its start (envelope case 304)."""
+    from that by degrees: backing the whole way to the start on the squarer
+    heading would put the robot centimetres to the side of it."""
     ctx = t.ctx
     floor = ctx.climb_twist[0]
     if ctx.turned_back or floor is None:

@@ -33,8 +33,7 @@ def floor_tolerance(cfg: RobotConfig) -> float:
     the mean of two filtered readings there.  Without the sigmas, a noisy
     pair (or a cone, whose slanted rays read a little long) that reads above
     BACK_CLEARANCE standing keeps the lift pushing segment 3 down, and
-    segment 2 tips nose down (found by the envelope sweep on the reference robot:
-    15 deg at the top of a flight)."""
+    segment 2 tips nose down."""
     sigma = median_sigma(cfg, True, cfg.BACK_CLEARANCE) / math.sqrt(2.0)
     return cfg.sensors.resolution / 2 + FLOOR_SIGMAS * sigma
 
@@ -48,10 +47,10 @@ def edge_clearance_m(cfg: RobotConfig) -> float:
     segment 3's rear) crossed the edge until segment 3's front wheels are
     clear of it, their front EDGE_MARGIN_M past its corner: over the step
     below, and not yet so far that the robot tips back off segment 2's rear
-    wheels.  (Their centre a wheel radius past it, the wheels stood on the
-    corner: lowered, segment 3 stayed up and the lift pitched segment 2 12
-    deg nose down -- the envelope sweep on the sonar robot, once the edge
-    was placed where the pair crossed it.)"""
+    wheels.  The wheels' front, not their centre, is what must clear the
+    corner: wheels whose centre is only a wheel radius past it stand on it,
+    segment 3 stays up when lowered, and the lift pitches segment 2 nose
+    down."""
     g = cfg.geometry
     return (g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear - g.wheel_inset
             + g.wheel_radius + EDGE_MARGIN_M + edge_doubt_m(cfg))
@@ -61,20 +60,19 @@ def edge_doubt_m(cfg: RobotConfig) -> float:
     """How far off :func:`edge_sight_m` may place the crossing: the distance
     backed at full speed in one of the back pair's measurement periods (the
     crossing falls anywhere between two measurements, and the median's
-    majority may take one more).  Added to the clearance: an HC-SR04 pair,
-    measuring every 60 ms, placed segment 3's front wheels up to 10 mm short
-    of where it meant to, on the corner, and lowered there, segment 3 pitched
-    the robot 15 deg nose down (the envelope sweep, cases 1631 and 1636 on
-    sonar)."""
+    majority may take one more).  Added to the clearance, so that a slow
+    pair (an HC-SR04 measures every 60 ms, about 10 mm of backing) still
+    stops segment 3's front wheels past the corner, not on it, where
+    lowering segment 3 would pitch the robot nose down."""
     return cfg.wheel_speed_m_s * measurement_period(cfg, True)
 
 
 LOW_DROP_M = 0.015
 """A continuous descent takes a drop this much past BACK_CLEARANCE (and its
-noise) for an edge: it has not climbed the flight, and a rise lower than
-half min_step_rise_m, unseen, was backed off wheels first (the red team:
-0.03-0.065 m rises tipped the robot back; 0.015 m is under a 32 mm wheel's
-radius)."""
+noise) for an edge: it has not climbed the flight, so any rise may come,
+and one lower than half min_step_rise_m, unseen, would be backed off wheels
+first and tip the robot back.  0.015 m is under a 32 mm wheel's radius, a
+drop the wheels roll down."""
 
 
 def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
@@ -102,9 +100,11 @@ def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> 
     period after the crossing on average), and for a sensor that reports
     the first echo in its cone, the riser's face below the edge that the
     cone's back half keeps seeing, nearer than the drop, until the sensor
-    is ``edge_drop_m`` x sin(half the cone) past it.  The HC-SR04 pair saw
-    the drop 2.4 cm past the edge; backing edge_clearance_m from there, the
-    sonar robot tipped back (the envelope sweep, case 925)."""
+    is ``edge_drop_m`` x sin(half the cone) past it.  For a wide cone this
+    is centimetres (an HC-SR04 pair sees the drop about 2.4 cm past the
+    edge), and the backing that follows subtracts it from
+    edge_clearance_m: counted from the sighting instead, it would tip the
+    robot back."""
     spec = cfg.sensors.spec(True)
     sight = abs(speed_mps) * edge_lag_s(cfg)
     if spec.first_echo:
@@ -137,11 +137,11 @@ def sees_drop(t: Tick) -> bool:
 EDGE_SQUARE_RAD = math.radians(3.0)
 """Continuous descent: turned further than this from square to the edge (by
 how far it backed between SBR and SBL reading the drop), the robot turns
-square before it backs on.  Set down 13 deg askew, it placed the edge where
-the second sensor crossed, backed the clearance, and segment 2's wheels on
-the first one's side went over (the red team: +15.5 deg, then a fall);
-the estimate's own error is about one measurement period's backing across
-the pair's spacing (3 deg for an HC-SR04 pair)."""
+square before it backs on: askew, backing the whole clearance from the
+second sensor's crossing takes segment 2's wheels on the first one's side
+over the edge.  The estimate's own error is about one measurement period's
+backing across the pair's spacing (3 deg for an HC-SR04 pair), and the
+threshold stays just above it."""
 MAX_EDGE_YAW_RAD = math.radians(25.0)
 """One back sensor reads the drop and the other still the floor after the
 robot backed as far as this yaw across the pair's spacing: it stops."""
@@ -155,11 +155,11 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
     square up (``w.square_yaw``), if more than EDGE_SQUARE_RAD and not
     squared at this edge yet.  Only on a crossing the watch sees as it
     happens (``w.edge_floor_s``).  Returns the error that ends the program,
-    if any.  (On a climbed step the robot is square to the edge after
-    calibration: SBL reading 0.1 m long took a drop 0.2 m before SBR's, the
-    crossing half-way put it that far past, and the robot, stopped short,
-    tipped nose down lowering segment 3 -- the red team, on a 0.7 m
-    tread.)"""
+    if any.  On a climbed step calibration has squared the robot to the
+    edge, so one sensor reading the drop far before the other is a sensor
+    reading wrong, not a yaw: placing the crossing half-way between them
+    would stop the robot short, and lowering segment 3 there tips it nose
+    down."""
     ctx, cfg = t.ctx, t.cfg
     if ctx.edge_wheel is not None or w.edge_floor_s is None:
         return None
@@ -202,10 +202,10 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
     passes edge_clearance_m beyond where the back pair saw the drop (more
     than half the lowest rise below BACK_CLEARANCE, or nothing in range):
     tab_length_to_edge, read on the way up, may be a centimetre or two off,
-    and the robot tipped back where it was; and on a tread little longer
-    than the robot, backing off the seed's approach turns already takes
-    segment 3 past the edge (the envelope sweep: the reference robot tipped back
-    backing up to the edge after that).
+    enough to tip the robot back; and on a tread little longer than the
+    robot, backing off the seed's approach turns already takes segment 3
+    past the edge, and backing up to the edge by the tab after that would
+    tip it back.
 
     Where the pair crossed is worked out only from a crossing the watch saw
     as it happened: the pair read the floor on a tick of this phase, then
@@ -214,11 +214,11 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
     or while calibration turned), or a tick came late (a stalled host: the
     robot ran on unwatched) -- where it crossed is not known: the back-off
     ends where it is, and backing up to the edge first drives forward until
-    the pair reads the floor again (``refind``: :func:`refind`).  Placed
-    at the tick that saw the drop, with the robot standing, the crossing
-    was put 0 mm behind the pair, and backing the whole clearance from
-    there tipped the robot back (``benchmarks/soak_host_stalls.py``, seed 19:
-    +15.8 deg)."""
+    the pair reads the floor again (``refind``: :func:`refind`).  A
+    crossing placed at the tick that first saw the drop after such a gap
+    (the robot standing, so :func:`edge_sight_m` is 0) would lie at the
+    pair, when the pair may be well past the edge, and backing the whole
+    clearance from there tips the robot back."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.edge_wheel is None:
         now = t.snap.time_s
@@ -263,16 +263,14 @@ def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
     (backing, the odometer runs down), so at a larger count.  If one sensor
     read the drop first (at ``first_wheel``), the crossing is placed
     half-way between the two: where the robot's centre line crossed, the
-    pair being mounted either side of it -- less what one measurement
-    period's backing explains (:func:`edge_doubt_m`: the two sensors measure
-    at their own times; counted in full, an HC-SR04 pair reading the drop
-    12 mm apart stopped segment 3's front wheels on the corner, and the
-    sonar robot tipped nose down lowering it: the envelope sweep, case
-    1464).  Placed where the second sensor
-    read it, a pair reading the drop 12 mm apart (a VL53L0X cone straddling
-    the edge, a stray measurement in its median, 2.3 deg off square) put it
-    7 mm past the pair when it was about 13 mm, and backing the rest of the
-    clearance the robot tipped back (the landings sweep, case 99)."""
+    pair being mounted either side of it; placed where the second sensor
+    read it, the crossing is up to half the gap too near, and backing the
+    rest of the clearance from there tips the robot back.  The gap counts
+    less what one measurement period's backing explains
+    (:func:`edge_doubt_m`): the two sensors measure at their own times, and
+    that much of the gap is timing, not yaw; counted in full it would stop
+    segment 3's front wheels on the corner, and lowering it there tips the
+    robot nose down."""
     cfg = t.cfg
     speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
     sight = edge_sight_m(cfg, speed * cfg.wheel_circumference, t.ctx.from_top)
@@ -296,11 +294,10 @@ def narrow_bound(t: Tick, w: Work) -> float | None:
     :func:`edge_bound` does) and
     keep where (``Context.narrow_edge_wheel``); once known, the odometer
     count the backing never passes: segment 2's rear axle
-    NARROW_AXLE_MARGIN_M past that edge.  The front pair alone placed the
-    robot there, with 8.5 mm to spare: both of its sensors reading 20 mm
-    short (a common fault the standing rule cannot see) backed segment 2's
-    rear wheels off the edge, and the robot fell (the narrow steps' red
-    team)."""
+    NARROW_AXLE_MARGIN_M past that edge.  The front pair's tab alone leaves
+    8.5 mm to spare there: both of its sensors reading 20 mm short (a common
+    fault the standing rule cannot see) would back segment 2's rear wheels
+    off the edge."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.narrow_edge_wheel is None:
         if not sees_drop(t):

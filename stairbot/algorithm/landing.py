@@ -192,9 +192,9 @@ def _record(t: Tick, w: Work) -> Step:
     ctx.landing_left_m = None if bases[1] is None else bases[1] + lat
     # open: past what it saw on most of the ticks standing at the top, and
     # seen over no lower than the lowest riser it climbs (the beam below that
-    # met something it then lost: a fault, not a flight -- a side sensor reading
-    # 1 m long from 10 mm up was taken for the flight, and the robot turned to a
-    # wall: the red team)
+    # met something it then lost: a fault, not a flight -- a side sensor
+    # reading long from just above the landing would otherwise send the robot
+    # turning to a wall)
     lifted = _lifted_m(t, w)
     seen_at = [lifted if o is None else o for o in w.side_open]
     low = cfg.min_step_rise_m - cfg.sensors.side_height - SCAN_BASE_M
@@ -387,10 +387,9 @@ def returns_here(t: Tick) -> bool:
 def _return_target(t: Tick) -> float | None:
     """What the front pair read on the next flight's first riser where the
     robot turned (squared up there); if it could not read it, what the side
-    pair said of that side, less the front face's reach.  (The side pair's
-    reading alone: a side sensor reading 0.3 m long sent the robot back to
-    the wrong place on a landing 0.6 m wide, and it turned back into a wall:
-    the red team.)"""
+    pair said of that side, less the front face's reach.  The front pair
+    first: a side sensor reading long, alone, would send the robot back to
+    the wrong place on the landing, and it would turn back into a wall."""
     if t.ctx.landing_riser_m is not None:
         return t.ctx.landing_riser_m
     open_m = _open_m(t)

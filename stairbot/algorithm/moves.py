@@ -31,8 +31,8 @@ of the filtered reading's sigma, if more) of what the wheels explain."""
 JUMP_SIGMAS = 6.0
 KEY_TICKS = 5
 """The surface a reading drive starts on is the median of its first this many
-ticks' readings (less what the wheels drove): a stray first reading (an
-outlier just after the pair came into range) found by the 20-seed noise test."""
+ticks' readings (less what the wheels drove), not of the first alone: that
+may be a stray (an outlier just after the pair came into range)."""
 
 
 def jump_limit(cfg: RobotConfig, distance_m: float) -> float:
@@ -90,10 +90,9 @@ def reading_drive(
             else:
                 # The target from the median of the last KEY_TICKS keys, not
                 # from this tick's reading alone: two stray HC-SR04
-                # measurements in three passed perception's median on one
-                # tick and set descent 5's target 4.6 cm short (the envelope
-                # sweep, case 808 on sonar); lowered on the step's edge,
-                # segment 1 pitched the robot 15 deg nose up.
+                # measurements in three pass perception's median on a tick,
+                # and a target set by it can be centimetres short; lowered
+                # on the step's edge there, segment 1 pitches the robot nose up.
                 recent = w.recent_keys
                 recent.append(key)
                 if len(recent) > KEY_TICKS:
@@ -110,10 +109,9 @@ def reading_drive(
             if limit is None and w.target_reading is not None and not w.reading_lost \
                     and 0 < len(w.first_keys) < KEY_TICKS:
                 # Ended by its first ticks' readings: stand until KEY_TICKS of
-                # them agree.  One stray far HC-SR04 reading at its start
-                # ended descent 5 at once, and lowered on the step's edge,
-                # segment 1 pitched the robot 15 deg nose up (the envelope
-                # sweep, case 298 on sonar).
+                # them agree.  One stray far reading at its start would end
+                # the drive at once, and lowered on the step's edge there,
+                # segment 1 pitches the robot nose up.
                 return stay(NO_MOTION)
             return done(t, w)
         return stay(motion.drive(cfg, direction, remaining))

@@ -31,9 +31,9 @@ BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
                            Phase.ASCENT_DRIVE_SECOND})
 """Ascent 4 to 6: onto a step the robot drives by turns (long_tread.near_length
 None), the front pair's rule is not armed.  It is in ascent 7, where the pair
-reads the tab: unarmed there, SFL reading 0.13 m short was not seen, the tab
-was stored 65 mm short, and descent 1 later stopped segment 3 short of the
-edge (the red team)."""
+reads the tab: unarmed there, one sensor reading short would go unseen, the
+tab would be stored short, and descent 1 would stop segment 3 short of the
+edge."""
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after
 the wait, before the program ends with an error)."""
@@ -71,16 +71,16 @@ def watch(t: Tick, phase: PhaseDef) -> Step | None:
     A continuous descent steers by the back pair alone (it squares up to
     each edge with it, and drives by turns): the front pair's rule is not
     armed.  On the top the front pair faces nothing, or a landing's walls
-    (one beam on a side wall, the other open: the red team's runs ended
-    before they moved); below, risers the robot did not climb, which a cone
+    (one beam on a side wall, the other open: a disagreement before the
+    robot moves); below, risers the robot did not climb, which a cone
     sees over when they are low, and, in a flight 0.3 m wide, a side wall
     (ended on the stairs by a disagreement that steered nothing).  Nor is it
     armed in ascent 4 to 6 of a step the robot drives onto by turns (nothing
     ahead, or a tread past FAR_TREAD_M): the front pair steers nothing
-    there, and pitched 5 deg nose down in ascent 5 on the top step of a
-    0.55 m wide second flight, it read the floor ahead at a graze and a side
-    wall (0.49 / 0.47 m), and the rule ended the program (the landings
-    sweep's deeper landings); ascent 7 reads the tab, and is armed."""
+    there, and pitched nose down in ascent 5 on the top step of a narrow
+    flight it reads the floor ahead at a graze and a side wall, a
+    disagreement about nothing it steers; ascent 7 reads the tab, and is
+    armed."""
     if phase.watches is None:
         return None
     ctx = t.ctx
@@ -113,11 +113,11 @@ def _paused(t: Tick, _w: Work) -> Step:
     back = resume.watches == "back"
     # Standing still, the difference over the wait decides, not one noisy tick
     # nor a smoothing that a burst at its end fills: the median of the wait's
-    # last MEDIAN_S of ticks (two stray HC-SR04 measurements passed SFR's
-    # median in its last 0.2 s, and the smoothed difference ended a sound run:
-    # envelope cases 596 and 1359 on sonar).  A pair that gives no figure now
-    # (nothing ahead, an error) does not disagree, as before; with none on
-    # any tick, the smoothed difference decides.
+    # last MEDIAN_S of ticks (two stray HC-SR04 measurements can pass a
+    # sensor's median in the wait's last 0.2 s, and a smoothed difference
+    # would then end a sound run).  A pair that gives no figure now
+    # (nothing ahead, an error) does not disagree (as in _disagree); with
+    # none on any tick, the smoothed difference decides.
     disagree = _disagree(t, back, raw_too=False)
     diff = motion.pair_difference(t.snap, t.cfg, back)
     if diff is not None:

@@ -76,8 +76,8 @@ def _turn_enter(t: Tick, w: Work) -> None:
         w.turn_limit_rad = MAX_SQUARE_YAW_RAD + TURN_MARGIN_RAD
     else:
         # the larger of what the standing mean the case was chosen on says and
-        # what the readings now say: one tick of a Sharp pair 0.36 m away read
-        # 1 deg askew where the mean had said 16 (ir envelope case 1452)
+        # what the readings now say: one tick of a noisy pair (a Sharp pair at
+        # 0.36 m) can read nearly square where the mean said 16 deg askew
         diff = max(abs(sfl - sfr), abs(t.ctx.case_diff or 0.0))
         w.turn_limit_rad = askew_rad(t.cfg, diff) + TURN_MARGIN_RAD
 
@@ -151,10 +151,10 @@ def _probe(t: Tick, w: Work) -> Step:
     """Lifted, measure SFR and SFL standing still, then turn left and watch
     how they change.  Both ends of the comparison are means: the start the
     trimmed mean standing, now the mean of the last PROBE_TICKS ticks.  One
-    tick at each end let a square VL53L1X pair's noise look like a corner
-    ("SFR grew 12 mm, SFL shrank 4 mm" against a start reading 13 mm long):
-    case 3B turned 42 deg looking for the riser and the robot was stranded
-    (the envelope sweep, cases 1119 and 1967 on reference)."""
+    tick at each end would let a square VL53L1X pair's noise look like a
+    corner (SFR growing and SFL shrinking by millimetres against a start
+    reading long), and case 3B would turn far looking for a riser that is
+    ahead."""
     ctx, cfg = t.ctx, t.cfg
     if not w.checked:
         if not settled(t, w) or not measured_standing(t, w, STILL_TICKS):
@@ -172,10 +172,9 @@ def _probe(t: Tick, w: Work) -> Step:
         sfl = sum(l_ for _r, l_ in w.probe_recent) / len(w.probe_recent)
     else:
         # A beam off the riser (or past LENGTH_OF_INFINITY) is as large a
-        # change as there is: now's readings.  Waiting for five ticks that
-        # see something, an ideal robot 18 deg askew 0.97 m away turned on
-        # until both beams read nothing, and squared up to nothing (the
-        # envelope sweep, case 1004 on ideal).
+        # change as there is: now's readings.  Waiting for ticks that see
+        # something, a robot well askew and far away would turn on until both
+        # beams read nothing, and square up to nothing.
         sfr, sfl = readings(t)
     # a corner is decided on a full window of means only
     window_full = both and len(w.probe_recent) >= PROBE_TICKS

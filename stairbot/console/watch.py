@@ -13,7 +13,16 @@ from collections.abc import Callable
 from typing import Protocol
 
 from stairbot.console.state import LiveState
-from stairbot.hardware import ZERO_SPEEDS, Clock, HasTruth, Robot, Snapshot, Speeds, Truth
+from stairbot.hardware import (
+    ZERO_SPEEDS,
+    Clock,
+    EstopsFromAnyThread,
+    HasTruth,
+    Robot,
+    Snapshot,
+    Speeds,
+    Truth,
+)
 from stairbot.side_view import SceneView
 from stairbot.top_view import TopPose
 
@@ -30,6 +39,7 @@ class WatchedRobot:
                  wall: Callable[[], float] = time.monotonic,
                  top: Callable[[], TopPose | None] | None = None) -> None:
         self.inner = inner
+        self._estop_unlocked = isinstance(inner, EstopsFromAnyThread)  # asked once, not per press
         self._state = state
         self._lock = lock
         self._scene = scene
@@ -106,10 +116,10 @@ class WatchedRobot:
         so even if the lock is busy for a moment no further motion is
         commanded, and the run thread's own call then reaches the robot.
         Never raises.  A robot whose ``estop()`` is made for any thread
-        (``estop_any_thread``: the boards' driver) is called at once, without
+        (EstopsFromAnyThread: the boards' driver) is called at once, without
         the lock, which a read retrying on a lossy wire may hold."""
         self._estop.set()
-        if getattr(type(self.inner), "estop_any_thread", False):
+        if self._estop_unlocked:
             if not self._estop_sent:
                 self._send_estop()
             return

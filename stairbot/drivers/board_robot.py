@@ -25,8 +25,8 @@ import functools
 import secrets
 import threading
 import time
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Concatenate, ParamSpec, TypeVar
+from collections.abc import Callable, Sequence
+from typing import Any, Concatenate, Final, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
 from stairbot.config import RobotConfig
@@ -39,7 +39,7 @@ from stairbot.drivers.link import BoardLink, Reply, Request
 from stairbot.drivers.telemetry import K, T, V
 from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import Clock, Imu, MotorId, SensorId, SensorReading, Snapshot
+from stairbot.hardware import Clock, Imu, SensorId, SensorReading, Snapshot, Speeds
 from stairbot.robots import RobotSession
 
 # The emergency stop (docs/protocol.md, "Emergency stop"): each press puts
@@ -80,7 +80,7 @@ class BoardRobot:
     readings; otherwise four, whatever the board sends."""
 
     LOCKSTEP = False  # what the boards' LOCKSTEP flag must say (fakes.lockstep: True)
-    estop_any_thread = True  # estop() does not wait for the lock (the console relies on it)
+    estop_any_thread: Final = True  # estop() does not wait for the lock (EstopsFromAnyThread)
     HOLD_COMMANDS = False  # True: commands wait for the next frame sent (a StepTo)
 
     def __init__(self, link: BoardLink, url: str, watchdog_ms: int = 250, *,
@@ -226,7 +226,7 @@ class BoardRobot:
         return telemetry.imu_of(reply.messages, max(0.0, self.clock.now() - sent)).imu
 
     @locked
-    def command(self, speeds: Mapping[MotorId, float]) -> None:
+    def command(self, speeds: Speeds) -> None:
         """Send every motor's speed in one frame; its Ack is checked later.
         While the e-stop is latched every speed sent is 0."""
         self._reap()

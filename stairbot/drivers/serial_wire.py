@@ -17,11 +17,11 @@ One frame, before stuffing::
                 big-endian
 
 The length byte closes a blind spot of a CRC without a final xor: the CRC
-of a body followed by its own CRC is 0, so before protocol 3.0 a frame whose
-CRC ended in 0x00, with the bytes ``01 01`` inserted before its delimiter,
-decoded (body + 00 00) as the same frame plus one zero-length message.  Now
-any byte added or lost after the header contradicts ``len``, which the CRC
-covers.  The session byte tells one host's requests from another's (or from
+of a body followed by its own CRC is 0, so without ``len`` a frame whose
+CRC ends in 0x00, with the bytes ``01 01`` inserted before its delimiter,
+decodes (body + 00 00) as the same frame plus one zero-length message.  With
+it, any byte added or lost after the header contradicts ``len``, which the
+CRC covers.  The session byte tells one host's requests from another's (or from
 the same host's before a restart) that reuse a sequence number: a board's
 duplicate filter compares it too, and a host takes only replies of its own
 session.  Bit 4 of the address makes a 2.x board drop 3.x frames as

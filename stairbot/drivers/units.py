@@ -16,7 +16,6 @@ into a number: :func:`imu_from_wire` raises TelemetryValueError for it.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 
 from stairbot.drivers.messages import (
     AGE_MAX_MS,
@@ -36,7 +35,7 @@ from stairbot.drivers.messages import (
     SetWheelSpeeds,
     TelemetryValueError,
 )
-from stairbot.hardware import Imu, MotorId, MotorState, SensorReading, SensorStatus
+from stairbot.hardware import Imu, MotorState, SensorReading, SensorStatus, Speeds
 
 
 def _clamp(value: int, low: int, high: int) -> int:
@@ -190,7 +189,7 @@ def state_from_wire(t: MotorTelemetry) -> MotorState:
                       fault_name(t.fault))
 
 
-def speeds_to_wire(speeds: Mapping[MotorId, float]) -> tuple[SetWheelSpeeds, SetLiftSpeeds]:
+def speeds_to_wire(speeds: Speeds) -> tuple[SetWheelSpeeds, SetLiftSpeeds]:
     """The two frames that set every motor's speed; motors left out get 0."""
     w = [speed_to_wire(speeds.get(m, 0.0)) for m in MOTOR_CHANNELS]
     return SetWheelSpeeds(w[0], w[1], w[2], w[3]), SetLiftSpeeds(w[4], w[5])

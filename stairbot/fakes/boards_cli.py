@@ -24,6 +24,7 @@ import argparse
 import contextlib
 import signal
 import sys
+from collections.abc import Callable
 from importlib import import_module
 
 from stairbot.cli import bounded
@@ -86,6 +87,22 @@ def faults_from(args: argparse.Namespace) -> WireFaults:
                       silent_after_s=args.silent_after, seed=args.fault_seed)
 
 
+def stop_on_signals(stop: Callable[[], None]) -> None:
+    """SIGTERM calls ``stop``; Ctrl-C (SIGINT) raises KeyboardInterrupt and
+    stops the boards, as their banner says, even when they were started with
+    SIGINT ignored (a background job, a test runner's worker): Python keeps
+    an inherited SIG_IGN, and `kill -INT` would do nothing.  Call it before
+    the URL is printed: whoever reads it may signal at once.  Outside the
+    main thread no handler can be set, and none is."""
+
+    def on_term(_sig: int, _frame: object) -> None:
+        stop()
+
+    with contextlib.suppress(ValueError):  # not the main thread: no handler
+        signal.signal(signal.SIGTERM, on_term)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def main(argv: list[str]) -> int:
     """Run the subcommand; returns the exit code (InputError propagates to the
     CLI, which prints one line and exits 2)."""
@@ -100,16 +117,7 @@ def main(argv: list[str]) -> int:
     pty = PtyPair()
     server = SerialBoardServer(pty.master, world, make_boards(world), faults_from(args),
                                time_scale=args.time_scale)
-
-    def on_term(_sig: int, _frame: object) -> None:
-        server.stop()
-
-    with contextlib.suppress(ValueError):  # not the main thread: no handler
-        signal.signal(signal.SIGTERM, on_term)
-        # Ctrl-C (SIGINT) stops the boards, as their banner says, even when they
-        # were started with SIGINT ignored (a background job, a test runner's worker):
-        # Python keeps an inherited SIG_IGN, and `kill -INT` then did nothing.
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+    stop_on_signals(server.stop)
     suffix = "?lockstep=1" if args.lockstep else (
         f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"serial://{pty.path}{suffix}", flush=True)

@@ -35,8 +35,6 @@ error frame), duplicated, late, and a board that goes silent.
 
 from __future__ import annotations
 
-import contextlib
-import signal
 import sys
 import threading
 import time
@@ -230,7 +228,7 @@ def reach(bus: can.BusABC) -> str:
 def main(argv: list[str]) -> int:
     """``stairbot fake-boards --can ...`` (the serial engineer's parser hands
     over here).  Bad input raises InputError: the CLI prints one line, exits 2."""
-    from stairbot.fakes.boards_cli import build_parser, faults_from, make_world
+    from stairbot.fakes.boards_cli import build_parser, faults_from, make_world, stop_on_signals
 
     args = build_parser().parse_args(argv)
     url = host_url(args.can)
@@ -244,16 +242,7 @@ def main(argv: list[str]) -> int:
     bus = open_bus(spec)
     server = CanBoardServer(bus, world, make_boards(world), faults_from(args),
                             time_scale=args.time_scale)
-    # before the URL is printed: whoever reads it may signal at once
-    def on_term(_sig: int, _frame: object) -> None:
-        server.stop()
-
-    with contextlib.suppress(ValueError):  # not the main thread: no handler
-        signal.signal(signal.SIGTERM, on_term)
-        # Ctrl-C (SIGINT) stops the boards, as their banner says, even when they
-        # were started with SIGINT ignored (a background job, a test runner's worker):
-        # Python keeps an inherited SIG_IGN, and `kill -INT` then did nothing.
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+    stop_on_signals(server.stop)  # before the URL is printed
 
     sep = "&" if "?" in url else "?"
     suffix = f"{sep}lockstep=1" if args.lockstep else (

@@ -55,7 +55,7 @@ CLIMB_YAW of its axis (climbing them, not turning).
 
 Limits: in a frame's side view the stairs reach sideways without end (a robot
 driven sideways off the landing over flight 1's top edge, in flight 2's
-frame, does not fall; nor off an open side of a flight, as before); the front
+frame, does not fall; nor off an open side of a flight, as in any side view); the front
 beams meet flight 2's first riser in flight 1's frame as a full-height wall
 (Plan's walls); the side view lays the robot along its axis, so near a riser
 at 45 degrees a switch may put an end segment into it (only where the

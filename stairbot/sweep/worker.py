@@ -30,9 +30,8 @@ SETTLE_TICKS = 5
 AFTER_S = 2.0
 """How long the simulation runs on after the run ended, every motor stopped,
 to see the robot stay where it stopped: one that the tilt supervisor
-stopped past its support went on tipping, and fell half a second later,
-with the run already over and "fell: no" (the continuous descent's
-red team: a back sensor failing as the robot backed to the top edge)."""
+stopped past its support goes on tipping, and may fall half a second
+later, after the run has ended and been judged "fell: no"."""
 
 
 def _left_moving(session: Any, config: Any) -> list[str]:

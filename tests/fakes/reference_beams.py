@@ -1,87 +1,103 @@
-"""The ray casts and the beams' combination as they were before they were
-made faster (stairbot/fakes/stairs.py, beams.py, sensor_model.combine on
-d578101), kept frozen as the oracle the fast ones must agree with, bit for bit
-(tests/fakes/test_casts_exact.py).  Not used by stairbot itself."""
+"""An oracle for the fast ray casts, cones and fans (stairbot/fakes/stairs.py,
+beams.py) and the beams' combination (sensor_model.combine):
+tests/fakes/test_casts_reference.py holds the fast ones to it.  Not used by
+stairbot itself.  The cones' top view still goes through
+:meth:`Plan.front_hit_at`, and :func:`combine` is the combination's rule
+written out plainly; the side-view cast is independent.
+
+The cast (:class:`Profile`) shares nothing with StairsProfile: no bisection,
+no walk along x, no per-segment vectors.  The stairs' outline is made of
+horizontal and vertical pieces only, so each piece's surface, ``radius``
+thick, is worked out by hand as a box: the face towards the ray's origin,
+``radius`` from the piece, reaching ``radius`` past its ends; every piece is
+tried, and the nearest met wins (a tie goes to the piece met first along
+the ray's direction in x, as the stairs are walked).  A ray that starts
+inside a piece's surface meets it at once; one that starts in its slab but
+beside its ends does not meet it at all.  The results agree with the fast
+casts to rounding, not bit for bit, except where the fast cast's walk stops
+short near a corner (test_casts_reference.py says where).
+"""
 
 from __future__ import annotations
 
 import math
-from bisect import bisect_left, bisect_right
 
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensor_model import Hit, SensorModel
 
-Geo = tuple[float, ...]
+TIE = 1e-12
+"""Two pieces met within this much of the ray's length are met together."""
 
 
 class Profile:
-    """StairsProfile's casts: every candidate segment found by bisecting both ends."""
+    """Ray casts against an outline of horizontal and vertical pieces, each
+    piece's surface ``radius`` thick."""
 
     def __init__(self, outline: list[tuple[float, float]], radius: float) -> None:
-        segments = [(ax, ay, bx, by) for (ax, ay), (bx, by) in zip(outline, outline[1:],
-                                                                   strict=False)]
         self.radius = radius
-        self._xmin = [s[0] for s in segments]
-        self._xmax = [s[2] for s in segments]
-        self._geo: list[Geo | None] = []
-        for ax, ay, bx, by in segments:
-            ex, ey = bx - ax, by - ay
-            length = math.hypot(ex, ey)
-            if length == 0.0:
-                self._geo.append(None)
-                continue
-            nx, ny = -ey / length, ex / length
-            r_len = radius / length
-            self._geo.append((ax, ay, ex, ey, length * length, nx, ny, -r_len, 1.0 + r_len,
-                              ax + nx * radius, ay + ny * radius,
-                              ax + -nx * radius, ay + -ny * radius))
+        self.pieces = list(zip(outline, outline[1:], strict=False))
+
+    def meets(self, i: int, x0: float, y0: float, x1: float, y1: float) -> float | None:
+        """Where (the ray's parameter in [0, 1]) the ray (x0, y0) -> (x1, y1)
+        meets piece ``i``'s surface, or None."""
+        r = self.radius
+        (ax, ay), (bx, by) = self.pieces[i]
+        if (ax, ay) == (bx, by):
+            return None  # no piece: a repeated point
+        if ay == by:  # a tread or a floor: its surface spans x in [lo, hi]
+            lo, hi = min(ax, bx) - r, max(ax, bx) + r
+            level, start, along, end, across = ay, y0, x0, y1, x1
+        elif ax == bx:  # a riser or a wall: its surface spans y in [lo, hi]
+            lo, hi = min(ay, by) - r, max(ay, by) + r
+            level, start, along, end, across = ax, x0, y0, x1, y1
+        else:
+            raise AssertionError(f"not a horizontal or vertical piece: {self.pieces[i]}")
+        gap = start - level  # from the piece to the origin, across it
+        if abs(gap) < r:  # the origin is inside the surface's slab
+            return 0.0 if lo <= along <= hi else None
+        face = level + math.copysign(r, gap) if r > 0.0 else level
+        if end == start:
+            return None  # parallel to the piece
+        t = (face - start) / (end - start)
+        if not 0.0 <= t <= 1.0:
+            return None
+        at = along + t * (across - along)
+        return t if lo <= at <= hi else None
+
+    def first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
+        """The ray's parameter where it first meets the surface (inf: never),
+        and the piece it meets there (-1: none)."""
+        met = [(t, i) for i in range(len(self.pieces))
+               if (t := self.meets(i, x0, y0, x1, y1)) is not None]
+        if not met:
+            return math.inf, -1
+        nearest = min(t for t, _ in met)
+        tied = [i for t, i in met if t - nearest <= TIE]
+        return nearest, (min(tied) if x1 >= x0 else max(tied))
+
+    def tied(self, x0: float, y0: float, x1: float, y1: float) -> list[int]:
+        """Every piece the ray meets first (more than one: at a corner)."""
+        best, _ = self.first(x0, y0, x1, y1)
+        return [i for i in range(len(self.pieces))
+                if (t := self.meets(i, x0, y0, x1, y1)) is not None and t - best <= TIE]
+
+    def normal(self, i: int) -> tuple[float, float]:
+        """Piece ``i``'s unit normal, to the left of its direction: up for a
+        tread walked forward, back (-x) for a riser walked up."""
+        (ax, ay), (bx, by) = self.pieces[i]
+        if ay == by:
+            return (0.0, 1.0 if bx > ax else -1.0)
+        return (-1.0 if by > ay else 1.0, 0.0)
 
     def ray_normal(self, x0: float, y0: float, x1: float, y1: float
                    ) -> tuple[float, float, float, float] | None:
+        """Where the ray first meets the surface, and the normal of the piece
+        it meets: (x, y, nx, ny), or None."""
         best, i = self.first(x0, y0, x1, y1)
-        if best == math.inf:
+        if i < 0:
             return None
-        g = self._geo[i]
-        assert g is not None
-        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, g[5], g[6])
-
-    def first(self, x0: float, y0: float, x1: float, y1: float) -> tuple[float, int]:
-        r = self.radius
-        lo, hi = (x0, x1) if x0 <= x1 else (x1, x0)
-        first = bisect_left(self._xmax, lo - r)
-        last = bisect_right(self._xmin, hi + r)
-        if first >= last:
-            return math.inf, -1
-        dx, dy = x1 - x0, y1 - y0
-        idx = range(first, last) if dx >= 0 else range(last - 1, first - 1, -1)
-        inf = math.inf
-        best, best_i = inf, -1
-        for i in idx:
-            g = self._geo[i]
-            t = inf
-            if g is not None:
-                ax, ay, ex, ey, len2, nx, ny, u_lo, u_hi, px, py, mx, my = g
-                side = (x0 - ax) * nx + (y0 - ay) * ny
-                if side < 0.0:
-                    side, px, py = -side, mx, my
-                if side < r:
-                    along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
-                    if u_lo <= along <= u_hi:
-                        t = 0.0
-                else:
-                    denom = dx * ey - dy * ex
-                    if denom != 0.0:
-                        wx, wy = px - x0, py - y0
-                        tt = (wx * ey - wy * ex) / denom
-                        if 0.0 <= tt <= 1.0:
-                            u = (wx * dy - wy * dx) / denom
-                            if u_lo <= u <= u_hi:
-                                t = tt
-            if t < best:
-                best, best_i = t, i
-            elif best < inf and dx != 0.0:
-                break
-        return best, best_i
+        nx, ny = self.normal(i)
+        return (x0 + (x1 - x0) * best, y0 + (y1 - y0) * best, nx, ny)
 
 
 def front_hits(profile: Profile, plan: Plan, model: SensorModel, mount: tuple[float, float],

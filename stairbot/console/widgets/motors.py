@@ -11,13 +11,11 @@ which is what the sign means (docs/protocol.md, section 1).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 from rich.text import Text
 from textual.widgets import Static
 
 from stairbot.console.freshness import age_key, is_stale, titled
-from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, Snapshot
+from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, Snapshot, Speeds
 
 STILL = 1e-3  # turns/s below which a motor counts as stopped
 NAMES = {MotorId.MWF: "front wheels", MotorId.MWB: "back wheels",
@@ -80,7 +78,7 @@ class MotorPanel(Static):
         self._last: object = ()
         self.border_title = titled("motors  turn/s  turns", None)
 
-    def show(self, snap: Snapshot | None, commands: Mapping[MotorId, float],
+    def show(self, snap: Snapshot | None, commands: Speeds,
              age_s: float | None = None, carried_by: tuple[int, ...] = ()) -> None:
         """``age_s``: wall seconds since ``snap`` was read (None: never);
         ``carried_by``: the segments that stand in the running phase."""
