@@ -26,7 +26,7 @@ from stairbot.sensor_specs import SPECS, SensorSpec
 
 # Physical bounds: generous around any robot of this kind (the reference robot
 # is 0.225 m long and 2.4 kg), tight enough that the simulation's pymunk world
-# stays sane and a run ends (README, "Bounds of the inputs").
+# stays sane and a run ends (docs/config.md, "Bounds of the inputs").
 Length = Annotated[float, msgspec.Meta(ge=0.001, le=10.0)]
 """A length that must be there: 1 mm to 10 m."""
 Gap = Annotated[float, msgspec.Meta(ge=0.0, le=10.0)]

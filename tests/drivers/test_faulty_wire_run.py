@@ -3,7 +3,7 @@ frames completes, on serial (a pty) and on CAN (python-can's ``virtual``),
 both in lockstep: the link retries, revives within its grace period and
 ignores what comes late or twice.  The one-step flight and short timeouts keep
 each case to seconds; ``benchmarks/soak_faults.py`` runs the five-step default
-flight over ten seeds per wire and fault (its count is in the README)."""
+flight over ten seeds per wire and fault (its count is in docs/figures.md)."""
 
 from __future__ import annotations
 

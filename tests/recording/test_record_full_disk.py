@@ -1,5 +1,5 @@
 """An MCAP record the disk refuses, or cannot open, behaves as the JSON-lines
-record does (README, "Writes"): one line, no traceback; exit 2 for a path
+record does (docs/config.md, "Writes"): one line, no traceback; exit 2 for a path
 that cannot be opened, exit 1 for a refused write -- during a run after
 every motor is stopped, the file keeping what was written before."""
 
