@@ -46,6 +46,12 @@ from stairbot.robots import RobotSession
 # ESTOP_COPIES EStop frames to each board on the wire at once, sends the
 # unanswered ones again every ESTOP_RESEND_S, and gives up on a board that has
 # not confirmed within ESTOP_CONFIRM_S (a LINK event says so).
+# A speed command keeps its motors running for at most COMMAND_HOLD_MS of
+# wall time (scaled like the watchdog) without a newer one: a host that falls
+# silent mid-drive has its motors stopped after that, well before its
+# watchdog latches (docs/protocol.md, "Command hold").  Five control ticks:
+# a lost command frame or two is ridden out.
+COMMAND_HOLD_MS = 100
 ESTOP_COPIES = 3
 ESTOP_RESEND_S = 0.02
 ESTOP_CONFIRM_S = 0.5
@@ -112,6 +118,7 @@ class BoardRobot:
         # Fake boards paced at X times real time count the watchdog in their
         # simulated time: X times the wall time the host has to feed it.
         self.board_watchdog_ms = min(65535, round(watchdog_ms * time_scale))
+        self.board_hold_ms = max(1, min(65535, round(COMMAND_HOLD_MS * time_scale)))
         self.lease_ms = m.LEASE_MS  # in wall-clock ms, as the watchdog
         self._lock = threading.RLock()
         self.latched: dict[int, int] = {}  # board -> latch flags found when opening
@@ -137,7 +144,8 @@ class BoardRobot:
         for board in m.Board:
             self.idents[board], status, owner = open_board(
                 self.link, self.url, board, lockstep=self.LOCKSTEP,
-                watchdog_ms=self.board_watchdog_ms, nonce=self.nonce,
+                watchdog_ms=self.board_watchdog_ms, hold_ms=self.board_hold_ms,
+                nonce=self.nonce,
                 lease_ms=self.board_lease_ms, wait_s=self._wait_board_s,
                 allow_latched=allow_latched, side_pair=self.side_pair)
             self.boots[board] = owner.boot

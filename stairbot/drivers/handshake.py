@@ -130,11 +130,12 @@ def release_board(link: BoardLink, board: m.Board, nonce: int) -> None:
 
 
 def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
-               watchdog_ms: int, nonce: int, lease_ms: int,
+               watchdog_ms: int, hold_ms: int, nonce: int, lease_ms: int,
                wait_s: Callable[[float], None], allow_latched: bool = False,
                side_pair: str | None = None
                ) -> tuple[m.Ident, m.Status | None, m.Owner]:
-    """Identify ``board``, take its lease (``claim_board``) and set it up;
+    """Identify ``board``, take its lease (``claim_board``) and set it up
+    (its watchdog, and the command hold ``hold_ms``: docs/protocol.md, "Command hold");
     its Ident, the Status after set-up and the Owner reply (the boot id).
     Raises NoBoardError (no answer), ProtocolVersionError, RobotUrlError (a
     lockstep mismatch), BoardOwnedError (another host holds it), LatchedError
@@ -182,7 +183,7 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
     # timeout (SetWatchdog sets a value: the same effect however often it runs).
     for attempt in range(link.retries + 1):
         try:
-            reply = link.exchange(board, [m.SetWatchdog(watchdog_ms)])
+            reply = link.exchange(board, [m.SetWatchdog(watchdog_ms, hold_ms)])
             break
         except LinkLostError:
             if attempt == link.retries:

@@ -108,12 +108,15 @@ class GetStatus(Message):
 
 @dataclass(frozen=True, slots=True)
 class SetWatchdog(Message):
-    """Set the watchdog timeout in ms (0 disables it).  Reply: Status."""
+    """Set the watchdog timeout in ms (0 disables it) and the command hold:
+    how long, in ms, a speed command keeps its motors running without a
+    newer one (0: until changed).  Reply: Status."""
 
     TYPE = 0x04
     ANSWER = STATUS
-    FORMAT = "<H"
+    FORMAT = "<HH"
     timeout_ms: int
+    hold_ms: int = 0
 
 
 @dataclass(frozen=True, slots=True)

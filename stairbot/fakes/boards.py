@@ -46,6 +46,8 @@ class Board:
         self.world = world
         self.serial = serial
         self.watchdog_ms = DEFAULT_WATCHDOG_MS
+        self.hold_ms = 0  # a speed command's life (SetWatchdog.hold_ms); 0: until changed
+        self.held_out = 0  # motors stopped because their command outlived hold_ms
         self.estop = False
         self.watchdog_tripped = False
         self.fault = m.MotorFault.NONE
@@ -180,7 +182,7 @@ class Board:
         if isinstance(msg, m.SetWatchdog):
             if msg.timeout_ms == 0 and self.may_move():
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_VALUE)]  # stop the motors first
-            self.watchdog_ms = msg.timeout_ms
+            self.watchdog_ms, self.hold_ms = msg.timeout_ms, msg.hold_ms
             return [self.status()]
         if isinstance(msg, m.EStop):
             self.estop = True
@@ -208,8 +210,10 @@ class MotorBoard(Board):
         self.modes = [m.MotorMode.IDLE] * self.CHANNELS
         self._move_target: list[float | None] = [None] * self.CHANNELS
         self.peer: Board | None = None  # the sensor board, whose StepTo polls we share
+        self._commanded = world.now()  # when the motors were last commanded
 
     def _set(self, speeds: dict[int, float], mode: m.MotorMode | None = None) -> None:
+        self._commanded = self.world.now()
         for ch, tps in speeds.items():
             self.modes[ch] = mode if mode is not None else (
                 m.MotorMode.RUN if tps != 0 else m.MotorMode.IDLE)
@@ -236,6 +240,12 @@ class MotorBoard(Board):
 
     def poll(self) -> None:
         super().poll()
+        if self.hold_ms and (self.world.now() - self._commanded) * 1000 > self.hold_ms:
+            running = {ch: 0.0 for ch, mode in enumerate(self.modes)
+                       if mode == m.MotorMode.RUN}
+            if running:  # the command outlived its hold: stop, latch nothing
+                self.held_out += 1
+                self._set(running)
         snap = None
         for ch, target in enumerate(self._move_target):
             if target is None:

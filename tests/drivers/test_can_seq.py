@@ -283,7 +283,8 @@ def test_a_protocol_3_can_board_is_refused_with_one_line() -> None:
     try:
         with pytest.raises(ProtocolVersionError) as info:
             open_board(link, "can://virtual/old", m.Board.MOTOR, lockstep=False,
-                       watchdog_ms=250, nonce=1, lease_ms=m.LEASE_MS, wait_s=time.sleep)
+                       watchdog_ms=250, hold_ms=100, nonce=1, lease_ms=m.LEASE_MS,
+                       wait_s=time.sleep)
         assert str(info.value) == (
             "can://virtual/old: the motor board speaks protocol 3.0; this host speaks "
             f"{m.PROTOCOL_MAJOR}.x (docs/protocol.md): update the board's firmware or the host")
@@ -291,7 +292,8 @@ def test_a_protocol_3_can_board_is_refused_with_one_line() -> None:
         # a board that answers neither way is still "no board"
         with pytest.raises(NoBoardError, match="no sensor board answered"):
             open_board(link, "can://virtual/old", m.Board.SENSOR, lockstep=False,
-                       watchdog_ms=250, nonce=1, lease_ms=m.LEASE_MS, wait_s=time.sleep)
+                       watchdog_ms=250, hold_ms=100, nonce=1, lease_ms=m.LEASE_MS,
+                       wait_s=time.sleep)
     finally:
         link.close()
 

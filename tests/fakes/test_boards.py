@@ -413,3 +413,29 @@ def test_a_lease_released_or_lapsed_can_be_taken(rig: tuple,
     clock[0] += 0.02
     assert sensor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)[0].result == m.ClaimResult.GRANTED
     assert sensor.handle([m.Clear()], HOST) == [m.Ack(m.Clear.TYPE, m.AckResult.NOT_OWNER)]
+
+
+def test_a_speed_command_outlives_its_hold_and_stops_without_a_latch(rig: tuple) -> None:
+    """A host that falls silent mid-drive: its motors stop after hold_ms (a
+    wheel coasts, a lift holds), long before the watchdog latches."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWatchdog(250, 100), m.SetWheelSpeeds(1000, 1000, 1000, 1000),
+                  m.SetLiftSpeeds(500, 0)], HOST)
+    step(motor, world, 0.08)
+    assert robot.speeds[MotorId.MWF] == 1.0 and robot.speeds[MotorId.MTF] == 0.5
+    step(motor, world, 0.04)  # 120 ms since the command
+    assert all(v == 0.0 for v in robot.speeds.values())
+    status = motor.handle([m.GetStatus()], HOST)[0]
+    assert status.flags & (m.StatusFlag.WATCHDOG | m.StatusFlag.ESTOP) == 0
+    assert motor.held_out == 1
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)  # runs again
+    assert robot.speeds[MotorId.MWF] == 1.0
+
+
+def test_commands_each_tick_keep_the_motors_running(rig: tuple) -> None:
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWatchdog(250, 100)], HOST)
+    for _ in range(20):  # 0.4 s of 20 ms ticks
+        motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(0, 0)], HOST)
+        step(motor, world, 0.02)
+    assert robot.speeds[MotorId.MWF] == 1.0 and motor.held_out == 0
