@@ -118,7 +118,8 @@ class BoardRobot:
         # Fake boards paced at X times real time count the watchdog in their
         # simulated time: X times the wall time the host has to feed it.
         self.board_watchdog_ms = min(65535, round(watchdog_ms * time_scale))
-        self.board_hold_ms = max(1, min(65535, round(COMMAND_HOLD_MS * time_scale)))
+        self.board_hold_ms = (max(1, min(65535, round(COMMAND_HOLD_MS * time_scale)))
+                              if COMMAND_HOLD_MS else 0)
         self.lease_ms = m.LEASE_MS  # in wall-clock ms, as the watchdog
         self._lock = threading.RLock()
         self.latched: dict[int, int] = {}  # board -> latch flags found when opening

@@ -9,6 +9,7 @@ import os
 
 import pytest
 
+from stairbot.drivers import board_robot
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.fakes import boards as fake_boards
 from stairbot.fakes.fault_matrix import FAULTS, PHASES, cells, run_cell
@@ -69,7 +70,8 @@ def test_a_fault_in_any_phase_ends_safe(fault: str, phase: str, wire: str) -> No
 
 def test_the_judge_sees_motors_left_running(monkeypatch: pytest.MonkeyPatch) -> None:
     """A host that drives a lift and does not stop it on a lost link, and
-    boards with no watchdog: the cell is UNSAFE, so the matrix can fail."""
+    boards with no watchdog and no command hold: the cell is UNSAFE, so the
+    matrix can fail."""
     command = BoardRobot.command
 
     def lift_too(self: BoardRobot, speeds: dict[MotorId, float]) -> None:
@@ -79,6 +81,7 @@ def test_the_judge_sees_motors_left_running(monkeypatch: pytest.MonkeyPatch) -> 
     for name in ("stop_all", "estop", "close"):
         monkeypatch.setattr(BoardRobot, name, lambda self: None)
     monkeypatch.setattr(fake_boards.Board, "poll", lambda self: None)
+    monkeypatch.setattr(board_robot, "COMMAND_HOLD_MS", 0)
     cell = run_cell("sensor board killed", "cal_lift", "can")
     assert cell.verdict == "UNSAFE"
     assert "motors left running" in cell.reason and "a lift moved" in cell.reason
