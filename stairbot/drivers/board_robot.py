@@ -68,9 +68,11 @@ def locked(method: Callable[Concatenate[S, P], R]) -> Callable[Concatenate[S, P]
 class BoardRobot:
     """Both boards over one link: see the module docstring.
 
-    ``watchdog_ms`` is the boards' watchdog in wall-clock ms (0: off); boards
-    paced at ``time_scale`` times real time are sent that many times it, and
-    the robot's clock (a WallClock unless ``clock`` is given) runs as fast.
+    ``watchdog_ms`` is the boards' watchdog in ms of the robot's clock (0:
+    off): wall time, or for boards paced at ``time_scale`` times real time,
+    simulated time, which they count it in; the robot's clock (a WallClock
+    unless ``clock`` is given) runs as fast, and the keepalive that many
+    times more often.
     ``monotonic`` is the wall clock the keepalive goes by.  ``side_pair``
     names where the robot config gives the robot the side pair (SSR, SSL;
     ``wanted_side_pair``), None when it has none: the sensor board must then
@@ -103,10 +105,11 @@ class BoardRobot:
         self._estopped = False
         self._link_lost = False
         self._last_tx: dict[int, float] = {}
-        self.watchdog_ms = watchdog_ms  # in wall-clock ms
-        # Fake boards paced at X times real time count the watchdog in their
-        # simulated time: X times the wall time the host has to feed it.
-        self.board_watchdog_ms = min(65535, round(watchdog_ms * time_scale))
+        self.watchdog_ms = watchdog_ms  # in ms of the robot's clock
+        # Fake boards paced at X times real time count it in simulated time:
+        # the host has 1/X of it in wall time to feed them (timing.py).
+        self.board_watchdog_ms = watchdog_ms
+        self._keepalive_s = watchdog_ms / 4000 / time_scale  # wall seconds
         self._lock = threading.RLock()
         self.latched: dict[int, int] = {}  # board -> latch flags found when opening
         self._handshake(allow_latched)
@@ -293,7 +296,7 @@ class BoardRobot:
             return
         now = self._monotonic()
         for board in m.Board:
-            if now - self._last_tx.get(board, 0.0) > self.watchdog_ms / 4000:
+            if now - self._last_tx.get(board, 0.0) > self._keepalive_s:
                 self._commands.append(self._request(board, [m.Heartbeat()]))
 
     @locked
@@ -306,8 +309,7 @@ class BoardRobot:
                         "rejected": self.imu_rejected}}
 
     def _keep_alive(self) -> None:
-        period = self.watchdog_ms / 4000
-        while not self._stop.wait(period):
+        while not self._stop.wait(self._keepalive_s):
             try:
                 with self._lock:
                     if self._closed:
