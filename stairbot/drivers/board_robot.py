@@ -33,7 +33,7 @@ from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
 from stairbot.drivers.handshake import LATCHES, open_board
 from stairbot.drivers.health import HealthReport
-from stairbot.drivers.link import BoardLink, Reply, Request
+from stairbot.drivers.link import BoardLink, BusFaultError, Reply, Request
 from stairbot.drivers.telemetry import K, T, V
 from stairbot.errors import BoardMismatchError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
@@ -354,34 +354,46 @@ class BoardRobot:
         try:
             return self.link.request(board, msgs, send=send)
         except LinkLostError as exc:  # the wire itself failed (a port that went away)
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
             raise  # unreachable: _lost raises
 
     def _broadcast(self, msg: m.Message) -> Sequence[Request]:
         try:
             return self.link.broadcast(msg)
         except LinkLostError as exc:  # the wire itself failed
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
             raise  # unreachable: _lost raises
 
     def _wait(self, requests: Sequence[Request]) -> list[Reply]:
         try:
             return self.link.wait(requests)
         except LinkLostError as exc:
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
             raise  # unreachable: _lost raises
         except HardwareError as exc:  # a board that broke the protocol
             raise HardwareError(f"{self.url}: {exc}") from None
 
-    def _lost(self, reason: str, boards_stopped: bool = False) -> None:
+    def _lost(self, reason: str, boards_stopped: bool = False, latch: bool = False) -> None:
         """Report the lost link (a LINK event, the first time only: the stop,
         truth and close that follow a loss would each report it again) and
-        raise LinkLostError saying what became of the motors."""
+        raise LinkLostError saying what became of the motors, and what is
+        wrong with the wire itself if the link knows (``bus_trouble``).  A
+        failed wire (``latch``: bus-off, a flood) first latches this robot's
+        emergency stop."""
+        if latch:
+            self.estop()  # never raises; the boards may not hear it
+        else:
+            trouble = self.link.bus_trouble()
+            if trouble is not None:
+                reason = f"{reason}; meanwhile {trouble}"
         if not self._link_lost:
             self._link_lost = True
             self.sink(Event(self.clock.now(), EventKind.LINK, f"link lost: {reason}", None,
                             self.health()))
-        if boards_stopped:
+        if latch:
+            after = ("; this host's emergency stop is latched (the boards' watchdogs stop "
+                     "the motors if they heard nothing)")
+        elif boards_stopped:
             after = ""
         elif self.watchdog_ms:
             # What the host cannot know it does not say: whether the boards
@@ -396,7 +408,7 @@ class BoardRobot:
         try:
             self.link.poll()
         except LinkLostError as exc:  # the wire itself failed
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
         still = []
         for p in self._commands:
             if p.reply is not None:

@@ -57,6 +57,12 @@ from stairbot.drivers.records import Heartbeat, Ident, Message, RawMessage
 from stairbot.errors import HardwareError, LinkLostError
 
 
+class BusFaultError(LinkLostError):
+    """The wire itself failed, not a board: a CAN bus that went bus-off, or a
+    flood of frames from another node.  The robot latches its emergency stop
+    before raising it on (``BoardRobot``)."""
+
+
 @dataclass(frozen=True, slots=True)
 class Reply:
     """A board's whole answer to one request, whatever the wire: the board
@@ -229,6 +235,11 @@ class BoardLink(Protocol):
         """What the wire is, for diagnostics."""
         ...
 
+    def bus_trouble(self) -> str | None:
+        """What is wrong with the wire itself, for a lost link's message (a
+        CAN bus error-passive, frames from other nodes); None if nothing."""
+        ...
+
     def close(self) -> None: ...
 
 
@@ -308,6 +319,13 @@ class RequestLink(ABC, Generic[R]):
 
     def _given_up(self, req: R) -> None:
         """``req`` failed: remember what a late reply to it would look like."""
+
+    def _check_bus(self) -> None:
+        """Raise BusFaultError if the wire says it has failed (the CAN link
+        reads its bus's state); called by every wait and poll."""
+
+    def bus_trouble(self) -> str | None:
+        return None
 
     def _on_wire(self, req: R) -> bool:
         """Whether ``req`` has gone out (a wire that holds requests back until
@@ -466,6 +484,7 @@ class RequestLink(ABC, Generic[R]):
     def poll(self) -> None:
         """Take in whatever has arrived, without waiting; expire old requests.
         Requests held back with ``send=False`` stay held."""
+        self._check_bus()
         self._drain()
         with self._mutex:
             self._expire()
@@ -515,6 +534,7 @@ class RequestLink(ABC, Generic[R]):
         silent as long."""
         with self._mutex:
             self.flush()
+        self._check_bus()
         while True:
             # Take in what has already arrived before judging deadlines: a host
             # descheduled past a timeout must not call a waiting reply late.
