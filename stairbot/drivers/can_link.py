@@ -135,25 +135,6 @@ class CanLink(RequestLink[CanRequest]):
         req.expect()
         self._send(req)
 
-    def _retry(self, requests: list[CanRequest]) -> set[int]:
-        """A request first broadcast goes again as the broadcast frame (its
-        seq, once for every request sharing it): both boards hear it, the one
-        that answered already answers from its cache (``duplicates``) and its
-        watchdog is fed."""
-        reached: set[int] = set()
-        sent: set[int] = set()
-        for req in requests:
-            if not req.broadcast:
-                self._resend(req)
-                reached.add(req.board)
-                continue
-            req.expect()
-            reached.update(int(b) for b in m.Board)
-            if req.seqs[0] not in sent:
-                sent.add(req.seqs[0])
-                self.send(BROADCAST, req.messages[0], req.seqs[0])
-        return reached
-
     def flush(self) -> None:
         """Send every held request, in order; a single message held for every
         board in a row (ReadAll to both) becomes one broadcast frame."""
@@ -181,7 +162,6 @@ class CanLink(RequestLink[CanRequest]):
                     if not q.seqs:
                         self._going_out(q)
                     q.seqs = seqs
-                    q.broadcast = True
                 yield BROADCAST, first.messages[0], seqs[0]
                 i += len(group)
             else:

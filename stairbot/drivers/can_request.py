@@ -89,7 +89,6 @@ class CanRequest(Request):
 
     channels: int | None = None  # the board's, from its Ident (None: its base)
     seqs: tuple[int, ...] = ()
-    broadcast: bool = False  # its one frame went to board 15, and so goes every retry
     got: list[m.Message] = field(default_factory=list)
     todo: deque[Due] = field(default_factory=deque)
     taken: list[Due] = field(default_factory=list)

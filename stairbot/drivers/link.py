@@ -31,8 +31,8 @@ Rules (docs/protocol.md, "Requests and replies"):
 * A retry round feeds every board: a board none of the round's frames
   reaches is sent a Heartbeat (``feeds``), so that while the host waits for
   one board the other's watchdog does not starve (``timing.py`` has the
-  arithmetic; on CAN a request first broadcast is retried as the broadcast
-  frame, which reaches both).
+  arithmetic).  A Heartbeat costs its board one reply; the same ReadAll
+  again (on CAN the broadcast frame) would cost a whole ReadAll reply.
 * :meth:`RequestLink.urgent` (the emergency stop) may be called from any
   thread while another waits for replies: its frames go on the wire at once,
   ahead of anything held back and between a waiting read's retries.  The
@@ -457,8 +457,7 @@ class RequestLink(ABC, Generic[R]):
                 self._feed(board)
 
     def _retry(self, requests: list[R]) -> set[int]:
-        """Send ``requests`` again; the boards their frames reach (a wire that
-        retries a broadcast frame reaches every board)."""
+        """Send ``requests`` again; the boards their frames reach."""
         for req in requests:
             self._resend(req)
         return {req.board for req in requests}
