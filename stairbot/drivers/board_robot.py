@@ -391,8 +391,8 @@ class BoardRobot:
             self.sink(Event(self.clock.now(), EventKind.LINK, f"link lost: {reason}", None,
                             self.health()))
         if latch:
-            after = ("; this host's emergency stop is latched (the boards' watchdogs stop "
-                     "the motors if they heard nothing)")
+            after = ("; this host's emergency stop is latched (EStop frames sent; a board "
+                     "that did not hear them stops its motors when its watchdog runs out)")
         elif boards_stopped:
             after = ""
         elif self.watchdog_ms:
