@@ -1,6 +1,6 @@
 """Default runs over a faulty wire: does the run ride out ordinary link noise?
 
-    python benchmarks/soak_faults.py [--seeds N] [--wire serial|can]
+    python benchmarks/soak_faults.py [--seeds N] [--first-seed S] [--wire serial|can]
                                      [--fault drop|corrupt|late|duplicate]
                                      [--p 0.05] [-j 2] [--url-options OPTS]
                                      [--realtime [--time-scale X]]
@@ -116,6 +116,7 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=1, help="seeds FIRST..FIRST+N-1")
     ap.add_argument("--wire", choices=("serial", "can"), action="append")
     ap.add_argument("--fault", choices=FAULTS, action="append")
     ap.add_argument("--p", type=float, default=0.05, help="probability per frame")
@@ -132,9 +133,10 @@ def main(argv: list[str] | None = None) -> int:
     mode = mode_name(scale)
     wires = args.wire or ["serial", "can"]
     faults = args.fault or ["drop", "corrupt", "late"]
-    jobs = [(w, f, s) for w in wires for f in faults for s in range(1, args.seeds + 1)]
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    jobs = [(w, f, s) for w in wires for f in faults for s in seeds]
     print(f"{len(jobs)} runs, {mode}: wires {wires}, faults {faults} at {args.p:.0%}, "
-          f"seeds 1..{args.seeds}, {args.j} at once", flush=True)
+          f"seeds {seeds.start}..{seeds.stop - 1}, {args.j} at once", flush=True)
     results: list[Outcome] = []
     with ThreadPoolExecutor(args.j) as pool:
         futures = [pool.submit(one_run, w, f, args.p, s, args.url_options, scale)
