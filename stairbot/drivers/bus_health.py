@@ -9,7 +9,9 @@ health").
   ``BusABC.state``, always ACTIVE) is not asked.  SocketCAN reports the
   same in its error frames' class bits instead
   (``CAN_ERR_BUSOFF``; ``CAN_ERR_CRTL`` with the RX/TX passive bits), which
-  are read too.  Bus-off raises BusFaultError: the host can no longer send.
+  are read on a SocketCAN bus only: other interfaces' error frames (the fake
+  boards' corrupted frames on ``udp_multicast``) keep whatever id they had.
+  Bus-off raises BusFaultError: the host can no longer send.
 * **Error frames** (``is_error_frame``) are counted as ``error_frames``, not
   as CRC errors: CAN's CRC is checked by the controller, and an error frame
   may be any of the bus's errors.
@@ -67,14 +69,22 @@ def frame_name(frame: can.Message) -> str:
     return f"id 0x{frame.arbitration_id:0{width}X}"
 
 
+def socketcan_errors(bus: object) -> bool:
+    """Whether ``bus``'s error frames carry SocketCAN's error classes in their
+    id (linux/can/error.h): a ``SocketcanBus``, or a bus that says so with a
+    ``socketcan_errors`` attribute (a test double)."""
+    return bool(getattr(bus, "socketcan_errors", type(bus).__name__ == "SocketcanBus"))
+
+
 class BusWatch:
     """The bus's state and its foreign frames, for one link: figures in
     ``stats`` (a CanStats: ``bus_state``, ``bus_passive``, ``error_frames``,
     ``foreign``, ``flood_id``, ``flood_per_s``) and BusFaultError when the
     bus is off or flooded."""
 
-    def __init__(self, stats: CanStats) -> None:
+    def __init__(self, stats: CanStats, error_classes: bool = False) -> None:
         self.stats = stats
+        self.error_classes = error_classes  # error frames in SocketCAN's layout
         self._window_start = float("-inf")
         # (id, -2 for error frames; its name; what it is) -> frames this window
         self._counts: dict[tuple[int, str, str], int] = {}
@@ -106,10 +116,10 @@ class BusWatch:
                                 "left the bus after too many errors and can send nothing)")
 
     def error_frame(self, frame: can.Message, now: float) -> None:
-        """Count an error frame, read its SocketCAN class bits, and count it
-        as foreign traffic."""
+        """Count an error frame, read its SocketCAN class bits (on a bus whose
+        error frames have them), and count it as foreign traffic."""
         self.stats.error_frames += 1
-        cls = frame.arbitration_id
+        cls = frame.arbitration_id if self.error_classes else 0
         ctrl = frame.data[1] if len(frame.data) > 1 else 0
         if cls & CAN_ERR_BUSOFF:
             self.set_state(BusState.BUS_OFF, "an error frame says bus-off")

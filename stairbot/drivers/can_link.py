@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import can
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.bus_health import BusWatch
+from stairbot.drivers.bus_health import BusWatch, socketcan_errors
 from stairbot.drivers.can_request import CanRequest, Offer
 from stairbot.drivers.can_wire import BROADCAST, SESSION_MAX, CanFrame, CanWire, frame_bits, wire
 from stairbot.drivers.frame_log import CanFrameLog
@@ -98,7 +98,7 @@ class CanLink(RequestLink[CanRequest]):
         self._held: list[CanRequest] = []
         self.old_idents: dict[int, m.Ident] = {}  # boards heard speaking protocol 3.x
         self.channels: dict[int, int] = {}  # board -> its channels, from its Ident
-        self.watch = BusWatch(self.stats)
+        self.watch = BusWatch(self.stats, socketcan_errors(bus))
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[m.Message, ...], idempotent: bool,

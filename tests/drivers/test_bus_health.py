@@ -36,9 +36,11 @@ class StatefulBus(InlineBus):
     reports none), and a clock that moves by the time asked only when
     nothing is there to receive."""
 
-    def __init__(self, bus: can.BusABC, server: CanBoardServer) -> None:
+    def __init__(self, bus: can.BusABC, server: CanBoardServer,
+                 socketcan_errors: bool = True) -> None:
         super().__init__(bus, server)
         self.state: can.BusState | None = None
+        self.socketcan_errors = socketcan_errors  # its error frames in SocketCAN's layout
         self.t = 0.0
 
     def now(self) -> float:
@@ -70,12 +72,13 @@ def rig() -> Iterator[BusRig]:
     yield from make_rig()
 
 
-def make_rig(faults: WireFaults | None = None) -> Iterator[BusRig]:
+def make_rig(faults: WireFaults | None = None, socketcan_errors: bool = True
+             ) -> Iterator[BusRig]:
     channel = f"bus-health-{next(_names)}"
     world = make_world(load_config(), load_scenario(), True)
     boards = make_boards(world)
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world, boards, faults)
-    bus = StatefulBus(can.Bus(interface="virtual", channel=channel), server)
+    bus = StatefulBus(can.Bus(interface="virtual", channel=channel), server, socketcan_errors)
     link = CanLink(bus, timeout_s=0.05, retries=1, now=bus.now)  # type: ignore[arg-type]
     events: list[Event] = []
     robot = LockstepRobot(link, f"can://virtual/{channel}?lockstep=1", sink=events.append)
@@ -127,6 +130,17 @@ def test_a_socketcan_bus_off_error_frame_stops_the_run_latched(rig: BusRig) -> N
     with pytest.raises(LinkLostError, match="the CAN bus is off .an error frame says bus-off"):
         rig.tick()
     assert rig.robot.estopped
+
+
+def test_error_frames_of_a_bus_other_than_socketcan_are_counted_not_decoded() -> None:
+    # the fake boards' corrupted frames on udp_multicast: error frames that
+    # keep the frame's own id, whatever its bits (here SocketCAN's bus-off)
+    for rig in make_rig(socketcan_errors=False):
+        rig.tick()
+        rig.other.send(can.Message(is_error_frame=True, arbitration_id=0x040, dlc=8))
+        rig.tick()
+        h = rig.robot.health()
+        assert (h["error_frames"], h["bus_state"]) == (1, 0) and not rig.robot.estopped
 
 
 def test_a_flood_from_another_node_stops_the_run_latched_and_names_its_id(rig: BusRig) -> None:
