@@ -145,7 +145,7 @@ def main(argv: list[str] | None = None) -> int:
             o = fut.result()
             results.append(o)
             keys = ("retries", "revived", "feeds", "lost", "late", "stray", "duplicates",
-                    "crc_errors")
+                    "crc_errors", "error_frames")
             counts = " ".join(f"{k} {o.link[k]}" for k in keys if k in o.link)
             print(f"{o.mode}: {o.wire:6} {o.fault:9} seed {o.seed:2}: {o.outcome:9} up {o.climbed} "
                   f"down {o.descended} fell {o.fell!s:5} {o.wall_s:5.0f} s  {counts}"
