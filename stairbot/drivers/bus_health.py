@@ -14,9 +14,12 @@ health").
   Bus-off raises BusFaultError: the host can no longer send.
 * **Error frames** (``is_error_frame``) are counted as ``error_frames``, not
   as CRC errors: CAN's CRC is checked by the controller, and an error frame
-  may be any of the bus's errors.
+  may be any of the bus's errors.  A storm of them is the controller's to
+  judge (error-passive, bus-off: the state above); they are not foreign
+  frames, so that a lossy bus in a simulation running faster than real time
+  is not taken for a flood.
 * **Foreign frames**: frames no board of this protocol sends and no host of
-  ours -- undecodable ones, error frames, another session's.  Counted per
+  ours -- undecodable ones, another session's.  Counted per
   window of ``FLOOD_WINDOW_S`` of the link's clock; more than
   ``FLOOD_FRAMES_PER_S`` of them a second is a flood or a babbling node, and
   raises BusFaultError naming the identifier that sent most of them.  The
@@ -62,9 +65,7 @@ _FROM_PYTHON_CAN = {can.BusState.ACTIVE: BusState.ACTIVE, can.BusState.PASSIVE: 
 
 def frame_name(frame: can.Message) -> str:
     """A frame's identifier as a person reads it: 0x000 (11-bit), 0x1FFC0000
-    (29-bit), or "error frames"."""
-    if frame.is_error_frame:
-        return "error frames"
+    (29-bit)."""
     width = 8 if frame.is_extended_id else 3
     return f"id 0x{frame.arbitration_id:0{width}X}"
 
@@ -86,7 +87,7 @@ class BusWatch:
         self.stats = stats
         self.error_classes = error_classes  # error frames in SocketCAN's layout
         self._window_start = float("-inf")
-        # (id, -2 for error frames; its name; what it is) -> frames this window
+        # (id, its name, what it is) -> frames this window
         self._counts: dict[tuple[int, str, str], int] = {}
         self._total = 0
         self.last_flood: str | None = None
@@ -115,9 +116,9 @@ class BusWatch:
             raise BusFaultError(f"the CAN bus is off ({source}: this host's controller has "
                                 "left the bus after too many errors and can send nothing)")
 
-    def error_frame(self, frame: can.Message, now: float) -> None:
-        """Count an error frame, read its SocketCAN class bits (on a bus whose
-        error frames have them), and count it as foreign traffic."""
+    def error_frame(self, frame: can.Message) -> None:
+        """Count an error frame and read its SocketCAN class bits (on a bus
+        whose error frames have them)."""
         self.stats.error_frames += 1
         cls = frame.arbitration_id if self.error_classes else 0
         ctrl = frame.data[1] if len(frame.data) > 1 else 0
@@ -127,7 +128,6 @@ class BusWatch:
             self.set_state(BusState.PASSIVE, "an error frame says error-passive")
         elif cls & CAN_ERR_RESTARTED or (cls & CAN_ERR_CRTL and ctrl & CAN_ERR_CRTL_ACTIVE):
             self.set_state(BusState.ACTIVE, "an error frame says error-active")
-        self.foreign(frame, "error frame", now)
 
     # -- foreign frames ------------------------------------------------------------
     def foreign(self, frame: can.Message, what: str, now: float) -> None:
@@ -137,7 +137,7 @@ class BusWatch:
         self.stats.foreign += 1
         if now - self._window_start >= FLOOD_WINDOW_S:
             self._window_start, self._counts, self._total = now, {}, 0
-        key = (-2 if frame.is_error_frame else frame.arbitration_id, frame_name(frame), what)
+        key = (frame.arbitration_id, frame_name(frame), what)
         self._counts[key] = self._counts.get(key, 0) + 1
         self._total += 1
         if self._total == int(FLOOD_FRAMES_PER_S * FLOOD_WINDOW_S) + 1:

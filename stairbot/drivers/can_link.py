@@ -63,10 +63,10 @@ class CanStats(LinkStats):
     bits_rx: int = 0
     ignored: int = 0  # frames from hosts (our own echo included)
     error_frames: int = 0  # python-can's is_error_frame
-    foreign: int = 0  # frames from other nodes: undecodable, error frames, other sessions'
+    foreign: int = 0  # frames from other nodes: undecodable, other sessions'
     bus_state: int = 0  # bus_health.BusState: 0 active, 1 error-passive, 2 bus-off
     bus_passive: int = 0  # times the bus went error-passive
-    flood_id: int = -1  # the id that flooded the bus (-2: error frames), -1 none
+    flood_id: int = -1  # the id that flooded the bus, -1 none
     flood_per_s: int = 0  # its window's foreign frames a second
 
 
@@ -224,11 +224,11 @@ class CanLink(RequestLink[CanRequest]):
     def take(self, frame: can.Message) -> None:
         """Handle one received frame: a board's reply is matched to what waits
         for it; anything else is counted (error frames as ``error_frames``,
-        undecodable ones as ``malformed``, host frames as ``ignored``; those
-        not of this protocol's nodes as ``foreign`` too).  BusFaultError when
+        undecodable ones as ``malformed``, host frames as ``ignored``;
+        undecodable frames and another session's as ``foreign`` too).  BusFaultError when
         the bus is off or flooded (``bus_health``)."""
         if frame.is_error_frame:
-            self.watch.error_frame(frame, self._now())
+            self.watch.error_frame(frame)
             return
         try:
             f = self.codec.from_can(frame)

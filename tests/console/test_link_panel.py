@@ -26,5 +26,5 @@ def test_the_cans_bus_state_error_frames_and_a_flood_are_on_screen() -> None:
                              "flood_id": 0.0})
     assert "errors 4" in faults.plain and "bus passive" in faults.plain
     assert "flood 0x000" in faults.plain
-    _, off = health_text({"bus_state": 2.0, "flood_id": -2.0})
-    assert "BUS-OFF" in off.plain and "flood error frames" in off.plain
+    _, off = health_text({"bus_state": 2.0, "flood_id": 0x1FFC0000})
+    assert "BUS-OFF" in off.plain and "flood 0x1FFC0000" in off.plain

@@ -143,6 +143,19 @@ def test_error_frames_of_a_bus_other_than_socketcan_are_counted_not_decoded() ->
         assert (h["error_frames"], h["bus_state"]) == (1, 0) and not rig.robot.estopped
 
 
+def test_error_frames_are_not_a_flood_the_controller_judges_them() -> None:
+    # a lossy bus in a simulation faster than real time: many error frames
+    # in little wall time, and the bus still error-active
+    for rig in make_rig(socketcan_errors=False):
+        rig.tick()
+        for _ in range(FLOOD):
+            rig.other.send(can.Message(is_error_frame=True, arbitration_id=0x123, dlc=8))
+        rig.tick()
+        h = rig.robot.health()
+        assert (h["error_frames"], h["foreign"], h["flood_id"]) == (FLOOD, 0, -1)
+        assert not rig.robot.estopped
+
+
 def test_a_flood_from_another_node_stops_the_run_latched_and_names_its_id(rig: BusRig) -> None:
     rig.tick()
     for _ in range(FLOOD):  # all at one instant of the link's clock

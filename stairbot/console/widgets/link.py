@@ -54,9 +54,8 @@ def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
     if state is not None:
         faults.append(state + "  ", "bold red")
     flood = health.get("flood_id", -1.0)
-    if flood != -1.0:
-        what = "error frames" if flood == -2.0 else f"0x{int(flood):03X}"
-        faults.append(f"flood {what}  ", "bold red")
+    if flood >= 0:
+        faults.append(f"flood 0x{int(flood):03X}  ", "bold red")
     return rates, faults
 
 
