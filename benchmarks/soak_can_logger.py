@@ -71,7 +71,13 @@ def one_run(n: int, scale: float, folder: Path) -> tuple[bool, str]:
     t0 = time.monotonic()
     try:
         assert boards.stdout is not None and logger.stdout is not None
-        url = boards.stdout.readline().strip()
+        # timeout, grace and watchdog are robot time (docs/protocol.md, "Riding
+        # through noise in real time"): keep the wall-time margins this soak
+        # soaks the logger and the host's stalls with (50 ms, 0.5 s, 250 ms),
+        # X times longer in robot time, rather than shrink them X times.
+        url = boards.stdout.readline().strip() + (
+            f"&timeout={0.05 * scale:g}&grace={0.5 * scale:g}"
+            f"&watchdog={min(65535, round(250 * scale))}")
         logger.stdout.readline()  # "Connected to ...": listening
         host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
                                "--json", "-q"], capture_output=True, text=True, timeout=1800)

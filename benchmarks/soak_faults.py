@@ -1,19 +1,34 @@
 """Default runs over a faulty wire: does the run ride out ordinary link noise?
 
-    python benchmarks/soak_faults.py [--seeds N] [--wire serial|can]
+    python benchmarks/soak_faults.py [--seeds N] [--first-seed S] [--wire serial|can]
                                      [--fault drop|corrupt|late|duplicate]
                                      [--p 0.05] [-j 2] [--url-options OPTS]
+                                     [--realtime [--time-scale X]]
 
-For each wire, fault and seed it starts ``stairbot fake-boards --lockstep``
-with that fault at probability P on every frame the boards send or take
+For each wire, fault and seed it starts ``stairbot fake-boards`` with that
+fault at probability P on every frame the boards send or take
 (``--fault-seed`` = the seed), then ``stairbot run --robot URL --json`` with
 the URL's default options, and prints one line per run (outcome, steps,
-fell, what the link counted) and a count per wire and fault.  Lockstep: the
-boards' world stands still while the host waits or retries, so a run's
-physics is the same at any machine load; what the faults change is what the
-host hears.  Serial boards sit on a pseudo-terminal, CAN boards on
+fell, what the link counted) and a count per wire and fault, each saying
+its mode.  Serial boards sit on a pseudo-terminal, CAN boards on
 ``udp_multicast`` on loopback, each run on a group of its own.  Exit status
 1 if any run did not complete or fell.
+
+Two modes:
+
+* **lockstep** (the default, ``--lockstep`` to the boards): the boards'
+  world stands still while the host waits or retries, so a run's physics is
+  the same at any machine load; what the faults change is what the host
+  hears.  It cannot show whether a watchdog survives the noise: the
+  watchdog's clock stands still too.
+* **real time** (``--realtime``): the boards run free, paced at
+  ``--time-scale X`` times real time (default 1), and count their watchdog in
+  that time; the host's clock, timeouts and grace run X times faster too
+  (docs/protocol.md, "Riding through noise in real time"), so a run at X is
+  the real-time run played X times faster, no more lenient -- provided the
+  machine keeps up: the host must do a tick's work in 1/X of a tick, and on
+  a loaded machine a run that falls behind trips a watchdog.  Run a clean
+  run (``--p 0``) at X first.
 """
 
 from __future__ import annotations
@@ -33,6 +48,7 @@ _groups = itertools.count(1)
 
 @dataclass
 class Outcome:
+    mode: str
     wire: str
     fault: str
     seed: int
@@ -49,12 +65,24 @@ class Outcome:
         return self.outcome == "completed" and not self.fell
 
 
-def one_run(wire: str, fault: str, p: float, seed: int, url_options: str) -> Outcome:
+def mode_name(time_scale: float | None) -> str:
+    """``lockstep``, or ``real time`` with its pace (None: lockstep)."""
+    if time_scale is None:
+        return "lockstep"
+    return "real time" if time_scale == 1 else f"real time x{time_scale:g}"
+
+
+def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
+            time_scale: float | None = None) -> Outcome:
+    """One default run; ``time_scale`` None: lockstep, else free-running
+    boards paced at that many times real time."""
     t0 = time.monotonic()
     where = ["--serial"] if wire == "serial" else [
         "--can", f"udp_multicast/239.74.164.{next(_groups) % 250 + 1}"]
+    pace = ["--lockstep"] if time_scale is None else ["--time-scale", f"{time_scale:g}"]
+    mode = mode_name(time_scale)
     boards = subprocess.Popen(
-        [sys.executable, "-m", "stairbot", "fake-boards", *where, "--lockstep",
+        [sys.executable, "-m", "stairbot", "fake-boards", *where, *pace,
          f"--{fault}", str(p), "--fault-seed", str(seed)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -76,10 +104,10 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str) -> Out
         r = json.loads(host.stdout)
     except json.JSONDecodeError:
         last = (host.stderr.strip().splitlines() or ["no output"])[-1]
-        return Outcome(wire, fault, seed, f"exit {host.returncode}", 0, 0, False, {}, wall,
+        return Outcome(mode, wire, fault, seed, f"exit {host.returncode}", 0, 0, False, {}, wall,
                        last)
     link = r.get("link") or {}
-    return Outcome(wire, fault, seed, r["outcome"], r["steps_climbed"], r["steps_descended"],
+    return Outcome(mode, wire, fault, seed, r["outcome"], r["steps_climbed"], r["steps_descended"],
                    bool(r["fell"]), {k: int(v) for k, v in link.items()
                                      if isinstance(v, (int, float)) and not isinstance(v, bool)},
                    wall, r.get("error"))
@@ -88,26 +116,38 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str) -> Out
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=1, help="seeds FIRST..FIRST+N-1")
     ap.add_argument("--wire", choices=("serial", "can"), action="append")
     ap.add_argument("--fault", choices=FAULTS, action="append")
     ap.add_argument("--p", type=float, default=0.05, help="probability per frame")
     ap.add_argument("-j", type=int, default=2, help="runs at once")
     ap.add_argument("--url-options", default="", help="added to the boards' URL, e.g. grace=0")
+    ap.add_argument("--realtime", action="store_true",
+                    help="free-running boards (not lockstep): the watchdogs count real time")
+    ap.add_argument("--time-scale", type=float, default=1.0,
+                    help="with --realtime: boards and host paced at X times real time")
     args = ap.parse_args(argv)
+    if args.time_scale != 1.0 and not args.realtime:
+        ap.error("--time-scale needs --realtime (lockstep runs as fast as it can)")
+    scale = args.time_scale if args.realtime else None
+    mode = mode_name(scale)
     wires = args.wire or ["serial", "can"]
     faults = args.fault or ["drop", "corrupt", "late"]
-    jobs = [(w, f, s) for w in wires for f in faults for s in range(1, args.seeds + 1)]
-    print(f"{len(jobs)} runs: wires {wires}, faults {faults} at {args.p:.0%}, "
-          f"seeds 1..{args.seeds}, {args.j} at once", flush=True)
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    jobs = [(w, f, s) for w in wires for f in faults for s in seeds]
+    print(f"{len(jobs)} runs, {mode}: wires {wires}, faults {faults} at {args.p:.0%}, "
+          f"seeds {seeds.start}..{seeds.stop - 1}, {args.j} at once", flush=True)
     results: list[Outcome] = []
     with ThreadPoolExecutor(args.j) as pool:
-        futures = [pool.submit(one_run, w, f, args.p, s, args.url_options) for w, f, s in jobs]
+        futures = [pool.submit(one_run, w, f, args.p, s, args.url_options, scale)
+                   for w, f, s in jobs]
         for fut in futures:
             o = fut.result()
             results.append(o)
-            keys = ("retries", "revived", "lost", "late", "stray", "duplicates", "crc_errors")
+            keys = ("retries", "revived", "feeds", "lost", "late", "stray", "duplicates",
+                    "crc_errors", "error_frames")
             counts = " ".join(f"{k} {o.link[k]}" for k in keys if k in o.link)
-            print(f"{o.wire:6} {o.fault:9} seed {o.seed:2}: {o.outcome:9} up {o.climbed} "
+            print(f"{o.mode}: {o.wire:6} {o.fault:9} seed {o.seed:2}: {o.outcome:9} up {o.climbed} "
                   f"down {o.descended} fell {o.fell!s:5} {o.wall_s:5.0f} s  {counts}"
                   + (f"  error: {o.error}" if o.error else ""), flush=True)
     print()
@@ -117,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
             group = [o for o in results if (o.wire, o.fault) == (w, f)]
             good = sum(o.ok for o in group)
             bad += len(group) - good
-            print(f"{w:6} {f:9} {args.p:.0%}: {good}/{len(group)} completed, "
+            print(f"{mode}: {w:6} {f:9} {args.p:.0%}: {good}/{len(group)} completed, "
                   f"fell {sum(o.fell for o in group)}")
     return 1 if bad else 0
 

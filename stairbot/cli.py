@@ -509,8 +509,8 @@ def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:
 
 
 def _link_line(link: dict[str, Any]) -> str:
-    keys = ("frames_tx", "frames_rx", "retries", "revived", "lost", "late", "stray",
-            "duplicates", "crc_errors")
+    keys = ("frames_tx", "frames_rx", "retries", "revived", "feeds", "lost", "late", "stray",
+            "duplicates", "crc_errors", "error_frames", "foreign")
     return "  link              " + ", ".join(
         f"{k.replace('_', ' ')} {link[k]:g}" for k in keys if k in link)
 

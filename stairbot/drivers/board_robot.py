@@ -35,7 +35,7 @@ from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
 from stairbot.drivers.handshake import LATCHES, open_board, release_board
 from stairbot.drivers.health import HealthReport
-from stairbot.drivers.link import BoardLink, Reply, Request
+from stairbot.drivers.link import BoardLink, BusFaultError, Reply, Request
 from stairbot.drivers.telemetry import K, T, V
 from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
@@ -76,9 +76,11 @@ def locked(method: Callable[Concatenate[S, P], R]) -> Callable[Concatenate[S, P]
 class BoardRobot:
     """Both boards over one link: see the module docstring.
 
-    ``watchdog_ms`` is the boards' watchdog in wall-clock ms (0: off); boards
-    paced at ``time_scale`` times real time are sent that many times it, and
-    the robot's clock (a WallClock unless ``clock`` is given) runs as fast.
+    ``watchdog_ms`` is the boards' watchdog in ms of the robot's clock (0:
+    off): wall time, or for boards paced at ``time_scale`` times real time,
+    simulated time, which they count it in; the robot's clock (a WallClock
+    unless ``clock`` is given) runs as fast, and the keepalive that many
+    times more often.
     ``monotonic`` is the wall clock the keepalive goes by.  ``side_pair``
     names where the robot config gives the robot the side pair (SSR, SSL;
     ``wanted_side_pair``), None when it has none: the sensor board must then
@@ -114,13 +116,13 @@ class BoardRobot:
         self._estopped = False
         self._link_lost = False
         self._last_tx: dict[int, float] = {}
-        self.watchdog_ms = watchdog_ms  # in wall-clock ms
-        # Fake boards paced at X times real time count the watchdog in their
-        # simulated time: X times the wall time the host has to feed it.
-        self.board_watchdog_ms = min(65535, round(watchdog_ms * time_scale))
-        self.board_hold_ms = (max(1, min(65535, round(COMMAND_HOLD_MS * time_scale)))
-                              if COMMAND_HOLD_MS else 0)
-        self.lease_ms = m.LEASE_MS  # in wall-clock ms, as the watchdog
+        self.watchdog_ms = watchdog_ms  # in ms of the robot's clock
+        # Fake boards paced at X times real time count it, the lease and the
+        # command hold in simulated time: the host has 1/X of each in wall
+        # time (timing.py).
+        self.board_watchdog_ms = watchdog_ms
+        self.board_hold_ms = COMMAND_HOLD_MS
+        self.lease_ms = m.LEASE_MS  # in ms of the robot's clock, as the watchdog
         self._lock = threading.RLock()
         self.latched: dict[int, int] = {}  # board -> latch flags found when opening
         try:
@@ -160,8 +162,8 @@ class BoardRobot:
 
     @property
     def board_lease_ms(self) -> int:
-        """The lease asked of the boards, in their ms (time-scaled as the watchdog)."""
-        return max(1, min(65535, round(self.lease_ms * self._time_scale)))
+        """The lease asked of the boards, in their ms (the robot's, as the watchdog)."""
+        return self.lease_ms
 
     def _wait_board_s(self, seconds: float) -> None:
         """Sleep ``seconds`` of the boards' clock."""
@@ -171,7 +173,7 @@ class BoardRobot:
     def feed_s(self) -> float:
         """How often, in wall seconds, a board must hear from this host to
         keep both its watchdog fed and its lease: a quarter of the shorter."""
-        return min(self.watchdog_ms or self.lease_ms, self.lease_ms) / 4000
+        return min(self.watchdog_ms or self.lease_ms, self.lease_ms) / 4000 / self._time_scale
 
     def identity(self) -> dict[str, dict[str, int]]:
         """Each board's serial number, uptime (ms, from its last Status) and
@@ -365,8 +367,7 @@ class BoardRobot:
                         "rejected": self.imu_rejected}}
 
     def _keep_alive(self) -> None:
-        period = self.feed_s
-        while not self._stop.wait(period):
+        while not self._stop.wait(self.feed_s):
             try:
                 with self._lock:
                     if self._closed:
@@ -416,34 +417,46 @@ class BoardRobot:
         try:
             return self.link.request(board, msgs, send=send)
         except LinkLostError as exc:  # the wire itself failed (a port that went away)
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
             raise  # unreachable: _lost raises
 
     def _broadcast(self, msg: m.Message) -> Sequence[Request]:
         try:
             return self.link.broadcast(msg)
         except LinkLostError as exc:  # the wire itself failed
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
             raise  # unreachable: _lost raises
 
     def _wait(self, requests: Sequence[Request]) -> list[Reply]:
         try:
             return self.link.wait(requests)
         except LinkLostError as exc:
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
             raise  # unreachable: _lost raises
         except HardwareError as exc:  # a board that broke the protocol
             raise HardwareError(f"{self.url}: {exc}") from None
 
-    def _lost(self, reason: str, boards_stopped: bool = False) -> None:
+    def _lost(self, reason: str, boards_stopped: bool = False, latch: bool = False) -> None:
         """Report the lost link (a LINK event, the first time only: the stop,
         truth and close that follow a loss would each report it again) and
-        raise LinkLostError saying what became of the motors."""
+        raise LinkLostError saying what became of the motors, and what is
+        wrong with the wire itself if the link knows (``bus_trouble``).  A
+        failed wire (``latch``: bus-off, a flood) first latches this robot's
+        emergency stop."""
+        if latch:
+            self.estop()  # never raises; the boards may not hear it
+        else:
+            trouble = self.link.bus_trouble()
+            if trouble is not None:
+                reason = f"{reason}; meanwhile {trouble}"
         if not self._link_lost:
             self._link_lost = True
             self.sink(Event(self.clock.now(), EventKind.LINK, f"link lost: {reason}", None,
                             self.health()))
-        if boards_stopped:
+        if latch:
+            after = ("; this host's emergency stop is latched (EStop frames sent; a board "
+                     "that did not hear them stops its motors when its watchdog runs out)")
+        elif boards_stopped:
             after = ""
         elif self.watchdog_ms:
             # What the host cannot know it does not say: whether the boards
@@ -458,7 +471,7 @@ class BoardRobot:
         try:
             self.link.poll()
         except LinkLostError as exc:  # the wire itself failed
-            self._lost(str(exc))
+            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
         still = []
         done_now = []
         for p in self._commands:

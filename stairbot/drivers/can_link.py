@@ -24,6 +24,9 @@ CAN's own (docs/protocol.md, "CAN"):
   up ``late``; a reply of another session, or of a seq nobody sent, ``stray``.
   Frames a host sends (its own echo on ``udp_multicast``, another host's) are
   ``ignored``; 11-bit frames (protocol 3.x) are ``malformed``.
+* The bus's own health -- its state, error frames, floods of frames from
+  other nodes -- is ``bus_health.BusWatch``'s: bus-off or a flood raises
+  BusFaultError.
 
 How one request takes its replies is :class:`~stairbot.drivers.can_request.CanRequest`.
 """
@@ -39,6 +42,7 @@ from dataclasses import dataclass
 import can
 
 from stairbot.drivers import messages as m
+from stairbot.drivers.bus_health import BusWatch, socketcan_errors
 from stairbot.drivers.can_request import CanRequest, Offer
 from stairbot.drivers.can_wire import BROADCAST, SESSION_MAX, CanFrame, CanWire, frame_bits, wire
 from stairbot.drivers.frame_log import CanFrameLog
@@ -58,6 +62,12 @@ class CanStats(LinkStats):
     bits_tx: int = 0
     bits_rx: int = 0
     ignored: int = 0  # frames from hosts (our own echo included)
+    error_frames: int = 0  # python-can's is_error_frame
+    foreign: int = 0  # frames from other nodes: undecodable, other sessions'
+    bus_state: int = 0  # bus_health.BusState: 0 active, 1 error-passive, 2 bus-off
+    bus_passive: int = 0  # times the bus went error-passive
+    flood_id: int = -1  # the id that flooded the bus, -1 none
+    flood_per_s: int = 0  # its window's foreign frames a second
 
 
 class CanLink(RequestLink[CanRequest]):
@@ -88,6 +98,7 @@ class CanLink(RequestLink[CanRequest]):
         self._held: list[CanRequest] = []
         self.old_idents: dict[int, m.Ident] = {}  # boards heard speaking protocol 3.x
         self.channels: dict[int, int] = {}  # board -> its channels, from its Ident
+        self.watch = BusWatch(self.stats, socketcan_errors(bus))
 
     # -- sending ---------------------------------------------------------------
     def _new(self, board: int, messages: tuple[m.Message, ...], idempotent: bool,
@@ -212,10 +223,12 @@ class CanLink(RequestLink[CanRequest]):
 
     def take(self, frame: can.Message) -> None:
         """Handle one received frame: a board's reply is matched to what waits
-        for it; anything else is counted (error frames as ``crc_errors``,
-        undecodable ones as ``malformed``, host frames as ``ignored``)."""
+        for it; anything else is counted (error frames as ``error_frames``,
+        undecodable ones as ``malformed``, host frames as ``ignored``;
+        undecodable frames and another session's as ``foreign`` too).  BusFaultError when
+        the bus is off or flooded (``bus_health``)."""
         if frame.is_error_frame:
-            self.stats.crc_errors += 1
+            self.watch.error_frame(frame)
             return
         try:
             f = self.codec.from_can(frame)
@@ -224,12 +237,18 @@ class CanLink(RequestLink[CanRequest]):
             old = self.codec.old_ident(frame)
             if old is not None:
                 self.old_idents[old[0]] = old[1]
+            else:
+                self.watch.foreign(frame, "malformed", self._now())
             return
         if not f.message.REPLY:
             self.stats.ignored += 1  # not counted in bits_rx: our own echo is in bits_tx
+            if f.session != self.session:
+                self.watch.foreign(frame, "another host's", self._now())
             return
         self.stats.bits_rx += frame_bits(len(frame.data))
         self.stats.bytes_rx += len(frame.data)
+        if f.session != self.session:
+            self.watch.foreign(frame, "another session's reply", self._now())
         self._match(f)
 
     def _match(self, f: CanFrame) -> None:
@@ -291,6 +310,12 @@ class CanLink(RequestLink[CanRequest]):
             if remaining <= 0 or not self._receive(remaining):
                 break
         return self.old_idents.get(board)
+
+    def _check_bus(self) -> None:
+        self.watch.read_state(self.bus)
+
+    def bus_trouble(self) -> str | None:
+        return self.watch.trouble()
 
     def describe(self) -> dict[str, object]:
         out: dict[str, object] = {

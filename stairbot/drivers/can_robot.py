@@ -15,8 +15,9 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
 
   - ``bitrate=N``     bit/s, given to the interface (else ``CAN_BITRATE``...)
   - ``context=NAME``  the section of python-can's config file to read
-  - ``timeout=S``     seconds to wait for a board's replies, default 0.1;
-                      0 < S <= 60
+  - ``timeout=S``     seconds to wait for a board's replies, default 0.05;
+                      0 < S <= 60; (retries + 1) x timeout must be below
+                      watchdog - one tick (``timing.py``), else refused
   - ``retries=N``     re-sends of a query that timed out, default 2; 0 to 100
   - ``lost=N``        unanswered commands in a row that mean the link is
                       lost (once the grace period is over), default 3; 1 to
@@ -25,14 +26,15 @@ URL format: ``can://INTERFACE/CHANNEL[?option=value[&option=value...]]``
                       lost, default 0.5: until then a query that got no
                       reply after its retries is sent again; 0 = lost at the
                       first query given up; at most 60
-  - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
-                      default 250 (0 = off), at most 65535; time-scaled fake
-                      boards get X times it
+  - ``watchdog=MS``   the boards' watchdog in ms of the robot's clock, set
+                      at open, default 250 (0 = off), at most 65535
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
                       (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
-                      the host's wall clock runs at the same rate; 0.01 to 1000
+                      the host's clock runs at the same rate, and timeout,
+                      grace and watchdog are times of that clock (the host
+                      waits timeout / X of wall time); 0.01 to 1000
   - ``lan=1``         ``udp_multicast`` only: open the bus to the network
                       (python-can's own socket: see below).  Default 0.
   - ``log=FILE``      write every frame sent and received to FILE with
@@ -86,13 +88,14 @@ from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import CanFrameLog, check_can_log
 from stairbot.drivers.port_lock import PortLock, take_port_lock
+from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
 
 OPTION_DEFAULTS: dict[str, float] = {
-    "timeout": 0.1, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
+    "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,
     "lan": 0, "grace": 0.5,
 }
 
@@ -252,6 +255,7 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     answers."""
     spec = parse_can_url(url)
     opts = spec.options
+    check_ride_through(url, opts, config.algorithm.tick)
     lock = lock_bus(spec)
     try:
         bus = open_bus(spec)
@@ -272,10 +276,12 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     except RobotUrlError:
         bus.shutdown()
         raise
-    link = CanLink(bus, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                   max_lost=int(opts["lost"]), grace_s=opts["grace"], log=log)
+    time_scale = options.time_scale or opts["time_scale"]
+    timing = link_timing(opts, time_scale)
+    link = CanLink(bus, timeout_s=timing.timeout_s, retries=int(opts["retries"]),
+                   max_lost=int(opts["lost"]), grace_s=timing.grace_s, log=log)
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
-                              time_scale=options.time_scale or opts["time_scale"],
+                              time_scale=time_scale,
                               allow_latched=options.allow_latched,
                               side_pair=wanted_side_pair(config))

@@ -12,7 +12,8 @@ from stairbot.events import Event, EventKind, EventSink
 
 EVENT_EVERY_S = 1.0  # at most one link-trouble event per second of robot time
 TROUBLE = ("retries", "revived", "timeouts", "lost", "late", "stray", "duplicates", "crc_errors",
-           "malformed", "refused")
+           "malformed", "refused", "error_frames", "foreign", "bus_passive")
+"""Counters whose move is a LINK event (the last three only a CAN link has)."""
 
 
 class HealthReport:
@@ -48,7 +49,7 @@ class HealthReport:
         """One LINK event naming the trouble counters that moved since the last
         one, if a second of robot time has passed since."""
         changed = {k: health[k] - self._reported.get(k, 0.0) for k in TROUBLE
-                   if health[k] != self._reported.get(k, 0.0)}
+                   if k in health and health[k] != self._reported.get(k, 0.0)}
         if changed and now - self._last_event >= EVENT_EVERY_S:
             self._last_event = now
             self._reported = dict(health)

@@ -28,6 +28,11 @@ Rules (docs/protocol.md, "Requests and replies"):
   complete it: HardwareError, at once, rather than retries without end.  ``max_lost``
   commands in a row (in the order they were sent) that went unanswered mean
   the link is lost too, again once the board has been silent for ``grace_s``.
+* A retry round feeds every board: a board none of the round's frames
+  reaches is sent a Heartbeat (``feeds``), so that while the host waits for
+  one board the other's watchdog does not starve (``timing.py`` has the
+  arithmetic).  A Heartbeat costs its board one reply; the same ReadAll
+  again (on CAN the broadcast frame) would cost a whole ReadAll reply.
 * :meth:`RequestLink.urgent` (the emergency stop) may be called from any
   thread while another waits for replies: its frames go on the wire at once,
   ahead of anything held back and between a waiting read's retries.  The
@@ -48,8 +53,14 @@ from dataclasses import dataclass, field
 from typing import Generic, Protocol, TypeVar, cast, runtime_checkable
 
 from stairbot.drivers.codes import Board
-from stairbot.drivers.records import Ident, Message, RawMessage
+from stairbot.drivers.records import Heartbeat, Ident, Message, RawMessage
 from stairbot.errors import HardwareError, LinkLostError
+
+
+class BusFaultError(LinkLostError):
+    """The wire itself failed, not a board: a CAN bus that went bus-off, or a
+    flood of frames from another node.  The robot latches its emergency stop
+    before raising it on (``BoardRobot``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,6 +88,7 @@ class Request:
     reply: Reply | None = None
     failed: bool = False
     urgent: bool = False  # sent by urgent(): resent and given up by its sender
+    feed: bool = False  # a Heartbeat of a retry round (RequestLink._feed): nobody waits for it
     broken: str | None = None
     """Why the board's answers can never complete this request (it leaves the
     same replies out every time: a protocol error); never sent again."""
@@ -108,6 +120,7 @@ class LinkStats:
     timeouts: int = 0  # requests whose (last) attempt got no reply in time
     lost: int = 0  # requests given up: no reply after every allowed attempt
     revived: int = 0  # queries sent again beyond their retries, within the grace period
+    feeds: int = 0  # Heartbeats to a board a retry round did not reach
     late: int = 0
     stray: int = 0
     duplicates: int = 0  # second copies of a reply already taken
@@ -222,6 +235,11 @@ class BoardLink(Protocol):
         """What the wire is, for diagnostics."""
         ...
 
+    def bus_trouble(self) -> str | None:
+        """What is wrong with the wire itself, for a lost link's message (a
+        CAN bus error-passive, frames from other nodes); None if nothing."""
+        ...
+
     def close(self) -> None: ...
 
 
@@ -301,6 +319,13 @@ class RequestLink(ABC, Generic[R]):
 
     def _given_up(self, req: R) -> None:
         """``req`` failed: remember what a late reply to it would look like."""
+
+    def _check_bus(self) -> None:
+        """Raise BusFaultError if the wire says it has failed (the CAN link
+        reads its bus's state); called by every wait and poll."""
+
+    def bus_trouble(self) -> str | None:
+        return None
 
     def _on_wire(self, req: R) -> bool:
         """Whether ``req`` has gone out (a wire that holds requests back until
@@ -395,9 +420,15 @@ class RequestLink(ABC, Generic[R]):
 
     def _expire(self) -> None:
         now = self._now()
+        again: list[R] = []
         for queue in self._in_flight.values():
             for req in list(queue):
                 if now < req.deadline or req.urgent or not self._on_wire(req):
+                    continue
+                if req.feed:  # it has fed the watchdog or not; nobody waits
+                    req.failed = True
+                    queue.remove(req)
+                    self._given_up(req)
                     continue
                 self.stats.timeouts += 1
                 req.broken = req.broken or req.attempt_failed()
@@ -405,7 +436,7 @@ class RequestLink(ABC, Generic[R]):
                     req.attempts += 1
                     self.stats.retries += 1
                     req.sent_at, req.deadline = now, now + self.timeout_s
-                    self._resend(req)
+                    again.append(req)
                     continue
                 req.failed = True
                 self.stats.lost += 1
@@ -414,6 +445,31 @@ class RequestLink(ABC, Generic[R]):
                 if not req.idempotent:
                     self._failed.append(req.order)
                     self._count_streak()
+        if again:
+            self._send_again(again)
+
+    def _send_again(self, requests: list[R]) -> None:
+        """One retry round: ``requests`` go out again, and every board none of
+        their frames reaches is fed a Heartbeat."""
+        reached = self._retry(requests)
+        for board in Board:
+            if board not in reached:
+                self._feed(board)
+
+    def _retry(self, requests: list[R]) -> set[int]:
+        """Send ``requests`` again; the boards their frames reach."""
+        for req in requests:
+            self._resend(req)
+        return {req.board for req in requests}
+
+    def _feed(self, board: int) -> None:
+        """A Heartbeat to ``board``, for its watchdog: written at once, never
+        behind requests held back, given up silently at its deadline."""
+        req = self._new(board, (Heartbeat(),), True, self._now())
+        req.feed = True
+        self.stats.feeds += 1
+        self._in_flight.setdefault(board, []).append(req)
+        self._send_now([req])
 
     def _count_streak(self) -> None:
         # "In a row" goes by sending order, not by when a timeout noticed the
@@ -427,6 +483,7 @@ class RequestLink(ABC, Generic[R]):
     def poll(self) -> None:
         """Take in whatever has arrived, without waiting; expire old requests.
         Requests held back with ``send=False`` stay held."""
+        self._check_bus()
         self._drain()
         with self._mutex:
             self._expire()
@@ -464,7 +521,7 @@ class RequestLink(ABC, Generic[R]):
             now = self._now()
             req.sent_at, req.deadline = now, now + self.timeout_s
             self._in_flight.setdefault(req.board, []).append(req)
-            self._resend(req)
+            self._send_again([req])
         return True
 
     def wait(self, requests: Sequence[Request]) -> list[Reply]:
@@ -476,6 +533,7 @@ class RequestLink(ABC, Generic[R]):
         silent as long."""
         with self._mutex:
             self.flush()
+        self._check_bus()
         while True:
             # Take in what has already arrived before judging deadlines: a host
             # descheduled past a timeout must not call a waiting reply late.

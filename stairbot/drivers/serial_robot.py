@@ -11,7 +11,9 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
   the pyserial URL, e.g. ``logging=debug`` for ``socket://``):
 
   - ``baud=N``        bit rate, default 1000000 (UART 8N1); 50 to 20000000
-  - ``timeout=S``     seconds to wait for a reply, default 0.05; 0 < S <= 60
+  - ``timeout=S``     seconds to wait for a reply, default 0.05; 0 < S <= 60;
+                      (retries + 1) x timeout must be below watchdog - one
+                      tick (``timing.py``), else refused
   - ``retries=N``     re-sends of a query that timed out, default 2; 0 to 100
   - ``lost=N``        unanswered commands in a row that mean the link is
                       lost (once the grace period is over), default 3; 1 to
@@ -20,13 +22,15 @@ URL format: ``serial://PORT[?option=value[&option=value...]]``
                       lost, default 0.5: until then a query that got no reply
                       after its retries is sent again (line noise is ridden
                       out); 0 = lost at the first query given up; at most 60
-  - ``watchdog=MS``   the boards' watchdog in wall-clock ms, set at open,
-                      default 250 (0 = off); at most 65535
+  - ``watchdog=MS``   the boards' watchdog in ms of the robot's clock, set
+                      at open, default 250 (0 = off); at most 65535
   - ``lockstep=1``    simulation only: the fake boards' world advances only
                       when the host's clock sends StepTo, once per tick
                       (``stairbot.fakes.lockstep`` opens such boards)
   - ``time_scale=X``  simulation only: the fake boards run X times real time;
-                      the host's wall clock runs at the same rate; 0.01 to 1000
+                      the host's clock runs at the same rate, and timeout,
+                      grace and watchdog are times of that clock (the host
+                      waits timeout / X of wall time); 0.01 to 1000
   - ``log=FILE``      write every frame sent and received to FILE, one line
                       each: time, TX or RX, the bytes on the line in hex
                       (``frame_log.py``); flushed as written
@@ -55,6 +59,7 @@ from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.port_lock import PortLock, serial_lock_key, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
+from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, RobotSession
@@ -150,17 +155,20 @@ def open_serial_robot(url: str, config: RobotConfig, options: RobotOptions) -> R
     malformed or the port cannot open; NoBoardError (a HardwareError, one
     line naming the board and the URL) when no board answers."""
     port, opts, log_path = parse_serial_url_log(url)
+    check_ride_through(url, opts, config.algorithm.tick)
     channel = open_channel(port, int(opts["baud"]), url)
     try:
         log = SerialFrameLog(url, log_path) if log_path else None
     except RobotUrlError:
         channel.close()
         raise
-    link = SerialLink(channel, timeout_s=opts["timeout"], retries=int(opts["retries"]),
-                      max_lost=int(opts["lost"]), grace_s=opts["grace"], log=log)
+    time_scale = options.time_scale or opts["time_scale"]
+    timing = link_timing(opts, time_scale)
+    link = SerialLink(channel, timeout_s=timing.timeout_s, retries=int(opts["retries"]),
+                      max_lost=int(opts["lost"]), grace_s=timing.grace_s, log=log)
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
-                              time_scale=options.time_scale or opts["time_scale"],
+                              time_scale=time_scale,
                               allow_latched=options.allow_latched,
                               side_pair=wanted_side_pair(config))
 

@@ -17,3 +17,14 @@ def test_stray_replies_count_as_errors_and_duplicates_are_shown_when_there_are_a
 def test_no_figures_yet_says_so() -> None:
     rates, _ = health_text({})
     assert "no link figures yet" in rates.plain
+
+
+def test_the_cans_bus_state_error_frames_and_a_flood_are_on_screen() -> None:
+    _, quiet = health_text({"frames_per_s": 500.0, "bus_state": 0.0, "flood_id": -1.0})
+    assert "bus" not in quiet.plain and "flood" not in quiet.plain
+    _, faults = health_text({"frames_per_s": 500.0, "error_frames": 4.0, "bus_state": 1.0,
+                             "flood_id": 0.0})
+    assert "errors 4" in faults.plain and "bus passive" in faults.plain
+    assert "flood 0x000" in faults.plain
+    _, off = health_text({"bus_state": 2.0, "flood_id": 0x1FFC0000})
+    assert "BUS-OFF" in off.plain and "flood 0x1FFC0000" in off.plain

@@ -368,7 +368,8 @@ def test_fake_boards_help_says_udp_multicast_stays_on_loopback() -> None:
 
 def test_faster_than_real_time_without_lockstep() -> None:
     """--time-scale on both sides: the fake's world runs 20x the wall clock and
-    so does the host's clock; the robot drives forward as commanded."""
+    so does the host's clock, its timeouts and its grace are 1/20 of the
+    URL's in wall time; the robot drives forward as commanded."""
     channel = f"scaled-{next(_names)}"
     world = make_world(load_config(), load_scenario(), False)
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
@@ -376,7 +377,7 @@ def test_faster_than_real_time_without_lockstep() -> None:
     thread = threading.Thread(target=server.serve, daemon=True)
     thread.start()
     try:
-        session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1",
+        session = open_can_robot(f"can://virtual/{channel}?time_scale=20&timeout=1&watchdog=5000",
                                  load_config(), RobotOptions())
         assert not isinstance(session.robot, HasTruth)  # a board robot, as a real one
         first = session.robot.read()
@@ -388,8 +389,11 @@ def test_faster_than_real_time_without_lockstep() -> None:
         assert last.time_s > first.time_s
         assert last.turns(MotorId.MWF) > first.turns(MotorId.MWF)
         assert world.now() > 0
-        # the watchdog is wall-clock ms: the boards count 20x as many of theirs
+        # timeout, grace and watchdog are times of the robot's clock: the
+        # boards count the watchdog in theirs, the host waits 1/20 of the wall
+        link = session.robot.link  # type: ignore[attr-defined]
         assert session.robot.board_watchdog_ms == 5000  # type: ignore[attr-defined]
+        assert (link.timeout_s, link.grace_s) == (1 / 20, 0.5 / 20)
         session.close()
     finally:
         server.stop()

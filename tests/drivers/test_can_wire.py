@@ -4,6 +4,7 @@ arithmetic, and arbitrary frames never crashing a decoder."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import random
 import struct
@@ -206,7 +207,11 @@ def fuzz_targets() -> Iterator[tuple[CanBoardServer, CanLink]]:
     world = make_world(load_config(), load_scenario(), False)
     server = CanBoardServer(can.Bus(interface="virtual", channel="fuzz-boards"), world,
                             make_boards(world))
-    link = CanLink(can.Bus(interface="virtual", channel="fuzz-host"))
+    # a clock that moves a second a look: the frames fuzzed here, however
+    # many, never make a flood (bus_health: 500 foreign frames in 250 ms)
+    seconds = itertools.count()
+    link = CanLink(can.Bus(interface="virtual", channel="fuzz-host"),
+                   now=lambda: float(next(seconds)))
     yield server, link
     server.bus.shutdown()
     link.close()
@@ -234,7 +239,7 @@ def test_arbitrary_frames_never_crash_the_decoders_and_are_counted(
     s = {k: v - s0[k] for k, v in vars(server.stats).items()}
     ls = {k: v - l0[k] for k, v in link.stats.as_dict().items()}
     assert s["error_frames"] + s["malformed"] == bad
-    assert ls["crc_errors"] + ls["malformed"] == bad
+    assert ls["error_frames"] + ls["malformed"] == bad and ls["crc_errors"] == 0
     assert ls["ignored"] + ls["stray"] + ls["late"] + ls["duplicates"] == len(batch) - bad
     assert s["ignored"] + s["frames_rx"] + s["stray"] >= len(batch) - bad
 

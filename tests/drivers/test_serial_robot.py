@@ -399,7 +399,7 @@ def test_spy_wrapper_sees_the_traffic(fake: Fake, tmp_path: Path) -> None:
 
 def test_lockstep_must_match_the_boards(fake: Fake) -> None:
     with pytest.raises(RobotUrlError, match="run in lockstep; add \\?lockstep=1"):
-        fake.open("timeout=0.2")
+        fake.open("timeout=0.2&watchdog=1000")  # 3 x 200 ms fit in 1 s - a tick
 
 
 def test_url_options() -> None:

@@ -13,7 +13,8 @@ from textual.widgets import Static
 from stairbot.console.freshness import age_key, is_stale, titled
 
 SPEED_NAMES = {"1x": "1×", "10x": "10×", "max": "max"}
-ERROR_KEYS = ("crc_errors", "malformed", "stray")
+ERROR_KEYS = ("crc_errors", "malformed", "stray", "error_frames")
+BUS_STATES = {1.0: "bus passive", 2.0: "BUS-OFF"}  # the CAN link's bus_state
 
 
 def _figure(out: Text, label: str, value: float | None, unit: str = "",
@@ -30,7 +31,8 @@ def _figure(out: Text, label: str, value: float | None, unit: str = "",
 def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
     """Two lines: frames per second and round-trip times; errors (stray
     replies among them), lost and late replies, retries (red when not zero),
-    and duplicated replies when there were any (ignored, so not red)."""
+    and duplicated replies when there were any (ignored, so not red); on
+    CAN a bus that is not error-active, and the id of a flood, in red."""
     if not health:
         return Text("no link figures yet  ", "dim"), Text()
     rates = Text(no_wrap=True, overflow="ellipsis")
@@ -48,6 +50,12 @@ def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
         _figure(faults, label, value, bad=value > 0)
     if health.get("duplicates", 0.0) > 0:
         _figure(faults, "dup", health["duplicates"])
+    state = BUS_STATES.get(health.get("bus_state", 0.0))
+    if state is not None:
+        faults.append(state + "  ", "bold red")
+    flood = health.get("flood_id", -1.0)
+    if flood >= 0:
+        faults.append(f"flood 0x{int(flood):03X}  ", "bold red")
     return rates, faults
 
 
