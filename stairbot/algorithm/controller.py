@@ -18,6 +18,7 @@ The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -121,6 +122,7 @@ class Controller:
         self._supervisor = Supervisor(config)
         self._tilt = self._supervisor.tilt
         self._sensor_since: float | None = None
+        self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
         self._now_key: tuple[str, str | None] | None = None  # see _present
         self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
 
@@ -286,6 +288,7 @@ class Controller:
                          for s in errors] + ([imu] if imu is not None else []))
         if self._sensor_since is None:
             self._sensor_since = snap.time_s
+            self._sensor_link = dict(snap.health)
             ctx.pauses += 1
             self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
                        f"stopped, lifts holding, waiting up to {SENSOR_WAIT_S:g} s",
@@ -295,8 +298,8 @@ class Controller:
         if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
             return True
         self._sensor_since = None
-        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"),
-                    snap)
+        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
+                         f"{_link_meanwhile(self._sensor_link, snap.health)}"), snap)
         return True
 
     def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
@@ -432,3 +435,18 @@ _TERMINAL: dict[str, bool] = {p.value: p.terminal for p in Phase}
 
 def _zeros() -> dict[MotorId, float]:
     return _ZEROS.copy()
+
+
+LINK_TROUBLE = ("retries", "timeouts", "lost", "revived")
+"""The link figures (Snapshot.health) that say frames went missing."""
+
+
+def _link_meanwhile(before: Mapping[str, float], now: Mapping[str, float]) -> str:
+    """What the link counted during a sensor hold, when it lost frames: a
+    reading goes stale on a wire that loses its replies too, and the error
+    says so (empty for a robot with no link, or a link that lost nothing)."""
+    grown = {k: now[k] - before.get(k, 0.0) for k in LINK_TROUBLE if k in now}
+    if not any(v > 0 for v in grown.values()):
+        return ""
+    counts = ", ".join(f"{v:.0f} {k}" for k, v in grown.items() if v > 0)
+    return f"; meanwhile the link lost frames ({counts}): the readings were stale on the wire"

@@ -4,6 +4,7 @@ stops safely, says why, and never moves again once it has ended."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 from kinematic import Fault, KinematicRobot, run
@@ -389,3 +390,32 @@ def test_a_pair_that_reads_nothing_when_the_wait_ends_does_not_disagree() -> Non
     run(ctrl, robot)
     r = ctrl.result
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 2, 2), r.error
+
+
+def test_a_sensor_stale_while_the_link_lost_frames_names_the_link() -> None:
+    """A robot on a lossy wire: its readings go stale because the replies
+    are lost, and the error says what the link counted meanwhile."""
+    ctrl, robot, _ = start(faults=[Fault(SensorId.SFL, 25.0, freeze=True)])
+    read = robot.read
+    figures = {"retries": 0.0, "timeouts": 0.0, "lost": 0.0}
+
+    def lossy() -> Snapshot:
+        snap = read()
+        if snap.time_s > 25.0:
+            figures["retries"] += 3
+            figures["timeouts"] += 1
+        return replace(snap, health=dict(figures))
+
+    robot.read = lossy  # type: ignore[method-assign]
+    run(ctrl, robot)
+    error = str(ctrl.result.error)
+    assert "SFL stale" in error and "meanwhile the link lost frames (" in error
+    assert " retries, " in error and " timeouts)" in error and "lost)" not in error
+
+
+def test_a_sensor_stale_on_a_link_that_lost_nothing_says_nothing_of_it() -> None:
+    ctrl, robot, _ = start(faults=[Fault(SensorId.SFL, 25.0, freeze=True)])
+    read = robot.read
+    robot.read = lambda: replace(read(), health={"retries": 7.0})  # type: ignore[method-assign]
+    run(ctrl, robot)
+    assert "SFL stale" in str(ctrl.result.error) and "link" not in str(ctrl.result.error)
