@@ -9,6 +9,7 @@ from collections.abc import Callable
 
 import can
 import pytest
+from test_serial_link import ScriptedChannel, answer
 
 from stairbot.config import load_config
 from stairbot.drivers import messages as m
@@ -21,7 +22,6 @@ from stairbot.drivers.serial_wire import Frame
 from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.errors import RobotUrlError
 from stairbot.robots import RobotOptions, open_robot
-from tests.drivers.test_serial_link import ScriptedChannel, answer
 
 _names = itertools.count()
 MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)
