@@ -23,7 +23,7 @@ import contextlib
 from collections.abc import Callable
 
 from stairbot.drivers import messages as m
-from stairbot.drivers.link import BoardLink, CountsReplies, ProbesOldBoards
+from stairbot.drivers.link import BoardLink, CountsReplies, ProbesOldBoards, Reply
 from stairbot.drivers.telemetry import BASE_NAMES, SIDE_NAMES
 from stairbot.errors import (
     BoardMismatchError,
@@ -101,11 +101,7 @@ def claim_board(link: BoardLink, url: str, board: m.Board, *, nonce: int, lease_
     name = board.name.lower()
     holder = 0
     for attempt in (1, 2):
-        try:
-            reply = link.exchange(board, [m.Claim(lease_ms, nonce)])
-        except LinkLostError:
-            raise NoBoardError(url, name, f"the {name} board did not answer Claim on the "
-                               f"{link.wire}") from None
+        reply = _claim_exchange(link, url, board, m.Claim(lease_ms, nonce))
         owner = reply.messages[0] if reply.messages else None
         if not isinstance(owner, m.Owner):
             raise HardwareError(f"{url}: the {name} board gave an unexpected answer to "
@@ -120,6 +116,21 @@ def claim_board(link: BoardLink, url: str, board: m.Board, *, nonce: int, lease_
         f"{url}: the {name} board is held by another host (session {holder}; its "
         "lease runs on while that host keeps sending): close that host first, one host "
         "owns the robot")
+
+
+def _claim_exchange(link: BoardLink, url: str, board: m.Board, claim: m.Claim) -> Reply:
+    """Claim's reply.  A board that answered Identify a moment ago and misses
+    a Claim and its retries (a host or a fake board starved of CPU) is asked
+    again as many times: Claim does the same however often it runs."""
+    name = board.name.lower()
+    for attempt in range(link.retries + 1):
+        try:
+            return link.exchange(board, [claim])
+        except LinkLostError:
+            if attempt == link.retries:
+                raise NoBoardError(url, name, f"the {name} board did not answer Claim on "
+                                   f"the {link.wire}") from None
+    raise AssertionError("unreachable")
 
 
 def release_board(link: BoardLink, board: m.Board, nonce: int) -> None:
