@@ -79,8 +79,10 @@ def one_run(n: int, scale: float, folder: Path) -> tuple[bool, str]:
             f"&timeout={0.05 * scale:g}&grace={0.5 * scale:g}"
             f"&watchdog={min(65535, round(250 * scale))}")
         logger.stdout.readline()  # "Connected to ...": listening
-        host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
-                               "--json", "-q"], capture_output=True, text=True, timeout=1800)
+        with tempfile.TemporaryDirectory() as tmp:  # a journal of its own (soak_faults.py)
+            host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
+                                   "--journal", str(Path(tmp) / "journal.jsonl"), "--json",
+                                   "-q"], capture_output=True, text=True, timeout=1800)
     finally:
         logger.send_signal(signal.SIGINT)  # can.logger flushes and closes its file
         boards.terminate()

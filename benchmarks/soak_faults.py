@@ -38,9 +38,11 @@ import itertools
 import json
 import subprocess
 import sys
+import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from pathlib import Path
 
 FAULTS = ("drop", "corrupt", "late", "duplicate")
 _groups = itertools.count(1)
@@ -90,8 +92,12 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
         url = boards.stdout.readline().strip()
         if url_options:
             url += ("&" if "?" in url else "?") + url_options
-        host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
-                               "--json", "-q"], capture_output=True, text=True, timeout=1800)
+        # A journal of its own: a run that ends on a lost link leaves its
+        # journal resumable, and the next run on a reused pty would be refused.
+        with tempfile.TemporaryDirectory() as tmp:
+            host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
+                                   "--journal", str(Path(tmp) / "journal.jsonl"), "--json",
+                                   "-q"], capture_output=True, text=True, timeout=1800)
     finally:
         boards.terminate()
         try:
