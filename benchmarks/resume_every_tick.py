@@ -12,7 +12,6 @@ ticks, the resumable ones, and per phase those that are not.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import shutil
 import sys
@@ -22,35 +21,17 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from stairbot.algorithm.phases import Mode
-from stairbot.cli_journal import start_journal
 from stairbot.config import load_config
-from stairbot.errors import HardwareError, StairbotError
-from stairbot.fakes.boards import make_boards
-from stairbot.fakes.boards_cli import make_world
-from stairbot.fakes.fault_matrix import _Boards
+from stairbot.errors import StairbotError
+from stairbot.fakes.host_kills import journaled_run
 from stairbot.journal import JournalState, mark_path, read_journal
 from stairbot.resume import check, restored_context
-from stairbot.runner import run
 from stairbot.scenario import load_scenario
 
 
 def record(scenario_name: str | None, journal: Path) -> str:
-    config, scenario = load_config(), load_scenario(scenario_name)
-    world = make_world(config, scenario, lockstep=True)
-    boards = _Boards("can", world, make_boards(world), config)
-    try:
-        session = boards.open()
-        writer = start_journal(journal, boards.url, session, config, scenario.name, Mode.FULL)
-        assert writer is not None
-        try:
-            result = run(session, config, journal=writer)
-        finally:
-            writer.close()
-            with contextlib.suppress(HardwareError):
-                session.close()
-    finally:
-        boards.close()
+    scenario = load_scenario(scenario_name)
+    result, _ = journaled_run("can", scenario, journal)
     return f"{scenario.name}: {result.outcome}, climbed {result.steps_climbed}, " \
            f"descended {result.steps_descended}"
 

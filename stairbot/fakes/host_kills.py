@@ -47,8 +47,8 @@ from stairbot.fakes.fault_matrix import (
 )
 from stairbot.hardware import Snapshot
 from stairbot.journal import mark_path
-from stairbot.runner import run
-from stairbot.scenario import parse_scenario
+from stairbot.runner import RunResult, run
+from stairbot.scenario import Scenario, parse_scenario
 
 POINTS = ("first", "middle", "last")
 """Where in a phase's ticks the host is killed."""
@@ -137,11 +137,12 @@ def phase_ticks(wire: str) -> dict[str, tuple[int, int]]:
     return _spans(list(recorded(wire)[0]))
 
 
-def record_run(wire: str, journal: Path) -> list[str]:
-    """Run the flight with no fault on ``wire``, journaled at ``journal``;
-    each tick's phase, in order.  AssertionError when it does not complete."""
+def journaled_run(wire: str, scenario: Scenario, journal: Path
+                  ) -> tuple[RunResult, list[str]]:
+    """The reference robot on fake boards in lockstep on ``wire`` running
+    ``scenario`` with no fault, journaled at ``journal``: its result and each
+    tick's phase, in order."""
     config = load_config()
-    scenario = parse_scenario(SCENARIO, "<host kills>")
     world = make_world(config, scenario, lockstep=True)
     boards = _Boards(wire, world, make_boards(world), config)
     phases: list[str] = []
@@ -158,6 +159,13 @@ def record_run(wire: str, journal: Path) -> list[str]:
                 session.close()
     finally:
         boards.close()
+    return result, phases
+
+
+def record_run(wire: str, journal: Path) -> list[str]:
+    """Run the flight with no fault on ``wire``, journaled at ``journal``;
+    each tick's phase, in order.  AssertionError when it does not complete."""
+    result, phases = journaled_run(wire, parse_scenario(SCENARIO, "<host kills>"), journal)
     assert result.outcome == "completed" and not result.fell, result
     return phases
 
