@@ -101,7 +101,7 @@ def claim_board(link: BoardLink, url: str, board: m.Board, *, nonce: int, lease_
     name = board.name.lower()
     holder = 0
     for attempt in (1, 2):
-        reply = _claim_exchange(link, url, board, m.Claim(lease_ms, nonce))
+        reply = _set_up(link, url, board, m.Claim(lease_ms, nonce))
         owner = reply.messages[0] if reply.messages else None
         if not isinstance(owner, m.Owner):
             raise HardwareError(f"{url}: the {name} board gave an unexpected answer to "
@@ -118,19 +118,27 @@ def claim_board(link: BoardLink, url: str, board: m.Board, *, nonce: int, lease_
         "owns the robot")
 
 
-def _claim_exchange(link: BoardLink, url: str, board: m.Board, claim: m.Claim) -> Reply:
-    """Claim's reply.  A board that answered Identify a moment ago and misses
-    a Claim and its retries (a host or a fake board starved of CPU) is asked
-    again as many times: Claim does the same however often it runs."""
+def _tries(link: BoardLink) -> str:
+    """How hard the link asks, for a message saying nothing answered."""
+    n = link.retries + 1
+    return f"{n} {'try' if n == 1 else 'tries'} of {link.timeout_s * 1e3:.0f} ms"
+
+
+def _set_up(link: BoardLink, url: str, board: m.Board, msg: m.Message) -> Reply:
+    """The reply to a setting-up message that does the same however often it
+    runs (Claim, SetWatchdog): a board that answered Identify a moment ago and
+    misses it and its retries (a host or a fake board starved of CPU) is asked
+    again, under a fresh seq, as many times.  NoBoardError when it never answers."""
     name = board.name.lower()
     for attempt in range(link.retries + 1):
         try:
-            return link.exchange(board, [claim])
+            return link.exchange(board, [msg])
         except LinkLostError:
             if attempt == link.retries:
-                raise NoBoardError(url, name, f"the {name} board did not answer Claim on "
-                                   f"the {link.wire}") from None
-    raise AssertionError("unreachable")
+                raise NoBoardError(url, name, f"the {name} board did not answer "
+                                   f"{type(msg).__name__} on the {link.wire} "
+                                   f"({_tries(link)})") from None
+    raise AssertionError("unreachable: the last attempt returns or raises")
 
 
 def release_board(link: BoardLink, board: m.Board, nonce: int) -> None:
@@ -154,8 +162,6 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
     (a sensor board without the side pair that ``side_pair`` names: see
     ``check_sensor_channels``) or HardwareError (an answer that is not Ident +
     Status, a sensor board's channel count)."""
-    n = link.retries + 1
-    tries = f"{n} {'try' if n == 1 else 'tries'} of {link.timeout_s * 1e3:.0f} ms"
     name = board.name.lower()
     try:
         reply = link.exchange(board, [m.Identify(), m.GetStatus()])
@@ -167,7 +173,7 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
         if old is not None:
             check_version(url, board, old)
         raise NoBoardError(url, name, f"no {name} board answered on the "
-                           f"{link.wire} ({tries})") from None
+                           f"{link.wire} ({_tries(link)})") from None
     ident, status = (reply.messages + (None, None))[:2]
     if isinstance(ident, m.Ident):
         check_version(url, board, ident)
@@ -192,14 +198,7 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
             f"clears a latch: check the robot, then `stairbot clear --robot {url}`")
     # Setting up is the one place where a command frame is sent again after a
     # timeout (SetWatchdog sets a value: the same effect however often it runs).
-    for attempt in range(link.retries + 1):
-        try:
-            reply = link.exchange(board, [m.SetWatchdog(watchdog_ms, hold_ms)])
-            break
-        except LinkLostError:
-            if attempt == link.retries:
-                raise NoBoardError(url, name, f"the {name} board did not answer "
-                                   f"SetWatchdog on the {link.wire} ({tries})") from None
+    reply = _set_up(link, url, board, m.SetWatchdog(watchdog_ms, hold_ms))
     last = reply.messages[-1] if reply.messages else None
     if isinstance(last, m.Ack) and last.result == m.AckResult.NOT_OWNER:
         raise BoardOwnedError(f"{url}: the {name} board refused SetWatchdog: another host "
