@@ -252,8 +252,8 @@ class CanLink(RequestLink[CanRequest]):
         self._match(f)
 
     def _match(self, f: CanFrame) -> None:
-        self._hear(f.board)
         if f.session != self.session:
+            self._hear(f.board)
             self.other_session += 1
             self.stats.stray += 1
             return
@@ -261,6 +261,7 @@ class CanLink(RequestLink[CanRequest]):
             index = p.index_of(f.seq)
             if index is None:
                 continue
+            self._hear(f.board, feed=p.feed)
             verdict = p.offer(f.message, index)
             if verdict is Offer.TAKEN:
                 if p.todo:
@@ -278,6 +279,7 @@ class CanLink(RequestLink[CanRequest]):
             else:
                 self.stats.stray += 1
             return
+        self._hear(f.board)
         past = self._past.get((f.board, f.seq))
         if past is None:
             self.stats.stray += 1

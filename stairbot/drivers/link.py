@@ -20,17 +20,19 @@ Rules (docs/protocol.md, "Requests and replies"):
   reply already taken ``duplicates``; a reply matching nothing (another
   session's, an echo) ``stray``.
 * :meth:`RequestLink.wait` raises LinkLostError when a waited-for request got
-  no reply after its retries and its board has not answered anything for
-  ``grace_s``; until then the request is sent again (a query) -- ordinary
+  no reply after its retries and its board has answered nothing but retry
+  rounds' Heartbeats for ``grace_s``; until then the request is sent again (a query) -- ordinary
   line noise, a lost frame here and there, is ridden out.  A board that
   answers every attempt but never wholly (``Request.attempt_failed``: on CAN
   the same replies left out, attempt after attempt) is alive but will never
   complete it: HardwareError, at once, rather than retries without end.  ``max_lost``
   commands in a row (in the order they were sent) that went unanswered mean
   the link is lost too, again once the board has been silent for ``grace_s``.
-* A retry round feeds every board: a board none of the round's frames
-  reaches is sent a Heartbeat (``feeds``), so that while the host waits for
-  one board the other's watchdog does not starve (``timing.py`` has the
+* A retry round feeds every board: each board is sent a Heartbeat
+  (``feeds``) beside whatever request goes to it again, so that while the
+  host waits for one board the other's watchdog does not starve, and the
+  board being asked again hears two frames a round: its watchdog starves
+  only if both are lost, round after round (``timing.py`` has the
   arithmetic).  A Heartbeat costs its board one reply; the same ReadAll
   again (on CAN the broadcast frame) would cost a whole ReadAll reply.
 * :meth:`RequestLink.urgent` (the emergency stop) may be called from any
@@ -284,6 +286,7 @@ class RequestLink(ABC, Generic[R]):
         self.grace_s = grace_s
         self._now = now
         self._heard: dict[int, float] = {}  # board -> when its latest reply came
+        self._replied: dict[int, float] = {}  # the same, not counting feeds' replies
         self._in_flight: dict[int, list[R]] = {}  # per board, in sending order
         self._commands_sent = 0
         self._last_answered = -1  # order of the latest-sent command that was answered
@@ -410,7 +413,7 @@ class RequestLink(ABC, Generic[R]):
                   frames: int = 1) -> None:
         """``req`` has its whole reply, ``frames`` frames of it."""
         self.stats.frames_rx += frames
-        now = self._hear(req.board)
+        now = self._hear(req.board, req.feed)
         self.stats.add_rtt(now - req.sent_at)
         req.reply = Reply(req.board, messages)
         self._in_flight[req.board].remove(req)
@@ -449,18 +452,17 @@ class RequestLink(ABC, Generic[R]):
             self._send_again(again)
 
     def _send_again(self, requests: list[R]) -> None:
-        """One retry round: ``requests`` go out again, and every board none of
-        their frames reaches is fed a Heartbeat."""
-        reached = self._retry(requests)
+        """One retry round: ``requests`` go out again, and every board is fed a
+        Heartbeat -- a second frame to a board asked again, the only one to a
+        board that is not."""
+        self._retry(requests)
         for board in Board:
-            if board not in reached:
-                self._feed(board)
+            self._feed(board)
 
-    def _retry(self, requests: list[R]) -> set[int]:
-        """Send ``requests`` again; the boards their frames reach."""
+    def _retry(self, requests: list[R]) -> None:
+        """Send ``requests`` again."""
         for req in requests:
             self._resend(req)
-        return {req.board for req in requests}
 
     def _feed(self, board: int) -> None:
         """A Heartbeat to ``board``, for its watchdog: written at once, never
@@ -488,16 +490,27 @@ class RequestLink(ABC, Generic[R]):
         with self._mutex:
             self._expire()
 
-    def _hear(self, board: int) -> float:
+    def _hear(self, board: int, feed: bool = False) -> float:
         """``board`` said something (any valid frame, late or stray too): it is
-        alive.  Returns the time."""
+        alive.  ``feed``: the reply to a Heartbeat of a retry round, which
+        shows the board alive but not that anything else gets through.
+        Returns the time."""
         now = self._now()
         self._heard[board] = now
+        if not feed:
+            self._replied[board] = now
         return now
 
     def silent_s(self, board: int) -> float:
         """How long ``board`` has not answered (since the link opened, if never)."""
         return self._now() - self._heard.get(board, self._opened)
+
+    def unanswered_s(self, board: int) -> float:
+        """How long ``board`` has sent nothing but the replies to retry rounds'
+        Heartbeats (since the link opened, if never): what the grace period
+        counts, so that a board whose Heartbeats get through but nothing
+        else still runs out of it."""
+        return self._now() - self._replied.get(board, self._opened)
 
     def commands_lost(self) -> str | None:
         """Why the commands say the link is lost, or None: ``max_lost`` in a row
@@ -511,7 +524,7 @@ class RequestLink(ABC, Generic[R]):
         """Send a query that got no reply again, as a fresh request, while its
         board is within its grace period; False once it is beyond it."""
         if (not req.idempotent or req.broken is not None
-                or self.silent_s(req.board) >= self.grace_s):
+                or self.unanswered_s(req.board) >= self.grace_s):
             return False
         with self._mutex:
             self.stats.revived += 1
@@ -548,7 +561,7 @@ class RequestLink(ABC, Generic[R]):
                     if req.broken is not None:
                         raise HardwareError(f"{who} broke the protocol: {req.broken}")
                     attempts = req.attempts + req.revived * (self.retries + 1)
-                    silent = max(self.silent_s(req.board), attempts * self.timeout_s)
+                    silent = max(self.unanswered_s(req.board), attempts * self.timeout_s)
                     raise LinkLostError(
                         f"no reply from {who} for {silent:.2f} s "
                         f"({names}: {attempts} attempt(s) of "

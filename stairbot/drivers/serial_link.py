@@ -213,9 +213,9 @@ class SerialLink(RequestLink[SerialRequest]):
             self.stats.bytes_rx += len(data)
             rs = self._reader.stats
             for frame in self._reader.feed(data):
-                if frame.from_board:
-                    self._hear(frame.board)
                 req = self._match(frame) if frame.from_board else None
+                if frame.from_board:
+                    self._hear(frame.board, feed=req is not None and req.feed)
                 mine = frame.session == self.session
                 if req is not None:
                     self._complete(req, frame.messages)

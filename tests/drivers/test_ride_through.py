@@ -1,5 +1,6 @@
 """Riding through noise in real time: the retry budget fits in the watchdog
-(URLs that break it are refused), a retry round feeds every board, and the
+(URLs that break it are refused), a retry round feeds every board (the one
+asked again too), and the
 host's waits scale with time-scaled boards."""
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from stairbot.drivers.serial_link import SerialLink
 from stairbot.drivers.serial_robot import DEFAULTS as SERIAL_DEFAULTS
 from stairbot.drivers.serial_wire import Frame
 from stairbot.drivers.timing import check_ride_through, link_timing
-from stairbot.errors import RobotUrlError
+from stairbot.errors import LinkLostError, RobotUrlError
 from stairbot.robots import RobotOptions, open_robot
 
 _names = itertools.count()
@@ -76,7 +77,8 @@ def test_a_serial_retry_to_one_board_feeds_the_other_boards_watchdog() -> None:
     def respond(frame: Frame) -> bytes | None:
         heard.append((ch.t, frame))
         if frame.board == SENSOR and isinstance(frame.messages[0], m.ReadAll):
-            tries = sum(1 for _, f in heard if f.board == SENSOR)
+            tries = sum(1 for _, f in heard
+                        if f.board == SENSOR and isinstance(f.messages[0], m.ReadAll))
             if tries <= 3:  # the sensor board's first three ReadAlls are lost
                 return None
         return answer(frame, m.Status(0, 0, 250, 0))
@@ -91,7 +93,56 @@ def test_a_serial_retry_to_one_board_feeds_the_other_boards_watchdog() -> None:
     assert [type(f.messages[0]) for _, f in motor] == [m.ReadAll] + [m.Heartbeat] * 3
     times = [t for t, _ in motor]
     assert max(b - a for a, b in itertools.pairwise(times)) <= 0.05 + 1e-9
-    assert link.stats.feeds == 3 and link.stats.revived == 1
+    # each of those rounds sent the sensor board its ReadAll and a Heartbeat
+    sensor = [type(f.messages[0]) for _, f in heard if f.board == SENSOR]
+    assert sensor == [m.ReadAll] + [m.ReadAll, m.Heartbeat] * 3
+    assert link.stats.feeds == 6 and link.stats.revived == 1
+
+
+def test_a_board_whose_every_retried_read_is_lost_is_still_fed_each_round() -> None:
+    # A lossy line can lose one board's request attempt after attempt; the
+    # Heartbeat beside each attempt still reaches it, so its watchdog is fed
+    # every timeout while the host asks again.
+    reached: list[tuple[float, Frame]] = []
+    lost = [0]
+    ch: ScriptedChannel
+
+    def respond(frame: Frame) -> bytes | None:
+        if frame.board == MOTOR and isinstance(frame.messages[0], m.ReadAll) and lost[0] < 4:
+            lost[0] += 1  # the first four ReadAlls to the motor board never arrive
+            return None
+        reached.append((ch.t, frame))
+        return answer(frame, m.Status(0, 0, 250, 0))
+
+    ch = ScriptedChannel(respond)
+    link = SerialLink(ch, timeout_s=0.05, retries=2, grace_s=1.0, now=ch.now)
+    link.wait([link.request(MOTOR, [m.ReadAll()])])
+    motor = [t for t, f in reached if f.board == MOTOR]
+    assert lost[0] == 4 and link.stats.revived == 1
+    # heard at least once a round, the gap at most one timeout (well inside
+    # the 250 ms watchdog) although five ReadAll attempts went out
+    assert len(motor) >= 4 and motor[0] <= 0.05 + 1e-9
+    assert max(b - a for a, b in itertools.pairwise(motor)) <= 0.05 + 1e-9
+
+
+def test_a_board_that_answers_only_heartbeats_is_lost_after_the_grace_period() -> None:
+    # The Heartbeats of the retry rounds get through, its ReadAll never does:
+    # the board is alive but the host learns nothing from it.  The read ends
+    # in LinkLostError once the grace period is over instead of asking for
+    # ever.
+    ch: ScriptedChannel
+
+    def respond(frame: Frame) -> bytes | None:
+        assert ch.t < 5.0, "the host is still asking a board that only answers Heartbeats"
+        if isinstance(frame.messages[0], m.ReadAll):
+            return None
+        return answer(frame, m.Status(0, 0, 250, 0))
+
+    ch = ScriptedChannel(respond)
+    link = SerialLink(ch, timeout_s=0.05, retries=2, grace_s=0.5, now=ch.now)
+    with pytest.raises(LinkLostError, match=r"no reply from the motor board for 0\.[56]"):
+        link.wait([link.request(MOTOR, [m.ReadAll()])])
+    assert 0.5 <= ch.t < 0.5 + 4 * 0.05 and link.stats.feeds > 0
 
 
 # -- a retry round feeds every board: CAN --------------------------------------
@@ -158,5 +209,6 @@ def test_a_can_retry_to_one_board_feeds_the_other_boards_watchdog() -> None:
     # the broadcast ReadAll, then each retry round: the ReadAll again to the
     # sensor board and a Heartbeat to the motor board
     sent = [(b, type(msg)) for _, b, msg in bus.sent]
-    assert sent == [(BROADCAST, m.ReadAll)] + [(SENSOR, m.ReadAll), (MOTOR, m.Heartbeat)] * 2
-    assert link.stats.retries == 2 and link.stats.feeds == 2
+    assert sent == [(BROADCAST, m.ReadAll)] + [
+        (SENSOR, m.ReadAll), (MOTOR, m.Heartbeat), (SENSOR, m.Heartbeat)] * 2
+    assert link.stats.retries == 2 and link.stats.feeds == 4
