@@ -27,8 +27,10 @@ Two modes:
   (docs/protocol.md, "Riding through noise in real time"), so a run at X is
   the real-time run played X times faster, no more lenient -- provided the
   machine keeps up: the host must do a tick's work in 1/X of a tick, and on
-  a loaded machine a run that falls behind trips a watchdog.  Run a clean
-  run (``--p 0``) at X first.
+  a loaded machine a host that falls behind trips a watchdog.  Boards that
+  fall behind pause their world (``Pacer``) and say so on exit; such a run
+  is marked ``boards fell behind real time`` and was not real time
+  throughout.  Run a clean run (``--p 0``) at X first, on a quiet machine.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -61,6 +64,7 @@ class Outcome:
     link: dict[str, int]
     wall_s: float
     error: str | None
+    behind: str = ""  # the boards' "fell behind real time ..." on exit, if they did
 
     @property
     def ok(self) -> bool:
@@ -101,22 +105,24 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
     finally:
         boards.terminate()
         try:
-            boards.communicate(timeout=10)
+            _, said = boards.communicate(timeout=10)
         except subprocess.TimeoutExpired:
             boards.kill()
-            boards.communicate()
+            _, said = boards.communicate()
     wall = time.monotonic() - t0
+    behind = re.search(r"fell behind real time [^(]*", said or "")
+    lagged = behind.group(0).strip() if behind else ""
     try:
         r = json.loads(host.stdout)
     except json.JSONDecodeError:
         last = (host.stderr.strip().splitlines() or ["no output"])[-1]
         return Outcome(mode, wire, fault, seed, f"exit {host.returncode}", 0, 0, False, {}, wall,
-                       last)
+                       last, lagged)
     link = r.get("link") or {}
     return Outcome(mode, wire, fault, seed, r["outcome"], r["steps_climbed"], r["steps_descended"],
                    bool(r["fell"]), {k: int(v) for k, v in link.items()
                                      if isinstance(v, (int, float)) and not isinstance(v, bool)},
-                   wall, r.get("error"))
+                   wall, r.get("error"), lagged)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -155,7 +161,8 @@ def main(argv: list[str] | None = None) -> int:
             counts = " ".join(f"{k} {o.link[k]}" for k in keys if k in o.link)
             print(f"{o.mode}: {o.wire:6} {o.fault:9} seed {o.seed:2}: {o.outcome:9} up {o.climbed} "
                   f"down {o.descended} fell {o.fell!s:5} {o.wall_s:5.0f} s  {counts}"
-                  + (f"  error: {o.error}" if o.error else ""), flush=True)
+                  + (f"  error: {o.error}" if o.error else "")
+                  + (f"  boards {o.behind}" if o.behind else ""), flush=True)
     print()
     bad = 0
     for w in wires:
@@ -163,8 +170,11 @@ def main(argv: list[str] | None = None) -> int:
             group = [o for o in results if (o.wire, o.fault) == (w, f)]
             good = sum(o.ok for o in group)
             bad += len(group) - good
+            lagged = sum(bool(o.behind) for o in group)
             print(f"{mode}: {w:6} {f:9} {args.p:.0%}: {good}/{len(group)} completed, "
-                  f"fell {sum(o.fell for o in group)}")
+                  f"fell {sum(o.fell for o in group)}"
+                  + (f"; in {lagged} the boards fell behind real time (the machine did not "
+                     "keep up)" if lagged else ""))
     return 1 if bad else 0
 
 

@@ -106,9 +106,19 @@ class Pacer:
     """Keeps a world that is not in lockstep up with the wall clock times
     ``time_scale``, one ``step_s`` step per :meth:`step`, so that a server
     looks at its line between steps: one that fell behind answers the host
-    before it catches up.  Shared by the serial and the CAN server."""
+    before it catches up.  Shared by the serial and the CAN server.
+
+    A server that was not scheduled for a while (a loaded machine) finds
+    the world behind the wall clock.  It catches up at most ``MAX_LAG_S``
+    of wall time; beyond that the world pauses: the rest is let go (counted
+    in ``behind`` and ``behind_s``) rather than run in a rush.  Run in a
+    rush, the boards' watchdogs would count time in which the host's frames
+    were on the line, unread, and trip where a real board, whose clock and
+    UART never stall, would have heard them.  A run whose boards fell behind
+    was not a real-time run throughout; the servers report it on exit."""
 
     MAX_WAIT_S = 0.05  # the longest a server waits on its line before looking again
+    MAX_LAG_S = 0.05  # the most wall time a world that fell behind catches up
 
     def __init__(self, world: BoardWorld, boards: Iterable[Board], time_scale: float = 1.0,
                  step_s: float = 0.005, monotonic: Callable[[], float] = time.monotonic
@@ -119,6 +129,8 @@ class Pacer:
         self.step_s = step_s
         self._monotonic = monotonic
         self._start: tuple[float, float] | None = None  # (wall, world) at the first step
+        self.behind = 0  # times the world fell more than MAX_LAG_S behind and paused
+        self.behind_s = 0.0  # wall seconds let go in all
 
     def step(self) -> float:
         """Advance the world one step if it is due (and let every board check
@@ -130,10 +142,25 @@ class Pacer:
         if self._start is None:
             self._start = (self._monotonic(), self.world.now())
         wall0, world0 = self._start
-        due = world0 + (self._monotonic() - wall0) * self.time_scale
+        wall = self._monotonic()
+        due = world0 + (wall - wall0) * self.time_scale
+        lag_s = (due - self.world.now()) / self.time_scale  # in wall time
+        if lag_s > self.MAX_LAG_S + self.step_s / self.time_scale:
+            let_go = lag_s - self.MAX_LAG_S
+            self._start = (wall0 + let_go, world0)
+            self.behind += 1
+            self.behind_s += let_go
+            due -= let_go * self.time_scale
         if self.world.now() + self.step_s <= due:
             self.world.advance(self.step_s)
             for board in self.boards:
                 board.poll()
             return 0.0
         return min(self.MAX_WAIT_S, (self.world.now() + self.step_s - due) / self.time_scale)
+
+    def report(self) -> str:
+        """What a server's exit line adds: '' while the world kept up."""
+        if not self.behind:
+            return ""
+        return (f", fell behind real time {self.behind} time(s), {self.behind_s:.2f} s let go "
+                f"(the world paused meanwhile)")

@@ -131,7 +131,8 @@ def main(argv: list[str]) -> int:
         s = server.stats
         print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.crc_errors} CRC "
               f"errors, {s.malformed} malformed, {s.duplicates} repeats, {s.injected} faults "
-              f"injected, {s.overflows} replies nobody read", file=sys.stderr)
+              f"injected, {s.overflows} replies nobody read{server.pacer.report()}",
+              file=sys.stderr)
     return 0
 
 

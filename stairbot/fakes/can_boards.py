@@ -88,6 +88,7 @@ class CanBoardServer:
         # and its replies
         self._last: dict[int, tuple[tuple[int, int, int, bytes], list[m.Message]]] = {}
         self._stop = threading.Event()
+        self.pacer = Pacer(world, boards.values(), time_scale, step_s)
         self.last_send_error: str | None = None
 
     # -- faults ------------------------------------------------------------------
@@ -198,7 +199,7 @@ class CanBoardServer:
         ``step_s`` steps to keep up with the wall clock times ``time_scale``
         (a :class:`Pacer`: the bus is looked at between steps, as on the serial
         server); in lockstep only StepTo advances it."""
-        pacer = Pacer(self.world, self.boards.values(), self.time_scale, self.step_s)
+        pacer = self.pacer
         while not self._stop.is_set():
             timeout = pacer.step()
             if self._late:
@@ -261,7 +262,7 @@ def main(argv: list[str]) -> int:
         print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.error_frames} "
               f"error frames, {s.malformed} malformed, {s.duplicates} repeated frames "
               f"answered from the cache, {s.injected} faults injected, "
-              f"{s.send_errors} replies the bus refused",
+              f"{s.send_errors} replies the bus refused{server.pacer.report()}",
               file=sys.stderr)
     return 0
 

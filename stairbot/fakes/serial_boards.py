@@ -113,6 +113,7 @@ class SerialBoardServer:
         self._last: dict[int, tuple[Frame, bytes]] = {}
         self._late: list[tuple[float, bytes]] = []
         self._stop = threading.Event()
+        self.pacer = Pacer(world, boards.values(), time_scale, step_s)
         self._crc_seen = 0
         self._out = bytearray()
 
@@ -234,7 +235,7 @@ class SerialBoardServer:
         """Serve until :meth:`stop` (or the fd closes).  In real time the world
         advances in ``step_s`` steps to keep up with the wall clock times
         ``time_scale`` (a :class:`Pacer`); in lockstep only StepTo advances it."""
-        pacer = Pacer(self.world, self.boards.values(), self.time_scale, self.step_s)
+        pacer = self.pacer
         while not self._stop.is_set():
             timeout = pacer.step()
             if self._late:

@@ -298,6 +298,35 @@ def test_the_pacer_keeps_the_world_up_with_the_wall_clock_one_step_at_a_time(
     assert motor.watchdog_tripped  # the boards are polled between steps
 
 
+def test_a_server_that_stalled_pauses_the_world_instead_of_rushing_its_watchdog(
+        rig: tuple) -> None:
+    # A loaded machine leaves the server unscheduled for 0.4 s while the
+    # host's frames wait on the line.  It reads them when it runs again; the
+    # world must not then run the missed 0.4 s in a burst, or the watchdog
+    # counts time in which the host was feeding it and trips.
+    robot, world, motor, _ = rig
+    wall = [100.0]
+    pacer = Pacer(world, [motor], time_scale=1.0, step_s=0.005, monotonic=lambda: wall[0])
+    world.lockstep = False
+    motor.handle([m.SetWatchdog(250)], HOST)
+    while pacer.step() == 0.0:
+        pass
+    wall[0] += 0.4
+    motor.handle([m.Heartbeat()], HOST)  # the frame that waited, read at once
+    t0 = robot.t
+    while pacer.step() == 0.0:
+        pass
+    assert robot.t - t0 <= Pacer.MAX_LAG_S + 0.005 + 1e-9
+    assert not motor.watchdog_tripped
+    assert pacer.behind == 1 and pacer.behind_s == pytest.approx(0.4 - Pacer.MAX_LAG_S, abs=0.006)
+    assert "fell behind real time 1 time(s), 0.35 s let go" in pacer.report()
+    for _ in range(60):  # the server keeps up; the host says nothing for 0.3 s: it trips
+        wall[0] += 0.005
+        while pacer.step() == 0.0:
+            pass
+    assert motor.watchdog_tripped and pacer.behind == 1
+
+
 # -- the side pair (protocol 4.1) ---------------------------------------------------
 
 def side_rig(sensors: tuple[SensorId, ...]) -> tuple[StubRobot, SensorBoard]:
