@@ -79,10 +79,12 @@ class CanLink(RequestLink[CanRequest]):
     def __init__(self, bus: can.BusABC, timeout_s: float = 0.1, retries: int = 2,
                  max_lost: int = 3, now: Callable[[], float] = time.perf_counter,
                  codec: CanWire | None = None, grace_s: float = 0.0,
-                 session: int | None = None, log: CanFrameLog | None = None) -> None:
+                 session: int | None = None, log: CanFrameLog | None = None,
+                 on_close: Callable[[], None] | None = None) -> None:
         super().__init__(CanStats(), timeout_s, retries, max_lost, now, grace_s)
         self.bus = bus
         self.log = log  # every frame sent and received
+        self._on_close = on_close  # after the bus shut down: the machine's lock on it
         self.codec = codec or wire()
         # This link's session: a reply of another (an earlier host's, still on
         # the bus) is never taken for one of ours, and a board executes a
@@ -328,8 +330,14 @@ class CanLink(RequestLink[CanRequest]):
         return out
 
     def close(self) -> None:
+        """Shut the bus down, close the frame log, then run ``on_close``
+        (each even if the one before failed)."""
         try:
             self.bus.shutdown()
         finally:
-            if self.log is not None:
-                self.log.close()
+            try:
+                if self.log is not None:
+                    self.log.close()
+            finally:
+                if self._on_close is not None:
+                    self._on_close()

@@ -262,24 +262,19 @@ def open_can_robot(url: str, config: RobotConfig, options: RobotOptions) -> Robo
     except BaseException:
         lock.release()
         raise
-    shutdown = bus.shutdown
-
-    def shutdown_and_unlock() -> None:
-        try:
-            shutdown()
-        finally:
-            lock.release()
-
-    bus.shutdown = shutdown_and_unlock  # type: ignore[method-assign]
     try:
         log = CanFrameLog(url, spec.log) if spec.log else None
     except RobotUrlError:
-        bus.shutdown()
+        try:
+            bus.shutdown()
+        finally:
+            lock.release()
         raise
     time_scale = options.time_scale or opts["time_scale"]
     timing = link_timing(opts, time_scale)
     link = CanLink(bus, timeout_s=timing.timeout_s, retries=int(opts["retries"]),
-                   max_lost=int(opts["lost"]), grace_s=timing.grace_s, log=log)
+                   max_lost=int(opts["lost"]), grace_s=timing.grace_s, log=log,
+                   on_close=lock.release)
     return open_board_session(link, url, watchdog_ms=int(opts["watchdog"]),
                               lockstep=bool(opts["lockstep"]),
                               time_scale=time_scale,
