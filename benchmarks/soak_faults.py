@@ -110,7 +110,7 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
             boards.kill()
             _, said = boards.communicate()
     wall = time.monotonic() - t0
-    behind = re.search(r"fell behind real time [^(]*", said or "")
+    behind = re.search(r"fell behind real time \d+ time\(s\), [\d.]+ s let go", said or "")
     lagged = behind.group(0).strip() if behind else ""
     try:
         r = json.loads(host.stdout)
