@@ -32,14 +32,11 @@ from textual.widgets import Footer
 from stairbot.cli_journal import ResumePlan
 from stairbot.config import RobotConfig, load_config
 from stairbot.console import motion_gate
+from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key, age_words, is_stale
 from stairbot.console.help import HelpScreen
 from stairbot.console.modals import AskScreen
-from stairbot.console.runner_thread import (
-    SPEEDS,
-    ConsoleEngine,
-    EngineHooks,
-)
+from stairbot.console.robot_holder import SPEEDS
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
