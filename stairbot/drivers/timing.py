@@ -3,7 +3,7 @@ wait for the host (docs/protocol.md, "Riding through noise in real time").
 
 A board's watchdog is fed by every valid frame addressed to it.  While a
 read waits for a reply, the host sends its request again every ``timeout``
-(and feeds the other board with the same round: ``link.py``), so a board
+(and feeds the other board with the same round: ``request_link.py``), so a board
 that lost a request hears the next attempt one ``timeout`` later.  The
 board last heard the host at most one control tick before the read began
 (the previous cycle's frames).  Every attempt of one request lost, the
