@@ -22,11 +22,11 @@ import time
 from pathlib import Path
 
 from stairbot.console.replay import ReplayPlayer
-from stairbot.recording.replay_source import load_replay
+from stairbot.recording.replay_load import load_replay
 
 LOAD = ("import resource, sys, time\n"
         "t = time.perf_counter()\n"
-        "from stairbot.recording.replay_source import load_replay\n"
+        "from stairbot.recording.replay_load import load_replay\n"
         "s = load_replay(sys.argv[1])\n"
         "print(time.perf_counter() - t, len(s.ticks), "
         "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)\n")

@@ -20,7 +20,8 @@ import time
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
-from stairbot.fakes.fault_matrix import FAULTS, PHASES, WIRES, Cell, run_cell
+from stairbot.fakes.fault_matrix import FAULTS, PHASES, WIRES, run_cell
+from stairbot.fakes.fault_rig import Cell
 
 LETTER = {"completed": "C", "stopped": "S", "resumed": "R", "refused": "F", "UNSAFE": "X"}
 

@@ -18,7 +18,8 @@ import time
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
-from stairbot.fakes.fault_matrix import PHASES, WIRES, Cell
+from stairbot.fakes.fault_matrix import PHASES, WIRES
+from stairbot.fakes.fault_rig import Cell
 from stairbot.fakes.host_kills import POINTS, run_kill
 
 

@@ -20,7 +20,6 @@ from pathlib import Path
 from types import FrameType
 from typing import Any, Unpack
 
-from rich.text import Text
 from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
@@ -31,15 +30,11 @@ from textual.widgets import Footer
 
 from stairbot.cli_journal import ResumePlan
 from stairbot.config import RobotConfig, load_config
-from stairbot.console import motion_gate
-from stairbot.console.freshness import age_key, age_words, is_stale
+from stairbot.console import choices, motion_gate, paint
+from stairbot.console.engine import ConsoleEngine, EngineHooks
+from stairbot.console.freshness import age_key
 from stairbot.console.help import HelpScreen
-from stairbot.console.modals import AskScreen
-from stairbot.console.runner_thread import (
-    SPEEDS,
-    ConsoleEngine,
-    EngineHooks,
-)
+from stairbot.console.robot_holder import SPEEDS
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
@@ -51,17 +46,10 @@ from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
 from stairbot.console.widgets.top_view import TopViewPicture
 from stairbot.console.widgets.trends import TrendsPanel
-from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
-from stairbot.hardware import MotorId
-from stairbot.reckon import dead_reckon
 from stairbot.top_view import RobotShape
 
 REFRESH_HZ = 10.0
-GRAPHS_ROWS = 36
-"""From this many rows the graphs show under the picture; on a smaller
-screen they take the picture's place while the operator wants them (g)."""
-SPEED_ORDER = tuple(SPEEDS)
 
 # (action, palette title, palette help) for every operator action.
 COMMANDS: tuple[tuple[str, str, str], ...] = (
@@ -123,8 +111,8 @@ class StairbotConsole(App[None]):
         self.url = url
         self.scenario = scenario
         self._record = record
-        self._shown_key: object = None
-        self._shown_event = 0
+        self.shown_key: object = None  # what the panels show (None: redraw at the next refresh)
+        self.shown_event = 0  # the last event the list shows
         self.asking_quit = False
         """The console asks whether to quit (mid-run)."""
         self._sigint: Any = None  # the SIGINT handler before ours
@@ -135,8 +123,8 @@ class StairbotConsole(App[None]):
         self.top_view = TopViewPicture(id="topview")
         self.top_shown = False
         """The picture shows the top view (t), not the side view."""
-        self._shape = RobotShape.of(engine.config)
-        self._contact_said: str | None = None  # the wall contact told the operator
+        self.robot_shape = RobotShape.of(engine.config)
+        self.contact_said: str | None = None  # the wall contact told the operator
         side_pair = engine.config.sensors.has_side_pair
         self.sensors = SensorPanel(engine.config.algorithm.equal_tolerance, side_pair=side_pair,
                                    id="sensors")
@@ -146,8 +134,8 @@ class StairbotConsole(App[None]):
         self.log_panel = EventLog(id="log")
         self.trends = TrendsPanel(engine.config.motors.lift_travel_per_turn,
                                   side_pair=side_pair, id="trends")
+        self.screen_rows: int | None = None  # the screen's height, as the last resize said
         self.graphs: bool | None = None
-        self._rows: int | None = None  # the screen's height, as the last resize said
         """The operator's choice of graphs (g); None: by the screen's size."""
 
     # -- layout ------------------------------------------------------------------
@@ -177,31 +165,14 @@ class StairbotConsole(App[None]):
         return EStopButton(id="estop")
 
     def on_resize(self, event: events.Resize) -> None:
-        self.lay_out_graphs(event.size.height)  # before the app's own size follows
-
-    def _tall(self, rows: int | None = None) -> bool:
-        return (self.size.height if rows is None else rows) >= GRAPHS_ROWS
-
-    def lay_out_graphs(self, rows: int | None = None) -> None:
-        """Show the graphs under the picture on a tall screen (``rows``: its
-        height, None: the app's); on a smaller one in the picture's place,
-        and only while the operator wants them."""
-        tall = self._tall(rows)
-        self._rows = rows if rows is not None else self.size.height
-        wanted = tall if self.graphs is None else self.graphs
-        self.trends.display = wanted
-        picture = tall or not wanted
-        self.picture.display = picture and not self.top_shown
-        self.top_view.display = picture and self.top_shown
-        if wanted:
-            self._shown_key = None  # draw them now
+        paint.lay_out(self, event.size.height)  # before the app's own size follows
 
     def on_mount(self) -> None:
         # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):
         # the robot stops first, then the console asks, as for Ctrl-C typed.
         with contextlib.suppress(ValueError):  # not the main thread: left as it is
             self._sigint = signal.signal(signal.SIGINT, self._on_sigint)
-        self.lay_out_graphs()
+        paint.lay_out(self)
         self.begin()
 
     def begin(self) -> None:
@@ -209,7 +180,7 @@ class StairbotConsole(App[None]):
         robot and read it while idle.  (A subclass replaces this, not
         ``on_mount``: Textual calls every class's ``on_mount``.)"""
         if self._record:
-            self._start_recording(self._record)
+            choices.start_recording(self, self._record)
         self.refresh_view()
         self.set_interval(1 / REFRESH_HZ, self.refresh_view)
         self.open_robot(self.url, self.scenario)
@@ -219,51 +190,12 @@ class StairbotConsole(App[None]):
     def refresh_view(self) -> None:
         """Copy the live state and update every panel that changed (the ages
         of the values shown change with the wall clock alone)."""
-        view = self.state.view(events_after=self._shown_event)
+        view = self.state.view(events_after=self.shown_event)
         key = (view.version, age_key(view.read_age_s), age_key(view.top_age_s))
-        if key == self._shown_key:
+        if key == self.shown_key:
             return
-        self._shown_key = key
-        self._show(view)
-
-    def _show(self, v: StateView) -> None:
-        self.banner.show(v.url, v.scenario, v.status, v.recording)
-        picture = self.picture
-        age = v.read_age_s
-        # never markup: the URL may hold brackets; with a landing, the frame it is in
-        framed = v.top.flight if v.top is not None and v.plan and v.plan.landing else None
-        title = Text("side view · " if framed is None else f"side view, flight {framed} · ")
-        title.append(age_words(age), "bold red" if is_stale(age) else "dim")
-        title.append(f" · {v.url} · {v.scenario}")
-        picture.border_title = title
-        picture.set_class(is_stale(age), "-stale")
-        snap = v.snapshot
-        lifts = None
-        if snap is not None and MotorId.MTF in snap.motors and MotorId.MTB in snap.motors:
-            per_turn = self.engine.config.motors.lift_travel_per_turn
-            lifts = (snap.turns(MotorId.MTF) * per_turn, snap.turns(MotorId.MTB) * per_turn)
-        scene, note = v.scene, self.picture_note() if v.scene is None else ""
-        if v.wired and scene is None and not self.replaying:
-            scenario = self.engine.scenario
-            if snap is not None and v.stairs and scenario is not None:
-                scene = dead_reckon(snap, v.stairs, self.engine.config, scenario.start.distance)
-                note = "dead-reckoned (wired robot)"
-            else:
-                note = "no pose from a wired robot"
-        picture.show(scene, v.stairs, lifts, note)
-        self._show_top(v)
-        running = v.status.robot in ("running", "replay")  # a replay: the recorded phase
-        self.sensors.show(snap, age)
-        self.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
-        self.phase.show(v.phase, v.flow, v.context, v.phase_id)
-        self.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age,
-                       replay=self.replaying)
-        if self.trends.display:
-            self.trends.show(v.history, age)
-        if v.events:
-            log = self.log_panel
-            log.add(v.events)
-            self._shown_event = log.last_seq
+        self.shown_key = key
+        paint.show(self, view)
 
     def top_note(self, v: StateView) -> str:
         """Why the top view has nothing to draw ("": it has)."""
@@ -274,27 +206,6 @@ class StairbotConsole(App[None]):
                 return "no robot open"
             return "no top view: this robot tells no pose seen from above"
         return ""
-
-    def _show_top(self, v: StateView) -> None:
-        """The top view, and a wall contact told once in the event list (the
-        side view cannot show it)."""
-        top, age, note = self.top_view, v.top_age_s, self.top_note(v)
-        stale = not note and is_stale(age)
-        title = Text("top view · ")
-        if note:
-            title.append("none", "dim")
-        else:
-            title.append(age_words(age), "bold red" if stale else "dim")
-        title.append(f" · {v.url} · {v.scenario}")
-        top.border_title = title
-        top.set_class(stale, "-stale")
-        top.show(None if note else v.plan, None if note else v.top, self._shape, note, stale)
-        if v.top is None:
-            return
-        contact = v.top.wall_contact
-        if contact and contact != self._contact_said:
-            self.say(f"wall contact: {contact} (t: the top view)", "warning", timeout=10)
-        self._contact_said = contact  # a new robot's pose has none: the next is told
 
     # -- workers -------------------------------------------------------------------
     @work(thread=True, group="robot", exclusive=True, exit_on_error=False)
@@ -387,100 +298,29 @@ class StairbotConsole(App[None]):
             self.open_robot(self.url, self.scenario)
 
     def action_choose_robot(self) -> None:
-        if self.engine.running:
-            self.say("stop the run first (x)", severity="warning")
-            return
-
-        def chosen(url: str | None) -> None:
-            if url:
-                self.open_robot(url, self.scenario)
-
-        self.push_screen(AskScreen("Robot URL", self.url, "sim://",
-                                   "sim://  serial://PORT?baud=N  can://IF/CHANNEL"), chosen)
+        choices.choose_robot(self)
 
     def action_choose_scenario(self) -> None:
-        if self.engine.running:
-            self.say("stop the run first (x)", severity="warning")
-            return
-
-        def chosen(name: str | None) -> None:
-            if name is not None:
-                self.open_robot(self.url, name or None)
-
-        self.push_screen(AskScreen("Scenario file or shipped name (empty: default stairs)",
-                                   self.scenario or "", "default"), chosen)
+        choices.choose_scenario(self)
 
     def action_speed(self) -> None:
-        if self.engine.session is not None and not self.engine.in_process:
-            self.say("a robot on a wire keeps its own time (fake boards: --time-scale)",
-                        severity="warning")
-            return
-        current = self.state.view().speed
-        nxt = SPEED_ORDER[(SPEED_ORDER.index(current) + 1) % len(SPEED_ORDER)]
-        self.engine.set_speed(nxt)
-        self.refresh_view()
+        choices.speed(self)
 
     def action_record(self) -> None:
-        if self.engine.recorder is not None:
-            path = self.engine.recorder.path
-            self.engine.stop_recording()
-            self.say(f"recording stopped: {path}")
-            return
-
-        def chosen(path: str | None) -> None:
-            if path:
-                self._start_recording(path)
-
-        self.push_screen(AskScreen("Record to (FILE.mcap: every tick, MCAP; else the events, "
-                                   "JSON lines)", "events.jsonl"), chosen)
-
-    def _start_recording(self, path: str) -> None:
-        """Record to ``path``, or beside it when a file is there (never over it)."""
-        try:
-            chosen = self.engine.start_recording(path)
-        except InputError as exc:
-            self.say(str(exc), "error", timeout=8)
-            return
-        if chosen != path:
-            self.say(f"{path} exists (not overwritten): recording to {chosen}",
-                     "warning", timeout=8)
-        else:
-            self.say(f"recording to {chosen}")
+        choices.record(self)
 
     def action_help(self) -> None:
         if not isinstance(self.screen, HelpScreen):
             self.push_screen(HelpScreen())
 
     def action_graphs(self) -> None:
-        tall = self._tall(self._rows)
-        self.graphs = not (tall if self.graphs is None else self.graphs)
-        self.lay_out_graphs(self._rows)
-        where = "under the picture" if tall else "in place of the picture (g: the picture)"
-        self.say(f"graphs {'shown ' + where if self.graphs else 'hidden'}", keep=False)
-        self.refresh_view()
+        choices.graphs(self)
 
     def action_zoom(self) -> None:
-        if self.top_shown:
-            mode = self.top_view.cycle_zoom()
-            names = {"auto": "auto zoom", "flight": "the whole stairwell",
-                     "robot": "following the robot"}
-            self.say(f"top view: {names[mode]}", keep=False)
-            return
-        mode = self.picture.cycle_zoom()
-        names = {"auto": "auto zoom", "flight": "whole flight", "robot": "following the robot"}
-        self.say(f"picture: {names[mode]}", keep=False)
+        choices.zoom(self)
 
     def action_top_view(self) -> None:
-        """The picture between the side view and the top view; on a small screen
-        it also comes back in the graphs' place."""
-        self.top_shown = not self.top_shown
-        if not self._tall(self._rows) and self.graphs:
-            self.graphs = False
-        self.lay_out_graphs(self._rows)
-        self.say("picture: top view (t: the side view)" if self.top_shown
-                 else "picture: side view (t: the top view)", keep=False)
-        self._shown_key = None
-        self.refresh_view()
+        choices.top_view(self)
 
     def get_system_commands(self, screen: Screen) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from urllib.parse import urlsplit
 
 from stairbot.config import load_config
-from stairbot.console.runner_thread import SPEEDS
+from stairbot.console.robot_holder import SPEEDS
 from stairbot.console.serve import parse_bind, serve
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile

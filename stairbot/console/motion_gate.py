@@ -15,8 +15,9 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from stairbot.console.climb_gate import MidClimb
+from stairbot.console.engine import MID_CLIMB_HINT
 from stairbot.console.modals import ChoiceScreen, ConfirmScreen
-from stairbot.console.runner_thread import LATCH_HINT, MID_CLIMB_HINT
+from stairbot.console.robot_holder import LATCH_HINT
 from stairbot.errors import StairbotError
 
 if TYPE_CHECKING:

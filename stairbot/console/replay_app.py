@@ -27,9 +27,9 @@ from textual.widgets import Static
 
 from stairbot.config import RobotConfig, load_config
 from stairbot.console.app import REFRESH_HZ, StairbotConsole
+from stairbot.console.engine import ConsoleEngine
 from stairbot.console.help import HelpScreen
 from stairbot.console.replay import ReplayPlayer, speed_name
-from stairbot.console.runner_thread import ConsoleEngine
 from stairbot.console.state import StateView
 from stairbot.console.widgets.estop import ESTOP_KEY
 from stairbot.recording.replay_source import ReplaySource

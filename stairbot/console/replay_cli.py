@@ -73,7 +73,7 @@ def check_reader(path: str) -> None:
 def replay(path: str, speed: float = 1.0, paused: bool = False) -> int:
     """Load ``path`` (bad input raises InputError), then play it until the
     operator quits; the exit code."""
-    from stairbot.recording.replay_source import load_replay
+    from stairbot.recording.replay_load import load_replay
 
     check_reader(path)
     source = load_replay(path)  # a ReadFault: the CLI's one line and exit 1

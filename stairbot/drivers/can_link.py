@@ -1,6 +1,6 @@
 """The link protocol over a python-can bus.
 
-:class:`CanLink` is a :class:`~stairbot.drivers.link.RequestLink`, as the
+:class:`CanLink` is a :class:`~stairbot.drivers.request_link.RequestLink`, as the
 serial link is: retries, expiry and the health counters are shared.  What is
 CAN's own (docs/protocol.md, "CAN"):
 
@@ -46,7 +46,8 @@ from stairbot.drivers.bus_health import BusWatch, socketcan_errors
 from stairbot.drivers.can_request import CanRequest, Offer
 from stairbot.drivers.can_wire import BROADCAST, SESSION_MAX, CanFrame, CanWire, frame_bits, wire
 from stairbot.drivers.frame_log import CanFrameLog
-from stairbot.drivers.link import LinkStats, RequestLink
+from stairbot.drivers.link import LinkStats
+from stairbot.drivers.request_link import RequestLink
 from stairbot.errors import LinkLostError
 
 PAST_SEQS = 512

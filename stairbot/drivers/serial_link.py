@@ -7,7 +7,8 @@ Several requests may be in flight at once (one per board per control cycle),
 so a cycle costs one round trip, not one per board.  A request sent again
 after a timeout is the same frame, byte for byte, with the same ``seq``: a
 board answers a repeated frame from its cache without acting twice.
-Retries, expiry and the health counters are :class:`~stairbot.drivers.link.RequestLink`'s.
+Retries, expiry and the health counters are
+:class:`~stairbot.drivers.request_link.RequestLink`'s.
 """
 
 from __future__ import annotations
@@ -22,8 +23,9 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from stairbot.drivers.frame_log import SerialFrameLog
-from stairbot.drivers.link import LinkStats, Request, RequestLink
+from stairbot.drivers.link import LinkStats, Request
 from stairbot.drivers.records import Message
+from stairbot.drivers.request_link import RequestLink
 from stairbot.drivers.serial_wire import Frame, FrameReader, encode_frame
 from stairbot.errors import LinkLostError
 

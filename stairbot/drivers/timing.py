@@ -3,11 +3,11 @@ wait for the host (docs/protocol.md, "Riding through noise in real time").
 
 A board's watchdog is fed by every valid frame addressed to it.  While a
 read waits for a reply, the host sends its request again every ``timeout``,
-and each such round sends every board a Heartbeat too (``link.py``), so a
-board that lost a request hears the next round's two frames one
-``timeout`` later.  The
-board last heard the host at most one control tick before the read began
-(the previous cycle's frames).  Every attempt of one request lost, the
+and each such round sends every board a Heartbeat too
+(``request_link.py``), so a board that lost a request hears the next
+round's two frames one ``timeout`` later.  The board last heard the host
+at most one control tick before the read began (the previous cycle's
+frames).  Every attempt of one request lost, the
 first frame after them -- the query sent again within the grace period --
 reaches the board ``tick + attempts * timeout`` after it was last fed; it
 must come before the watchdog runs out::
@@ -16,8 +16,8 @@ must come before the watchdog runs out::
 
 so that a board misses ``retries + 1`` attempts in a row and still hears
 the next one in time; an attempt after the first is lost only when both of
-its round's frames are.  A URL whose options break this is refused (RobotUrlError,
-one line naming the options and what is allowed); nothing is clamped behind
+its round's frames are.  A URL whose options break this is refused
+(RobotUrlError, one line naming the options and what is allowed); nothing is clamped behind
 the operator's back.  It does not apply in lockstep, where the boards'
 clock stands still while the host waits, nor with the watchdog off.
 

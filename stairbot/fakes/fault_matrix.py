@@ -27,6 +27,8 @@ A cell is **safe** (:func:`run_cell`) when the run
   refused before any Clear, the boards still latched, is "refused": safe,
   but not what the matrix expects).
 
+The flight, the boards on their wire and the resuming host are
+:mod:`stairbot.fakes.fault_rig`'s, shared with :mod:`stairbot.fakes.host_kills`.
 ``benchmarks/fault_matrix.py`` runs every cell and prints the table of
 docs/reliability.md; tests/safety/test_fault_matrix.py runs a subset in CI.
 """
@@ -34,63 +36,39 @@ docs/reliability.md; tests/safety/test_fault_matrix.py runs a subset in CI.
 from __future__ import annotations
 
 import contextlib
-import io
 import tempfile
-import threading
 import time
-import uuid
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, cast
-
-import can
+from typing import Any
 
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
-from stairbot.cli_journal import resume, start_journal
+from stairbot.cli_journal import start_journal
 from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.can_link import CanLink
-from stairbot.errors import HardwareError, InputError
+from stairbot.errors import HardwareError
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
-from stairbot.fakes.can_boards import CanBoardServer, InlineBus
-from stairbot.fakes.lockstep import LockstepRobot
-from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
+from stairbot.fakes.fault_rig import (
+    HOST_DEAD_S,
+    SCENARIO,
+    BoardsOnWire,
+    Cell,
+    HostKilled,
+    resume_watched,
+    run_on,
+)
+from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Snapshot
 from stairbot.journal import read_journal
-from stairbot.resume import ResumeRefused
-from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunResult, run
 from stairbot.scenario import parse_scenario
 
-SCENARIO = """
-name = "fault_matrix"
-description = "Two residential steps, then a landing, starting close"
-[stairs]
-count = 2
-rise = 0.17
-tread = 0.28
-top = "landing"
-width = 1.0
-side_wall = "none"
-[start]
-distance = 0.2
-[sensors]
-noise = 0.001
-seed = 3
-"""
-
-TIMEOUT_S = {"can": 0.0005, "serial": 0.005}
-"""The host's reply timeout on each wire: a lost frame costs this much wall
-time.  The CAN boards answer in the host's own thread (InlineBus), at once;
-the serial boards answer from a thread of their own."""
-GRACE_S = 0.5  # the URLs' default grace period
 LATE_S = {"can": 0.005, "serial": 0.03}  # a late frame: ten and six timeouts late
 AFTER_S = 2.0  # world seconds run on after a stopped run, no host
-HOST_DEAD_S = 1.0  # world seconds between the host killed and the new host
 LIFT_HELD_TURNS = 1e-3  # a held lift's give under load is 1e-5 turns
 MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)
 
@@ -133,30 +111,6 @@ FAULTS: dict[str, Fault] = _faults()
 WIRES = ("can", "serial")
 
 
-@dataclass
-class Cell:
-    """One cell's run: ``verdict`` is "completed", "stopped", "resumed" (the
-    host killed, the new host finished), "refused" (the host killed, the new
-    host refused to resume before touching the boards) or "UNSAFE";
-    ``reason`` the run's error, or what made it unsafe."""
-
-    fault: str
-    phase: str
-    wire: str
-    verdict: str
-    reason: str = ""
-    injected: bool = False
-    wall_s: float = 0.0
-
-    @property
-    def safe(self) -> bool:
-        return self.verdict != "UNSAFE"
-
-
-class _HostKilled(BaseException):
-    """Raised in the tick callback: the host dies where it stands."""
-
-
 class _DeadBoard:
     """A board that answers nothing and executes nothing (killed or hung)."""
 
@@ -170,50 +124,6 @@ class _DeadBoard:
         return getattr(self.board, name)
 
 
-class _Boards:
-    """The fake boards on one wire, and sessions of hosts opening them."""
-
-    def __init__(self, wire: str, world: BoardWorld, boards: dict[int, Board],
-                 config: RobotConfig) -> None:
-        self.wire, self.world, self.boards, self.config = wire, world, boards, config
-        self._thread: threading.Thread | None = None
-        if wire == "can":
-            self.channel = f"fault-matrix-{uuid.uuid4().hex[:8]}"
-            self.url = f"can://virtual/{self.channel}?lockstep=1"
-            self.server: CanBoardServer | SerialBoardServer = CanBoardServer(
-                can.Bus(interface="virtual", channel=self.channel), world, dict(boards))
-        else:
-            self.pty = PtyPair()
-            self.url = f"serial://{self.pty.path}?lockstep=1&timeout={TIMEOUT_S['serial']}"
-            self.server = SerialBoardServer(self.pty.master, world, dict(boards))
-            self._thread = threading.Thread(target=self.server.serve, daemon=True)
-            self._thread.start()
-
-    def open(self, allow_latched: bool = False) -> RobotSession:
-        if isinstance(self.server, CanBoardServer):
-            bus = InlineBus(can.Bus(interface="virtual", channel=self.channel), self.server)
-            link = CanLink(cast(can.BusABC, bus), timeout_s=TIMEOUT_S["can"], grace_s=GRACE_S)
-            robot = LockstepRobot(link, self.url, allow_latched=allow_latched)
-            return RobotSession(robot, robot.clock, self.url, robot.simulated)
-        return open_robot(self.url, self.config, RobotOptions(allow_latched=allow_latched))
-
-    def deaf(self, on: bool) -> None:
-        """The boards hear nothing from the host (it is dead), or again."""
-        server: Any = self.server
-        if on:
-            server.receive = lambda *_: None
-        else:
-            vars(server).pop("receive", None)
-
-    def close(self) -> None:
-        if isinstance(self.server, CanBoardServer):
-            self.server.bus.shutdown()
-            return
-        self.server.stop()
-        if self._thread is not None:
-            self._thread.join(5)
-        self.pty.close()
-
 
 def _lifts(world: BoardWorld) -> tuple[float, ...]:
     snap = world.snapshot()
@@ -222,17 +132,8 @@ def _lifts(world: BoardWorld) -> tuple[float, ...]:
     return tuple(snap.motors[m.MOTOR_CHANNELS[ch]].turns for ch in sorted(m.LIFT_CHANNELS))
 
 
-def _run_on(world: BoardWorld, boards: dict[int, Board], seconds: float) -> None:
-    """The world goes on with no host: the boards' watchdogs see time pass."""
-    t_us = round(world.now() * 1e6)
-    for _ in range(round(seconds / 0.01)):
-        t_us += 10_000
-        world.step_to(t_us)
-        for board in boards.values():
-            board.poll()
 
-
-def _after_stop(cell: Cell, result: RunResult, boards: _Boards, journal: Path,
+def _after_stop(cell: Cell, result: RunResult, boards: BoardsOnWire, journal: Path,
                 alive: bool) -> Cell:
     """Check a run that did not complete: see the module docstring."""
     world = boards.world
@@ -243,9 +144,9 @@ def _after_stop(cell: Cell, result: RunResult, boards: _Boards, journal: Path,
         problems.append("stopped with no reason given")
     if alive and any(world.speeds().values()):
         problems.append(f"motors left running: {world.speeds()}")
-    _run_on(world, boards.boards, 0.5)  # every watchdog has tripped by now
+    run_on(world, boards.boards, 0.5)  # every watchdog has tripped by now
     before = _lifts(world)
-    _run_on(world, boards.boards, AFTER_S - 0.5)
+    run_on(world, boards.boards, AFTER_S - 0.5)
     after = _lifts(world)
     if any(world.speeds().values()):
         problems.append(f"motors running {AFTER_S:.0f} s on: {world.speeds()}")
@@ -285,7 +186,7 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
     scenario = parse_scenario(SCENARIO, "<fault matrix>")
     world = make_world(config, scenario, lockstep=True)
     real = make_boards(world)
-    boards = _Boards(wire, world, real, config)
+    boards = BoardsOnWire(wire, world, real, config)
     cell = Cell(fault.name, phase, wire, "UNSAFE")
     try:
         session = boards.open()
@@ -308,11 +209,11 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
                                                     silent_after_s=0.0))
             else:
                 boards.deaf(True)
-                raise _HostKilled
+                raise HostKilled
 
         try:
             result = run(session, config, on_tick=inject, journal=writer)
-        except _HostKilled:
+        except HostKilled:
             result = None
         finally:
             writer.close()
@@ -332,70 +233,14 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
         boards.close()
 
 
-def _resumed(cell: Cell, boards: _Boards, config: RobotConfig, journal: Path) -> Cell:
+def _resumed(cell: Cell, boards: BoardsOnWire, config: RobotConfig, journal: Path) -> Cell:
     """The host was killed: the world runs on, then a new host resumes."""
-    _run_on(boards.world, boards.boards, HOST_DEAD_S)
+    run_on(boards.world, boards.boards, HOST_DEAD_S)
     boards.deaf(False)
     taken = resume_watched(boards, config, journal)
     cell.verdict, cell.reason = taken.verdict, taken.reason
     return cell
 
-
-@dataclass
-class Resumption:
-    """What a new host made of a killed one's journal: ``verdict`` "resumed"
-    (the run completed, never fell), "refused" (one line, ``reason``, before
-    any Clear: the boards still hold their latches) or "UNSAFE" (refused
-    after the latches were cleared, or a resumed run that did not
-    complete); ``cleared``: whether the host sent the boards a Clear."""
-
-    verdict: str
-    reason: str
-    cleared: bool
-    latched: bool
-
-
-def latched(boards: _Boards) -> bool:
-    """Whether a fake board holds a latch (its e-stop or its tripped watchdog)."""
-    return any(b.estop or b.watchdog_tripped for b in boards.boards.values())
-
-
-def resume_watched(boards: _Boards, config: RobotConfig, journal: Path,
-                   url: str | None = None) -> Resumption:
-    """``stairbot run --resume --yes`` on ``boards`` (at ``url``, default
-    theirs) from ``journal``, in this process, watching for the Clear."""
-    session = boards.open(allow_latched=True)
-    cleared = False
-    clear = session.robot.clear
-
-    def watched(*args: Any) -> None:
-        nonlocal cleared
-        cleared = True
-        clear(*args)
-
-    session.robot.clear = watched  # type: ignore[method-assign]
-    try:
-        try:
-            resumed = resume(journal, url or boards.url, session, config, lambda _e: None,
-                             yes=True, out=io.StringIO())
-        except (ResumeRefused, InputError) as exc:
-            held = latched(boards)
-            safe = not cleared and held and "\n" not in str(exc)
-            return Resumption("refused" if safe else "UNSAFE",
-                              str(exc) if safe else f"refused after a Clear, or not in one "
-                              f"line, or the latches gone: {exc}", cleared, held)
-        try:
-            result = run(session, config, controller=resumed.controller,
-                         journal=resumed.journal)
-        finally:
-            resumed.journal.close()
-    finally:
-        with contextlib.suppress(HardwareError):
-            session.close()
-    if result.outcome == "completed" and not result.fell:
-        return Resumption("resumed", "", cleared, latched(boards))
-    return Resumption("UNSAFE", f"the resumed run ended {result.outcome}: {result.error}",
-                      cleared, latched(boards))
 
 
 def cells(wires: tuple[str, ...] = WIRES) -> Iterator[tuple[str, str, str]]:
@@ -404,5 +249,3 @@ def cells(wires: tuple[str, ...] = WIRES) -> Iterator[tuple[str, str, str]]:
         for fault in FAULTS:
             for phase in PHASES:
                 yield fault, phase, wire
-
-

@@ -8,7 +8,7 @@ runs are deterministic in lockstep): :func:`phase_ticks`.  A kill at tick
 ``kill -9`` would: no end, no close); the boards hear nothing more, their
 watchdogs trip and latch, the world runs on for a second, then a new host
 reads the journal and resumes it with the operator's yes
-(:func:`~stairbot.fakes.fault_matrix.resume_watched`).  A kill is safe when
+(:func:`~stairbot.fakes.fault_rig.resume_watched`).  A kill is safe when
 the resumed run completes, or the resume is refused, in one line, before any
 Clear, the boards still latched.
 
@@ -35,15 +35,15 @@ from stairbot.config import RobotConfig, load_config
 from stairbot.errors import HardwareError
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
-from stairbot.fakes.fault_matrix import (
+from stairbot.fakes.fault_rig import (
     HOST_DEAD_S,
     SCENARIO,
+    BoardsOnWire,
     Cell,
-    _Boards,
-    _HostKilled,
-    _run_on,
+    HostKilled,
     latched,
     resume_watched,
+    run_on,
 )
 from stairbot.hardware import Snapshot
 from stairbot.journal import mark_path
@@ -59,7 +59,7 @@ class Killed:
     """A host killed on fake boards: the boards (latched by now), its
     journal, the config it ran, and the tick it died after (0-based)."""
 
-    boards: _Boards
+    boards: BoardsOnWire
     journal: Path
     config: RobotConfig
     tick: int
@@ -87,7 +87,7 @@ def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
     scenario = parse_scenario(SCENARIO, "<host kills>")
     world = make_world(config, scenario, lockstep=True)
     real = make_boards(world)
-    boards = _Boards(wire, world, real, config)
+    boards = BoardsOnWire(wire, world, real, config)
     try:
         journal = journal or default_path(boards.url)
         assert journal is not None
@@ -101,11 +101,11 @@ def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
             ticks += 1
             if ticks > tick:
                 boards.deaf(True)
-                raise _HostKilled
+                raise HostKilled
 
         try:
             run(session, config, on_tick=kill, journal=writer)
-        except _HostKilled:
+        except HostKilled:
             pass
         else:
             raise AssertionError(f"the run ended after {ticks} ticks, before tick {tick}")
@@ -113,7 +113,7 @@ def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
             writer.close()
             with contextlib.suppress(HardwareError):
                 session.close()
-        _run_on(world, real, HOST_DEAD_S)
+        run_on(world, real, HOST_DEAD_S)
         boards.deaf(False)
         yield Killed(boards, journal, config, tick)
     finally:
@@ -144,7 +144,7 @@ def journaled_run(wire: str, scenario: Scenario, journal: Path
     tick's phase, in order."""
     config = load_config()
     world = make_world(config, scenario, lockstep=True)
-    boards = _Boards(wire, world, make_boards(world), config)
+    boards = BoardsOnWire(wire, world, make_boards(world), config)
     phases: list[str] = []
     try:
         session = boards.open()

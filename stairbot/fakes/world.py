@@ -1,13 +1,12 @@
-"""The side view of the simulated robot on its stairs: a pymunk world.
+"""The side view of the simulated robot on its stairs: a pymunk world that
+steps the physics, moves the lifts, and watches for a fall.
 
 x points forward (towards the stairs), y up, gravity -9.81 m/s^2, metres and
 kilograms throughout.  Riser 1 stands at x = 0; the robot starts with its front
-face ``scenario.start.distance`` before it.  The robot is three box segments
-(index 0 = segment 1, the front) with two wheels each; segments 1 and 3 slide
-vertically against segment 2 on lead-screw lifts (a groove keeps them in line,
-a gear joint keeps them parallel, a pin joint whose length moves with the
-commanded speed sets the offset and holds it when stopped).  Segments do not
-collide with each other.
+face ``scenario.start.distance`` before it.  The robot's bodies and joints
+are built by :mod:`stairbot.fakes.robot_bodies`; the world moves each lift's
+pin joint with the commanded speed (it holds the offset when stopped), and
+:mod:`stairbot.fakes.fall_watch` says when the robot has fallen.
 
 Python work per physics step is kept to the lift targets; everything else
 (motor rates, stability checks) happens once per :meth:`World.advance` call,
@@ -28,16 +27,13 @@ try:  # the C functions behind pymunk's Body properties, without the Python wrap
 except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
     _cp = None
 from stairbot.config import RobotConfig
+from stairbot.fakes.fall_watch import FallWatch
+from stairbot.fakes.robot_bodies import CAT_STAIRS, PIN_REACH, build_robot
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
 from stairbot.fakes.world_params import WorldParams
 from stairbot.scenario import Scenario
 
 TWO_PI = 2.0 * math.pi
-_PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's axles
-
-CAT_STAIRS = 0b01
-CAT_ROBOT = 0b10
-ROBOT_GROUP = 1
 
 
 def top_edge(scenario: Scenario) -> tuple[float, float]:
@@ -79,80 +75,17 @@ class World:
         self.lengths = (g.LENGTH_OF_FIRST_MODULE, g.LENGTH_OF_SECOND_MODULE,
                         g.LENGTH_OF_THIRD_MODULE)
         self.height = g.segment_height
-        self.radius = r = g.wheel_radius
-        masses = (config.masses.first_module, config.masses.second_module,
-                  config.masses.third_module)
-        robot_filter = pymunk.ShapeFilter(group=ROBOT_GROUP, categories=CAT_ROBOT,
-                                          mask=CAT_STAIRS)
+        self.radius = g.wheel_radius
         front, base = start_pose(scenario, sum(self.lengths))
-        self.segments: list[pymunk.Body] = []
-        self.boxes: list[pymunk.Poly] = []
-        self.wheels: list[tuple[pymunk.Body, pymunk.Body]] = []  # (rear, front)
-        self.motors: list[tuple[pymunk.SimpleMotor, pymunk.SimpleMotor]] = []
-        self.wheel_x: list[float] = []  # axle x from the segment centre (+ = front)
-        left = front
-        for length, mass in zip(self.lengths, masses, strict=True):
-            body = pymunk.Body()
-            # local frame: origin at the segment's centre on its axle line
-            body.position = (left - length / 2, base + r)
-            half, ch = length / 2, min(p.chamfer, length / 4, self.height / 4)
-            # the chassis' bottom edges are chamfered, as a real one's would be
-            box = pymunk.Poly(body, [(-half + ch, 0.0), (half - ch, 0.0), (half, ch),
-                                     (half, self.height), (-half, self.height), (-half, ch)])
-            box.mass = mass
-            box.friction = p.body_friction
-            box.filter = robot_filter
-            space.add(body, box)
-            ax = length / 2 - g.wheel_inset
-            self.wheel_x.append(ax)
-            pair: list[pymunk.Body] = []
-            mots: list[pymunk.SimpleMotor] = []
-            for sx in (-ax, ax):
-                wheel = pymunk.Body()
-                wheel.position = body.local_to_world((sx, 0.0))
-                circle = pymunk.Circle(wheel, r)
-                circle.mass = 2 * config.masses.wheel  # the left and right wheel
-                circle.friction = p.wheel_friction
-                circle.filter = robot_filter
-                pivot = pymunk.PivotJoint(body, wheel, (sx, 0.0), (0.0, 0.0))
-                pivot.collide_bodies = False
-                # rate = body.w - wheel.w: positive rolls forward (clockwise)
-                motor = pymunk.SimpleMotor(body, wheel, 0.0)
-                motor.max_force = config.motors.wheel_torque
-                space.add(wheel, circle, pivot, motor)
-                pair.append(wheel)
-                mots.append(motor)
-            self.segments.append(body)
-            self.boxes.append(box)
-            self.wheels.append((pair[0], pair[1]))
-            self.motors.append((mots[0], mots[1]))
-            left -= length
-        s1, s2, s3 = self.segments
-        self._lift_x = ((self.lengths[0] + self.lengths[1]) / 2,
-                        -(self.lengths[1] + self.lengths[2]) / 2)
-        travel = config.motors.lift_travel + 0.02
-        self.pins: list[pymunk.PinJoint] = []
-        for end, gx in ((s1, self._lift_x[0]), (s3, self._lift_x[1])):
-            groove = pymunk.GrooveJoint(s2, end, (gx, -travel), (gx, travel), (0.0, 0.0))
-            gear = pymunk.GearJoint(s2, end, 0.0, 1.0)
-            pin = pymunk.PinJoint(s2, end, (gx, -_PIN_REACH), (0.0, 0.0))
-            pin.distance = _PIN_REACH
-            pin.max_force = config.motors.lift_force
-            for c in (groove, gear, pin):
-                c.error_bias = 0.5 ** (1.0 / p.dt)
-                c.collide_bodies = False
-                space.add(c)
-            self.pins.append(pin)
+        bodies = build_robot(space, config, p, self.lengths, front, base)
+        self.segments, self.boxes = bodies.segments, bodies.boxes
+        self.wheels, self.motors = bodies.wheels, bodies.motors
+        self.wheel_x, self.pins = bodies.wheel_x, bodies.pins
         self.lift_target = [0.0, 0.0]  # metres, + = end segment up
         self.lift_speed = [0.0, 0.0]  # metres per second (already clamped)
         self._wheel_zero = [w1.angle - b.angle
                             for b, (_w0, w1) in zip(self.segments, self.wheels, strict=True)]
         self.all_wheels = [w for pair in self.wheels for w in pair]
-        self.max_pitch_deg = 0.0
-        self.fell = False
-        self.fall_reason: str | None = None
-        self._airborne_s = 0.0
-        self._since_contact_check = 0.0
         self._rates = [0.0, 0.0, 0.0]
         self._bias = [-1.0, -1.0]
         self._moving = [False, False]
@@ -171,7 +104,7 @@ class World:
         self._set_rate = [[_setter(m, "rate", "cpSimpleMotorSetRate") for m in pair]
                           for pair in self.motors]
         self._fetch()
-        self._check_y, self._check_t = list(self._py), 0.0
+        self.falls = FallWatch(p, self.all_wheels, self._py)
         self.start_x = self._px[1]
 
     # -- the stairs, and a change of frame ---------------------------------------------
@@ -365,73 +298,37 @@ class World:
                 t = min(max(self.lift_target[i], actual - stall), actual + stall) + v * seconds
                 t = stroke if t > stroke else (-stroke if t < -stroke else t)
                 self.lift_target[i] = t
-                self._set_distance[i](_PIN_REACH + t)
+                self._set_distance[i](PIN_REACH + t)
             elif moving[i]:
                 # just stopped: the screw stands where the nut is now, no coasting on
                 t = self.lift_offset(i)
                 self.lift_target[i] = t
-                self._set_distance[i](_PIN_REACH + t)
+                self._set_distance[i](PIN_REACH + t)
             moving[i] = v != 0.0
             bias = abs(v) if v != 0.0 else self.params.lift_hold_speed
             if bias != self._bias[i]:
                 self._bias[i] = bias
                 self.pins[i].max_bias = bias
 
-    # -- instability ----------------------------------------------------------------
-    def _wheel_in_contact(self) -> bool:
-        found = False
+    # -- falls ----------------------------------------------------------------------
+    @property
+    def fell(self) -> bool:
+        """The robot has fallen (:class:`~stairbot.fakes.fall_watch.FallWatch`)."""
+        return self.falls.fell
 
-        def seen(_arb: pymunk.Arbiter) -> None:
-            nonlocal found
-            found = True
+    @property
+    def fall_reason(self) -> str | None:
+        return self.falls.reason
 
-        for w in self.all_wheels:
-            w.each_arbiter(seen)
-            if found:
-                return True
-        return False
+    @property
+    def max_pitch_deg(self) -> float:
+        """The largest pitch of any segment so far, degrees."""
+        return self.falls.max_pitch_deg
 
     def _check(self) -> None:
-        """Track the pitch; detect a pitch beyond the limit, a segment falling (by
-        its height change since the last check) and every wheel off every support."""
-        if self.fell:
-            return
-        p = self.params
-        self._fetch()
-        py, pa = self._py, self._pa
-        prev_y, self._check_y = self._check_y, py[:]
-        elapsed = max(self.time - self._check_t, 1e-9)
-        self._check_t = self.time
-        for i in (0, 1, 2):
-            pitch = abs(math.degrees(pa[i]))
-            if pitch > self.max_pitch_deg:
-                self.max_pitch_deg = pitch
-            if pitch > p.pitch_limit_deg:
-                self._fall(f"segment {i + 1} pitched {pitch:.0f} deg (limit "
-                           f"{p.pitch_limit_deg:.0f})")
-                return
-            vy = (py[i] - prev_y[i]) / elapsed
-            if vy < -p.fall_speed:
-                self._fall(f"segment {i + 1} falling at {-vy:.1f} m/s")
-                return
-            if py[i] < -0.1:
-                self._fall(f"segment {i + 1} below the floor")
-                return
-        # contacts are looked up a few times a second: enough for a 0.3 s limit
-        self._since_contact_check += elapsed
-        if self._since_contact_check < p.contact_check_s - 1e-9:
-            return
-        if self._wheel_in_contact():
-            self._airborne_s = 0.0
-        else:
-            self._airborne_s += self._since_contact_check
-            if self._airborne_s > p.airborne_limit_s:
-                self._fall(f"no wheel on any support for {self._airborne_s:.2f} s")
-        self._since_contact_check = 0.0
-
-    def _fall(self, reason: str) -> None:
-        self.fell = True
-        self.fall_reason = reason
+        if not self.falls.fell:
+            self._fetch()
+            self.falls.check(self.time, self._py, self._pa)
 
     # -- queries --------------------------------------------------------------------
     def ray(self, start: tuple[float, float], end: tuple[float, float]

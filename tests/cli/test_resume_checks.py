@@ -17,7 +17,7 @@ import pytest
 
 from stairbot.cli import main
 from stairbot.drivers.board_robot import BoardRobot
-from stairbot.fakes.fault_matrix import SCENARIO, resume_watched
+from stairbot.fakes.fault_rig import SCENARIO, resume_watched
 from stairbot.fakes.host_kills import Killed, killed_host
 from stairbot.hardware import Imu
 from stairbot.journal import line_hash, mark_path, read_journal

@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from stairbot.config import load_config
-from stairbot.console.runner_thread import ConsoleEngine, describe_result
+from stairbot.console.engine import ConsoleEngine, describe_result
 from stairbot.console.state import LiveState
 from stairbot.errors import InputError
 from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
@@ -247,10 +247,10 @@ class LosesTheLink:
 
 
 def test_a_lost_link_leaves_the_robot_in_fault_not_ended() -> None:
-    from stairbot.console.runner_thread import _default_open
+    from stairbot.console.robot_holder import default_open
 
     def open_fn(*args: Any) -> Any:
-        session = _default_open(*args)
+        session = default_open(*args)
         return replace(session, robot=LosesTheLink(session.robot))
 
     engine = ConsoleEngine(LiveState(), load_config(), open_fn=open_fn)

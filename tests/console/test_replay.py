@@ -28,7 +28,8 @@ from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, 
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.pose import DeadReckonedPose
-from stairbot.recording.replay_source import PART_GAP_S, load_replay
+from stairbot.recording.replay_load import load_replay
+from stairbot.recording.replay_source import PART_GAP_S
 from stairbot.scenario import load_scenario
 
 

@@ -15,7 +15,7 @@ from mcap.reader import make_reader
 
 from stairbot.cli import main
 from stairbot.config import load_config
-from stairbot.console.runner_thread import ConsoleEngine
+from stairbot.console.engine import ConsoleEngine
 from stairbot.console.state import LiveState
 from stairbot.recording import topics
 from stairbot.recording.read import read_recording

@@ -31,7 +31,7 @@ from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.read import read_recording
 from stairbot.recording.record import JsonLinesRecord
-from stairbot.recording.replay_source import load_replay
+from stairbot.recording.replay_load import load_replay
 
 SIDE_CONFIG: RobotConfig = parse_config(
     'extends = "reference"\n[sensors]\nside_model = "vl53l0x"\n', "side.toml")

@@ -12,9 +12,10 @@ import pytest
 from stairbot.cli import main
 from stairbot.config import load_config
 from stairbot.scenario import parse_scenario
-from stairbot.sweep.cases import build_case, check_spec, first_sight, zone
+from stairbot.sweep.cases import build_case, check_spec
 from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec
+from stairbot.sweep.zones import first_sight, zone
 
 GOOD = """
 [sweep]

@@ -1,5 +1,6 @@
-"""The console's side of a run: the robot opened by URL, the run loop on a
-worker thread, and the operator's controls reaching it safely.
+"""The console's run: the program on a worker thread, on the robot the
+console holds (:class:`~stairbot.console.robot_holder.RobotHolder`), and
+the operator's controls reaching it safely.
 
 The run thread owns the robot; the UI thread only ever calls
 :meth:`ConsoleEngine.estop`, :meth:`pause` and friends, which set flags (and,
@@ -11,47 +12,33 @@ the robot at once).
 from __future__ import annotations
 
 import contextlib
-import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, TypedDict
+from dataclasses import dataclass
+from typing import TypedDict
 
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume, start_journal
 from stairbot.config import RobotConfig
-from stairbot.console.climb_gate import MidClimb, after_run, from_journal
-from stairbot.console.freshness import POLL_PERIOD_S
+from stairbot.console.climb_gate import MidClimb, after_run
+from stairbot.console.robot_holder import LATCH_HINT, OpenFn, RobotHolder, default_open
 from stairbot.console.state import LiveState
-from stairbot.console.watch import PacedClock, WatchedRobot, watch
-from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
+from stairbot.errors import StairbotError
 from stairbot.events import Event, EventKind, EventSink
-from stairbot.hardware import HasScene, HasTruth, ReportsEvents, Snapshot
+from stairbot.hardware import Snapshot
 from stairbot.journal import JournalWriter
-from stairbot.paths import unused_path
-from stairbot.recording.record import JsonLinesRecord, RecordsTicks, is_mcap
+from stairbot.recording.record import RecordsTicks
 from stairbot.resume import ResumeRefused
-from stairbot.robots import RobotOptions, RobotSession
+from stairbot.robots import RobotSession
 from stairbot.runner import RunControl, RunResult
-from stairbot.scenario import Scenario, load_scenario
-from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
-from stairbot.top_view import TopPlan, TopPose, plan_of, top_pose
 
-if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
-    from stairbot.recording.mcap_sink import McapRecord
-
-LATCH_HINT = "EMERGENCY STOP latched — c clears it (after you look at the robot)"
 MID_CLIMB_HINT = ("the robot may stand part way up the stairs: a new run would drive it at "
                   "the riser; s offers resume (boards) or your word it is back at the start")
-
-SPEEDS: dict[str, float | None] = {"1x": 1.0, "10x": 10.0, "max": None}
-"""Simulation speeds the operator can pick: sim seconds per wall second."""
 
 PHASE_PERIOD_S = 0.2  # wall seconds between copies of the controller's context
 
 OnTick = Callable[[Controller, Snapshot], None]
-OpenFn = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
 
 
 @dataclass(frozen=True)
@@ -81,13 +68,6 @@ class EngineHooks(TypedDict, total=False):
     sleep: Callable[[float], None]
 
 
-def _default_open(url: str, config: RobotConfig, scenario: Scenario,
-                  options: RobotOptions) -> RobotSession:
-    from stairbot.robots import open_robot
-
-    return open_robot(url, config, replace(options, world=scenario))
-
-
 def _default_run(session: RobotSession, config: RobotConfig, sink: EventSink,
                  mode: str, control: RunControl, on_tick: OnTick, plan: RunPlan) -> RunResult:
     from stairbot.runner import run
@@ -112,194 +92,23 @@ def describe_result(result: RunResult) -> tuple[str, str]:
     return " · ".join(parts), severity
 
 
-class ConsoleEngine:
-    """Opens robots, runs the program on the calling (worker) thread, and takes
-    the operator's controls from the UI thread."""
+class ConsoleEngine(RobotHolder):
+    """Runs the program on the calling (worker) thread, on the robot the
+    console holds, and takes the operator's controls from the UI thread."""
 
     def __init__(self, state: LiveState, config: RobotConfig, *,
-                 open_fn: OpenFn = _default_open,
+                 open_fn: OpenFn = default_open,
                  run_fn: RunFn = _default_run,
                  control_fn: Callable[[], RunControl] = RunControl,
                  wall: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
-        self.state = state
-        self.config = config
-        self._open_fn, self._run_fn, self._control_fn = open_fn, run_fn, control_fn
-        self._wall, self._sleep = wall, sleep
-        self._lock = threading.RLock()
-        self.session: RobotSession | None = None
-        self.robot: WatchedRobot | None = None
-        self.clock: PacedClock | None = None
-        self.scenario: Scenario | None = None
+        super().__init__(state, config, open_fn=open_fn, wall=wall, sleep=sleep)
+        self._run_fn, self._control_fn = run_fn, control_fn
         self.control: RunControl | None = None
-        self.recorder: JsonLinesRecord | McapRecord | None = None
-        self._running = threading.Event()
-        self._speed = "max"
         self._last_phase: object = None
         self._controller: Controller | None = None  # the run's, as the last tick saw it
         self._last_ctx = -1.0
-        self._poller: threading.Thread | None = None
-        self._closing = threading.Event()
-        self._poll_fault: str | None = None  # why the last idle read failed
-        self._opening = False
-        self.mid_climb: MidClimb | None = None
-        """The robot may stand part way up (stairbot.console.climb_gate): no
-        fresh start until the operator resumes or says it is back at the start."""
         self._last_flow, self._last_label = "", ""  # the run's last phase before its end
-        self.latched_boards: tuple[str, str | None, str] | None = None
-        """(url, scenario, why) of boards refused for the latch they hold."""
-
-    # -- robot -----------------------------------------------------------------
-    @property
-    def robot_lock(self) -> threading.RLock:
-        """Held around every call to the robot and the clock (take it to look at
-        the simulation from another thread)."""
-        return self._lock
-
-    @property
-    def running(self) -> bool:
-        return self._running.is_set()
-
-    @property
-    def in_process(self) -> bool:
-        """The simulation runs here (sim://): the console draws it and sets its speed."""
-        return self.session is not None and self.session.sim is not None
-
-    @property
-    def latched(self) -> bool:
-        """The console's emergency stop latch: set by the operator or by a run
-        that ended on an error; it outlives the robot (a reset, another URL)
-        and only :meth:`clear_estop` clears it."""
-        return self.state.view().status.estopped
-
-    def open(self, url: str, scenario_path: str | None, *, clear_latches: bool = False) -> None:
-        """Open the robot at ``url`` on the scenario (None: the default stairs),
-        closing the previous one.  Opening never clears a latch: the
-        console's own carries over to the new robot (its ``estop()`` is
-        called at once), and boards that hold one are refused (LatchedError,
-        naming ``c`` and ``stairbot clear``; :attr:`latched_boards` remembers
-        them) -- unless ``clear_latches``: the operator pressed ``c`` and
-        confirmed, and the boards' latches and the console's are cleared.
-        Raises InputError (bad URL or scenario) or StairbotError (the robot
-        cannot be opened); the old robot stays closed."""
-        if self.running:
-            raise InputError(url, None, "a run is going on; stop it first")
-        scenario = load_scenario(scenario_path)
-        self._opening = True
-        try:
-            self._open(url, scenario, scenario_path, clear_latches)
-        finally:
-            self._opening = False
-
-    def _open(self, url: str, scenario: Scenario, scenario_path: str | None,
-              clear_latches: bool) -> None:
-        self.close()
-        self._poll_fault = None
-        self.state.set_status(robot="connecting", message=f"opening {url}", severity="info")
-        try:
-            session = self._open_fn(url, self.config, scenario,
-                                    RobotOptions(allow_latched=clear_latches))
-        except LatchedError as exc:
-            message = f"{exc}; or press c here once you have looked at the robot"
-            self.latched_boards = (url, scenario_path, message)
-            raise LatchedError(message) from None
-        self.latched_boards = None
-        if clear_latches:
-            try:
-                session.robot.clear()  # the boards' latches, as `stairbot clear` does
-            except BaseException:
-                with contextlib.suppress(Exception):
-                    session.close()
-                raise
-            self.state.set_status(estopped=False, latch="")
-            self._sink(Event(self._now(), EventKind.INFO,
-                             "latches cleared by the operator (confirmed)"))
-        self.session, self.scenario = session, scenario
-        sim = session.sim
-        scene_fn: Callable[[], SceneView] | None = None
-        if isinstance(sim, HasScene):
-            def scene_fn() -> SceneView:
-                return scene_view(sim.scene())
-        # the top view: a simulation that tells its truth tells its pose seen from above
-        top_fn: Callable[[], TopPose | None] | None = None
-        plan: TopPlan | None = None
-        if isinstance(sim, HasTruth):
-            truthful = sim  # bound for the closure, narrowed
-
-            def top_fn() -> TopPose | None:
-                return top_pose(truthful.truth())
-            plan = plan_of(scenario)
-        if isinstance(session.robot, ReportsEvents):  # LINK events: the log and the record
-            session.robot.attach_sink(self._sink)
-        self.robot = watch(session.robot, self.state, self._lock, scene_fn, self._wall, top_fn)
-        if self.latched:  # the latch outlives the robot it was pressed on
-            self.robot.estop()
-        self.clock = PacedClock(session.clock, self._lock, self._wall, self._sleep)
-        self.clock.set_scale(SPEEDS[self._speed] if sim is not None else None)
-        stairs = stairs_from_scenario(scenario, self.config.LENGTH_OF_A_ROBOT)
-        self.state.set_robot(url, scenario.name, session.simulated, stairs, wired=sim is None,
-                             plan=plan)
-        self._recording_safely(self._watch_recording)
-        try:
-            self.robot.read()  # first readings and picture, before any motion
-        except StairbotError as exc:
-            self.state.set_status(robot="fault", message=f"cannot read the robot: {exc}",
-                                  severity="error")
-            return
-        self.robot.refresh_scene()
-        # boards: their journal says whether an earlier host left them mid-climb
-        self.mid_climb = None if sim is not None else from_journal(
-            default_path(url), self.robot.identity())
-        latched = self.latched
-        self.state.set_status(robot="ready", paused=False,
-                              message=LATCH_HINT if latched else "",
-                              severity="error" if latched else "info")
-
-    # -- idle polling --------------------------------------------------------------
-    def start_polling(self, period_s: float = POLL_PERIOD_S) -> None:
-        """Read the robot every ``period_s`` while no run goes on (a daemon
-        thread, until :meth:`shutdown`): its sensors and link stay live on
-        the screen, and a link that dies while idle shows as a FAULT."""
-        if self._poller is not None:
-            return
-        self._poller = threading.Thread(target=self._poll_loop, args=(period_s,),
-                                        name="console idle poll", daemon=True)
-        self._poller.start()
-
-    def _poll_loop(self, period_s: float) -> None:
-        while not self._closing.wait(period_s):
-            self.poll()
-
-    def poll(self) -> None:
-        """One idle read (nothing while a run goes on: the run reads every
-        tick).  A read that fails makes the state FAULT with the driver's
-        reason, once; one that works again after that makes it READY."""
-        robot = self.robot
-        if robot is None or self.running or self._opening:
-            return
-        try:
-            robot.read()
-        except Exception as exc:  # noqa: BLE001 - a failing read is news, not a crash
-            if self.running or robot is not self.robot:
-                return  # a run or another robot took over meanwhile
-            why = f"no reading from {self.state.view().url}: {exc}"
-            if why != self._poll_fault:
-                self._poll_fault = why
-                self.state.set_status(robot="fault", severity="error", message=why)
-                self.state.note(why, "error")
-            return
-        if self._poll_fault is not None and robot is self.robot and not self.running:
-            self._poll_fault = None
-            self.state.set_status(robot="ready", severity="warning",
-                                  message="the robot answers again")
-            self.state.note("the robot answers again", "warning")
-
-    def close(self) -> None:
-        """Stop and release the robot (never raises)."""
-        if self.robot is not None:
-            with contextlib.suppress(Exception):  # closing must not fail the console
-                self.robot.close()
-        self.session = self.robot = self.clock = None
 
     # -- the run (worker thread) -----------------------------------------------
     def run(self, mode: str = "full", resume: ResumePlan | None = None) -> RunResult | None:
@@ -402,42 +211,12 @@ class ConsoleEngine:
         self.mid_climb = None
         self.state.note("the operator says the robot is back at the start", "warning")
 
-    def _sink(self, event: Event) -> None:
-        """The run's events (and the engine's own): the live state, the record.
-        A record the disk refuses raises OutputError, which ends a run as it
-        does ``stairbot run``'s."""
-        self.state.on_event(event)
-        if self.recorder is not None:
-            self.recorder.write(event)
-
-    def _say(self, event: Event) -> None:
-        """An event from the UI thread: a refused record write stops the
-        recording (and says so) rather than reach the key that pressed it."""
-        self._recording_safely(lambda: self._sink(event))
-
-    def _recording_safely(self, write: Callable[[], None]) -> None:
-        try:
-            write()
-        except (OutputError, OSError) as exc:
-            self.state.set_status(severity="error", message=f"recording stopped: {exc}")
-            self.stop_recording()
-
     def _on_tick(self, ctl: Controller, snap: Snapshot) -> None:
         self._controller = ctl
         self._watch_phase(ctl)
         recorder = self.recorder
         if isinstance(recorder, RecordsTicks) and self.robot is not None:
             recorder.tick(snap, self.robot.sent)
-
-    def _watch_recording(self) -> None:
-        """Tell an MCAP record which robot its ticks come from (and where it
-        stands: the simulation's pose, or a dead-reckoned one)."""
-        recorder, session, scenario = self.recorder, self.session, self.scenario
-        if isinstance(recorder, RecordsTicks) and session is not None and scenario is not None:
-            from stairbot.recording.pose import pose_source
-
-            recorder.watch(pose_source(session.sim, self.config, scenario), scenario,
-                           session.url)
 
     def _watch_phase(self, ctl: Controller, final: bool = False) -> None:
         try:
@@ -524,51 +303,6 @@ class ConsoleEngine:
         if self.control is not None and self.running:
             self.control.request_stop(reason)
 
-    def set_speed(self, speed: str) -> None:
-        self._speed = speed
-        if self.clock is not None and self.in_process:
-            self.clock.set_scale(SPEEDS[speed])
-        self.state.set_speed(speed)
-
-    def start_recording(self, path: str) -> str:
-        """Record from now on to ``path``, or, when a file is there already,
-        beside it under a name not taken (``name-1.jsonl``: a recording is
-        never overwritten); returns the path written to.  A name ending .mcap
-        records every tick and event as MCAP (as ``stairbot run --record
-        FILE.mcap``), any other the events as JSON lines.  Raises InputError
-        (the file cannot be opened, or an MCAP file's start cannot be
-        written)."""
-        self.stop_recording()
-        try:
-            chosen = unused_path(path)
-        except FileExistsError as exc:
-            raise InputError(path, None, f"cannot write the record: {exc}") from None
-        if is_mcap(chosen):
-            from stairbot.recording.mcap_sink import McapRecord
-
-            try:
-                self.recorder = McapRecord(chosen, self.config)
-                self._watch_recording()
-            except OutputError as exc:
-                self.stop_recording()
-                raise InputError(exc.path, None, f"cannot write {exc.what}: "
-                                 f"{exc.problem}") from None
-        else:
-            self.recorder = JsonLinesRecord(chosen)  # whole lines; a full disk: OutputError
-        self.state.set_recording(chosen)
-        return chosen
-
-    def stop_recording(self) -> None:
-        """Stop recording (an MCAP file is finished: its summary written).
-        Never raises: a file the disk refused to finish keeps what it had."""
-        recorder, self.recorder = self.recorder, None
-        if recorder is not None:
-            try:
-                recorder.close()
-            except (OutputError, OSError) as exc:
-                self.state.set_status(severity="error", message=f"recording stopped: {exc}")
-        self.state.set_recording(None)
-
     def shutdown(self, wait_s: float = 2.0) -> None:
         """Stop any run, wait a little for it to end, stop recording, release the
         robot.  A console that closes mid-run (a browser tab closed, a hang-up:
@@ -586,6 +320,3 @@ class ConsoleEngine:
         self.stop_recording()
         self.close()
 
-    def _now(self) -> float:
-        snap = self.state.view().snapshot
-        return snap.time_s if snap is not None else 0.0
