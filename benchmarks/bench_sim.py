@@ -29,11 +29,11 @@ import statistics
 import time
 from typing import Any
 
-from stairbot.config import RobotConfig, load_config
 from stairbot.hardware import MotorId
+from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, load_scenario
 
 
 def full_run(config: RobotConfig, scenario: Scenario) -> tuple[RunResult, float]:

@@ -18,11 +18,11 @@ import argparse
 from dataclasses import dataclass
 
 from stairbot.algorithm.controller import Controller
-from stairbot.config import load_config
 from stairbot.hardware import Snapshot
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario, shipped_scenarios
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import run
-from stairbot.scenario import load_scenario, shipped_scenarios
 
 
 @dataclass

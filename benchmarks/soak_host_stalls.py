@@ -27,9 +27,9 @@ import collections
 import random
 import sys
 
-from stairbot.config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Clock
+from stairbot.inputs.config import load_config
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import run
 

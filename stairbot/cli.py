@@ -38,7 +38,6 @@ from stairbot.cli_show import (
     cmd_scenario_check,
     cmd_scenario_list,
 )
-from stairbot.config import RobotConfig, load_config
 from stairbot.errors import (
     HardwareError,
     InputError,
@@ -48,14 +47,15 @@ from stairbot.errors import (
     ReadFault,
 )
 from stairbot.events import Event, EventKind
-from stairbot.paths import unused_path
-from stairbot.recording.record import EventRecord, RecordsTicks, open_record
-from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
-from stairbot.scenario import (
+from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.scenario import (
     Scenario,
     expectation_mismatches,
     load_scenario,
 )
+from stairbot.paths import unused_path
+from stairbot.recording.record import EventRecord, RecordsTicks, open_record
+from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 from stairbot.text import printable
 
 EXIT_MISMATCH, EXIT_INTERRUPTED = 1, 130

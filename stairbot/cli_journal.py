@@ -28,9 +28,9 @@ from stairbot.algorithm.context import Context
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
 from stairbot.cli_show import ask
-from stairbot.config import RobotConfig
 from stairbot.events import EventSink
 from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
+from stairbot.inputs.config import RobotConfig
 from stairbot.journal import (
     MAX_LINE,
     JournalError,

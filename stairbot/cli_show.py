@@ -8,9 +8,9 @@ import argparse
 import json
 import sys
 
-from stairbot.config import load_config
 from stairbot.errors import InputError
-from stairbot.scenario import Scenario, load_scenario, shipped_scenarios
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import Scenario, load_scenario, shipped_scenarios
 from stairbot.text import printable
 
 PROG = "stairbot"

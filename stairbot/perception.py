@@ -21,7 +21,7 @@ tick repeats its last value, and the board says how old it is
 
 Decisions that compare two sensors ("equal", the standing rule) use
 tolerances derived from the sensors' stated noise at the distance measured
-(:mod:`stairbot.sensor_specs`, ``[sensors]`` in the robot config), not from a
+(:mod:`stairbot.inputs.sensor_specs`, ``[sensors]`` in the robot config), not from a
 guess.  Pure Python, on the controller's clock (the snapshots' times),
 deterministic.
 """
@@ -33,7 +33,6 @@ from collections import deque
 from collections.abc import Iterable
 from enum import IntEnum
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
@@ -44,7 +43,8 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.sensor_specs import SensorSpec
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.sensor_specs import SensorSpec
 
 WINDOW = 5
 """Measurements a sensor's median spans, whatever its period.  Five, not

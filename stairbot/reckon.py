@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import WHEEL_MOTORS, MotorId, Snapshot
+from stairbot.inputs.config import RobotConfig
 from stairbot.side_view import Point, SceneView
 
 

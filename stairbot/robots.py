@@ -20,10 +20,10 @@ from importlib import import_module
 from importlib.metadata import entry_points
 from urllib.parse import urlsplit
 
-from stairbot.config import RobotConfig
 from stairbot.errors import RobotUrlError
 from stairbot.hardware import Clock, HasScene, Robot
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 
 TIME_SCALE_MIN, TIME_SCALE_MAX = 0.01, 1000.0
 """The pace a simulated robot may run at, simulated seconds per wall second

@@ -19,7 +19,6 @@ from typing import Any, Literal
 
 from stairbot.algorithm.controller import Controller, phase_timeout_s
 from stairbot.algorithm.phases import Mode
-from stairbot.config import RobotConfig
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
@@ -31,6 +30,7 @@ from stairbot.hardware import (
     Speeds,
     Truth,
 )
+from stairbot.inputs.config import RobotConfig
 from stairbot.journal import JournalWriter
 from stairbot.robots import RobotSession
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from stairbot.hardware import Point, Scene
-from stairbot.scenario import Scenario
+from stairbot.inputs.scenario import Scenario
 
 
 @dataclass(frozen=True)

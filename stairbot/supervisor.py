@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import LIFT_MOTORS, MotorId, Snapshot, Speeds
+from stairbot.inputs.config import RobotConfig
 from stairbot.tilt import TiltWatch
 
 STALL_S = 1.0

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import math
 
-from stairbot.config import Safety
 from stairbot.hardware import Imu, Snapshot
+from stairbot.inputs.config import Safety
 
 STOPPED = "every motor stopped, lifts holding"
 _INF = math.inf

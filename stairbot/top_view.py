@@ -21,9 +21,9 @@ import math
 import re
 from dataclasses import dataclass
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import Point, Truth
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 
 # The simulation's constants (fakes/stairs.py, fakes/landing.py), held equal by a test.
 FLOOR_BEHIND = 30.0

@@ -4,11 +4,11 @@
 from __future__ import annotations
 
 from stairbot.algorithm.phases import Mode
-from stairbot.config import RobotConfig
 from stairbot.events import Event, discard
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario
 
 
 def run_sim(config: RobotConfig, scenario: Scenario,

@@ -12,10 +12,10 @@ from pathlib import Path
 import pytest
 from simrun import run_sim
 
-from stairbot.config import load_config
 from stairbot.events import Event
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario, parse_scenario
 from stairbot.runner import RunResult
-from stairbot.scenario import load_scenario, parse_scenario
 from stairbot.sweep.spec import SpecError, load_spec, with_config
 
 REFERENCE = load_config("reference")
@@ -55,7 +55,7 @@ def test_a_rise_too_low_for_its_cone_is_refused_and_it_comes_home() -> None:
 
 
 def test_a_sweep_runs_on_another_robot_by_name() -> None:
-    spec = load_spec(Path(__file__).parents[1] / "stairbot" / "sweeps" / "quick.toml")
+    spec = load_spec(Path(__file__).parents[1] / "stairbot" / "inputs" / "sweeps" / "quick.toml")
     ideal = with_config(spec, "ideal")
     assert ideal.hash != spec.hash
     assert ideal.config_text is not None and 'front_model = "ideal"' in ideal.config_text

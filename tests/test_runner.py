@@ -9,9 +9,9 @@ import threading
 from collections.abc import Callable
 
 from stairbot.algorithm.controller import Controller
-from stairbot.config import load_config
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import Robot, Snapshot, Speeds
+from stairbot.inputs.config import load_config
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunControl, run
 

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 from simrun import run_sim
 
-from stairbot.config import load_config, shipped_configs
 from stairbot.events import Event
-from stairbot.scenario import expectation_mismatches, load_scenario, parse_scenario
+from stairbot.inputs.config import load_config, shipped_configs
+from stairbot.inputs.scenario import expectation_mismatches, load_scenario, parse_scenario
 
 
 def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:

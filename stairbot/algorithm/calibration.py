@@ -28,8 +28,8 @@ from stairbot.algorithm.phase import (
 )
 from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
+from stairbot.inputs.config import RobotConfig
 from stairbot.perception import settle_s, still_samples, still_tolerance
 
 P = Phase

@@ -28,7 +28,6 @@ from stairbot.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.algorithm.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
     BACK_SENSORS,
@@ -40,6 +39,7 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
 )
+from stairbot.inputs.config import RobotConfig
 from stairbot.perception import Perception
 from stairbot.supervisor import Supervisor
 

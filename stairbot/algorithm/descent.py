@@ -44,8 +44,8 @@ from stairbot.algorithm.phase import (
 )
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import BACK_SENSORS, MotorId, SensorStatus
+from stairbot.inputs.config import RobotConfig
 
 P = Phase
 FLOW = "descent"

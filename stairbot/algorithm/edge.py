@@ -18,8 +18,8 @@ import math
 from stairbot.algorithm import motion
 from stairbot.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorStatus
+from stairbot.inputs.config import RobotConfig
 from stairbot.perception import measurement_period, median_sigma, window
 
 FLOOR_SIGMAS = 2.0

@@ -40,8 +40,8 @@ from stairbot.algorithm.moves import lift, reading_drive, stood
 from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
+from stairbot.inputs.config import RobotConfig
 from stairbot.perception import side_settle_s
 
 P = Phase

@@ -8,7 +8,6 @@ millimetre (wheels) or a few hundredths of a turn (lifts) of its target.
 
 from __future__ import annotations
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
@@ -20,6 +19,7 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
 )
+from stairbot.inputs.config import RobotConfig
 
 SLOW_FLOOR = 0.15
 """Slowest approach speed, as a fraction of the motor's maximum."""

@@ -16,8 +16,8 @@ from collections.abc import Callable
 from stairbot.algorithm import motion
 from stairbot.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
+from stairbot.inputs.config import RobotConfig
 from stairbot.perception import median_sigma
 
 Enter = Callable[[Tick, Work], None]

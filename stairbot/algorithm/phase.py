@@ -23,8 +23,8 @@ from types import MappingProxyType
 from stairbot.algorithm.context import Context
 from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import Snapshot, Speeds
+from stairbot.inputs.config import RobotConfig
 
 FAULT = "sensor error, motor fault or phase timeout"
 FRONT_DISAGREE = "SFR ≠ SFL for 3 ticks"

@@ -31,8 +31,8 @@ from itertools import combinations
 
 from stairbot.algorithm.phase import PhaseDef, Step, Tick, fail
 from stairbot.algorithm.work import Work
-from stairbot.config import RobotConfig
 from stairbot.hardware import MotorId
+from stairbot.inputs.config import RobotConfig
 
 UNSTABLE = "unstable lift"
 """How the reason of a refused lift begins (as "sensor error", "motor fault")."""

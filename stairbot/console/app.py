@@ -30,7 +30,6 @@ from textual.widget import Widget
 from textual.widgets import Footer
 
 from stairbot.cli_journal import ResumePlan
-from stairbot.config import RobotConfig, load_config
 from stairbot.console import motion_gate
 from stairbot.console.freshness import age_key, age_words, is_stale
 from stairbot.console.help import HelpScreen
@@ -54,6 +53,7 @@ from stairbot.console.widgets.trends import TrendsPanel
 from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
+from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.reckon import dead_reckon
 from stairbot.top_view import RobotShape
 

@@ -25,13 +25,13 @@ from textual.screen import Screen
 from textual.widget import Widget
 from textual.widgets import Static
 
-from stairbot.config import RobotConfig, load_config
 from stairbot.console.app import REFRESH_HZ, StairbotConsole
 from stairbot.console.help import HelpScreen
 from stairbot.console.replay import ReplayPlayer, speed_name
 from stairbot.console.runner_thread import ConsoleEngine
 from stairbot.console.state import StateView
 from stairbot.console.widgets.estop import ESTOP_KEY
+from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.recording.replay_source import ReplaySource
 
 NO_ROBOT = "replay: no robot"

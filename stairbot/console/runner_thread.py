@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, TypedDict
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume, start_journal
-from stairbot.config import RobotConfig
 from stairbot.console.climb_gate import MidClimb, after_run, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.state import LiveState
@@ -28,13 +27,14 @@ from stairbot.console.watch import PacedClock, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, HasTruth, ReportsEvents, Snapshot
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.journal import JournalWriter
 from stairbot.paths import unused_path
 from stairbot.recording.record import JsonLinesRecord, RecordsTicks, is_mcap
 from stairbot.resume import ResumeRefused
 from stairbot.robots import RobotOptions, RobotSession
 from stairbot.runner import RunControl, RunResult
-from stairbot.scenario import Scenario, load_scenario
 from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
 from stairbot.top_view import TopPlan, TopPose, plan_of, top_pose
 

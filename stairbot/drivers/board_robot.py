@@ -29,7 +29,6 @@ from collections.abc import Callable, Sequence
 from typing import Any, Concatenate, Final, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
-from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
@@ -40,6 +39,7 @@ from stairbot.drivers.telemetry import K, T, V
 from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import Clock, Imu, SensorId, SensorReading, Snapshot, Speeds
+from stairbot.inputs.config import RobotConfig
 from stairbot.robots import RobotSession
 
 # The emergency stop (docs/protocol.md, "Emergency stop"): each press puts

@@ -83,7 +83,6 @@ from urllib.parse import unquote
 import can
 import can.util
 
-from stairbot.config import RobotConfig
 from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import CanFrameLog, check_can_log
@@ -92,6 +91,7 @@ from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
+from stairbot.inputs.config import RobotConfig
 from stairbot.robots import RobotOptions, RobotSession
 
 OPTION_DEFAULTS: dict[str, float] = {

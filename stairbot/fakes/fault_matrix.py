@@ -49,7 +49,6 @@ import can
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import resume, start_journal
-from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import HardwareError, InputError
@@ -60,11 +59,12 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import Snapshot
+from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.scenario import parse_scenario
 from stairbot.journal import read_journal
 from stairbot.resume import ResumeRefused
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunResult, run
-from stairbot.scenario import parse_scenario
 
 SCENARIO = """
 name = "fault_matrix"

@@ -31,7 +31,6 @@ from pathlib import Path
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import default_path, start_journal
-from stairbot.config import RobotConfig, load_config
 from stairbot.errors import HardwareError
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -46,9 +45,10 @@ from stairbot.fakes.fault_matrix import (
     resume_watched,
 )
 from stairbot.hardware import Snapshot
+from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.scenario import Scenario, parse_scenario
 from stairbot.journal import mark_path
 from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, parse_scenario
 
 POINTS = ("first", "middle", "last")
 """Where in a phase's ticks the host is killed."""

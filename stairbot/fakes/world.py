@@ -27,10 +27,10 @@ try:  # the C functions behind pymunk's Body properties, without the Python wrap
     from pymunk._chipmunk import lib as _cp
 except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
     _cp = None
-from stairbot.config import RobotConfig
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
 from stairbot.fakes.world_params import WorldParams
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 
 TWO_PI = 2.0 * math.pi
 _PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's axles

@@ -41,15 +41,15 @@ from foxglove.channels import (
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
 from stairbot import __version__
-from stairbot.config import RobotConfig
 from stairbot.errors import OutputError
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
 from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, Snapshot, Speeds
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 from stairbot.recording import messages, topics
 from stairbot.recording.pose import PoseSource
 from stairbot.recording.stream import AppendStream
-from stairbot.scenario import Scenario
 
 FLUSH_PERIOD_S = 0.5
 """Wall seconds between flushes at most (a run paced to the wall clock)."""

@@ -20,10 +20,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import HasScene, Point, Snapshot
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 from stairbot.reckon import dead_reckon
-from stairbot.scenario import Scenario
 from stairbot.side_view import stairs_from_scenario
 
 SEGMENT_FRAMES = ("segment1", "segment2", "segment3")

@@ -30,8 +30,6 @@ from dataclasses import dataclass, field
 from pathlib import PurePath
 from typing import Any
 
-from stairbot._schema import convert
-from stairbot.config import ConfigFile, RobotConfig
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
 from stairbot.hardware import (
@@ -44,6 +42,8 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.inputs.config import ConfigFile, RobotConfig
+from stairbot.inputs.schema import convert
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES, pitch_of
 from stairbot.recording.read import (

@@ -23,10 +23,9 @@ from typing import Any
 
 import msgspec
 
-from stairbot._schema import _tokens
-from stairbot.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
 from stairbot.errors import ConfigError, ScenarioError
-from stairbot.scenario import (
+from stairbot.inputs.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
+from stairbot.inputs.scenario import (
     DEFAULT_COUNT,
     DEFAULT_RISE,
     DEFAULT_TREAD,
@@ -34,6 +33,7 @@ from stairbot.scenario import (
     Step,
     parse_scenario,
 )
+from stairbot.inputs.schema import _tokens
 from stairbot.sweep import tomlw
 from stairbot.sweep.spec import VIRTUAL, Axis, Rules, Spec, SpecError, case_rng
 
@@ -54,7 +54,7 @@ class Case:
 
 @cache
 def _default_config_text() -> str:
-    return resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
+    return resources.files("stairbot.inputs").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
 
 
 @cache

@@ -72,10 +72,10 @@ def run_case(case: Case) -> dict[str, Any]:
     record: dict[str, Any] = {"case": case.index, "axes": case.axes, "facts": case.facts}
     try:
         from stairbot.algorithm.phases import Mode
-        from stairbot.config import load_config, parse_config
+        from stairbot.inputs.config import load_config, parse_config
+        from stairbot.inputs.scenario import parse_scenario
         from stairbot.robots import RobotOptions, open_robot
         from stairbot.runner import run
-        from stairbot.scenario import parse_scenario
 
         scenario = parse_scenario(case.scenario_text, f"<case {case.index}>")
         config = (load_config() if case.config_text is None

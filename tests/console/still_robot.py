@@ -7,7 +7,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
@@ -21,8 +20,9 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
 )
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario
 from stairbot.robots import RobotSession
-from stairbot.scenario import load_scenario
 from stairbot.side_view import stairs_from_scenario
 
 LIFT = 0.19  # segment 1 raised this far above segment 2, m

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from stairbot.config import load_config
 from stairbot.console.canvas import BrailleCanvas
 from stairbot.hardware import Scene
-from stairbot.scenario import load_scenario
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario
 from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
 
 

@@ -10,11 +10,11 @@ from typing import Any
 
 import pytest
 
-from stairbot.config import load_config
 from stairbot.console.runner_thread import ConsoleEngine, describe_result
 from stairbot.console.state import LiveState
 from stairbot.errors import InputError
 from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
+from stairbot.inputs.config import load_config
 from stairbot.runner import RunControl, RunResult
 
 FORWARD = {m: 1.0 for m in WHEEL_MOTORS}

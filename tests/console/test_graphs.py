@@ -12,7 +12,6 @@ from typing import Any
 from pilot import press, ready, until
 from still_robot import StillClock, StillRobot, StillSim
 
-from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import SERIES, History
@@ -26,6 +25,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.inputs.config import load_config
 from stairbot.robots import RobotSession
 
 PER_TURN = load_config().motors.lift_travel_per_turn

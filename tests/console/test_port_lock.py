@@ -12,8 +12,8 @@ import pytest
 from lockstep_boards import fake_boards, stairbot
 from pilot import banner, said, until
 
-from stairbot.config import load_config
 from stairbot.console.app import build_app
+from stairbot.inputs.config import load_config
 from stairbot.robots import RobotSession, open_robot
 
 

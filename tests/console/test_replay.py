@@ -19,17 +19,17 @@ from mcap.reader import make_reader
 from pilot import press, shown, until
 
 from stairbot.cli import main
-from stairbot.config import load_config
 from stairbot.console.freshness import STALE_S
 from stairbot.console.replay_app import ReplayConsole, build_replay_app
 from stairbot.console.widgets.motors import NAMES as MOTOR_NAMES
 from stairbot.events import Event, EventKind
 from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.pose import DeadReckonedPose
 from stairbot.recording.replay_source import PART_GAP_S, load_replay
-from stairbot.scenario import load_scenario
 
 
 class Clock:

@@ -14,12 +14,12 @@ from typing import Any
 from pilot import press, ready, shown, until
 from still_robot import HEALTH, StillClock, StillRobot, StillSim
 
-from stairbot.config import RobotConfig, load_config, parse_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import COLUMNS, NOT_CARRIED, SERIES, column, row_of
 from stairbot.errors import LinkLostError
 from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
+from stairbot.inputs.config import RobotConfig, load_config, parse_config
 from stairbot.robots import RobotSession
 
 SIDE_CONFIG: RobotConfig = parse_config(

@@ -8,13 +8,13 @@ import math
 
 import pytest
 
-from stairbot.config import load_config
 from stairbot.fakes import landing as sim_landing
 from stairbot.fakes import stairs as sim_stairs
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import Truth
-from stairbot.scenario import Scenario, load_scenario, parse_scenario
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import Scenario, load_scenario, parse_scenario
 from stairbot.top_view import (
     FLOOR_BEHIND,
     FOOTPRINT_MARGIN,

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.config import load_config, parse_config
 from stairbot.errors import ConfigError
+from stairbot.inputs.config import load_config, parse_config
 
-DEFAULT_TEXT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
+DEFAULT_TEXT = resources.files("stairbot.inputs").joinpath("default_robot.toml").read_text("utf-8")
 
 
 def with_change(section: str, key: str, value: str | None) -> str:

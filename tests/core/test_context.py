@@ -12,8 +12,8 @@ from stairbot.algorithm.context import TAB_SIZE, Context
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.work import Work
-from stairbot.config import load_config
 from stairbot.errors import InputError
+from stairbot.inputs.config import load_config
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 

@@ -16,9 +16,9 @@ from stairbot.algorithm.controller import (
     phase_timeout_s,
 )
 from stairbot.algorithm.phases import Phase
-from stairbot.config import load_config, parse_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.inputs.config import load_config, parse_config
 from stairbot.perception import CONFIRM
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for

@@ -10,8 +10,8 @@ from stairbot.algorithm.edge import edge_bound, edge_clearance_m, edge_doubt_m, 
 from stairbot.algorithm.phase import Tick
 from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.work import Work
-from stairbot.config import load_config
 from stairbot.hardware import WHEEL_MOTORS, MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.inputs.config import load_config
 
 CFG = load_config("reference")
 FLOOR = CFG.BACK_CLEARANCE

@@ -11,7 +11,7 @@ from stairbot.algorithm.context import Context
 from stairbot.algorithm.phase import Tick
 from stairbot.algorithm.phases import Mode
 from stairbot.algorithm.work import Work
-from stairbot.config import load_config
+from stairbot.inputs.config import load_config
 
 CFG = load_config("reference")
 

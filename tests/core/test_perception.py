@@ -6,7 +6,6 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from stairbot.config import RobotConfig, load_config
 from stairbot.hardware import (
     MotorId,
     MotorState,
@@ -15,6 +14,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.perception import CONFIRM, Perception, max_age, pair_tolerance, window
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for

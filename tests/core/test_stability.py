@@ -16,8 +16,8 @@ from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.stability import UNSTABLE, UNSTABLE_EDGE, balance, worst
 from stairbot.algorithm.transitions import TRANSITIONS
-from stairbot.config import RobotConfig, load_config
 from stairbot.hardware import LIFT_MOTORS, MotorId
+from stairbot.inputs.config import RobotConfig, load_config
 
 CFG = load_config()
 PER_TURN = CFG.motors.lift_travel_per_turn  # 2 mm

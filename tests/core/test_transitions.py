@@ -23,8 +23,8 @@ from stairbot.algorithm.transitions import (
     mermaid,
 )
 from stairbot.algorithm.work import Work
-from stairbot.config import load_config
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.inputs.config import load_config
 from stairbot.perception import settle_s
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import can
 import pytest
 
-from stairbot.config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_COPIES
 from stairbot.drivers.can_link import CanLink
@@ -30,8 +29,9 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Clock, HasTruth, MotorId
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario
 from stairbot.robots import RobotOptions, open_robot
-from stairbot.scenario import load_scenario
 
 _names = itertools.count()
 FORWARD = {MotorId.MWF: 1.0, MotorId.MWB: 1.0, MotorId.MWR: 1.0, MotorId.MWL: 1.0}

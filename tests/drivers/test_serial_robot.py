@@ -17,7 +17,6 @@ import serial
 import serial.rfc2217
 
 from stairbot.cli_clear import main as clear_main
-from stairbot.config import RobotConfig, load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_robot import parse_serial_url
@@ -35,9 +34,10 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import BASE_SENSORS, HasTruth, MotorId, SensorId
+from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.robots import RobotSession, open_robot
 from stairbot.runner import run
-from stairbot.scenario import Scenario, load_scenario
 
 CONFIG: RobotConfig = load_config()
 SCENARIO: Scenario = load_scenario()

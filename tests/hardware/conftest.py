@@ -13,8 +13,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from stairbot.config import RobotConfig, load_config
 from stairbot.drivers.board_robot import BoardRobot
+from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.robots import RobotSession, open_robot
 
 URL_VARIABLE = "STAIRBOT_HW_URL"

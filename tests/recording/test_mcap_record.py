@@ -19,7 +19,7 @@ from mcap.records import Schema
 from mcap_protobuf.decoder import DecoderFactory
 
 from stairbot.cli import main
-from stairbot.config import load_config
+from stairbot.inputs.config import load_config
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES
 

@@ -7,8 +7,9 @@ import math
 
 import pytest
 
-from stairbot.config import load_config
 from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import load_scenario
 from stairbot.recording.pose import (
     DeadReckonedPose,
     SegmentPose,
@@ -17,7 +18,6 @@ from stairbot.recording.pose import (
     side_pose,
     stair_blocks,
 )
-from stairbot.scenario import load_scenario
 from stairbot.side_view import stairs_from_scenario
 
 

@@ -9,12 +9,12 @@ import pytest
 import simrun
 
 from stairbot.algorithm.phases import Mode
-from stairbot.config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import parse_scenario
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import run
-from stairbot.scenario import parse_scenario
 
 CONFIG = load_config()
 

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Phase
-from stairbot.config import load_config
 from stairbot.events import Event
 from stairbot.hardware import Clock, Snapshot
+from stairbot.inputs.config import load_config
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import RunResult, run
 

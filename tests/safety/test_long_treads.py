@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import simrun
 
-from stairbot.config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.scenario import parse_scenario
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import parse_scenario
 
 REFERENCE = load_config("reference")
 

@@ -14,9 +14,9 @@ from stairbot.algorithm.context import Context
 from stairbot.algorithm.phase import Tick
 from stairbot.algorithm.phases import Mode, Phase
 from stairbot.algorithm.stability import carried_now
-from stairbot.config import load_config, parse_config
 from stairbot.events import Event, EventKind
-from stairbot.scenario import load_scenario, parse_scenario
+from stairbot.inputs.config import load_config, parse_config
+from stairbot.inputs.scenario import load_scenario, parse_scenario
 
 HEAVY = load_config("heavy_middle")
 REFERENCE = load_config()

@@ -22,11 +22,11 @@ import pytest
 from stairbot.algorithm.controller import Controller
 from stairbot.algorithm.phases import Phase
 from stairbot.algorithm.stability import UNSTABLE
-from stairbot.config import RobotConfig, load_config
 from stairbot.hardware import ZERO_SPEEDS, HasTruth, MotorId
+from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.scenario import load_scenario
 from stairbot.robots import RobotOptions, RobotSession, open_robot
 from stairbot.runner import RunResult, run
-from stairbot.scenario import load_scenario
 
 HOLD_S = 3.0
 """After the run, the robot is left standing this long with every motor at 0."""

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from stairbot.cli import main
-from stairbot.config import load_config
-from stairbot.scenario import parse_scenario
+from stairbot.inputs.config import load_config
+from stairbot.inputs.scenario import parse_scenario
 from stairbot.sweep.cases import build_case, check_spec, first_sight, zone
 from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec
@@ -173,7 +173,7 @@ def test_dask_local_listens_on_loopback_only(monkeypatch: pytest.MonkeyPatch) ->
 
 
 def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
-    root = Path(__file__).parents[2] / "stairbot" / "sweeps"
+    root = Path(__file__).parents[2] / "stairbot" / "inputs" / "sweeps"
     sizes = {}
     for path in sorted(root.glob("*.toml")):
         spec = parse_spec(path.read_text("utf-8"), str(path), root)

@@ -9,7 +9,7 @@ figures, plus what only a simulation needs (the cone's rays, outlier and
 dropout rates).  Pure data: the core may import it.
 
 "Datasheet" figures are the maker's; "assumed" ones are ours.  The names must
-match :data:`stairbot.config.SensorModelName` (a test checks).
+match :data:`stairbot.inputs.config.SensorModelName` (a test checks).
 """
 
 from __future__ import annotations

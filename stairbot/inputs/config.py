@@ -18,11 +18,11 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
-from stairbot._schema import convert, load_toml, read_named, shipped
-from stairbot.config_checks import check_consistency
 from stairbot.errors import ConfigError
 from stairbot.files import shown
-from stairbot.sensor_specs import SPECS, SensorSpec
+from stairbot.inputs.config_checks import check_consistency
+from stairbot.inputs.schema import convert, load_toml, read_named, shipped
+from stairbot.inputs.sensor_specs import SPECS, SensorSpec
 
 # Physical bounds: generous around any robot of this kind (the reference robot
 # is 0.225 m long and 2.4 kg), tight enough that the simulation's pymunk world
@@ -35,7 +35,7 @@ Mass = Annotated[float, msgspec.Meta(ge=0.001, le=1000.0)]
 """A mass: 1 g to 1 t."""
 TurnsPerSecond = Annotated[float, msgspec.Meta(ge=0.01, le=1000.0)]
 
-# The kinds of distance sensor (stairbot.sensor_specs; the names must agree)
+# The kinds of distance sensor (stairbot.inputs.sensor_specs; the names must agree)
 SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"]
 
 
@@ -87,9 +87,9 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     noise: Annotated[float, msgspec.Meta(ge=0.0, le=1.0)] = 0.005
     """Stated sigma of a distance reading of the ``ideal`` model: perception
     derives its tolerances from it.  A named model states its own
-    (stairbot.sensor_specs)."""
+    (stairbot.inputs.sensor_specs)."""
     front_model: SensorModelName = "ideal"
-    """The kind of sensor SFR/SFL are (stairbot.sensor_specs): its timing and
+    """The kind of sensor SFR/SFL are (stairbot.inputs.sensor_specs): its timing and
     noise set perception's staleness limit and tolerances, and the simulation
     models it (stairbot.fakes.sensor_presets)."""
     back_model: SensorModelName = "ideal"
@@ -540,7 +540,7 @@ def _config_text(path: str | Path | None, beside: Path | None = None) -> tuple[s
     ``"reference"``), a shipped robot by name, or a file (relative to
     ``beside`` when given)."""
     if path is None or path == REFERENCE:
-        text = resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
+        text = resources.files("stairbot.inputs").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
         return text, f"<default {DEFAULT_CONFIG_NAME}>"
     if beside is not None and isinstance(path, str) and (beside / path).exists():
         path = beside / path

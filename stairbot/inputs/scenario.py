@@ -16,8 +16,8 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 
-from stairbot._schema import convert, load_toml, read_named, shipped
 from stairbot.errors import ScenarioError
+from stairbot.inputs.schema import convert, load_toml, read_named, shipped
 from stairbot.text import check_line, printable
 
 # Bounds that keep the simulated world sane (docs/scenarios.md): a riser from
@@ -265,7 +265,8 @@ def load_scenario(path: str | Path | None = None) -> Scenario:
     plain word that is no existing file), or the default stairs when ``path``
     is None.  Raises ScenarioError."""
     if path is None:
-        text = resources.files("stairbot").joinpath("default_scenario.toml").read_text("utf-8")
+        entry = resources.files("stairbot.inputs").joinpath("default_scenario.toml")
+        text = entry.read_text("utf-8")
         return parse_scenario(text, "<default scenario>")
     return parse_scenario(*read_named(path, SHIPPED_DIR, "scenario", ScenarioError))
 

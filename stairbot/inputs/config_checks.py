@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 from stairbot.errors import ConfigError
 
 if TYPE_CHECKING:
-    from stairbot.config import RobotConfig
+    from stairbot.inputs.config import RobotConfig
 
 BACK_RANGE_MARGIN = 0.005
 """The floor must read at least this far inside the back sensors' range."""

@@ -35,7 +35,7 @@ def read_text(path: Path, error: type[InputError], what: str = "a TOML file") ->
 
 def shipped(folder: str) -> list[str]:
     """Names of the TOML files shipped in the package's ``folder``."""
-    entries = resources.files("stairbot").joinpath(folder)
+    entries = resources.files("stairbot.inputs").joinpath(folder)
     return sorted(f.name.removesuffix(".toml") for f in entries.iterdir()
                   if f.name.endswith(".toml"))
 
@@ -53,7 +53,7 @@ def read_named(path: str | Path, folder: str, what: str,
             names = sorted([*names, *also])
             raise error(shown(path), None, f"no such file, nor a shipped {what}; shipped: "
                         + ", ".join(names))
-        entry = resources.files("stairbot").joinpath(folder, f"{path}.toml")
+        entry = resources.files("stairbot.inputs").joinpath(folder, f"{path}.toml")
         return entry.read_text("utf-8"), f"<{what} {path}>"
     return read_text(p, error, f"a {what} file"), str(p)
 
