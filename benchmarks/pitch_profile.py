@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 from dataclasses import dataclass
 
-from stairbot.algorithm.controller import Controller
+from stairbot.control.algorithm.controller import Controller
 from stairbot.hardware import Snapshot
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario, shipped_scenarios

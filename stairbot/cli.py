@@ -326,7 +326,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     """``stairbot run``: open the robot, run the program, summarise, judge."""
     config, scenario = _load_inputs(args)
     # Imported here: the runner pulls in the controller, which `config show` needs not.
-    from stairbot.algorithm.phases import Mode
     from stairbot.cli_journal import (
         NotConfirmed,
         journal_path,
@@ -335,6 +334,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         unfinished,
     )
     from stairbot.cli_journal import resume as resume_run
+    from stairbot.control.algorithm.phases import Mode
     from stairbot.resume import ResumeRefused
     from stairbot.robots import RobotOptions, open_robot
     from stairbot.runner import RunControl, run

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
 from stairbot.cli_show import ask
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
 from stairbot.events import EventSink
 from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
 from stairbot.inputs.config import RobotConfig

@@ -36,8 +36,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, BinaryIO
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phases import BY_VALUE, Mode
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phases import BY_VALUE, Mode
 from stairbot.errors import InputError
 from stairbot.files import open_regular, shown
 from stairbot.hardware import MotorId

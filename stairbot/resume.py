@@ -34,8 +34,8 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phases import BY_VALUE
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.errors import InputError, StairbotError
 from stairbot.journal import JournalError, JournalState
 

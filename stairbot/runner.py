@@ -17,8 +17,8 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
-from stairbot.algorithm.controller import Controller, phase_timeout_s
-from stairbot.algorithm.phases import Mode
+from stairbot.control.algorithm.controller import Controller, phase_timeout_s
+from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (

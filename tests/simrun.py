@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from stairbot.algorithm.phases import Mode
+from stairbot.control.algorithm.phases import Mode
 from stairbot.events import Event, discard
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario

@@ -106,7 +106,7 @@ def test_far_and_askew_it_closes_in_squares_up_and_retraces_its_way_home() -> No
     square_range_m (no further than its first reading allows), squares up
     there, climbs, and comes home the way it went: turning back the squaring
     turn before it backs the distance it closed in."""
-    from stairbot.algorithm.phases import Phase
+    from stairbot.control.algorithm.phases import Phase
 
     events: list[Event] = []
     r = run_reference(FAR_ASKEW, events)
@@ -180,7 +180,7 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it(
     step 6, read on the way up, was 1.4 cm long; backing up to it, the
     robot tipped back 15 deg off segment 2's rear wheels.  The back pair
     now bounds the backing: edge_clearance_m past where it saw the drop."""
-    from stairbot.algorithm.edge import edge_clearance_m
+    from stairbot.control.algorithm.edge import edge_clearance_m
 
     assert edge_clearance_m(REFERENCE) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006
                                                        + REFERENCE.wheel_speed_m_s * 0.030)
@@ -227,7 +227,7 @@ def test_backing_off_a_short_tread_is_bounded_by_the_edge_too() -> None:
     edge then allowed edge_clearance_m more from there, and the robot tipped
     back (the tilt supervisor stopped it at 145 deg/s).  The back pair now
     bounds the back-off as well, from where it first saw the drop."""
-    from stairbot.algorithm.phases import Phase
+    from stairbot.control.algorithm.phases import Phase
 
     events: list[Event] = []
     r = run_reference(SHORT_TREADS, events)

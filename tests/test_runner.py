@@ -8,7 +8,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from stairbot.algorithm.controller import Controller
+from stairbot.control.algorithm.controller import Controller
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import Robot, Snapshot, Speeds
 from stairbot.inputs.config import load_config

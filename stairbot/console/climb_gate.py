@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from stairbot.algorithm.phases import BY_VALUE
+from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.errors import StairbotError
 from stairbot.journal import read_journal
 from stairbot.resume import describe

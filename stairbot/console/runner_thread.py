@@ -17,13 +17,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, TypedDict
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume, start_journal
 from stairbot.console.climb_gate import MidClimb, after_run, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, WatchedRobot, watch
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, HasTruth, ReportsEvents, Snapshot

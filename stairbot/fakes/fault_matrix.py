@@ -46,9 +46,9 @@ from typing import Any, cast
 
 import can
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import resume, start_journal
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import HardwareError, InputError

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
 from stairbot.cli_journal import default_path, start_journal
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import HardwareError
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world

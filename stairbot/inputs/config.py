@@ -179,9 +179,9 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 
 
 class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
-    """What the supervisor watches every tick (stairbot.tilt) and the margin
+    """What the supervisor watches every tick (stairbot.control.tilt) and the margin
     the static-stability check keeps before every lift
-    (stairbot.algorithm.stability).  The defaults' reasons are in
+    (stairbot.control.algorithm.stability).  The defaults' reasons are in
     default_robot.toml."""
 
     imu: bool
@@ -195,7 +195,7 @@ class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     """Pitch or roll rate beyond which every motor stops, degrees per second."""
     imu_max_age_s: Annotated[float, msgspec.Meta(gt=0, le=1)]
     """An IMU reading older than this cannot watch tilt: every motor stops
-    until a fresher one comes (stairbot/tilt.py)."""
+    until a fresher one comes (stairbot/control/tilt.py)."""
     stability_margin: Gap
     """Metres the centre of mass must stay inside the wheels that carry the
     robot while a lift moves."""
@@ -342,10 +342,10 @@ class RobotConfig:
         read the first riser alone (farther, the upper rays pass over it and
         the reading blends the risers beyond); and the pair's stated noise
         lets it square up to equal_tolerance
-        (:func:`~stairbot.perception.quiet_range_m`).  Infinite for level,
+        (:func:`~stairbot.control.perception.quiet_range_m`).  Infinite for level,
         quiet rays."""
         # perception builds on the config: imported here, not at the top
-        from stairbot.perception import quiet_range_m
+        from stairbot.control.perception import quiet_range_m
 
         top = self.front_cone_top_rad
         cone = math.inf if top <= 0.0 else \
@@ -379,12 +379,12 @@ class RobotConfig:
         over the step below) and segment 1 anywhere from down to lifted its
         whole stroke, pitched either way as far as the supervisor lets it
         (``[safety] max_pitch_deg``): what narrow steps ask of the masses
-        (:mod:`stairbot.algorithm.stability`; negative: outside).  Level,
+        (:mod:`stairbot.control.algorithm.stability`; negative: outside).  Level,
         any robot that calibrates passes (calibration's lift stands it on
         segment 2's wheels too); pitched, segment 1 lifted high swings its
         weight over them, and the lighter the end segments the less."""
         # the stability check builds on the config: imported here, not at the top
-        from stairbot.algorithm.stability import worst
+        from stairbot.control.algorithm.stability import worst
 
         top = (self.MAX_OF_VERTICAL_TURNS, 0.0)
         return min(worst(self, (2,), (0.0, 0.0), top, pitch).margin
@@ -446,7 +446,7 @@ class RobotConfig:
             out["square_range_m"] = self.square_range_m
         if self.algorithm.landings:
             # the controller's own figures (it refuses a landing with less room)
-            from stairbot.algorithm.landing import DEPTH_MARGIN, turn_room_m
+            from stairbot.control.algorithm.landing import DEPTH_MARGIN, turn_room_m
 
             room = turn_room_m(self)
             out["landing_turn_room_m"] = room

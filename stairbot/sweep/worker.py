@@ -71,7 +71,7 @@ def run_case(case: Case) -> dict[str, Any]:
     wall0, cpu0 = time.perf_counter(), time.process_time()
     record: dict[str, Any] = {"case": case.index, "axes": case.axes, "facts": case.facts}
     try:
-        from stairbot.algorithm.phases import Mode
+        from stairbot.control.algorithm.phases import Mode
         from stairbot.inputs.config import load_config, parse_config
         from stairbot.inputs.scenario import parse_scenario
         from stairbot.robots import RobotOptions, open_robot

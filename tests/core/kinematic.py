@@ -16,7 +16,7 @@ import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from stairbot.algorithm.controller import Controller
+from stairbot.control.algorithm.controller import Controller
 from stairbot.hardware import (
     LIFT_MOTORS,
     Imu,

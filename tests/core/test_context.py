@@ -8,10 +8,10 @@ import json
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.context import TAB_SIZE, Context
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.context import TAB_SIZE, Context
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
 from stairbot.errors import InputError
 from stairbot.inputs.config import load_config
 

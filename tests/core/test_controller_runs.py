@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode, Phase
 from stairbot.events import Event, EventKind
 from stairbot.hardware import LIFT_MOTORS, MotorId
 from stairbot.inputs.config import load_config

@@ -6,6 +6,7 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from stairbot.control.perception import CONFIRM, Perception, max_age, pair_tolerance, window
 from stairbot.hardware import (
     MotorId,
     MotorState,
@@ -15,7 +16,6 @@ from stairbot.hardware import (
     Snapshot,
 )
 from stairbot.inputs.config import RobotConfig, load_config
-from stairbot.perception import CONFIRM, Perception, max_age, pair_tolerance, window
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 TICK = CFG.algorithm.tick

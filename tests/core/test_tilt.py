@@ -13,15 +13,15 @@ import msgspec
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.tilt import TiltWatch
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.robots import RobotOptions, open_robot
 from stairbot.runner import run as run_session
-from stairbot.tilt import TiltWatch
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 SAFETY = CFG.safety

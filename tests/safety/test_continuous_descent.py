@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 import simrun
 
-from stairbot.algorithm.phases import Mode
+from stairbot.control.algorithm.phases import Mode
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import load_config

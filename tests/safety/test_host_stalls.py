@@ -14,8 +14,8 @@ watching it cross.  The whole runs are on the pymunk robot.
 
 from __future__ import annotations
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
 from stairbot.events import Event
 from stairbot.hardware import Clock, Snapshot
 from stairbot.inputs.config import load_config

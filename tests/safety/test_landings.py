@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 import simrun
 
-from stairbot.algorithm.phases import Phase
+from stairbot.control.algorithm.phases import Phase
 from stairbot.errors import ConfigError, ScenarioError
 from stairbot.events import Event, EventKind
 from stairbot.inputs.config import load_config, parse_config

@@ -10,10 +10,10 @@ import json
 import pytest
 import simrun
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phase import Tick
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.algorithm.stability import carried_now
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phase import Tick
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.stability import carried_now
 from stairbot.events import Event, EventKind
 from stairbot.inputs.config import load_config, parse_config
 from stairbot.inputs.scenario import load_scenario, parse_scenario

@@ -19,9 +19,9 @@ from dataclasses import replace
 import msgspec
 import pytest
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.stability import UNSTABLE
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.stability import UNSTABLE
 from stairbot.hardware import ZERO_SPEEDS, HasTruth, MotorId
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import load_scenario

@@ -2,7 +2,7 @@
 
 A :class:`Phase` is the phase's identity (its ``value`` is the stable name in
 logs and JSON); everything else about it is its record
-(:class:`~stairbot.algorithm.phase.PhaseDef`, in the module of its flow): the
+(:class:`~stairbot.control.algorithm.phase.PhaseDef`, in the module of its flow): the
 label the seed would use for it (shown to the operator, e.g. "ascent 3 — lift
 segment 1"), the flow it belongs to (``"calibration"``, ``"ascent"``,
 ``"descent"``, or ``"end"`` for the standing rule's wait, done, error), its
@@ -17,7 +17,7 @@ from enum import Enum
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from stairbot.algorithm.phase import PhaseDef
+    from stairbot.control.algorithm.phase import PhaseDef
 
 
 class Mode(Enum):
@@ -109,7 +109,7 @@ def _records() -> dict[Phase, PhaseDef]:
     # The records live with their flows (calibration.py, turns.py, ascent.py...), which
     # import this module: they are gathered on first use.
     if not _RECORDS:
-        from stairbot.algorithm.table import PHASES
+        from stairbot.control.algorithm.table import PHASES
 
         _RECORDS.update(PHASES)
     return _RECORDS

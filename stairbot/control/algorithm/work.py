@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from stairbot.algorithm import motion
+from stairbot.control.algorithm import motion
 from stairbot.hardware import MotorId, Snapshot
 
 
@@ -57,7 +57,7 @@ class Work:
     not on one noisy reading)."""
     rise_rows: list[list[float]] = field(default_factory=lambda: [[], []])
     """Ascent 3's lift past the sight-over: SFR's and SFL's readings past the
-    riser, in the order segment 1 rose (:mod:`stairbot.algorithm.long_tread`)."""
+    riser, in the order segment 1 rose (:mod:`stairbot.control.algorithm.long_tread`)."""
     start_reading: float | None = None
     """A reading the phase measures from (the approach's last, the sight-over)."""
     diffs: list[float] = field(default_factory=list)

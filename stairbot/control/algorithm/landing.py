@@ -35,14 +35,14 @@ from __future__ import annotations
 import math
 import statistics
 
-from stairbot.algorithm import motion
-from stairbot.algorithm.moves import lift, reading_drive, stood
-from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.moves import lift, reading_drive, stood
+from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import side_settle_s
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
 from stairbot.inputs.config import RobotConfig
-from stairbot.perception import side_settle_s
 
 P = Phase
 FLOW = "landing"

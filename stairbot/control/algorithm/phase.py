@@ -4,7 +4,7 @@ returns (:class:`Step`), and its private working state (:class:`Work`).
 A phase is one record: its seed name, its flow, its entry action, its step and
 its transitions (the next phases it may return, each with the condition that
 makes it).  The transition table and the flowcharts are drawn from these
-records (:mod:`stairbot.algorithm.transitions`).
+records (:mod:`stairbot.control.algorithm.transitions`).
 
 A step is a function of (the tick's readings and context, the phase's work)
 that returns a :class:`Step`: the motor speeds to command and, when the phase
@@ -20,9 +20,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.work import Work
 from stairbot.hardware import Snapshot, Speeds
 from stairbot.inputs.config import RobotConfig
 
@@ -107,7 +107,7 @@ class PhaseDef:
     resumed from the pause, without saying so in ``to``.  ``carried_by``
     names the segments (1, 2, 3) whose wheels carry the robot while the phase
     moves its lifts: the static-stability check runs before its first step
-    (:mod:`stairbot.algorithm.stability`), and its error is added to the
+    (:mod:`stairbot.control.algorithm.stability`), and its error is added to the
     edge to ERROR, also without saying so in ``to``; empty: no lift moves."""
 
     phase: Phase

@@ -5,9 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from stairbot.algorithm import ascent, calibration, descent, landing, standing, turns
-from stairbot.algorithm.phase import PhaseDef
-from stairbot.algorithm.phases import Phase
+from stairbot.control.algorithm import ascent, calibration, descent, landing, standing, turns
+from stairbot.control.algorithm.phase import PhaseDef
+from stairbot.control.algorithm.phases import Phase
 
 PHASES: Mapping[Phase, PhaseDef] = MappingProxyType(
     {d.phase: d for d in (*calibration.PHASES, *turns.PHASES, *ascent.PHASES, *descent.PHASES,

@@ -2,7 +2,7 @@
 condition that makes it, drawn from the phases' records (each record's ``to``;
 an armed phase's pause and the resume back into it).  The controller refuses
 any change not listed here, and the flowcharts in docs/algorithm.md are drawn
-from it (``python -m stairbot.algorithm.transitions``).
+from it (``python -m stairbot.control.algorithm.transitions``).
 """
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from stairbot.algorithm.phase import BACK_DISAGREE, FRONT_DISAGREE
-from stairbot.algorithm.phases import FLOWS, Phase
-from stairbot.algorithm.stability import UNSTABLE_EDGE
-from stairbot.algorithm.table import PHASES
+from stairbot.control.algorithm.phase import BACK_DISAGREE, FRONT_DISAGREE
+from stairbot.control.algorithm.phases import FLOWS, Phase
+from stairbot.control.algorithm.stability import UNSTABLE_EDGE
+from stairbot.control.algorithm.table import PHASES
 
 P = Phase
 

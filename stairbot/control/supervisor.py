@@ -1,7 +1,7 @@
 """The safety supervisor: checks the robot every tick, whatever the phase logic
 believes, and names what is wrong.
 
-It watches the robot's tilt (:mod:`stairbot.tilt`: the IMU's pitch, roll and
+It watches the robot's tilt (:mod:`stairbot.control.tilt`: the IMU's pitch, roll and
 their rates against ``[safety]``, and an IMU that is declared but missing or
 not a number; a stale one the controller holds on, as on a stale sensor),
 and a stalled motor: one commanded to turn that does not (a wheel
@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from stairbot.control.tilt import TiltWatch
 from stairbot.hardware import LIFT_MOTORS, MotorId, Snapshot, Speeds
 from stairbot.inputs.config import RobotConfig
-from stairbot.tilt import TiltWatch
 
 STALL_S = 1.0
 """A motor that makes less than STALL_SHARE of its commanded motion for this

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import landing, motion
-from stairbot.algorithm.moves import lift, stood
-from stairbot.algorithm.phase import (
+from stairbot.control.algorithm import landing, motion
+from stairbot.control.algorithm.moves import lift, stood
+from stairbot.control.algorithm.phase import (
     FAULT,
     NO_MOTION,
     PhaseDef,
@@ -26,11 +26,11 @@ from stairbot.algorithm.phase import (
     stay,
     where,
 )
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import settle_s, still_samples, still_tolerance
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
-from stairbot.perception import settle_s, still_samples, still_tolerance
 
 P = Phase
 FLOW = "calibration"
@@ -70,7 +70,8 @@ MAX_SQUARING_TURNS = 4
 turn, then corrections by the odometer) and still does not read SFR = SFL
 standing on all wheels ends with an error."""
 LANDING_PURPOSES = ("landing", "landing_back")
-"""A landing's 90° turn onto the next flight, and back (:mod:`~stairbot.algorithm.landing`)."""
+"""A landing's 90° turn onto the next flight, and back
+(:mod:`~stairbot.control.algorithm.landing`)."""
 LANDING_TURN_MARGIN_RAD = math.radians(15.0)
 """A landing's turn may make this much more than 90° by the odometer before
 it ends with an error."""
@@ -427,4 +428,4 @@ LOWER = PhaseDef(
         P.ERROR: FAULT})
 
 PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, LOWER)
-"""This module's phases; the turns' are in :mod:`~stairbot.algorithm.turns`."""
+"""This module's phases; the turns' are in :mod:`~stairbot.control.algorithm.turns`."""

@@ -1,15 +1,15 @@
 """Calibration's turns on segment 2's wheels (segments 1 and 3 lifted): the
 squaring turn, case 3's probe and the corner, turning away (case 3B), and
 turning back to a heading (descent 1 and 7).  The rest of calibration, and
-the helpers both share: :mod:`~stairbot.algorithm.calibration`.
+the helpers both share: :mod:`~stairbot.control.algorithm.calibration`.
 """
 
 from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import motion
-from stairbot.algorithm.calibration import (
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.calibration import (
     FLOW,
     LANDING_PURPOSES,
     LANDING_TURN_MARGIN_RAD,
@@ -30,7 +30,7 @@ from stairbot.algorithm.calibration import (
     settled,
     trimmed_mean,
 )
-from stairbot.algorithm.phase import (
+from stairbot.control.algorithm.phase import (
     FAULT,
     NO_MOTION,
     PhaseDef,
@@ -41,10 +41,10 @@ from stairbot.algorithm.phase import (
     stay,
     where,
 )
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import pair_tolerance, still_samples, still_tolerance
 from stairbot.hardware import MotorId
-from stairbot.perception import pair_tolerance, still_samples, still_tolerance
 
 P = Phase
 

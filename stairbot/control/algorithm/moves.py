@@ -13,12 +13,12 @@ from __future__ import annotations
 import statistics
 from collections.abc import Callable
 
-from stairbot.algorithm import motion
-from stairbot.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import median_sigma
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
-from stairbot.perception import median_sigma
 
 Enter = Callable[[Tick, Work], None]
 StepFn = Callable[[Tick, Work], Step]

@@ -29,8 +29,8 @@ import math
 from dataclasses import dataclass
 from itertools import combinations
 
-from stairbot.algorithm.phase import PhaseDef, Step, Tick, fail
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail
+from stairbot.control.algorithm.work import Work
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 

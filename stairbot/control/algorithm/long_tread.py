@@ -28,8 +28,8 @@ from __future__ import annotations
 
 import statistics
 
-from stairbot.algorithm.phase import Tick
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phase import Tick
+from stairbot.control.algorithm.work import Work
 
 FAR_TREAD_M = 0.5
 """A length_of_next_step longer than this: ascent 4, 6 and 9 drive by turns,

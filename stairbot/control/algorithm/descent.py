@@ -13,17 +13,17 @@ from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import landing, long_tread, motion
-from stairbot.algorithm.ascent import narrow
-from stairbot.algorithm.calibration import HEADING_TOLERANCE_RAD, heading_off_rad
-from stairbot.algorithm.edge import (
+from stairbot.control.algorithm import landing, long_tread, motion
+from stairbot.control.algorithm.ascent import narrow
+from stairbot.control.algorithm.calibration import HEADING_TOLERANCE_RAD, heading_off_rad
+from stairbot.control.algorithm.edge import (
     edge_bound,
     edge_clearance_m,
     floor_tolerance,
     narrow_bound,
     refind,
 )
-from stairbot.algorithm.moves import (
+from stairbot.control.algorithm.moves import (
     checked_first,
     drive_phase,
     lift,
@@ -31,7 +31,7 @@ from stairbot.algorithm.moves import (
     reading_drive,
     turns_drive,
 )
-from stairbot.algorithm.phase import (
+from stairbot.control.algorithm.phase import (
     FAULT,
     PhaseDef,
     Step,
@@ -42,8 +42,8 @@ from stairbot.algorithm.phase import (
     stay,
     where,
 )
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
 from stairbot.hardware import BACK_SENSORS, MotorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
@@ -105,9 +105,10 @@ def _back_off_target(t: Tick) -> float | None:
 
 
 def _edge_or_tab(t: Tick, w: Work, refind: bool) -> float | None:
-    """The edge watch's bound (:func:`~stairbot.algorithm.edge.edge_bound`); on a narrow step, the
-    tab read on the way up places the robot (the back pair is over the step
-    below, segment 3 in the air), bounded by :func:`~stairbot.algorithm.edge.narrow_bound`."""
+    """The edge watch's bound (:func:`~stairbot.control.algorithm.edge.edge_bound`);
+    on a narrow step, the tab read on the way up places the robot (the back
+    pair is over the step below, segment 3 in the air), bounded by
+    :func:`~stairbot.control.algorithm.edge.narrow_bound`."""
     if not _narrow(t):
         return edge_bound(t, w, refind)
     limit = narrow_bound(t, w)
@@ -490,7 +491,7 @@ LOWER_SECOND = lift_phase(
 
 def _first_bound(t: Tick, w: Work) -> float | None:
     """Descent 5 onto a narrow tread: watch its edge go by
-    (:func:`~stairbot.algorithm.edge.narrow_bound`); the drive's own target
+    (:func:`~stairbot.control.algorithm.edge.narrow_bound`); the drive's own target
     is not bounded."""
     if _narrow(t, t.descent_index - 1):
         narrow_bound(t, w)

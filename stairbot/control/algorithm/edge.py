@@ -15,12 +15,12 @@ from __future__ import annotations
 
 import math
 
-from stairbot.algorithm import motion
-from stairbot.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import measurement_period, median_sigma, window
 from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorStatus
 from stairbot.inputs.config import RobotConfig
-from stairbot.perception import measurement_period, median_sigma, window
 
 FLOOR_SIGMAS = 2.0
 """Descent 2: SBR/SBL "read BACK_CLEARANCE" within this many sigmas of their

@@ -6,10 +6,10 @@ Armed in the phases whose record names a pair in ``watches`` (where both
 sensors of the pair look at the same flat surface): SBR/SBL in descent 2,
 SFR/SFL elsewhere.  A disagreement only counts when both sensors give a
 usable distance, and both the (filtered) difference and its smoothed value
-(:data:`~stairbot.algorithm.motion.DIFF_SMOOTHING`) must exceed their
+(:data:`~stairbot.control.algorithm.motion.DIFF_SMOOTHING`) must exceed their
 tolerances for DEBOUNCE_TICKS ticks in a row: what calibration may have left
 when it squared up, plus four sigmas of the difference from the sensors'
-stated noise (:func:`~stairbot.perception.standing_tolerance`).  Neither a
+stated noise (:func:`~stairbot.control.perception.standing_tolerance`).  Neither a
 short spike, sensor noise, nor a yaw calibration accepted stops the robot.
 
 :func:`watch` runs before an armed phase's step and returns the pause; the
@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import statistics
 
-from stairbot.algorithm import long_tread, motion
-from stairbot.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
-from stairbot.perception import standing_tolerance
+from stairbot.control.algorithm import long_tread, motion
+from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import standing_tolerance
 
 BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
                            Phase.ASCENT_DRIVE_SECOND})

@@ -1,4 +1,4 @@
-"""Ascent steps 2–9 (step 1 is calibration: :mod:`stairbot.algorithm.calibration`).
+"""Ascent steps 2–9 (step 1 is calibration: :mod:`stairbot.control.algorithm.calibration`).
 
 h below is number_of_turns_for_step_height.  Ascent 3 lifts segment 1 until
 the front sensors see over the step, then number_of_vertical_turns more; h is
@@ -12,14 +12,14 @@ from __future__ import annotations
 import math
 import statistics
 
-from stairbot.algorithm import landing, long_tread, motion
-from stairbot.algorithm.moves import (
+from stairbot.control.algorithm import landing, long_tread, motion
+from stairbot.control.algorithm.moves import (
     KEY_TICKS,
     drive_phase,
     lift,
     lift_phase,
 )
-from stairbot.algorithm.phase import (
+from stairbot.control.algorithm.phase import (
     FAULT,
     NO_MOTION,
     PhaseDef,
@@ -29,8 +29,8 @@ from stairbot.algorithm.phase import (
     go,
     stay,
 )
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
 from stairbot.hardware import MotorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
@@ -272,7 +272,7 @@ def _held(t: Tick, w: Work, tread: float) -> bool:
     """A tread past FAR_TREAD_M whose rise is below min_rise_for: whether the
     pair's readings held as segment 1 rose (a wall, or a riser the cone
     sees whole: climbed), said either way
-    (:mod:`~stairbot.algorithm.long_tread`)."""
+    (:mod:`~stairbot.control.algorithm.long_tread`)."""
     if not long_tread.far(tread):
         return False
     reading = tread + _gap(t)

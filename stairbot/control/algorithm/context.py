@@ -1,6 +1,6 @@
 """The controller's context: the seed's variables under their seed names,
 where the program stands, and the present phase's own working state
-(:class:`~stairbot.algorithm.work.Work`).
+(:class:`~stairbot.control.algorithm.work.Work`).
 
 Everything a phase needs to carry on is here, and motion targets are absolute
 counter values (not "N more turns"), so a controller restored from
@@ -15,8 +15,8 @@ import types
 from dataclasses import asdict, dataclass, field, fields, is_dataclass
 from typing import Any, Union, get_args, get_origin, get_type_hints
 
-from stairbot.algorithm.phases import BY_VALUE
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm.phases import BY_VALUE
+from stairbot.control.algorithm.work import Work
 from stairbot.errors import InputError
 
 TAB_SIZE = 20
@@ -46,7 +46,7 @@ class Context:
 
     # -- where the program stands ---------------------------------------------------
     phase: str = "cal_check"
-    """Value of the present :class:`~stairbot.algorithm.phases.Phase`."""
+    """Value of the present :class:`~stairbot.control.algorithm.phases.Phase`."""
     purpose: str = "start"
     """What the calibration phases are doing: "start", "ascent", "descent", or
     "home" or "floor" (descent 7 lifts and lowers segments 1 and 3 to turn
@@ -65,7 +65,7 @@ class Context:
     squared up, its start position is then nearer the stairs)."""
     home_twist: float | None = None
     """The heading by the odometer where the program began: half of MWR's
-    counter less MWL's (:func:`~stairbot.algorithm.motion.twist`).  Descent 7
+    counter less MWL's (:func:`~stairbot.control.algorithm.motion.twist`).  Descent 7
     turns back to it before it backs the distance the first calibration
     closed in."""
     tread_length: list[float | None] = field(default_factory=_empty_tab)
@@ -96,7 +96,7 @@ class Context:
     while above 0, the calibration's check verifies the last one."""
     steps_descended: int = 0
     from_top: bool = False
-    """Continuous descent (:attr:`~stairbot.algorithm.phases.Mode.DESCEND`): the
+    """Continuous descent (:attr:`~stairbot.control.algorithm.phases.Mode.DESCEND`): the
     program began on the top of a flight it did not climb.  Its steps are
     counted from the top (number_of_steps stays 0); each step's
     tab_length_to_edge is read where descent 1 leaves segment 3 over its
@@ -133,7 +133,7 @@ class Context:
     """Descent 1: the odometer where the back pair crossed the edge of the
     step it stands on (where it read the drop, less how far the robot
     backed while the reading came through:
-    :func:`~stairbot.algorithm.edge.edge_sight_m`), backing
+    :func:`~stairbot.control.algorithm.edge.edge_sight_m`), backing
     off or backing up to it."""
     edge_squared: bool = False
     """Continuous descent: the robot turned square to this step's edge by

@@ -6,12 +6,12 @@ phase's own logic (a motor fault, a phase that takes too long, the
 supervisor's tilt and stall), then a sensor the phase needs that reads as
 ERROR (the robot stands and waits for it, up to SENSOR_WAIT_S), then the
 standing rule, then -- once, before a lift phase's first step -- the
-static-stability check (:mod:`~stairbot.algorithm.stability`), then the
+static-stability check (:mod:`~stairbot.control.algorithm.stability`), then the
 phase's step.
-Whichever decides returns a :class:`~stairbot.algorithm.phase.Step`; if it
+Whichever decides returns a :class:`~stairbot.control.algorithm.phase.Step`; if it
 names a next phase, :meth:`Controller._apply` enters it — the one place a
 phase is entered, at most once a tick — after checking the change against
-:data:`~stairbot.algorithm.transitions.TRANSITIONS`, and tells it as an event.
+:data:`~stairbot.control.algorithm.transitions.TRANSITIONS`, and tells it as an event.
 The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 """
 
@@ -22,12 +22,19 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from stairbot.algorithm import calibration, motion, stability, standing
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phase import PhaseDef, Step, Tick, fail, where
-from stairbot.algorithm.phases import BY_VALUE, Mode, Phase
-from stairbot.algorithm.transitions import BACK_PAIR_PHASES, TRANSITIONS, TransitionError, allowed
-from stairbot.algorithm.work import Work
+from stairbot.control.algorithm import calibration, motion, stability, standing
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
+from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.control.algorithm.transitions import (
+    BACK_PAIR_PHASES,
+    TRANSITIONS,
+    TransitionError,
+    allowed,
+)
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import Perception
+from stairbot.control.supervisor import Supervisor
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
     BACK_SENSORS,
@@ -40,8 +47,6 @@ from stairbot.hardware import (
     Speeds,
 )
 from stairbot.inputs.config import RobotConfig
-from stairbot.perception import Perception
-from stairbot.supervisor import Supervisor
 
 SENSOR_WAIT_S = 1.0
 """How long the robot stands, lifts holding, for a sensor it needs that reads
@@ -92,7 +97,7 @@ class Controller:
     must then come from the same clock.  ``hold``/``release``/``abort`` are
     for the operator and must be called from the thread that ticks.
     ``check_stability=False`` skips the static-stability check before the
-    lifts (:mod:`stairbot.algorithm.stability`): only for a test that shows
+    lifts (:mod:`stairbot.control.algorithm.stability`): only for a test that shows
     what the supervisor does without it.
     """
 
@@ -270,7 +275,7 @@ class Controller:
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
         """While a sensor the phase needs (``needed``) reads as ERROR (it reports
         errors, or it is stale), or the IMU's reading is too old to watch tilt
-        by (:meth:`~stairbot.tilt.TiltWatch.stale`): every motor stops, the
+        by (:meth:`~stairbot.control.tilt.TiltWatch.stale`): every motor stops, the
         lifts hold, the timers stand, for up to SENSOR_WAIT_S; then the program
         ends with the error.  True while holding."""
         ctx = self._ctx
