@@ -45,7 +45,7 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotOptions, open_robot
+from stairbot.run.robots import RobotOptions, open_robot
 
 TICK_S = 0.02
 GROUP = "239.74.163.{}"

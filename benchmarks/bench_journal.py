@@ -28,9 +28,9 @@ from typing import Any
 
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.journal import JournalWriter, mark_path
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
+from stairbot.run.journal import JournalWriter, mark_path
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 
 def recorded_ticks(n: int) -> list[dict[str, Any]]:

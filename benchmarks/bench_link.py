@@ -30,7 +30,7 @@ from stairbot.drivers.serial_robot import open_serial_robot
 from stairbot.drivers.serial_wire import Frame, encode_frame
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotOptions
+from stairbot.run.robots import RobotOptions
 
 BAUD = 1_000_000
 BITS_PER_BYTE = 10  # 8N1

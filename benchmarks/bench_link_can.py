@@ -36,7 +36,7 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotOptions
+from stairbot.run.robots import RobotOptions
 
 # The cycle and its statistics are the serial benchmark's (this file's folder
 # is on the path whether it runs alone or from bench_link.py).

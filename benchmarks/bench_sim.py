@@ -32,8 +32,8 @@ from typing import Any
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 
 def full_run(config: RobotConfig, scenario: Scenario) -> tuple[RunResult, float]:

@@ -21,8 +21,8 @@ from stairbot.control.algorithm.controller import Controller
 from stairbot.hardware import Snapshot
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario, shipped_scenarios
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 
 @dataclass

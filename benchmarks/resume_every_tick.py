@@ -25,8 +25,8 @@ from stairbot.errors import StairbotError
 from stairbot.fakes.host_kills import journaled_run
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.journal import JournalState, mark_path, read_journal
-from stairbot.resume import check, restored_context
+from stairbot.run.journal import JournalState, mark_path, read_journal
+from stairbot.run.resume import check, restored_context
 
 
 def record(scenario_name: str | None, journal: Path) -> str:

@@ -30,8 +30,8 @@ import sys
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Clock
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 
 class StallingClock:

@@ -34,6 +34,7 @@ from stairbot.cli_show import (
     EXIT_INPUT,
     EXIT_OK,
     PROG,
+    ask,
     cmd_config_show,
     cmd_scenario_check,
     cmd_scenario_list,
@@ -53,9 +54,9 @@ from stairbot.inputs.scenario import (
     expectation_mismatches,
     load_scenario,
 )
-from stairbot.paths import unused_path
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
-from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
+from stairbot.run.paths import unused_path
+from stairbot.run.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 from stairbot.text import printable
 
 EXIT_MISMATCH, EXIT_INTERRUPTED = 1, 130
@@ -326,18 +327,18 @@ def cmd_run(args: argparse.Namespace) -> int:
     """``stairbot run``: open the robot, run the program, summarise, judge."""
     config, scenario = _load_inputs(args)
     # Imported here: the runner pulls in the controller, which `config show` needs not.
-    from stairbot.cli_journal import (
+    from stairbot.control.algorithm.phases import Mode
+    from stairbot.run.journaled import (
         NotConfirmed,
         journal_path,
         set_aside,
         start_journal,
         unfinished,
     )
-    from stairbot.cli_journal import resume as resume_run
-    from stairbot.control.algorithm.phases import Mode
-    from stairbot.resume import ResumeRefused
-    from stairbot.robots import RobotOptions, open_robot
-    from stairbot.runner import RunControl, run
+    from stairbot.run.journaled import resume as resume_run
+    from stairbot.run.resume import ResumeRefused
+    from stairbot.run.robots import RobotOptions, open_robot
+    from stairbot.run.runner import RunControl, run
 
     progress: TextIO = sys.stderr if args.json else sys.stdout
     options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale,
@@ -419,7 +420,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                 tap = record.tick
             if args.resume:
                 resumed = resume_run(path, args.robot, session, config, sink, yes=args.yes,
-                                     out=progress)
+                                     out=progress, confirm=ask)
                 controller, journal = resumed.controller, resumed.journal
             else:
                 journal = start_journal(path, args.robot, session, config, scenario.name, mode)

@@ -27,7 +27,7 @@ from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.handshake import latch_names
 from stairbot.errors import HardwareError
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotOptions, open_robot
+from stairbot.run.robots import RobotOptions, open_robot
 
 EXIT_FAILED = 1
 
@@ -46,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _say_unfinished(url: str) -> None:
     """Say so when the robot's journal holds a run that did not finish."""
-    from stairbot.cli_journal import default_path, unfinished
+    from stairbot.run.journaled import default_path, unfinished
 
     path = default_path(url)
     left = None if path is None else unfinished(path)

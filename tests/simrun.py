@@ -7,8 +7,8 @@ from stairbot.control.algorithm.phases import Mode
 from stairbot.events import Event, discard
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 
 def run_sim(config: RobotConfig, scenario: Scenario,

@@ -15,7 +15,7 @@ from simrun import run_sim
 from stairbot.events import Event
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario, parse_scenario
-from stairbot.runner import RunResult
+from stairbot.run.runner import RunResult
 from stairbot.sweep.spec import SpecError, load_spec, with_config
 
 REFERENCE = load_config("reference")

@@ -51,7 +51,7 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
 
 CONFIG: RobotConfig = load_config()
 SCENARIO: Scenario = load_scenario()

@@ -12,8 +12,8 @@ from stairbot.control.algorithm.controller import Controller
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import Robot, Snapshot, Speeds
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunControl, run
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunControl, run
 
 CONFIG = load_config()
 

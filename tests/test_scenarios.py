@@ -11,7 +11,7 @@ from stairbot.events import Event, EventKind
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import Scenario, expectation_mismatches, load_scenario, parse_scenario
 from stairbot.inputs.scenario import shipped_scenarios as shipped
-from stairbot.runner import RunResult
+from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
 IDEAL = load_config("ideal")

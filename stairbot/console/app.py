@@ -29,7 +29,6 @@ from textual.screen import Screen
 from textual.widget import Widget
 from textual.widgets import Footer
 
-from stairbot.cli_journal import ResumePlan
 from stairbot.console import motion_gate
 from stairbot.console.freshness import age_key, age_words, is_stale
 from stairbot.console.help import HelpScreen
@@ -54,8 +53,9 @@ from stairbot.console.words import carried_by
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig, load_config
-from stairbot.reckon import dead_reckon
-from stairbot.top_view import RobotShape
+from stairbot.run.journaled import ResumePlan
+from stairbot.views.reckon import dead_reckon
+from stairbot.views.top_view import RobotShape
 
 REFRESH_HZ = 10.0
 GRAPHS_ROWS = 36

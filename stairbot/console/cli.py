@@ -22,8 +22,8 @@ from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.paths import unused_path
-from stairbot.robots import known_schemes
+from stairbot.run.paths import unused_path
+from stairbot.run.robots import known_schemes
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -17,7 +17,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, TypedDict
 
-from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume, start_journal
 from stairbot.console.climb_gate import MidClimb, after_run, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.state import LiveState
@@ -29,14 +28,15 @@ from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import HasScene, HasTruth, ReportsEvents, Snapshot
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.journal import JournalWriter
-from stairbot.paths import unused_path
 from stairbot.recording.record import JsonLinesRecord, RecordsTicks, is_mcap
-from stairbot.resume import ResumeRefused
-from stairbot.robots import RobotOptions, RobotSession
-from stairbot.runner import RunControl, RunResult
-from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
-from stairbot.top_view import TopPlan, TopPose, plan_of, top_pose
+from stairbot.run.journal import JournalWriter
+from stairbot.run.journaled import ResumePlan, carry_on, default_path, plan_resume, start_journal
+from stairbot.run.paths import unused_path
+from stairbot.run.resume import ResumeRefused
+from stairbot.run.robots import RobotOptions, RobotSession
+from stairbot.run.runner import RunControl, RunResult
+from stairbot.views.side_view import SceneView, scene_view, stairs_from_scenario
+from stairbot.views.top_view import TopPlan, TopPose, plan_of, top_pose
 
 if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
     from stairbot.recording.mcap_sink import McapRecord
@@ -83,14 +83,14 @@ class EngineHooks(TypedDict, total=False):
 
 def _default_open(url: str, config: RobotConfig, scenario: Scenario,
                   options: RobotOptions) -> RobotSession:
-    from stairbot.robots import open_robot
+    from stairbot.run.robots import open_robot
 
     return open_robot(url, config, replace(options, world=scenario))
 
 
 def _default_run(session: RobotSession, config: RobotConfig, sink: EventSink,
                  mode: str, control: RunControl, on_tick: OnTick, plan: RunPlan) -> RunResult:
-    from stairbot.runner import run
+    from stairbot.run.runner import run
 
     return run(session, config, sink, _mode(mode), control, on_tick=on_tick,
                controller=plan.controller, journal=plan.journal)

@@ -40,7 +40,7 @@ from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, 
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import Clock, Imu, SensorId, SensorReading, Snapshot, Speeds
 from stairbot.inputs.config import RobotConfig
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 # The emergency stop (docs/protocol.md, "Emergency stop"): each press puts
 # ESTOP_COPIES EStop frames to each board on the wire at once, sends the

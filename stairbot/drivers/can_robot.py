@@ -92,7 +92,7 @@ from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
 from stairbot.inputs.config import RobotConfig
-from stairbot.robots import RobotOptions, RobotSession
+from stairbot.run.robots import RobotOptions, RobotSession
 
 OPTION_DEFAULTS: dict[str, float] = {
     "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,

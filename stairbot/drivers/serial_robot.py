@@ -62,7 +62,7 @@ from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
 from stairbot.inputs.config import RobotConfig
-from stairbot.robots import RobotOptions, RobotSession
+from stairbot.run.robots import RobotOptions, RobotSession
 
 DEFAULTS: dict[str, float] = {
     "baud": 1_000_000, "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250,

@@ -34,7 +34,7 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
+from stairbot.run.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 
 _probability = bounded(0.0, 1.0, " (a probability)")
 

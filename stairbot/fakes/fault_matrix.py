@@ -46,7 +46,6 @@ from typing import Any, cast
 
 import can
 
-from stairbot.cli_journal import resume, start_journal
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode
 from stairbot.drivers import messages as m
@@ -61,10 +60,11 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import Snapshot
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import parse_scenario
-from stairbot.journal import read_journal
-from stairbot.resume import ResumeRefused
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.journal import read_journal
+from stairbot.run.journaled import resume, start_journal
+from stairbot.run.resume import ResumeRefused
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 SCENARIO = """
 name = "fault_matrix"

@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from stairbot.cli_journal import default_path, start_journal
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import HardwareError
@@ -47,8 +46,9 @@ from stairbot.fakes.fault_matrix import (
 from stairbot.hardware import Snapshot
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import Scenario, parse_scenario
-from stairbot.journal import mark_path
-from stairbot.runner import RunResult, run
+from stairbot.run.journal import mark_path
+from stairbot.run.journaled import default_path, start_journal
+from stairbot.run.runner import RunResult, run
 
 POINTS = ("first", "middle", "last")
 """Where in a phase's ticks the host is killed."""
@@ -79,7 +79,7 @@ class Killed:
 def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
     """Fake boards on ``wire`` running the flight with a journal at
     ``journal`` (None: where a run on them keeps it by default,
-    :func:`~stairbot.cli_journal.default_path`), the host killed after tick
+    :func:`~stairbot.run.journaled.default_path`), the host killed after tick
     ``tick``, the world run on
     :data:`HOST_DEAD_S` and the boards listening again; closed when the
     block ends.  AssertionError when the run ends before that tick."""

@@ -55,7 +55,7 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.robots import RobotOptions, RobotSession
+from stairbot.run.robots import RobotOptions, RobotSession
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
 

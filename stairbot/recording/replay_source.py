@@ -54,7 +54,7 @@ from stairbot.recording.read import (
     recording_bytes,
     scan_mcap,
 )
-from stairbot.side_view import SceneView
+from stairbot.views.side_view import SceneView
 
 MCAP_SUFFIXES = (".mcap",)
 JSONL_SUFFIXES = (".jsonl", ".ndjson")

@@ -74,8 +74,8 @@ def run_case(case: Case) -> dict[str, Any]:
         from stairbot.control.algorithm.phases import Mode
         from stairbot.inputs.config import load_config, parse_config
         from stairbot.inputs.scenario import parse_scenario
-        from stairbot.robots import RobotOptions, open_robot
-        from stairbot.runner import run
+        from stairbot.run.robots import RobotOptions, open_robot
+        from stairbot.run.runner import run
 
         scenario = parse_scenario(case.scenario_text, f"<case {case.index}>")
         config = (load_config() if case.config_text is None

@@ -22,8 +22,8 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotSession
-from stairbot.side_view import stairs_from_scenario
+from stairbot.run.robots import RobotSession
+from stairbot.views.side_view import stairs_from_scenario
 
 LIFT = 0.19  # segment 1 raised this far above segment 2, m
 

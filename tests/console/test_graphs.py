@@ -26,7 +26,7 @@ from stairbot.hardware import (
     Snapshot,
 )
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 PER_TURN = load_config().motors.lift_travel_per_turn
 

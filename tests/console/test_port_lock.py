@@ -14,7 +14,7 @@ from pilot import banner, said, until
 
 from stairbot.console.app import build_app
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotSession, open_robot
+from stairbot.run.robots import RobotSession, open_robot
 
 
 @pytest.fixture

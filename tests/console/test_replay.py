@@ -121,7 +121,7 @@ def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[st
 def test_banner_says_replay_and_the_file_and_no_robot_is_opened(
         recorded: dict[str, Path], monkeypatch: pytest.MonkeyPatch) -> None:
     opened: list[str] = []
-    monkeypatch.setattr("stairbot.robots.open_robot", lambda url, *a, **k: opened.append(url))
+    monkeypatch.setattr("stairbot.run.robots.open_robot", lambda url, *a, **k: opened.append(url))
 
     async def go() -> None:
         app = replay_app(recorded["mcap"], Clock())

@@ -20,7 +20,7 @@ from stairbot.console.history import COLUMNS, NOT_CARRIED, SERIES, column, row_o
 from stairbot.errors import LinkLostError
 from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
 from stairbot.inputs.config import RobotConfig, load_config, parse_config
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 SIDE_CONFIG: RobotConfig = parse_config(
     'extends = "reference"\n[sensors]\nside_model = "vl53l0x"\n', "side.toml")

@@ -25,8 +25,8 @@ from stairbot.errors import LinkLostError
 from stairbot.hardware import Snapshot, Truth
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotSession
-from stairbot.top_view import TopPose, plan_of
+from stairbot.run.robots import RobotSession
+from stairbot.views.top_view import TopPose, plan_of
 
 BRAILLE = {chr(c) for c in range(0x2801, 0x2900)}
 README = Path(__file__).parents[2] / "stairbot" / "console" / "README.md"

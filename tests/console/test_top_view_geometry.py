@@ -1,4 +1,4 @@
-"""The top view's geometry (stairbot/top_view.py): the stairwell seen from
+"""The top view's geometry (stairbot/views/top_view.py): the stairwell seen from
 above is the simulation's (fakes/landing.py), face for face; the footprint
 is the one the simulation checks; the pose comes from Truth."""
 
@@ -15,7 +15,7 @@ from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import Truth
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, load_scenario, parse_scenario
-from stairbot.top_view import (
+from stairbot.views.top_view import (
     FLOOR_BEHIND,
     FOOTPRINT_MARGIN,
     LANDING,

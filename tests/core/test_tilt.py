@@ -20,8 +20,8 @@ from stairbot.events import Event, EventKind
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run as run_session
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run as run_session
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 SAFETY = CFG.safety

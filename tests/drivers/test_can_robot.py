@@ -31,7 +31,7 @@ from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Clock, HasTruth, MotorId
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotOptions, open_robot
+from stairbot.run.robots import RobotOptions, open_robot
 
 _names = itertools.count()
 FORWARD = {MotorId.MWF: 1.0, MotorId.MWB: 1.0, MotorId.MWR: 1.0, MotorId.MWL: 1.0}

@@ -26,8 +26,8 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 WIRE_TICKS = 3
 """How many ticks apart a phase change over the wire may come from sim://'s."""

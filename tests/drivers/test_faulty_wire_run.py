@@ -25,8 +25,8 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotSession, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 FAULTS = {
     "drop": {"drop": 0.05},

@@ -29,7 +29,7 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotSession, open_robot
+from stairbot.run.robots import RobotSession, open_robot
 
 _names = itertools.count()
 DBC = str(resources.files("stairbot.drivers").joinpath("stairbot.dbc"))

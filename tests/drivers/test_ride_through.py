@@ -21,7 +21,7 @@ from stairbot.drivers.serial_wire import Frame
 from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.errors import RobotUrlError
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotOptions, open_robot
+from stairbot.run.robots import RobotOptions, open_robot
 
 _names = itertools.count()
 MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)

@@ -36,8 +36,8 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import BASE_SENSORS, HasTruth, MotorId, SensorId
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import Scenario, load_scenario
-from stairbot.robots import RobotSession, open_robot
-from stairbot.runner import run
+from stairbot.run.robots import RobotSession, open_robot
+from stairbot.run.runner import run
 
 CONFIG: RobotConfig = load_config()
 SCENARIO: Scenario = load_scenario()

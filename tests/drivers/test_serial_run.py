@@ -13,8 +13,8 @@ from lockstep_boards import lockstep_boards
 
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "fell")
 

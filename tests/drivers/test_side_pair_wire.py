@@ -30,7 +30,7 @@ from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
 from stairbot.hardware import BASE_SENSORS, SIDE_SENSORS, MotorId, SensorId, SensorStatus
 from stairbot.inputs.config import RobotConfig, load_config, parse_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotSession, open_robot
+from stairbot.run.robots import RobotSession, open_robot
 
 SIDE_CONFIG: RobotConfig = parse_config(
     'extends = "reference"\n[sensors]\nside_model = "vl53l0x"\n', "side.toml")

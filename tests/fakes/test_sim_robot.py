@@ -24,7 +24,7 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, parse_scenario
-from stairbot.robots import RobotOptions
+from stairbot.run.robots import RobotOptions
 
 CFG = load_config("ideal")  # the simulation's mechanics, read with one exact ray
 TICK = CFG.algorithm.tick

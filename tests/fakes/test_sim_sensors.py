@@ -16,8 +16,8 @@ from stairbot.fakes.world import WorldParams
 from stairbot.hardware import SensorId
 from stairbot.inputs.config import Safety, load_config
 from stairbot.inputs.scenario import parse_scenario
-from stairbot.robots import RobotSession
-from stairbot.runner import run
+from stairbot.run.robots import RobotSession
+from stairbot.run.runner import run
 
 CFG = load_config("ideal")  # one level ray, fresh at every read
 TICK = CFG.algorithm.tick

@@ -15,7 +15,7 @@ import pytest
 
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.inputs.config import RobotConfig, load_config
-from stairbot.robots import RobotSession, open_robot
+from stairbot.run.robots import RobotSession, open_robot
 
 URL_VARIABLE = "STAIRBOT_HW_URL"
 

@@ -18,7 +18,7 @@ from stairbot.recording.pose import (
     side_pose,
     stair_blocks,
 )
-from stairbot.side_view import stairs_from_scenario
+from stairbot.views.side_view import stairs_from_scenario
 
 
 def rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]

@@ -13,8 +13,8 @@ from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import parse_scenario
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 CONFIG = load_config()
 

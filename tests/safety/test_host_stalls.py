@@ -19,8 +19,8 @@ from stairbot.control.algorithm.phases import Phase
 from stairbot.events import Event
 from stairbot.hardware import Clock, Snapshot
 from stairbot.inputs.config import load_config
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 CFG = load_config()
 NOT_SEEN = "they were not seen crossing it"

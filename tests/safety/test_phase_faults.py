@@ -18,8 +18,8 @@ import pytest
 from stairbot.events import Event, EventKind
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, parse_scenario
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 CONFIG = load_config()
 STAIRS = """

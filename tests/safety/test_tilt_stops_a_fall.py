@@ -25,8 +25,8 @@ from stairbot.control.algorithm.stability import UNSTABLE
 from stairbot.hardware import ZERO_SPEEDS, HasTruth, MotorId
 from stairbot.inputs.config import RobotConfig, load_config
 from stairbot.inputs.scenario import load_scenario
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 HOLD_S = 3.0
 """After the run, the robot is left standing this long with every motor at 0."""

@@ -1,4 +1,4 @@
-"""Reading a run journal back (:mod:`stairbot.journal` writes it), every line
+"""Reading a run journal back (:mod:`stairbot.run.journal` writes it), every line
 checked before a resume trusts any of it.
 
 :func:`read_journal` refuses the journal -- one :class:`JournalError`

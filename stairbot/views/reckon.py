@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 from stairbot.hardware import WHEEL_MOTORS, MotorId, Snapshot
 from stairbot.inputs.config import RobotConfig
-from stairbot.side_view import Point, SceneView
+from stairbot.views.side_view import Point, SceneView
 
 
 def ground_at(stairs: Sequence[Point], x: float) -> float:

@@ -31,8 +31,8 @@ from stairbot.hardware import (
     Truth,
 )
 from stairbot.inputs.config import RobotConfig
-from stairbot.journal import JournalWriter
-from stairbot.robots import RobotSession
+from stairbot.run.journal import JournalWriter
+from stairbot.run.robots import RobotSession
 
 Latch = Literal["estop", "clear"]
 

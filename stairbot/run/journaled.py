@@ -1,5 +1,6 @@
-"""``stairbot run``'s journal and ``--resume`` (the journal's format:
-:mod:`stairbot.journal`; what a resume checks: :mod:`stairbot.resume`).
+"""A run's journal and its resume, as ``stairbot run``, the console and the
+fake-board harnesses keep them (the journal's format:
+:mod:`stairbot.run.journal`; what a resume checks: :mod:`stairbot.run.resume`).
 
 A run on boards (``serial://``, ``can://``) keeps a journal by default, at
 ``$XDG_STATE_HOME/stairbot/journal-<robot>.jsonl`` (``~/.local/state`` when
@@ -24,14 +25,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
-from stairbot.cli_show import ask
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode
 from stairbot.events import EventSink
 from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
 from stairbot.inputs.config import RobotConfig
-from stairbot.journal import (
+from stairbot.run.journal import (
     MAX_LINE,
     JournalError,
     JournalState,
@@ -40,10 +40,10 @@ from stairbot.journal import (
     mark_path,
     read_journal,
 )
-from stairbot.paths import unused_path
-from stairbot.resume import ResumeRefused, check, describe, restored_context
-from stairbot.robots import RobotSession
-from stairbot.runner import board_identity
+from stairbot.run.paths import unused_path
+from stairbot.run.resume import ResumeRefused, check, describe, restored_context
+from stairbot.run.robots import RobotSession
+from stairbot.run.runner import board_identity
 from stairbot.text import printable
 
 
@@ -245,11 +245,12 @@ def carry_on(plan: ResumePlan, session: RobotSession, config: RobotConfig,
 
 def resume(path: Path | None, url: str, session: RobotSession, config: RobotConfig,
            sink: EventSink, *, yes: bool, out: TextIO,
-           confirm: Callable[[str], bool] = ask) -> Resumed:
+           confirm: Callable[[str], bool] = lambda _question: False) -> Resumed:
     """Check the journal's run against the boards, say where the robot
-    believes it is, and -- once the operator confirms -- clear the boards'
-    latches and hand back the restored controller.  ResumeRefused (one line)
-    otherwise; nothing has moved then."""
+    believes it is, and -- once the operator confirms (``yes``, or
+    ``confirm`` answers the question true; ``stairbot run`` asks on the
+    terminal) -- clear the boards' latches and hand back the restored
+    controller.  ResumeRefused (one line) otherwise; nothing has moved then."""
     plan = plan_resume(path, url, session, config)
     for line in plan.lines:
         print(f"resume: {printable(line)}", file=out)

@@ -21,7 +21,7 @@ durable, and that line's hash; the fsync thread rewrites it (and fsyncs it)
 after each fsync of the journal.  A journal whose lines end before its mark's
 was cut short after it was written -- not by a killed host, which leaves
 every line it wrote, nor by a power loss, which costs only lines after the
-mark -- and is not resumed (:mod:`stairbot.journal_read` checks all this).
+mark -- and is not resumed (:mod:`stairbot.run.journal_read` checks all this).
 
 * ``{"kind": "start", "seq", "prev", "run_id", "format", "url", "config",
   "config_sha256", "scenario", "mode", "boards", "time_s"}`` -- a run began
@@ -60,7 +60,7 @@ from typing import Any
 
 from stairbot.errors import OutputError
 from stairbot.files import LineFile, refused, shown
-from stairbot.journal_read import (
+from stairbot.run.journal_read import (
     FORMAT,
     MAX_LINE,
     JournalError,

@@ -1,7 +1,7 @@
 """Carrying on a run that a host left unfinished (``stairbot run --resume``).
 
-The journal (:mod:`stairbot.journal`) has been read and checked whole
-(:func:`~stairbot.journal_read.read_journal`); what it says of the run is
+The journal (:mod:`stairbot.run.journal`) has been read and checked whole
+(:func:`~stairbot.run.journal_read.read_journal`); what it says of the run is
 checked here against the boards as they are now and the robot's config,
 before anything moves -- before the boards' latches are cleared:
 
@@ -37,7 +37,7 @@ from typing import Any
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.errors import InputError, StairbotError
-from stairbot.journal import JournalError, JournalState
+from stairbot.run.journal import JournalError, JournalState
 
 
 class ResumeRefused(StairbotError):
