@@ -47,7 +47,8 @@ def test_every_module_is_listed_once() -> None:
 def test_the_core_modules_are_found() -> None:
     names = core_modules()
     for expected in ("stairbot.inputs.config", "stairbot.inputs.scenario", "stairbot.hardware",
-                     "stairbot.events", "stairbot.cli", "stairbot.control.algorithm.controller"):
+                     "stairbot.events", "stairbot.cli.command",
+                     "stairbot.control.algorithm.controller"):
         assert expected in names
 
 

@@ -27,7 +27,7 @@ import sys
 from collections.abc import Callable
 from importlib import import_module
 
-from stairbot.cli import bounded
+from stairbot.args import bounded
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults

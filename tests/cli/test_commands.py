@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.cli import EXTERNAL, main
+from stairbot.cli.command import EXTERNAL, main
 from stairbot.inputs.scenario import shipped_scenarios
 
 

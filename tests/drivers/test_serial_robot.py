@@ -16,7 +16,7 @@ import pytest
 import serial
 import serial.rfc2217
 
-from stairbot.cli_clear import main as clear_main
+from stairbot.cli.clear import main as clear_main
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_robot import parse_serial_url

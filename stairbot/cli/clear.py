@@ -21,7 +21,7 @@ import argparse
 import sys
 from collections.abc import Callable
 
-from stairbot.cli_show import EXIT_INPUT, EXIT_OK, PROG, ask
+from stairbot.cli.common import EXIT_INPUT, EXIT_OK, PROG, ask
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.handshake import latch_names

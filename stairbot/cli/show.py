@@ -1,6 +1,5 @@
 """The ``stairbot`` commands that show inputs: ``config show``, ``scenario
-check``, ``scenario list`` (the parser and the run are in :mod:`stairbot.cli`);
-and what every command shares: its name, the exit codes, and :func:`ask`."""
+check``, ``scenario list`` (the parser is in :mod:`stairbot.cli.command`)."""
 
 from __future__ import annotations
 
@@ -8,24 +7,11 @@ import argparse
 import json
 import sys
 
+from stairbot.cli.common import EXIT_INPUT, EXIT_OK, PROG
 from stairbot.errors import InputError
 from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, load_scenario, shipped_scenarios
 from stairbot.text import printable
-
-PROG = "stairbot"
-EXIT_OK, EXIT_INPUT = 0, 2
-
-
-def ask(prompt: str) -> bool:
-    """The operator's answer on the terminal (no terminal: no)."""
-    if not sys.stdin.isatty():
-        return False
-    try:
-        return input(prompt).strip().lower() in ("y", "yes")
-    except EOFError:
-        return False
-
 
 # -- config show ---------------------------------------------------------------------
 
