@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 from stairbot.hardware import Imu, Snapshot
-from stairbot.inputs.config import Safety
+from stairbot.inputs.sections import Safety
 
 STOPPED = "every motor stopped, lifts holding"
 _INF = math.inf

@@ -18,7 +18,7 @@ from typing import Any
 
 from stairbot.fakes.sensor_model import SensorModel
 from stairbot.inputs import sensor_specs as specs
-from stairbot.inputs.config import Sensors
+from stairbot.inputs.sections import Sensors
 from stairbot.inputs.sensor_specs import SensorSpec
 
 

@@ -42,8 +42,9 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.inputs.config import ConfigFile, RobotConfig
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.schema import convert
+from stairbot.inputs.sections import ConfigFile
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES, pitch_of
 from stairbot.recording.read import (

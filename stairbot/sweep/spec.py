@@ -43,9 +43,10 @@ import msgspec
 import msgspec.inspect as mi
 
 from stairbot.errors import ConfigError, InputError
-from stairbot.inputs.config import ConfigFile, config_table
+from stairbot.inputs.config import config_table
 from stairbot.inputs.scenario import ScenarioFile
 from stairbot.inputs.schema import _tokens, _type_at, convert, load_toml, read_text
+from stairbot.inputs.sections import ConfigFile
 from stairbot.sweep import tomlw
 from stairbot.text import check_line, printable
 

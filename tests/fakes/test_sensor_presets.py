@@ -17,8 +17,9 @@ from stairbot.fakes.sensor_model import Cause, ModelSensor, SensorModel, combine
 from stairbot.fakes.sensor_presets import HCSR04, IDEAL, PRESETS, VL53L0X, preset
 from stairbot.fakes.sim import SimRobot
 from stairbot.hardware import SensorId, SensorStatus
-from stairbot.inputs.config import SensorModelName, load_config
+from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Fault, load_scenario
+from stairbot.inputs.sections import SensorModelName
 
 SFL = SensorId.SFL
 

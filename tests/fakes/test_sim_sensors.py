@@ -14,8 +14,9 @@ import pytest
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.fakes.world import WorldParams
 from stairbot.hardware import SensorId
-from stairbot.inputs.config import Safety, load_config
+from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import parse_scenario
+from stairbot.inputs.sections import Safety
 from stairbot.run.robots import RobotSession
 from stairbot.run.runner import run
 
