@@ -26,7 +26,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.journal import JournalWriter, mark_path
 from stairbot.run.robots import RobotOptions, open_robot

@@ -24,12 +24,12 @@ import tempfile
 import time
 from pathlib import Path
 
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.serial_robot import open_serial_robot
 from stairbot.drivers.serial_wire import Frame, encode_frame
 from stairbot.hardware import MotorId
-from stairbot.inputs.config import load_config
 from stairbot.run.robots import RobotOptions
 
 BAUD = 1_000_000

@@ -29,8 +29,9 @@ import statistics
 import time
 from typing import Any
 
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import MotorId
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult, run

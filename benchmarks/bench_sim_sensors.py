@@ -33,8 +33,8 @@ import statistics
 import time
 from collections.abc import Callable
 
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.sim import SimClock, SimRobot
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 
 

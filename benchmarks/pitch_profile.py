@@ -18,8 +18,8 @@ import argparse
 from dataclasses import dataclass
 
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import Snapshot
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario, shipped_scenarios
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import run

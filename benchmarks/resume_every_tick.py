@@ -21,9 +21,9 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from stairbot.control.robot_config import load_config
 from stairbot.errors import StairbotError
 from stairbot.fakes.host_kills import journaled_run
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.journal import JournalState, mark_path, read_journal
 from stairbot.run.resume import check, restored_context

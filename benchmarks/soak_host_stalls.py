@@ -27,9 +27,9 @@ import collections
 import random
 import sys
 
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Clock
-from stairbot.inputs.config import load_config
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import run
 

@@ -12,8 +12,9 @@ from pathlib import Path
 import pytest
 from simrun import run_sim
 
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario, parse_scenario
 from stairbot.run.runner import RunResult
 from stairbot.sweep.spec import SpecError, load_spec, with_config
@@ -38,12 +39,12 @@ def test_the_default_stairs_up_and_back() -> None:
 
 def test_its_cone_raises_the_lowest_rise_it_measures_a_tread_against() -> None:
     ideal = load_config("ideal")
-    assert ideal.min_rise_for(0.5) == ideal.min_step_rise_m  # a level ray
+    assert ideal.min_rise_for(0.5) == limits.min_step_rise_m(ideal)  # a level ray
     top = math.radians(7.5 + 15.0 / 2)
     ref = REFERENCE
     assert ref.front_cone_top_rad == pytest.approx(top)
     assert ref.min_rise_for(0.30) - ref.min_rise_for(0.26) == pytest.approx(0.04 * math.tan(top))
-    assert ref.min_step_rise_m == pytest.approx(ref.min_rise_for(ref.min_tread_m))
+    assert limits.min_step_rise_m(ref) == pytest.approx(ref.min_rise_for(limits.min_tread_m(ref)))
 
 
 def test_a_rise_too_low_for_its_cone_is_refused_and_it_comes_home() -> None:
@@ -76,11 +77,13 @@ def test_refused_at_the_first_step_it_comes_back_by_the_odometer() -> None:
 
 
 def test_square_range_is_where_the_cone_rises_to_the_lowest_riser_it_climbs() -> None:
-    assert load_config("ideal").square_range_m == math.inf  # a level ray squares up from anywhere
+    # a level ray squares up from anywhere
+    assert limits.square_range_m(load_config("ideal")) == math.inf
     ref = REFERENCE
-    expected = (ref.min_step_rise_m - ref.sensors.front_height) / math.tan(ref.front_cone_top_rad)
-    assert ref.square_range_m == pytest.approx(expected)
-    assert ref.SAFE_DISTANCE_IN_FRONT_OF_STEP < ref.square_range_m < 0.4
+    rise = limits.min_step_rise_m(ref)
+    expected = (rise - ref.sensors.front_height) / math.tan(ref.front_cone_top_rad)
+    assert limits.square_range_m(ref) == pytest.approx(expected)
+    assert ref.SAFE_DISTANCE_IN_FRONT_OF_STEP < limits.square_range_m(ref) < 0.4
 
 
 FAR_ASKEW = """

@@ -28,6 +28,7 @@ from dataclasses import dataclass, replace
 import can
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -49,7 +50,7 @@ from stairbot.hardware import (
     Snapshot,
     Truth,
 )
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.run.robots import RobotOptions, RobotSession, open_robot
 

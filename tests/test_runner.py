@@ -9,9 +9,9 @@ import threading
 from collections.abc import Callable
 
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import Robot, Snapshot, Speeds
-from stairbot.inputs.config import load_config
 from stairbot.run.robots import RobotOptions, RobotSession, open_robot
 from stairbot.run.runner import RunControl, run
 

@@ -11,8 +11,10 @@ from pathlib import Path
 import pytest
 from simrun import run_sim
 
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event
-from stairbot.inputs.config import load_config, shipped_configs
+from stairbot.inputs.config import shipped_configs
 from stairbot.inputs.scenario import expectation_mismatches, load_scenario, parse_scenario
 
 
@@ -59,9 +61,9 @@ def test_the_ir_robot_closes_in_to_square_up_where_its_noise_allows() -> None:
     from stairbot.control.perception import quiet_range_m, square_tolerance
 
     ir = load_config("ir")
-    assert ir.square_range_m == quiet_range_m(ir) < 0.4
-    assert square_tolerance(ir, ir.square_range_m) <= ir.algorithm.equal_tolerance + 1e-9
-    assert square_tolerance(ir, ir.square_range_m + 0.01) > ir.algorithm.equal_tolerance
+    assert limits.square_range_m(ir) == quiet_range_m(ir) < 0.4
+    assert square_tolerance(ir, limits.square_range_m(ir)) <= ir.algorithm.equal_tolerance + 1e-9
+    assert square_tolerance(ir, limits.square_range_m(ir) + 0.01) > ir.algorithm.equal_tolerance
     assert quiet_range_m(load_config("ideal")) == math.inf
     events: list[Event] = []
     r = run_sim(ir, parse_scenario(IR_FAR_START, "ir_far_start"), events)

@@ -22,11 +22,11 @@ import sys
 from collections.abc import Callable
 
 from stairbot.cli.common import EXIT_INPUT, EXIT_OK, PROG, ask
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.handshake import latch_names
 from stairbot.errors import HardwareError
-from stairbot.inputs.config import load_config
 from stairbot.run.robots import RobotOptions, open_robot
 
 EXIT_FAILED = 1

@@ -17,9 +17,11 @@ from types import FrameType
 from typing import Any, TextIO
 
 from stairbot.cli.common import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_MISMATCH, EXIT_OK, PROG, ask
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.errors import HardwareError, InputError, LatchedError, NoBoardError
 from stairbot.events import Event, EventKind
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, expectation_mismatches, load_scenario
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
 from stairbot.run.paths import unused_path
@@ -208,9 +210,10 @@ def cmd_run(args: argparse.Namespace) -> int:
             session.close()
             raise
         if not args.quiet:
-            if config.narrow_steps_refusal is not None:
-                print(f"narrow_steps refused: {config.narrow_steps_refusal}; treads down to "
-                      f"min_tread_m = {config.min_tread_m:.3f} m only", file=progress)
+            refusal = limits.narrow_steps_refusal(config)
+            if refusal is not None:
+                print(f"narrow_steps refused: {refusal}; treads down to "
+                      f"min_tread_m = {limits.min_tread_m(config):.3f} m only", file=progress)
             what = f" ({scenario.description})" if scenario.description else ""
             verb = "resuming" if args.resume else "running"
             line = (f"{verb} {scenario.name}{what} on {args.robot}"

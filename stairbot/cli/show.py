@@ -8,8 +8,9 @@ import json
 import sys
 
 from stairbot.cli.common import EXIT_INPUT, EXIT_OK, PROG
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, load_scenario, shipped_scenarios
 from stairbot.text import printable
 
@@ -28,7 +29,7 @@ def _unit(name: str) -> str:
 def cmd_config_show(args: argparse.Namespace) -> int:
     """``stairbot config show``: the resolved config and its derived values."""
     cfg = load_config(args.config)
-    data = cfg.to_dict()
+    data = limits.config_dict(cfg)
     if args.json:
         print(json.dumps(data, indent=2, sort_keys=True))
         return EXIT_OK
@@ -44,7 +45,7 @@ def cmd_config_show(args: argparse.Namespace) -> int:
     width = max(len(k) for k in data["derived"])
     for key, value in data["derived"].items():
         print(f"{key:<{width}} = {value:<10g} # {_unit(key)}")
-    refusal = cfg.narrow_steps_refusal
+    refusal = limits.narrow_steps_refusal(cfg)
     if refusal is not None:
         print(f"# narrow_steps refused: {refusal}: min_tread_m stays LENGTH_OF_A_ROBOT + "
               "SAFE_LENGTH")

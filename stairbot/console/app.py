@@ -50,9 +50,10 @@ from stairbot.console.widgets.sensors import SensorPanel
 from stairbot.console.widgets.top_view import TopViewPicture
 from stairbot.console.widgets.trends import TrendsPanel
 from stairbot.console.words import carried_by
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError, StairbotError
 from stairbot.hardware import MotorId
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.run.journaled import ResumePlan
 from stairbot.views.reckon import dead_reckon
 from stairbot.views.top_view import RobotShape

@@ -18,9 +18,9 @@ from urllib.parse import urlsplit
 
 from stairbot.console.runner_thread import SPEEDS
 from stairbot.console.serve import parse_bind, serve
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.paths import unused_path
 from stairbot.run.robots import known_schemes

@@ -31,7 +31,8 @@ from stairbot.console.replay import ReplayPlayer, speed_name
 from stairbot.console.runner_thread import ConsoleEngine
 from stairbot.console.state import StateView
 from stairbot.console.widgets.estop import ESTOP_KEY
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.control.robot_config import load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording.replay_source import ReplaySource
 
 NO_ROBOT = "replay: no robot"

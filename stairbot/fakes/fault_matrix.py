@@ -48,6 +48,7 @@ import can
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import HardwareError, InputError
@@ -58,7 +59,7 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import Snapshot
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.journal import read_journal
 from stairbot.run.journaled import resume, start_journal

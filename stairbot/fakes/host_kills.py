@@ -30,6 +30,7 @@ from pathlib import Path
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode
+from stairbot.control.robot_config import load_config
 from stairbot.errors import HardwareError
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -44,7 +45,7 @@ from stairbot.fakes.fault_matrix import (
     resume_watched,
 )
 from stairbot.hardware import Snapshot
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, parse_scenario
 from stairbot.run.journal import mark_path
 from stairbot.run.journaled import default_path, start_journal

@@ -11,16 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import msgspec
-
 from stairbot.errors import ConfigError
 from stairbot.files import shown
-from stairbot.inputs.config_checks import check_consistency
 from stairbot.inputs.schema import convert, load_toml, read_named, shipped
 from stairbot.inputs.sections import (
     Algorithm,
@@ -35,7 +31,10 @@ from stairbot.inputs.sections import (
 
 @dataclass(frozen=True)
 class RobotConfig:
-    """The resolved config: the file's values plus everything derived from them."""
+    """The resolved config: the file's values plus what follows from them
+    alone (turn counts, lengths, speeds).  What the controller allows a robot
+    (the shortest tread, the lowest riser, narrow steps) is worked out from it
+    by :mod:`stairbot.control.algorithm.limits`."""
 
     source: str
     geometry: Geometry
@@ -144,36 +143,12 @@ class RobotConfig:
         return self.MAX_OF_VERTICAL_TURNS * self.motors.lift_travel_per_turn
 
     @property
-    def min_step_rise_m(self) -> float:
-        """Lowest rise it climbs: :meth:`min_rise_for` the shortest tread it
-        enters.  Lower steps are refused."""
-        return self.min_rise_for(self.min_tread_m)
-
-    @property
     def front_cone_top_rad(self) -> float:
         """How far above level the front pair's highest ray looks: the mount's
         tilt plus half the cone (0 for one level ray)."""
         s = self.sensors
         fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
         return math.radians(max(0.0, s.front_tilt_deg + fov / 2.0))
-
-    @property
-    def square_range_m(self) -> float:
-        """Farthest reading the front pair squares up from at the start.
-        Within it, a cone looking up front_cone_top_rad rises no higher than
-        the lowest riser the robot climbs (min_step_rise_m), so both beams
-        read the first riser alone (farther, the upper rays pass over it and
-        the reading blends the risers beyond); and the pair's stated noise
-        lets it square up to equal_tolerance
-        (:func:`~stairbot.control.perception.quiet_range_m`).  Infinite for level,
-        quiet rays."""
-        # perception builds on the config: imported here, not at the top
-        from stairbot.control.perception import quiet_range_m
-
-        top = self.front_cone_top_rad
-        cone = math.inf if top <= 0.0 else \
-            (self.min_step_rise_m - self.sensors.front_height) / math.tan(top)
-        return min(cone, quiet_range_m(self))
 
     def min_rise_for(self, tread_m: float) -> float:
         """Lowest next riser it can measure a tread of ``tread_m`` against:
@@ -186,63 +161,6 @@ class RobotConfig:
         return self.sensors.front_height + self.algorithm.drive_clearance + 0.01 + reach
 
     @property
-    def min_tread_m(self) -> float:
-        """Shortest tread it enters, measured at the first sight over the riser
-        as the reading less the approach's gap: LENGTH_OF_A_ROBOT + SAFE_LENGTH;
-        with narrow steps (when :attr:`narrow_steps_safe`), LENGTH_OF_FIRST_MODULE
-        + LENGTH_OF_SECOND_MODULE + SAFE_LENGTH."""
-        if self.narrow_steps_safe:
-            return self.LENGTH_OF_FIRST_MODULE + self.LENGTH_OF_SECOND_MODULE + self.SAFE_LENGTH
-        return self.LENGTH_OF_A_ROBOT + self.SAFE_LENGTH
-
-    @cached_property
-    def narrow_steps_margin_m(self) -> float:
-        """How far inside segment 2's wheels the centre of mass stays while
-        segment 2 alone carries the robot, segment 3 at its height (in the air
-        over the step below) and segment 1 anywhere from down to lifted its
-        whole stroke, pitched either way as far as the supervisor lets it
-        (``[safety] max_pitch_deg``): what narrow steps ask of the masses
-        (:mod:`stairbot.control.algorithm.stability`; negative: outside).  Level,
-        any robot that calibrates passes (calibration's lift stands it on
-        segment 2's wheels too); pitched, segment 1 lifted high swings its
-        weight over them, and the lighter the end segments the less."""
-        # the stability check builds on the config: imported here, not at the top
-        from stairbot.control.algorithm.stability import worst
-
-        top = (self.MAX_OF_VERTICAL_TURNS, 0.0)
-        return min(worst(self, (2,), (0.0, 0.0), top, pitch).margin
-                   for pitch in (-self.safety.max_pitch_deg, 0.0, self.safety.max_pitch_deg))
-
-    @property
-    def narrow_steps_refusal(self) -> str | None:
-        """Why ``[algorithm] narrow_steps`` is not safe for this robot, or None
-        (also None when it is not asked for)."""
-        if not self.algorithm.narrow_steps:
-            return None
-        margin, need = self.narrow_steps_margin_m, self.safety.stability_margin
-        if margin < need:
-            side = "inside" if margin >= 0 else "outside"
-            return (f"with segment 2's wheels alone carrying the robot, segment 1 lifted and "
-                    f"the robot pitched {self.safety.max_pitch_deg:g}°, the centre of mass "
-                    f"would stand {abs(margin) * 1000:.1f} mm {side} them, less than [safety] "
-                    f"stability_margin ({need * 1000:g} mm)")
-        near = self.SAFE_LENGTH + self.algorithm.approach_gap
-        reads_from = self.sensors.range(back=False)[0]
-        if reads_from > near:
-            return (f"on a narrow step the front pair stands SAFE_LENGTH + approach_gap "
-                    f"({near:.3f} m) from the next riser, nearer than it reads "
-                    f"({reads_from:.3f} m)")
-        return None
-
-    @property
-    def narrow_steps_safe(self) -> bool:
-        """``[algorithm] narrow_steps`` is set and nothing refuses it
-        (:attr:`narrow_steps_refusal`: the static-stability check, and the
-        front pair's range).  When refused, the robot keeps the whole
-        length's min_tread_m (``config show`` and ``run`` say why)."""
-        return self.algorithm.narrow_steps and self.narrow_steps_refusal is None
-
-    @property
     def wheel_speed_m_s(self) -> float:
         return self.motors.wheel_speed * self.wheel_circumference
 
@@ -250,58 +168,22 @@ class RobotConfig:
     def lift_speed_m_s(self) -> float:
         return self.motors.lift_speed * self.motors.lift_travel_per_turn
 
-    def derived(self) -> dict[str, float]:
-        """Everything that follows from the file, for ``config show``."""
-        names = ("LENGTH_OF_A_ROBOT", "BACK_CLEARANCE", "MAX_OF_VERTICAL_TURNS",
-                 "NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE",
-                 "NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH",
-                 "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE",
-                 "NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE")
-        out = {name: float(getattr(self, name)) for name in names}
-        out["number_of_vertical_turns"] = self.initial_number_of_vertical_turns
-        out["wheel_circumference_m"] = self.wheel_circumference
-        for name in ("wheel_speed_m_s", "lift_speed_m_s", "max_step_rise_m", "min_tread_m",
-                     "min_step_rise_m", "max_drop_m"):
-            out[name] = float(getattr(self, name))
-        if self.algorithm.narrow_steps:
-            out["narrow_steps_margin_m"] = self.narrow_steps_margin_m
-        if math.isfinite(self.square_range_m):  # a cone looking up, or a noisy pair
-            out["square_range_m"] = self.square_range_m
-        if self.algorithm.landings:
-            # the controller's own figures (it refuses a landing with less room)
-            from stairbot.control.algorithm.landing import DEPTH_MARGIN, turn_room_m
-
-            room = turn_room_m(self)
-            out["landing_turn_room_m"] = room
-            out["min_landing_m"] = 2.0 * room + DEPTH_MARGIN
-        return out
-
-    def to_dict(self) -> dict[str, Any]:
-        """The resolved config as plain data: the file's sections plus ``derived``."""
-        out: dict[str, Any] = {
-            name: msgspec.to_builtins(getattr(self, name))
-            for name in ("geometry", "masses", "motors", "sensors", "algorithm", "safety")
-        }
-        out["geometry"]["LENGTH_OF_A_ROBOT"] = round(self.LENGTH_OF_A_ROBOT, 6)
-        out["derived"] = {k: round(v, 6) for k, v in self.derived().items()}
-        if self.algorithm.narrow_steps:
-            out["narrow_steps_refused"] = self.narrow_steps_refusal  # None: it may
-        out["source"] = self.source
-        return out
 
 
 DEFAULT_CONFIG_NAME = "default_robot.toml"
 
 
-def parse_config(text: str, source: str) -> RobotConfig:
-    """Parse and validate a config document (and the one it ``extends``).
-    Raises ConfigError naming the file, the field and what it allows."""
+def resolve_config(text: str, source: str) -> RobotConfig:
+    """A config document (and the one it ``extends``) read into a
+    RobotConfig, each field's type and bounds checked; how the values fit
+    together is checked by :func:`check_consistency`, which
+    :func:`stairbot.control.robot_config.parse_config` runs with the
+    controller's limits.  Raises ConfigError naming the file, the field and
+    what it allows."""
     raw = _extended(load_toml(text, source, ConfigError), source, ())
     data = convert(raw, ConfigFile, source, ConfigError)
-    cfg = RobotConfig(source, data.geometry, data.masses, data.motors, data.sensors,
-                      data.algorithm, data.safety)
-    check_consistency(cfg)
-    return cfg
+    return RobotConfig(source, data.geometry, data.masses, data.motors, data.sensors,
+                       data.algorithm, data.safety)
 
 
 REFERENCE = "reference"
@@ -327,7 +209,7 @@ def _extended(raw: dict[str, Any], source: str, chain: tuple[str, ...]) -> dict[
     if not isinstance(base, str) or not base:
         raise ConfigError(source, "extends", "must be a shipped robot's name ("
                           + ", ".join(shipped_configs()) + ") or a config file's path")
-    text, base_source = _config_text(base, Path(source).parent if Path(source).exists() else None)
+    text, base_source = config_text(base, Path(source).parent if Path(source).exists() else None)
     ids = [_identity(s) for s in chain]
     if _identity(base_source) in ids:
         loop = (*chain[ids.index(_identity(base_source)):], base_source)
@@ -358,7 +240,7 @@ def _merged(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _config_text(path: str | Path | None, beside: Path | None = None) -> tuple[str, str]:
+def config_text(path: str | Path | None, beside: Path | None = None) -> tuple[str, str]:
     """The text and source name of a config: the reference robot (None or
     ``"reference"``), a shipped robot by name, or a file (relative to
     ``beside`` when given)."""
@@ -381,11 +263,5 @@ def shipped_configs() -> list[str]:
 def config_table(path: str | Path | None = None) -> dict[str, Any]:
     """A config's document as plain data with what it ``extends`` laid under
     it (no ``extends`` left): a sweep's base for its cases.  Raises ConfigError."""
-    text, source = _config_text(path)
+    text, source = config_text(path)
     return _extended(load_toml(text, source, ConfigError), source, ())
-
-
-def load_config(path: str | Path | None = None) -> RobotConfig:
-    """Load a config file, a shipped robot by name (a plain word that is no
-    existing file), or the reference robot when ``path`` is None."""
-    return parse_config(*_config_text(path))

@@ -5,6 +5,7 @@ allowed."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from stairbot.errors import ConfigError
@@ -22,9 +23,11 @@ LIFT_SPEED_M_S = (0.0002, 1.0)
 """What the lifts' speed may make, m/s (a 0.21 m stroke in 18 min at the least)."""
 
 
-def check_consistency(cfg: RobotConfig) -> None:
+def check_consistency(cfg: RobotConfig, min_step_rise_m: Callable[[RobotConfig], float]) -> None:
     """Raise ConfigError naming the field when the config's values do not fit
-    together (the file's own types and ranges are checked as it is read)."""
+    together (the file's own types and ranges are checked as it is read).
+    ``min_step_rise_m``: the lowest riser the controller climbs with this
+    robot (:func:`stairbot.control.algorithm.limits.min_step_rise_m`)."""
     src = cfg.source
     g, s, m, a = cfg.geometry, cfg.sensors, cfg.motors, cfg.algorithm
     if g.LENGTH_OF_A_ROBOT is not None and abs(g.LENGTH_OF_A_ROBOT - cfg.LENGTH_OF_A_ROBOT) > 1e-3:
@@ -40,11 +43,11 @@ def check_consistency(cfg: RobotConfig) -> None:
                           "[sensors] side_model (one of the sensor models) for the pair")
     if s.has_side_pair and s.side_min_range >= s.side_max_range:
         raise ConfigError(src, "sensors.side_min_range", "must be below side_max_range")
-    if s.has_side_pair and s.side_height >= cfg.min_step_rise_m:
+    if s.has_side_pair and s.side_height >= (lowest := min_step_rise_m(cfg)):
         raise ConfigError(src, "sensors.side_height",
                           f"{s.side_height} m: the side pair's beams must start below the "
                           f"lowest riser the robot climbs (min_step_rise_m, "
-                          f"{cfg.min_step_rise_m:.3f} m), or they read past a landing's next "
+                          f"{lowest:.3f} m), or they read past a landing's next "
                           "flight's first riser to the ones beyond; allowed: less than that")
     if s.has_side_pair and s.side_from_rear > g.LENGTH_OF_THIRD_MODULE:
         raise ConfigError(src, "sensors.side_from_rear",

@@ -157,7 +157,8 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     """The seed's extension 3: climb treads down to LENGTH_OF_FIRST_MODULE +
     LENGTH_OF_SECOND_MODULE (+ SAFE_LENGTH), segment 3 in the air over the
     step below while segment 1 is lifted onto the next -- if segment 2's
-    wheels alone carry the robot then (:attr:`RobotConfig.narrow_steps_margin_m`)."""
+    wheels alone carry the robot then
+    (:func:`stairbot.control.algorithm.limits.narrow_steps_margin_m`)."""
     landings: bool = False
     """The seed's extension 1: at the top of a flight that ends on a landing
     with a wall ahead, look sideways with the side pair for the next flight,

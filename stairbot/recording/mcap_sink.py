@@ -41,6 +41,7 @@ from foxglove.channels import (
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
 from stairbot import __version__
+from stairbot.control.algorithm import limits
 from stairbot.errors import OutputError
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
@@ -121,7 +122,7 @@ class McapRecord:
                     "time": "log time = time_origin_ns + the robot's clock (time_s)",
                     "config": config.source})
                 self._attach("robot_config.json", "application/json",
-                             json.dumps(config.to_dict(), indent=1).encode())
+                             json.dumps(limits.config_dict(config), indent=1).encode())
                 dbc = resources.files("stairbot").joinpath("drivers/stairbot.dbc")
                 self._attach("stairbot.dbc", "text/plain", dbc.read_bytes())
                 self._flush()

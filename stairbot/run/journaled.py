@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
+from stairbot.control.algorithm import limits
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode
@@ -52,7 +53,7 @@ class NotConfirmed(ResumeRefused):
 
 
 def config_digest(config: RobotConfig) -> str:
-    values = config.to_dict()
+    values = limits.config_dict(config)
     values.pop("source", None)
     return digest(values)
 

@@ -23,8 +23,10 @@ from typing import Any
 
 import msgspec
 
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import parse_config
 from stairbot.errors import ConfigError, ScenarioError
-from stairbot.inputs.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
+from stairbot.inputs.config import DEFAULT_CONFIG_NAME, RobotConfig
 from stairbot.inputs.scenario import (
     DEFAULT_COUNT,
     DEFAULT_RISE,
@@ -166,7 +168,7 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     last = len(scenario.steps) - 1
     treads = [s.tread for i, s in enumerate(steps) if not (i == last and scenario.top == "landing")]
     min_tread = min(treads, default=math.inf)
-    lr, lo, lt = config.max_step_rise_m, config.min_step_rise_m, config.min_tread_m
+    lr, lo, lt = config.max_step_rise_m, limits.min_step_rise_m(config), limits.min_tread_m(config)
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
     # how far each riser clears what the front cone needs to measure the tread
     # before it, and each measured tread's own riser what the robot asks of it
@@ -392,7 +394,7 @@ def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) 
         "zone": z, "count": len(scenario.steps), "max_rise_m": max_rise,
         "min_tread_m": min_tread if math.isfinite(min_tread) else None,
         "limit_rise_m": round(config.max_step_rise_m, DIGITS),
-        "limit_tread_m": round(config.min_tread_m, DIGITS),
+        "limit_tread_m": round(limits.min_tread_m(config), DIGITS),
         "expected_steps": min(len(scenario.steps), config.algorithm.max_steps),
         "faults": len(scenario.faults), "home_m": spec.rules.home_m,
     }

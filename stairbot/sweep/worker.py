@@ -72,7 +72,7 @@ def run_case(case: Case) -> dict[str, Any]:
     record: dict[str, Any] = {"case": case.index, "axes": case.axes, "facts": case.facts}
     try:
         from stairbot.control.algorithm.phases import Mode
-        from stairbot.inputs.config import load_config, parse_config
+        from stairbot.control.robot_config import load_config, parse_config
         from stairbot.inputs.scenario import parse_scenario
         from stairbot.run.robots import RobotOptions, open_robot
         from stairbot.run.runner import run

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import Any
 
 from stairbot.console.app import StairbotConsole, build_app
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
     Imu,
@@ -20,7 +21,6 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
 )
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotSession
 from stairbot.views.side_view import stairs_from_scenario

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 from stairbot.console.canvas import BrailleCanvas
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import Scene
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.views.side_view import SceneView, scene_view, stairs_from_scenario
 

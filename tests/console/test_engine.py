@@ -12,9 +12,9 @@ import pytest
 
 from stairbot.console.runner_thread import ConsoleEngine, describe_result
 from stairbot.console.state import LiveState
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
 from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
-from stairbot.inputs.config import load_config
 from stairbot.run.runner import RunControl, RunResult
 
 FORWARD = {m: 1.0 for m in WHEEL_MOTORS}

@@ -15,6 +15,7 @@ from still_robot import StillClock, StillRobot, StillSim
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import SERIES, History
+from stairbot.control.robot_config import load_config
 from stairbot.errors import LinkLostError
 from stairbot.hardware import (
     Imu,
@@ -25,7 +26,6 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.inputs.config import load_config
 from stairbot.run.robots import RobotSession
 
 PER_TURN = load_config().motors.lift_travel_per_turn

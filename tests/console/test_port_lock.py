@@ -13,7 +13,7 @@ from lockstep_boards import fake_boards, stairbot
 from pilot import banner, said, until
 
 from stairbot.console.app import build_app
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.run.robots import RobotSession, open_robot
 
 

@@ -22,9 +22,9 @@ from stairbot.cli import main
 from stairbot.console.freshness import STALE_S
 from stairbot.console.replay_app import ReplayConsole, build_replay_app
 from stairbot.console.widgets.motors import NAMES as MOTOR_NAMES
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord

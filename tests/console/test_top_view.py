@@ -21,9 +21,9 @@ from stairbot.console.replay_app import REPLAY_HELP, ReplayConsole
 from stairbot.console.state import LiveState
 from stairbot.console.watch import watch
 from stairbot.console.widgets.top_view import CONTACT_LINE_STYLE
+from stairbot.control.robot_config import load_config
 from stairbot.errors import LinkLostError
 from stairbot.hardware import Snapshot, Truth
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotSession
 from stairbot.views.top_view import TopPose, plan_of

@@ -8,12 +8,12 @@ import math
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.fakes import landing as sim_landing
 from stairbot.fakes import stairs as sim_stairs
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import Truth
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, load_scenario, parse_scenario
 from stairbot.views.top_view import (
     FLOOR_BEHIND,

@@ -10,9 +10,9 @@ from kinematic import Fault, KinematicRobot, run
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, SensorId
-from stairbot.inputs.config import load_config
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 CLEARANCE = CFG.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE

@@ -12,8 +12,8 @@ from stairbot.control.algorithm.context import TAB_SIZE, Context
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.work import Work
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
-from stairbot.inputs.config import load_config
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 

@@ -17,9 +17,9 @@ from stairbot.control.algorithm.controller import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.perception import CONFIRM
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.inputs.config import load_config, parse_config
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 STEPS = [(0.17, 0.28)] * 2

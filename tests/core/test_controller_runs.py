@@ -8,9 +8,9 @@ from kinematic import KinematicRobot, run
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import LIFT_MOTORS, MotorId
-from stairbot.inputs.config import load_config
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 STEP = (0.17, 0.28)

@@ -10,8 +10,8 @@ from stairbot.control.algorithm.edge import edge_bound, edge_clearance_m, edge_d
 from stairbot.control.algorithm.phase import Tick
 from stairbot.control.algorithm.phases import Mode, Phase
 from stairbot.control.algorithm.work import Work
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import WHEEL_MOTORS, MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.inputs.config import load_config
 
 CFG = load_config("reference")
 FLOOR = CFG.BACK_CLEARANCE

@@ -11,7 +11,7 @@ from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phase import Tick
 from stairbot.control.algorithm.phases import Mode
 from stairbot.control.algorithm.work import Work
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 
 CFG = load_config("reference")
 

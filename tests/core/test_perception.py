@@ -7,6 +7,7 @@ import msgspec
 import pytest
 
 from stairbot.control.perception import CONFIRM, Perception, max_age, pair_tolerance, window
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import (
     MotorId,
     MotorState,
@@ -15,7 +16,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 TICK = CFG.algorithm.tick

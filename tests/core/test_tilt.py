@@ -15,10 +15,11 @@ from kinematic import KinematicRobot, run
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.robot_config import load_config
 from stairbot.control.tilt import TiltWatch
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import run as run_session

@@ -24,8 +24,8 @@ from stairbot.control.algorithm.transitions import (
 )
 from stairbot.control.algorithm.work import Work
 from stairbot.control.perception import settle_s
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.inputs.config import load_config
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import can
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_COPIES
 from stairbot.drivers.can_link import CanLink
@@ -29,7 +30,6 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Clock, HasTruth, MotorId
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 

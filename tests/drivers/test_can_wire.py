@@ -19,6 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_wire import (
@@ -35,7 +36,6 @@ from stairbot.drivers.can_wire import (
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 
 VECTORS: list[dict[str, Any]] = json.loads(

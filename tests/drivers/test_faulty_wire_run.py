@@ -14,6 +14,7 @@ import can
 import pytest
 from test_can_run import ONE_STEP
 
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.can_link import CanLink
@@ -23,7 +24,6 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotSession, open_robot
 from stairbot.run.runner import RunResult, run

@@ -17,6 +17,7 @@ import serial
 import serial.rfc2217
 
 from stairbot.cli.clear import main as clear_main
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_robot import parse_serial_url
@@ -34,7 +35,7 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import BASE_SENSORS, HasTruth, MotorId, SensorId
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.run.robots import RobotSession, open_robot
 from stairbot.run.runner import run

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from lockstep_boards import lockstep_boards
 
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult, run

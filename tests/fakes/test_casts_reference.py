@@ -14,12 +14,12 @@ import pytest
 import reference_beams as ref
 from reference_beams import Profile
 
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.beams import down_fans, down_hits, front_hits, total_weight
 from stairbot.fakes.sensor_model import Hit, combine
 from stairbot.fakes.sensor_presets import GP2Y0A21, HCSR04, PRESETS, VL53L0X, VL53L1X
 from stairbot.fakes.sim import SimRobot
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 
 OUTLINES = [

@@ -10,10 +10,11 @@ from collections.abc import Callable
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.errors import RobotFellError
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import MotorId, SensorId, Snapshot
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
 
 F, B, R, L = MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL

@@ -10,6 +10,7 @@ import sys
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
 from stairbot.hardware import (
@@ -22,7 +23,6 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, parse_scenario
 from stairbot.run.robots import RobotOptions
 
@@ -268,7 +268,7 @@ def test_clock_paces_only_when_asked() -> None:
 
 _RUN_IN_CHILD = """
 import hashlib
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import MotorId as M

@@ -11,10 +11,10 @@ import msgspec
 import msgspec.inspect as mi
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.fakes.world import WorldParams
 from stairbot.hardware import SensorId
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.inputs.sections import Safety
 from stairbot.run.robots import RobotSession

@@ -13,8 +13,9 @@ from collections.abc import Iterator
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.drivers.board_robot import BoardRobot
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.run.robots import RobotSession, open_robot
 
 URL_VARIABLE = "STAIRBOT_HW_URL"

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
 from stairbot.events import Event, EventKind
 from stairbot.hardware import BASE_SENSORS, Imu, MotorId, MotorState, SensorReading, Snapshot
-from stairbot.inputs.config import load_config
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import FLUSH_PERIOD_S, FLUSH_TICKS, McapRecord
 from stairbot.recording.read import read_recording

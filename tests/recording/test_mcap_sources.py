@@ -16,7 +16,7 @@ from mcap.reader import make_reader
 from stairbot.cli import main
 from stairbot.console.runner_thread import ConsoleEngine
 from stairbot.console.state import LiveState
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.recording import topics
 from stairbot.recording.read import read_recording
 

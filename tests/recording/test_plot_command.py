@@ -14,8 +14,8 @@ import pytest
 from mcap.writer import Writer
 
 from stairbot.cli import main
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.inputs.config import load_config
 from stairbot.recording.mcap_sink import McapRecord
 
 QUICK = "[stairs]\ncount = 1\n"

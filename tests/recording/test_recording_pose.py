@@ -7,8 +7,8 @@ import math
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import load_scenario
 from stairbot.recording.pose import (
     DeadReckonedPose,

@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
     BASE_SENSORS,
@@ -26,7 +27,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.inputs.config import RobotConfig, load_config, parse_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.read import read_recording

@@ -9,9 +9,9 @@ import pytest
 import simrun
 
 from stairbot.control.algorithm.phases import Mode
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import run

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.host_kills import kill_tick, recorded, run_kill
-from stairbot.inputs.config import load_config
 from stairbot.run.journal import JournalState, mark_path, read_journal
 from stairbot.run.resume import check, restored_context
 

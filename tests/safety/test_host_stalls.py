@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event
 from stairbot.hardware import Clock, Snapshot
-from stairbot.inputs.config import load_config
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult, run
 

@@ -10,9 +10,9 @@ import pytest
 import simrun
 
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.errors import ConfigError, ScenarioError
 from stairbot.events import Event, EventKind
-from stairbot.inputs.config import load_config, parse_config
 from stairbot.inputs.scenario import load_scenario, parse_scenario
 
 LANDINGS = load_config("landings")

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import simrun
 
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import parse_scenario
 
 REFERENCE = load_config("reference")

@@ -15,8 +15,8 @@ from functools import cache
 
 import pytest
 
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.inputs.config import load_config
 from stairbot.inputs.scenario import Scenario, parse_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult, run

@@ -22,8 +22,9 @@ import pytest
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.stability import UNSTABLE
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import ZERO_SPEEDS, HasTruth, MotorId
-from stairbot.inputs.config import RobotConfig, load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotOptions, RobotSession, open_robot
 from stairbot.run.runner import RunResult, run

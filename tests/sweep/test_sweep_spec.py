@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from stairbot.cli import main
-from stairbot.inputs.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.sweep.cases import build_case, check_spec, first_sight, zone
 from stairbot.sweep.execute import open_executor

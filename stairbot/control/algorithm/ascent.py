@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import statistics
 
-from stairbot.control.algorithm import landing, long_tread, motion
+from stairbot.control.algorithm import landing, limits, long_tread, motion
 from stairbot.control.algorithm.moves import (
     KEY_TICKS,
     drive_phase,
@@ -188,12 +188,12 @@ def _lift_first(t: Tick, w: Work) -> Step:
         rise = lifted * cfg.motors.lift_travel_per_turn + cfg.sensors.front_height
         t.say(f"segment 1 sees over step {ctx.number_of_steps + 1} after {lifted:.1f} MTF turns "
               f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m", rise=rise)
-        if rise >= cfg.min_step_rise_m:
+        if rise >= limits.min_step_rise_m(cfg):
             return go(P.ASCENT_LIFT_FIRST_MORE)
         ctx.ascent_end = "obstacle"
         t.say(f"step {ctx.number_of_steps + 1} is too low to climb: rise about {rise:.3f} m < "
-              f"{cfg.min_step_rise_m:.3f} m (lifting on, the sensors could see past the next "
-              "riser); the ascent ends (obstacle)", ascent_end="obstacle")
+              f"{limits.min_step_rise_m(cfg):.3f} m (lifting on, the sensors could see past "
+              "the next riser); the ascent ends (obstacle)", ascent_end="obstacle")
         return go(P.ASCENT_LOWER_OBSTACLE, "rise lower than the robot measures")
     assert w.target_mtf is not None
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
@@ -225,7 +225,7 @@ def narrow(cfg: RobotConfig, tread: float | None) -> bool:
 
 def _lifted_first(t: Tick, w: Work) -> Step:
     ctx, cfg = t.ctx, t.cfg
-    need = cfg.min_tread_m
+    need = limits.min_tread_m(cfg)
     # Measured over the second half of the lift, clear of the edge: at the
     # first sight over it the beam still grazes the step's own tread and
     # reads short.

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.control.algorithm import landing, motion
+from stairbot.control.algorithm import landing, limits, motion
 from stairbot.control.algorithm.moves import lift, stood
 from stairbot.control.algorithm.phase import (
     FAULT,
@@ -199,10 +199,10 @@ def _check(t: Tick, w: Work) -> Step:
             ctx.home_wheel = motion.wheel_position(t.snap)
             ctx.home_twist = motion.twist(t.snap)
         near = _nearer(t)
-        if near is not None and near > cfg.square_range_m + cfg.algorithm.equal_tolerance:
+        if near is not None and near > limits.square_range_m(cfg) + cfg.algorithm.equal_tolerance:
             t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
-                  f"farther than square_range_m ({cfg.square_range_m:.3f} m), where the front "
-                  "cones see over the first riser or the pair's noise allows only a loose "
+                  f"farther than square_range_m ({limits.square_range_m(cfg):.3f} m), where the "
+                  "front cones see over the first riser or the pair's noise allows only a loose "
                   "square; closing in before squaring up",
                   SFR=sfr.distance_m, SFL=sfl.distance_m)
             return go(P.CAL_CLOSE_IN)
@@ -334,7 +334,7 @@ def _close_in_enter(t: Tick, w: Work) -> None:
     # No further than the first reading allows: its nearer beam to square_range_m.
     near = _nearer(t)
     assert near is not None  # CAL_CHECK closes in only on a reading
-    w.target_wheel = w.entry_wheel + t.cfg.wheel_turns(near - t.cfg.square_range_m)
+    w.target_wheel = w.entry_wheel + t.cfg.wheel_turns(near - limits.square_range_m(t.cfg))
 
 
 def _close_in(t: Tick, w: Work) -> Step:
@@ -344,7 +344,8 @@ def _close_in(t: Tick, w: Work) -> Step:
     assert w.target_wheel is not None  # set on entry
     near = _nearer(t)
     remaining = w.target_wheel - motion.wheel_position(t.snap)
-    if remaining <= motion.WHEEL_DONE or (near is not None and near <= t.cfg.square_range_m):
+    square = limits.square_range_m(t.cfg)
+    if remaining <= motion.WHEEL_DONE or (near is not None and near <= square):
         return go(P.CAL_CHECK, f"closed in: SFR/SFL nearer reads "
                                f"{'nothing' if near is None else f'{near:.3f} m'}")
     return stay(motion.drive(t.cfg, 1, remaining))

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import limits, motion
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
 from stairbot.control.algorithm.work import Work
 from stairbot.control.perception import measurement_period, median_sigma, window
@@ -79,7 +79,7 @@ def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
     """The back pair reads "past the edge" beyond this: more than half the
     lowest rise below BACK_CLEARANCE (and its noise); in a continuous
     descent, LOW_DROP_M more than BACK_CLEARANCE (and its noise)."""
-    low = LOW_DROP_M if from_top else cfg.min_step_rise_m / 2
+    low = LOW_DROP_M if from_top else limits.min_step_rise_m(cfg) / 2
     return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + low
 
 

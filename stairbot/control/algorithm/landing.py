@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 import statistics
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import limits, motion
 from stairbot.control.algorithm.moves import lift, reading_drive, stood
 from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
 from stairbot.control.algorithm.phases import Phase
@@ -197,7 +197,7 @@ def _record(t: Tick, w: Work) -> Step:
     # turning to a wall)
     lifted = _lifted_m(t, w)
     seen_at = [lifted if o is None else o for o in w.side_open]
-    low = cfg.min_step_rise_m - cfg.sensors.side_height - SCAN_BASE_M
+    low = limits.min_step_rise_m(cfg) - cfg.sensors.side_height - SCAN_BASE_M
     opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS
               and seen_at[i] >= low for i in (0, 1)]
     ctx.landing_rise_m = [seen_at[i] + cfg.sensors.side_height if opened[i] else None
