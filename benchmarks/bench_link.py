@@ -24,6 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import stairbot.fakes.lockstep  # noqa: F401 - registers the lockstep robot with the drivers
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u

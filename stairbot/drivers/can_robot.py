@@ -83,7 +83,7 @@ from urllib.parse import unquote
 import can
 import can.util
 
-from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
+from stairbot.drivers.board_session import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import CanFrameLog, check_can_log
 from stairbot.drivers.port_lock import PortLock, take_port_lock

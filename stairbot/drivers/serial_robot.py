@@ -54,7 +54,7 @@ from urllib.parse import urlencode
 
 import serial
 
-from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
+from stairbot.drivers.board_session import open_board_session, wanted_side_pair
 from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.port_lock import PortLock, serial_lock_key, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink

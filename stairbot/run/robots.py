@@ -18,7 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
-from urllib.parse import urlsplit
+from urllib.parse import parse_qs, urlsplit
 
 from stairbot.errors import RobotUrlError
 from stairbot.hardware import Clock, HasScene, Robot
@@ -74,6 +74,11 @@ _BUILTIN: dict[str, str] = {
 
 ENTRY_POINT_GROUP = "stairbot.robots"
 
+LOCKSTEP_MODULE = "stairbot.fakes.lockstep"
+"""Fake boards in lockstep (a ``lockstep`` option in a board URL) are a
+simulation: this module of the fakes registers the robot that opens them with
+the drivers, and is loaded before such a URL is handed to its driver."""
+
 
 def known_schemes() -> dict[str, str]:
     """Scheme -> "module:attribute" for every robot URL scheme available."""
@@ -108,4 +113,10 @@ def open_robot(
         what = f"unknown scheme {scheme!r}" if scheme else "not a robot URL"
         raise RobotUrlError(url, None, f"{what}; allowed: {allowed}")
     factory = _load(schemes[scheme], url)
+    if "lockstep" in parse_qs(urlsplit(url).query):
+        try:
+            import_module(LOCKSTEP_MODULE)
+        except ImportError as exc:
+            raise RobotUrlError(url, "lockstep", f"the simulation's boards cannot be "
+                                f"loaded: {exc}") from exc
     return factory(url, config, options or RobotOptions())

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import can
 import pytest
 
+import stairbot.fakes.lockstep  # noqa: F401 - registers the lockstep robot with the drivers
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_COPIES

@@ -18,7 +18,7 @@ from scripted_boards import WIRES, Boards, link_to, scripted_world, wired
 
 from stairbot.control.robot_config import load_config, parse_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
+from stairbot.drivers.board_session import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_request import SAME_SHORT_LIMIT, CanRequest, Offer
 from stairbot.errors import BoardMismatchError, HardwareError, LinkLostError
