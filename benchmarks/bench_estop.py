@@ -32,7 +32,7 @@ import time
 from multiprocessing.connection import Connection
 from typing import Any
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_CONFIRM_S, BoardRobot
 from stairbot.drivers.can_robot import open_bus, parse_can_url
@@ -44,8 +44,8 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions, open_robot
 
 TICK_S = 0.02
 GROUP = "239.74.163.{}"

@@ -26,11 +26,11 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from stairbot.config import load_config
-from stairbot.journal import JournalWriter, mark_path
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
-from stairbot.scenario import load_scenario
+from stairbot.control.robot_config import load_config
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.journal import JournalWriter, mark_path
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 
 def recorded_ticks(n: int) -> list[dict[str, Any]]:

@@ -24,13 +24,14 @@ import tempfile
 import time
 from pathlib import Path
 
-from stairbot.config import load_config
+import stairbot.fakes.lockstep  # noqa: F401 - registers the lockstep robot with the drivers
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.serial_robot import open_serial_robot
 from stairbot.drivers.serial_wire import Frame, encode_frame
 from stairbot.hardware import MotorId
-from stairbot.robots import RobotOptions
+from stairbot.run.robots import RobotOptions
 
 BAUD = 1_000_000
 BITS_PER_BYTE = 10  # 8N1

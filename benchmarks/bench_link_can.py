@@ -28,15 +28,15 @@ from pathlib import Path
 
 import can
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_can_robot
 from stairbot.drivers.can_wire import frame_bits, wire
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
-from stairbot.robots import RobotOptions
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions
 
 # The cycle and its statistics are the serial benchmark's (this file's folder
 # is on the path whether it runs alone or from bench_link.py).

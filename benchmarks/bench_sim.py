@@ -29,11 +29,12 @@ import statistics
 import time
 from typing import Any
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import MotorId
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 
 def full_run(config: RobotConfig, scenario: Scenario) -> tuple[RunResult, float]:

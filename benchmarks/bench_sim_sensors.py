@@ -33,9 +33,9 @@ import statistics
 import time
 from collections.abc import Callable
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.sim import SimClock, SimRobot
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 
 def _median_us(fn: Callable[[], object], rounds: int, calls: int) -> float:

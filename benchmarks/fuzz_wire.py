@@ -42,7 +42,7 @@ from itertools import count
 
 import can
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers import serial_wire
 from stairbot.drivers.can_wire import SESSION_MAX, CanWire, make_id, wire
@@ -51,7 +51,7 @@ from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
 from stairbot.fakes.serial_boards import SerialBoardServer
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 HANG_S = 1.0
 STALL_S = 60

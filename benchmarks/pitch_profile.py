@@ -17,12 +17,12 @@ from __future__ import annotations
 import argparse
 from dataclasses import dataclass
 
-from stairbot.algorithm.controller import Controller
-from stairbot.config import load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import Snapshot
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
-from stairbot.scenario import load_scenario, shipped_scenarios
+from stairbot.inputs.scenario import load_scenario, shipped_scenarios
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 
 @dataclass

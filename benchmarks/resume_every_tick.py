@@ -21,12 +21,12 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.errors import StairbotError
 from stairbot.fakes.host_kills import journaled_run
-from stairbot.journal import JournalState, mark_path, read_journal
-from stairbot.resume import check, restored_context
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.journal import JournalState, mark_path, read_journal
+from stairbot.run.resume import check, restored_context
 
 
 def record(scenario_name: str | None, journal: Path) -> str:

@@ -27,11 +27,11 @@ import collections
 import random
 import sys
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Clock
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 
 class StallingClock:

@@ -20,7 +20,7 @@ import tempfile
 
 EXE = [sys.executable, "-m", "stairbot"]
 d = pathlib.Path(tempfile.mkdtemp(prefix="hostile-"))
-ROBOT = r.files("stairbot").joinpath("default_robot.toml").read_text()
+ROBOT = r.files("stairbot.inputs").joinpath("default_robot.toml").read_text()
 
 
 def w(name: str, text: str) -> str:
@@ -89,7 +89,7 @@ cases = {
  "sweep check fifo": ["sweep", "check", str(fifo)],
  "sweep check /dev/zero": ["sweep", "check", "/dev/zero"],
  "sweep check nested": ["sweep", "check", w("s.toml", nested)],
- "sweep --config /dev/zero": ["sweep", "--config", "/dev/zero", "--limit", "1", str(r.files("stairbot").joinpath("sweeps", "quick.toml"))],
+ "sweep --config /dev/zero": ["sweep", "--config", "/dev/zero", "--limit", "1", str(r.files("stairbot.inputs").joinpath("sweeps", "quick.toml"))],
  "console --scenario /dev/zero": ["console", "--scenario", "/dev/zero"],
  "console --config fifo": ["console", "--config", str(fifo)],
  "fake-boards --config /dev/zero": ["fake-boards", "--serial", "--config", "/dev/zero"],

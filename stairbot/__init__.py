@@ -2,7 +2,7 @@
 
 The rooms, one folder each:
 
-* ``stairbot.algorithm``  the seed's phases, transitions and controller (pure Python)
+* ``stairbot.control.algorithm``  the seed's phases, transitions and controller (pure Python)
 * ``stairbot.drivers``    board protocol, serial and CAN transports (pyserial, python-can)
 * ``stairbot.fakes``      the pymunk simulation and the fake boards
 * ``stairbot.console``    the Textual operator console

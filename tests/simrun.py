@@ -3,12 +3,12 @@
 
 from __future__ import annotations
 
-from stairbot.algorithm.phases import Mode
-from stairbot.config import RobotConfig
+from stairbot.control.algorithm.phases import Mode
 from stairbot.events import Event, discard
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 
 def run_sim(config: RobotConfig, scenario: Scenario,

@@ -39,15 +39,16 @@ def test_every_module_is_listed_once() -> None:
     names = all_modules()
     assert len(names) == len(set(names))
     assert not any(name.startswith("stairbot.stairbot") for name in names)
-    for expected in ("stairbot.algorithm.controller", "stairbot.drivers.serial_robot",
+    for expected in ("stairbot.control.algorithm.controller", "stairbot.drivers.serial_robot",
                      "stairbot.fakes.sim", "stairbot.console.app"):
         assert expected in names
 
 
 def test_the_core_modules_are_found() -> None:
     names = core_modules()
-    for expected in ("stairbot.config", "stairbot.scenario", "stairbot.hardware",
-                     "stairbot.events", "stairbot.cli", "stairbot.algorithm.controller"):
+    for expected in ("stairbot.inputs.config", "stairbot.inputs.scenario", "stairbot.hardware",
+                     "stairbot.events", "stairbot.cli.command",
+                     "stairbot.control.algorithm.controller"):
         assert expected in names
 
 

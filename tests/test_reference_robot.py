@@ -12,10 +12,11 @@ from pathlib import Path
 import pytest
 from simrun import run_sim
 
-from stairbot.config import load_config
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event
-from stairbot.runner import RunResult
-from stairbot.scenario import load_scenario, parse_scenario
+from stairbot.inputs.scenario import load_scenario, parse_scenario
+from stairbot.run.runner import RunResult
 from stairbot.sweep.spec import SpecError, load_spec, with_config
 
 REFERENCE = load_config("reference")
@@ -38,12 +39,12 @@ def test_the_default_stairs_up_and_back() -> None:
 
 def test_its_cone_raises_the_lowest_rise_it_measures_a_tread_against() -> None:
     ideal = load_config("ideal")
-    assert ideal.min_rise_for(0.5) == ideal.min_step_rise_m  # a level ray
+    assert ideal.min_rise_for(0.5) == limits.min_step_rise_m(ideal)  # a level ray
     top = math.radians(7.5 + 15.0 / 2)
     ref = REFERENCE
     assert ref.front_cone_top_rad == pytest.approx(top)
     assert ref.min_rise_for(0.30) - ref.min_rise_for(0.26) == pytest.approx(0.04 * math.tan(top))
-    assert ref.min_step_rise_m == pytest.approx(ref.min_rise_for(ref.min_tread_m))
+    assert limits.min_step_rise_m(ref) == pytest.approx(ref.min_rise_for(limits.min_tread_m(ref)))
 
 
 def test_a_rise_too_low_for_its_cone_is_refused_and_it_comes_home() -> None:
@@ -55,7 +56,7 @@ def test_a_rise_too_low_for_its_cone_is_refused_and_it_comes_home() -> None:
 
 
 def test_a_sweep_runs_on_another_robot_by_name() -> None:
-    spec = load_spec(Path(__file__).parents[1] / "stairbot" / "sweeps" / "quick.toml")
+    spec = load_spec(Path(__file__).parents[1] / "stairbot" / "inputs" / "sweeps" / "quick.toml")
     ideal = with_config(spec, "ideal")
     assert ideal.hash != spec.hash
     assert ideal.config_text is not None and 'front_model = "ideal"' in ideal.config_text
@@ -76,11 +77,13 @@ def test_refused_at_the_first_step_it_comes_back_by_the_odometer() -> None:
 
 
 def test_square_range_is_where_the_cone_rises_to_the_lowest_riser_it_climbs() -> None:
-    assert load_config("ideal").square_range_m == math.inf  # a level ray squares up from anywhere
+    # a level ray squares up from anywhere
+    assert limits.square_range_m(load_config("ideal")) == math.inf
     ref = REFERENCE
-    expected = (ref.min_step_rise_m - ref.sensors.front_height) / math.tan(ref.front_cone_top_rad)
-    assert ref.square_range_m == pytest.approx(expected)
-    assert ref.SAFE_DISTANCE_IN_FRONT_OF_STEP < ref.square_range_m < 0.4
+    rise = limits.min_step_rise_m(ref)
+    expected = (rise - ref.sensors.front_height) / math.tan(ref.front_cone_top_rad)
+    assert limits.square_range_m(ref) == pytest.approx(expected)
+    assert ref.SAFE_DISTANCE_IN_FRONT_OF_STEP < limits.square_range_m(ref) < 0.4
 
 
 FAR_ASKEW = """
@@ -106,7 +109,7 @@ def test_far_and_askew_it_closes_in_squares_up_and_retraces_its_way_home() -> No
     square_range_m (no further than its first reading allows), squares up
     there, climbs, and comes home the way it went: turning back the squaring
     turn before it backs the distance it closed in."""
-    from stairbot.algorithm.phases import Phase
+    from stairbot.control.algorithm.phases import Phase
 
     events: list[Event] = []
     r = run_reference(FAR_ASKEW, events)
@@ -180,7 +183,7 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it(
     step 6, read on the way up, was 1.4 cm long; backing up to it, the
     robot tipped back 15 deg off segment 2's rear wheels.  The back pair
     now bounds the backing: edge_clearance_m past where it saw the drop."""
-    from stairbot.algorithm.edge import edge_clearance_m
+    from stairbot.control.algorithm.edge import edge_clearance_m
 
     assert edge_clearance_m(REFERENCE) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006
                                                        + REFERENCE.wheel_speed_m_s * 0.030)
@@ -227,7 +230,7 @@ def test_backing_off_a_short_tread_is_bounded_by_the_edge_too() -> None:
     edge then allowed edge_clearance_m more from there, and the robot tipped
     back (the tilt supervisor stopped it at 145 deg/s).  The back pair now
     bounds the back-off as well, from where it first saw the drop."""
-    from stairbot.algorithm.phases import Phase
+    from stairbot.control.algorithm.phases import Phase
 
     events: list[Event] = []
     r = run_reference(SHORT_TREADS, events)

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 import can
 import pytest
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -50,8 +50,9 @@ from stairbot.hardware import (
     Snapshot,
     Truth,
 )
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
 
 CONFIG: RobotConfig = load_config()
 SCENARIO: Scenario = load_scenario()

@@ -8,12 +8,12 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from stairbot.algorithm.controller import Controller
-from stairbot.config import load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import Robot, Snapshot, Speeds
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunControl, run
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunControl, run
 
 CONFIG = load_config()
 

@@ -7,11 +7,13 @@ from __future__ import annotations
 import pytest
 import simrun
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.runner import RunResult
-from stairbot.scenario import Scenario, expectation_mismatches, load_scenario, parse_scenario
-from stairbot.scenario import shipped_scenarios as shipped
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, expectation_mismatches, load_scenario, parse_scenario
+from stairbot.inputs.scenario import shipped_scenarios as shipped
+from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
 IDEAL = load_config("ideal")
@@ -192,7 +194,7 @@ noise = 0.0
 def test_min_tread_m_is_where_the_simulated_robot_stops_entering() -> None:
     # Without noise the edge is exact; with noise a single reading pair decides,
     # so a tread a noise deviation or two shorter is sometimes entered.
-    limit = CONFIG.min_tread_m
+    limit = limits.min_tread_m(CONFIG)
     over, _ = run_sim(parse_scenario(TREAD_EDGE.format(tread=limit + 0.002), "over"))
     assert (over.outcome, over.ascent_end, over.steps_climbed, over.steps_descended) == (
         "completed", "top_reached", 2, 2), over.to_dict()

@@ -11,9 +11,11 @@ from pathlib import Path
 import pytest
 from simrun import run_sim
 
-from stairbot.config import load_config, shipped_configs
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event
-from stairbot.scenario import expectation_mismatches, load_scenario, parse_scenario
+from stairbot.inputs.config import shipped_configs
+from stairbot.inputs.scenario import expectation_mismatches, load_scenario, parse_scenario
 
 
 def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:
@@ -56,12 +58,12 @@ def test_the_ir_robot_closes_in_to_square_up_where_its_noise_allows() -> None:
     it drifted 5.7 cm from home).  square_range_m is now also the farthest
     reading the pair squares up to equal_tolerance from (quiet_range_m),
     and the start closes in to it first."""
-    from stairbot.perception import quiet_range_m, square_tolerance
+    from stairbot.control.perception import quiet_range_m, square_tolerance
 
     ir = load_config("ir")
-    assert ir.square_range_m == quiet_range_m(ir) < 0.4
-    assert square_tolerance(ir, ir.square_range_m) <= ir.algorithm.equal_tolerance + 1e-9
-    assert square_tolerance(ir, ir.square_range_m + 0.01) > ir.algorithm.equal_tolerance
+    assert limits.square_range_m(ir) == quiet_range_m(ir) < 0.4
+    assert square_tolerance(ir, limits.square_range_m(ir)) <= ir.algorithm.equal_tolerance + 1e-9
+    assert square_tolerance(ir, limits.square_range_m(ir) + 0.01) > ir.algorithm.equal_tolerance
     assert quiet_range_m(load_config("ideal")) == math.inf
     events: list[Event] = []
     r = run_sim(ir, parse_scenario(IR_FAR_START, "ir_far_start"), events)
@@ -94,7 +96,7 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     edge_clearance_m from where it saw the drop, the robot tipped back.
     The edge is now placed where the pair crossed it (edge_sight_m), and
     segment 3's front wheels stop clear of the edge's corner."""
-    from stairbot.algorithm.edge import edge_clearance_m, edge_sight_m
+    from stairbot.control.algorithm.edge import edge_clearance_m, edge_sight_m
     sonar, reference = load_config("sonar"), load_config("reference")
     full = sonar.motors.wheel_speed * sonar.wheel_circumference
     # backing at full speed: its latency, then half a period and two more
@@ -218,7 +220,7 @@ def test_the_sonar_robot_places_the_riser_on_many_readings_not_one() -> None:
     lifting segment 3 over the step pitched the robot 15° nose up.  The
     approach now places the riser by the median of its last ticks' readings
     plus the odometer."""
-    from stairbot.algorithm.edge import edge_clearance_m, edge_doubt_m
+    from stairbot.control.algorithm.edge import edge_clearance_m, edge_doubt_m
 
     sonar = load_config("sonar")
     # and the edge: one HC-SR04 period of backing at full speed more clearance

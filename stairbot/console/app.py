@@ -28,8 +28,6 @@ from textual.screen import Screen
 from textual.widget import Widget
 from textual.widgets import Footer
 
-from stairbot.cli_journal import ResumePlan
-from stairbot.config import RobotConfig, load_config
 from stairbot.console import choices, motion_gate, paint
 from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key
@@ -46,8 +44,11 @@ from stairbot.console.widgets.picture import StairsPicture
 from stairbot.console.widgets.sensors import SensorPanel
 from stairbot.console.widgets.top_view import TopViewPicture
 from stairbot.console.widgets.trends import TrendsPanel
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError, StairbotError
-from stairbot.top_view import RobotShape
+from stairbot.inputs.config import RobotConfig
+from stairbot.run.journaled import ResumePlan
+from stairbot.views.top_view import RobotShape
 
 REFRESH_HZ = 10.0
 

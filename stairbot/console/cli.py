@@ -16,14 +16,14 @@ import os
 from collections.abc import Sequence
 from urllib.parse import urlsplit
 
-from stairbot.config import load_config
 from stairbot.console.robot_holder import SPEEDS
 from stairbot.console.serve import parse_bind, serve
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
-from stairbot.paths import unused_path
-from stairbot.robots import known_schemes
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.paths import unused_path
+from stairbot.run.robots import known_schemes
 
 
 def build_parser() -> argparse.ArgumentParser:

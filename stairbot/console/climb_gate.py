@@ -6,7 +6,7 @@ the riser until a phase times out.
 The robot is *mid-climb* after a run that did not complete and had got past
 calibration (its last phase was in the ascent or the descent).  The console
 knows it from its own last run, and -- for boards on a wire -- from the run
-journal (:mod:`stairbot.journal`), which outlives the console: a console
+journal (:mod:`stairbot.run.journal`), which outlives the console: a console
 that crashed, or was killed, mid-run leaves the journal behind, and the next
 one reads it when it opens the same boards.  From there only two ways lead
 on: resuming the journal's run (boards only, with the checks of ``stairbot
@@ -18,11 +18,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from stairbot.algorithm.phases import BY_VALUE
+from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.errors import StairbotError
-from stairbot.journal import read_journal
-from stairbot.resume import describe
-from stairbot.runner import RunResult
+from stairbot.run.journal import read_journal
+from stairbot.run.resume import describe
+from stairbot.run.runner import RunResult
 
 CLIMB_FLOWS = ("ascent", "descent", "landing")
 

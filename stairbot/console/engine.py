@@ -17,21 +17,21 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypedDict
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
-from stairbot.cli_journal import ResumePlan, carry_on, default_path, plan_resume, start_journal
-from stairbot.config import RobotConfig
 from stairbot.console.climb_gate import MidClimb, after_run
 from stairbot.console.robot_holder import LATCH_HINT, OpenFn, RobotHolder, default_open
 from stairbot.console.state import LiveState
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import StairbotError
 from stairbot.events import Event, EventKind, EventSink
 from stairbot.hardware import Snapshot
-from stairbot.journal import JournalWriter
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording.record import RecordsTicks
-from stairbot.resume import ResumeRefused
-from stairbot.robots import RobotSession
-from stairbot.runner import RunControl, RunResult
+from stairbot.run.journal import JournalWriter
+from stairbot.run.journaled import ResumePlan, carry_on, default_path, plan_resume, start_journal
+from stairbot.run.resume import ResumeRefused
+from stairbot.run.robots import RobotSession
+from stairbot.run.runner import RunControl, RunResult
 
 MID_CLIMB_HINT = ("the robot may stand part way up the stairs: a new run would drive it at "
                   "the riser; s offers resume (boards) or your word it is back at the start")
@@ -70,7 +70,7 @@ class EngineHooks(TypedDict, total=False):
 
 def _default_run(session: RobotSession, config: RobotConfig, sink: EventSink,
                  mode: str, control: RunControl, on_tick: OnTick, plan: RunPlan) -> RunResult:
-    from stairbot.runner import run
+    from stairbot.run.runner import run
 
     return run(session, config, sink, _mode(mode), control, on_tick=on_tick,
                controller=plan.controller, journal=plan.journal)

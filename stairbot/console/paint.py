@@ -15,7 +15,7 @@ from stairbot.console.freshness import age_words, is_stale
 from stairbot.console.state import StateView
 from stairbot.console.words import carried_by
 from stairbot.hardware import MotorId
-from stairbot.reckon import dead_reckon
+from stairbot.views.reckon import dead_reckon
 
 if TYPE_CHECKING:
     from stairbot.console.app import StairbotConsole

@@ -18,10 +18,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from stairbot.config import RobotConfig
 from stairbot.console.history import WINDOW_S
 from stairbot.console.state import LiveState
 from stairbot.events import EventKind
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording.pose import DeadReckonedPose
 from stairbot.recording.replay_source import ReplaySource, scene_of
 

@@ -25,13 +25,14 @@ from textual.screen import Screen
 from textual.widget import Widget
 from textual.widgets import Static
 
-from stairbot.config import RobotConfig, load_config
 from stairbot.console.app import REFRESH_HZ, StairbotConsole
 from stairbot.console.engine import ConsoleEngine
 from stairbot.console.help import HelpScreen
 from stairbot.console.replay import ReplayPlayer, speed_name
 from stairbot.console.state import StateView
 from stairbot.console.widgets.estop import ESTOP_KEY
+from stairbot.control.robot_config import load_config
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording.replay_source import ReplaySource
 
 NO_ROBOT = "replay: no robot"

@@ -16,8 +16,6 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from stairbot.cli_journal import default_path
-from stairbot.config import RobotConfig
 from stairbot.console.climb_gate import MidClimb, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
 from stairbot.console.state import LiveState
@@ -25,12 +23,14 @@ from stairbot.console.watch import PacedClock, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
 from stairbot.events import Event, EventKind
 from stairbot.hardware import HasScene, HasTruth, ReportsEvents
-from stairbot.paths import unused_path
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.recording.record import JsonLinesRecord, RecordsTicks, is_mcap
-from stairbot.robots import RobotOptions, RobotSession
-from stairbot.scenario import Scenario, load_scenario
-from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
-from stairbot.top_view import TopPlan, TopPose, plan_of, top_pose
+from stairbot.run.journaled import default_path
+from stairbot.run.paths import unused_path
+from stairbot.run.robots import RobotOptions, RobotSession
+from stairbot.views.side_view import SceneView, scene_view, stairs_from_scenario
+from stairbot.views.top_view import TopPlan, TopPose, plan_of, top_pose
 
 if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
     from stairbot.recording.mcap_sink import McapRecord
@@ -45,8 +45,8 @@ OpenFn = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
 
 def default_open(url: str, config: RobotConfig, scenario: Scenario,
                  options: RobotOptions) -> RobotSession:
-    """The robot at ``url`` on ``scenario``'s world (:func:`stairbot.robots.open_robot`)."""
-    from stairbot.robots import open_robot
+    """The robot at ``url`` on ``scenario``'s world (:func:`stairbot.run.robots.open_robot`)."""
+    from stairbot.run.robots import open_robot
 
     return open_robot(url, config, replace(options, world=scenario))
 

@@ -16,9 +16,9 @@ from typing import Any
 from stairbot.console.history import History, Row
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, Snapshot
-from stairbot.runner import RunResult
-from stairbot.side_view import SceneView
-from stairbot.top_view import TopPlan, TopPose
+from stairbot.run.runner import RunResult
+from stairbot.views.side_view import SceneView
+from stairbot.views.top_view import TopPlan, TopPose
 
 LOG_LENGTH = 1000
 NOTE_KINDS = {"information": EventKind.INFO, "warning": EventKind.WARNING,

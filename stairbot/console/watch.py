@@ -23,8 +23,8 @@ from stairbot.hardware import (
     Speeds,
     Truth,
 )
-from stairbot.side_view import SceneView
-from stairbot.top_view import TopPose
+from stairbot.views.side_view import SceneView
+from stairbot.views.top_view import TopPose
 
 SCENE_PERIOD_S = 0.04  # wall seconds between pictures taken from the simulation
 
@@ -162,7 +162,7 @@ class WatchedRobot:
     def identity(self) -> dict[str, dict[str, int]] | None:
         """The boards' serial numbers and uptimes (what a journal keeps), or
         None for a robot that has none (the simulation)."""
-        from stairbot.runner import board_identity
+        from stairbot.run.runner import board_identity
 
         with self._lock:
             return board_identity(self.inner)

@@ -5,7 +5,7 @@ beneath, dimmer.  Segments are numbered front to back, as in the picture
 
 from __future__ import annotations
 
-from stairbot.algorithm.phases import Phase
+from stairbot.control.algorithm.phases import Phase
 
 PHASE_WORDS: dict[Phase, str] = {
     Phase.CAL_CHECK: "squaring up: reading the front sensors",

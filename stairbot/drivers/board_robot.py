@@ -14,8 +14,8 @@ lost link raises LinkLostError; a board that never answers while opening,
 NoBoardError.
 
 Fake boards in lockstep are a simulation, not a robot on a wire: their clock,
-StepTo, truth and falls are ``stairbot.fakes.lockstep``'s, which
-:func:`open_board_session` hands a ``lockstep=1`` URL to.
+StepTo, truth and falls belong to the fakes, which register their robot
+with :mod:`stairbot.drivers.board_session` (the drivers never import them).
 """
 
 from __future__ import annotations
@@ -29,7 +29,6 @@ from collections.abc import Callable, Sequence
 from typing import Any, Concatenate, Final, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
-from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
@@ -40,7 +39,6 @@ from stairbot.drivers.telemetry import K, T, V
 from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import Clock, Imu, SensorId, SensorReading, Snapshot, Speeds
-from stairbot.robots import RobotSession
 
 # The emergency stop (docs/protocol.md, "Emergency stop"): each press puts
 # ESTOP_COPIES EStop frames to each board on the wire at once, sends the
@@ -87,7 +85,7 @@ class BoardRobot:
     have it (BoardMismatchError when opening), and every snapshot carries six
     readings; otherwise four, whatever the board sends."""
 
-    LOCKSTEP = False  # what the boards' LOCKSTEP flag must say (fakes.lockstep: True)
+    LOCKSTEP = False  # what the boards' LOCKSTEP flag must say (the lockstep robot: True)
     estop_any_thread: Final = True  # estop() does not wait for the lock (EstopsFromAnyThread)
     HOLD_COMMANDS = False  # True: commands wait for the next frame sent (a StepTo)
 
@@ -546,39 +544,6 @@ class BoardRobot:
                                 f"{got.problem}", None, {"imu": got.state}))
         self.imu_read = got
         return got.imu
-
-
-def wanted_side_pair(config: RobotConfig) -> str | None:
-    """Where ``config`` gives the robot the side pair, for messages
-    (``robot.toml: [sensors] side_model = "ir"``); None when it has none."""
-    if not config.sensors.has_side_pair:
-        return None
-    return f'{config.source}: [sensors] side_model = "{config.sensors.side_model}"'
-
-
-def open_board_session(link: BoardLink, url: str, *, watchdog_ms: int, lockstep: bool,
-                       time_scale: float, allow_latched: bool = False,
-                       side_pair: str | None = None) -> RobotSession:
-    """The session of the boards on ``link`` (closed again if they cannot be
-    opened).  Fake boards in lockstep (``lockstep``) are opened by
-    ``stairbot.fakes.lockstep``: their clock steps their world.  Boards that
-    hold a latch raise LatchedError unless ``allow_latched``; a sensor board
-    without the side pair ``side_pair`` names (``wanted_side_pair``) raises
-    BoardMismatchError."""
-    robot: BoardRobot
-    try:
-        if lockstep:
-            from stairbot.fakes.lockstep import LockstepRobot  # the simulation's own part
-
-            robot = LockstepRobot(link, url, watchdog_ms, allow_latched=allow_latched,
-                                  side_pair=side_pair)
-        else:
-            robot = BoardRobot(link, url, watchdog_ms, time_scale=time_scale,
-                               allow_latched=allow_latched, side_pair=side_pair)
-    except BaseException:
-        link.close()
-        raise
-    return RobotSession(robot=robot, clock=robot.clock, url=url, simulated=robot.simulated)
 
 
 def vars_of(ident: m.Ident) -> dict[str, int]:

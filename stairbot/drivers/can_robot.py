@@ -83,8 +83,7 @@ from urllib.parse import unquote
 import can
 import can.util
 
-from stairbot.config import RobotConfig
-from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
+from stairbot.drivers.board_session import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import CanFrameLog, check_can_log
 from stairbot.drivers.port_lock import PortLock, take_port_lock
@@ -92,7 +91,8 @@ from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
-from stairbot.robots import RobotOptions, RobotSession
+from stairbot.inputs.config import RobotConfig
+from stairbot.run.robots import RobotOptions, RobotSession
 
 OPTION_DEFAULTS: dict[str, float] = {
     "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250, "lockstep": 0, "time_scale": 1.0,

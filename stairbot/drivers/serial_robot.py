@@ -54,15 +54,15 @@ from urllib.parse import urlencode
 
 import serial
 
-from stairbot.config import RobotConfig
-from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
+from stairbot.drivers.board_session import open_board_session, wanted_side_pair
 from stairbot.drivers.frame_log import SerialFrameLog
 from stairbot.drivers.port_lock import PortLock, serial_lock_key, take_port_lock
 from stairbot.drivers.serial_link import FdChannel, PortChannel, SerialLink
 from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.drivers.url_options import number_option, query_pairs
 from stairbot.errors import RobotUrlError
-from stairbot.robots import RobotOptions, RobotSession
+from stairbot.inputs.config import RobotConfig
+from stairbot.run.robots import RobotOptions, RobotSession
 
 DEFAULTS: dict[str, float] = {
     "baud": 1_000_000, "timeout": 0.05, "retries": 2, "lost": 3, "watchdog": 250,

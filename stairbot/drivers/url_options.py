@@ -12,7 +12,7 @@ from collections.abc import Callable
 from urllib.parse import parse_qsl
 
 from stairbot.errors import RobotUrlError
-from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
+from stairbot.run.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 
 MAX_TIMEOUT_S = 60.0
 MAX_RETRIES = 100

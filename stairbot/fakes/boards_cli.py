@@ -27,14 +27,15 @@ import sys
 from collections.abc import Callable
 from importlib import import_module
 
-from stairbot.cli import bounded
-from stairbot.config import RobotConfig, load_config
+from stairbot.args import bounded
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
-from stairbot.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.run.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
 
 _probability = bounded(0.0, 1.0, " (a probability)")
 

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import can
 from can.interfaces.udp_multicast import UdpMulticastBus
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanFrame, CanWire, wire
@@ -52,7 +52,7 @@ from stairbot.errors import RobotUrlError
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.serial_boards import FaultDice, WireFaults
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 
 @dataclass

@@ -43,10 +43,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
-from stairbot.cli_journal import start_journal
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.errors import HardwareError
 from stairbot.fakes.board_world import BoardWorld
@@ -63,9 +62,11 @@ from stairbot.fakes.fault_rig import (
 )
 from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Snapshot
-from stairbot.journal import read_journal
-from stairbot.runner import RunResult, run
-from stairbot.scenario import parse_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import parse_scenario
+from stairbot.run.journal import read_journal
+from stairbot.run.journaled import start_journal
+from stairbot.run.runner import RunResult, run
 
 LATE_S = {"can": 0.005, "serial": 0.03}  # a late frame: ten and six timeouts late
 AFTER_S = 2.0  # world seconds run on after a stopped run, no host

@@ -19,8 +19,6 @@ from typing import Any, cast
 
 import can
 
-from stairbot.cli_journal import resume
-from stairbot.config import RobotConfig
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import HardwareError, InputError
 from stairbot.fakes.board_world import BoardWorld
@@ -28,9 +26,11 @@ from stairbot.fakes.boards import Board
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
-from stairbot.resume import ResumeRefused
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import run
+from stairbot.inputs.config import RobotConfig
+from stairbot.run.journaled import resume
+from stairbot.run.resume import ResumeRefused
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import run
 
 SCENARIO = """
 name = "fault_matrix"

@@ -28,10 +28,9 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode
-from stairbot.cli_journal import default_path, start_journal
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode
+from stairbot.control.robot_config import load_config
 from stairbot.errors import HardwareError
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -46,9 +45,11 @@ from stairbot.fakes.fault_rig import (
     run_on,
 )
 from stairbot.hardware import Snapshot
-from stairbot.journal import mark_path
-from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, parse_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, parse_scenario
+from stairbot.run.journal import mark_path
+from stairbot.run.journaled import default_path, start_journal
+from stairbot.run.runner import RunResult, run
 
 POINTS = ("first", "middle", "last")
 """Where in a phase's ticks the host is killed."""
@@ -79,7 +80,7 @@ class Killed:
 def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
     """Fake boards on ``wire`` running the flight with a journal at
     ``journal`` (None: where a run on them keeps it by default,
-    :func:`~stairbot.cli_journal.default_path`), the host killed after tick
+    :func:`~stairbot.run.journaled.default_path`), the host killed after tick
     ``tick``, the world run on
     :data:`HOST_DEAD_S` and the boards listening again; closed when the
     block ends.  AssertionError when the run ends before that tick."""

@@ -70,7 +70,7 @@ from dataclasses import dataclass, replace
 from stairbot.fakes.plan import WHOLE_LENGTH, Plan, Range, Walls
 from stairbot.fakes.stairs import FLOOR_BEHIND, LANDING, OPEN_FLOOR, WALL_HEIGHT, stairs_outline
 from stairbot.fakes.world import World, top_edge
-from stairbot.scenario import Scenario
+from stairbot.inputs.scenario import Scenario
 
 Point = tuple[float, float]
 

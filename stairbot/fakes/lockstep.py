@@ -2,7 +2,9 @@
 
 A ``serial://...?lockstep=1`` or ``can://...?lockstep=1`` URL names fake
 boards (``stairbot fake-boards --lockstep``) whose world advances only when
-the host says so.  The drivers open such boards with :class:`LockstepRobot`:
+the host says so.  The drivers open such boards with :class:`LockstepRobot`,
+which this module registers with them on import
+(:func:`stairbot.drivers.board_session.register_lockstep`):
 the board robot of ``stairbot.drivers`` plus what only a simulation has --
 
 * :class:`LockstepClock`: ``advance(dt)`` sends the motor board StepTo (the
@@ -23,6 +25,7 @@ import contextlib
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot, locked
+from stairbot.drivers.board_session import register_lockstep
 from stairbot.drivers.link import BoardLink, Reply, Request
 from stairbot.drivers.sim_messages import FELL
 from stairbot.errors import HardwareError, RobotFellError
@@ -150,3 +153,6 @@ class LockstepRobot(BoardRobot):
             t = self.truth()
             out.update(fell=t.fell, max_pitch_deg=t.max_pitch_deg, offset_m=t.offset_m)
         return out
+
+
+register_lockstep(LockstepRobot)

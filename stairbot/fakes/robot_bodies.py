@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import pymunk
 
-from stairbot.config import RobotConfig
 from stairbot.fakes.world_params import WorldParams
+from stairbot.inputs.config import RobotConfig
 
 PIN_REACH = 1.0  # the lift pin's lower anchor sits this far below segment 2's axles
 

@@ -49,7 +49,7 @@ from typing import Literal
 
 from stairbot.fakes.sensors import active_faults, frozen, sensor_rng
 from stairbot.hardware import SensorId, SensorReading, SensorStatus
-from stairbot.scenario import Fault
+from stairbot.inputs.scenario import Fault
 
 Hit = tuple[float, float, float]  # distance m, cos(incidence), weight in the beam
 ConeRay = tuple[float, float, float]  # angle along the side view, across it (rad), weight

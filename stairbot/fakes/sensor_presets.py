@@ -2,7 +2,7 @@
 (``[sensors] front_model``, ``back_model``).
 
 The datasheet's timing, noise and range come from
-:mod:`stairbot.sensor_specs` (the controller's perception uses the same
+:mod:`stairbot.inputs.sensor_specs` (the controller's perception uses the same
 figures, cited there); here is what only a simulation needs, each figure
 saying where it comes from: how many rays stand for the cone, how they
 combine, outlier and dropout rates ("assumed": the datasheets do not give
@@ -16,10 +16,10 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from stairbot import sensor_specs as specs
-from stairbot.config import Sensors
 from stairbot.fakes.sensor_model import SensorModel
-from stairbot.sensor_specs import SensorSpec
+from stairbot.inputs import sensor_specs as specs
+from stairbot.inputs.sections import Sensors
+from stairbot.inputs.sensor_specs import SensorSpec
 
 
 def _from(spec: SensorSpec, **sim_only: Any) -> SensorModel:

@@ -16,7 +16,7 @@ import random
 from collections.abc import Iterable
 
 from stairbot.hardware import SensorId
-from stairbot.scenario import Fault
+from stairbot.inputs.scenario import Fault
 
 
 def sensor_rng(seed: int, sensor: SensorId) -> random.Random:

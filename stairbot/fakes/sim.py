@@ -38,7 +38,6 @@ import time
 from collections.abc import Callable
 from urllib.parse import urlsplit
 
-from stairbot.config import RobotConfig
 from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.landing import FOOTPRINT_MARGIN, Stairwell
 from stairbot.fakes.plan import Plan
@@ -54,8 +53,9 @@ from stairbot.hardware import (
     Speeds,
     Truth,
 )
-from stairbot.robots import RobotOptions, RobotSession
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.run.robots import RobotOptions, RobotSession
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
 

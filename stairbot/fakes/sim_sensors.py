@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import math
 
-from stairbot.config import RobotConfig
 from stairbot.errors import ScenarioError
 from stairbot.fakes.beams import down_fans, front_hits, total_weight
 from stairbot.fakes.landing import Stairwell
@@ -38,7 +37,8 @@ from stairbot.fakes.sensor_model import Hit, ModelSensor, combine
 from stairbot.fakes.sensor_presets import model_for, preset
 from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 
 _SFR, _SFL, _SBR, _SBL = SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL  # bound once
 _SSR, _SSL = SensorId.SSR, SensorId.SSL

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_left, bisect_right
 
-from stairbot.scenario import Scenario
+from stairbot.inputs.scenario import Scenario
 
 FLOOR_BEHIND = 30.0  # floor length behind riser 1, m
 LANDING = 3.0  # flat landing beyond the last tread, m

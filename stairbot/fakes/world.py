@@ -26,12 +26,12 @@ try:  # the C functions behind pymunk's Body properties, without the Python wrap
     from pymunk._chipmunk import lib as _cp
 except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
     _cp = None
-from stairbot.config import RobotConfig
 from stairbot.fakes.fall_watch import FallWatch
 from stairbot.fakes.robot_bodies import CAT_STAIRS, PIN_REACH, build_robot
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
 from stairbot.fakes.world_params import WorldParams
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 
 TWO_PI = 2.0 * math.pi
 

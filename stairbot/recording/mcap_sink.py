@@ -41,15 +41,16 @@ from foxglove.channels import (
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
 from stairbot import __version__
-from stairbot.config import RobotConfig
+from stairbot.control.algorithm import limits
 from stairbot.errors import OutputError
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
 from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, Snapshot, Speeds
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 from stairbot.recording import messages, topics
 from stairbot.recording.pose import PoseSource
 from stairbot.recording.stream import AppendStream
-from stairbot.scenario import Scenario
 
 FLUSH_PERIOD_S = 0.5
 """Wall seconds between flushes at most (a run paced to the wall clock)."""
@@ -121,7 +122,7 @@ class McapRecord:
                     "time": "log time = time_origin_ns + the robot's clock (time_s)",
                     "config": config.source})
                 self._attach("robot_config.json", "application/json",
-                             json.dumps(config.to_dict(), indent=1).encode())
+                             json.dumps(limits.config_dict(config), indent=1).encode())
                 dbc = resources.files("stairbot").joinpath("drivers/stairbot.dbc")
                 self._attach("stairbot.dbc", "text/plain", dbc.read_bytes())
                 self._flush()

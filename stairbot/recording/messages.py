@@ -26,9 +26,9 @@ from foxglove.messages import (
     Vector3,
 )
 
-from stairbot.config import RobotConfig
 from stairbot.events import Event, EventKind
 from stairbot.hardware import LIFT_MOTORS, MotorId, Point, Snapshot
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording.pose import (
     SEGMENT_FRAMES,
     WORLD_FRAME,

@@ -20,11 +20,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
-from stairbot.config import RobotConfig
 from stairbot.hardware import HasScene, Point, Snapshot
-from stairbot.reckon import dead_reckon
-from stairbot.scenario import Scenario
-from stairbot.side_view import stairs_from_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
+from stairbot.views.reckon import dead_reckon
+from stairbot.views.side_view import stairs_from_scenario
 
 SEGMENT_FRAMES = ("segment1", "segment2", "segment3")
 """The frames of segments 1, 2 and 3 (front to back), children of ``world``."""
@@ -158,7 +158,7 @@ class SimulationPose:
 class DeadReckonedPose:
     """The host's estimate for a robot on a wire: the segments where the wheel
     and lift turn counters put them on the scenario's stairs
-    (:func:`stairbot.reckon.dead_reckon`).  Slip, yaw, the lateral
+    (:func:`stairbot.views.reckon.dead_reckon`).  Slip, yaw, the lateral
     position and a tipped robot are not in it."""
 
     topic = "/robot/estimated_pose"

@@ -9,12 +9,12 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
-from stairbot.config import RobotConfig
 from stairbot.errors import OutputError
 from stairbot.events import Event
 from stairbot.files import LineFile
 from stairbot.hardware import Snapshot, Speeds
-from stairbot.scenario import Scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario
 
 if TYPE_CHECKING:  # the pose module draws on the console's side view
     from stairbot.recording.pose import PoseSource

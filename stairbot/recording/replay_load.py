@@ -28,8 +28,6 @@ from dataclasses import dataclass, field
 from pathlib import PurePath
 from typing import Any
 
-from stairbot._schema import convert
-from stairbot.config import ConfigFile, RobotConfig
 from stairbot.events import Event, EventKind
 from stairbot.files import shown
 from stairbot.hardware import (
@@ -42,6 +40,9 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.schema import convert
+from stairbot.inputs.sections import ConfigFile
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES, pitch_of
 from stairbot.recording.read import (

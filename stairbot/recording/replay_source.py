@@ -13,10 +13,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from stairbot.config import RobotConfig
 from stairbot.events import Event
 from stairbot.hardware import MotorId, Point, Snapshot
-from stairbot.side_view import SceneView
+from stairbot.inputs.config import RobotConfig
+from stairbot.views.side_view import SceneView
 
 PART_GAP_S = 0.001
 """On the replay's timeline a robot's part starts this long after the one

@@ -21,15 +21,17 @@ from functools import cache
 from importlib import resources
 from typing import Any
 
-from stairbot._schema import _tokens
-from stairbot.config import DEFAULT_CONFIG_NAME, RobotConfig, parse_config
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import parse_config
 from stairbot.errors import ConfigError, ScenarioError
-from stairbot.scenario import (
+from stairbot.inputs.config import DEFAULT_CONFIG_NAME, RobotConfig
+from stairbot.inputs.scenario import (
     DEFAULT_COUNT,
     DEFAULT_RISE,
     DEFAULT_TREAD,
     parse_scenario,
 )
+from stairbot.inputs.schema import _tokens
 from stairbot.sweep import tomlw
 from stairbot.sweep.spec import VIRTUAL, Axis, Spec, SpecError, case_rng
 from stairbot.sweep.zones import zone
@@ -51,7 +53,7 @@ class Case:
 
 @cache
 def _default_config_text() -> str:
-    return resources.files("stairbot").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
+    return resources.files("stairbot.inputs").joinpath(DEFAULT_CONFIG_NAME).read_text("utf-8")
 
 
 @cache
@@ -150,7 +152,7 @@ def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) 
         "zone": z, "count": len(scenario.steps), "max_rise_m": max_rise,
         "min_tread_m": min_tread if math.isfinite(min_tread) else None,
         "limit_rise_m": round(config.max_step_rise_m, DIGITS),
-        "limit_tread_m": round(config.min_tread_m, DIGITS),
+        "limit_tread_m": round(limits.min_tread_m(config), DIGITS),
         "expected_steps": min(len(scenario.steps), config.algorithm.max_steps),
         "faults": len(scenario.faults), "home_m": spec.rules.home_m,
     }

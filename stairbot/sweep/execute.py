@@ -46,7 +46,7 @@ def open_executor(jobs: int, dask: str | None = None) -> Iterator[tuple[Executor
     """An executor and a label for it.  Raises ExtraMissing without Dask."""
     if dask is None:
         ctx = multiprocessing.get_context("forkserver")
-        ctx.set_forkserver_preload(["stairbot.sweep.worker", "stairbot.runner",
+        ctx.set_forkserver_preload(["stairbot.sweep.worker", "stairbot.run.runner",
                                     "stairbot.fakes.sim"])
         pool = ProcessPoolExecutor(jobs, mp_context=ctx, initializer=ignore_sigint)
         try:

@@ -42,10 +42,11 @@ from typing import Annotated, Any
 import msgspec
 import msgspec.inspect as mi
 
-from stairbot._schema import _tokens, _type_at, convert, load_toml, read_text
-from stairbot.config import ConfigFile, config_table
 from stairbot.errors import ConfigError, InputError
-from stairbot.scenario import ScenarioFile
+from stairbot.inputs.config import config_table
+from stairbot.inputs.scenario import ScenarioFile
+from stairbot.inputs.schema import _tokens, _type_at, convert, load_toml, read_text
+from stairbot.inputs.sections import ConfigFile
 from stairbot.sweep import tomlw
 from stairbot.text import check_line, printable
 
@@ -305,12 +306,12 @@ def parse_axis(src: str, path: str, value: Any) -> Axis:
 def _base_text(spec_dir: Path, name: str | None, src: str, key: str, default: str,
                folder: str | None) -> str:
     if name is None:
-        return resources.files("stairbot").joinpath(default).read_text("utf-8")
+        return resources.files("stairbot.inputs").joinpath(default).read_text("utf-8")
     p = spec_dir / name
     if p.is_file():
         return read_text(p, SpecError)
     if folder is not None and "/" not in name and not name.endswith(".toml"):
-        entry = resources.files("stairbot").joinpath(folder, f"{name}.toml")
+        entry = resources.files("stairbot.inputs").joinpath(folder, f"{name}.toml")
         if entry.is_file():
             return entry.read_text("utf-8")
     raise SpecError(src, f"sweep.{key}", f"{name!r}: no such file (relative to the spec)"

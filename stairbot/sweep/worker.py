@@ -71,11 +71,11 @@ def run_case(case: Case) -> dict[str, Any]:
     wall0, cpu0 = time.perf_counter(), time.process_time()
     record: dict[str, Any] = {"case": case.index, "axes": case.axes, "facts": case.facts}
     try:
-        from stairbot.algorithm.phases import Mode
-        from stairbot.config import load_config, parse_config
-        from stairbot.robots import RobotOptions, open_robot
-        from stairbot.runner import run
-        from stairbot.scenario import parse_scenario
+        from stairbot.control.algorithm.phases import Mode
+        from stairbot.control.robot_config import load_config, parse_config
+        from stairbot.inputs.scenario import parse_scenario
+        from stairbot.run.robots import RobotOptions, open_robot
+        from stairbot.run.runner import run
 
         scenario = parse_scenario(case.scenario_text, f"<case {case.index}>")
         config = (load_config() if case.config_text is None

@@ -14,8 +14,9 @@ from dataclasses import replace
 
 import msgspec
 
-from stairbot.config import RobotConfig
-from stairbot.scenario import Scenario, Step
+from stairbot.control.algorithm import limits
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, Step
 from stairbot.sweep.spec import Rules
 
 SIGHT_MARGIN_M = 0.02
@@ -75,7 +76,7 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     last = len(scenario.steps) - 1
     treads = [s.tread for i, s in enumerate(steps) if not (i == last and scenario.top == "landing")]
     min_tread = min(treads, default=math.inf)
-    lr, lo, lt = config.max_step_rise_m, config.min_step_rise_m, config.min_tread_m
+    lr, lo, lt = config.max_step_rise_m, limits.min_step_rise_m(config), limits.min_tread_m(config)
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
     # how far each riser clears what the front cone needs to measure the tread
     # before it, and each measured tread's own riser what the robot asks of it
@@ -102,7 +103,7 @@ def _riser_seen_m(tread: float, config: RobotConfig) -> float:
     LENGTH_OF_INFINITY (give or take the sight margin) the robot takes that
     step for the top: like stairs out of sight at the start, the rest is
     outside."""
-    from stairbot.algorithm.landing import TAB_PAST_EDGE_M
+    from stairbot.control.algorithm.landing import TAB_PAST_EDGE_M
 
     return tread - (config.LENGTH_OF_FIRST_MODULE + config.LENGTH_OF_SECOND_MODULE
                     - TAB_PAST_EDGE_M)
@@ -117,11 +118,13 @@ def _cone_clearances(scenario: Scenario, steps: tuple[Step, ...] | list[Step],
     FAR_TREAD_M (the reading, tread + approach_gap, give or take the tread
     margin) holds the riser it climbs, and the next, to min_rise_for it;
     past it the robot climbs a riser lower than that if its readings held
-    as segment 1 rose (:mod:`stairbot.algorithm.long_tread`): the next
+    as segment 1 rose (:mod:`stairbot.control.algorithm.long_tread`): the next
     riser lower than min_rise_for, climbing and refusing are both right (a
     wall is higher than any: no bound).  Within the margin of FAR_TREAD_M,
     either rule may hold: the readings'."""
-    from stairbot.algorithm.long_tread import FAR_TREAD_M  # the sweep runs the controller anyway
+    from stairbot.control.algorithm.long_tread import (
+        FAR_TREAD_M,  # the sweep runs the controller anyway
+    )
 
     near: list[float] = []
     far: list[float] = []
@@ -154,13 +157,13 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     side pair and ``[algorithm] landings``, the second flight has steps, the
     landing is not so deep that the wall ahead reads as the top (the front
     pair's LENGTH_OF_INFINITY past the robot standing at the edge), and the
-    robot's turning room (:func:`~stairbot.algorithm.landing.turn_room_m`)
+    robot's turning room (:func:`~stairbot.control.algorithm.landing.turn_room_m`)
     fits in half the landing's measured depth and on either side of where it
     climbed (half the width, less start.lateral), give or take the tread
     margin.  Where the landing refuses, the first flight's zone stands: the
     robot climbs it, refuses the landing, comes home, and that is right
     ("refused"); where it does not, both flights must be climbed."""
-    from stairbot.algorithm.landing import DEPTH_MARGIN, turn_room_m
+    from stairbot.control.algorithm.landing import DEPTH_MARGIN, turn_room_m
 
     landing = scenario.landing
     assert landing is not None
@@ -223,7 +226,7 @@ def _first_flight_zone(scenario: Scenario, config: RobotConfig, rules: Rules
 def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
                  ) -> tuple[str, float, float]:
     """A continuous descent's zone: every rise from the least drop the back
-    pair reads as one (:func:`~stairbot.algorithm.edge.edge_drop_m` less
+    pair reads as one (:func:`~stairbot.control.algorithm.edge.edge_drop_m` less
     BACK_CLEARANCE) to max_step_rise_m, and every tread it steps down onto (all
     but the top one, which runs on into the landing it starts on) at least
     LENGTH_OF_A_ROBOT + SAFE_LENGTH (narrow steps or not), give or take the
@@ -235,7 +238,7 @@ def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     before it steps down onto it: one shorter than min_tread_m it descends
     while its back pair still reads the tread after the step, and refuses
     once it reads past the next edge.)"""
-    from stairbot.algorithm.edge import edge_drop_m  # the sweep runs the controller anyway
+    from stairbot.control.algorithm.edge import edge_drop_m  # the sweep runs the controller anyway
 
     steps = scenario.steps
     low = edge_drop_m(config, from_top=True) - config.BACK_CLEARANCE  # the least drop seen

@@ -14,7 +14,7 @@ import pytest
 
 from stairbot.cli import main
 
-ROBOT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
+ROBOT = resources.files("stairbot.inputs").joinpath("default_robot.toml").read_text("utf-8")
 
 
 def write(tmp_path: Path, name: str, text: str) -> str:

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.cli import EXTERNAL, main
-from stairbot.scenario import shipped_scenarios
+from stairbot.cli.command import EXTERNAL, main
+from stairbot.inputs.scenario import shipped_scenarios
 
 
 @pytest.mark.parametrize("argv", [[], ["run"], ["config"], ["config", "show"], ["scenario"],

@@ -22,7 +22,7 @@ import pytest
 
 from stairbot.cli import main
 
-ROBOT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
+ROBOT = resources.files("stairbot.inputs").joinpath("default_robot.toml").read_text("utf-8")
 ROOT = Path(__file__).resolve().parents[2]
 QUICK = "[stairs]\ncount = 1\n"  # a short run: what a disk can fill during
 

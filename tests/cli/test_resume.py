@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 from lockstep_boards import kill_mid_lift, last_tick, lockstep_boards
 
-from stairbot.journal import JournalWriter, read_journal
-from stairbot.resume import ResumeRefused, check, describe
+from stairbot.run.journal import JournalWriter, read_journal
+from stairbot.run.resume import ResumeRefused, check, describe
 
 
 def stairbot(*args: str, env: dict[str, str], **kw: object) -> subprocess.Popen[str]:
@@ -173,7 +173,7 @@ def test_resumes_are_counted_through_a_journal_longer_than_a_read_piece(
         tmp_path: Path) -> None:
     """read_journal reads a journal whole, a piece at a time: the resumes of
     a long run in its first piece are counted too."""
-    from stairbot.journal_read import CHUNK
+    from stairbot.run.journal_read import CHUNK
 
     path = tmp_path / "j.jsonl"
     w = JournalWriter(path, fresh=True)
@@ -244,7 +244,7 @@ def test_a_climb_killed_mid_scan_on_a_landing_resumes_turns_and_comes_home(
 def test_a_resume_drops_a_line_cut_short_and_carries_the_chain_on(tmp_path: Path) -> None:
     """A power loss cut the last line: the resumed run's writer drops it
     before it appends, and the journal reads back whole, chained."""
-    from stairbot.journal import mark_path
+    from stairbot.run.journal import mark_path
 
     path = tmp_path / "j.jsonl"
     w = JournalWriter(path, fresh=True)

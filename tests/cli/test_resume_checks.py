@@ -20,7 +20,7 @@ from stairbot.drivers.board_robot import BoardRobot
 from stairbot.fakes.fault_rig import SCENARIO, resume_watched
 from stairbot.fakes.host_kills import Killed, killed_host
 from stairbot.hardware import Imu
-from stairbot.journal import line_hash, mark_path, read_journal
+from stairbot.run.journal import line_hash, mark_path, read_journal
 
 Records = list[dict[str, Any]]
 KILL_TICK = 30  # the flight's calibration check: ticks 0 to 40; a context at 25

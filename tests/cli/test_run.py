@@ -15,7 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.cli import _ctrl_c_stops, main
+from stairbot.cli import main
+from stairbot.cli.run import _ctrl_c_stops
 
 RESULT_KEYS = {"outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "error",
                "fell", "max_pitch_deg", "final_offset_m", "sim_time_s", "wall_time_s",

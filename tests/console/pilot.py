@@ -15,7 +15,7 @@ from textual.widgets import Input
 
 from stairbot.console.app import StairbotConsole
 from stairbot.hardware import MotorId, Speeds
-from stairbot.robots import RobotSession, open_robot
+from stairbot.run.robots import RobotSession, open_robot
 
 
 async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:

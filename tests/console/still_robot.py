@@ -7,8 +7,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
     Imu,
@@ -21,9 +21,9 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
 )
-from stairbot.robots import RobotSession
-from stairbot.scenario import load_scenario
-from stairbot.side_view import stairs_from_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotSession
+from stairbot.views.side_view import stairs_from_scenario
 
 LIFT = 0.19  # segment 1 raised this far above segment 2, m
 

@@ -19,7 +19,7 @@ from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ConfirmScreen
 from stairbot.errors import LinkLostError
 from stairbot.hardware import MotorId, Snapshot
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 
 def _comparable(line: str) -> dict[str, Any]:

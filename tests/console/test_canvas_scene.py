@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from stairbot.config import load_config
 from stairbot.console.canvas import BrailleCanvas
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import Scene
-from stairbot.scenario import load_scenario
-from stairbot.side_view import SceneView, scene_view, stairs_from_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.views.side_view import SceneView, scene_view, stairs_from_scenario
 
 
 def test_dots_map_to_braille_bits() -> None:
@@ -41,7 +41,7 @@ def test_scenario_stairs_outline() -> None:
 
 def test_scene_from_the_simulation_shows_the_robot_before_the_stairs() -> None:
     from stairbot.fakes.sim import open_sim_robot
-    from stairbot.robots import RobotOptions
+    from stairbot.run.robots import RobotOptions
 
     session = open_sim_robot("sim://", load_config(), RobotOptions(world=load_scenario()))
     view = scene_view(session.sim.scene())  # type: ignore[union-attr]
@@ -112,12 +112,12 @@ def test_dead_reckoning_follows_the_simulated_climb() -> None:
     """The picture of a robot on a wire, from its counters alone, stays within
     5 cm (wheel slip adds up) and 2 cm in height of the simulation's truth
     over calibration and the first two steps."""
-    from stairbot.reckon import dead_reckon
-    from stairbot.robots import open_robot
-    from stairbot.runner import RunControl, run
+    from stairbot.run.robots import open_robot
+    from stairbot.run.runner import RunControl, run
+    from stairbot.views.reckon import dead_reckon
 
     cfg, sc = load_config(), load_scenario()
-    from stairbot.robots import RobotOptions
+    from stairbot.run.robots import RobotOptions
 
     session = open_robot("sim://", cfg, RobotOptions(world=sc))
     control = RunControl()

@@ -10,12 +10,12 @@ from typing import Any
 
 import pytest
 
-from stairbot.config import load_config
 from stairbot.console.engine import ConsoleEngine, describe_result
 from stairbot.console.state import LiveState
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
 from stairbot.hardware import LIFT_MOTORS, WHEEL_MOTORS, MotorId, Snapshot
-from stairbot.runner import RunControl, RunResult
+from stairbot.run.runner import RunControl, RunResult
 
 FORWARD = {m: 1.0 for m in WHEEL_MOTORS}
 
@@ -176,7 +176,7 @@ def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> Non
             return getattr(self.inner, name)
 
     def spy_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
-        from stairbot.robots import RobotSession, open_robot
+        from stairbot.run.robots import RobotSession, open_robot
 
         s = open_robot(url, config, replace(options, world=scenario))
         return RobotSession(Spy(s.robot), s.clock, s.url, s.simulated, s.sim)
@@ -205,7 +205,7 @@ def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
     from stairbot.errors import LinkLostError
 
     def broken_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
-        from stairbot.robots import RobotSession, open_robot
+        from stairbot.run.robots import RobotSession, open_robot
 
         s = open_robot(url, config, replace(options, world=scenario))
 

@@ -12,10 +12,10 @@ from typing import Any
 from pilot import press, ready, until
 from still_robot import StillClock, StillRobot, StillSim
 
-from stairbot.config import load_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import SERIES, History
+from stairbot.control.robot_config import load_config
 from stairbot.errors import LinkLostError
 from stairbot.hardware import (
     Imu,
@@ -26,7 +26,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 PER_TURN = load_config().motors.lift_travel_per_turn
 

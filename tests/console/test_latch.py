@@ -15,7 +15,7 @@ from still_robot import StillClock, StillRobot
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ConfirmScreen
 from stairbot.errors import LatchedError
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 
 def latched(app: StairbotConsole) -> bool:

@@ -27,7 +27,7 @@ from still_robot import StillClock, StillRobot, make_still_app
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ConfirmScreen
 from stairbot.hardware import Imu, Snapshot
-from stairbot.robots import RobotSession
+from stairbot.run.robots import RobotSession
 
 
 @pytest.fixture

@@ -17,10 +17,10 @@ from lockstep_boards import fake_boards, kill_mid_lift, last_tick
 from pilot import SpyRobot, banner, press, ready, spied_open, until
 from textual.widgets import Label
 
-from stairbot.cli_journal import default_path
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ChoiceScreen, ConfirmScreen
-from stairbot.journal import read_journal
+from stairbot.run.journal import read_journal
+from stairbot.run.journaled import default_path
 
 
 def dialog_text(app: StairbotConsole) -> str:

@@ -12,9 +12,9 @@ import pytest
 from lockstep_boards import fake_boards, stairbot
 from pilot import banner, said, until
 
-from stairbot.config import load_config
 from stairbot.console.app import build_app
-from stairbot.robots import RobotSession, open_robot
+from stairbot.control.robot_config import load_config
+from stairbot.run.robots import RobotSession, open_robot
 
 
 @pytest.fixture

@@ -19,18 +19,18 @@ from mcap.reader import make_reader
 from pilot import press, shown, until
 
 from stairbot.cli import main
-from stairbot.config import load_config
 from stairbot.console.freshness import STALE_S
 from stairbot.console.replay_app import ReplayConsole, build_replay_app
 from stairbot.console.widgets.motors import NAMES as MOTOR_NAMES
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
+from stairbot.inputs.scenario import load_scenario
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.pose import DeadReckonedPose
 from stairbot.recording.replay_load import load_replay
 from stairbot.recording.replay_source import PART_GAP_S
-from stairbot.scenario import load_scenario
 
 
 class Clock:
@@ -122,7 +122,7 @@ def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[st
 def test_banner_says_replay_and_the_file_and_no_robot_is_opened(
         recorded: dict[str, Path], monkeypatch: pytest.MonkeyPatch) -> None:
     opened: list[str] = []
-    monkeypatch.setattr("stairbot.robots.open_robot", lambda url, *a, **k: opened.append(url))
+    monkeypatch.setattr("stairbot.run.robots.open_robot", lambda url, *a, **k: opened.append(url))
 
     async def go() -> None:
         app = replay_app(recorded["mcap"], Clock())

@@ -14,13 +14,14 @@ from typing import Any
 from pilot import press, ready, shown, until
 from still_robot import HEALTH, StillClock, StillRobot, StillSim
 
-from stairbot.config import RobotConfig, load_config, parse_config
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import COLUMNS, NOT_CARRIED, SERIES, column, row_of
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.errors import LinkLostError
 from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
-from stairbot.robots import RobotSession
+from stairbot.inputs.config import RobotConfig
+from stairbot.run.robots import RobotSession
 
 SIDE_CONFIG: RobotConfig = parse_config(
     'extends = "reference"\n[sensors]\nside_model = "vl53l0x"\n', "side.toml")

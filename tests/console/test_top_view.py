@@ -15,18 +15,18 @@ from pilot import banner, press, ready, said, shown, until
 from rich.text import Text
 from still_robot import StillClock, StillRobot, StillSim, make_still_app
 
-from stairbot.config import load_config
 from stairbot.console.app import COMMANDS, StairbotConsole, build_app
 from stairbot.console.help import HELP, WIDTH
 from stairbot.console.replay_app import REPLAY_HELP, ReplayConsole
 from stairbot.console.state import LiveState
 from stairbot.console.watch import watch
 from stairbot.console.widgets.top_view import CONTACT_LINE_STYLE
+from stairbot.control.robot_config import load_config
 from stairbot.errors import LinkLostError
 from stairbot.hardware import Snapshot, Truth
-from stairbot.robots import RobotSession
-from stairbot.scenario import load_scenario
-from stairbot.top_view import TopPose, plan_of
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotSession
+from stairbot.views.top_view import TopPose, plan_of
 
 BRAILLE = {chr(c) for c in range(0x2801, 0x2900)}
 README = Path(__file__).parents[2] / "stairbot" / "console" / "README.md"

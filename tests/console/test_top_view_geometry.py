@@ -1,4 +1,4 @@
-"""The top view's geometry (stairbot/top_view.py): the stairwell seen from
+"""The top view's geometry (stairbot/views/top_view.py): the stairwell seen from
 above is the simulation's (fakes/landing.py), face for face; the footprint
 is the one the simulation checks; the pose comes from Truth."""
 
@@ -8,14 +8,14 @@ import math
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes import landing as sim_landing
 from stairbot.fakes import stairs as sim_stairs
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import Truth
-from stairbot.scenario import Scenario, load_scenario, parse_scenario
-from stairbot.top_view import (
+from stairbot.inputs.scenario import Scenario, load_scenario, parse_scenario
+from stairbot.views.top_view import (
     FLOOR_BEHIND,
     FOOTPRINT_MARGIN,
     LANDING,

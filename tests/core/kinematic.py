@@ -16,8 +16,7 @@ import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from stairbot.algorithm.controller import Controller
-from stairbot.config import RobotConfig
+from stairbot.control.algorithm.controller import Controller
 from stairbot.hardware import (
     LIFT_MOTORS,
     Imu,
@@ -28,6 +27,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.inputs.config import RobotConfig
 
 WALL_HEIGHT = 10.0
 

@@ -8,9 +8,9 @@ import math
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.config import load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, SensorId
 
@@ -188,7 +188,7 @@ def test_descent_1_turns_back_to_the_heading_it_climbed_the_step_with() -> None:
     flight that put it 0.1 m to the side of its start (the envelope sweep).
     Descent 1 turns back, by the odometer, to the heading it climbed the
     step with, then checks the readings as the seed says."""
-    from stairbot.algorithm import motion
+    from stairbot.control.algorithm import motion
 
     events: list[Event] = []
     ctrl = Controller(CFG, events.append)
@@ -231,7 +231,7 @@ def test_descent_7_turns_back_to_the_heading_it_crossed_the_floor_with() -> None
     heading put the robot 5.7 cm to the side of its start.  Descent 7 turns
     back, by the odometer, to the heading the floor was crossed with
     (climb_twist[0]) before it backs to the start position."""
-    from stairbot.algorithm import motion
+    from stairbot.control.algorithm import motion
 
     events: list[Event] = []
     ctrl = Controller(CFG, events.append)

@@ -11,10 +11,11 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.config import load_config, parse_config
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.errors import ConfigError
 
-DEFAULT_TEXT = resources.files("stairbot").joinpath("default_robot.toml").read_text("utf-8")
+DEFAULT_TEXT = resources.files("stairbot.inputs").joinpath("default_robot.toml").read_text("utf-8")
 
 
 def with_change(section: str, key: str, value: str | None) -> str:
@@ -49,11 +50,11 @@ def test_default_loads_and_derives_the_reference_robot() -> None:
 def test_the_reference_robot_climbs_residential_stairs() -> None:
     cfg = load_config()
     assert cfg.max_step_rise_m >= 0.18  # rise 0.15-0.18 m
-    assert cfg.min_tread_m <= 0.26  # tread 0.26-0.30 m
+    assert limits.min_tread_m(cfg) <= 0.26  # tread 0.26-0.30 m
 
 
 def test_to_dict_has_every_section_and_the_derived_values() -> None:
-    d = load_config().to_dict()
+    d = limits.config_dict(load_config())
     assert set(d) >= {"geometry", "masses", "motors", "sensors", "algorithm", "safety", "derived",
                       "source"}
     assert d["derived"]["max_step_rise_m"] == pytest.approx(0.202)

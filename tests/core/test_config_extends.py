@@ -9,8 +9,9 @@ from pathlib import Path
 import pytest
 
 from stairbot.cli import main
-from stairbot.config import MAX_EXTENDS, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.errors import ConfigError
+from stairbot.inputs.config import MAX_EXTENDS
 
 
 def chain(folder: Path, files: int, last: str = "reference") -> Path:

@@ -8,11 +8,11 @@ import json
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.context import TAB_SIZE, Context
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.work import Work
-from stairbot.config import load_config
+from stairbot.control.algorithm.context import TAB_SIZE, Context
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for

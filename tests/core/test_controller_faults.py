@@ -9,17 +9,17 @@ from dataclasses import replace
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
-from stairbot.algorithm.controller import (
+from stairbot.control.algorithm.controller import (
     PHASE_TIMEOUT_S,
     SENSOR_WAIT_S,
     Controller,
     phase_timeout_s,
 )
-from stairbot.algorithm.phases import Phase
-from stairbot.config import load_config, parse_config
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.perception import CONFIRM
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.perception import CONFIRM
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 STEPS = [(0.17, 0.28)] * 2

@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.config import load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import LIFT_MOTORS, MotorId
 

@@ -1,16 +1,16 @@
-"""Descent 1's edge watch (stairbot.algorithm.edge): where it places the
+"""Descent 1's edge watch (stairbot.control.algorithm.edge): where it places the
 back pair's crossing of an edge, fed readings tick by tick."""
 
 from __future__ import annotations
 
 import pytest
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.edge import edge_bound, edge_clearance_m, edge_doubt_m, edge_sight_m
-from stairbot.algorithm.phase import Tick
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.algorithm.work import Work
-from stairbot.config import load_config
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.edge import edge_bound, edge_clearance_m, edge_doubt_m, edge_sight_m
+from stairbot.control.algorithm.phase import Tick
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import WHEEL_MOTORS, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config("reference")

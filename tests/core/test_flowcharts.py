@@ -1,6 +1,6 @@
 """docs/algorithm.md draws the calibration, ascent and descent flowcharts from
 the controller's transition table: this fails when the drawing and the code
-disagree (regenerate with ``python -m stairbot.algorithm.transitions``)."""
+disagree (regenerate with ``python -m stairbot.control.algorithm.transitions``)."""
 
 from __future__ import annotations
 
@@ -9,12 +9,17 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.algorithm.phases import FLOWS
-from stairbot.algorithm.transitions import EXTENSIONS, TRANSITIONS, mermaid, mermaid_extension
+from stairbot.control.algorithm.phases import FLOWS
+from stairbot.control.algorithm.transitions import (
+    EXTENSIONS,
+    TRANSITIONS,
+    mermaid,
+    mermaid_extension,
+)
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "algorithm.md"
 FIX = ("the flowcharts in docs/algorithm.md are stale: paste "
-       "`python -m stairbot.algorithm.transitions`")
+       "`python -m stairbot.control.algorithm.transitions`")
 
 
 def drawn(flow: str) -> str:

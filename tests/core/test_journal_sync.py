@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from stairbot import journal as journal_mod
 from stairbot.errors import OutputError
-from stairbot.journal import JournalWriter
+from stairbot.run import journal as journal_mod
+from stairbot.run.journal import JournalWriter
 
 
 class GatedFsync:

@@ -1,4 +1,4 @@
-"""Ascent 3 on a long tread (stairbot.algorithm.long_tread): whether the
+"""Ascent 3 on a long tread (stairbot.control.algorithm.long_tread): whether the
 front pair's readings held as segment 1 rose, and the drives onto such a
 tread going by turns."""
 
@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import pytest
 
-from stairbot.algorithm import long_tread
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phase import Tick
-from stairbot.algorithm.phases import Mode
-from stairbot.algorithm.work import Work
-from stairbot.config import load_config
+from stairbot.control.algorithm import long_tread
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phase import Tick
+from stairbot.control.algorithm.phases import Mode
+from stairbot.control.algorithm.work import Work
+from stairbot.control.robot_config import load_config
 
 CFG = load_config("reference")
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from stairbot import paths
-from stairbot.paths import unused_path
+from stairbot.run import paths
+from stairbot.run.paths import unused_path
 
 
 def test_a_free_name_is_kept(tmp_path: Path) -> None:

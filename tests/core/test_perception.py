@@ -6,7 +6,8 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.perception import CONFIRM, Perception, max_age, pair_tolerance, window
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import (
     MotorId,
     MotorState,
@@ -15,7 +16,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.perception import CONFIRM, Perception, max_age, pair_tolerance, window
+from stairbot.inputs.config import RobotConfig
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 TICK = CFG.algorithm.tick

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from stairbot.errors import ScenarioError
-from stairbot.scenario import (
+from stairbot.inputs.scenario import (
     Expect,
     expectation_mismatches,
     load_scenario,

@@ -12,12 +12,13 @@ import msgspec
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.stability import UNSTABLE, UNSTABLE_EDGE, balance, worst
-from stairbot.algorithm.transitions import TRANSITIONS
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.stability import UNSTABLE, UNSTABLE_EDGE, balance, worst
+from stairbot.control.algorithm.transitions import TRANSITIONS
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import LIFT_MOTORS, MotorId
+from stairbot.inputs.config import RobotConfig
 
 CFG = load_config()
 PER_TURN = CFG.motors.lift_travel_per_turn  # 2 mm

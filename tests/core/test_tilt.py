@@ -13,15 +13,16 @@ import msgspec
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.robot_config import load_config
+from stairbot.control.tilt import TiltWatch
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run as run_session
-from stairbot.scenario import load_scenario
-from stairbot.tilt import TiltWatch
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run as run_session
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 SAFETY = CFG.safety

@@ -8,13 +8,13 @@ from dataclasses import replace
 
 import pytest
 
-from stairbot.algorithm import phases
-from stairbot.algorithm.calibration import STILL_TICKS
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phase import Step, Tick, go
-from stairbot.algorithm.phases import FLOWS, Mode, Phase
-from stairbot.algorithm.transitions import (
+from stairbot.control.algorithm import phases
+from stairbot.control.algorithm.calibration import STILL_TICKS
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phase import Step, Tick, go
+from stairbot.control.algorithm.phases import FLOWS, Mode, Phase
+from stairbot.control.algorithm.transitions import (
     BACK_PAIR_PHASES,
     STANDING_ARMED,
     TRANSITIONS,
@@ -22,10 +22,10 @@ from stairbot.algorithm.transitions import (
     allowed,
     mermaid,
 )
-from stairbot.algorithm.work import Work
-from stairbot.config import load_config
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import settle_s
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
-from stairbot.perception import settle_s
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import can
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers.bus_health import FLOOD_FRAMES_PER_S, FLOOD_WINDOW_S
 from stairbot.drivers.can_link import CanLink
 from stairbot.errors import LinkLostError
@@ -25,7 +25,7 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import WireFaults
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 _names = itertools.count()
 FLOOD = int(FLOOD_FRAMES_PER_S * FLOOD_WINDOW_S) + 1  # one frame past the limit

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import can
 import pytest
 
-from stairbot.config import load_config
+import stairbot.fakes.lockstep  # noqa: F401 - registers the lockstep robot with the drivers
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import ESTOP_COPIES
 from stairbot.drivers.can_link import CanLink
@@ -30,8 +31,8 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Clock, HasTruth, MotorId
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions, open_robot
 
 _names = itertools.count()
 FORWARD = {MotorId.MWF: 1.0, MotorId.MWB: 1.0, MotorId.MWR: 1.0, MotorId.MWL: 1.0}

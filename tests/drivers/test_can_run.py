@@ -18,16 +18,16 @@ from pathlib import Path
 import can
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers.can_link import CanLink
 from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 WIRE_TICKS = 3
 """How many ticks apart a phase change over the wire may come from sim://'s."""

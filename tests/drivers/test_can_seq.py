@@ -19,7 +19,7 @@ from pathlib import Path
 import can
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_wire import make_id, wire
@@ -31,7 +31,7 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.hardware import MotorId
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 _names = itertools.count()
 STATUS = m.Status(0x40, 0, 250, 1)

@@ -19,7 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_wire import (
@@ -36,7 +36,7 @@ from stairbot.drivers.can_wire import (
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 VECTORS: list[dict[str, Any]] = json.loads(
     resources.files("stairbot.drivers").joinpath("vectors_can.json").read_text())["vectors"]

@@ -14,7 +14,7 @@ import can
 import pytest
 from test_can_run import ONE_STEP
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.can_link import CanLink
@@ -24,9 +24,9 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
-from stairbot.robots import RobotSession, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 FAULTS = {
     "drop": {"drop": 0.05},

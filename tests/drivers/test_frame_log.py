@@ -17,7 +17,7 @@ from pathlib import Path
 import can
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.frame_log import read_serial_log
@@ -28,8 +28,8 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
 from stairbot.hardware import MotorId
-from stairbot.robots import RobotSession, open_robot
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotSession, open_robot
 
 _names = itertools.count()
 DBC = str(resources.files("stairbot.drivers").joinpath("stairbot.dbc"))

@@ -11,14 +11,15 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_link import SerialLink
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.serial_boards import InlineChannel, SerialBoardServer
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
 
 CONFIG: RobotConfig = load_config()
 SCENARIO: Scenario = load_scenario()

@@ -12,7 +12,7 @@ import can
 import pytest
 from test_serial_link import ScriptedChannel, answer
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import OPTION_DEFAULTS as CAN_DEFAULTS
@@ -22,7 +22,7 @@ from stairbot.drivers.serial_robot import DEFAULTS as SERIAL_DEFAULTS
 from stairbot.drivers.serial_wire import Frame
 from stairbot.drivers.timing import check_ride_through, link_timing
 from stairbot.errors import LinkLostError, RobotUrlError
-from stairbot.robots import RobotOptions, open_robot
+from stairbot.run.robots import RobotOptions, open_robot
 
 _names = itertools.count()
 MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)

@@ -16,8 +16,8 @@ import pytest
 import serial
 import serial.rfc2217
 
-from stairbot.cli_clear import main as clear_main
-from stairbot.config import RobotConfig, load_config
+from stairbot.cli.clear import main as clear_main
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.serial_robot import parse_serial_url
@@ -35,9 +35,10 @@ from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.hardware import BASE_SENSORS, HasTruth, MotorId, SensorId
-from stairbot.robots import RobotSession, open_robot
-from stairbot.runner import run
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.run.robots import RobotSession, open_robot
+from stairbot.run.runner import run
 
 CONFIG: RobotConfig = load_config()
 SCENARIO: Scenario = load_scenario()

@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 from lockstep_boards import lockstep_boards
 
-from stairbot.config import load_config
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import load_scenario
+from stairbot.control.robot_config import load_config
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "fell")
 

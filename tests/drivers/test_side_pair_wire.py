@@ -16,9 +16,9 @@ import can
 import pytest
 from scripted_boards import WIRES, Boards, link_to, scripted_world, wired
 
-from stairbot.config import RobotConfig, load_config, parse_config
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import open_board_session, wanted_side_pair
+from stairbot.drivers.board_session import open_board_session, wanted_side_pair
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_request import SAME_SHORT_LIMIT, CanRequest, Offer
 from stairbot.errors import BoardMismatchError, HardwareError, LinkLostError
@@ -29,8 +29,9 @@ from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
 from stairbot.hardware import BASE_SENSORS, SIDE_SENSORS, MotorId, SensorId, SensorStatus
-from stairbot.robots import RobotSession, open_robot
-from stairbot.scenario import load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotSession, open_robot
 
 SIDE_CONFIG: RobotConfig = parse_config(
     'extends = "reference"\n[sensors]\nside_model = "vl53l0x"\n', "side.toml")

@@ -16,8 +16,10 @@ import pytest
 from cobs import cobs
 from scripted_boards import WIRES, Boards, Scripted, ScriptedClock, link_to, wired
 
+import stairbot.fakes.lockstep  # noqa: F401 - registers the lockstep robot with the drivers
 from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import BoardRobot, open_board_session
+from stairbot.drivers.board_robot import BoardRobot
+from stairbot.drivers.board_session import open_board_session
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_wire import wire
 from stairbot.drivers.serial_wire import FrameReader, crc16

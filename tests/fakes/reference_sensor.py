@@ -8,7 +8,7 @@ from collections.abc import Iterable
 
 from stairbot.fakes.sensors import active_faults, sensor_rng
 from stairbot.hardware import SensorId, SensorReading, SensorStatus
-from stairbot.scenario import Fault
+from stairbot.inputs.scenario import Fault
 
 
 class RangeSensor:

@@ -14,13 +14,13 @@ import pytest
 import reference_beams as ref
 from reference_beams import Profile
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.beams import down_fans, down_hits, front_hits, total_weight
 from stairbot.fakes.sensor_model import Hit, combine
 from stairbot.fakes.sensor_presets import GP2Y0A21, HCSR04, PRESETS, VL53L0X, VL53L1X
 from stairbot.fakes.sim import SimRobot
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
-from stairbot.scenario import load_scenario
+from stairbot.inputs.scenario import load_scenario
 
 OUTLINES = [
     stairs_outline(load_scenario()),

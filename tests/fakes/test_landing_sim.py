@@ -8,13 +8,14 @@ import math
 
 import pytest
 
-from stairbot.config import RobotConfig, load_config, parse_config
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.fakes.stairs import WALL_HEIGHT, stairs_outline
 from stairbot.hardware import BASE_SENSORS, MotorId, SensorId, SensorStatus
-from stairbot.scenario import Scenario, parse_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, parse_scenario
 
 # the reference robot's mechanics, every sensor one exact ray, and the side pair
 SIDE = parse_config('extends = "ideal"\n[sensors]\nside_model = "ideal"\n', "side.toml")

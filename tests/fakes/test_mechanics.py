@@ -10,11 +10,12 @@ from collections.abc import Callable
 
 import pytest
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.errors import RobotFellError
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import MotorId, SensorId, Snapshot
-from stairbot.scenario import Scenario, load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import Scenario, load_scenario
 
 F, B, R, L = MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL
 MTF, MTB = MotorId.MTF, MotorId.MTB

@@ -12,7 +12,7 @@ from stairbot.fakes.sensor_model import ModelSensor
 from stairbot.fakes.sensor_presets import IDEAL
 from stairbot.fakes.stairs import StairsProfile
 from stairbot.hardware import SensorId, SensorStatus
-from stairbot.scenario import Fault
+from stairbot.inputs.scenario import Fault
 
 
 def sensor(noise: float = 0.0, seed: int = 1, faults: tuple[Fault, ...] = (),

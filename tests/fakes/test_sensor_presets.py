@@ -11,14 +11,15 @@ import msgspec
 import pytest
 from reference_sensor import RangeSensor
 
-from stairbot.config import SensorModelName, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.beams import front_hits, total_weight
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensor_model import Cause, ModelSensor, SensorModel, combine
 from stairbot.fakes.sensor_presets import HCSR04, IDEAL, PRESETS, VL53L0X, preset
 from stairbot.fakes.sim import SimRobot
 from stairbot.hardware import SensorId, SensorStatus
-from stairbot.scenario import Fault, load_scenario
+from stairbot.inputs.scenario import Fault, load_scenario
+from stairbot.inputs.sections import SensorModelName
 
 SFL = SensorId.SFL
 

@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.errors import RobotFellError, RobotUrlError
 from stairbot.fakes.sim import SimClock, SimRobot, open_sim_robot
 from stairbot.hardware import (
@@ -23,8 +23,8 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.robots import RobotOptions
-from stairbot.scenario import Scenario, parse_scenario
+from stairbot.inputs.scenario import Scenario, parse_scenario
+from stairbot.run.robots import RobotOptions
 
 CFG = load_config("ideal")  # the simulation's mechanics, read with one exact ray
 TICK = CFG.algorithm.tick
@@ -268,8 +268,8 @@ def test_clock_paces_only_when_asked() -> None:
 
 _RUN_IN_CHILD = """
 import hashlib
-from stairbot.config import load_config
-from stairbot.scenario import parse_scenario
+from stairbot.control.robot_config import load_config
+from stairbot.inputs.scenario import parse_scenario
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.hardware import MotorId as M
 r = SimRobot(load_config("ideal"), parse_scenario("[sensors]\\nnoise = 0.003\\n", "<child>"))

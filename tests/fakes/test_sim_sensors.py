@@ -11,13 +11,14 @@ import msgspec
 import msgspec.inspect as mi
 import pytest
 
-from stairbot.config import Safety, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.fakes.world import WorldParams
 from stairbot.hardware import SensorId
-from stairbot.robots import RobotSession
-from stairbot.runner import run
-from stairbot.scenario import parse_scenario
+from stairbot.inputs.scenario import parse_scenario
+from stairbot.inputs.sections import Safety
+from stairbot.run.robots import RobotSession
+from stairbot.run.runner import run
 
 CFG = load_config("ideal")  # one level ray, fresh at every read
 TICK = CFG.algorithm.tick

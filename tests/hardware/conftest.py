@@ -13,9 +13,10 @@ from collections.abc import Iterator
 
 import pytest
 
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.robot_config import load_config
 from stairbot.drivers.board_robot import BoardRobot
-from stairbot.robots import RobotSession, open_robot
+from stairbot.inputs.config import RobotConfig
+from stairbot.run.robots import RobotSession, open_robot
 
 URL_VARIABLE = "STAIRBOT_HW_URL"
 

@@ -9,10 +9,10 @@ import time
 
 import pytest
 
-from stairbot.config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.hardware import BASE_SENSORS, SIDE_SENSORS, ZERO_SPEEDS, MotorId
+from stairbot.inputs.config import RobotConfig
 
 pytestmark = pytest.mark.hardware
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
 from stairbot.events import Event, EventKind
 from stairbot.hardware import BASE_SENSORS, Imu, MotorId, MotorState, SensorReading, Snapshot

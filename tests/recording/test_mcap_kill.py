@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import FLUSH_TICKS
 from stairbot.recording.plot import render

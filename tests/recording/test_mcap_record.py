@@ -19,7 +19,8 @@ from mcap.records import Schema
 from mcap_protobuf.decoder import DecoderFactory
 
 from stairbot.cli import main
-from stairbot.config import load_config
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config
 from stairbot.recording import topics
 from stairbot.recording.pose import SEGMENT_FRAMES
 
@@ -133,7 +134,7 @@ def test_attachments_metadata_and_scene(default_run: dict[str, Any]) -> None:
     dbc = resources.files("stairbot").joinpath("drivers/stairbot.dbc").read_bytes()
     assert by_name["stairbot.dbc"].data == dbc
     assert json.loads(by_name["robot_config.json"].data) == json.loads(
-        json.dumps(load_config(None).to_dict()))
+        json.dumps(limits.config_dict(load_config(None))))
     scenario = json.loads(by_name["scenario.json"].data)
     assert scenario["name"] == "default" and len(scenario["steps"]) == 5
     robot = next(m for m in meta if m.name == "robot").metadata

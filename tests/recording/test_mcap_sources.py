@@ -14,9 +14,9 @@ import pytest
 from mcap.reader import make_reader
 
 from stairbot.cli import main
-from stairbot.config import load_config
 from stairbot.console.engine import ConsoleEngine
 from stairbot.console.state import LiveState
+from stairbot.control.robot_config import load_config
 from stairbot.recording import topics
 from stairbot.recording.read import read_recording
 

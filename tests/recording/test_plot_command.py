@@ -14,7 +14,7 @@ import pytest
 from mcap.writer import Writer
 
 from stairbot.cli import main
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.recording.mcap_sink import McapRecord
 

@@ -7,8 +7,9 @@ import math
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot
+from stairbot.inputs.scenario import load_scenario
 from stairbot.recording.pose import (
     DeadReckonedPose,
     SegmentPose,
@@ -17,8 +18,7 @@ from stairbot.recording.pose import (
     side_pose,
     stair_blocks,
 )
-from stairbot.scenario import load_scenario
-from stairbot.side_view import stairs_from_scenario
+from stairbot.views.side_view import stairs_from_scenario
 
 
 def rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]

@@ -14,7 +14,8 @@ from typing import Any
 
 import pytest
 
-from stairbot.config import RobotConfig, load_config, parse_config
+from stairbot.control.algorithm import limits
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
     BASE_SENSORS,
@@ -27,6 +28,7 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
+from stairbot.inputs.config import RobotConfig
 from stairbot.recording import topics
 from stairbot.recording.mcap_sink import McapRecord
 from stairbot.recording.read import read_recording
@@ -122,14 +124,14 @@ def test_a_recording_made_before_the_side_pair_still_replays(
         del old["properties"][s.value]
     old["required"] = ["time_s", *(s.value for s in BASE_SENSORS), "imu"]
     monkeypatch.setattr(topics, "SENSORS_SCHEMA", old)
-    original = RobotConfig.to_dict
+    original = limits.config_dict
 
-    def without_side_keys(self: RobotConfig) -> dict[str, Any]:
-        d = original(self)
+    def without_side_keys(config: RobotConfig) -> dict[str, Any]:
+        d = original(config)
         d["sensors"] = {k: v for k, v in d["sensors"].items() if not k.startswith("side_")}
         return d
 
-    monkeypatch.setattr(RobotConfig, "to_dict", without_side_keys)
+    monkeypatch.setattr(limits, "config_dict", without_side_keys)
     path = record(tmp_path / "old.mcap", load_config(), side_pair=False)
     attached = json.loads(read_recording(path).attachments["robot_config.json"])
     assert not any(k.startswith("side_") for k in attached["sensors"])

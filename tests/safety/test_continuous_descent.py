@@ -8,13 +8,13 @@ from __future__ import annotations
 import pytest
 import simrun
 
-from stairbot.algorithm.phases import Mode
-from stairbot.config import load_config
+from stairbot.control.algorithm.phases import Mode
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import run
-from stairbot.scenario import parse_scenario
+from stairbot.inputs.scenario import parse_scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import run
 
 CONFIG = load_config()
 

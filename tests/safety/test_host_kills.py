@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.fakes.host_kills import kill_tick, recorded, run_kill
-from stairbot.journal import JournalState, mark_path, read_journal
-from stairbot.resume import check, restored_context
+from stairbot.run.journal import JournalState, mark_path, read_journal
+from stairbot.run.resume import check, restored_context
 
 
 def test_the_context_restores_at_every_tick_of_a_whole_run(tmp_path: Path) -> None:

@@ -14,13 +14,13 @@ watching it cross.  The whole runs are on the pymunk robot.
 
 from __future__ import annotations
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.config import load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event
 from stairbot.hardware import Clock, Snapshot
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 CFG = load_config()
 NOT_SEEN = "they were not seen crossing it"

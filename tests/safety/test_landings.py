@@ -9,11 +9,11 @@ from __future__ import annotations
 import pytest
 import simrun
 
-from stairbot.algorithm.phases import Phase
-from stairbot.config import load_config, parse_config
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.errors import ConfigError, ScenarioError
 from stairbot.events import Event, EventKind
-from stairbot.scenario import load_scenario, parse_scenario
+from stairbot.inputs.scenario import load_scenario, parse_scenario
 
 LANDINGS = load_config("landings")
 

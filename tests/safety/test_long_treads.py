@@ -1,4 +1,4 @@
-"""Long treads (stairbot.algorithm.long_tread): past FAR_TREAD_M the robot
+"""Long treads (stairbot.control.algorithm.long_tread): past FAR_TREAD_M the robot
 climbs a riser lower than the front cone's rule asks when its readings held
 as segment 1 rose, refuses it when they grew, and drives onto and off such a
 tread by turns."""
@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import simrun
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.scenario import parse_scenario
+from stairbot.inputs.scenario import parse_scenario
 
 REFERENCE = load_config("reference")
 

@@ -10,13 +10,14 @@ import json
 import pytest
 import simrun
 
-from stairbot.algorithm.context import Context
-from stairbot.algorithm.phase import Tick
-from stairbot.algorithm.phases import Mode, Phase
-from stairbot.algorithm.stability import carried_now
-from stairbot.config import load_config, parse_config
+from stairbot.control.algorithm import limits
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phase import Tick
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.stability import carried_now
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.events import Event, EventKind
-from stairbot.scenario import load_scenario, parse_scenario
+from stairbot.inputs.scenario import load_scenario, parse_scenario
 
 HEAVY = load_config("heavy_middle")
 REFERENCE = load_config()
@@ -34,28 +35,29 @@ def test_the_reference_robot_refuses_narrow_steps_and_comes_home() -> None:
 
 def test_min_tread_falls_to_the_first_two_segments_only_where_segment_2_carries_it() -> None:
     g = HEAVY.geometry
-    assert HEAVY.narrow_steps_safe
-    assert HEAVY.min_tread_m == pytest.approx(
+    assert limits.narrow_steps_safe(HEAVY)
+    assert limits.min_tread_m(HEAVY) == pytest.approx(
         g.LENGTH_OF_FIRST_MODULE + g.LENGTH_OF_SECOND_MODULE + HEAVY.SAFE_LENGTH)
-    assert REFERENCE.min_tread_m == pytest.approx(
+    assert limits.min_tread_m(REFERENCE) == pytest.approx(
         REFERENCE.LENGTH_OF_A_ROBOT + REFERENCE.SAFE_LENGTH)  # the flag is off
     # asked for, but the front segment's weight would tip the robot off segment 2's wheels
-    assert FRONT_HEAVY.narrow_steps_margin_m < FRONT_HEAVY.safety.stability_margin
-    assert not FRONT_HEAVY.narrow_steps_safe
-    assert FRONT_HEAVY.min_tread_m == pytest.approx(REFERENCE.min_tread_m)
+    assert limits.narrow_steps_margin_m(FRONT_HEAVY) < FRONT_HEAVY.safety.stability_margin
+    assert not limits.narrow_steps_safe(FRONT_HEAVY)
+    assert limits.min_tread_m(FRONT_HEAVY) == pytest.approx(limits.min_tread_m(REFERENCE))
     # the reference robot's masses, pitched to the tilt limit with segment 1 lifted high,
     # leave 0.1 mm: a heavy middle is what narrow steps need
     reference_asks = parse_config("extends = 'reference'\n[algorithm]\nnarrow_steps = true\n",
                                   "reference_narrow.toml")
-    assert 0.0 < reference_asks.narrow_steps_margin_m < reference_asks.safety.stability_margin
-    assert "pitched 15°" in (reference_asks.narrow_steps_refusal or "")
-    assert HEAVY.narrow_steps_margin_m >= HEAVY.safety.stability_margin
+    margin = limits.narrow_steps_margin_m(reference_asks)
+    assert 0.0 < margin < reference_asks.safety.stability_margin
+    assert "pitched 15°" in (limits.narrow_steps_refusal(reference_asks) or "")
+    assert limits.narrow_steps_margin_m(HEAVY) >= HEAVY.safety.stability_margin
     # a front pair that cannot read as near as a narrow step leaves it to the next riser
     ir_asks = parse_config("extends = 'ir'\n[masses]\nfirst_module = 0.3\n"
                            "second_module = 2.0\nthird_module = 0.3\n"
                            "[algorithm]\nnarrow_steps = true\n", "ir_narrow.toml")
-    assert "nearer than it reads" in (ir_asks.narrow_steps_refusal or "")
-    assert ir_asks.min_tread_m == pytest.approx(REFERENCE.min_tread_m)
+    assert "nearer than it reads" in (limits.narrow_steps_refusal(ir_asks) or "")
+    assert limits.min_tread_m(ir_asks) == pytest.approx(limits.min_tread_m(REFERENCE))
 
 
 def test_config_show_says_why_narrow_steps_are_refused(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]

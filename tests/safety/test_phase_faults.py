@@ -15,11 +15,11 @@ from functools import cache
 
 import pytest
 
-from stairbot.config import load_config
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
-from stairbot.robots import RobotOptions, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import Scenario, parse_scenario
+from stairbot.inputs.scenario import Scenario, parse_scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
 
 CONFIG = load_config()
 STAIRS = """

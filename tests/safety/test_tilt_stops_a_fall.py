@@ -19,14 +19,15 @@ from dataclasses import replace
 import msgspec
 import pytest
 
-from stairbot.algorithm.controller import Controller
-from stairbot.algorithm.phases import Phase
-from stairbot.algorithm.stability import UNSTABLE
-from stairbot.config import RobotConfig, load_config
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.stability import UNSTABLE
+from stairbot.control.robot_config import load_config
 from stairbot.hardware import ZERO_SPEEDS, HasTruth, MotorId
-from stairbot.robots import RobotOptions, RobotSession, open_robot
-from stairbot.runner import RunResult, run
-from stairbot.scenario import load_scenario
+from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
+from stairbot.run.runner import RunResult, run
 
 HOLD_S = 3.0
 """After the run, the robot is left standing this long with every motor at 0."""

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from stairbot.cli import main
-from stairbot.config import load_config
-from stairbot.scenario import parse_scenario
+from stairbot.control.robot_config import load_config
+from stairbot.inputs.scenario import parse_scenario
 from stairbot.sweep.cases import build_case, check_spec
 from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec

@@ -104,7 +104,7 @@ def test_a_robot_that_falls_after_the_run_is_unsafe_whatever_the_run_said() -> N
             self.clock = Clock()
             self.robot = Robot(self.clock, falls_at)
 
-    from stairbot.config import load_config
+    from stairbot.control.robot_config import load_config
 
     cfg = load_config()
     assert _fell_after(Session(0.5), cfg) == "segment 1 pitched 38 deg"

@@ -12,8 +12,8 @@ from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
-from stairbot.algorithm.phases import FLOWS
 from stairbot.console.words import phase_words
+from stairbot.control.algorithm.phases import FLOWS
 
 
 def flow_text(flow: str) -> Text:

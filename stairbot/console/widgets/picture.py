@@ -7,7 +7,7 @@ from rich.text import Text
 from textual.widget import Widget
 
 from stairbot.console.canvas import BrailleCanvas
-from stairbot.side_view import Point, SceneView
+from stairbot.views.side_view import Point, SceneView
 
 SEGMENT_STYLES = ("bold bright_cyan", "bold yellow", "bold magenta")
 STAIRS_STYLE = "grey70"

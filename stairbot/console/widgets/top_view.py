@@ -5,7 +5,7 @@ its left side up -- and the robot's footprint on it, in braille dots.
 Flight 1's risers are lines across it; a quarter-turn landing's walls, the
 second flight's risers (up the screen for a left turn, down for a right one)
 and any side walls are drawn as the simulation holds them
-(stairbot/top_view.py).  The first wall contact the simulation reported is
+(stairbot/views/top_view.py).  The first wall contact the simulation reported is
 written in red under the picture, and the face it names is drawn red.
 """
 
@@ -19,7 +19,7 @@ from textual.widget import Widget
 from stairbot.console.canvas import BrailleCanvas
 from stairbot.console.widgets.picture import SEGMENT_STYLES
 from stairbot.hardware import Point
-from stairbot.top_view import (
+from stairbot.views.top_view import (
     RISER2,
     WALL,
     PlanLine,

@@ -1,0 +1,457 @@
+"""The controller: the seed's algorithm advanced one tick at a time.
+
+Each :meth:`Controller.tick` takes one :class:`~stairbot.hardware.Snapshot`
+and returns a speed for all six motors.  Faults are checked before the
+phase's own logic (a motor fault, a phase that takes too long, the
+supervisor's tilt and stall), then a sensor the phase needs that reads as
+ERROR (the robot stands and waits for it, up to SENSOR_WAIT_S), then the
+standing rule, then -- once, before a lift phase's first step -- the
+static-stability check (:mod:`~stairbot.control.algorithm.stability`), then the
+phase's step.
+Whichever decides returns a :class:`~stairbot.control.algorithm.phase.Step`; if it
+names a next phase, :meth:`Controller._apply` enters it — the one place a
+phase is entered, at most once a tick — after checking the change against
+:data:`~stairbot.control.algorithm.transitions.TRANSITIONS`, and tells it as an event.
+The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from stairbot.control.algorithm import calibration, motion, stability, standing
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
+from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.control.algorithm.transitions import (
+    BACK_PAIR_PHASES,
+    TRANSITIONS,
+    TransitionError,
+    allowed,
+)
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import Perception
+from stairbot.control.supervisor import Supervisor
+from stairbot.events import Event, EventKind, EventSink, discard
+from stairbot.hardware import (
+    BACK_SENSORS,
+    FRONT_SENSORS,
+    LIFT_MOTORS,
+    MotorId,
+    SensorId,
+    SensorStatus,
+    Snapshot,
+    Speeds,
+)
+from stairbot.inputs.config import RobotConfig
+
+SENSOR_WAIT_S = 1.0
+"""How long the robot stands, lifts holding, for a sensor it needs that reads
+as ERROR (errors, or stale) to come back before the program ends with the
+error."""
+
+PHASE_TIMEOUT_S = 60.0
+"""A phase (other than the standing rule's wait) that lasts longer than this,
+in controller time, ends the program with an error: something is stuck.  A
+robot with slow motors gets longer: :func:`phase_timeout_s`."""
+
+
+def phase_timeout_s(config: RobotConfig) -> float:
+    """How long one phase may last: twice the longest motion a phase makes at
+    the config's speeds (a lift over its whole stroke, a drive of
+    LENGTH_OF_INFINITY, a calibration turn of its largest yaw), and at least
+    PHASE_TIMEOUT_S."""
+    m = config.motors
+    lift_s = 2 * config.MAX_OF_VERTICAL_TURNS / m.lift_speed
+    drive_s = config.wheel_turns(config.LENGTH_OF_INFINITY) / m.wheel_speed
+    turn = calibration.MAX_TURN_YAW_RAD * config.geometry.track_width / 2
+    turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
+    return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
+
+OUTCOMES = ("completed", "stopped", "error")
+
+
+@dataclass(frozen=True)
+class ControllerResult:
+    """How the program ended (``outcome`` is "running" until it has)."""
+
+    outcome: str  # "completed" | "stopped" | "error" | "running"
+    ascent_end: str | None  # "top_reached" | "obstacle" | "step_limit" | None
+    error: str | None
+    steps_climbed: int
+    steps_descended: int
+    pauses: int
+    reason: str | None = None  # why it ended, whatever the outcome
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class Controller:
+    """Runs the algorithm against snapshots of a robot.
+
+    ``context`` restores a saved run (:meth:`Context.to_dict`); the snapshots
+    must then come from the same clock.  ``hold``/``release``/``abort`` are
+    for the operator and must be called from the thread that ticks.
+    ``check_stability=False`` skips the static-stability check before the
+    lifts (:mod:`stairbot.control.algorithm.stability`): only for a test that shows
+    what the supervisor does without it.
+    """
+
+    def __init__(self, config: RobotConfig, sink: EventSink = discard,
+                 mode: Mode = Mode.FULL, context: Context | None = None, *,
+                 check_stability: bool = True) -> None:
+        self.config = config
+        self.mode = mode
+        self.check_stability = check_stability
+        self._sink = sink
+        if context is None:
+            context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns)
+            if mode is Mode.DESCEND:  # on the top: no riser to square up to, the edge behind
+                context.from_top = True
+                context.purpose = "descent"
+                context.phase = Phase.DESCENT_BACK_TO_EDGE.value
+        self._ctx = context
+        self._started = context.phase_started_s is not None
+        self._held: str | None = None
+        self._held_since: float | None = None
+        self._time = context.phase_started_s or 0.0
+        m = config.motors
+        self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
+        self._stroke = config.MAX_OF_VERTICAL_TURNS
+        self._timeout = phase_timeout_s(config)
+        self._perception = Perception(config)
+        self._supervisor = Supervisor(config)
+        self._tilt = self._supervisor.tilt
+        self._sensor_since: float | None = None
+        self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
+        self._now_key: tuple[str, str | None] | None = None  # see _present
+        self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
+
+    # -- what the outside sees --------------------------------------------------------
+    @property
+    def phase(self) -> Phase:
+        return BY_VALUE[self._ctx.phase]
+
+    @property
+    def flow(self) -> str:
+        """Where the program stands: the present phase's flow, or, while the
+        standing rule waits, the flow of the phase it stopped in."""
+        ctx = self._ctx
+        if ctx.phase == Phase.PAUSED.value and ctx.resume_phase is not None:
+            return BY_VALUE[ctx.resume_phase].flow
+        return self.phase.flow
+
+    @property
+    def context(self) -> Context:
+        return self._ctx
+
+    @property
+    def finished(self) -> bool:
+        return _TERMINAL[self._ctx.phase]  # asked twice a tick: no Phase look-up
+
+    @property
+    def held(self) -> bool:
+        return self._held is not None
+
+    @property
+    def result(self) -> ControllerResult:
+        ctx = self._ctx
+        return ControllerResult(ctx.outcome or "running", ctx.ascent_end, ctx.error,
+                                ctx.number_of_steps, ctx.steps_descended, ctx.pauses,
+                                ctx.end_reason)
+
+    # -- operator ---------------------------------------------------------------------
+    def hold(self, reason: str) -> None:
+        """Stop every motor from the next tick on and freeze the timers, until
+        :meth:`release`.  The phase carries on from where it was afterwards."""
+        if self.finished or self._held is not None:
+            return
+        self._held = reason
+        self._emit(EventKind.INFO, f"held: {reason}", self._time, {"held": True})
+
+    def release(self) -> None:
+        """Let a held controller go on where it was."""
+        if self._held is None:
+            return
+        self._held = None
+        self._emit(EventKind.INFO, "released: carrying on", self._time, {"held": False})
+
+    def abort(self, reason: str, outcome: str = "error") -> None:
+        """End the program now with ``outcome`` ("error" or "stopped"); every
+        later tick commands zero.  Outside the transition table on purpose: it
+        is the operator's (or the run loop's) decision, not the algorithm's."""
+        if outcome not in OUTCOMES:
+            raise ValueError(f"outcome {outcome!r}; allowed: {', '.join(OUTCOMES)}")
+        if self.finished:
+            return
+        self._finish(Phase.ERROR if outcome == "error" else Phase.DONE, outcome, reason,
+                     self._time)
+
+    # -- the tick ---------------------------------------------------------------------
+    def tick(self, snap: Snapshot) -> dict[MotorId, float]:
+        """Advance the program by one snapshot; returns a speed (turns/s) for
+        every motor.  After the end, and while held, every speed is 0.  The
+        first tick enters the program's first phase and moves nothing."""
+        self._time = snap.time_s
+        if self.finished:
+            return _zeros()
+        snap = self._perception.see(snap)
+        if self._held is not None:
+            if self._held_since is None:
+                self._held_since = snap.time_s
+            self._supervisor.commanded({})
+            return _zeros()
+        if self._held_since is not None:
+            self._shift_timers(snap.time_s - self._held_since)
+            self._held_since = None
+        if not self._started:
+            self._started = True
+            self._enter(self.phase, "program start", snap)
+            tilt = self._supervisor.tilt
+            self._say(tilt.describe(), tilt_watched=tilt.watched)
+            return _zeros()
+        ctx = self._ctx
+        phase, record, needed = self._present()
+        fault = self._fault(snap, phase, needed) or self._supervisor.check(snap)
+        if fault is not None:
+            self._apply(fail(fault), snap)
+            return _zeros()
+        if self._sensor_hold(snap, phase, needed):
+            self._supervisor.commanded({})
+            return _zeros()
+        t = Tick(snap, self.config, ctx, self.mode, self._say)
+        step = standing.watch(t, record)
+        if step is None and record.carried_by and not ctx.work.balanced \
+                and self.check_stability:
+            step = stability.before_lift(t, record, ctx.work)
+        if step is None:
+            assert record.step is not None  # only DONE and ERROR have none
+            step = record.step(t, ctx.work)
+        if step.next is not None:
+            self._apply(step, snap)
+            speeds = _zeros()
+        else:
+            speeds = self._limit(step.speeds, snap)
+        self._supervisor.commanded(speeds)
+        return speeds
+
+    def _present(self) -> tuple[Phase, PhaseDef, tuple[SensorId, ...]]:
+        """The present phase, its record and :func:`_needed_sensors`, looked up
+        again only when the context's phase or the one a pause resumes changes."""
+        ctx = self._ctx
+        key = (ctx.phase, ctx.resume_phase)
+        now = self._now
+        if now is None or key != self._now_key:
+            phase = BY_VALUE[ctx.phase]
+            now = self._now = (phase, phase.record, _needed_sensors(phase, ctx))
+            self._now_key = key
+        return now
+
+    def _fault(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> str | None:
+        """A motor fault, a sensor ``needed`` that reads no number, or the
+        phase's timeout, in words; None when there is none."""
+        isfinite = math.isfinite
+        for motor, state in snap.motors.items():
+            if state.fault:
+                return f"motor fault: {motor} reports {state.fault!r} in {phase.label}"
+            if not isfinite(state.turns):
+                return f"motor fault: {motor} counts {state.turns} turns in {phase.label}"
+        sensors = snap.sensors
+        for sensor in needed:
+            # an ERROR reading's distance means nothing; any other must be a number
+            reading = sensors[sensor]
+            if reading.status is not _ERROR and not isfinite(reading.distance_m):
+                return f"sensor error: {sensor} reads {reading.distance_m} m in {phase.label}"
+        started = self._ctx.phase_started_s
+        if phase is not _PAUSED and started is not None \
+                and snap.time_s - started > self._timeout:
+            return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
+        return None
+
+    def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
+        """While a sensor the phase needs (``needed``) reads as ERROR (it reports
+        errors, or it is stale), or the IMU's reading is too old to watch tilt
+        by (:meth:`~stairbot.control.tilt.TiltWatch.stale`): every motor stops, the
+        lifts hold, the timers stand, for up to SENSOR_WAIT_S; then the program
+        ends with the error.  True while holding."""
+        ctx = self._ctx
+        errors = motion.sensor_errors(snap, needed)
+        imu = self._tilt.stale(snap)
+        if not errors and imu is None:
+            if self._sensor_since is not None:
+                held = snap.time_s - self._sensor_since
+                self._shift_timers(held)
+                self._sensor_since = None
+                self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
+                           f"{phase.label}", snap.time_s, {"phase": phase.value})
+            return False
+        why = "; ".join([f"{s} {self._perception.why(s) or 'reports an error'}"
+                         for s in errors] + ([imu] if imu is not None else []))
+        if self._sensor_since is None:
+            self._sensor_since = snap.time_s
+            self._sensor_link = dict(snap.health)
+            ctx.pauses += 1
+            self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
+                       f"stopped, lifts holding, waiting up to {SENSOR_WAIT_S:g} s",
+                       snap.time_s, {"resume_phase": phase.value, "sensors": list(errors),
+                                         "imu_stale": imu is not None})
+            return True
+        if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
+            return True
+        self._sensor_since = None
+        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
+                         f"{_link_meanwhile(self._sensor_link, snap.health)}"), snap)
+        return True
+
+    def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
+        """Every motor gets a speed within its maximum; a lift at the end of its
+        stroke is not driven further."""
+        stroke, vmax_of, isfinite = self._stroke, self._vmax, math.isfinite
+        out = _zeros()
+        for motor, v in speeds.items():
+            vmax = vmax_of[motor]
+            # min/max pass a NaN through as a full-speed limit: it stops instead
+            v = max(-vmax, min(vmax, v)) if isfinite(v) else 0.0
+            if motor in LIFT_MOTORS:
+                turns = snap.motors[motor].turns
+                if (v > 0 and turns >= stroke) or (v < 0 and turns <= -stroke):
+                    v = 0.0
+            out[motor] = v
+        return out
+
+    # -- phase changes: the one place a phase is entered ----------------------------------
+    def _apply(self, step: Step, snap: Snapshot) -> None:
+        """Enter ``step.next``; raises TransitionError when the table does not
+        allow the change (a bug in a phase)."""
+        nxt, src, ctx = step.next, self.phase, self._ctx
+        assert nxt is not None
+        if not allowed(src, nxt):
+            raise TransitionError(f"{src.value} -> {nxt.value} is not in the transition table")
+        if nxt is Phase.ERROR:
+            self._finish(Phase.ERROR, "error", step.reason or "error", snap.time_s)
+        elif nxt is Phase.DONE:
+            self._finish(Phase.DONE, step.outcome or "completed", step.reason or "done",
+                         snap.time_s)
+        elif nxt is Phase.PAUSED:
+            ctx.resume_phase = src.value
+            ctx.pause_started_s = snap.time_s
+            ctx.pause_diffs = []
+            ctx.pauses += 1
+            self._emit(EventKind.PAUSE, step.reason or "paused", snap.time_s,
+                       {"resume_phase": ctx.resume_phase})
+            self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
+        elif src is Phase.PAUSED:
+            assert ctx.pause_started_s is not None
+            if ctx.phase_started_s is not None:
+                ctx.phase_started_s += snap.time_s - ctx.pause_started_s
+            ctx.resume_phase = ctx.pause_started_s = None
+            self._emit(EventKind.RESUME, step.reason or "resumed", snap.time_s,
+                       {"phase": nxt.value})
+            self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
+        else:
+            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap)
+
+    def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True) -> None:
+        """Make ``phase`` the present one.  ``fresh``: a new start of the phase
+        (its timer, its work, its entry action); not fresh: the standing rule's
+        wait, or the phase it resumes."""
+        ctx = self._ctx
+        previous = ctx.phase
+        ctx.phase = phase.value
+        ctx.disagree_ticks = 0
+        ctx.standing_diff = None
+        if fresh:
+            ctx.phase_started_s = snap.time_s
+            ctx.work = Work.at_entry(snap)
+        note = where(ctx, phase)
+        where_text = f" ({note})" if note else ""
+        resumed = "" if fresh or phase is Phase.PAUSED else " (resumed)"
+        self._emit(EventKind.PHASE, f"{phase.label}{where_text}{resumed}", snap.time_s,
+                   {"phase": phase.value, "flow": phase.flow, "from": previous, "why": why})
+        if fresh:
+            phase.record.enter(Tick(snap, self.config, ctx, self.mode, self._say), ctx.work)
+
+    def _say(self, message: str, **data: Any) -> None:
+        self._emit(EventKind.INFO, message, self._time, data)
+
+    def _finish(self, phase: Phase, outcome: str, reason: str, time_s: float) -> None:
+        ctx = self._ctx
+        previous = ctx.phase
+        ctx.outcome = outcome
+        ctx.end_reason = reason
+        ctx.phase = phase.value
+        if outcome == "error":
+            ctx.error = reason
+            self._emit(EventKind.ERROR, reason, time_s, {"from": previous})
+        self._emit(EventKind.PHASE, phase.label, time_s,
+                   {"phase": phase.value, "flow": phase.flow, "from": previous, "why": reason})
+        self._emit(EventKind.END, f"program ended ({outcome}): {reason}", time_s,
+                   self.result.to_dict())
+
+    def _shift_timers(self, delta: float) -> None:
+        ctx = self._ctx
+        if ctx.phase_started_s is not None:
+            ctx.phase_started_s += delta
+        if ctx.pause_started_s is not None:
+            ctx.pause_started_s += delta
+
+
+    def _emit(self, kind: EventKind, message: str, time_s: float,
+              data: dict[str, Any]) -> None:
+        phase = self.phase.label
+        self._sink(Event(time_s, kind, message, phase, data))
+
+
+def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
+    """The sensors whose ERROR status (errors, or stale) stands the robot in
+    ``phase``, and ends the program if it lasts."""
+    if phase is _PAUSED and ctx.resume_phase is not None:
+        phase = Phase(ctx.resume_phase)
+    if phase.terminal:
+        return ()
+    if ctx.from_top and phase.flow != "ascent":
+        return BACK_SENSORS  # a continuous descent steers by the back pair alone
+    if phase in _EDGE_WATCH:
+        return FRONT_SENSORS + BACK_SENSORS
+    if phase is Phase.LANDING_SCAN:
+        # The scan moves segment 3 alone, and steers nothing: a side pair that
+        # reads no distance there is no flight (the landing is refused, the
+        # robot goes home), not a reason to end the program on the landing.
+        return ()
+    return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
+
+
+_EDGE_WATCH = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
+"""Descent 1's phases watch the back pair for the edge as they back: a back
+sensor that reports errors, or stops measuring, would hide it (the edge is
+where both read the drop), and backing from the top of a flight the robot
+would go over the edge unseen."""
+
+
+_PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
+ALL_MOTORS: tuple[MotorId, ...] = tuple(MotorId)
+_ZEROS: dict[MotorId, float] = dict.fromkeys(ALL_MOTORS, 0.0)
+_TERMINAL: dict[str, bool] = {p.value: p.terminal for p in Phase}
+
+
+def _zeros() -> dict[MotorId, float]:
+    return _ZEROS.copy()
+
+
+LINK_TROUBLE = ("retries", "timeouts", "lost", "revived")
+"""The link figures (Snapshot.health) that say frames went missing."""
+
+
+def _link_meanwhile(before: Mapping[str, float], now: Mapping[str, float]) -> str:
+    """What the link counted during a sensor hold, when it lost frames: a
+    reading goes stale on a wire that loses its replies too, and the error
+    says so (empty for a robot with no link, or a link that lost nothing)."""
+    grown = {k: now[k] - before.get(k, 0.0) for k in LINK_TROUBLE if k in now}
+    if not any(v > 0 for v in grown.values()):
+        return ""
+    counts = ", ".join(f"{v:.0f} {k}" for k, v in grown.items() if v > 0)
+    return f"; meanwhile the link lost frames ({counts}): the readings were stale on the wire"

@@ -1,0 +1,345 @@
+"""Descent 1's edge watch: where the back pair (SBR/SBL, looking down under
+segment 3) reads the floor and where the drop past an edge, where it saw an
+edge go by, and how far backing may go from there.
+
+:func:`edge_bound` bounds descent 1's backing: edge_clearance_m past where
+the pair crossed the edge, a crossing placed only when the watch saw it as
+it happened (else the robot drives forward until the pair reads the floor
+again: :func:`refind`).  In a continuous descent it also squares the robot
+up to the edge (:func:`square_to_edge`).  On a narrow step,
+:func:`narrow_bound` keeps segment 2's rear axle on the tread.
+:func:`floor_tolerance` is how near BACK_CLEARANCE the pair reads the floor.
+"""
+
+from __future__ import annotations
+
+import math
+
+from stairbot.control.algorithm import limits, motion
+from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import measurement_period, median_sigma, window
+from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorStatus
+from stairbot.inputs.config import RobotConfig
+
+FLOOR_SIGMAS = 2.0
+"""Descent 2: SBR/SBL "read BACK_CLEARANCE" within this many sigmas of their
+filtered mean (and half a resolution step)."""
+
+
+def floor_tolerance(cfg: RobotConfig) -> float:
+    """How far above BACK_CLEARANCE the pair's mean may read and segment 3
+    stand on the floor: half a resolution step, and FLOOR_SIGMAS sigmas of
+    the mean of two filtered readings there.  Without the sigmas, a noisy
+    pair (or a cone, whose slanted rays read a little long) that reads above
+    BACK_CLEARANCE standing keeps the lift pushing segment 3 down, and
+    segment 2 tips nose down."""
+    sigma = median_sigma(cfg, True, cfg.BACK_CLEARANCE) / math.sqrt(2.0)
+    return cfg.sensors.resolution / 2 + FLOOR_SIGMAS * sigma
+
+
+EDGE_MARGIN_M = 0.006
+"""Segment 3's front wheels stop this far clear of the edge's corner."""
+
+
+def edge_clearance_m(cfg: RobotConfig) -> float:
+    """How far the robot backs after its back pair (``back_from_rear`` from
+    segment 3's rear) crossed the edge until segment 3's front wheels are
+    clear of it, their front EDGE_MARGIN_M past its corner: over the step
+    below, and not yet so far that the robot tips back off segment 2's rear
+    wheels.  The wheels' front, not their centre, is what must clear the
+    corner: wheels whose centre is only a wheel radius past it stand on it,
+    segment 3 stays up when lowered, and the lift pitches segment 2 nose
+    down."""
+    g = cfg.geometry
+    return (g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear - g.wheel_inset
+            + g.wheel_radius + EDGE_MARGIN_M + edge_doubt_m(cfg))
+
+
+def edge_doubt_m(cfg: RobotConfig) -> float:
+    """How far off :func:`edge_sight_m` may place the crossing: the distance
+    backed at full speed in one of the back pair's measurement periods (the
+    crossing falls anywhere between two measurements, and the median's
+    majority may take one more).  Added to the clearance, so that a slow
+    pair (an HC-SR04 measures every 60 ms, about 10 mm of backing) still
+    stops segment 3's front wheels past the corner, not on it, where
+    lowering segment 3 would pitch the robot nose down."""
+    return cfg.wheel_speed_m_s * measurement_period(cfg, True)
+
+
+LOW_DROP_M = 0.015
+"""A continuous descent takes a drop this much past BACK_CLEARANCE (and its
+noise) for an edge: it has not climbed the flight, so any rise may come,
+and one lower than half min_step_rise_m, unseen, would be backed off wheels
+first and tip the robot back.  0.015 m is under a 32 mm wheel's radius, a
+drop the wheels roll down."""
+
+
+def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
+    """The back pair reads "past the edge" beyond this: more than half the
+    lowest rise below BACK_CLEARANCE (and its noise); in a continuous
+    descent, LOW_DROP_M more than BACK_CLEARANCE (and its noise)."""
+    low = LOW_DROP_M if from_top else limits.min_step_rise_m(cfg) / 2
+    return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + low
+
+
+def edge_lag_s(cfg: RobotConfig) -> float:
+    """How long after the back pair crosses an edge perception reports the
+    drop: the sensor's latency, then the median's majority of the window,
+    one period each, the first of them half a period after the crossing on
+    average."""
+    return cfg.sensors.spec(True).latency_s \
+        + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
+
+
+def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> float:
+    """How far past an edge the back pair's sensors are when perception first
+    reports the drop, backing at ``speed_mps``: the distance backed while
+    the measurements came through (the sensor's latency, then the median's
+    majority of the window, one period each, the first of them half a
+    period after the crossing on average), and for a sensor that reports
+    the first echo in its cone, the riser's face below the edge that the
+    cone's back half keeps seeing, nearer than the drop, until the sensor
+    is ``edge_drop_m`` x sin(half the cone) past it.  For a wide cone this
+    is centimetres (an HC-SR04 pair sees the drop about 2.4 cm past the
+    edge), and the backing that follows subtracts it from
+    edge_clearance_m: counted from the sighting instead, it would tip the
+    robot back."""
+    spec = cfg.sensors.spec(True)
+    sight = abs(speed_mps) * edge_lag_s(cfg)
+    if spec.first_echo:
+        fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
+        sight += edge_drop_m(cfg, from_top) * math.sin(math.radians(fov) / 2)
+    return sight
+
+
+EDGE_GAP_TICKS = 2.5
+"""The edge watch missed a stretch when two of its ticks are further apart
+than this many control ticks."""
+REFIND_TICKS = 3
+"""Finding the floor again: ticks in a row the back pair must read it."""
+
+
+def drops(t: Tick) -> list[bool]:
+    """Each of SBR and SBL reads past an edge: more than edge_drop_m, or
+    nothing in range."""
+    cfg, drop = t.cfg, edge_drop_m(t.cfg, t.ctx.from_top)
+    return [r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
+            or r.ok and r.distance_m > drop
+            for r in (t.snap.sensors[s] for s in BACK_SENSORS)]
+
+
+def sees_drop(t: Tick) -> bool:
+    """The back pair reads past an edge: both of them."""
+    return all(drops(t))
+
+
+EDGE_SQUARE_RAD = math.radians(3.0)
+"""Continuous descent: turned further than this from square to the edge (by
+how far it backed between SBR and SBL reading the drop), the robot turns
+square before it backs on: askew, backing the whole clearance from the
+second sensor's crossing takes segment 2's wheels on the first one's side
+over the edge.  The estimate's own error is about one measurement period's
+backing across the pair's spacing (3 deg for an HC-SR04 pair), and the
+threshold stays just above it."""
+MAX_EDGE_YAW_RAD = math.radians(25.0)
+"""One back sensor reads the drop and the other still the floor after the
+robot backed as far as this yaw across the pair's spacing: it stops."""
+
+
+def square_to_edge(t: Tick, w: Work) -> str | None:
+    """Watch which back sensor reads the drop first, and where
+    (``w.edge_first_wheel``: :func:`_crossed` places the crossing between
+    the two); an error if the other does not follow within
+    MAX_EDGE_YAW_RAD.  In a continuous descent, once both do, the yaw to
+    square up (``w.square_yaw``), if more than EDGE_SQUARE_RAD and not
+    squared at this edge yet.  Only on a crossing the watch sees as it
+    happens (``w.edge_floor_s``).  Returns the error that ends the program,
+    if any.  On a climbed step calibration has squared the robot to the
+    edge, so one sensor reading the drop far before the other is a sensor
+    reading wrong, not a yaw: placing the crossing half-way between them
+    would stop the robot short, and lowering segment 3 there tips it nose
+    down."""
+    ctx, cfg = t.ctx, t.cfg
+    if ctx.edge_wheel is not None or w.edge_floor_s is None:
+        return None
+    right, left = drops(t)
+    here = motion.wheel_position(t.snap)
+    if not right and not left:
+        w.edge_first_wheel = w.edge_first = None  # both on the floor: no crossing begun
+        return None
+    if right != left:
+        first = "SBR" if right else "SBL"
+        if w.edge_first_wheel is None or w.edge_first != first:
+            w.edge_first_wheel, w.edge_first = here, first
+        lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
+        most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
+        if lag > most:
+            other = "SBL" if right else "SBR"
+            return (f"descent 1: {first} reads the drop, {other} still the floor "
+                        f"after backing {lag * 1000:.0f} mm more (at most {most * 1000:.0f} mm: "
+                        f"{math.degrees(MAX_EDGE_YAW_RAD):.0f}° from square to the edge): "
+                        "turned too far from the edge, the edge not straight, or a back "
+                        "sensor reading wrong")
+        return None
+    if not ctx.from_top:
+        return None
+    if right and w.edge_first_wheel is not None and not ctx.edge_squared:
+        lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
+        yaw = math.atan2(lag, 2 * cfg.sensors.back_lateral)
+        if yaw > EDGE_SQUARE_RAD:
+            # SBR first: its side is further back, the robot turned right: turn left
+            w.square_yaw = yaw if w.edge_first == "SBR" else -yaw
+            t.say(f"{w.edge_first} read the drop {lag * 1000:.0f} mm before the other: "
+                  f"{math.degrees(yaw):.1f}° from square to the edge; turning "
+                  f"{'left' if w.square_yaw > 0 else 'right'} to square up",
+                  edge_yaw_deg=math.degrees(w.square_yaw))
+    return None
+
+
+def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
+    """Descent 1's backing (backing off, and backing up to the edge) never
+    passes edge_clearance_m beyond where the back pair saw the drop (more
+    than half the lowest rise below BACK_CLEARANCE, or nothing in range):
+    tab_length_to_edge, read on the way up, may be a centimetre or two off,
+    enough to tip the robot back; and on a tread little longer than the
+    robot, backing off the seed's approach turns already takes segment 3
+    past the edge, and backing up to the edge by the tab after that would
+    tip it back.
+
+    Where the pair crossed is worked out only from a crossing the watch saw
+    as it happened: the pair read the floor on a tick of this phase, then
+    the drop, with no stretch between missed.  Otherwise -- the pair already
+    past the edge when the phase began (it crossed as the back-off ended,
+    or while calibration turned), or a tick came late (a stalled host: the
+    robot ran on unwatched) -- where it crossed is not known: the back-off
+    ends where it is, and backing up to the edge first drives forward until
+    the pair reads the floor again (``refind``: :func:`refind`).  A
+    crossing placed at the tick that first saw the drop after such a gap
+    (the robot standing, so :func:`edge_sight_m` is 0) would lie at the
+    pair, when the pair may be well past the edge, and backing the whole
+    clearance from there tips the robot back."""
+    cfg, ctx = t.cfg, t.ctx
+    if ctx.edge_wheel is None:
+        now = t.snap.time_s
+        if w.square_yaw is None and w.edge_stop is None:
+            w.edge_stop = square_to_edge(t, w)
+        if w.edge_stop is not None or w.square_yaw is not None:
+            # the step wrapper ends the program, or turns square first (the
+            # back-off ends here and turns)
+            return None if refind else motion.wheel_position(t.snap)
+        if w.edge_watch_s is not None \
+                and now - w.edge_watch_s > EDGE_GAP_TICKS * cfg.algorithm.tick:
+            # a stretch unwatched: the floor read before it no longer counts,
+            # nor one read until perception's lag has passed
+            w.edge_floor_s = w.edge_first_wheel = w.edge_first = None
+            w.edge_blind_until = now + edge_lag_s(cfg) + measurement_period(cfg, True)
+        w.edge_watch_s = now
+        if not sees_drop(t):
+            if w.edge_blind_until is None or now > w.edge_blind_until:
+                w.edge_floor_s = now
+        elif w.edge_floor_s is None:
+            if refind:
+                w.refind_from = motion.wheel_position(t.snap)
+                w.refind_floor = 0
+                t.say("SBR/SBL read past the edge, but they were not seen crossing it: "
+                      "driving forward until they read the floor again")
+                return None
+            return motion.wheel_position(t.snap)  # the back-off ends here
+        else:
+            ctx.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
+            more = max(0.0, edge_clearance_m(cfg) - sight)
+            t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m, "
+                  f"about {sight * 1000:.0f} mm past it): backing at most {more:.3f} m more")
+    if ctx.edge_wheel is None:
+        return None
+    return ctx.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
+
+
+def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
+    """Where the back pair crossed the edge whose drop it reads now for the
+    first time, on the odometer, and how far past it the pair is
+    (:func:`edge_sight_m` at the wheels' speed): behind the robot's back
+    (backing, the odometer runs down), so at a larger count.  If one sensor
+    read the drop first (at ``first_wheel``), the crossing is placed
+    half-way between the two: where the robot's centre line crossed, the
+    pair being mounted either side of it; placed where the second sensor
+    read it, the crossing is up to half the gap too near, and backing the
+    rest of the clearance from there tips the robot back.  The gap counts
+    less what one measurement period's backing explains
+    (:func:`edge_doubt_m`): the two sensors measure at their own times, and
+    that much of the gap is timing, not yaw; counted in full it would stop
+    segment 3's front wheels on the corner, and lowering it there tips the
+    robot nose down."""
+    cfg = t.cfg
+    speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
+    sight = edge_sight_m(cfg, speed * cfg.wheel_circumference, t.ctx.from_top)
+    here = motion.wheel_position(t.snap)
+    if first_wheel is not None:
+        # what one measurement period's backing explains is the sensors'
+        # timing, not where they crossed (edge_doubt_m covers it)
+        apart = max(0.0, (first_wheel - here) * cfg.wheel_circumference - edge_doubt_m(cfg))
+        return here + cfg.wheel_turns(sight + apart / 2), sight + apart / 2
+    return here + cfg.wheel_turns(sight), sight
+
+
+NARROW_AXLE_MARGIN_M = 0.004
+"""On a narrow step, descent 1 never backs segment 2's rear axle nearer the
+edge than this (the tab puts it 8.5 mm past it, as ascent 6 left it)."""
+
+
+def narrow_bound(t: Tick, w: Work) -> float | None:
+    """Narrow steps: watch the back pair cross the edge of the narrow tread
+    the robot stands on, or steps down onto (floor, then the drop, as
+    :func:`edge_bound` does) and
+    keep where (``Context.narrow_edge_wheel``); once known, the odometer
+    count the backing never passes: segment 2's rear axle
+    NARROW_AXLE_MARGIN_M past that edge.  The front pair's tab alone leaves
+    8.5 mm to spare there: both of its sensors reading 20 mm short (a common
+    fault the standing rule cannot see) would back segment 2's rear wheels
+    off the edge."""
+    cfg, ctx = t.cfg, t.ctx
+    if ctx.narrow_edge_wheel is None:
+        if not sees_drop(t):
+            w.edge_floor_s = t.snap.time_s
+        elif w.edge_floor_s is not None:
+            ctx.narrow_edge_wheel = _crossed(t)[0]
+    if ctx.narrow_edge_wheel is None:
+        return None
+    g = cfg.geometry
+    reach = g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear + g.wheel_inset
+    return ctx.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M)
+
+
+def refind_max_m(cfg: RobotConfig) -> float:
+    """The farthest finding the floor again drives forward: back over the
+    whole clearance, what the pair's lag may have carried it past, and 2 cm."""
+    return edge_clearance_m(cfg) + edge_sight_m(cfg, cfg.wheel_speed_m_s) + 0.02
+
+
+def refind(t: Tick, w: Work) -> Step:
+    """Drive forward until the back pair reads the floor again (REFIND_TICKS
+    ticks in a row, and at least as far as its lag carries the robot at full
+    speed), then back up to the edge, the watch seeing it cross."""
+    cfg = t.cfg
+    assert w.refind_from is not None
+    driven_m = (motion.wheel_position(t.snap) - w.refind_from) * cfg.wheel_circumference
+    w.refind_floor = 0 if sees_drop(t) else w.refind_floor + 1
+    if w.refind_floor >= REFIND_TICKS and driven_m >= edge_sight_m(cfg, cfg.wheel_speed_m_s,
+                                                                   t.ctx.from_top):
+        t.say(f"SBR/SBL read the floor again {driven_m * 1000:.0f} mm forward: backing up "
+              "to the edge")
+        w.refind_from = w.edge_blind_until = w.edge_first_wheel = w.edge_first = None
+        w.edge_watch_s = w.edge_floor_s = t.snap.time_s
+        return stay(NO_MOTION)
+    most = refind_max_m(cfg)
+    if driven_m >= most and t.ctx.from_top:
+        return end("stopped", f"refused: SBR/SBL read past an edge from the start of step "
+                              f"{t.ctx.steps_descended + 1} from the top, and still after "
+                              f"driving {driven_m * 1000:.0f} mm forward: the tread is shorter "
+                              "than the robot")
+    if driven_m >= most:
+        return fail(f"descent 1: SBR/SBL still read past the edge after driving "
+                    f"{driven_m * 1000:.0f} mm forward to find the floor again (at most "
+                    f"{most * 1000:.0f} mm): the edge of the step cannot be found")
+    return stay(motion.drive(cfg, 1, cfg.wheel_turns(most - driven_m)))

@@ -1,0 +1,428 @@
+"""Quarter-turn landings (the seed's extension 1): look sideways for the next
+flight, turn 90° towards it, climb on; on the way down, turn back.
+
+The seed turns one back sensor to look parallel to the floor; this robot
+has a side pair, SSR and SSL, on segment 3, looking right and left.  A
+landing shows itself as the seed's wall at the top: ascent 3 lifts segment
+1 its whole stroke in front of the wall ahead and still sees it (an
+obstacle).  With ``[algorithm] landings`` the robot then, before it turns
+back down:
+
+1. *scans* (landing 1): lifts segment 3 its whole stroke with the side pair
+   looking out.  A side that, standing at the top, reads on past what it
+   saw below by SIDE_JUMP_M, having first done so no lower than the lowest
+   riser the robot climbs, is the next flight's first riser; any other is a
+   wall.  The readings before the lift say how far the sides are.
+2. *decides*: no side open, the ascent ends as at a wall (``landing_closed``);
+   a landing too small for the robot to turn in (its turning circle,
+   TURN_ROOM_MARGIN clear of the walls, the riser and the edge behind), it
+   ends too (``landing_too_small``) -- both then descend home as from a wall.
+3. *centres* (landing 2): backs from the wall ahead to the landing's middle,
+   by the front pair, so that the turning circle clears the wall and the
+   edge behind it;
+4. *turns* 90° towards the open side by calibration's turn (segments 1 and 3
+   lifted, segment 2's wheels, by the odometer), and calibrates on the next
+   flight's first riser: the ascent goes on, counting steps on.
+
+The descent mirrors it: having come down the second flight's first step, the
+robot backs to where it turned (landing 3), turns back to the heading it
+came up with, and descends the first flight (descent 1's calibration on the
+wall ahead, then the edge its back pair finds).  One landing a climb.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+
+from stairbot.control.algorithm import limits, motion
+from stairbot.control.algorithm.moves import lift, reading_drive, stood
+from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import side_settle_s
+from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
+from stairbot.inputs.config import RobotConfig
+
+P = Phase
+FLOW = "landing"
+
+TURN_ROOM_MARGIN = 0.03
+"""The robot turns on a landing only if its turning circle stays this far
+(m) from the walls, the next flight's riser and the edge behind it."""
+WHEEL_WIDTH = 0.01
+"""How far a wheel stands out past the track on each side, m: the robot's
+width is track_width plus twice this."""
+DEPTH_MARGIN = 0.01
+"""The landing's depth is taken this much less than it was measured, m."""
+TAB_PAST_EDGE_M = 0.02
+"""Where ascent 7 read tab_length_to_edge, segment 1's front face stood
+LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE less about this past the
+edge (segment 2's rear wheels just onto the step: ascent 6 ends at
+length_of_next_step less the two, and a 0.28 m tread read tabs of 0.145 to
+0.150 m), m."""
+SIDE_JUMP_M = 0.05
+"""A side sees over what it saw when it reads this much farther (or nothing
+in range): ascent 3's SIGHT_JUMP_M, for the same reason -- no tread is this
+short, and it is ten times the sensors' noise."""
+SCAN_CONFIRM_TICKS = 5
+"""Lifting, a side has been seen over once its reading has stayed past what
+it saw this many ticks in a row (then the lift may stop early)."""
+SCAN_TOP_TICKS = 15
+"""Standing at the top of the scan, the ticks each side is read over: open
+if past what it saw on most of them."""
+SCAN_BASE_M = 0.01
+"""The scan takes what each side sees from the readings of its first this
+much of segment 3's lift, m."""
+LEFT, RIGHT = 1, -1
+
+
+def half_width(cfg: RobotConfig) -> float:
+    """Half the robot's width, wheels included."""
+    return cfg.geometry.track_width / 2.0 + WHEEL_WIDTH
+
+
+def centre_to_front(cfg: RobotConfig) -> float:
+    """From segment 2's centre (where the robot turns) to segment 1's front face."""
+    g = cfg.geometry
+    return g.LENGTH_OF_FIRST_MODULE + g.LENGTH_OF_SECOND_MODULE / 2.0
+
+
+def turning_radius(cfg: RobotConfig) -> float:
+    """The farthest corner of the robot from segment 2's centre."""
+    g = cfg.geometry
+    reach = max(centre_to_front(cfg), g.LENGTH_OF_SECOND_MODULE / 2.0 + g.LENGTH_OF_THIRD_MODULE)
+    return math.hypot(reach, half_width(cfg))
+
+
+def turn_room_m(cfg: RobotConfig) -> float:
+    """How far every wall, riser and edge must be from the centre to turn."""
+    return turning_radius(cfg) + TURN_ROOM_MARGIN
+
+
+def can_scan(t: Tick) -> bool:
+    """A wall ahead at the top of a step (too high to see over: a tread too
+    short to stand on is no landing to turn on), on a robot that turns on
+    landings, with no landing scanned yet: look sideways before turning
+    back down."""
+    ctx, cfg = t.ctx, t.cfg
+    return (cfg.algorithm.landings and cfg.sensors.has_side_pair and ctx.number_of_steps > 0
+            and ctx.wall_ahead and not ctx.landing_seen and not ctx.from_top)
+
+
+# -- landing 1: scan ---------------------------------------------------------------------
+def _side(reading: SensorReading) -> float | None:
+    """A side reading's distance, or None (nothing in range, or an error)."""
+    return reading.distance_m if reading.ok else None
+
+
+def _scan_enter(t: Tick, w: Work) -> None:
+    t.ctx.landing_seen = True
+    t.ctx.return_mtb = w.entry_mtb
+    w.target_mtb = max(w.entry_mtb, t.cfg.MAX_OF_VERTICAL_TURNS)
+
+
+def _lifted_m(t: Tick, w: Work) -> float:
+    return (t.snap.turns(MotorId.MTB) - w.entry_mtb) * t.cfg.motors.lift_travel_per_turn
+
+
+def _jumped(reading: SensorReading, base: float) -> bool:
+    """The side reads on past what it saw (by SIDE_JUMP_M, or nothing in range)."""
+    if reading.status is SensorStatus.OUT_OF_RANGE:
+        return reading.distance_m > base
+    return reading.ok and reading.distance_m >= base + SIDE_JUMP_M
+
+
+def _sample(t: Tick, w: Work) -> None:
+    """Lifting, per side (SSR, SSL): the readings of the lift's first
+    SCAN_BASE_M (what the side sees), then the height from which the reading
+    has stayed past them SCAN_CONFIRM_TICKS ticks in a row (where the beam
+    saw over what it saw: a hint of the riser's height)."""
+    lifted = _lifted_m(t, w)
+    for i, sid in enumerate(SIDE_SENSORS):
+        reading = t.snap.sensors[sid]
+        if lifted < SCAN_BASE_M:
+            d = _side(reading)
+            if d is not None:
+                w.side_base[i].append(d)
+            continue
+        if not w.side_base[i] or w.side_run[i] >= SCAN_CONFIRM_TICKS:
+            continue
+        if _jumped(reading, statistics.median(w.side_base[i])):
+            if w.side_run[i] == 0:
+                w.side_open[i] = lifted
+            w.side_run[i] += 1
+        else:
+            w.side_run[i], w.side_open[i] = 0, None
+
+
+def _scan(t: Tick, w: Work) -> Step:
+    """Lift segment 3 to the top of its stroke (or until both sides have been
+    seen over), then, standing, read both sides SCAN_TOP_TICKS ticks once
+    the filter has settled: a side is open only if what it reads standing
+    there lies past what it saw below.  A stray measurement while lifting
+    (1 % outliers) took a wall for a flight: the robot turned to it."""
+    if not w.checked:
+        _sample(t, w)
+        speeds = motion.lifts_to(t.cfg, t.snap, w.lift_targets())
+        if speeds is not None and min(w.side_run) < SCAN_CONFIRM_TICKS:
+            return stay(speeds)
+        w.checked = True
+    if not stood(t, w, side_settle_s(t.cfg)):
+        return stay(NO_MOTION)
+    for i, sid in enumerate(SIDE_SENSORS):
+        reading = t.snap.sensors[sid]
+        if not w.side_base[i]:
+            continue
+        w.side_top[i] += 1 if _jumped(reading, statistics.median(w.side_base[i])) else 0
+    w.side_ticks += 1
+    if w.side_ticks < SCAN_TOP_TICKS:
+        return stay(NO_MOTION)
+    return _record(t, w)
+
+
+def _record(t: Tick, w: Work) -> Step:
+    """What the scan found, kept in the context for the turn and the way back:
+    how far each side is from the centre line, which sides open onto a
+    flight, and its first riser's height (where the beam saw over it)."""
+    ctx, cfg = t.ctx, t.cfg
+    lat = cfg.sensors.side_lateral
+    bases = [statistics.median(b) if b else None for b in w.side_base]
+    ctx.landing_right_m = None if bases[0] is None else bases[0] + lat
+    ctx.landing_left_m = None if bases[1] is None else bases[1] + lat
+    # open: past what it saw on most of the ticks standing at the top, and
+    # seen over no lower than the lowest riser it climbs (the beam below that
+    # met something it then lost: a fault, not a flight -- a side sensor
+    # reading long from just above the landing would otherwise send the robot
+    # turning to a wall)
+    lifted = _lifted_m(t, w)
+    seen_at = [lifted if o is None else o for o in w.side_open]
+    low = limits.min_step_rise_m(cfg) - cfg.sensors.side_height - SCAN_BASE_M
+    opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS
+              and seen_at[i] >= low for i in (0, 1)]
+    ctx.landing_rise_m = [seen_at[i] + cfg.sensors.side_height if opened[i] else None
+                          for i in (0, 1)]
+    ctx.landing_open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
+    for i, sid in enumerate(SIDE_SENSORS):
+        if opened[i]:
+            name = "right" if i == 0 else "left"
+            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
+                  f"({bases[i]:.3f} m) with segment 3 lifted {seen_at[i]:.3f} m, and "
+                  f"standing at the top: the next flight", sensor=sid.value, base=bases[i])
+    return go(P.LANDING_SCAN_LOWER)
+
+
+SCAN = PhaseDef(
+    P.LANDING_SCAN, "landing 1 — lift segment 3, looking sideways for the next flight", FLOW,
+    _scan, enter=_scan_enter, carried_by=(1, 2),
+    to={P.LANDING_SCAN_LOWER: "segment 3 at the top of its stroke (or both sides seen over), "
+                              "read standing there",
+        P.ERROR: FAULT})
+
+
+# -- landing 1: lower, decide ------------------------------------------------------------------
+def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
+    return {MotorId.MTB: t.ctx.return_mtb - w.entry_mtb}
+
+
+def _decide(t: Tick, _w: Work) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    right, left = ctx.landing_right_m, ctx.landing_left_m
+    opened = ctx.landing_open
+    if not opened:
+        return _refuse(t, "landing_closed",
+                       "landing: no next flight to either side (SSR "
+                       f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
+                       "3's whole stroke does not see over)")
+    room = turn_room_m(cfg)
+    depth = landing_depth(t)
+    if depth is None:
+        return _refuse(t, "landing_too_small",
+                       "landing: its depth was not measured (neither the tread past the "
+                       "last riser nor tab_length_to_edge read the wall ahead): no room to "
+                       "turn is known")
+    ctx.landing_depth_m = depth
+    short = [f"{name} {_said(have)}" for name, have in
+             (("right", right), ("left", left), ("depth/2", depth / 2.0))
+             if have is None or have < room]
+    if short:
+        return _refuse(t, "landing_too_small",
+                       f"landing too small to turn in: the robot's turning circle needs "
+                       f"{room:.3f} m from its centre on every side (radius "
+                       f"{turning_radius(cfg):.3f} m + {TURN_ROOM_MARGIN} m), it has "
+                       + ", ".join(short))
+    side = LEFT if LEFT in opened else RIGHT
+    if len(opened) == 2:
+        # both open: the lower first riser (the side seen over first)
+        side = LEFT if (ctx.landing_rise_m[1] or 0.0) <= (ctx.landing_rise_m[0] or 0.0) \
+            else RIGHT
+    ctx.landing_side = side
+    t.say(f"landing: the next flight is to the {'left' if side == LEFT else 'right'}; "
+          f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
+          "centring to turn", side=side, depth=depth)
+    return go(P.LANDING_CENTRE)
+
+
+def landing_depth(t: Tick) -> float | None:
+    """The landing's depth, from the edge behind to the wall ahead, less
+    DEPTH_MARGIN: the smaller of what ascent 3 measured for the last step's
+    tread (the reading past its riser: beyond LENGTH_OF_INFINITY not
+    measured) and what ascent 7's tab_length_to_edge puts it at
+    (TAB_PAST_EDGE_M); None if neither was measured."""
+    ctx, cfg = t.ctx, t.cfg
+    i = ctx.number_of_steps - 1
+    seen: list[float] = []
+    tread, tab = ctx.tread_length[i], ctx.tab_length_to_edge[i]
+    if tread is not None and math.isfinite(tread):
+        seen.append(tread)
+    if tab is not None:
+        seen.append(tab + cfg.LENGTH_OF_FIRST_MODULE + cfg.LENGTH_OF_SECOND_MODULE
+                    - TAB_PAST_EDGE_M)
+    return min(seen) - DEPTH_MARGIN if seen else None
+
+
+def _said(d: float | None) -> str:
+    return "nothing in range" if d is None else f"{d:.3f} m"
+
+
+def _refuse(t: Tick, why: str, message: str) -> Step:
+    t.ctx.ascent_end = why
+    t.say(message + "; the ascent ends, the descent begins", ascent_end=why)
+    return go(P.DESCENT_BACK_OFF)
+
+
+_scan_lower = lift(_lower_deltas, _decide)
+SCAN_LOWER = PhaseDef(
+    P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
+    _scan_lower[1], enter=_scan_lower[0], carried_by=(1, 2),
+    to={P.LANDING_CENTRE: "lowered; a side seen over, and room to turn",
+        P.DESCENT_BACK_OFF: "lowered; no side seen over (landing_closed), or too little "
+                            "room to turn (landing_too_small): the descent begins",
+        P.ERROR: FAULT})
+
+
+# -- landing 2: centre, then turn --------------------------------------------------------------
+def _centre_target(t: Tick) -> float | None:
+    depth = t.ctx.landing_depth_m
+    assert depth is not None  # set by the decision
+    return depth / 2.0 - centre_to_front(t.cfg)
+
+
+def _centre_turns(t: Tick) -> float:
+    """Backing by turns, if the front pair cannot read the wall ahead: from
+    where ascent 2 left the front face (approach_gap from it)."""
+    target = _centre_target(t)
+    assert target is not None
+    return t.cfg.wheel_turns(max(0.0, target - t.cfg.algorithm.approach_gap))
+
+
+def _centred(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    ctx.landing_twist = motion.twist(t.snap)
+    yaw = ctx.landing_side * math.pi / 2.0
+    ctx.turn_to = ctx.landing_twist + motion.yaw_turns(t.cfg, yaw)
+    ctx.squaring_turns = 0
+    ctx.purpose = "landing"
+    return go(P.CAL_LIFT, f"centred on the landing: turning {math.degrees(yaw):+.0f}° "
+                          "towards the next flight")
+
+
+_centre = reading_drive(-1, _centre_target, _centre_turns, _centred)
+CENTRE = PhaseDef(
+    P.LANDING_CENTRE, "landing 2 — back to the landing's middle", FLOW, _centre[1],
+    enter=_centre[0], watches="front",
+    to={P.CAL_LIFT: "reads half the landing's depth less the front face's reach: lift "
+                    "to turn 90° towards the next flight",
+        P.ERROR: FAULT})
+
+
+def turned(t: Tick) -> Step:
+    """Calibration's lowering after a landing's turn: on up the next flight
+    (calibrate on its first riser), or down the first (calibrate on the wall
+    ahead, descent 1)."""
+    ctx = t.ctx
+    if ctx.purpose == "landing":
+        ctx.landing_step = ctx.number_of_steps
+        ctx.purpose = "ascent"
+        t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
+              landing_step=ctx.landing_step)
+    else:
+        # descent 1 of the first flight's top step, as its back-off would begin it:
+        # that step's edge not seen yet (the edge watch's mark is the last step's)
+        ctx.purpose = "descent"
+        ctx.edge_wheel = None
+        ctx.turned_back = ctx.edge_squared = False
+    return go(P.CAL_CHECK)
+
+
+def after_calibration(t: Tick) -> None:
+    """Squared up on the next flight's first riser, standing where it turned:
+    what the front pair reads there is where the way down turns back
+    (``landing_riser_m``)."""
+    ctx = t.ctx
+    if ctx.landing_step is None or ctx.number_of_steps != ctx.landing_step \
+            or ctx.landing_riser_m is not None or not motion.measurable(t.snap, t.cfg):
+        return
+    ctx.landing_riser_m = motion.mean_distance(t.snap)
+    t.say(f"where it turned: SFR/SFL read {ctx.landing_riser_m:.3f} m to the next flight's "
+          "first riser", landing_riser_m=ctx.landing_riser_m)
+
+
+# -- landing 3: back to where it turned, turn back ------------------------------------------
+def turned_here(t: Tick) -> bool:
+    """Turned onto the next flight, and refusing its first step: the way down
+    begins with the turn back."""
+    ctx = t.ctx
+    return ctx.landing_step is not None and ctx.number_of_steps == ctx.landing_step
+
+
+def returns_here(t: Tick) -> bool:
+    """Just down the next flight's first step: back to the landing's turn."""
+    ctx = t.ctx
+    return (ctx.landing_step is not None and not ctx.from_top
+            and ctx.steps_descended < ctx.number_of_steps
+            and t.descent_index == ctx.landing_step - 1)
+
+
+def _return_target(t: Tick) -> float | None:
+    """What the front pair read on the next flight's first riser where the
+    robot turned (squared up there); if it could not read it, what the side
+    pair said of that side, less the front face's reach.  The front pair
+    first: a side sensor reading long, alone, would send the robot back to
+    the wrong place on the landing, and it would turn back into a wall."""
+    if t.ctx.landing_riser_m is not None:
+        return t.ctx.landing_riser_m
+    open_m = _open_m(t)
+    return None if open_m is None else open_m - centre_to_front(t.cfg)
+
+
+def _open_m(t: Tick) -> float | None:
+    ctx = t.ctx
+    return ctx.landing_left_m if ctx.landing_side == LEFT else ctx.landing_right_m
+
+
+def _return_turns(t: Tick) -> float:
+    target = _return_target(t)
+    return t.cfg.wheel_turns(max(0.0, (target or 0.0) - t.cfg.algorithm.approach_gap))
+
+
+def _returned(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    assert ctx.landing_twist is not None  # set before the turn
+    ctx.turn_to = ctx.landing_twist
+    ctx.squaring_turns = 0
+    ctx.purpose = "landing_back"
+    return go(P.CAL_LIFT, "back where it turned: turning back to the first flight")
+
+
+_return = reading_drive(-1, _return_target, _return_turns, _returned)
+RETURN = PhaseDef(
+    P.LANDING_RETURN, "landing 3 — back to where it turned", FLOW, _return[1],
+    enter=_return[0], watches="front",
+    to={P.CAL_LIFT: "reads where it turned (down the next flight's first step, or having "
+                    "refused it): lift to turn back to the heading it came up the first "
+                    "flight with",
+        P.ERROR: FAULT})
+
+
+PHASES: tuple[PhaseDef, ...] = (SCAN, SCAN_LOWER, CENTRE, RETURN)

@@ -1,0 +1,154 @@
+"""The standing rule: when the two sensors of a pair disagree, stop every
+motor, wait standing_wait seconds on the controller's clock, measure again;
+resume exactly where it stopped if they agree, end with an error if not.
+
+Armed in the phases whose record names a pair in ``watches`` (where both
+sensors of the pair look at the same flat surface): SBR/SBL in descent 2,
+SFR/SFL elsewhere.  A disagreement only counts when both sensors give a
+usable distance, and both the (filtered) difference and its smoothed value
+(:data:`~stairbot.control.algorithm.motion.DIFF_SMOOTHING`) must exceed their
+tolerances for DEBOUNCE_TICKS ticks in a row: what calibration may have left
+when it squared up, plus four sigmas of the difference from the sensors'
+stated noise (:func:`~stairbot.control.perception.standing_tolerance`).  Neither a
+short spike, sensor noise, nor a yaw calibration accepted stops the robot.
+
+:func:`watch` runs before an armed phase's step and returns the pause; the
+PAUSED phase's step returns the resume (to the phase it stopped in) or the
+error.  The controller does the bookkeeping of both.
+"""
+
+from __future__ import annotations
+
+import statistics
+
+from stairbot.control.algorithm import long_tread, motion
+from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import standing_tolerance
+
+BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
+                           Phase.ASCENT_DRIVE_SECOND})
+"""Ascent 4 to 6: onto a step the robot drives by turns (long_tread.near_length
+None), the front pair's rule is not armed.  It is in ascent 7, where the pair
+reads the tab: unarmed there, one sensor reading short would go unseen, the
+tab would be stored short, and descent 1 would stop segment 3 short of the
+edge."""
+DEBOUNCE_TICKS = 3
+"""Ticks in a row a disagreement must last before the robot stops (and, after
+the wait, before the program ends with an error)."""
+
+
+def _pair_name(back: bool) -> str:
+    return "SBR/SBL" if back else "SFR/SFL"
+
+
+def _readings(t: Tick, back: bool) -> str:
+    r, left = motion.pair(t.snap, back)
+    return f"{r.distance_m:.3f} m / {left.distance_m:.3f} m"
+
+
+def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
+    """Update the smoothed difference; True when it exceeds equal_tolerance
+    (and, with ``raw_too``, the newest difference does as well)."""
+    ctx = t.ctx
+    diff = motion.pair_difference(t.snap, t.cfg, back)
+    if diff is None:
+        ctx.standing_diff = None
+        return False
+    ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
+    right, left = motion.pair(t.snap, back)
+    near = min(right.distance_m, left.distance_m)
+    smoothed_tol = standing_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
+    return abs(ctx.standing_diff) > smoothed_tol and \
+        (not raw_too or abs(diff) > standing_tolerance(t.cfg, near, back=back))
+
+
+def watch(t: Tick, phase: PhaseDef) -> Step | None:
+    """In an armed phase: the Step that pauses the robot when the watched pair
+    has disagreed long enough, else None.
+
+    A continuous descent steers by the back pair alone (it squares up to
+    each edge with it, and drives by turns): the front pair's rule is not
+    armed.  On the top the front pair faces nothing, or a landing's walls
+    (one beam on a side wall, the other open: a disagreement before the
+    robot moves); below, risers the robot did not climb, which a cone
+    sees over when they are low, and, in a flight 0.3 m wide, a side wall
+    (ended on the stairs by a disagreement that steered nothing).  Nor is it
+    armed in ascent 4 to 6 of a step the robot drives onto by turns (nothing
+    ahead, or a tread past FAR_TREAD_M): the front pair steers nothing
+    there, and pitched nose down in ascent 5 on the top step of a narrow
+    flight it reads the floor ahead at a graze and a side wall, a
+    disagreement about nothing it steers; ascent 7 reads the tab, and is
+    armed."""
+    if phase.watches is None:
+        return None
+    ctx = t.ctx
+    back = phase.watches == "back"
+    if ctx.from_top and not back:
+        return None
+    if not back and phase.phase in BY_TURNS_ONTO and long_tread.near_length(t) is None:
+        return None
+    if not _disagree(t, back):
+        ctx.disagree_ticks = 0
+        return None
+    ctx.disagree_ticks += 1
+    if ctx.disagree_ticks < DEBOUNCE_TICKS:
+        return None
+    return go(Phase.PAUSED,
+              f"standing rule: {_pair_name(back)} disagree ({_readings(t, back)}) in "
+              f"{phase.label}: all motors stopped, measuring again in "
+              f"{t.cfg.algorithm.standing_wait:g} s")
+
+
+MEDIAN_S = 1.0
+"""The end of the standing rule's wait: the median of the pair's difference
+over its last this many seconds decides."""
+
+
+def _paused(t: Tick, _w: Work) -> Step:
+    ctx = t.ctx
+    assert ctx.resume_phase is not None and ctx.pause_started_s is not None
+    resume = Phase(ctx.resume_phase).record
+    back = resume.watches == "back"
+    # Standing still, the difference over the wait decides, not one noisy tick
+    # nor a smoothing that a burst at its end fills: the median of the wait's
+    # last MEDIAN_S of ticks (two stray HC-SR04 measurements can pass a
+    # sensor's median in the wait's last 0.2 s, and a smoothed difference
+    # would then end a sound run).  A pair that gives no figure now
+    # (nothing ahead, an error) does not disagree (as in _disagree); with
+    # none on any tick, the smoothed difference decides.
+    disagree = _disagree(t, back, raw_too=False)
+    diff = motion.pair_difference(t.snap, t.cfg, back)
+    if diff is not None:
+        ctx.pause_diffs.append(diff)
+        del ctx.pause_diffs[:-max(1, round(MEDIAN_S / t.cfg.algorithm.tick))]
+    if t.snap.time_s - ctx.pause_started_s < t.cfg.algorithm.standing_wait:
+        return stay(NO_MOTION)
+    if diff is not None and ctx.pause_diffs:
+        recent = ctx.pause_diffs  # the last MEDIAN_S of ticks that gave a figure
+        right, left = motion.pair(t.snap, back)
+        near = min(right.distance_m, left.distance_m)
+        disagree = abs(statistics.median(recent)) > standing_tolerance(
+            t.cfg, near, motion.DIFF_SMOOTHING, back)
+    if not disagree:
+        ctx.disagree_ticks = 0
+        return go(resume.phase, f"standing rule: {_pair_name(back)} agree again "
+                                f"({_readings(t, back)}): resuming {resume.label}")
+    ctx.disagree_ticks += 1
+    if ctx.disagree_ticks >= DEBOUNCE_TICKS:
+        return fail(f"standing rule: {_pair_name(back)} still disagree after "
+                    f"{t.cfg.algorithm.standing_wait:g} s ({_readings(t, back)}) in "
+                    f"{resume.label}")
+    return stay(NO_MOTION)
+
+
+PAUSED = PhaseDef(
+    Phase.PAUSED, "standing rule — readings disagree: stopped, waiting", "end", _paused,
+    # the resumes, back to every armed phase, are added by the transition table
+    to={Phase.ERROR: "readings still disagree after standing_wait; " + FAULT})
+
+DONE = PhaseDef(Phase.DONE, "end — program finished", "end", None)
+ERROR = PhaseDef(Phase.ERROR, "end — program ended with an error", "end", None)
+
+PHASES: tuple[PhaseDef, ...] = (PAUSED, DONE, ERROR)

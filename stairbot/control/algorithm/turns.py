@@ -1,0 +1,295 @@
+"""Calibration's turns on segment 2's wheels (segments 1 and 3 lifted): the
+squaring turn, case 3's probe and the corner, turning away (case 3B), and
+turning back to a heading (descent 1 and 7).  The rest of calibration, and
+the helpers both share: :mod:`~stairbot.control.algorithm.calibration`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.calibration import (
+    FLOW,
+    LANDING_PURPOSES,
+    LANDING_TURN_MARGIN_RAD,
+    MAX_AWAY_YAW_RAD,
+    MAX_SQUARE_YAW_RAD,
+    MAX_TURN_FLIPS,
+    MAX_TURN_YAW_RAD,
+    PROBE_TICKS,
+    PROBE_YAW_RAD,
+    STILL_TICKS,
+    TURN_MARGIN_RAD,
+    TURN_SLOW_FLOOR,
+    askew_rad,
+    mean_diff,
+    measured_standing,
+    one_riser,
+    readings,
+    settled,
+    trimmed_mean,
+)
+from stairbot.control.algorithm.phase import (
+    FAULT,
+    NO_MOTION,
+    PhaseDef,
+    Step,
+    Tick,
+    fail,
+    go,
+    stay,
+    where,
+)
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.perception import pair_tolerance, still_samples, still_tolerance
+from stairbot.hardware import MotorId
+
+P = Phase
+
+
+# -- turning ---------------------------------------------------------------------------
+def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
+    made = abs(t.snap.turns(MotorId.MWR) - t.ctx.turn_origin)
+    limit = MAX_TURN_YAW_RAD
+    if t.ctx.purpose in LANDING_PURPOSES:
+        limit += LANDING_TURN_MARGIN_RAD  # a landing's turn is 90° by the odometer
+    if motion.turn_yaw_rad(t.cfg, made) <= limit:
+        return None
+    return fail(f"calibration ({where(t.ctx, phase)}) turned "
+                f"{math.degrees(limit):.0f}° without finding SFR = SFL")
+
+
+def _turn_enter(t: Tick, w: Work) -> None:
+    r, l_ = motion.pair(t.snap)
+    sfr, sfl = r.distance_m, l_.distance_m
+    # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
+    w.turn_direction = 1 if sfl < sfr else -1
+    w.turn_diff = sfl - sfr
+    # Both beams on one riser, the difference says how far the robot is turned
+    # from square to it: the turn may make that and a margin, no more.
+    w.turn_from = t.snap.turns(MotorId.MWR)
+    if motion.far(r, t.cfg) or motion.far(l_, t.cfg):
+        # one beam off the flight's side: no figure, at most as askew as a
+        # calibration may stand
+        w.turn_limit_rad = MAX_SQUARE_YAW_RAD + TURN_MARGIN_RAD
+    else:
+        # the larger of what the standing mean the case was chosen on says and
+        # what the readings now say: one tick of a noisy pair (a Sharp pair at
+        # 0.36 m) can read nearly square where the mean said 16 deg askew
+        diff = max(abs(sfl - sfr), abs(t.ctx.case_diff or 0.0))
+        w.turn_limit_rad = askew_rad(t.cfg, diff) + TURN_MARGIN_RAD
+
+
+def _turned_past_limit(t: Tick, w: Work) -> Step | None:
+    made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
+    if made <= w.turn_limit_rad:
+        return None
+    return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned {math.degrees(made):.0f}° "
+                f"without finding SFR = SFL, more than the "
+                f"{math.degrees(w.turn_limit_rad):.0f}° its first readings allow: "
+                "not squaring up to something other than the riser")
+
+
+def _turn(t: Tick, w: Work) -> Step:
+    cfg = t.cfg
+    sfr, sfl = readings(t)
+    if w.checked:  # stopped at SFR = SFL: measuring standing still, once settled
+        if not settled(t, w):
+            return stay(NO_MOTION)
+        # as long as it takes to know the difference to within equal_tolerance
+        if not measured_standing(t, w, max(STILL_TICKS, still_samples(cfg, min(sfr, sfl)))):
+            return stay(NO_MOTION)
+        diff = mean_diff(t, w)
+        if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
+            t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} readings "
+                  f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
+                  diff=diff)
+            t.ctx.squaring_turns += 1
+            return go(P.CAL_LOWER)
+        # Not square yet: turn on, slowly, the way the difference says.
+        direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
+        if direction != w.turn_direction:
+            w.turn_flips += 1
+            if w.turn_flips > MAX_TURN_FLIPS:
+                return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned back and forth "
+                            f"{MAX_TURN_FLIPS} times without finding SFR = SFL: standing, "
+                            f"SFL − SFR reads {diff * 1000:+.1f} mm (SFR {sfr:.3f} m, SFL "
+                            f"{sfl:.3f} m); a beam may be off the flight's side, or one "
+                            "sensor reading long or short")
+        w.checked, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
+        w.turn_direction = direction
+        w.turn_diff = diff
+    w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
+    # Turning left closes SFL - SFR from below, turning right from above: stop
+    # when the smoothed difference has reached zero (or, with readings that
+    # no longer change, has decayed to a twentieth of their resolution), then
+    # check it standing still.
+    remaining = -w.turn_direction * w.turn_diff
+    if remaining <= cfg.sensors.resolution / 20:
+        w.checked = True
+        return stay(NO_MOTION)
+    too_far = _turned_too_far(t, P.CAL_TURN) or _turned_past_limit(t, w)
+    if too_far is not None:
+        return too_far
+    slow = min(1.0, max(TURN_SLOW_FLOOR, remaining / (2 * cfg.algorithm.equal_tolerance)))
+    return stay(motion.turn(w.turn_direction, cfg, slow))
+
+
+TURN = PhaseDef(
+    P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, enter=_turn_enter,
+    to={P.CAL_LOWER: "SFR = SFL",
+        P.ERROR: "turned too far, or more than its first readings allow; " + FAULT})
+
+
+def _probe_enter(t: Tick, w: Work) -> None:
+    w.probe_sfr, w.probe_sfl = readings(t)
+
+
+def _probe(t: Tick, w: Work) -> Step:
+    """Lifted, measure SFR and SFL standing still, then turn left and watch
+    how they change.  Both ends of the comparison are means: the start the
+    trimmed mean standing, now the mean of the last PROBE_TICKS ticks.  One
+    tick at each end would let a square VL53L1X pair's noise look like a
+    corner (SFR growing and SFL shrinking by millimetres against a start
+    reading long), and case 3B would turn far looking for a riser that is
+    ahead."""
+    ctx, cfg = t.ctx, t.cfg
+    if not w.checked:
+        if not settled(t, w) or not measured_standing(t, w, STILL_TICKS):
+            return stay(NO_MOTION)
+        if not w.standing:  # no tick gave both: now's readings, as the seed
+            w.standing.append(readings(t))
+        w.probe_sfr = trimmed_mean([r for r, _l in w.standing])
+        w.probe_sfl = trimmed_mean([l_ for _r, l_ in w.standing])
+        w.checked = True
+    r, l_ = motion.pair(t.snap)
+    both = r.ok and l_.ok and not motion.far(r, cfg) and not motion.far(l_, cfg)
+    if both:
+        w.probe_recent = [*w.probe_recent[-(PROBE_TICKS - 1):], (r.distance_m, l_.distance_m)]
+        sfr = sum(r_ for r_, _l in w.probe_recent) / len(w.probe_recent)
+        sfl = sum(l_ for _r, l_ in w.probe_recent) / len(w.probe_recent)
+    else:
+        # A beam off the riser (or past LENGTH_OF_INFINITY) is as large a
+        # change as there is: now's readings.  Waiting for ticks that see
+        # something, a robot well askew and far away would turn on until both
+        # beams read nothing, and square up to nothing.
+        sfr, sfl = readings(t)
+    # a corner is decided on a full window of means only
+    window_full = both and len(w.probe_recent) >= PROBE_TICKS
+    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
+    d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
+    # Half a resolution step off the readings' grid: whole-millimetre readings
+    # that sum to the threshold exactly must not be decided by float rounding
+    # (the simulation's and the wire's last bits differ).
+    tol = cfg.algorithm.equal_tolerance + cfg.sensors.resolution / 4
+    # A corner only if the changes exceed the pair's noise at the distance
+    # (pair_tolerance), not equal_tolerance alone; a corner's look within the
+    # noise is probed further, not decided.
+    corner_tol = max(tol, pair_tolerance(cfg, (w.probe_sfr + w.probe_sfl) / 2.0))
+    cornerish = d_sfr > 0 and d_sfl < 0
+    unsure = abs(d_sfr) + abs(d_sfl) < 2 * tol or (
+        cornerish and (not window_full or d_sfr - d_sfl < corner_tol))
+    if unsure and motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
+        return stay(motion.turn(1, cfg))
+    corner = cornerish and d_sfr - d_sfl >= corner_tol
+    ctx.calibration_case = "3B" if corner else "3A"
+    data = {"case": ctx.calibration_case, "dSFR": d_sfr, "dSFL": d_sfl}
+    if corner:
+        t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
+              f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
+        return go(P.CAL_CORNER)
+    t.say(f"calibration case 3A: square to the riser (turning left, SFR changed "
+          f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
+    return go(P.CAL_TURN)
+
+
+PROBE = PhaseDef(
+    P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe,
+    to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
+        P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
+
+
+def _corner(t: Tick, w: Work) -> Step:
+    sfr, _sfl = readings(t)
+    w.probe_sfr = max(w.probe_sfr, sfr)  # the largest SFR seen while turning
+    if sfr < w.probe_sfr - t.cfg.algorithm.equal_tolerance:
+        t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
+        return go(P.CAL_TURN)
+    too_far = _turned_too_far(t, P.CAL_CORNER)
+    if too_far is not None:
+        return too_far
+    return stay(motion.turn(1, t.cfg))
+
+
+CORNER = PhaseDef(
+    P.CAL_CORNER, "calibration case 3B — turn left until both readings shrink", FLOW, _corner,
+    enter=_probe_enter,
+    to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
+
+
+def _away_enter(t: Tick, w: Work) -> None:
+    sfr, sfl = readings(t)
+    # The nearer beam sees a side wall: turn away from it (left when SFR is
+    # the nearer), the opposite of case 2's rule, until it sees the riser.
+    w.turn_direction = 1 if sfr < sfl else -1
+    w.turn_diff = sfl - sfr
+    w.turn_from = t.snap.turns(MotorId.MWR)
+
+
+def _away(t: Tick, w: Work) -> Step:
+    """Off the wall, the beam that saw it reads the riser: the pair flips
+    (the other sensor is now the nearer, the robot still askew the same way)
+    and the squaring turn goes on in the same direction.  Askew by less than
+    the pair can tell, it flips and flips back as the robot passes square."""
+    cfg = t.cfg
+    r, l_ = motion.pair(t.snap)
+    sfr, sfl = r.distance_m, l_.distance_m
+    first = w.turn_direction  # the sign of SFL − SFR at the start
+    w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
+    d = w.turn_diff
+    seen = not motion.far(r, cfg) and not motion.far(l_, cfg)
+    flipped = d * first < 0
+    w.checked = w.checked or flipped
+    off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance
+    passed_square = w.checked and not flipped and abs(d) <= one_riser(cfg)
+    if seen and (off_wall or passed_square):
+        t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
+              "riser; squaring up", SFR=sfr, SFL=sfl)
+        return go(P.CAL_TURN)
+    made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
+    if made > MAX_AWAY_YAW_RAD:
+        return fail(f"calibration ({where(t.ctx, P.CAL_AWAY)}) turned "
+                    f"{math.degrees(MAX_AWAY_YAW_RAD):.0f}° away from the side wall and the "
+                    f"readings still do not fit one riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")
+    return stay(motion.turn(w.turn_direction, cfg))
+
+
+AWAY = PhaseDef(
+    P.CAL_AWAY, "calibration case 2W — turn away from the side wall until both see the riser",
+    FLOW, _away, enter=_away_enter,
+    to={P.CAL_TURN: "off the wall: the pair flipped (or flipped back, square)",
+        P.ERROR: "turned too far; " + FAULT})
+
+
+# -- turn back to a heading (descent 1 and 7) ------------------------------------------
+def _turn_to(t: Tick, w: Work) -> Step:
+    """Turn on segment 2's wheels until the odometer's heading is ctx.turn_to."""
+    assert t.ctx.turn_to is not None  # set by whoever lifted for this turn
+    remaining = t.ctx.turn_to - motion.twist(t.snap)
+    if abs(remaining) <= motion.WHEEL_DONE:
+        return go(P.CAL_LOWER)
+    too_far = _turned_too_far(t, P.CAL_TURN_TO)
+    if too_far is not None:
+        return too_far
+    slow = min(1.0, max(TURN_SLOW_FLOOR, abs(remaining) / motion.WHEEL_SLOW_ZONE))
+    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, slow))
+
+
+TURN_TO = PhaseDef(
+    P.CAL_TURN_TO, "calibration — turn by the odometer to a heading", FLOW,
+    _turn_to,
+    to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
+
+PHASES: tuple[PhaseDef, ...] = (PROBE, CORNER, AWAY, TURN, TURN_TO)

@@ -1,0 +1,94 @@
+"""What the controller knows of each kind of distance sensor: its datasheet's
+timing, noise and range.
+
+The robot config names the kind fitted on each pair (``[sensors]
+front_model``, ``back_model``).  Perception takes its tolerances from the
+stated noise and its staleness limit from the timing here; the simulation's
+sensor models (:mod:`stairbot.fakes.sensor_presets`) are built on the same
+figures, plus what only a simulation needs (the cone's rays, outlier and
+dropout rates).  Pure data: the core may import it.
+
+"Datasheet" figures are the maker's; "assumed" ones are ours.  The names must
+match :data:`stairbot.inputs.config.SensorModelName` (a test checks).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class SensorSpec:
+    """One kind of distance sensor, as its datasheet states it.  None: the
+    robot config's value (ranges, resolution) or its ``[sensors] noise``."""
+
+    name: str
+    period_s: float = 0.0
+    """Between measurements; 0: a new one at every read."""
+    latency_s: float = 0.0
+    """From a measurement to its publication."""
+    noise_a: float | None = None
+    """Stated sigma = noise_a + noise_b * distance (m)."""
+    noise_b: float = 0.0
+    resolution: float | None = None
+    min_range: float | None = None
+    max_range: float | None = None
+    fov_deg: float = 0.0
+    """Full angle of the cone as shipped (a ToF's ROI may narrow it: the robot
+    config's ``front_fov_deg`` / ``back_fov_deg``)."""
+    first_echo: bool = False
+    """It reports the nearest surface anywhere in its cone (an ultrasonic
+    ranger's first echo), not a mean over the cone."""
+
+    def sigma(self, distance_m: float, stated_noise: float) -> float:
+        """The stated sigma of a reading at ``distance_m``."""
+        a = stated_noise if self.noise_a is None else self.noise_a
+        return a + self.noise_b * max(0.0, distance_m)
+
+
+# Today's simulated sensor: one ray, measured at every read, the config's noise.
+IDEAL = SensorSpec(name="ideal")
+
+# ST VL53L1X time-of-flight ranger, long-distance mode.
+# - Datasheet DS12385, "Features": full field of view 27 degrees (the ROI on the
+#   receiving array narrows it); 4 cm to 4 m; up to 50 Hz.
+# - UM2356 (VL53L1X API) 2.5.2 "Timing budget and inter-measurement period":
+#   budget 33 ms minimum for all modes.  Here 50 ms budget = period, the result
+#   ready at its end (latency 50 ms); reported in mm.
+# - Noise: the datasheet's ranging error is about +-20 mm; assumed sigma =
+#   3 mm + 0.5 % of the distance (5 mm at 0.4 m, 18 mm at 3 m).
+VL53L1X = SensorSpec(name="vl53l1x", period_s=0.050, latency_s=0.050, noise_a=0.003,
+                     noise_b=0.005, resolution=0.001, min_range=0.04, max_range=4.0,
+                     fov_deg=27.0)
+
+# ST VL53L0X time-of-flight ranger, default mode.
+# - Datasheet DocID029104: up to 2 m; field of view 25 degrees; ranging
+#   profiles table: default mode 30 ms budget, 1.2 m.
+# - Accuracy about +-4 % indoors in default mode (read as 2 sigma): assumed
+#   sigma = 3 mm + 2 % of the distance.  Range in mm.  Minimum 3 cm (assumed:
+#   the accuracy tables start there).
+VL53L0X = SensorSpec(name="vl53l0x", period_s=0.030, latency_s=0.030, noise_a=0.003,
+                     noise_b=0.02, resolution=0.001, min_range=0.03, max_range=2.0,
+                     fov_deg=25.0)
+
+# HC-SR04 ultrasonic ranger.
+# - Datasheet (Elecfreaks/SparkFun), "Electric Parameter": 2 cm to 4 m,
+#   measuring angle 15 degrees; "we suggest to use over 60ms measurement
+#   cycle"; "ranging accuracy can reach to 3mm".
+# - Latency: the echo pulse lasts up to ~23 ms at 4 m: assumed 25 ms.
+# - Assumed sigma = 2 mm + 0.3 % of the distance.
+# - The first echo back ends the measurement: the nearest surface in the cone.
+HCSR04 = SensorSpec(name="hcsr04", period_s=0.060, latency_s=0.025, noise_a=0.002,
+                    noise_b=0.003, resolution=0.003, min_range=0.02, max_range=4.0,
+                    fov_deg=15.0, first_echo=True)
+
+# Sharp GP2Y0A21YK0F infrared triangulation ranger (analog output).
+# - Datasheet "Electro-optical Characteristics": 10 to 80 cm; "Timing chart":
+#   one measurement every 38.3 ms +- 9.6 ms, held until the next.
+# - Output roughly as 1/distance: assumed sigma = 1 mm + 2 % of the distance,
+#   read through an ADC to 1 mm.  A narrow spot: assumed a 4-degree cone.
+GP2Y0A21 = SensorSpec(name="gp2y0a21", period_s=0.0383, latency_s=0.0383, noise_a=0.001,
+                      noise_b=0.02, resolution=0.001, min_range=0.10, max_range=0.80,
+                      fov_deg=4.0)
+
+SPECS: dict[str, SensorSpec] = {s.name: s for s in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21)}
