@@ -174,7 +174,7 @@ def test_dask_local_listens_on_loopback_only(monkeypatch: pytest.MonkeyPatch) ->
 
 
 def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
-    root = Path(__file__).parents[2] / "stairbot" / "sweeps"
+    root = Path(__file__).parents[2] / "stairbot" / "inputs" / "sweeps"
     sizes = {}
     for path in sorted(root.glob("*.toml")):
         spec = parse_spec(path.read_text("utf-8"), str(path), root)
