@@ -38,6 +38,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import json
+import os
 import re
 import subprocess
 import sys
@@ -49,6 +50,7 @@ from pathlib import Path
 
 FAULTS = ("drop", "corrupt", "late", "duplicate")
 _groups = itertools.count(1)
+_PORT = 43000 + os.getpid() % 2000  # two soaks at once do not share a group and port
 
 
 @dataclass
@@ -84,7 +86,7 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
     boards paced at that many times real time."""
     t0 = time.monotonic()
     where = ["--serial"] if wire == "serial" else [
-        "--can", f"udp_multicast/239.74.164.{next(_groups) % 250 + 1}"]
+        "--can", f"udp_multicast/239.74.164.{next(_groups) % 250 + 1}?port={_PORT}"]
     pace = ["--lockstep"] if time_scale is None else ["--time-scale", f"{time_scale:g}"]
     mode = mode_name(time_scale)
     boards = subprocess.Popen(
