@@ -11,8 +11,11 @@ from __future__ import annotations
 
 import math
 import statistics
+from typing import Any
 
 from stairbot.control.algorithm import landing, limits, long_tread, motion
+from stairbot.control.algorithm.families import LiftFirst
+from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.moves import (
     KEY_TICKS,
     drive_phase,
@@ -25,12 +28,20 @@ from stairbot.control.algorithm.phase import (
     PhaseDef,
     Step,
     Tick,
+    calibrate,
     fail,
     go,
     stay,
 )
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import (
+    ApproachTurnsWork,
+    ApproachWork,
+    DriveWork,
+    LiftWork,
+    SightWork,
+    WaitWork,
+)
 from stairbot.hardware import MotorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
@@ -49,7 +60,7 @@ RISER_LOST_WAIT_S = 0.5
 is lost (an error) only if it still does after this long standing still."""
 
 
-def _approach(t: Tick, w: Work) -> Step:
+def _approach(t: Tick, w: ApproachWork) -> Step:
     cfg, ctx = t.cfg, t.ctx
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) or motion.far(sfl, cfg):
@@ -77,7 +88,7 @@ RISER_KEYS = 15
 (plus the odometer), once it has KEY_TICKS of them."""
 
 
-def _riser_ahead(t: Tick, w: Work) -> float:
+def _riser_ahead(t: Tick, w: ApproachWork) -> float:
     """How far the riser is: the median over the last RISER_KEYS ticks of
     the mean reading plus the odometer (``ctx.riser_wheel``), less the
     odometer now; the reading itself until KEY_TICKS ticks have measured it.
@@ -89,7 +100,7 @@ def _riser_ahead(t: Tick, w: Work) -> float:
     reading = motion.mean_distance(t.snap)
     here = motion.wheel_position(t.snap)
     if motion.measurable(t.snap, cfg):
-        keys = w.first_keys
+        keys = w.riser_keys
         keys.append(here + cfg.wheel_turns(reading))
         del keys[:-RISER_KEYS]
         if len(keys) >= KEY_TICKS:
@@ -100,12 +111,12 @@ def _riser_ahead(t: Tick, w: Work) -> float:
 
 APPROACH = PhaseDef(
     P.ASCENT_APPROACH, "ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", FLOW, _approach,
-    watches="front",
+    ApproachWork, watches="front",
     to={P.ASCENT_APPROACH_TURNS: "reads SAFE_DISTANCE_IN_FRONT_OF_STEP",
         P.ERROR: "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); " + FAULT})
 
 
-def _approach_turns_enter(t: Tick, w: Work) -> None:
+def _approach_turns_enter(t: Tick, w: ApproachTurnsWork) -> None:
     # From SAFE_DISTANCE_IN_FRONT_OF_STEP on, NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
     # more.  A robot that starts nearer (after ascent 9) drives only the rest.
     cfg = t.cfg
@@ -118,7 +129,7 @@ def _approach_turns_enter(t: Tick, w: Work) -> None:
         - cfg.wheel_turns(nearer)
 
 
-def _reckoned_riser(t: Tick, w: Work) -> float | None:
+def _reckoned_riser(t: Tick, w: ApproachTurnsWork) -> float | None:
     """How far the riser is by dead reckoning from where the approach's
     readings (or ascent 9's) put it, ``ctx.riser_wheel`` (the median of many
     ticks, where the reading now is one); when a front sensor reads "too
@@ -136,34 +147,38 @@ def _reckoned_riser(t: Tick, w: Work) -> float | None:
     return reckoned
 
 
-def _approach_turns(t: Tick, w: Work) -> Step:
+def _approach_turns(t: Tick, w: ApproachTurnsWork) -> Step:
     assert w.target_wheel is not None and w.start_reading is not None  # set on entry
     here = motion.wheel_position(t.snap)
     remaining = w.target_wheel - here
     if remaining <= motion.WHEEL_DONE:
         # The sensors read "too near" from here on: the gap is dead reckoned.
         driven = (here - w.entry_wheel) * t.cfg.wheel_circumference
-        t.ctx.riser_gap = max(0.0, w.start_reading - driven)
-        t.say(f"at the riser: {t.ctx.riser_gap:.3f} m from it", riser_gap=t.ctx.riser_gap)
-        return go(P.ASCENT_LIFT_FIRST)
+        gap = max(0.0, w.start_reading - driven)
+        t.say(f"at the riser: {gap:.3f} m from it", riser_gap=gap)
+        return go(P.ASCENT_LIFT_FIRST, begin=LiftFirst(riser_gap=gap))
     return stay(motion.drive(t.cfg, 1, remaining))
 
 
 APPROACH_TURNS = PhaseDef(
     P.ASCENT_APPROACH_TURNS, "ascent 2 — approach: NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH more",
-    FLOW, _approach_turns, enter=_approach_turns_enter, watches="front",
+    FLOW, _approach_turns, ApproachTurnsWork, enter=_approach_turns_enter, watches="front",
     to={P.ASCENT_LIFT_FIRST: "turns made", P.ERROR: FAULT})
 
 
 # -- ascent 3: lift segment 1 -------------------------------------------------------------
-def _lift_first_enter(t: Tick, w: Work) -> None:
+def _lf(t: Tick) -> LiftFirst:
+    return t.ctx.family_of(LiftFirst)
+
+
+def _lift_first_enter(t: Tick, w: LiftWork) -> None:
     ctx, cfg = t.ctx, t.cfg
-    ctx.return_mtf = w.entry_mtf
+    _lf(t).return_mtf = w.entry_mtf
     w.target_mtf = w.entry_mtf + cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
 
 
 def _gap(t: Tick) -> float:
-    gap = t.ctx.riser_gap
+    gap = _lf(t).riser_gap
     return t.cfg.algorithm.approach_gap if gap is None else gap
 
 
@@ -180,17 +195,17 @@ def tread_seen(t: Tick) -> float | None:
     return min(near) - gap if near else float("inf")
 
 
-def _lift_first(t: Tick, w: Work) -> Step:
+def _lift_first(t: Tick, w: LiftWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     if tread_seen(t) is not None:
         sfr, sfl = (r.distance_m for r in motion.pair(t.snap))
-        lifted = t.snap.turns(MotorId.MTF) - ctx.return_mtf
+        lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
         rise = lifted * cfg.motors.lift_travel_per_turn + cfg.sensors.front_height
         t.say(f"segment 1 sees over step {ctx.number_of_steps + 1} after {lifted:.1f} MTF turns "
               f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m", rise=rise)
         if rise >= limits.min_step_rise_m(cfg):
             return go(P.ASCENT_LIFT_FIRST_MORE)
-        ctx.ascent_end = "obstacle"
+        ctx.ascent_end = AscentEnd.OBSTACLE
         t.say(f"step {ctx.number_of_steps + 1} is too low to climb: rise about {rise:.3f} m < "
               f"{limits.min_step_rise_m(cfg):.3f} m (lifting on, the sensors could see past "
               "the next riser); the ascent ends (obstacle)", ascent_end="obstacle")
@@ -198,8 +213,8 @@ def _lift_first(t: Tick, w: Work) -> Step:
     assert w.target_mtf is not None
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
-        ctx.ascent_end = "obstacle"
-        ctx.wall_ahead = True
+        ctx.ascent_end = AscentEnd.OBSTACLE
+        _lf(t).wall_ahead = True
         allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
         t.say(f"step {ctx.number_of_steps + 1} too high: the front sensors did not see over "
               f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
@@ -209,8 +224,8 @@ def _lift_first(t: Tick, w: Work) -> Step:
 
 
 LIFT_FIRST = PhaseDef(
-    P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, enter=_lift_first_enter,
-    carried_by=(2, 3),
+    P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, LiftWork,
+    enter=_lift_first_enter, carried_by=(2, 3), family=LiftFirst,
     to={P.ASCENT_LIFT_FIRST_MORE: "sees over the riser (reads ≥ gap + SIGHT_JUMP_M)",
         P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
                                  "step too high; or sees over a rise < min_step_rise_m",
@@ -223,7 +238,7 @@ def narrow(cfg: RobotConfig, tread: float | None) -> bool:
     return tread is not None and tread < cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
 
 
-def _lifted_first(t: Tick, w: Work) -> Step:
+def _lifted_first(t: Tick, w: SightWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     need = limits.min_tread_m(cfg)
     # Measured over the second half of the lift, clear of the edge: at the
@@ -235,19 +250,19 @@ def _lifted_first(t: Tick, w: Work) -> Step:
     t.say(f"step {ctx.number_of_steps + 1}: {ahead} (the reading less {_gap(t):.3f} m to the "
           "riser)", tread=None if tread is None or tread == float("inf") else tread)
     if tread is not None and tread < need:
-        ctx.ascent_end = "obstacle"
+        ctx.ascent_end = AscentEnd.OBSTACLE
         t.say(f"the tread of step {ctx.number_of_steps + 1} is too short: {tread:.3f} m < "
               f"min_tread_m = {need:.3f} m; the ascent ends (obstacle)",
               ascent_end="obstacle")
         return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than min_tread_m")
-    lifted = t.snap.turns(MotorId.MTF) - ctx.return_mtf
+    lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
     rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
         + cfg.sensors.front_height
     if tread is not None and tread != float("inf") and rise < cfg.min_rise_for(tread) \
             and not _held(t, w, tread):
         # A cone looking up sees over the next riser (as high as this one, we
         # assume) this far away: the readings mix what lies beyond it.
-        ctx.ascent_end = "obstacle"
+        ctx.ascent_end = AscentEnd.OBSTACLE
         t.say(f"step {ctx.number_of_steps + 1} is too low for its tread: rise about {rise:.3f} "
               f"m < {cfg.min_rise_for(tread):.3f} m (the front cone's top, "
               f"{math.degrees(cfg.front_cone_top_rad):.1f}° up, would see over the next riser "
@@ -268,7 +283,7 @@ def _lifted_first(t: Tick, w: Work) -> Step:
     return go(P.ASCENT_DRIVE_FIRST)
 
 
-def _held(t: Tick, w: Work, tread: float) -> bool:
+def _held(t: Tick, w: SightWork, tread: float) -> bool:
     """A tread past FAR_TREAD_M whose rise is below min_rise_for: whether the
     pair's readings held as segment 1 rose (a wall, or a riser the cone
     sees whole: climbed), said either way
@@ -291,7 +306,7 @@ def _held(t: Tick, w: Work, tread: float) -> bool:
     return held
 
 
-def _sample_sight(t: Tick, w: Work) -> None:
+def _sample_sight(t: Tick, w: SightWork) -> None:
     """Over the lift past the sight-over, keep each front reading that still
     sees past the riser in ``w.rise_rows`` (the long tread's rule), and over
     its second half in ``w.sights`` too."""
@@ -305,7 +320,7 @@ def _sample_sight(t: Tick, w: Work) -> None:
                 w.sights[i].append(r.distance_m)
 
 
-def _sight_medians(t: Tick, w: Work) -> list[float | None]:
+def _sight_medians(t: Tick, w: SightWork) -> list[float | None]:
     """SFR's and SFL's readings past the riser: each one's median over the
     lift's second half where it has them, else its reading now; None for a
     sensor that reads nothing ahead now.  The median, not the mean: stray
@@ -321,7 +336,7 @@ def _sight_medians(t: Tick, w: Work) -> list[float | None]:
     return out
 
 
-def _tread_measured(t: Tick, w: Work) -> float | None:
+def _tread_measured(t: Tick, w: SightWork) -> float | None:
     """:func:`tread_seen` now, on :func:`_sight_medians`."""
     tread = tread_seen(t)
     if tread is None or tread == float("inf"):
@@ -333,14 +348,14 @@ _more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_verti
                                _lifted_first)
 
 
-def _more_step(t: Tick, w: Work) -> Step:
+def _more_step(t: Tick, w: SightWork) -> Step:
     _sample_sight(t, w)
     return _lift_more(t, w)
 
 
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
-    _more_step, enter=_more_enter, carried_by=(2, 3),
+    _more_step, SightWork, enter=_more_enter, carried_by=(2, 3), family=LiftFirst,
     to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ min_tread_m: "
                               "number_of_turns_for_step_height stored",
         P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < min_tread_m: "
@@ -350,8 +365,8 @@ LIFT_FIRST_MORE = PhaseDef(
         P.ERROR: FAULT})
 
 
-def _lowered_obstacle(t: Tick, _w: Work) -> Step:
-    if landing.can_scan(t):
+def _lowered_obstacle(t: Tick, _w: LiftWork) -> Step:
+    if landing.can_scan(t, _lf(t).wall_ahead):
         # a wall ahead at the top of a flight may be a landing's: look sideways first
         return go(P.LANDING_SCAN)
     if landing.turned_here(t):
@@ -361,10 +376,10 @@ def _lowered_obstacle(t: Tick, _w: Work) -> Step:
 
 
 _obstacle_enter, _obstacle_step = lift(
-    lambda t, w: {MotorId.MTF: t.ctx.return_mtf - w.entry_mtf}, _lowered_obstacle)
+    lambda t, w: {MotorId.MTF: _lf(t).return_mtf - w.entry_mtf}, _lowered_obstacle)
 LOWER_OBSTACLE = PhaseDef(
     P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
-    enter=_obstacle_enter, carried_by=(2, 3),
+    LiftWork, enter=_obstacle_enter, carried_by=(2, 3), family=LiftFirst,
     to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
         P.LANDING_SCAN: "lowered; number_of_steps > 0, [algorithm] landings and no landing "
                         "scanned yet: look sideways for the next flight",
@@ -374,7 +389,7 @@ LOWER_OBSTACLE = PhaseDef(
 
 
 # -- ascent 4-7: segment by segment onto the step -------------------------------------------
-def _measure_next_step(t: Tick, w: Work) -> None:
+def _measure_next_step(t: Tick, w: SightWork) -> None:
     """Ascent 4's "store the reading in length_of_next_step", on the pair's
     medians over ascent 3's last lift (:func:`_sight_medians`) rather than one
     reading: a Sharp's single reading at 0.35 m is 8 mm off one time in
@@ -423,7 +438,7 @@ def _h(t: Tick) -> float:
     return t.ctx.number_of_turns_for_step_height
 
 
-def _driven_first(t: Tick, _w: Work) -> Step:
+def _driven_first(t: Tick, _w: DriveWork) -> Step:
     # segment 3, in the air over the step below if that is narrow, has rolled on with the
     # robot onto the tread behind the riser just climbed: it carries again
     t.ctx.third_in_air = False
@@ -434,7 +449,7 @@ DRIVE_FIRST = drive_phase(
     P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, 1, _first_target,
     lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, P.ASCENT_LIFT_SECOND,
     "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns made); from a narrow "
-    "step, segment 3 on its tread again", _driven_first)
+    "step, segment 3 on its tread again", _driven_first, work=DriveWork)
 
 LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
@@ -444,10 +459,10 @@ DRIVE_SECOND = drive_phase(
     P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, 1, _second_target,
     lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE, P.ASCENT_LIFT_THIRD,
     "reads length_of_next_step − LENGTH_OF_FIRST_MODULE − LENGTH_OF_SECOND_MODULE "
-    "(or turns made)")
+    "(or turns made)", work=DriveWork)
 
 
-def _lifted_third(t: Tick, _w: Work) -> Step:
+def _lifted_third(t: Tick, _w: LiftWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps
     if motion.measurable(t.snap, cfg):
@@ -465,7 +480,7 @@ def _lifted_third(t: Tick, _w: Work) -> Step:
 
 _lift3 = lift(lambda t, _w: {MotorId.MTB: _h(t)}, _lifted_third)
 LIFT_THIRD = PhaseDef(
-    P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], enter=_lift3[0],
+    P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], LiftWork, enter=_lift3[0],
     watches="front", carried_by=(1, 2),
     to={P.ASCENT_CHECK: "turns made; tab_length_to_edge[i] stored, number_of_steps + 1",
         P.ERROR: FAULT})
@@ -477,11 +492,11 @@ TAB_WAIT_S = 1.0
 measurable while the pair does not read "nothing ahead" either."""
 
 
-def _check(t: Tick, w: Work) -> Step:
+def _check(t: Tick, w: WaitWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
-        ctx.ascent_end = "top_reached"
+        ctx.ascent_end = AscentEnd.TOP_REACHED
         t.say(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
               "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
         return go(P.DESCENT_LOWER_THIRD)
@@ -489,14 +504,14 @@ def _check(t: Tick, w: Work) -> Step:
     if tab is not None:
         return tab
     if ctx.number_of_steps >= cfg.algorithm.max_steps:
-        ctx.ascent_end = "step_limit"
+        ctx.ascent_end = AscentEnd.STEP_LIMIT
         t.say(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
               "the descent begins", ascent_end="step_limit")
         return go(P.DESCENT_LOWER_THIRD)
     return go(P.ASCENT_DRIVE_THIRD)
 
 
-def _tab_again(t: Tick, w: Work) -> Step | None:
+def _tab_again(t: Tick, w: WaitWork) -> Step | None:
     """Ascent 7 found no tab (one sensor at least read nothing ahead) and
     the pair does not read "nothing ahead" now: a riser about
     LENGTH_OF_INFINITY away, which one beam reaches and the other not.  The
@@ -529,31 +544,31 @@ def _tab_again(t: Tick, w: Work) -> Step | None:
 
 
 CHECK = PhaseDef(
-    P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, watches="front",
+    P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, WaitWork,
+    watches="front",
     to={P.DESCENT_LOWER_THIRD: "reads ≥ LENGTH_OF_INFINITY (top reached) "
                                "or number_of_steps = max_steps",
         P.ASCENT_DRIVE_THIRD: "otherwise",
         P.ERROR: FAULT})
 
 
-def _driven_third(t: Tick, w: Work) -> Step:
-    t.ctx.purpose = "ascent"
+def _driven_third(t: Tick, w: DriveWork) -> Step:
     t.ctx.riser_wheel = None
     t.ctx.third_in_air = narrow(t.cfg, t.ctx.tread_length[t.ctx.number_of_steps - 1])
     if w.target_reading is not None and not w.reading_lost and w.target_wheel is not None:
         # where the last readings put the riser: ascent 2 starts from it if
         # the sensors cannot read that near
         t.ctx.riser_wheel = w.target_wheel + t.cfg.wheel_turns(w.target_reading)
-    return go(P.CAL_CHECK)
+    return calibrate(Purpose.ASCENT)
 
 
 DRIVE_THIRD = drive_phase(
     P.ASCENT_DRIVE_THIRD, "ascent 9 — drive segment 3 onto the step", FLOW, 1, _third_target,
     lambda t: t.cfg.wheel_turns(t.cfg.LENGTH_OF_THIRD_MODULE), P.CAL_CHECK,
     "reads length_of_next_step − LENGTH_OF_A_ROBOT, on a narrow step SAFE_LENGTH + "
-    "approach_gap (or turns made): next step, ascent 1", _driven_third)
+    "approach_gap (or turns made): next step, ascent 1", _driven_third, work=DriveWork)
 
-PHASES: tuple[PhaseDef, ...] = (
+PHASES: tuple[PhaseDef[Any], ...] = (
     APPROACH, APPROACH_TURNS, LIFT_FIRST, LIFT_FIRST_MORE, LOWER_OBSTACLE, DRIVE_FIRST,
     LIFT_SECOND, DRIVE_SECOND, LIFT_THIRD, CHECK, DRIVE_THIRD,
 )

@@ -23,7 +23,9 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from stairbot.control.algorithm import calibration, motion, stability, standing
-from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.context import Context, Pause, Watch
+from stairbot.control.algorithm.families import Calibration, Family
+from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.control.algorithm.transitions import (
@@ -32,9 +34,9 @@ from stairbot.control.algorithm.transitions import (
     TransitionError,
     allowed,
 )
-from stairbot.control.algorithm.work import Work
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
+from stairbot.errors import InputError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
     BACK_SENSORS,
@@ -71,15 +73,15 @@ def phase_timeout_s(config: RobotConfig) -> float:
     turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
     return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
 
-OUTCOMES = ("completed", "stopped", "error")
+OUTCOMES = tuple(o.value for o in Outcome)
 
 
 @dataclass(frozen=True)
 class ControllerResult:
     """How the program ended (``outcome`` is "running" until it has)."""
 
-    outcome: str  # "completed" | "stopped" | "error" | "running"
-    ascent_end: str | None  # "top_reached" | "obstacle" | "step_limit" | None
+    outcome: str  # an Outcome's value, or "running"
+    ascent_end: str | None  # an AscentEnd's value, or None
     error: str | None
     steps_climbed: int
     steps_descended: int
@@ -109,11 +111,14 @@ class Controller:
         self.check_stability = check_stability
         self._sink = sink
         if context is None:
-            context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns)
+            context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns,
+                              family=Calibration(Purpose.START))
             if mode is Mode.DESCEND:  # on the top: no riser to square up to, the edge behind
                 context.from_top = True
-                context.purpose = "descent"
+                context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
+        elif context.phase_started_s is not None:
+            _check_restored(context)
         self._ctx = context
         self._started = context.phase_started_s is not None
         self._held: str | None = None
@@ -129,7 +134,7 @@ class Controller:
         self._sensor_since: float | None = None
         self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
         self._now_key: tuple[str, str | None] | None = None  # see _present
-        self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
+        self._now: tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]] | None = None
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -141,8 +146,8 @@ class Controller:
         """Where the program stands: the present phase's flow, or, while the
         standing rule waits, the flow of the phase it stopped in."""
         ctx = self._ctx
-        if ctx.phase == Phase.PAUSED.value and ctx.resume_phase is not None:
-            return BY_VALUE[ctx.resume_phase].flow
+        if ctx.phase == Phase.PAUSED.value and ctx.pause is not None:
+            return BY_VALUE[ctx.pause.resume_phase].flow
         return self.phase.flow
 
     @property
@@ -160,7 +165,9 @@ class Controller:
     @property
     def result(self) -> ControllerResult:
         ctx = self._ctx
-        return ControllerResult(ctx.outcome or "running", ctx.ascent_end, ctx.error,
+        return ControllerResult("running" if ctx.outcome is None else ctx.outcome.value,
+                                None if ctx.ascent_end is None else ctx.ascent_end.value,
+                                ctx.error,
                                 ctx.number_of_steps, ctx.steps_descended, ctx.pauses,
                                 ctx.end_reason)
 
@@ -180,15 +187,17 @@ class Controller:
         self._held = None
         self._emit(EventKind.INFO, "released: carrying on", self._time, {"held": False})
 
-    def abort(self, reason: str, outcome: str = "error") -> None:
-        """End the program now with ``outcome`` ("error" or "stopped"); every
-        later tick commands zero.  Outside the transition table on purpose: it
-        is the operator's (or the run loop's) decision, not the algorithm's."""
-        if outcome not in OUTCOMES:
+    def abort(self, reason: str, outcome: Outcome | str = Outcome.ERROR) -> None:
+        """End the program now with ``outcome`` (ERROR or STOPPED, or its
+        value); every later tick commands zero.  Outside the transition table
+        on purpose: it is the operator's (or the run loop's) decision, not the
+        algorithm's."""
+        if outcome not in OUTCOMES and not isinstance(outcome, Outcome):
             raise ValueError(f"outcome {outcome!r}; allowed: {', '.join(OUTCOMES)}")
         if self.finished:
             return
-        self._finish(Phase.ERROR if outcome == "error" else Phase.DONE, outcome, reason,
+        ends = Outcome(outcome)
+        self._finish(Phase.ERROR if ends is Outcome.ERROR else Phase.DONE, ends, reason,
                      self._time)
 
     # -- the tick ---------------------------------------------------------------------
@@ -239,7 +248,7 @@ class Controller:
         self._supervisor.commanded(speeds)
         return speeds
 
-    def _present(self) -> tuple[Phase, PhaseDef, tuple[SensorId, ...]]:
+    def _present(self) -> tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]]:
         """The present phase, its record and :func:`_needed_sensors`, looked up
         again only when the context's phase or the one a pause resumes changes."""
         ctx = self._ctx
@@ -332,41 +341,48 @@ class Controller:
         if not allowed(src, nxt):
             raise TransitionError(f"{src.value} -> {nxt.value} is not in the transition table")
         if nxt is Phase.ERROR:
-            self._finish(Phase.ERROR, "error", step.reason or "error", snap.time_s)
+            self._finish(Phase.ERROR, Outcome.ERROR, step.reason or "error", snap.time_s)
         elif nxt is Phase.DONE:
-            self._finish(Phase.DONE, step.outcome or "completed", step.reason or "done",
+            self._finish(Phase.DONE, step.outcome or Outcome.COMPLETED, step.reason or "done",
                          snap.time_s)
         elif nxt is Phase.PAUSED:
-            ctx.resume_phase = src.value
-            ctx.pause_started_s = snap.time_s
-            ctx.pause_diffs = []
+            ctx.pause = Pause(src.value, snap.time_s)
             ctx.pauses += 1
             self._emit(EventKind.PAUSE, step.reason or "paused", snap.time_s,
-                       {"resume_phase": ctx.resume_phase})
+                       {"resume_phase": ctx.pause.resume_phase})
             self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
         elif src is Phase.PAUSED:
-            assert ctx.pause_started_s is not None
+            assert ctx.pause is not None
             if ctx.phase_started_s is not None:
-                ctx.phase_started_s += snap.time_s - ctx.pause_started_s
-            ctx.resume_phase = ctx.pause_started_s = None
+                ctx.phase_started_s += snap.time_s - ctx.pause.started_s
+            ctx.pause = None
             self._emit(EventKind.RESUME, step.reason or "resumed", snap.time_s,
                        {"phase": nxt.value})
             self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
         else:
-            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap)
+            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap, begin=step.begin)
 
-    def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True) -> None:
+    def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True,
+               begin: Family | None = None) -> None:
         """Make ``phase`` the present one.  ``fresh``: a new start of the phase
-        (its timer, its work, its entry action); not fresh: the standing rule's
-        wait, or the phase it resumes."""
+        (its timer, its work, its family's state if it enters the family
+        (``begin``, or the family's defaults), its entry action); not fresh:
+        the standing rule's wait, or the phase it resumes."""
         ctx = self._ctx
         previous = ctx.phase
         ctx.phase = phase.value
-        ctx.disagree_ticks = 0
-        ctx.standing_diff = None
+        ctx.watch = Watch()
         if fresh:
+            record = phase.record
             ctx.phase_started_s = snap.time_s
-            ctx.work = Work.at_entry(snap)
+            ctx.work = record.work.at_entry(snap)
+            if begin is not None:
+                assert record.family is not None and isinstance(begin, record.family), begin
+                ctx.family = begin
+            elif record.family is None:
+                ctx.family = None
+            elif type(ctx.family) is not record.family:
+                ctx.family = record.family()
         note = where(ctx, phase)
         where_text = f" ({note})" if note else ""
         resumed = "" if fresh or phase is Phase.PAUSED else " (resumed)"
@@ -378,26 +394,26 @@ class Controller:
     def _say(self, message: str, **data: Any) -> None:
         self._emit(EventKind.INFO, message, self._time, data)
 
-    def _finish(self, phase: Phase, outcome: str, reason: str, time_s: float) -> None:
+    def _finish(self, phase: Phase, outcome: Outcome, reason: str, time_s: float) -> None:
         ctx = self._ctx
         previous = ctx.phase
         ctx.outcome = outcome
         ctx.end_reason = reason
         ctx.phase = phase.value
-        if outcome == "error":
+        if outcome is Outcome.ERROR:
             ctx.error = reason
             self._emit(EventKind.ERROR, reason, time_s, {"from": previous})
         self._emit(EventKind.PHASE, phase.label, time_s,
                    {"phase": phase.value, "flow": phase.flow, "from": previous, "why": reason})
-        self._emit(EventKind.END, f"program ended ({outcome}): {reason}", time_s,
+        self._emit(EventKind.END, f"program ended ({outcome.value}): {reason}", time_s,
                    self.result.to_dict())
 
     def _shift_timers(self, delta: float) -> None:
         ctx = self._ctx
         if ctx.phase_started_s is not None:
             ctx.phase_started_s += delta
-        if ctx.pause_started_s is not None:
-            ctx.pause_started_s += delta
+        if ctx.pause is not None:
+            ctx.pause.started_s += delta
 
 
     def _emit(self, kind: EventKind, message: str, time_s: float,
@@ -406,11 +422,29 @@ class Controller:
         self._sink(Event(time_s, kind, message, phase, data))
 
 
+def _check_restored(ctx: Context) -> None:
+    """A restored context's work and family are the present phase's kinds
+    (while the standing rule waits, the phase it resumes); InputError naming
+    the key when not."""
+    phase = BY_VALUE[ctx.phase]
+    if phase is _PAUSED and ctx.pause is not None:
+        phase = BY_VALUE[ctx.pause.resume_phase]
+    if phase.terminal:
+        return
+    record = phase.record
+    if type(ctx.work) is not record.work:
+        raise InputError("context", "work.kind", f"{ctx.work.KIND} is not the work of "
+                         f"{phase.value} ({record.work.KIND})")
+    if record.family is not None and type(ctx.family) is not record.family:
+        raise InputError("context", "family.kind", f"{type(ctx.family).__name__} is not the "
+                         f"family of {phase.value} ({record.family.__name__})")
+
+
 def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     """The sensors whose ERROR status (errors, or stale) stands the robot in
     ``phase``, and ends the program if it lasts."""
-    if phase is _PAUSED and ctx.resume_phase is not None:
-        phase = Phase(ctx.resume_phase)
+    if phase is _PAUSED and ctx.pause is not None:
+        phase = Phase(ctx.pause.resume_phase)
     if phase.terminal:
         return ()
     if ctx.from_top and phase.flow != "ascent":

@@ -12,6 +12,7 @@ counts.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from stairbot.control.algorithm import landing, long_tread, motion
 from stairbot.control.algorithm.ascent import narrow
@@ -23,6 +24,8 @@ from stairbot.control.algorithm.edge import (
     narrow_bound,
     refind,
 )
+from stairbot.control.algorithm.families import LowerThird
+from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.moves import (
     checked_first,
     drive_phase,
@@ -36,6 +39,7 @@ from stairbot.control.algorithm.phase import (
     PhaseDef,
     Step,
     Tick,
+    calibrate,
     end,
     fail,
     go,
@@ -43,7 +47,13 @@ from stairbot.control.algorithm.phase import (
     where,
 )
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import (
+    DriveWork,
+    EdgeWork,
+    LiftWork,
+    LowerThirdWork,
+    RefuseWork,
+)
 from stairbot.hardware import BACK_SENSORS, MotorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
@@ -75,8 +85,7 @@ def _narrow(t: Tick, index: int | None = None) -> bool:
 
 
 # -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
-def _backed_off(t: Tick, w: Work) -> Step:
-    t.ctx.purpose = "descent"
+def _backed_off(t: Tick, w: EdgeWork) -> Step:
     if w.edge_stop is not None:
         return fail(w.edge_stop)
     if w.square_yaw is not None:
@@ -86,12 +95,12 @@ def _backed_off(t: Tick, w: Work) -> Step:
         # faces risers the robot did not climb, and one too low for its cone
         # reads as nothing ahead, which calibration takes for case 1
         return go(P.DESCENT_BACK_TO_EDGE)
-    return go(P.CAL_CHECK)
+    return calibrate(Purpose.DESCENT)
 
 
-def _back_off_enter(t: Tick, w: Work) -> None:
-    t.ctx.edge_wheel = None  # a new step: its edge not seen yet, nor turned back
-    t.ctx.turned_back = t.ctx.edge_squared = False
+def _back_off_enter(t: Tick, w: EdgeWork) -> None:
+    t.ctx.descent.edge_wheel = None  # a new step: its edge not seen yet, nor turned back
+    t.ctx.descent.turned_back = t.ctx.descent.edge_squared = False
     _back_off_drive[0](t, w)
 
 
@@ -104,7 +113,7 @@ def _back_off_target(t: Tick) -> float | None:
     return _tab(t) if _narrow(t) else None
 
 
-def _edge_or_tab(t: Tick, w: Work, refind: bool) -> float | None:
+def _edge_or_tab(t: Tick, w: EdgeWork, refind: bool) -> float | None:
     """The edge watch's bound (:func:`~stairbot.control.algorithm.edge.edge_bound`);
     on a narrow step, the tab read on the way up places the robot (the back
     pair is over the step below, segment 3 in the air), bounded by
@@ -118,7 +127,7 @@ def _edge_or_tab(t: Tick, w: Work, refind: bool) -> float | None:
     return max(limit, w.target_wheel)
 
 
-def _narrow_tab_known(t: Tick, _w: Work) -> Step | None:
+def _narrow_tab_known(t: Tick, _w: EdgeWork) -> Step | None:
     if _narrow(t) and _tab(t) is None:
         return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured on "
                     "a narrow step: the robot cannot be placed on a tread it does not fit on")
@@ -141,7 +150,7 @@ _back_off_drive = reading_drive(-1, _back_off_target, _back_off_turns,
                                 _backed_off, lambda t, w: _edge_or_tab(t, w, refind=False))
 BACK_OFF = PhaseDef(
     P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW,
-    checked_first(_narrow_tab_known, _back_off_drive[1]),
+    checked_first(_narrow_tab_known, _back_off_drive[1]), EdgeWork,
     enter=_back_off_enter, watches="front",
     to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
                      "edge; on a narrow step, reads tab_length_to_edge[i]: calibrate "
@@ -201,7 +210,7 @@ def _edge_fallback(t: Tick) -> float:
 # way up where segment 3 was lifted over the edge, can leave segment 3's
 # front wheels on the edge's corner, and lowered there segment 3 stays up
 # while the lift pitches the robot.
-def _at_edge(t: Tick, w: Work) -> Step:
+def _at_edge(t: Tick, w: EdgeWork) -> Step:
     """Backed up to the edge.  In a continuous descent, backing the whole
     search without seeing an edge is the floor.  (Its tab_length_to_edge stay
     unknown, and descent 3 and 5 go by the seed's turn counts: the front pair
@@ -211,17 +220,17 @@ def _at_edge(t: Tick, w: Work) -> Step:
     the edge, would pitch the robot nose up.)"""
     ctx = t.ctx
     searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
-    if not ctx.from_top and ctx.edge_wheel is None and _edge_by_watch(t):
+    if not ctx.from_top and ctx.descent.edge_wheel is None and _edge_by_watch(t):
         return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured, and "
                     f"SBR/SBL saw no edge backing {searched:.2f} m (the tread measured, or "
                     "LENGTH_OF_INFINITY): the edge of the step cannot be found")
-    if not ctx.from_top or ctx.edge_wheel is not None:
+    if not ctx.from_top or ctx.descent.edge_wheel is not None:
         return go(P.DESCENT_LOWER_THIRD)
     if ctx.steps_descended == 0:
-        return end("stopped", f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
+        return end(Outcome.STOPPED, f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
                               f"backing from the start (at most LENGTH_OF_INFINITY = "
                               f"{t.cfg.LENGTH_OF_INFINITY} m): not on the top of a flight")
-    return end("completed", f"on the floor, or a landing: no edge within {searched:.2f} m "
+    return end(Outcome.COMPLETED, f"on the floor, or a landing: no edge within {searched:.2f} m "
                             f"behind step {ctx.steps_descended} from the top, the last "
                             "descended")
 
@@ -230,7 +239,7 @@ _to_edge = reading_drive(-1, _tab, _edge_fallback, _at_edge,
                          lambda t, w: _edge_or_tab(t, w, refind=True), exact=True)
 
 
-def _to_edge_step(t: Tick, w: Work) -> Step:
+def _to_edge_step(t: Tick, w: EdgeWork) -> Step:
     if w.refind_from is None:
         step = _to_edge[1](t, w)
         if w.edge_stop is not None:
@@ -244,21 +253,19 @@ def _to_edge_step(t: Tick, w: Work) -> Step:
     return refind(t, w)
 
 
-def _turn_square(t: Tick, w: Work) -> Step:
+def _turn_square(t: Tick, w: EdgeWork) -> Step:
     """Lift segments 1 and 3 and turn on segment 2's wheels by the odometer
     (calibration's turn to a heading), square to the edge; then back up to
     it again, finding the floor first (the pair is past the edge now)."""
-    ctx = t.ctx
     assert w.square_yaw is not None
-    ctx.edge_squared = True
-    ctx.turn_to = motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw)
-    ctx.purpose = "edge"
-    return go(P.CAL_LIFT, f"turning {math.degrees(w.square_yaw):+.1f}° square to the edge")
+    t.ctx.descent.edge_squared = True
+    return calibrate(Purpose.EDGE, motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw),
+                     f"turning {math.degrees(w.square_yaw):+.1f}° square to the edge")
 
 
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
-    _to_edge_step, enter=_to_edge[0], watches="front",
+    _to_edge_step, EdgeWork, enter=_to_edge[0], watches="front",
     to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
                                 "edge (driving forward first until they read the floor, "
                                 "if they were past it unseen); or, not crossed yet, reads "
@@ -275,12 +282,16 @@ BACK_TO_EDGE = PhaseDef(
 
 
 # -- descent 2: lower segment 3 until the back sensors find the step below ------------------------
-def _lower_third_enter(t: Tick, w: Work) -> None:
-    t.ctx.return_mtb = w.entry_mtb
+def _lt(t: Tick) -> LowerThird:
+    return t.ctx.family_of(LowerThird)
+
+
+def _lower_third_enter(t: Tick, w: LowerThirdWork) -> None:
+    _lt(t).return_mtb = w.entry_mtb
     w.target_mtb = -t.cfg.MAX_OF_VERTICAL_TURNS
 
 
-def _over_an_edge(t: Tick, _w: Work) -> Step | None:
+def _over_an_edge(t: Tick, _w: LowerThirdWork) -> Step | None:
     cfg = t.cfg
     reading = motion.mean_distance(t.snap, back=True)
     if reading <= cfg.BACK_CLEARANCE + floor_tolerance(cfg):
@@ -293,7 +304,7 @@ def _over_an_edge(t: Tick, _w: Work) -> Step | None:
 def _refuse_because(t: Tick, why: str) -> Step:
     """Refuse the drop below (``why`` is said, and kept for the end)."""
     t.say(why)
-    t.ctx.end_reason = why
+    _lt(t).refused = why
     return go(P.DESCENT_REFUSE, why)
 
 
@@ -303,7 +314,7 @@ def lowerable_m(cfg: RobotConfig, mtb: float) -> float:
     return max(0.0, cfg.MAX_OF_VERTICAL_TURNS + mtb) * cfg.motors.lift_travel_per_turn
 
 
-def _deep_drop(t: Tick, w: Work) -> Step | None:
+def _deep_drop(t: Tick, w: LowerThirdWork) -> Step | None:
     """Continuous descent: a drop below the edge deeper than segment 3 can be
     lowered (SBR/SBL read the step below further than that past
     BACK_CLEARANCE, or nothing within their range when the range is beyond
@@ -345,7 +356,7 @@ def _floor_not_found(t: Tick, reading: float) -> Step:
                 f"still read {reading:.3f} m")
 
 
-def _lower_third(t: Tick, w: Work) -> Step:
+def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     reading = motion.mean_distance(t.snap, back=True)
     to_go = reading - cfg.BACK_CLEARANCE
@@ -364,9 +375,9 @@ def _lower_third(t: Tick, w: Work) -> Step:
         finish = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
         if finish is not None:
             return stay({MotorId.MTB: finish})
-        ctx.number_of_turns_for_step_height = ctx.return_mtb - t.snap.turns(MotorId.MTB)
+        ctx.number_of_turns_for_step_height = _lt(t).return_mtb - t.snap.turns(MotorId.MTB)
         ctx.third_in_air = False  # on the step below
-        ctx.narrow_edge_wheel = None  # the next edge's, if narrow, is watched for
+        ctx.descent.narrow_edge_wheel = None  # the next edge's, if narrow, is watched for
         t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
               f"{ctx.number_of_turns_for_step_height:.2f} ({where(ctx, P.DESCENT_LOWER_THIRD)})",
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
@@ -386,7 +397,8 @@ def _lower_third(t: Tick, w: Work) -> Step:
 LOWER_THIRD = PhaseDef(
     P.DESCENT_LOWER_THIRD, "descent 2 — lower segment 3", FLOW,
     checked_first(lambda t, w: _over_an_edge(t, w) or _deep_drop(t, w), _lower_third),
-    enter=_lower_third_enter, watches="back", carried_by=(1, 2),
+    LowerThirdWork,
+    enter=_lower_third_enter, watches="back", carried_by=(1, 2), family=LowerThird,
     to={P.DESCENT_DRIVE_SECOND: "SBR/SBL read BACK_CLEARANCE: "
                                 "number_of_turns_for_step_height stored",
         P.DESCENT_REFUSE: "continuous descent: SBR/SBL read a drop deeper than segment 3 "
@@ -402,11 +414,11 @@ RETREAT_MARGIN_M = 0.03
 the back pair crossed the edge: segment 3 wholly on the step again."""
 
 
-def _refuse_enter(t: Tick, w: Work) -> None:
-    w.target_mtb = t.ctx.return_mtb  # where descent 2 began lowering
+def _refuse_enter(t: Tick, w: RefuseWork) -> None:
+    w.target_mtb = _lt(t).return_mtb  # where descent 2 began lowering
 
 
-def _refuse(t: Tick, w: Work) -> Step:
+def _refuse(t: Tick, w: RefuseWork) -> Step:
     cfg = t.cfg
     speeds = motion.lifts_to(cfg, t.snap, w.lift_targets())
     if speeds is not None:
@@ -416,14 +428,14 @@ def _refuse(t: Tick, w: Work) -> Step:
         w.target_wheel = here + cfg.wheel_turns(edge_clearance_m(cfg) + RETREAT_MARGIN_M)
     remaining = w.target_wheel - here
     if remaining <= motion.WHEEL_DONE:
-        why = t.ctx.end_reason or f"refused the drop below step {t.ctx.steps_descended + 1}"
-        return end("stopped", f"{why}; segment 3 raised again, the robot back on the step")
+        why = _lt(t).refused or f"refused the drop below step {t.ctx.steps_descended + 1}"
+        return end(Outcome.STOPPED, f"{why}; segment 3 raised again, the robot back on the step")
     return stay(motion.drive(cfg, 1, remaining))
 
 
 REFUSE = PhaseDef(
     P.DESCENT_REFUSE, "descent 2 — refused: raise segment 3, drive back onto the step", FLOW,
-    _refuse, enter=_refuse_enter, carried_by=(1, 2),
+    _refuse, RefuseWork, enter=_refuse_enter, carried_by=(1, 2), family=LowerThird,
     to={P.DONE: "segment 3 raised to where descent 2 began, and driven forward "
                 "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step (stopped)",
         P.ERROR: FAULT})
@@ -482,14 +494,14 @@ DRIVE_SECOND = drive_phase(
     P.DESCENT_DRIVE_SECOND, "descent 3 — drive segment 2 off the step", FLOW, -1,
     _second_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE,
     P.DESCENT_LOWER_SECOND, "reads LENGTH_OF_SECOND_MODULE + tab_length_to_edge[i] "
-    "(or turns made)")
+    "(or turns made)", work=DriveWork)
 
 LOWER_SECOND = lift_phase(
     P.DESCENT_LOWER_SECOND, "descent 4 — lower segment 2", FLOW,
     lambda t, _w: {MotorId.MTF: _h(t), MotorId.MTB: _h(t)}, P.DESCENT_DRIVE_FIRST, (1, 3))
 
 
-def _first_bound(t: Tick, w: Work) -> float | None:
+def _first_bound(t: Tick, w: EdgeWork) -> float | None:
     """Descent 5 onto a narrow tread: watch its edge go by
     (:func:`~stairbot.control.algorithm.edge.narrow_bound`); the drive's own target
     is not bounded."""
@@ -498,7 +510,7 @@ def _first_bound(t: Tick, w: Work) -> float | None:
     return None
 
 
-def _driven_first(t: Tick, _w: Work) -> Step:
+def _driven_first(t: Tick, _w: EdgeWork) -> Step:
     # on a narrow tread below, segment 3 has backed off its edge: in the air over the next
     t.ctx.third_in_air = _narrow(t, t.descent_index - 1)
     return go(P.DESCENT_LOWER_FIRST)
@@ -509,10 +521,10 @@ DRIVE_FIRST = drive_phase(
     _first_target, lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE,
     P.DESCENT_LOWER_FIRST, "reads LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE + "
     "tab_length_to_edge[i] (or turns made); onto a narrow tread, segment 3 is in the air now",
-    _driven_first, _first_bound)
+    _driven_first, _first_bound, work=EdgeWork)
 
 
-def _lowered_first(t: Tick, _w: Work) -> Step:
+def _lowered_first(t: Tick, _w: LiftWork) -> Step:
     ctx = t.ctx
     ctx.steps_descended += 1
     if ctx.from_top:
@@ -525,13 +537,14 @@ def _lowered_first(t: Tick, _w: Work) -> Step:
         return go(P.LANDING_RETURN)
     if ctx.steps_descended < ctx.number_of_steps:
         return go(P.DESCENT_BACK_OFF)
-    ctx.turned_back = False  # descent 7 turns back to the floor's heading once
+    ctx.descent.turned_back = False  # descent 7 turns back to the floor's heading once
     return go(P.DESCENT_FINISH)
 
 
 _lower1 = lift(lambda t, _w: {MotorId.MTF: -_h(t)}, _lowered_first)
 LOWER_FIRST = PhaseDef(
-    P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], enter=_lower1[0],
+    P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], LiftWork,
+    enter=_lower1[0],
     carried_by=(2, 3),
     to={P.DESCENT_BACK_OFF: "turns made; steps remain (a continuous descent: always)",
         P.LANDING_RETURN: "turns made; down the first step of the flight after a landing's "
@@ -544,7 +557,7 @@ def _on_the_floor_all_along(t: Tick) -> bool:
     """No step was climbed: the wheels drove only on the floor, and their
     odometer knows the way back better than a reading of stairs it refused
     (a cone may see over low risers there)."""
-    return t.ctx.number_of_steps == 0 and t.ctx.start_wheel is not None
+    return t.ctx.number_of_steps == 0 and t.ctx.start.wheel is not None
 
 
 def _finish_turns(t: Tick) -> float:
@@ -554,39 +567,37 @@ def _finish_turns(t: Tick) -> float:
     NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, within which a pair that reads
     only from 10 cm (a Sharp) may not yet measure, which would stop the
     robot 0.4 m short."""
-    ctx, cfg = t.ctx, t.cfg
+    start, cfg = t.ctx.start, t.cfg
     if _on_the_floor_all_along(t):
-        assert ctx.start_wheel is not None
-        return max(0.0, motion.wheel_position(t.snap) - ctx.start_wheel)
-    if ctx.start_reading is None:
+        assert start.wheel is not None
+        return max(0.0, motion.wheel_position(t.snap) - start.wheel)
+    if start.reading is None:
         return cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
-    return cfg.wheel_turns(max(0.0, ctx.start_reading - cfg.algorithm.approach_gap))
+    return cfg.wheel_turns(max(0.0, start.reading - cfg.algorithm.approach_gap))
 
 
 def _closed_in_turns(t: Tick) -> float:
     """How far the first calibration closed in before it squared up (turns)."""
-    ctx = t.ctx
-    if ctx.start_wheel is None or ctx.home_wheel is None:
+    start = t.ctx.start
+    if start.wheel is None or start.home_wheel is None:
         return 0.0
-    return max(0.0, ctx.start_wheel - ctx.home_wheel)
+    return max(0.0, start.wheel - start.home_wheel)
 
 
-def _at_start_position(t: Tick, _w: Work) -> Step:
+def _at_start_position(t: Tick, _w: DriveWork) -> Step:
     """At the start position (where the first calibration squared up).  If it
     closed in first, the way home retraces it: turn back to the heading the
     program began with (segments 1 and 3 lifted, as calibration turns), then
     back the distance."""
-    ctx = t.ctx
+    home_twist = t.ctx.start.home_twist
     if _closed_in_turns(t) <= motion.WHEEL_DONE:
-        return end("completed", "back at the start position")
-    if ctx.home_twist is None or abs(heading_off_rad(t, ctx.home_twist)) <= HEADING_TOLERANCE_RAD:
+        return end(Outcome.COMPLETED, "back at the start position")
+    if home_twist is None or abs(heading_off_rad(t, home_twist)) <= HEADING_TOLERANCE_RAD:
         return go(P.DESCENT_FINISH_FLOOR)
-    ctx.purpose = "home"
-    ctx.turn_to = ctx.home_twist
-    return go(P.CAL_LIFT)
+    return calibrate(Purpose.HOME, home_twist)
 
 
-def _floor_heading(t: Tick, _w: Work) -> Step | None:
+def _floor_heading(t: Tick, _w: DriveWork) -> Step | None:
     """Before backing to the start position: turn back (once) to the heading
     the robot crossed the floor with, where the first calibration left it
     (climb_twist[0]), if the odometer says it is further off than
@@ -596,24 +607,22 @@ def _floor_heading(t: Tick, _w: Work) -> Step | None:
     heading would put the robot centimetres to the side of it."""
     ctx = t.ctx
     floor = ctx.climb_twist[0]
-    if ctx.turned_back or floor is None:
+    if ctx.descent.turned_back or floor is None:
         return None
-    ctx.turned_back = True
+    ctx.descent.turned_back = True
     off = heading_off_rad(t, floor)
     if abs(off) <= HEADING_TOLERANCE_RAD:
         return None
-    ctx.purpose = "floor"
-    ctx.turn_to = floor
     t.say(f"descent 7: turned {math.degrees(off):+.2f}° from the heading it crossed the floor "
           "with (by the odometer); turning back to it", off_deg=math.degrees(off))
-    return go(P.CAL_LIFT)
+    return calibrate(Purpose.FLOOR, floor)
 
 
-_finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start_reading,
+_finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start.reading,
                         _finish_turns, _at_start_position)
 FINISH = PhaseDef(
     P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW,
-    checked_first(_floor_heading, _finish[1]), enter=_finish[0], watches="front",
+    checked_first(_floor_heading, _finish[1]), DriveWork, enter=_finish[0], watches="front",
     to={P.DONE: "reads the start reading (or turns made; with no step climbed: back by the "
                 "odometer to the start position)",
         P.CAL_LIFT: "turned from the heading it crossed the floor with: lift to turn back to "
@@ -625,13 +634,13 @@ FINISH = PhaseDef(
 
 
 _floor = turns_drive(-1, _closed_in_turns,
-                     lambda _t, _w: end("completed", "back where the program began"))
+                     lambda _t, _w: end(Outcome.COMPLETED, "back where the program began"))
 FINISH_FLOOR = PhaseDef(
     P.DESCENT_FINISH_FLOOR, "descent 7 — finish: back the distance calibration closed in",
-    FLOW, _floor[1], enter=_floor[0],
+    FLOW, _floor[1], DriveWork, enter=_floor[0],
     to={P.DONE: "turns made: where the program began", P.ERROR: FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (
+PHASES: tuple[PhaseDef[Any], ...] = (
     BACK_OFF, BACK_TO_EDGE, LOWER_THIRD, REFUSE, DRIVE_SECOND, LOWER_SECOND, DRIVE_FIRST,
     LOWER_FIRST, FINISH, FINISH_FLOOR,
 )

@@ -14,7 +14,7 @@ step 1 on later steps, descent step 1); the context says which.
 from __future__ import annotations
 
 from enum import Enum
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from stairbot.control.algorithm.phase import PhaseDef
@@ -79,7 +79,7 @@ class Phase(Enum):
     ERROR = "error"
 
     @property
-    def record(self) -> PhaseDef:
+    def record(self) -> PhaseDef[Any]:
         """The phase's record: seed name, flow, entry action, step, transitions."""
         return _records()[self]
 
@@ -102,10 +102,10 @@ class Phase(Enum):
         return self.label
 
 
-_RECORDS: dict[Phase, PhaseDef] = {}
+_RECORDS: dict[Phase, PhaseDef[Any]] = {}
 
 
-def _records() -> dict[Phase, PhaseDef]:
+def _records() -> dict[Phase, PhaseDef[Any]]:
     # The records live with their flows (calibration.py, turns.py, ascent.py...), which
     # import this module: they are gathered on first use.
     if not _RECORDS:

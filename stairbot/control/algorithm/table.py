@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
+from typing import Any
 
 from stairbot.control.algorithm import ascent, calibration, descent, landing, standing, turns
 from stairbot.control.algorithm.phase import PhaseDef
 from stairbot.control.algorithm.phases import Phase
 
-PHASES: Mapping[Phase, PhaseDef] = MappingProxyType(
+PHASES: Mapping[Phase, PhaseDef[Any]] = MappingProxyType(
     {d.phase: d for d in (*calibration.PHASES, *turns.PHASES, *ascent.PHASES, *descent.PHASES,
                            *landing.PHASES, *standing.PHASES)}
 )
