@@ -9,13 +9,13 @@ from dataclasses import replace
 import pytest
 
 from stairbot.control.algorithm import phases
-from stairbot.control.algorithm.calibration import STILL_TICKS
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import CalibrationCase
 from stairbot.control.algorithm.phase import Step, Tick, go
 from stairbot.control.algorithm.phases import FLOWS, Mode, Phase
+from stairbot.control.algorithm.squaring import STILL_TICKS
 from stairbot.control.algorithm.transitions import (
     BACK_PAIR_PHASES,
     STANDING_ARMED,
@@ -25,8 +25,8 @@ from stairbot.control.algorithm.transitions import (
     mermaid,
 )
 from stairbot.control.algorithm.work import StandingWork
-from stairbot.control.perception import settle_s
 from stairbot.control.robot_config import load_config
+from stairbot.control.tolerances import settle_s
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for

@@ -18,29 +18,31 @@ The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import asdict, dataclass
 from typing import Any
 
-from stairbot.control.algorithm import calibration, motion, stability, standing
+from stairbot.control.algorithm import motion, stability, standing
 from stairbot.control.algorithm.context import Context, Pause, Watch
 from stairbot.control.algorithm.families import Calibration, Family
+from stairbot.control.algorithm.guards import (
+    SENSOR_WAIT_S,
+    check_restored,
+    link_meanwhile,
+    needed_sensors,
+    phase_timeout_s,
+)
 from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.control.algorithm.result import OUTCOMES, ControllerResult
 from stairbot.control.algorithm.transitions import (
-    BACK_PAIR_PHASES,
     TRANSITIONS,
     TransitionError,
     allowed,
 )
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
-from stairbot.errors import InputError
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
-    BACK_SENSORS,
-    FRONT_SENSORS,
     LIFT_MOTORS,
     MotorId,
     SensorId,
@@ -49,47 +51,6 @@ from stairbot.hardware import (
     Speeds,
 )
 from stairbot.inputs.config import RobotConfig
-
-SENSOR_WAIT_S = 1.0
-"""How long the robot stands, lifts holding, for a sensor it needs that reads
-as ERROR (errors, or stale) to come back before the program ends with the
-error."""
-
-PHASE_TIMEOUT_S = 60.0
-"""A phase (other than the standing rule's wait) that lasts longer than this,
-in controller time, ends the program with an error: something is stuck.  A
-robot with slow motors gets longer: :func:`phase_timeout_s`."""
-
-
-def phase_timeout_s(config: RobotConfig) -> float:
-    """How long one phase may last: twice the longest motion a phase makes at
-    the config's speeds (a lift over its whole stroke, a drive of
-    LENGTH_OF_INFINITY, a calibration turn of its largest yaw), and at least
-    PHASE_TIMEOUT_S."""
-    m = config.motors
-    lift_s = 2 * config.MAX_OF_VERTICAL_TURNS / m.lift_speed
-    drive_s = config.wheel_turns(config.LENGTH_OF_INFINITY) / m.wheel_speed
-    turn = calibration.MAX_TURN_YAW_RAD * config.geometry.track_width / 2
-    turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
-    return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
-
-OUTCOMES = tuple(o.value for o in Outcome)
-
-
-@dataclass(frozen=True)
-class ControllerResult:
-    """How the program ended (``outcome`` is "running" until it has)."""
-
-    outcome: str  # an Outcome's value, or "running"
-    ascent_end: str | None  # an AscentEnd's value, or None
-    error: str | None
-    steps_climbed: int
-    steps_descended: int
-    pauses: int
-    reason: str | None = None  # why it ended, whatever the outcome
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 class Controller:
@@ -118,7 +79,7 @@ class Controller:
                 context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
         elif context.phase_started_s is not None:
-            _check_restored(context)
+            check_restored(context)
         self._ctx = context
         self._started = context.phase_started_s is not None
         self._held: str | None = None
@@ -256,7 +217,7 @@ class Controller:
         now = self._now
         if now is None or key != self._now_key:
             phase = BY_VALUE[ctx.phase]
-            now = self._now = (phase, phase.record, _needed_sensors(phase, ctx))
+            now = self._now = (phase, phase.record, needed_sensors(phase, ctx))
             self._now_key = key
         return now
 
@@ -313,7 +274,7 @@ class Controller:
             return True
         self._sensor_since = None
         self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
-                         f"{_link_meanwhile(self._sensor_link, snap.health)}"), snap)
+                         f"{link_meanwhile(self._sensor_link, snap.health)}"), snap)
         return True
 
     def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
@@ -422,50 +383,6 @@ class Controller:
         self._sink(Event(time_s, kind, message, phase, data))
 
 
-def _check_restored(ctx: Context) -> None:
-    """A restored context's work and family are the present phase's kinds
-    (while the standing rule waits, the phase it resumes); InputError naming
-    the key when not."""
-    phase = BY_VALUE[ctx.phase]
-    if phase is _PAUSED and ctx.pause is not None:
-        phase = BY_VALUE[ctx.pause.resume_phase]
-    if phase.terminal:
-        return
-    record = phase.record
-    if type(ctx.work) is not record.work:
-        raise InputError("context", "work.kind", f"{ctx.work.KIND} is not the work of "
-                         f"{phase.value} ({record.work.KIND})")
-    if record.family is not None and type(ctx.family) is not record.family:
-        raise InputError("context", "family.kind", f"{type(ctx.family).__name__} is not the "
-                         f"family of {phase.value} ({record.family.__name__})")
-
-
-def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
-    """The sensors whose ERROR status (errors, or stale) stands the robot in
-    ``phase``, and ends the program if it lasts."""
-    if phase is _PAUSED and ctx.pause is not None:
-        phase = Phase(ctx.pause.resume_phase)
-    if phase.terminal:
-        return ()
-    if ctx.from_top and phase.flow != "ascent":
-        return BACK_SENSORS  # a continuous descent steers by the back pair alone
-    if phase in _EDGE_WATCH:
-        return FRONT_SENSORS + BACK_SENSORS
-    if phase is Phase.LANDING_SCAN:
-        # The scan moves segment 3 alone, and steers nothing: a side pair that
-        # reads no distance there is no flight (the landing is refused, the
-        # robot goes home), not a reason to end the program on the landing.
-        return ()
-    return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
-
-
-_EDGE_WATCH = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
-"""Descent 1's phases watch the back pair for the edge as they back: a back
-sensor that reports errors, or stops measuring, would hide it (the edge is
-where both read the drop), and backing from the top of a flight the robot
-would go over the edge unseen."""
-
-
 _PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
 ALL_MOTORS: tuple[MotorId, ...] = tuple(MotorId)
 _ZEROS: dict[MotorId, float] = dict.fromkeys(ALL_MOTORS, 0.0)
@@ -475,17 +392,3 @@ _TERMINAL: dict[str, bool] = {p.value: p.terminal for p in Phase}
 def _zeros() -> dict[MotorId, float]:
     return _ZEROS.copy()
 
-
-LINK_TROUBLE = ("retries", "timeouts", "lost", "revived")
-"""The link figures (Snapshot.health) that say frames went missing."""
-
-
-def _link_meanwhile(before: Mapping[str, float], now: Mapping[str, float]) -> str:
-    """What the link counted during a sensor hold, when it lost frames: a
-    reading goes stale on a wire that loses its replies too, and the error
-    says so (empty for a robot with no link, or a link that lost nothing)."""
-    grown = {k: now[k] - before.get(k, 0.0) for k in LINK_TROUBLE if k in now}
-    if not any(v > 0 for v in grown.values()):
-        return ""
-    counts = ", ".join(f"{v:.0f} {k}" for k, v in grown.items() if v > 0)
-    return f"; meanwhile the link lost frames ({counts}): the readings were stale on the wire"

@@ -19,7 +19,7 @@ from stairbot.control.algorithm import limits, motion
 from stairbot.control.algorithm.modes import Outcome
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
 from stairbot.control.algorithm.work import EdgeWork
-from stairbot.control.perception import measurement_period, median_sigma, window
+from stairbot.control.tolerances import measurement_period, median_sigma, window
 from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 

@@ -17,7 +17,7 @@ from typing import Protocol, TypeVar
 from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
 from stairbot.control.algorithm.work import DriveWork, LiftWork, Work
-from stairbot.control.perception import median_sigma
+from stairbot.control.tolerances import median_sigma
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 

@@ -9,7 +9,7 @@ usable distance, and both the (filtered) difference and its smoothed value
 (:data:`~stairbot.control.algorithm.motion.DIFF_SMOOTHING`) must exceed their
 tolerances for DEBOUNCE_TICKS ticks in a row: what calibration may have left
 when it squared up, plus four sigmas of the difference from the sensors'
-stated noise (:func:`~stairbot.control.perception.standing_tolerance`).  Neither a
+stated noise (:func:`~stairbot.control.tolerances.standing_tolerance`).  Neither a
 short spike, sensor noise, nor a yaw calibration accepted stops the robot.
 
 :func:`watch` runs before an armed phase's step and returns the pause; the
@@ -26,7 +26,7 @@ from stairbot.control.algorithm import long_tread, motion
 from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import standing_tolerance
+from stairbot.control.tolerances import standing_tolerance
 
 BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
                            Phase.ASCENT_DRIVE_SECOND})

@@ -10,8 +10,22 @@ import math
 from typing import Any
 
 from stairbot.control.algorithm import motion
-from stairbot.control.algorithm.calibration import (
-    FLOW,
+from stairbot.control.algorithm.calibration import FLOW
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase
+from stairbot.control.algorithm.phase import (
+    FAULT,
+    NO_MOTION,
+    PhaseDef,
+    Step,
+    Tick,
+    fail,
+    go,
+    stay,
+    where,
+)
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.squaring import (
     LANDING_TURN_MARGIN_RAD,
     MAX_AWAY_YAW_RAD,
     MAX_SQUARE_YAW_RAD,
@@ -30,22 +44,8 @@ from stairbot.control.algorithm.calibration import (
     settled,
     trimmed_mean,
 )
-from stairbot.control.algorithm.families import Calibration
-from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase
-from stairbot.control.algorithm.phase import (
-    FAULT,
-    NO_MOTION,
-    PhaseDef,
-    Step,
-    Tick,
-    fail,
-    go,
-    stay,
-    where,
-)
-from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
-from stairbot.control.perception import pair_tolerance, still_samples, still_tolerance
+from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
 from stairbot.hardware import MotorId
 
 P = Phase
