@@ -13,6 +13,7 @@ step 1 on later steps, descent step 1); the context says which.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from enum import Enum
 from typing import TYPE_CHECKING, Any
 
@@ -103,15 +104,21 @@ class Phase(Enum):
 
 
 _RECORDS: dict[Phase, PhaseDef[Any]] = {}
+"""Every phase's record.  The records live with their flows (calibration.py,
+ascent.py...), which import this module: this module imports none of them.
+:mod:`~stairbot.control.algorithm.table` gathers them and binds them here
+(:func:`bind`) when it is imported, and the package imports it first."""
+
+
+def bind(records: Mapping[Phase, PhaseDef[Any]]) -> None:
+    """Make ``records`` the phases' records (the table does, once)."""
+    missing = set(Phase) - set(records)
+    if missing:
+        raise RuntimeError(f"phases without a record: {sorted(p.value for p in missing)}")
+    _RECORDS.update(records)
 
 
 def _records() -> dict[Phase, PhaseDef[Any]]:
-    # The records live with their flows (calibration.py, turns.py, ascent.py...), which
-    # import this module: they are gathered on first use.
-    if not _RECORDS:
-        from stairbot.control.algorithm.table import PHASES
-
-        _RECORDS.update(PHASES)
     return _RECORDS
 
 

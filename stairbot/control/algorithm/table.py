@@ -1,4 +1,7 @@
-"""Every phase's record, gathered from the modules of the flows."""
+"""Every phase's record, gathered from the modules of the flows and bound to
+the :class:`~stairbot.control.algorithm.phases.Phase` enum (whose ``record``,
+``label`` and ``flow`` read them).  The package imports this module first, so
+the records are bound before any phase is asked for one."""
 
 from __future__ import annotations
 
@@ -8,7 +11,7 @@ from typing import Any
 
 from stairbot.control.algorithm import ascent, calibration, descent, landing, standing, turns
 from stairbot.control.algorithm.phase import PhaseDef
-from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.phases import Phase, bind
 
 PHASES: Mapping[Phase, PhaseDef[Any]] = MappingProxyType(
     {d.phase: d for d in (*calibration.PHASES, *turns.PHASES, *ascent.PHASES, *descent.PHASES,
@@ -16,6 +19,4 @@ PHASES: Mapping[Phase, PhaseDef[Any]] = MappingProxyType(
 )
 """phase -> its record, for every Phase."""
 
-missing = set(Phase) - set(PHASES)
-if missing:  # pragma: no cover - caught by the import in every test
-    raise RuntimeError(f"phases without a record: {sorted(p.value for p in missing)}")
+bind(PHASES)
