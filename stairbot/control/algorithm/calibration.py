@@ -1,7 +1,8 @@
 """Calibration: squaring up to the riser (cases 1, 2, 3A, 3B).
 
 The same phases serve the start of the program (every case), ascent step 1 on
-later steps and descent step 1 (case 2 only); ``Context.purpose`` says which.
+later steps and descent step 1 (case 2 only); the calibration's state
+(:class:`~stairbot.control.algorithm.families.Calibration`) says which.
 Turning happens on segment 2's wheels with segments 1 and 3 lifted by
 NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE, slowly, and stops when the smoothed
 SFL − SFR reaches zero, so that sensor noise neither stops it early nor

@@ -293,7 +293,7 @@ def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     """Narrow steps: watch the back pair cross the edge of the narrow tread
     the robot stands on, or steps down onto (floor, then the drop, as
     :func:`edge_bound` does) and
-    keep where (``Context.narrow_edge_wheel``); once known, the odometer
+    keep where (``DescentStep.narrow_edge_wheel``); once known, the odometer
     count the backing never passes: segment 2's rear axle
     NARROW_AXLE_MARGIN_M past that edge.  The front pair's tab alone leaves
     8.5 mm to spare there: both of its sensors reading 20 mm short (a common

@@ -9,9 +9,10 @@ records (:mod:`stairbot.control.algorithm.transitions`).
 A step is a function of (the tick's readings and context, the phase's work)
 that returns a :class:`Step`: the motor speeds to command and, when the phase
 is over, which phase comes next.  Only the controller enters a phase, once per
-tick at most, in one place.  A step may update the seed's variables in the
-context (``number_of_steps``, ``tab_length_to_edge``...) and its own work;
-nothing else.
+tick at most, in one place.  A step may update the seed's variables and
+the run's progress in the context (``number_of_steps``,
+``tab_length_to_edge``...), its family's state and its own work; nothing
+else.
 """
 
 from __future__ import annotations
