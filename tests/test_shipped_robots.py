@@ -58,7 +58,7 @@ def test_the_ir_robot_closes_in_to_square_up_where_its_noise_allows() -> None:
     it drifted 5.7 cm from home).  square_range_m is now also the farthest
     reading the pair squares up to equal_tolerance from (quiet_range_m),
     and the start closes in to it first."""
-    from stairbot.control.perception import quiet_range_m, square_tolerance
+    from stairbot.control.tolerances import quiet_range_m, square_tolerance
 
     ir = load_config("ir")
     assert limits.square_range_m(ir) == quiet_range_m(ir) < 0.4

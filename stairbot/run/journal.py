@@ -23,9 +23,11 @@ was cut short after it was written -- not by a killed host, which leaves
 every line it wrote, nor by a power loss, which costs only lines after the
 mark -- and is not resumed (:mod:`stairbot.run.journal_read` checks all this).
 
-* ``{"kind": "start", "seq", "prev", "run_id", "format", "url", "config",
-  "config_sha256", "scenario", "mode", "boards", "time_s"}`` -- a run began
-  (``format``: :data:`FORMAT`; ``boards``: each board's identity --
+* ``{"kind": "start", "seq", "prev", "run_id", "format", "context_version",
+  "url", "config", "config_sha256", "scenario", "mode", "boards", "time_s"}``
+  -- a run began (``format``: :data:`FORMAT`; ``context_version``: the shape
+  of its contexts, :data:`~stairbot.control.algorithm.context.CONTEXT_VERSION`,
+  absent before version 2; ``boards``: each board's identity --
   serial number, uptime, and boot id where the boards give one -- or null
   in the simulation);
 * ``{"kind": "tick", "seq", "prev", "run_id", "n", "time_s", "phase",
@@ -58,6 +60,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from stairbot.control.algorithm.context import CONTEXT_VERSION
 from stairbot.errors import OutputError
 from stairbot.files import LineFile, refused, shown
 from stairbot.run.journal_read import (
@@ -226,7 +229,8 @@ class JournalWriter:
     def start(self, *, url: str, config: str, config_sha256: str, scenario: str, mode: str,
               boards: Any, time_s: float, run_id: str | None = None) -> None:
         self.run_id = run_id or uuid.uuid4().hex
-        self.write({"kind": "start", "run_id": self.run_id, "format": FORMAT, "url": url,
+        self.write({"kind": "start", "run_id": self.run_id, "format": FORMAT,
+                    "context_version": CONTEXT_VERSION, "url": url,
                     "config": config, "config_sha256": config_sha256, "scenario": scenario,
                     "mode": mode, "boards": boards, "time_s": time_s})
 

@@ -7,7 +7,10 @@ naming the file, the line and the field -- unless
 * every whole line is a JSON object (numbers finite: ``NaN`` and
   ``Infinity`` are refused) of a known kind, chained: ``seq`` its line's
   number, ``prev`` the :func:`line_hash` of the line before;
-* the first line starts the run, in this :data:`FORMAT`, with a run id;
+* the first line starts the run, in this :data:`FORMAT`, with a run id,
+  its contexts of this
+  :data:`~stairbot.control.algorithm.context.CONTEXT_VERSION` (a context of
+  another shape would be misread);
   every other line is of that run; nothing follows an end but a resume,
   and only after an end that was resumable;
 * each record has its kind's fields, of their types: times finite and
@@ -36,7 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, BinaryIO
 
-from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.context import CONTEXT_VERSION, Context
 from stairbot.control.algorithm.phases import BY_VALUE, Mode
 from stairbot.errors import InputError
 from stairbot.files import open_regular, shown
@@ -165,6 +168,11 @@ def _check_start(rec: dict[str, Any]) -> None:
     if rec.get("format") != FORMAT:
         raise _Bad("format", f"written by another version of stairbot (journal format "
                    f"{rec.get('format', 1)!r}; this one reads {FORMAT}): it cannot be checked, "
+                   "so it is not resumed")
+    version = rec.get("context_version", 1)  # version 1 journals did not name it
+    if version != CONTEXT_VERSION:
+        raise _Bad("context_version", f"its contexts are of version {version!r}; this "
+                   f"stairbot reads context version {CONTEXT_VERSION}: they would be misread, "
                    "so it is not resumed")
     run_id = _text(rec, "run_id")
     if not 0 < len(run_id) <= MAX_RUN_ID or not run_id.isascii() or not run_id.isalnum():

@@ -229,6 +229,26 @@ def test_a_crafted_line_is_refused_in_one_line(
     refused(code, err, killed, 2, f"{killed.journal}: ", words)
 
 
+def _version_1(records: Records) -> Records:
+    """The journal as stairbot wrote it before the context was split: no
+    context version at its start, its contexts one flat table."""
+    del records[0]["context_version"]
+    for rec in records:
+        if "context" in rec:
+            ctx = rec["context"]
+            ctx["purpose"] = ctx.pop("family")["purpose"]
+            del ctx["work"]["kind"]
+    return records
+
+
+def test_a_journal_of_the_context_before_version_2_is_refused_naming_both_versions(
+        killed: Killed, capsys: pytest.CaptureFixture[str]) -> None:
+    rewrite(killed.journal, _version_1)
+    code, err = resume(capsys, killed)
+    refused(code, err, killed, 2, f"{killed.journal}: line 1: context_version: its contexts "
+            "are of version 1; this stairbot reads context version 2")
+
+
 def test_steps_beyond_the_configs_max_steps_are_refused(
         killed: Killed, capsys: pytest.CaptureFixture[str]) -> None:
     rewrite(killed.journal, _set_context("number_of_steps", 15))

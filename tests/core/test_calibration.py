@@ -9,7 +9,10 @@ import pytest
 from kinematic import Fault, KinematicRobot, run
 
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import CalibrationCase, Purpose
 from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.work import TurnWork
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import MotorId, SensorId
@@ -34,7 +37,7 @@ def calibrate(**kw: object) -> tuple[Controller, KinematicRobot, list[Event], li
         if not seen or seen[-1] is not c.phase:
             seen.append(c.phase)
         if c.phase is Phase.CAL_TURN:  # the turn phase's own work, while it lasts
-            TURNED[id(c)] = c.context.work.turn_direction
+            TURNED[id(c)] = c.context.work_of(TurnWork).turn_direction
         if c.phase in (Phase.CAL_TURN, Phase.CAL_PROBE, Phase.CAL_CORNER):
             # turning happens only with both end segments lifted for clearance
             turning.append(min(robot.counters[MotorId.MTF], robot.counters[MotorId.MTB]))
@@ -48,6 +51,12 @@ def calibrate(**kw: object) -> tuple[Controller, KinematicRobot, list[Event], li
     return ctrl, robot, events, seen
 
 
+def case(events: list[Event]) -> str | None:
+    """The case the last calibration chose, as its events tell it."""
+    cases = [e.data["case"] for e in events if e.kind is EventKind.INFO and "case" in e.data]
+    return cases[-1] if cases else None
+
+
 def first_turn(events: list[Event]) -> str:
     return next(e.message for e in events if e.kind is EventKind.INFO and "case" in e.message)
 
@@ -55,7 +64,7 @@ def first_turn(events: list[Event]) -> str:
 @pytest.mark.parametrize("yaw", [15.0, -15.0])
 def test_case_2_turns_towards_the_nearer_side_until_square(yaw: float) -> None:
     ctrl, robot, events, seen = calibrate(yaw_deg=yaw, noise=0.001)
-    assert ctrl.context.calibration_case == "2"
+    assert case(events) == "2"
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_TURN, Phase.CAL_LOWER,
                     Phase.CAL_CHECK]  # checked standing on all wheels
     # turned left (+) for SFL < SFR, i.e. when yawed right (-), and vice versa
@@ -70,14 +79,14 @@ def test_a_small_yaw_squares_up_as_case_2_or_3a(yaw: float, seed: int) -> None:
     """At 3° the pair's difference (about 6 mm) is within two noise sigmas of
     equal_tolerance (5 mm): one reading may call it equal (case 3, whose probe
     finds 3A) or not (case 2).  Either way the robot ends square."""
-    ctrl, robot, _events, _seen = calibrate(yaw_deg=yaw, noise=0.001, seed=seed)
-    assert ctrl.context.calibration_case in ("2", "3A")
+    ctrl, robot, events, _seen = calibrate(yaw_deg=yaw, noise=0.001, seed=seed)
+    assert case(events) in ("2", "3A")
     assert abs(robot.yaw) < SQUARE
 
 
 def test_case_3a_probes_left_then_turns_back_square() -> None:
     ctrl, robot, events, seen = calibrate(noise=0.001)
-    assert ctrl.context.calibration_case == "3A"
+    assert case(events) == "3A"
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_TURN,
                     Phase.CAL_LOWER, Phase.CAL_CHECK]
     assert TURNED[id(ctrl)] == -1  # back right
@@ -114,13 +123,13 @@ def test_case_3b_a_corner_turns_left_until_both_shrink_then_squares_up() -> None
         if not seen or seen[-1] is not c.phase:
             seen.append(c.phase)
         if c.phase is Phase.CAL_TURN:  # the turn phase's own work, while it lasts
-            TURNED[id(c)] = c.context.work.turn_direction
+            TURNED[id(c)] = c.context.work_of(TurnWork).turn_direction
         return False
 
     run(ctrl, robot, until=watch)
     assert seen == [Phase.CAL_CHECK, Phase.CAL_LIFT, Phase.CAL_PROBE, Phase.CAL_CORNER,
                     Phase.CAL_TURN, Phase.CAL_LOWER, Phase.CAL_CHECK]
-    assert ctrl.context.calibration_case == "3B"
+    assert ctrl.context.family_of(Calibration).case is CalibrationCase.THREE_B
     assert abs(robot.yaw) < SQUARE
     assert ctrl.result.outcome == "completed"
 
@@ -140,12 +149,14 @@ def test_later_steps_calibrate_only_when_the_readings_differ() -> None:
 
 
 def test_later_steps_square_up_again_when_yawed() -> None:
-    ctrl = Controller(CFG)
+    events: list[Event] = []
+    ctrl = Controller(CFG, events.append)
     robot = KinematicRobot(CFG, steps=[(0.17, 0.28)] * 2)
-    run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_CHECK and c.context.purpose == "ascent")
+    run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_CHECK
+        and c.context.family_of(Calibration).purpose is Purpose.ASCENT)
     robot.yaw = math.radians(6.0)  # knocked sideways on the first tread
     run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
-    assert ctrl.context.calibration_case == "2"
+    assert case(events) == "2"
     assert abs(robot.yaw) < SQUARE
     run(ctrl, robot)
     assert ctrl.result.outcome == "completed"
@@ -161,7 +172,8 @@ def test_not_square_when_measured_standing_still_it_turns_back_the_right_way(
     the phase timeout, ended it.)"""
     ctrl = Controller(CFG, lambda _e: None, Mode.CALIBRATE_ONLY)
     robot = KinematicRobot(CFG, yaw_deg=15.0)
-    run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_TURN and c.context.work.checked)
+    run(ctrl, robot, until=lambda c: c.phase is Phase.CAL_TURN
+        and c.context.work_of(TurnWork).measuring)
     robot.yaw += math.radians(slip)
     started = robot.t
     run(ctrl, robot)
@@ -176,9 +188,9 @@ def test_a_bad_first_reading_does_not_choose_the_case() -> None:
     """A sensor's very first measurement is an outlier (SFR reads 0.42 m short
     for 0.1 s): the case is chosen from readings taken once the filter has a
     full window, not from the mean of whatever came first."""
-    ctrl, robot, _events, _seen = calibrate(
+    ctrl, robot, events, _seen = calibrate(
         faults=[Fault(SensorId.SFR, 0.0, 0.1, offset=-0.42)], noise=0.001)
-    assert ctrl.context.calibration_case in ("3A", "3B", "2")  # not 2W: no side wall here
+    assert case(events) in ("3A", "3B", "2")  # not 2W: no side wall here
     assert abs(robot.yaw) < SQUARE
 
 
@@ -220,7 +232,7 @@ def test_a_dropout_while_standing_is_no_figure_for_the_difference() -> None:
     out of the mean."""
     ctrl, robot, events, _seen = calibrate(
         faults=[Fault(SensorId.SFL, 0.3, 0.4, offset=1.2)], noise=0.001)
-    assert ctrl.context.calibration_case == "3A", first_turn(events)
+    assert case(events) == "3A", first_turn(events)
     assert abs(robot.yaw) < SQUARE
 
 

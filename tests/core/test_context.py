@@ -8,12 +8,22 @@ import json
 import pytest
 from kinematic import KinematicRobot, run
 
-from stairbot.control.algorithm.context import TAB_SIZE, Context
+from stairbot.control.algorithm.context import (
+    TAB_SIZE,
+    Context,
+    Landing,
+    Pause,
+    StartPosition,
+    Watch,
+)
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.families import Calibration, LandingTurn
+from stairbot.control.algorithm.modes import AscentEnd, CalibrationCase, Purpose
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import EdgeWork, LiftWork, ProbeWork, SightWork, StandingWork
 from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError
+from stairbot.hardware import SensorId
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 
@@ -29,7 +39,8 @@ def test_a_new_context_holds_the_seeds_variables() -> None:
 
 def test_round_trip_through_json() -> None:
     ctx = Context(length_of_next_step=0.29, number_of_steps=3, phase="ascent_lift_third",
-                  ascent_end="top_reached", work=Work(target_mtf=12.5, checked=True), pauses=2)
+                  ascent_end=AscentEnd.TOP_REACHED, work=LiftWork(target_mtf=12.5, checked=True),
+                  pauses=2)
     ctx.tab_length_to_edge[0] = 0.14
     data = json.loads(json.dumps(ctx.to_dict()))
     assert Context.from_dict(data) == ctx
@@ -45,9 +56,19 @@ def test_from_dict_names_a_bad_key_or_value() -> None:
     with pytest.raises(InputError, match="tab_length_to_edge: must be a list of 20"):
         Context.from_dict({"tab_length_to_edge": [0.1]})
     with pytest.raises(InputError, match="work.colour: unknown key"):
-        Context.from_dict({"work": {"colour": "red"}})
+        Context.from_dict({"work": {"kind": "Work", "colour": "red"}})
     with pytest.raises(InputError, match="work.target_mtf"):
-        Context.from_dict({"work": {"target_mtf": "high"}})
+        Context.from_dict({"work": {"kind": "LiftWork", "target_mtf": "high"}})
+    with pytest.raises(InputError, match="work.target_mtf: unknown key"):
+        Context.from_dict({"work": {"kind": "DriveWork", "target_mtf": 1.0}})
+    with pytest.raises(InputError, match="work.kind: 'Hammer' is not a kind of Work"):
+        Context.from_dict({"work": {"kind": "Hammer"}})
+    with pytest.raises(InputError, match="family.kind: None is not a kind of Family"):
+        Context.from_dict({"family": {"purpose": "start"}})
+    with pytest.raises(InputError, match="family.purpose: 'sideways' is not a Purpose"):
+        Context.from_dict({"family": {"kind": "Calibration", "purpose": "sideways"}})
+    with pytest.raises(InputError, match="ascent_end: 'bored' is not a AscentEnd"):
+        Context.from_dict({"ascent_end": "bored"})
 
 
 def test_a_restored_controller_continues_like_the_original() -> None:
@@ -75,38 +96,49 @@ def test_a_restored_controller_continues_like_the_original() -> None:
 def test_the_phases_lists_of_pairs_come_back_as_pairs() -> None:
     """JSON makes a list of a tuple: from_dict restores the declared type
     (the calibration check's ``standing``, the probe's ``probe_recent``)."""
-    ctx = Context(work=Work(standing=[(0.3, 0.31)], probe_recent=[(0.5, 0.52), (0.5, 0.53)]))
+    ctx = Context(work=ProbeWork(standing=[(0.3, 0.31)],
+                                 probe_recent=[(0.5, 0.52), (0.5, 0.53)]))
     back = Context.from_dict(json.loads(json.dumps(ctx.to_dict())))
     assert back == ctx
-    assert back.work.standing == [(0.3, 0.31)] and isinstance(back.work.standing[0], tuple)
+    work = back.work_of(ProbeWork)
+    assert work.standing == [(0.3, 0.31)] and isinstance(work.standing[0], tuple)
 
 
 def test_every_field_round_trips_through_json() -> None:
     """Each field set to a value unlike its default comes back equal, of its type."""
     ctx = Context(
         length_of_next_step=0.3, number_of_vertical_turns=1.5, number_of_steps=2,
-        phase="ascent_check", purpose="ascent", calibration_case="3B", start_reading=0.2,
-        home_twist=0.1, third_in_air=True, squaring_turns=1, steps_descended=1,
-        pause_diffs=[0.01, 0.02], disagree_ticks=3, landing_rise_m=[0.17, None],
-        landing_open=[1, -1], landing_step=2, resume_phase="cal_turn",
-        work=Work(entry_wheel=3.0, turn_direction=-1, probe_recent=[(0.1, 0.2)],
-                  first_keys=[1.0], sights=[[0.2], [0.3, 0.4]], side_open=[0.05, None],
-                  side_run=[1, 2], standing=[(0.3, 0.3)], edge_first="SBR"))
+        phase="paused", third_in_air=True, steps_descended=1,
+        start=StartPosition(reading=0.2, home_twist=0.1),
+        landing=Landing(step=2, side=-1), watch=Watch(3, 0.01),
+        pause=Pause("cal_probe", 4.0, [0.01, 0.02]),
+        family=Calibration(Purpose.DESCENT, case=CalibrationCase.THREE_B, squaring_turns=1),
+        work=ProbeWork(entry_wheel=3.0, probe_recent=[(0.1, 0.2)], standing=[(0.3, 0.3)]))
     ctx.tab_length_to_edge[1] = 0.14
     ctx.climb_twist[0] = -0.02
     back = Context.from_dict(json.loads(json.dumps(ctx.to_dict())))
     assert back == ctx
     assert type(back.work.entry_wheel) is float and type(back.number_of_steps) is int
+    for other in (LandingTurn(rise_m=[0.17, None], open=[1, -1]),):
+        ctx.family = other
+        assert Context.from_dict(json.loads(json.dumps(ctx.to_dict()))) == ctx
+    for work in (SightWork(sights=[[0.2], [0.3, 0.4]]), EdgeWork(edge_first=SensorId.SBR)):
+        ctx.work = work
+        assert Context.from_dict(json.loads(json.dumps(ctx.to_dict()))) == ctx
 
 
 @pytest.mark.parametrize(("data", "problem"), [
     ({"number_of_steps": 10**9}, "number_of_steps: 1000000000 is out of range; allowed: 0 to 20"),
     ({"number_of_steps": 1e9}, "number_of_steps: 1000000000.0 is not of type int"),
     ({"phase_started_s": float("nan")}, "phase_started_s: nan is out of range"),
-    ({"work": {"target_mtf": float("inf")}}, "work.target_mtf: inf is out of range"),
+    ({"work": {"kind": "LiftWork", "target_mtf": float("inf")}},
+     "work.target_mtf: inf is out of range"),
     ({"phase": "ascent_fly"}, "phase: 'ascent_fly' is not a phase"),
-    ({"work": {"standing": [[0.3]]}}, "work.standing[0]: [0.3] is not of type tuple"),
-    ({"landing_step": -1}, "landing_step: -1 is out of range"),
+    ({"pause": {"resume_phase": "ascent_fly", "started_s": 1.0}},
+     "pause.resume_phase: 'ascent_fly' is not a phase"),
+    ({"work": {"kind": "StandingWork", "standing": [[0.3]]}},
+     "work.standing[0]: [0.3] is not of type tuple"),
+    ({"landing": {"step": -1}}, "landing.step: -1 is out of range"),
 ])
 def test_from_dict_refuses_numbers_out_of_bounds_and_unknown_phases(
         data: dict[str, object], problem: str) -> None:
@@ -119,3 +151,15 @@ def test_steps_descended_are_bounded_by_those_climbed_unless_from_the_top() -> N
     with pytest.raises(InputError, match="steps_descended: 3 is out of range; allowed: 0 to 2"):
         Context.from_dict({"number_of_steps": 2, "steps_descended": 3})
     assert Context.from_dict({"from_top": True, "steps_descended": 35}).steps_descended == 35
+
+
+def test_a_restored_work_of_another_phase_is_refused() -> None:
+    ctx = Context(phase="cal_check", phase_started_s=1.0, family=Calibration(),
+                  work=StandingWork())
+    Controller(CFG, context=ctx)
+    ctx.work = LiftWork()
+    with pytest.raises(InputError, match="work.kind: LiftWork is not the work of cal_check"):
+        Controller(CFG, context=ctx)
+    ctx.work, ctx.family = StandingWork(), None
+    with pytest.raises(InputError, match="family.kind"):
+        Controller(CFG, context=ctx)

@@ -9,12 +9,8 @@ from dataclasses import replace
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
-from stairbot.control.algorithm.controller import (
-    PHASE_TIMEOUT_S,
-    SENSOR_WAIT_S,
-    Controller,
-    phase_timeout_s,
-)
+from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.guards import PHASE_TIMEOUT_S, SENSOR_WAIT_S, phase_timeout_s
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.perception import CONFIRM
 from stairbot.control.robot_config import load_config, parse_config

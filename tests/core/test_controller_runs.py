@@ -7,6 +7,8 @@ import pytest
 from kinematic import KinematicRobot, run
 
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import CalibrationCase
 from stairbot.control.algorithm.phases import Mode, Phase
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
@@ -162,7 +164,7 @@ def test_nothing_ahead_is_case_1_and_stops_without_moving() -> None:
     r = ctrl.result
     assert (r.outcome, r.ascent_end, r.error) == ("stopped", None, None)
     assert r.reason is not None and r.reason.startswith("nothing ahead")
-    assert ctrl.context.calibration_case == "1"
+    assert ctrl.context.family_of(Calibration).case is CalibrationCase.ONE
     assert all(v == 0.0 for speeds in sent for v in speeds.values())
     assert "nothing ahead" in events[-1].message
 
@@ -173,7 +175,7 @@ def test_calibrate_only_ends_after_the_first_calibration() -> None:
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", None, 0)
     assert phases(events)[-3:-1] == [Phase.CAL_LOWER, Phase.CAL_CHECK]  # lowered, checked
     assert abs(robot.yaw) < 0.01
-    assert ctrl.context.start_reading == pytest.approx(0.5, abs=0.01)
+    assert ctrl.context.start.reading == pytest.approx(0.5, abs=0.01)
 
 
 @pytest.mark.parametrize("yaw", [12.0, -12.0])

@@ -9,7 +9,7 @@ from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.edge import edge_bound, edge_clearance_m, edge_doubt_m, edge_sight_m
 from stairbot.control.algorithm.phase import Tick
 from stairbot.control.algorithm.phases import Mode, Phase
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import EdgeWork
 from stairbot.control.robot_config import load_config
 from stairbot.hardware import WHEEL_MOTORS, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
@@ -24,7 +24,7 @@ def _watch(right_at_m: float, left_at_m: float, ticks: int = 80) -> Context:
     crossing."""
     ctx = Context(phase=Phase.DESCENT_BACK_OFF.value)
     speed_tps = -CFG.wheel_speed_m_s / CFG.wheel_circumference
-    work: Work | None = None
+    work: EdgeWork | None = None
     for i in range(ticks):
         backed = i * CFG.algorithm.tick * CFG.wheel_speed_m_s
         motors = {m: MotorState(0.0) for m in MotorId}
@@ -35,17 +35,17 @@ def _watch(right_at_m: float, left_at_m: float, ticks: int = 80) -> Context:
                    SensorId.SBL: SensorReading(DROP if backed >= left_at_m else FLOOR)}
         snap = Snapshot(i * CFG.algorithm.tick, sensors, motors)
         if work is None:
-            work = Work.at_entry(snap)
+            work = EdgeWork.at_entry(snap)
         edge_bound(Tick(snap, CFG, ctx, Mode.FULL, lambda *a, **k: None), work, False)
-        if ctx.edge_wheel is not None:
+        if ctx.descent.edge_wheel is not None:
             return ctx
     raise AssertionError("the watch placed no crossing")
 
 
 def _crossing_m(ctx: Context) -> float:
     """How far from the start the watch placed the pair's crossing."""
-    assert ctx.edge_wheel is not None
-    return -ctx.edge_wheel * CFG.wheel_circumference
+    assert ctx.descent.edge_wheel is not None
+    return -ctx.descent.edge_wheel * CFG.wheel_circumference
 
 
 def test_both_sensors_reading_the_drop_together_place_the_crossing_their_lag_behind() -> None:
@@ -70,10 +70,11 @@ def test_one_sensor_reading_the_drop_first_places_the_crossing_between_the_two()
 
 def test_the_bound_is_the_clearance_past_the_crossing() -> None:
     ctx = _watch(0.050, 0.062)
-    assert ctx.edge_wheel is not None
+    assert ctx.descent.edge_wheel is not None
     bound = edge_bound(Tick(None, CFG, ctx, Mode.FULL, lambda *a, **k: None),  # type: ignore[arg-type]
-                       Work(), False)
-    assert bound == pytest.approx(ctx.edge_wheel - CFG.wheel_turns(edge_clearance_m(CFG)))
+                       EdgeWork(), False)
+    assert bound == pytest.approx(ctx.descent.edge_wheel
+                                  - CFG.wheel_turns(edge_clearance_m(CFG)))
 
 
 def test_a_lag_one_measurement_period_explains_moves_no_crossing() -> None:

@@ -10,7 +10,7 @@ from stairbot.control.algorithm import long_tread
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phase import Tick
 from stairbot.control.algorithm.phases import Mode
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import SightWork
 from stairbot.control.robot_config import load_config
 
 CFG = load_config("reference")
@@ -21,8 +21,8 @@ def tick(length: float | None = None) -> Tick:
     return Tick(None, CFG, ctx, Mode.FULL, lambda *a, **k: None)  # type: ignore[arg-type]
 
 
-def work(right: list[float], left: list[float]) -> Work:
-    w = Work()
+def work(right: list[float], left: list[float]) -> SightWork:
+    w = SightWork()
     w.rise_rows = [right, left]
     return w
 

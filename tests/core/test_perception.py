@@ -6,8 +6,9 @@ from __future__ import annotations
 import msgspec
 import pytest
 
-from stairbot.control.perception import CONFIRM, Perception, max_age, pair_tolerance, window
+from stairbot.control.perception import CONFIRM, Perception
 from stairbot.control.robot_config import load_config
+from stairbot.control.tolerances import max_age, pair_tolerance, window
 from stairbot.hardware import (
     MotorId,
     MotorState,

@@ -9,11 +9,13 @@ from dataclasses import replace
 import pytest
 
 from stairbot.control.algorithm import phases
-from stairbot.control.algorithm.calibration import STILL_TICKS
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import CalibrationCase
 from stairbot.control.algorithm.phase import Step, Tick, go
 from stairbot.control.algorithm.phases import FLOWS, Mode, Phase
+from stairbot.control.algorithm.squaring import STILL_TICKS
 from stairbot.control.algorithm.transitions import (
     BACK_PAIR_PHASES,
     STANDING_ARMED,
@@ -22,9 +24,9 @@ from stairbot.control.algorithm.transitions import (
     allowed,
     mermaid,
 )
-from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import settle_s
+from stairbot.control.algorithm.work import StandingWork
 from stairbot.control.robot_config import load_config
+from stairbot.control.tolerances import settle_s
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
@@ -70,14 +72,14 @@ def test_the_table_covers_every_phase_and_every_active_phase_has_a_step() -> Non
 def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
     """A phase's step is a function of (context, readings): it says what comes
     next; only the controller makes it so."""
-    ctx = Context(phase=Phase.CAL_CHECK.value)
+    ctx = Context(phase=Phase.CAL_CHECK.value, family=Calibration())
     said: list[str] = []
     sensors = {SensorId.SFR: SensorReading(0.50), SensorId.SFL: SensorReading(0.53),
                SensorId.SBR: SensorReading(0.04), SensorId.SBL: SensorReading(0.04)}
     motors = {m: MotorState(0.0) for m in MotorId}
     record = Phase.CAL_CHECK.record
     assert record.step is not None
-    work = Work.at_entry(Snapshot(0.0, sensors, motors))
+    work = StandingWork.at_entry(Snapshot(0.0, sensors, motors))
     # the filter settles, then the pair is averaged over STILL_TICKS, standing still
     ticks = math.ceil(settle_s(CFG) / CFG.algorithm.tick - 1e-9) + STILL_TICKS + 1
     steps = []
@@ -90,7 +92,8 @@ def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
     step = steps[-1]
     assert step.next is Phase.CAL_LIFT
     assert ctx.phase == Phase.CAL_CHECK.value  # not entered by the step
-    assert ctx.calibration_case == "2" and said  # the seed's variables and a message
+    # the calibration's state and a message
+    assert ctx.family_of(Calibration).case is CalibrationCase.TWO and said
     assert Phase.CAL_LIFT in TRANSITIONS[Phase.CAL_CHECK]
 
 

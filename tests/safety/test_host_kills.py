@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from stairbot.control.algorithm.work import ProbeWork, StandingWork
 from stairbot.control.robot_config import load_config
 from stairbot.fakes.host_kills import kill_tick, recorded, run_kill
 from stairbot.run.journal import JournalState, mark_path, read_journal
@@ -40,7 +41,9 @@ def test_the_context_restores_at_every_tick_of_a_whole_run(tmp_path: Path) -> No
         check(state, start["url"], rec["boards"])  # as if the host died after this tick
         ctx = restored_context(state, rec["time_s"] + 1.0, max_steps)
         assert ctx.phase == context["context"]["phase"]  # type: ignore[index]
-        pairs += bool(ctx.work.standing or ctx.work.probe_recent)
+        work = ctx.work
+        pairs += bool(isinstance(work, StandingWork) and work.standing
+                      or isinstance(work, ProbeWork) and work.probe_recent)
         restored += 1
     assert restored == len(phases)
     assert pairs > 0  # the ticks that could not be resumed before

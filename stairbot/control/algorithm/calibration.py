@@ -1,7 +1,8 @@
 """Calibration: squaring up to the riser (cases 1, 2, 3A, 3B).
 
 The same phases serve the start of the program (every case), ascent step 1 on
-later steps and descent step 1 (case 2 only); ``Context.purpose`` says which.
+later steps and descent step 1 (case 2 only); the calibration's state
+(:class:`~stairbot.control.algorithm.families.Calibration`) says which.
 Turning happens on segment 2's wheels with segments 1 and 3 lifted by
 NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE, slowly, and stops when the smoothed
 SFL − SFR reaches zero, so that sensor noise neither stops it early nor
@@ -11,9 +12,12 @@ leaves the robot askew.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from stairbot.control.algorithm import landing, limits, motion
-from stairbot.control.algorithm.moves import lift, stood
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
+from stairbot.control.algorithm.moves import lift
 from stairbot.control.algorithm.phase import (
     FAULT,
     NO_MOTION,
@@ -27,68 +31,29 @@ from stairbot.control.algorithm.phase import (
     where,
 )
 from stairbot.control.algorithm.phases import Mode, Phase
-from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import settle_s, still_samples, still_tolerance
+from stairbot.control.algorithm.squaring import (
+    HEADING_TOLERANCE_RAD,
+    MAX_SQUARE_YAW_RAD,
+    MAX_SQUARING_TURNS,
+    STILL_TICKS,
+    askew_rad,
+    heading_off_rad,
+    mean_diff,
+    measured_standing,
+    one_riser,
+    settled,
+    trimmed_mean,
+)
+from stairbot.control.algorithm.work import DriveWork, LiftWork, StandingWork
+from stairbot.control.tolerances import still_samples, still_tolerance
 from stairbot.hardware import MotorId
-from stairbot.inputs.config import RobotConfig
 
 P = Phase
 FLOW = "calibration"
 
-PROBE_YAW_RAD = math.radians(10.0)
-"""Case 3: the probe turn stops after this much yaw if the readings have not
-changed by 2 × equal_tolerance before."""
-PROBE_TICKS = 5
-"""Case 3: the probe turn compares the mean of its last this many ticks'
-readings with their mean standing before it."""
-STILL_TICKS = 25
-"""Calibration's check averages the pair's difference over this many ticks
-(0.5 s at the 20 ms tick) before it decides between the cases."""
-MAX_TURN_YAW_RAD = math.radians(90.0)
-"""A calibration that turns this far without SFR = SFL ends with an error."""
-MAX_SQUARE_YAW_RAD = math.radians(30.0)
-"""The most the robot may stand askew of the riser at a calibration: two
-readings further apart than both beams on one riser turned this far
-(2 × front_lateral × tan 30°, 58 mm on the reference robot) cannot both see
-the riser -- the nearer one sees a side wall (case 2W)."""
-TURN_MARGIN_RAD = math.radians(12.0)
-"""The squaring turn may turn this much more than the readings at its start
-say it needs (noise, the mounts' offsets) before it ends with an error: it
-never turns on to square up to a side wall."""
-MAX_AWAY_YAW_RAD = math.radians(45.0)
-"""Case 2W turns away from the side wall at most this far."""
-TURN_SLOW_FLOOR = 0.1
-"""The squaring turn slows near SFR = SFL, down to this fraction of its speed."""
-MAX_TURN_FLIPS = 4
-"""The squaring turn may reverse this many times after a check standing
-still; the next reversal ends it with an error.  One beam off the flight's
-side and the other reading long turned the robot back and forth 6 deg
-until the phase timed out 60 s later, with no reason given (SFL 30 mm long
-from the start, the robot at the flight's side after four steps askew)."""
-MAX_SQUARING_TURNS = 4
-"""A calibration that has turned this many times to square up (the squaring
-turn, then corrections by the odometer) and still does not read SFR = SFL
-standing on all wheels ends with an error."""
-LANDING_PURPOSES = ("landing", "landing_back")
-"""A landing's 90° turn onto the next flight, and back
-(:mod:`~stairbot.control.algorithm.landing`)."""
-LANDING_TURN_MARGIN_RAD = math.radians(15.0)
-"""A landing's turn may make this much more than 90° by the odometer before
-it ends with an error."""
-HEADING_TOLERANCE_RAD = math.radians(0.3)
-"""Descent 1 turns back to the heading it climbed the step with, and descent
-7 to the one the program began with, when the odometer says it is further
-off than this (0.3 deg: 1.6 mm sideways over a 0.3 m climb)."""
-
-
-def readings(t: Tick) -> tuple[float, float]:
-    sfr, sfl = motion.pair(t.snap)
-    return sfr.distance_m, sfl.distance_m
-
-
 def _after_calibration(t: Tick) -> Step:
     ctx = t.ctx
-    if ctx.purpose == "descent":
+    if t.cal.purpose is Purpose.DESCENT:
         return go(P.DESCENT_BACK_TO_EDGE)
     if ctx.number_of_steps < len(ctx.climb_twist):
         # the heading this step is climbed with: descent 1 comes back to it
@@ -97,66 +62,12 @@ def _after_calibration(t: Tick) -> Step:
     return go(P.ASCENT_APPROACH)
 
 
-def heading_off_rad(t: Tick, twist: float) -> float:
-    """How far (radians, + = left) the robot is turned from the heading whose
-    odometer twist is ``twist``."""
-    return motion.turn_yaw_rad(t.cfg, motion.twist(t.snap) - twist)
-
-
-def settled(t: Tick, w: Work) -> bool:
-    """Standing still since ``w.still_since`` (set now if unset) for as long
-    as the filter takes to stand for here (:func:`settle_s`)."""
-    return stood(t, w, settle_s(t.cfg))
-
-
-def measured_standing(t: Tick, w: Work, needed: int) -> bool:
-    """True once ``needed`` ticks have been measured; until then, add this
-    tick's SFL − SFR to ``w``'s sum when both read a distance.  A reading
-    that is an error, a dropout or nothing ahead is no figure for the
-    difference: one HC-SR04 dropout (1.3 m) among 25 ticks moves their mean
-    by centimetres, enough for a square robot to take the riser for a side
-    wall and turn away from it."""
-    if len(w.diffs) + w.diff_skipped >= needed:
-        return True
-    r, l_ = motion.pair(t.snap)
-    if r.ok and l_.ok and not motion.far(r, t.cfg) and not motion.far(l_, t.cfg):
-        w.diffs.append(l_.distance_m - r.distance_m)
-        w.standing.append((r.distance_m, l_.distance_m))
-    else:
-        w.diff_skipped += 1
-    return False
-
-
-TRIM = 0.2
-"""The share of the standing ticks' differences left out at each end before
-they are averaged."""
-
-
-def mean_diff(t: Tick, w: Work) -> float:
-    """The mean SFL − SFR measured standing, trimmed of its TRIM highest and
-    lowest ticks; now's if no tick gave one.  Two outliers among an HC-SR04's
-    last three measurements pass its median and stay for up to three ticks;
-    in a plain mean they move it by centimetres, enough for a square robot
-    to take the riser for a side wall (case 2W) and turn away from it.
-    Trimmed, the mean of normal noise keeps about 90 % of its efficiency."""
-    if not w.diffs:
-        sfr, sfl = readings(t)
-        return sfl - sfr
-    return trimmed_mean(w.diffs)
-
-
-def trimmed_mean(values: list[float]) -> float:
-    ordered = sorted(values)
-    k = int(len(ordered) * TRIM)
-    kept = ordered[k:len(ordered) - k]
-    return sum(kept) / len(kept)
-
-
 # -- check the readings --------------------------------------------------------------
-def _check(t: Tick, w: Work) -> Step:
-    cfg, ctx = t.cfg, t.ctx
+def _check(t: Tick, w: StandingWork) -> Step:
+    cfg, ctx, cal = t.cfg, t.ctx, t.cal
     sfr, sfl = motion.pair(t.snap)
-    if ctx.purpose == "descent" and ctx.squaring_turns == 0 and not ctx.turned_back:
+    if cal.purpose is Purpose.DESCENT and cal.squaring_turns == 0 \
+            and not ctx.descent.turned_back:
         # Descent 1 first turns back to the heading it climbed this step with
         # (by the odometer), so that the way down retraces the way up: squared
         # up within the pair's noise on the way up and again on the way down,
@@ -166,8 +77,8 @@ def _check(t: Tick, w: Work) -> Step:
         if climbed is not None:
             off = heading_off_rad(t, climbed)
             if abs(off) > HEADING_TOLERANCE_RAD:
-                ctx.turn_to = climbed
-                ctx.turned_back = True  # once a step: then the seed's check
+                cal.turn_to = climbed
+                ctx.descent.turned_back = True  # once a step: then the seed's check
                 t.say(f"descent 1, step {t.descent_index + 1}: turned {math.degrees(off):+.2f}° "
                       "from the heading it climbed this step with (by the odometer); turning "
                       "back to it", off_deg=math.degrees(off))
@@ -180,24 +91,24 @@ def _check(t: Tick, w: Work) -> Step:
         return stay(NO_MOTION)
     # Checking a squaring turn: as long as it takes to know the difference to
     # within equal_tolerance, as the turn's own check does.
-    needed = STILL_TICKS if ctx.squaring_turns == 0 else max(
+    needed = STILL_TICKS if cal.squaring_turns == 0 else max(
         STILL_TICKS, still_samples(cfg, min(sfr.distance_m, sfl.distance_m)))
     if not measured_standing(t, w, needed):
         return stay(NO_MOTION)
-    if ctx.squaring_turns > 0:
+    if cal.squaring_turns > 0:
         return _verify(t, w)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
-        if ctx.purpose != "start":
+        if cal.purpose is not Purpose.START:
             return fail(f"nothing ahead at {where(ctx, P.CAL_CHECK)}: SFR {sfr.distance_m:.3f} m, "
                         f"SFL {sfl.distance_m:.3f} m where a riser should be")
-        ctx.calibration_case = "1"
+        cal.case = CalibrationCase.ONE
         t.say("calibration case 1: nothing ahead (SFR and SFL read at least "
               f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
-        return end("stopped", "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
-    if ctx.purpose == "start":
-        if ctx.home_wheel is None:
-            ctx.home_wheel = motion.wheel_position(t.snap)
-            ctx.home_twist = motion.twist(t.snap)
+        return end(Outcome.STOPPED, "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
+    if cal.purpose is Purpose.START:
+        if ctx.start.home_wheel is None:
+            ctx.start.home_wheel = motion.wheel_position(t.snap)
+            ctx.start.home_twist = motion.twist(t.snap)
         near = _nearer(t)
         if near is not None and near > limits.square_range_m(cfg) + cfg.algorithm.equal_tolerance:
             t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
@@ -209,8 +120,8 @@ def _check(t: Tick, w: Work) -> Step:
     diff = mean_diff(t, w)
     equal = abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)),
                                          min(sfr.distance_m, sfl.distance_m))
-    if equal and ctx.purpose != "start":
-        ctx.calibration_case = None
+    if equal and cal.purpose is not Purpose.START:
+        cal.case = None
         return _after_calibration(t)
     # One beam reading nothing ahead is off the flight's open side (a side
     # wall would be seen): the other sees the riser, and case 2's rule turns
@@ -219,19 +130,20 @@ def _check(t: Tick, w: Work) -> Step:
     # case 2W would turn away from the riser the other beam sees.
     wall = (not equal and abs(diff) > one_riser(cfg)
             and not motion.far(sfr, cfg) and not motion.far(sfl, cfg))
-    ctx.calibration_case = "3" if equal else ("2W" if wall else "2")
-    ctx.case_diff = diff
+    cal.case = CalibrationCase.THREE if equal else (
+        CalibrationCase.TWO_W if wall else CalibrationCase.TWO)
+    cal.case_diff = diff
     said = ("equal, case 3" if equal else
             "too far apart for one riser within "
             f"{math.degrees(MAX_SQUARE_YAW_RAD):.0f}°: the nearer sees a side wall, case 2W"
             if wall else "not equal, case 2")
     t.say(f"calibration ({where(ctx, P.CAL_CHECK)}): SFR {sfr.distance_m:.3f} m, "
           f"SFL {sfl.distance_m:.3f} m: {said}",
-          case=ctx.calibration_case, SFR=sfr.distance_m, SFL=sfl.distance_m)
+          case=cal.case.value, SFR=sfr.distance_m, SFL=sfl.distance_m)
     return go(P.CAL_LIFT)
 
 
-def _verify(t: Tick, w: Work) -> Step:
+def _verify(t: Tick, w: StandingWork) -> Step:
     """Check a squaring turn standing on all wheels.  The turn ended on the
     readings taken with segments 1 and 3 lifted, their sensors a clearance
     higher: a cone tilted up then sees more of what lies over a low riser,
@@ -239,7 +151,7 @@ def _verify(t: Tick, w: Work) -> Step:
     the standing rule would then stop in the approach.  Not equal here, the robot turns
     by the odometer as far as the difference says (a flat riser, both beams
     on it), and checks again."""
-    ctx, cfg = t.ctx, t.cfg
+    ctx, cfg, cal = t.ctx, t.cfg, t.cal
     r, l_ = motion.pair(t.snap)
     sfr, sfl = r.distance_m, l_.distance_m
     if motion.far(r, cfg) or motion.far(l_, cfg):
@@ -252,58 +164,46 @@ def _verify(t: Tick, w: Work) -> Step:
         t.say(f"square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
               f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)",
               SFR=sfr, SFL=sfl, diff=diff)
-        ctx.squaring_turns = 0
+        cal.squaring_turns = 0
         return _squared(t, w)
-    if ctx.squaring_turns >= MAX_SQUARING_TURNS:
+    if cal.squaring_turns >= MAX_SQUARING_TURNS:
         return fail(f"calibration ({where(ctx, P.CAL_CHECK)}) cannot square up: after "
-                    f"{ctx.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
+                    f"{cal.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
                     f"standing (SFR {sfr:.3f} m, SFL {sfl:.3f} m): the beams do not see one "
                     "flat riser alike (a riser too low for them, or its edge)")
     # SFL farther than SFR: turned left of square, turn right (and the other way).
     yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
-    ctx.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
-    ctx.squaring_turns += 1
+    cal.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
+    cal.squaring_turns += 1
     t.say(f"not square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
           f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m): turning "
           f"{math.degrees(yaw):+.1f}° by the odometer", SFR=sfr, SFL=sfl, diff=diff)
     return go(P.CAL_LIFT)
 
 
-def _squared(t: Tick, w: Work) -> Step:
+def _squared(t: Tick, w: StandingWork) -> Step:
     """The calibration is square: the start records where it stands, the
     pair's trimmed means over the ticks the check measured standing still
     (one tick's filtered reading is as noisy as the sensors, and a fault that
     began after the check would count in it whole)."""
-    ctx, cfg = t.ctx, t.cfg
-    if ctx.purpose == "start":
+    start, cfg = t.ctx.start, t.cfg
+    if t.cal.purpose is Purpose.START:
         if w.standing:
-            ctx.start_reading = (trimmed_mean([r for r, _l in w.standing])
-                                 + trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
-            ctx.start_wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m (their means "
+            start.reading = (trimmed_mean([r for r, _l in w.standing])
+                             + trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
+            start.wheel = motion.wheel_position(t.snap)
+            t.say(f"start position: SFR/SFL read {start.reading:.3f} m (their means "
                   f"over {len(w.standing)} ticks standing still)",
-                  start_reading=ctx.start_reading)
+                  start_reading=start.reading)
         elif motion.measurable(t.snap, cfg):
-            ctx.start_reading = motion.mean_distance(t.snap)
-            ctx.start_wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {ctx.start_reading:.3f} m",
-                  start_reading=ctx.start_reading)
+            start.reading = motion.mean_distance(t.snap)
+            start.wheel = motion.wheel_position(t.snap)
+            t.say(f"start position: SFR/SFL read {start.reading:.3f} m",
+                  start_reading=start.reading)
         if t.mode is Mode.CALIBRATE_ONLY:
-            return end("completed", "calibrate-only: calibration done")
+            return end(Outcome.COMPLETED, "calibrate-only: calibration done")
     return _after_calibration(t)
-
-
-def askew_rad(cfg: RobotConfig, diff: float) -> float:
-    """How far the robot is turned left of square (radians) when both beams
-    on one flat riser read SFL − SFR = ``diff``."""
-    return math.atan(diff / (2 * max(cfg.sensors.front_lateral, 1e-6)))
-
-
-def one_riser(cfg: RobotConfig) -> float:
-    """The largest SFL − SFR (either sign) both beams on one riser can read,
-    the robot turned MAX_SQUARE_YAW_RAD from square to it."""
-    return 2 * cfg.sensors.front_lateral * math.tan(MAX_SQUARE_YAW_RAD)
 
 
 def _nearer(t: Tick) -> float | None:
@@ -313,7 +213,8 @@ def _nearer(t: Tick) -> float | None:
 
 
 CHECK = PhaseDef(
-    P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check,
+    P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check, StandingWork,
+    family=Calibration,
     to={
         P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead); calibrate-only: "
                 "squared up (checked)",
@@ -330,14 +231,14 @@ CHECK = PhaseDef(
 
 
 # -- close in (start) -------------------------------------------------------------------
-def _close_in_enter(t: Tick, w: Work) -> None:
+def _close_in_enter(t: Tick, w: DriveWork) -> None:
     # No further than the first reading allows: its nearer beam to square_range_m.
     near = _nearer(t)
     assert near is not None  # CAL_CHECK closes in only on a reading
     w.target_wheel = w.entry_wheel + t.cfg.wheel_turns(near - limits.square_range_m(t.cfg))
 
 
-def _close_in(t: Tick, w: Work) -> Step:
+def _close_in(t: Tick, w: DriveWork) -> Step:
     """Drive straight on, not squared up (the standing rule is not armed), until
     the nearer beam reads square_range_m or the first reading's distance is
     driven; then check the readings again, standing still."""
@@ -353,35 +254,37 @@ def _close_in(t: Tick, w: Work) -> Step:
 
 CLOSE_IN = PhaseDef(
     P.CAL_CLOSE_IN, "calibration — close in to square_range_m (start)", FLOW, _close_in,
-    enter=_close_in_enter,
+    DriveWork, enter=_close_in_enter, family=Calibration,
     to={P.CAL_CHECK: "the nearer reads square_range_m, or the first reading's distance driven",
         P.ERROR: FAULT})
 
 
 # -- lift segments 1 and 3 for clearance -----------------------------------------------
-def _lift_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
-    ctx, cfg = t.ctx, t.cfg
-    ctx.return_mtf, ctx.return_mtb = w.entry_mtf, w.entry_mtb
+def _lift_deltas(t: Tick, w: LiftWork) -> dict[MotorId, float]:
+    cal, cfg = t.cal, t.cfg
+    cal.return_mtf, cal.return_mtb = w.entry_mtf, w.entry_mtb
     up = cfg.NUMBER_OF_VERTICAL_TURNS_FOR_CLEARANCE
     limit = cfg.MAX_OF_VERTICAL_TURNS
     return {MotorId.MTF: min(up, limit - w.entry_mtf), MotorId.MTB: min(up, limit - w.entry_mtb)}
 
 
-def _lifted(t: Tick, _w: Work) -> Step:
-    if t.ctx.squaring_turns == 0:
+def _lifted(t: Tick, _w: LiftWork) -> Step:
+    cal = t.cal
+    if cal.squaring_turns == 0:
         # a calibration's first turn; its corrections count towards the same
         # MAX_TURN_YAW_RAD
-        t.ctx.turn_origin = t.snap.turns(MotorId.MWR)
-    if t.ctx.turn_to is not None:
+        cal.turn_origin = t.snap.turns(MotorId.MWR)
+    if cal.turn_to is not None:
         return go(P.CAL_TURN_TO)
-    case = t.ctx.calibration_case
-    return go(P.CAL_TURN if case == "2" else P.CAL_AWAY if case == "2W" else P.CAL_PROBE)
+    case = cal.case
+    return go(P.CAL_TURN if case is CalibrationCase.TWO
+              else P.CAL_AWAY if case is CalibrationCase.TWO_W else P.CAL_PROBE)
 
 
 _lift_enter, _lift_step = lift(_lift_deltas, _lifted)
 LIFT = PhaseDef(
     P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
-    enter=_lift_enter, carried_by=(2,),
+    LiftWork, enter=_lift_enter, carried_by=(2,), family=Calibration,
     to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
         P.CAL_PROBE: "lifted; case 3",
         P.CAL_TURN_TO: "lifted; a correction of the squaring turn, or descent 1 or 7 "
@@ -390,22 +293,21 @@ LIFT = PhaseDef(
 
 
 # -- lower segments 1 and 3 --------------------------------------------------------------
-def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
-    ctx = t.ctx
-    return {MotorId.MTF: ctx.return_mtf - w.entry_mtf, MotorId.MTB: ctx.return_mtb - w.entry_mtb}
+def _lower_deltas(t: Tick, w: LiftWork) -> dict[MotorId, float]:
+    cal = t.cal
+    return {MotorId.MTF: cal.return_mtf - w.entry_mtf, MotorId.MTB: cal.return_mtb - w.entry_mtb}
 
 
-def _lowered(t: Tick, _w: Work) -> Step:
-    ctx = t.ctx
-    ctx.turn_to = None
-    if ctx.purpose == "home":
+def _lowered(t: Tick, _w: LiftWork) -> Step:
+    cal = t.cal
+    cal.turn_to = None
+    if cal.purpose is Purpose.HOME:
         return go(P.DESCENT_FINISH_FLOOR)
-    if ctx.purpose == "floor":
+    if cal.purpose is Purpose.FLOOR:
         return go(P.DESCENT_FINISH)
-    if ctx.purpose == "edge":
-        ctx.purpose = "descent"
+    if cal.purpose is Purpose.EDGE:
         return go(P.DESCENT_BACK_TO_EDGE)
-    if ctx.purpose in LANDING_PURPOSES:
+    if cal.purpose in LANDING_PURPOSES:
         return landing.turned(t)
     # Check standing on all wheels, once the filter has settled there (the
     # check waits for it): a squaring turn (squaring_turns > 0), or descent
@@ -418,8 +320,8 @@ def _lowered(t: Tick, _w: Work) -> Step:
 
 _lower_enter, _lower_step = lift(_lower_deltas, _lowered)
 LOWER = PhaseDef(
-    P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, enter=_lower_enter,
-    carried_by=(2,),
+    P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, LiftWork,
+    enter=_lower_enter, carried_by=(2,), family=Calibration,
     to={P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back to where the program began)",
         P.DESCENT_FINISH: "lowered (descent 7, turned back to the floor's heading)",
         P.DESCENT_BACK_TO_EDGE: "lowered (continuous descent, turned square to the edge)",
@@ -428,5 +330,5 @@ LOWER = PhaseDef(
                      "wall ahead: descent 1)",
         P.ERROR: FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (CHECK, CLOSE_IN, LIFT, LOWER)
+PHASES: tuple[PhaseDef[Any], ...] = (CHECK, CLOSE_IN, LIFT, LOWER)
 """This module's phases; the turns' are in :mod:`~stairbot.control.algorithm.turns`."""

@@ -1,10 +1,13 @@
-"""The controller's context: the seed's variables under their seed names,
-where the program stands, and the present phase's own working state
-(:class:`~stairbot.control.algorithm.work.Work`).
+"""The controller's context: the seed's variables under their seed names, the
+run's progress (where the program stands, and what spans phases: the start
+position, the step being descended, a landing, the standing rule's watch and
+wait), and the present phase's own state: its family's
+(:mod:`~stairbot.control.algorithm.families`) and its work
+(:mod:`~stairbot.control.algorithm.work`).
 
 Everything a phase needs to carry on is here, and motion targets are absolute
 counter values (not "N more turns"), so a controller restored from
-:meth:`Context.to_dict` — or resumed after the standing rule's wait — picks up
+:meth:`Context.to_dict` -- or resumed after the standing rule's wait -- picks up
 exactly where it stopped.
 """
 
@@ -12,12 +15,19 @@ from __future__ import annotations
 
 import math
 import types
-from dataclasses import asdict, dataclass, field, fields, is_dataclass
-from typing import Any, Union, get_args, get_origin, get_type_hints
+from dataclasses import dataclass, field, fields, is_dataclass
+from enum import Enum
+from typing import Any, TypeVar, Union, get_args, get_origin, get_type_hints
 
+from stairbot.control.algorithm import families, work
+from stairbot.control.algorithm.families import Family
+from stairbot.control.algorithm.modes import AscentEnd, Outcome
 from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.control.algorithm.work import Work
 from stairbot.errors import InputError
+
+F = TypeVar("F", bound=Family)
+W = TypeVar("W", bound=Work)
 
 TAB_SIZE = 20
 """Length of tab_length_to_edge, as the seed declares it."""
@@ -27,9 +37,108 @@ def _empty_tab() -> list[float | None]:
     return [None] * TAB_SIZE
 
 
+CONTEXT_VERSION = 2
+"""The shape of :meth:`Context.to_dict`; a journal names the version of the
+contexts it holds, and one of another version is refused, not misread.
+Version 1 was one flat table of every phase's scratch state."""
+
+
+@dataclass
+class StartPosition:
+    """Where the program began and where its first calibration squared up:
+    what descent 7 comes back to."""
+
+    reading: float | None = None
+    """Mean SFR/SFL reading when the first calibration ended: the start position."""
+    wheel: float | None = None
+    """The drive's odometer (turns) there."""
+    home_wheel: float | None = None
+    """The drive's odometer where the program began: where descent 7 returns
+    to (the first calibration may have closed in on the riser before it
+    squared up; its start position is then nearer the stairs)."""
+    home_twist: float | None = None
+    """The heading by the odometer where the program began: half of MWR's
+    counter less MWL's (:func:`~stairbot.control.algorithm.motion.twist`).
+    Descent 7 turns back to it before it backs the distance the first
+    calibration closed in."""
+
+
+@dataclass
+class DescentStep:
+    """The step being descended, across descent 1's back-off, its calibration
+    and its backing up to the edge (and the narrow tread below, from descent
+    5 on)."""
+
+    edge_wheel: float | None = None
+    """The odometer where the back pair crossed the edge of the step it
+    stands on (where it read the drop, less how far the robot backed while
+    the reading came through:
+    :func:`~stairbot.control.algorithm.edge.edge_sight_m`)."""
+    edge_squared: bool = False
+    """Continuous descent: the robot turned square to this step's edge by
+    its back pair (once a step)."""
+    turned_back: bool = False
+    """Descent 1 has turned back to the climb's heading on this step (once);
+    descent 7 to the floor's."""
+    narrow_edge_wheel: float | None = None
+    """Narrow steps: the odometer where the back pair crossed the edge of the
+    narrow tread the robot steps down onto (descent 5 and on): what bounds
+    descent 1's backing there, whatever the front pair reads."""
+
+
+@dataclass
+class Landing:
+    """A quarter-turn landing ([algorithm] landings), from its scan to the
+    way back down the first flight."""
+
+    seen: bool = False
+    """Landing 1 has scanned a landing (one a climb)."""
+    right_m: float | None = None
+    left_m: float | None = None
+    """How far what SSR (SSL) saw at the landing stands from the robot's
+    centre line, m (None: nothing in range)."""
+    side: int = 0
+    """The side the robot turned to: +1 left, -1 right (0: not turned)."""
+    twist: float | None = None
+    """The heading (odometer twist) the robot came up the first flight with:
+    the way down turns back to it."""
+    riser_m: float | None = None
+    """What SFR/SFL read on the next flight's first riser, squared up where
+    the robot turned: landing 3 backs to it."""
+    step: int | None = None
+    """0-based index of the next flight's first step (number_of_steps when
+    the robot turned onto it); None: no landing turned at."""
+
+
+@dataclass
+class Watch:
+    """The standing rule's watch of the present phase: made afresh whenever
+    a phase is entered (the wait's and a resume's too)."""
+
+    ticks: int = 0
+    """Ticks in a row the watched pair has disagreed."""
+    diff: float | None = None
+    """The watched pair's smoothed difference (left − right)."""
+
+
+@dataclass
+class Pause:
+    """The standing rule's wait: made when it stops the robot, gone when it
+    resumes."""
+
+    resume_phase: str
+    """The phase it stopped in, resumed when the readings agree."""
+    started_s: float
+    diffs: list[float] = field(default_factory=list)
+    """The watched pair's difference (left − right) on the wait's last ticks
+    that gave one (MEDIAN_S of them): their median decides at its end."""
+
+
 @dataclass
 class Context:
-    """The state of one run of the algorithm.  Plain data; JSON-serialisable."""
+    """The state of one run of the algorithm: the seed's variables under their
+    seed names, the run's progress, and the present phase's own state (its
+    family's and its work).  Plain data; :meth:`to_dict` is JSON-serialisable."""
 
     # -- the seed's variables ----------------------------------------------------
     length_of_next_step: float | None = None
@@ -44,164 +153,94 @@ class Context:
     """Per step (0-based: the step's number before it was counted): the SFR/SFL
     reading at which segment 3 hangs over the edge; None when not measurable."""
 
-    # -- where the program stands ---------------------------------------------------
+    # -- the run's progress ----------------------------------------------------------
     phase: str = "cal_check"
     """Value of the present :class:`~stairbot.control.algorithm.phases.Phase`."""
-    purpose: str = "start"
-    """What the calibration phases are doing: "start", "ascent", "descent", or
-    "home" or "floor" (descent 7 lifts and lowers segments 1 and 3 to turn
-    back to the heading the program began with, or crossed the floor with),
-    or "edge" (a continuous descent turns square to the edge its back pair
-    found)."""
-    calibration_case: str | None = None
-    """The first calibration's case: "1", "2", "3A" or "3B"."""
-    start_reading: float | None = None
-    """Mean SFR/SFL reading when the first calibration ended: the start position."""
-    start_wheel: float | None = None
-    """The drive's odometer (turns) there."""
-    home_wheel: float | None = None
-    """The drive's odometer where the program began: where descent 7 returns
-    to (the first calibration may have closed in on the riser before it
-    squared up, its start position is then nearer the stairs)."""
-    home_twist: float | None = None
-    """The heading by the odometer where the program began: half of MWR's
-    counter less MWL's (:func:`~stairbot.control.algorithm.motion.twist`).  Descent 7
-    turns back to it before it backs the distance the first calibration
-    closed in."""
-    tread_length: list[float | None] = field(default_factory=_empty_tab)
-    """Per step (0-based, as tab_length_to_edge): its tread as ascent 3
-    measured it (None: not measurable, the top).  One shorter than
-    LENGTH_OF_A_ROBOT + SAFE_LENGTH is a narrow step
-    (``[algorithm] narrow_steps``): the robot does not fit on it."""
-    narrow_edge_wheel: float | None = None
-    """Narrow steps: the odometer where the back pair crossed the edge of the
-    narrow tread the robot steps down onto (descent 5 and on): what bounds
-    descent 1's backing there, whatever the front pair reads."""
-    third_in_air: bool = False
-    """Narrow steps: segment 3 hangs in the air over the step below (it did
-    not fit on the tread): it carries nothing, and the static-stability
-    check leaves it out."""
-    climb_twist: list[float | None] = field(default_factory=_empty_tab)
-    """Per step (0-based, as tab_length_to_edge): the heading by the odometer
-    the robot climbed it with (where ascent 1's calibration left it).
-    Descent 1 turns back to it, so that the way down retraces the way up."""
-    case_diff: float | None = None
-    """SFL − SFR, the standing mean the last calibration check chose its case
-    on: the squaring turn's bound starts from it."""
-    turn_to: float | None = None
-    """The heading (twist) the calibration's odometer turn is turning to."""
-    squaring_turns: int = 0
-    """Turns this calibration has made to square up (by the readings, then
-    by the odometer to correct what the check standing on all wheels found);
-    while above 0, the calibration's check verifies the last one."""
-    steps_descended: int = 0
+    phase_started_s: float | None = None
+    """When the present phase began (controller clock: Snapshot.time_s)."""
     from_top: bool = False
     """Continuous descent (:attr:`~stairbot.control.algorithm.phases.Mode.DESCEND`): the
     program began on the top of a flight it did not climb.  Its steps are
     counted from the top (number_of_steps stays 0); each step's
     tab_length_to_edge is read where descent 1 leaves segment 3 over its
     edge."""
+    steps_descended: int = 0
     pauses: int = 0
-    ascent_end: str | None = None
-    """"top_reached" | "obstacle" | "step_limit" once the ascent has ended."""
-    outcome: str | None = None
+    ascent_end: AscentEnd | None = None
+    outcome: Outcome | None = None
     error: str | None = None
     end_reason: str | None = None
     """Why the program ended, whatever the outcome."""
-
-    # -- timers (controller clock: Snapshot.time_s) ---------------------------------
-    phase_started_s: float | None = None
-    pause_started_s: float | None = None
-    resume_phase: str | None = None
-    """The phase the standing rule stopped in, resumed when readings agree."""
-    pause_diffs: list[float] = field(default_factory=list)
-    """The watched pair's difference (left − right) on the standing rule's
-    wait's last ticks that gave one (MEDIAN_S of them): their median decides
-    at its end."""
-    disagree_ticks: int = 0
-    standing_diff: float | None = None
-    """The standing rule's smoothed difference of the watched pair (left − right)."""
-
-    # -- bookkeeping that spans phases ---------------------------------------------
-    return_mtf: float = 0.0
-    return_mtb: float = 0.0
-    """Lift counters to come back to: before the calibration lift, before ascent 3
-    (and where descent 2 began lowering MTB)."""
-    turn_origin: float = 0.0
-    """MWR counter when calibration began turning: bounds the total turn."""
-    edge_wheel: float | None = None
-    """Descent 1: the odometer where the back pair crossed the edge of the
-    step it stands on (where it read the drop, less how far the robot
-    backed while the reading came through:
-    :func:`~stairbot.control.algorithm.edge.edge_sight_m`), backing
-    off or backing up to it."""
-    edge_squared: bool = False
-    """Continuous descent: the robot turned square to this step's edge by
-    its back pair (once a step)."""
-    turned_back: bool = False
-    """Descent 1 has turned back to the climb's heading on this step (once)."""
+    tread_length: list[float | None] = field(default_factory=_empty_tab)
+    """Per step (0-based, as tab_length_to_edge): its tread as ascent 3
+    measured it (None: not measurable, the top).  One shorter than
+    LENGTH_OF_A_ROBOT + SAFE_LENGTH is a narrow step
+    (``[algorithm] narrow_steps``): the robot does not fit on it."""
+    climb_twist: list[float | None] = field(default_factory=_empty_tab)
+    """Per step (0-based, as tab_length_to_edge): the heading by the odometer
+    the robot climbed it with (where ascent 1's calibration left it).
+    Descent 1 turns back to it, so that the way down retraces the way up."""
+    third_in_air: bool = False
+    """Narrow steps: segment 3 hangs in the air over the step below (it did
+    not fit on the tread): it carries nothing, and the static-stability
+    check leaves it out."""
     riser_wheel: float | None = None
-    """Ascent 9's estimate of the next riser: the drive's odometer (turns) at
-    which the front sensors would touch it, dead reckoned from the last
-    readings that measured it.  Ascent 2 starts from it when the sensors read
-    "too near" (a sensor whose minimum range is more than what ascent 9
+    """The next riser by dead reckoning: the drive's odometer (turns) at which
+    the front sensors would touch it, from the last readings that measured it
+    (ascent 9's, then ascent 2's).  Ascent 2 starts from it when the sensors
+    read "too near" (a sensor whose minimum range is more than what ascent 9
     leaves)."""
-    riser_gap: float | None = None
-    """How far the front sensors stand from the riser when ascent 3 begins:
-    the approach's last reading less what it drove after it (the sensors read
-    "too near" there).  The tread is what they see past the riser less this."""
+    start: StartPosition = field(default_factory=StartPosition)
+    descent: DescentStep = field(default_factory=DescentStep)
+    landing: Landing = field(default_factory=Landing)
 
-    # -- quarter-turn landings ([algorithm] landings) -----------------------------
-    wall_ahead: bool = False
-    """Ascent 3 lifted segment 1 its whole stroke and still saw what is ahead:
-    a wall (or a riser too high), not a tread too short or a rise too low.
-    Only a wall may be a landing's."""
-    landing_seen: bool = False
-    """Landing 1 has scanned a landing (one a climb)."""
-    landing_right_m: float | None = None
-    landing_left_m: float | None = None
-    """How far what SSR (SSL) saw at the landing stands from the robot's centre
-    line, m (None: nothing in range)."""
-    landing_rise_m: list[float | None] = field(default_factory=lambda: [None, None])
-    """The height at which SSR (SSL) saw over it: the next flight's first
-    riser on the right (left), m; None: not seen over (a wall)."""
-    landing_open: list[int] = field(default_factory=list)
-    """The sides that open onto a flight: +1 left, -1 right."""
-    landing_depth_m: float | None = None
-    """The landing's depth, from the edge behind to the wall ahead, m."""
-    landing_side: int = 0
-    """The side the robot turned to: +1 left, -1 right (0: not turned)."""
-    landing_twist: float | None = None
-    """The heading (odometer twist) the robot came up the first flight with:
-    the way down turns back to it."""
-    landing_riser_m: float | None = None
-    """What SFR/SFL read on the next flight's first riser, squared up where the
-    robot turned: landing 3 backs to it."""
-    landing_step: int | None = None
-    """0-based index of the next flight's first step (number_of_steps when the
-    robot turned onto it); None: no landing turned at."""
-    # -- the present phase's own working state ----------------------------------------
+    # -- the standing rule -----------------------------------------------------------
+    watch: Watch = field(default_factory=Watch)
+    pause: Pause | None = None
+
+    # -- the present phase's own state ----------------------------------------------
+    family: Family | None = None
+    """The state of the present phase's family (None: the phase has none)."""
     work: Work = field(default_factory=Work)
-    """Made afresh when a phase is entered; no other phase reads it."""
+    """The present phase's work: made afresh when a phase is entered; no
+    other phase reads it."""
+
+    @property
+    def resume_phase(self) -> str | None:
+        """The phase the standing rule's wait resumes (None: not waiting)."""
+        return None if self.pause is None else self.pause.resume_phase
+
+    def family_of(self, kind: type[F]) -> F:
+        """The present family's state, which must be a ``kind``."""
+        family = self.family
+        assert isinstance(family, kind), f"{self.phase}: {family!r} is not a {kind.__name__}"
+        return family
+
+    def work_of(self, kind: type[W]) -> W:
+        """The present phase's work, which must be a ``kind``."""
+        work = self.work
+        assert isinstance(work, kind), f"{self.phase}: {work!r} is not a {kind.__name__}"
+        return work
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON-serialisable) that :meth:`from_dict` restores."""
-        data = asdict(self)
-        data["tab_length_to_edge"] = list(self.tab_length_to_edge)
+        data = _plain(self)
+        assert isinstance(data, dict)
         return data
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], source: str = "<context>") -> Context:
         """Restore a context saved with :meth:`to_dict` (and sent through JSON):
         every value as its field declares it -- a tuple from the list JSON
-        made of it, a float from an int -- so that ``from_dict(to_dict())``
-        equals the original.
+        made of it, a float from an int, an enum from its value, a work or a
+        family as the class its ``kind`` names -- so that
+        ``from_dict(to_dict())`` equals the original.
 
         Raises InputError naming the key when a key is unknown, a value has
         the wrong type, a number is not finite or beyond :data:`MAX_ABS`, a
         per-step list is not :data:`TAB_SIZE` long, the steps climbed are
         beyond it, more steps were descended than climbed, or ``phase`` (or
-        ``resume_phase``) names no phase.
+        the pause's ``resume_phase``) names no phase.
         """
         if not isinstance(data, dict):
             raise InputError(source, None, "a context must be a table")
@@ -209,12 +248,14 @@ class Context:
         for key in _PER_STEP:
             if len(getattr(ctx, key)) != TAB_SIZE:
                 raise InputError(source, key, f"must be a list of {TAB_SIZE} numbers or nulls")
-        for key in ("phase", "resume_phase"):
-            value = getattr(ctx, key)
-            if value is not None and value not in BY_VALUE:
-                raise InputError(source, key, f"{value!r} is not a phase")
-        for key in _STEP_COUNTS:
-            value = getattr(ctx, key)
+        phases: tuple[tuple[str, str | None], ...] = (
+            ("phase", ctx.phase), ("pause.resume_phase", ctx.resume_phase))
+        for key, name in phases:
+            if name is not None and name not in BY_VALUE:
+                raise InputError(source, key, f"{name!r} is not a phase")
+        counts: tuple[tuple[str, int | None], ...] = (
+            ("number_of_steps", ctx.number_of_steps), ("landing.step", ctx.landing.step))
+        for key, value in counts:
             if value is not None and not 0 <= value <= TAB_SIZE:
                 raise InputError(source, key, f"{value} is out of range; allowed: 0 to "
                                  f"{TAB_SIZE} (the steps a context has room for)")
@@ -227,9 +268,6 @@ class Context:
 
 _PER_STEP = ("tab_length_to_edge", "climb_twist", "tread_length")
 """The context's lists with one entry per step (TAB_SIZE long)."""
-
-_STEP_COUNTS = ("number_of_steps", "landing_step")
-"""Counts (or indices) of steps climbed: each indexes the per-step lists."""
 
 MAX_ABS = 1e9
 """The largest magnitude a number in a context may have (counters in turns,
@@ -288,7 +326,21 @@ def _restore(value: object, tp: Any, source: str, key: str, shown: str = "") -> 
     if isinstance(tp, type) and is_dataclass(tp):
         if not isinstance(value, dict):
             raise wrong(f"must be a table of {tp.__name__}'s fields")
+        kinds = _KINDS.get(tp)
+        if kinds is not None:  # a work or a family: the class its kind names
+            value = dict(value)
+            kind = value.pop("kind", None)
+            if kind not in kinds:
+                raise InputError(source, key + ".kind", f"{kind!r} is not a kind of "
+                                 f"{tp.__name__}; allowed: " + ", ".join(kinds))
+            tp = kinds[kind]
         return tp(**_values(tp, value, source, key + "."))
+    if isinstance(tp, type) and issubclass(tp, Enum):
+        try:
+            return tp(value)
+        except ValueError:
+            raise wrong(f"{value!r} is not a {tp.__name__}; allowed: "
+                        + ", ".join(repr(m.value) for m in tp)) from None
     if tp is bool:
         if not isinstance(value, bool):
             raise wrong()
@@ -311,3 +363,27 @@ def _restore(value: object, tp: Any, source: str, key: str, shown: str = "") -> 
 def _name(tp: Any) -> str:
     return tp.__name__ if isinstance(tp, type) and not get_args(tp) else str(tp).replace(
         "NoneType", "None")
+
+
+_KINDS: dict[type, dict[str, Any]] = {Work: work.KINDS, Family: families.KINDS}
+"""The classes whose saved values name their kind: each one's registry."""
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as plain data: a dataclass as a table of its fields (a work or
+    a family with its ``kind``), an enum as its value, a list copied."""
+    if is_dataclass(value) and not isinstance(value, type):
+        out: dict[str, Any] = {}
+        kind = getattr(value, "KIND", None)
+        if kind is not None:
+            out["kind"] = kind
+        for f in fields(value):
+            out[f.name] = _plain(getattr(value, f.name))
+        return out
+    if isinstance(value, Enum):
+        return value.value
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    if isinstance(value, tuple):
+        return tuple(_plain(v) for v in value)
+    return value

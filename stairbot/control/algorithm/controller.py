@@ -18,27 +18,31 @@ The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import asdict, dataclass
 from typing import Any
 
-from stairbot.control.algorithm import calibration, motion, stability, standing
-from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm import motion, stability, standing
+from stairbot.control.algorithm.context import Context, Pause, Watch
+from stairbot.control.algorithm.families import Calibration, Family
+from stairbot.control.algorithm.guards import (
+    SENSOR_WAIT_S,
+    check_restored,
+    link_meanwhile,
+    needed_sensors,
+    phase_timeout_s,
+)
+from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.control.algorithm.result import OUTCOMES, ControllerResult
 from stairbot.control.algorithm.transitions import (
-    BACK_PAIR_PHASES,
     TRANSITIONS,
     TransitionError,
     allowed,
 )
-from stairbot.control.algorithm.work import Work
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
 from stairbot.events import Event, EventKind, EventSink, discard
 from stairbot.hardware import (
-    BACK_SENSORS,
-    FRONT_SENSORS,
     LIFT_MOTORS,
     MotorId,
     SensorId,
@@ -47,47 +51,6 @@ from stairbot.hardware import (
     Speeds,
 )
 from stairbot.inputs.config import RobotConfig
-
-SENSOR_WAIT_S = 1.0
-"""How long the robot stands, lifts holding, for a sensor it needs that reads
-as ERROR (errors, or stale) to come back before the program ends with the
-error."""
-
-PHASE_TIMEOUT_S = 60.0
-"""A phase (other than the standing rule's wait) that lasts longer than this,
-in controller time, ends the program with an error: something is stuck.  A
-robot with slow motors gets longer: :func:`phase_timeout_s`."""
-
-
-def phase_timeout_s(config: RobotConfig) -> float:
-    """How long one phase may last: twice the longest motion a phase makes at
-    the config's speeds (a lift over its whole stroke, a drive of
-    LENGTH_OF_INFINITY, a calibration turn of its largest yaw), and at least
-    PHASE_TIMEOUT_S."""
-    m = config.motors
-    lift_s = 2 * config.MAX_OF_VERTICAL_TURNS / m.lift_speed
-    drive_s = config.wheel_turns(config.LENGTH_OF_INFINITY) / m.wheel_speed
-    turn = calibration.MAX_TURN_YAW_RAD * config.geometry.track_width / 2
-    turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
-    return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
-
-OUTCOMES = ("completed", "stopped", "error")
-
-
-@dataclass(frozen=True)
-class ControllerResult:
-    """How the program ended (``outcome`` is "running" until it has)."""
-
-    outcome: str  # "completed" | "stopped" | "error" | "running"
-    ascent_end: str | None  # "top_reached" | "obstacle" | "step_limit" | None
-    error: str | None
-    steps_climbed: int
-    steps_descended: int
-    pauses: int
-    reason: str | None = None  # why it ended, whatever the outcome
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 class Controller:
@@ -109,11 +72,14 @@ class Controller:
         self.check_stability = check_stability
         self._sink = sink
         if context is None:
-            context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns)
+            context = Context(number_of_vertical_turns=config.initial_number_of_vertical_turns,
+                              family=Calibration(Purpose.START))
             if mode is Mode.DESCEND:  # on the top: no riser to square up to, the edge behind
                 context.from_top = True
-                context.purpose = "descent"
+                context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
+        elif context.phase_started_s is not None:
+            check_restored(context)
         self._ctx = context
         self._started = context.phase_started_s is not None
         self._held: str | None = None
@@ -129,7 +95,7 @@ class Controller:
         self._sensor_since: float | None = None
         self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
         self._now_key: tuple[str, str | None] | None = None  # see _present
-        self._now: tuple[Phase, PhaseDef, tuple[SensorId, ...]] | None = None
+        self._now: tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]] | None = None
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -141,8 +107,8 @@ class Controller:
         """Where the program stands: the present phase's flow, or, while the
         standing rule waits, the flow of the phase it stopped in."""
         ctx = self._ctx
-        if ctx.phase == Phase.PAUSED.value and ctx.resume_phase is not None:
-            return BY_VALUE[ctx.resume_phase].flow
+        if ctx.phase == Phase.PAUSED.value and ctx.pause is not None:
+            return BY_VALUE[ctx.pause.resume_phase].flow
         return self.phase.flow
 
     @property
@@ -160,7 +126,9 @@ class Controller:
     @property
     def result(self) -> ControllerResult:
         ctx = self._ctx
-        return ControllerResult(ctx.outcome or "running", ctx.ascent_end, ctx.error,
+        return ControllerResult("running" if ctx.outcome is None else ctx.outcome.value,
+                                None if ctx.ascent_end is None else ctx.ascent_end.value,
+                                ctx.error,
                                 ctx.number_of_steps, ctx.steps_descended, ctx.pauses,
                                 ctx.end_reason)
 
@@ -180,15 +148,17 @@ class Controller:
         self._held = None
         self._emit(EventKind.INFO, "released: carrying on", self._time, {"held": False})
 
-    def abort(self, reason: str, outcome: str = "error") -> None:
-        """End the program now with ``outcome`` ("error" or "stopped"); every
-        later tick commands zero.  Outside the transition table on purpose: it
-        is the operator's (or the run loop's) decision, not the algorithm's."""
-        if outcome not in OUTCOMES:
+    def abort(self, reason: str, outcome: Outcome | str = Outcome.ERROR) -> None:
+        """End the program now with ``outcome`` (ERROR or STOPPED, or its
+        value); every later tick commands zero.  Outside the transition table
+        on purpose: it is the operator's (or the run loop's) decision, not the
+        algorithm's."""
+        if outcome not in OUTCOMES and not isinstance(outcome, Outcome):
             raise ValueError(f"outcome {outcome!r}; allowed: {', '.join(OUTCOMES)}")
         if self.finished:
             return
-        self._finish(Phase.ERROR if outcome == "error" else Phase.DONE, outcome, reason,
+        ends = Outcome(outcome)
+        self._finish(Phase.ERROR if ends is Outcome.ERROR else Phase.DONE, ends, reason,
                      self._time)
 
     # -- the tick ---------------------------------------------------------------------
@@ -239,7 +209,7 @@ class Controller:
         self._supervisor.commanded(speeds)
         return speeds
 
-    def _present(self) -> tuple[Phase, PhaseDef, tuple[SensorId, ...]]:
+    def _present(self) -> tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]]:
         """The present phase, its record and :func:`_needed_sensors`, looked up
         again only when the context's phase or the one a pause resumes changes."""
         ctx = self._ctx
@@ -247,7 +217,7 @@ class Controller:
         now = self._now
         if now is None or key != self._now_key:
             phase = BY_VALUE[ctx.phase]
-            now = self._now = (phase, phase.record, _needed_sensors(phase, ctx))
+            now = self._now = (phase, phase.record, needed_sensors(phase, ctx))
             self._now_key = key
         return now
 
@@ -304,7 +274,7 @@ class Controller:
             return True
         self._sensor_since = None
         self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
-                         f"{_link_meanwhile(self._sensor_link, snap.health)}"), snap)
+                         f"{link_meanwhile(self._sensor_link, snap.health)}"), snap)
         return True
 
     def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
@@ -332,41 +302,48 @@ class Controller:
         if not allowed(src, nxt):
             raise TransitionError(f"{src.value} -> {nxt.value} is not in the transition table")
         if nxt is Phase.ERROR:
-            self._finish(Phase.ERROR, "error", step.reason or "error", snap.time_s)
+            self._finish(Phase.ERROR, Outcome.ERROR, step.reason or "error", snap.time_s)
         elif nxt is Phase.DONE:
-            self._finish(Phase.DONE, step.outcome or "completed", step.reason or "done",
+            self._finish(Phase.DONE, step.outcome or Outcome.COMPLETED, step.reason or "done",
                          snap.time_s)
         elif nxt is Phase.PAUSED:
-            ctx.resume_phase = src.value
-            ctx.pause_started_s = snap.time_s
-            ctx.pause_diffs = []
+            ctx.pause = Pause(src.value, snap.time_s)
             ctx.pauses += 1
             self._emit(EventKind.PAUSE, step.reason or "paused", snap.time_s,
-                       {"resume_phase": ctx.resume_phase})
+                       {"resume_phase": ctx.pause.resume_phase})
             self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
         elif src is Phase.PAUSED:
-            assert ctx.pause_started_s is not None
+            assert ctx.pause is not None
             if ctx.phase_started_s is not None:
-                ctx.phase_started_s += snap.time_s - ctx.pause_started_s
-            ctx.resume_phase = ctx.pause_started_s = None
+                ctx.phase_started_s += snap.time_s - ctx.pause.started_s
+            ctx.pause = None
             self._emit(EventKind.RESUME, step.reason or "resumed", snap.time_s,
                        {"phase": nxt.value})
             self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
         else:
-            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap)
+            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap, begin=step.begin)
 
-    def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True) -> None:
+    def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True,
+               begin: Family | None = None) -> None:
         """Make ``phase`` the present one.  ``fresh``: a new start of the phase
-        (its timer, its work, its entry action); not fresh: the standing rule's
-        wait, or the phase it resumes."""
+        (its timer, its work, its family's state if it enters the family
+        (``begin``, or the family's defaults), its entry action); not fresh:
+        the standing rule's wait, or the phase it resumes."""
         ctx = self._ctx
         previous = ctx.phase
         ctx.phase = phase.value
-        ctx.disagree_ticks = 0
-        ctx.standing_diff = None
+        ctx.watch = Watch()
         if fresh:
+            record = phase.record
             ctx.phase_started_s = snap.time_s
-            ctx.work = Work.at_entry(snap)
+            ctx.work = record.work.at_entry(snap)
+            if begin is not None:
+                assert record.family is not None and isinstance(begin, record.family), begin
+                ctx.family = begin
+            elif record.family is None:
+                ctx.family = None
+            elif type(ctx.family) is not record.family:
+                ctx.family = record.family()
         note = where(ctx, phase)
         where_text = f" ({note})" if note else ""
         resumed = "" if fresh or phase is Phase.PAUSED else " (resumed)"
@@ -378,58 +355,32 @@ class Controller:
     def _say(self, message: str, **data: Any) -> None:
         self._emit(EventKind.INFO, message, self._time, data)
 
-    def _finish(self, phase: Phase, outcome: str, reason: str, time_s: float) -> None:
+    def _finish(self, phase: Phase, outcome: Outcome, reason: str, time_s: float) -> None:
         ctx = self._ctx
         previous = ctx.phase
         ctx.outcome = outcome
         ctx.end_reason = reason
         ctx.phase = phase.value
-        if outcome == "error":
+        if outcome is Outcome.ERROR:
             ctx.error = reason
             self._emit(EventKind.ERROR, reason, time_s, {"from": previous})
         self._emit(EventKind.PHASE, phase.label, time_s,
                    {"phase": phase.value, "flow": phase.flow, "from": previous, "why": reason})
-        self._emit(EventKind.END, f"program ended ({outcome}): {reason}", time_s,
+        self._emit(EventKind.END, f"program ended ({outcome.value}): {reason}", time_s,
                    self.result.to_dict())
 
     def _shift_timers(self, delta: float) -> None:
         ctx = self._ctx
         if ctx.phase_started_s is not None:
             ctx.phase_started_s += delta
-        if ctx.pause_started_s is not None:
-            ctx.pause_started_s += delta
+        if ctx.pause is not None:
+            ctx.pause.started_s += delta
 
 
     def _emit(self, kind: EventKind, message: str, time_s: float,
               data: dict[str, Any]) -> None:
         phase = self.phase.label
         self._sink(Event(time_s, kind, message, phase, data))
-
-
-def _needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
-    """The sensors whose ERROR status (errors, or stale) stands the robot in
-    ``phase``, and ends the program if it lasts."""
-    if phase is _PAUSED and ctx.resume_phase is not None:
-        phase = Phase(ctx.resume_phase)
-    if phase.terminal:
-        return ()
-    if ctx.from_top and phase.flow != "ascent":
-        return BACK_SENSORS  # a continuous descent steers by the back pair alone
-    if phase in _EDGE_WATCH:
-        return FRONT_SENSORS + BACK_SENSORS
-    if phase is Phase.LANDING_SCAN:
-        # The scan moves segment 3 alone, and steers nothing: a side pair that
-        # reads no distance there is no flight (the landing is refused, the
-        # robot goes home), not a reason to end the program on the landing.
-        return ()
-    return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
-
-
-_EDGE_WATCH = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
-"""Descent 1's phases watch the back pair for the edge as they back: a back
-sensor that reports errors, or stops measuring, would hide it (the edge is
-where both read the drop), and backing from the top of a flight the robot
-would go over the edge unseen."""
 
 
 _PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
@@ -441,17 +392,3 @@ _TERMINAL: dict[str, bool] = {p.value: p.terminal for p in Phase}
 def _zeros() -> dict[MotorId, float]:
     return _ZEROS.copy()
 
-
-LINK_TROUBLE = ("retries", "timeouts", "lost", "revived")
-"""The link figures (Snapshot.health) that say frames went missing."""
-
-
-def _link_meanwhile(before: Mapping[str, float], now: Mapping[str, float]) -> str:
-    """What the link counted during a sensor hold, when it lost frames: a
-    reading goes stale on a wire that loses its replies too, and the error
-    says so (empty for a robot with no link, or a link that lost nothing)."""
-    grown = {k: now[k] - before.get(k, 0.0) for k in LINK_TROUBLE if k in now}
-    if not any(v > 0 for v in grown.values()):
-        return ""
-    counts = ", ".join(f"{v:.0f} {k}" for k, v in grown.items() if v > 0)
-    return f"; meanwhile the link lost frames ({counts}): the readings were stale on the wire"

@@ -16,10 +16,11 @@ from __future__ import annotations
 import math
 
 from stairbot.control.algorithm import limits, motion
+from stairbot.control.algorithm.modes import Outcome
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
-from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import measurement_period, median_sigma, window
-from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorStatus
+from stairbot.control.algorithm.work import EdgeWork
+from stairbot.control.tolerances import measurement_period, median_sigma, window
+from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
 FLOOR_SIGMAS = 2.0
@@ -147,7 +148,7 @@ MAX_EDGE_YAW_RAD = math.radians(25.0)
 robot backed as far as this yaw across the pair's spacing: it stops."""
 
 
-def square_to_edge(t: Tick, w: Work) -> str | None:
+def square_to_edge(t: Tick, w: EdgeWork) -> str | None:
     """Watch which back sensor reads the drop first, and where
     (``w.edge_first_wheel``: :func:`_crossed` places the crossing between
     the two); an error if the other does not follow within
@@ -161,7 +162,7 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
     would stop the robot short, and lowering segment 3 there tips it nose
     down."""
     ctx, cfg = t.ctx, t.cfg
-    if ctx.edge_wheel is not None or w.edge_floor_s is None:
+    if ctx.descent.edge_wheel is not None or w.edge_floor_s is None:
         return None
     right, left = drops(t)
     here = motion.wheel_position(t.snap)
@@ -169,13 +170,13 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
         w.edge_first_wheel = w.edge_first = None  # both on the floor: no crossing begun
         return None
     if right != left:
-        first = "SBR" if right else "SBL"
+        first = SensorId.SBR if right else SensorId.SBL
         if w.edge_first_wheel is None or w.edge_first != first:
             w.edge_first_wheel, w.edge_first = here, first
         lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
         most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
         if lag > most:
-            other = "SBL" if right else "SBR"
+            other = SensorId.SBL if right else SensorId.SBR
             return (f"descent 1: {first} reads the drop, {other} still the floor "
                         f"after backing {lag * 1000:.0f} mm more (at most {most * 1000:.0f} mm: "
                         f"{math.degrees(MAX_EDGE_YAW_RAD):.0f}° from square to the edge): "
@@ -184,12 +185,12 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
         return None
     if not ctx.from_top:
         return None
-    if right and w.edge_first_wheel is not None and not ctx.edge_squared:
+    if right and w.edge_first_wheel is not None and not ctx.descent.edge_squared:
         lag = (w.edge_first_wheel - here) * cfg.wheel_circumference
         yaw = math.atan2(lag, 2 * cfg.sensors.back_lateral)
         if yaw > EDGE_SQUARE_RAD:
             # SBR first: its side is further back, the robot turned right: turn left
-            w.square_yaw = yaw if w.edge_first == "SBR" else -yaw
+            w.square_yaw = yaw if w.edge_first is SensorId.SBR else -yaw
             t.say(f"{w.edge_first} read the drop {lag * 1000:.0f} mm before the other: "
                   f"{math.degrees(yaw):.1f}° from square to the edge; turning "
                   f"{'left' if w.square_yaw > 0 else 'right'} to square up",
@@ -197,7 +198,7 @@ def square_to_edge(t: Tick, w: Work) -> str | None:
     return None
 
 
-def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
+def edge_bound(t: Tick, w: EdgeWork, refind: bool) -> float | None:
     """Descent 1's backing (backing off, and backing up to the edge) never
     passes edge_clearance_m beyond where the back pair saw the drop (more
     than half the lowest rise below BACK_CLEARANCE, or nothing in range):
@@ -219,8 +220,8 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
     (the robot standing, so :func:`edge_sight_m` is 0) would lie at the
     pair, when the pair may be well past the edge, and backing the whole
     clearance from there tips the robot back."""
-    cfg, ctx = t.cfg, t.ctx
-    if ctx.edge_wheel is None:
+    cfg, step = t.cfg, t.ctx.descent
+    if step.edge_wheel is None:
         now = t.snap.time_s
         if w.square_yaw is None and w.edge_stop is None:
             w.edge_stop = square_to_edge(t, w)
@@ -247,13 +248,13 @@ def edge_bound(t: Tick, w: Work, refind: bool) -> float | None:
                 return None
             return motion.wheel_position(t.snap)  # the back-off ends here
         else:
-            ctx.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
+            step.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
             more = max(0.0, edge_clearance_m(cfg) - sight)
             t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m, "
                   f"about {sight * 1000:.0f} mm past it): backing at most {more:.3f} m more")
-    if ctx.edge_wheel is None:
+    if step.edge_wheel is None:
         return None
-    return ctx.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
+    return step.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
 
 
 def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
@@ -288,27 +289,27 @@ NARROW_AXLE_MARGIN_M = 0.004
 edge than this (the tab puts it 8.5 mm past it, as ascent 6 left it)."""
 
 
-def narrow_bound(t: Tick, w: Work) -> float | None:
+def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     """Narrow steps: watch the back pair cross the edge of the narrow tread
     the robot stands on, or steps down onto (floor, then the drop, as
     :func:`edge_bound` does) and
-    keep where (``Context.narrow_edge_wheel``); once known, the odometer
+    keep where (``DescentStep.narrow_edge_wheel``); once known, the odometer
     count the backing never passes: segment 2's rear axle
     NARROW_AXLE_MARGIN_M past that edge.  The front pair's tab alone leaves
     8.5 mm to spare there: both of its sensors reading 20 mm short (a common
     fault the standing rule cannot see) would back segment 2's rear wheels
     off the edge."""
-    cfg, ctx = t.cfg, t.ctx
-    if ctx.narrow_edge_wheel is None:
+    cfg, step = t.cfg, t.ctx.descent
+    if step.narrow_edge_wheel is None:
         if not sees_drop(t):
             w.edge_floor_s = t.snap.time_s
         elif w.edge_floor_s is not None:
-            ctx.narrow_edge_wheel = _crossed(t)[0]
-    if ctx.narrow_edge_wheel is None:
+            step.narrow_edge_wheel = _crossed(t)[0]
+    if step.narrow_edge_wheel is None:
         return None
     g = cfg.geometry
     reach = g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear + g.wheel_inset
-    return ctx.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M)
+    return step.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M)
 
 
 def refind_max_m(cfg: RobotConfig) -> float:
@@ -317,7 +318,7 @@ def refind_max_m(cfg: RobotConfig) -> float:
     return edge_clearance_m(cfg) + edge_sight_m(cfg, cfg.wheel_speed_m_s) + 0.02
 
 
-def refind(t: Tick, w: Work) -> Step:
+def refind(t: Tick, w: EdgeWork) -> Step:
     """Drive forward until the back pair reads the floor again (REFIND_TICKS
     ticks in a row, and at least as far as its lag carries the robot at full
     speed), then back up to the edge, the watch seeing it cross."""
@@ -334,7 +335,7 @@ def refind(t: Tick, w: Work) -> Step:
         return stay(NO_MOTION)
     most = refind_max_m(cfg)
     if driven_m >= most and t.ctx.from_top:
-        return end("stopped", f"refused: SBR/SBL read past an edge from the start of step "
+        return end(Outcome.STOPPED, f"refused: SBR/SBL read past an edge from the start of step "
                               f"{t.ctx.steps_descended + 1} from the top, and still after "
                               f"driving {driven_m * 1000:.0f} mm forward: the tread is shorter "
                               "than the robot")

@@ -33,15 +33,24 @@ wall ahead, then the edge its back pair finds).  One landing a climb.
 from __future__ import annotations
 
 import math
-import statistics
+from typing import Any
 
-from stairbot.control.algorithm import limits, motion
-from stairbot.control.algorithm.moves import lift, reading_drive, stood
-from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.families import LandingTurn
+from stairbot.control.algorithm.landing_scan import LEFT, RIGHT, SCAN
+from stairbot.control.algorithm.modes import AscentEnd, Purpose
+from stairbot.control.algorithm.moves import lift, reading_drive
+from stairbot.control.algorithm.phase import (
+    FAULT,
+    PhaseDef,
+    Step,
+    Tick,
+    calibrate,
+    go,
+)
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import side_settle_s
-from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
+from stairbot.control.algorithm.work import DriveWork, LiftWork
+from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 
 P = Phase
@@ -61,22 +70,6 @@ LENGTH_OF_FIRST_MODULE + LENGTH_OF_SECOND_MODULE less about this past the
 edge (segment 2's rear wheels just onto the step: ascent 6 ends at
 length_of_next_step less the two, and a 0.28 m tread read tabs of 0.145 to
 0.150 m), m."""
-SIDE_JUMP_M = 0.05
-"""A side sees over what it saw when it reads this much farther (or nothing
-in range): ascent 3's SIGHT_JUMP_M, for the same reason -- no tread is this
-short, and it is ten times the sensors' noise."""
-SCAN_CONFIRM_TICKS = 5
-"""Lifting, a side has been seen over once its reading has stayed past what
-it saw this many ticks in a row (then the lift may stop early)."""
-SCAN_TOP_TICKS = 15
-"""Standing at the top of the scan, the ticks each side is read over: open
-if past what it saw on most of them."""
-SCAN_BASE_M = 0.01
-"""The scan takes what each side sees from the readings of its first this
-much of segment 3's lift, m."""
-LEFT, RIGHT = 1, -1
-
-
 def half_width(cfg: RobotConfig) -> float:
     """Half the robot's width, wheels included."""
     return cfg.geometry.track_width / 2.0 + WHEEL_WIDTH
@@ -100,153 +93,47 @@ def turn_room_m(cfg: RobotConfig) -> float:
     return turning_radius(cfg) + TURN_ROOM_MARGIN
 
 
-def can_scan(t: Tick) -> bool:
-    """A wall ahead at the top of a step (too high to see over: a tread too
-    short to stand on is no landing to turn on), on a robot that turns on
-    landings, with no landing scanned yet: look sideways before turning
-    back down."""
+def can_scan(t: Tick, wall_ahead: bool) -> bool:
+    """A wall ahead at the top of a step (``wall_ahead``: too high to see
+    over; a tread too short to stand on is no landing to turn on), on a robot
+    that turns on landings, with no landing scanned yet: look sideways before
+    turning back down."""
     ctx, cfg = t.ctx, t.cfg
     return (cfg.algorithm.landings and cfg.sensors.has_side_pair and ctx.number_of_steps > 0
-            and ctx.wall_ahead and not ctx.landing_seen and not ctx.from_top)
+            and wall_ahead and not ctx.landing.seen and not ctx.from_top)
 
 
-# -- landing 1: scan ---------------------------------------------------------------------
-def _side(reading: SensorReading) -> float | None:
-    """A side reading's distance, or None (nothing in range, or an error)."""
-    return reading.distance_m if reading.ok else None
-
-
-def _scan_enter(t: Tick, w: Work) -> None:
-    t.ctx.landing_seen = True
-    t.ctx.return_mtb = w.entry_mtb
-    w.target_mtb = max(w.entry_mtb, t.cfg.MAX_OF_VERTICAL_TURNS)
-
-
-def _lifted_m(t: Tick, w: Work) -> float:
-    return (t.snap.turns(MotorId.MTB) - w.entry_mtb) * t.cfg.motors.lift_travel_per_turn
-
-
-def _jumped(reading: SensorReading, base: float) -> bool:
-    """The side reads on past what it saw (by SIDE_JUMP_M, or nothing in range)."""
-    if reading.status is SensorStatus.OUT_OF_RANGE:
-        return reading.distance_m > base
-    return reading.ok and reading.distance_m >= base + SIDE_JUMP_M
-
-
-def _sample(t: Tick, w: Work) -> None:
-    """Lifting, per side (SSR, SSL): the readings of the lift's first
-    SCAN_BASE_M (what the side sees), then the height from which the reading
-    has stayed past them SCAN_CONFIRM_TICKS ticks in a row (where the beam
-    saw over what it saw: a hint of the riser's height)."""
-    lifted = _lifted_m(t, w)
-    for i, sid in enumerate(SIDE_SENSORS):
-        reading = t.snap.sensors[sid]
-        if lifted < SCAN_BASE_M:
-            d = _side(reading)
-            if d is not None:
-                w.side_base[i].append(d)
-            continue
-        if not w.side_base[i] or w.side_run[i] >= SCAN_CONFIRM_TICKS:
-            continue
-        if _jumped(reading, statistics.median(w.side_base[i])):
-            if w.side_run[i] == 0:
-                w.side_open[i] = lifted
-            w.side_run[i] += 1
-        else:
-            w.side_run[i], w.side_open[i] = 0, None
-
-
-def _scan(t: Tick, w: Work) -> Step:
-    """Lift segment 3 to the top of its stroke (or until both sides have been
-    seen over), then, standing, read both sides SCAN_TOP_TICKS ticks once
-    the filter has settled: a side is open only if what it reads standing
-    there lies past what it saw below.  A stray measurement while lifting
-    (1 % outliers) took a wall for a flight: the robot turned to it."""
-    if not w.checked:
-        _sample(t, w)
-        speeds = motion.lifts_to(t.cfg, t.snap, w.lift_targets())
-        if speeds is not None and min(w.side_run) < SCAN_CONFIRM_TICKS:
-            return stay(speeds)
-        w.checked = True
-    if not stood(t, w, side_settle_s(t.cfg)):
-        return stay(NO_MOTION)
-    for i, sid in enumerate(SIDE_SENSORS):
-        reading = t.snap.sensors[sid]
-        if not w.side_base[i]:
-            continue
-        w.side_top[i] += 1 if _jumped(reading, statistics.median(w.side_base[i])) else 0
-    w.side_ticks += 1
-    if w.side_ticks < SCAN_TOP_TICKS:
-        return stay(NO_MOTION)
-    return _record(t, w)
-
-
-def _record(t: Tick, w: Work) -> Step:
-    """What the scan found, kept in the context for the turn and the way back:
-    how far each side is from the centre line, which sides open onto a
-    flight, and its first riser's height (where the beam saw over it)."""
-    ctx, cfg = t.ctx, t.cfg
-    lat = cfg.sensors.side_lateral
-    bases = [statistics.median(b) if b else None for b in w.side_base]
-    ctx.landing_right_m = None if bases[0] is None else bases[0] + lat
-    ctx.landing_left_m = None if bases[1] is None else bases[1] + lat
-    # open: past what it saw on most of the ticks standing at the top, and
-    # seen over no lower than the lowest riser it climbs (the beam below that
-    # met something it then lost: a fault, not a flight -- a side sensor
-    # reading long from just above the landing would otherwise send the robot
-    # turning to a wall)
-    lifted = _lifted_m(t, w)
-    seen_at = [lifted if o is None else o for o in w.side_open]
-    low = limits.min_step_rise_m(cfg) - cfg.sensors.side_height - SCAN_BASE_M
-    opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS
-              and seen_at[i] >= low for i in (0, 1)]
-    ctx.landing_rise_m = [seen_at[i] + cfg.sensors.side_height if opened[i] else None
-                          for i in (0, 1)]
-    ctx.landing_open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
-    for i, sid in enumerate(SIDE_SENSORS):
-        if opened[i]:
-            name = "right" if i == 0 else "left"
-            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
-                  f"({bases[i]:.3f} m) with segment 3 lifted {seen_at[i]:.3f} m, and "
-                  f"standing at the top: the next flight", sensor=sid.value, base=bases[i])
-    return go(P.LANDING_SCAN_LOWER)
-
-
-SCAN = PhaseDef(
-    P.LANDING_SCAN, "landing 1 — lift segment 3, looking sideways for the next flight", FLOW,
-    _scan, enter=_scan_enter, carried_by=(1, 2),
-    to={P.LANDING_SCAN_LOWER: "segment 3 at the top of its stroke (or both sides seen over), "
-                              "read standing there",
-        P.ERROR: FAULT})
+def _turn(t: Tick) -> LandingTurn:
+    return t.ctx.family_of(LandingTurn)
 
 
 # -- landing 1: lower, decide ------------------------------------------------------------------
-def _lower_deltas(t: Tick, w: Work) -> dict[MotorId, float]:
-    return {MotorId.MTB: t.ctx.return_mtb - w.entry_mtb}
+def _lower_deltas(t: Tick, w: LiftWork) -> dict[MotorId, float]:
+    return {MotorId.MTB: _turn(t).return_mtb - w.entry_mtb}
 
 
-def _decide(t: Tick, _w: Work) -> Step:
-    ctx, cfg = t.ctx, t.cfg
-    right, left = ctx.landing_right_m, ctx.landing_left_m
-    opened = ctx.landing_open
+def _decide(t: Tick, _w: LiftWork) -> Step:
+    landing, cfg, turn = t.ctx.landing, t.cfg, _turn(t)
+    right, left = landing.right_m, landing.left_m
+    opened = turn.open
     if not opened:
-        return _refuse(t, "landing_closed",
+        return _refuse(t, AscentEnd.LANDING_CLOSED,
                        "landing: no next flight to either side (SSR "
                        f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
                        "3's whole stroke does not see over)")
     room = turn_room_m(cfg)
     depth = landing_depth(t)
     if depth is None:
-        return _refuse(t, "landing_too_small",
+        return _refuse(t, AscentEnd.LANDING_TOO_SMALL,
                        "landing: its depth was not measured (neither the tread past the "
                        "last riser nor tab_length_to_edge read the wall ahead): no room to "
                        "turn is known")
-    ctx.landing_depth_m = depth
+    turn.depth_m = depth
     short = [f"{name} {_said(have)}" for name, have in
              (("right", right), ("left", left), ("depth/2", depth / 2.0))
              if have is None or have < room]
     if short:
-        return _refuse(t, "landing_too_small",
+        return _refuse(t, AscentEnd.LANDING_TOO_SMALL,
                        f"landing too small to turn in: the robot's turning circle needs "
                        f"{room:.3f} m from its centre on every side (radius "
                        f"{turning_radius(cfg):.3f} m + {TURN_ROOM_MARGIN} m), it has "
@@ -254,9 +141,8 @@ def _decide(t: Tick, _w: Work) -> Step:
     side = LEFT if LEFT in opened else RIGHT
     if len(opened) == 2:
         # both open: the lower first riser (the side seen over first)
-        side = LEFT if (ctx.landing_rise_m[1] or 0.0) <= (ctx.landing_rise_m[0] or 0.0) \
-            else RIGHT
-    ctx.landing_side = side
+        side = LEFT if (turn.rise_m[1] or 0.0) <= (turn.rise_m[0] or 0.0) else RIGHT
+    landing.side = side
     t.say(f"landing: the next flight is to the {'left' if side == LEFT else 'right'}; "
           f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
           "centring to turn", side=side, depth=depth)
@@ -285,16 +171,16 @@ def _said(d: float | None) -> str:
     return "nothing in range" if d is None else f"{d:.3f} m"
 
 
-def _refuse(t: Tick, why: str, message: str) -> Step:
+def _refuse(t: Tick, why: AscentEnd, message: str) -> Step:
     t.ctx.ascent_end = why
-    t.say(message + "; the ascent ends, the descent begins", ascent_end=why)
+    t.say(message + "; the ascent ends, the descent begins", ascent_end=why.value)
     return go(P.DESCENT_BACK_OFF)
 
 
 _scan_lower = lift(_lower_deltas, _decide)
 SCAN_LOWER = PhaseDef(
     P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
-    _scan_lower[1], enter=_scan_lower[0], carried_by=(1, 2),
+    _scan_lower[1], LiftWork, enter=_scan_lower[0], carried_by=(1, 2), family=LandingTurn,
     to={P.LANDING_CENTRE: "lowered; a side seen over, and room to turn",
         P.DESCENT_BACK_OFF: "lowered; no side seen over (landing_closed), or too little "
                             "room to turn (landing_too_small): the descent begins",
@@ -303,7 +189,7 @@ SCAN_LOWER = PhaseDef(
 
 # -- landing 2: centre, then turn --------------------------------------------------------------
 def _centre_target(t: Tick) -> float | None:
-    depth = t.ctx.landing_depth_m
+    depth = _turn(t).depth_m
     assert depth is not None  # set by the decision
     return depth / 2.0 - centre_to_front(t.cfg)
 
@@ -316,21 +202,19 @@ def _centre_turns(t: Tick) -> float:
     return t.cfg.wheel_turns(max(0.0, target - t.cfg.algorithm.approach_gap))
 
 
-def _centred(t: Tick, _w: Work) -> Step:
-    ctx = t.ctx
-    ctx.landing_twist = motion.twist(t.snap)
-    yaw = ctx.landing_side * math.pi / 2.0
-    ctx.turn_to = ctx.landing_twist + motion.yaw_turns(t.cfg, yaw)
-    ctx.squaring_turns = 0
-    ctx.purpose = "landing"
-    return go(P.CAL_LIFT, f"centred on the landing: turning {math.degrees(yaw):+.0f}° "
-                          "towards the next flight")
+def _centred(t: Tick, _w: DriveWork) -> Step:
+    landing = t.ctx.landing
+    landing.twist = motion.twist(t.snap)
+    yaw = landing.side * math.pi / 2.0
+    return calibrate(Purpose.LANDING, landing.twist + motion.yaw_turns(t.cfg, yaw),
+                     f"centred on the landing: turning {math.degrees(yaw):+.0f}° towards the "
+                     "next flight")
 
 
 _centre = reading_drive(-1, _centre_target, _centre_turns, _centred)
 CENTRE = PhaseDef(
     P.LANDING_CENTRE, "landing 2 — back to the landing's middle", FLOW, _centre[1],
-    enter=_centre[0], watches="front",
+    DriveWork, enter=_centre[0], watches="front", family=LandingTurn,
     to={P.CAL_LIFT: "reads half the landing's depth less the front face's reach: lift "
                     "to turn 90° towards the next flight",
         P.ERROR: FAULT})
@@ -341,31 +225,30 @@ def turned(t: Tick) -> Step:
     (calibrate on its first riser), or down the first (calibrate on the wall
     ahead, descent 1)."""
     ctx = t.ctx
-    if ctx.purpose == "landing":
-        ctx.landing_step = ctx.number_of_steps
-        ctx.purpose = "ascent"
+    if t.cal.purpose is Purpose.LANDING:
+        ctx.landing.step = ctx.number_of_steps
         t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
-              landing_step=ctx.landing_step)
-    else:
-        # descent 1 of the first flight's top step, as its back-off would begin it:
-        # that step's edge not seen yet (the edge watch's mark is the last step's)
-        ctx.purpose = "descent"
-        ctx.edge_wheel = None
-        ctx.turned_back = ctx.edge_squared = False
-    return go(P.CAL_CHECK)
+              landing_step=ctx.landing.step)
+        return calibrate(Purpose.ASCENT)
+    # descent 1 of the first flight's top step, as its back-off would begin it:
+    # that step's edge not seen yet (the edge watch's mark is the last step's)
+    ctx.descent.edge_wheel = None
+    ctx.descent.turned_back = ctx.descent.edge_squared = False
+    return calibrate(Purpose.DESCENT)
 
 
 def after_calibration(t: Tick) -> None:
     """Squared up on the next flight's first riser, standing where it turned:
     what the front pair reads there is where the way down turns back
-    (``landing_riser_m``)."""
+    (``Landing.riser_m``)."""
     ctx = t.ctx
-    if ctx.landing_step is None or ctx.number_of_steps != ctx.landing_step \
-            or ctx.landing_riser_m is not None or not motion.measurable(t.snap, t.cfg):
+    landing = ctx.landing
+    if landing.step is None or ctx.number_of_steps != landing.step \
+            or landing.riser_m is not None or not motion.measurable(t.snap, t.cfg):
         return
-    ctx.landing_riser_m = motion.mean_distance(t.snap)
-    t.say(f"where it turned: SFR/SFL read {ctx.landing_riser_m:.3f} m to the next flight's "
-          "first riser", landing_riser_m=ctx.landing_riser_m)
+    landing.riser_m = motion.mean_distance(t.snap)
+    t.say(f"where it turned: SFR/SFL read {landing.riser_m:.3f} m to the next flight's "
+          "first riser", landing_riser_m=landing.riser_m)
 
 
 # -- landing 3: back to where it turned, turn back ------------------------------------------
@@ -373,15 +256,15 @@ def turned_here(t: Tick) -> bool:
     """Turned onto the next flight, and refusing its first step: the way down
     begins with the turn back."""
     ctx = t.ctx
-    return ctx.landing_step is not None and ctx.number_of_steps == ctx.landing_step
+    return ctx.landing.step is not None and ctx.number_of_steps == ctx.landing.step
 
 
 def returns_here(t: Tick) -> bool:
     """Just down the next flight's first step: back to the landing's turn."""
     ctx = t.ctx
-    return (ctx.landing_step is not None and not ctx.from_top
+    return (ctx.landing.step is not None and not ctx.from_top
             and ctx.steps_descended < ctx.number_of_steps
-            and t.descent_index == ctx.landing_step - 1)
+            and t.descent_index == ctx.landing.step - 1)
 
 
 def _return_target(t: Tick) -> float | None:
@@ -390,15 +273,15 @@ def _return_target(t: Tick) -> float | None:
     pair said of that side, less the front face's reach.  The front pair
     first: a side sensor reading long, alone, would send the robot back to
     the wrong place on the landing, and it would turn back into a wall."""
-    if t.ctx.landing_riser_m is not None:
-        return t.ctx.landing_riser_m
+    if t.ctx.landing.riser_m is not None:
+        return t.ctx.landing.riser_m
     open_m = _open_m(t)
     return None if open_m is None else open_m - centre_to_front(t.cfg)
 
 
 def _open_m(t: Tick) -> float | None:
-    ctx = t.ctx
-    return ctx.landing_left_m if ctx.landing_side == LEFT else ctx.landing_right_m
+    landing = t.ctx.landing
+    return landing.left_m if landing.side == LEFT else landing.right_m
 
 
 def _return_turns(t: Tick) -> float:
@@ -406,23 +289,21 @@ def _return_turns(t: Tick) -> float:
     return t.cfg.wheel_turns(max(0.0, (target or 0.0) - t.cfg.algorithm.approach_gap))
 
 
-def _returned(t: Tick, _w: Work) -> Step:
-    ctx = t.ctx
-    assert ctx.landing_twist is not None  # set before the turn
-    ctx.turn_to = ctx.landing_twist
-    ctx.squaring_turns = 0
-    ctx.purpose = "landing_back"
-    return go(P.CAL_LIFT, "back where it turned: turning back to the first flight")
+def _returned(t: Tick, _w: DriveWork) -> Step:
+    twist = t.ctx.landing.twist
+    assert twist is not None  # set before the turn
+    return calibrate(Purpose.LANDING_BACK, twist,
+                     "back where it turned: turning back to the first flight")
 
 
 _return = reading_drive(-1, _return_target, _return_turns, _returned)
 RETURN = PhaseDef(
     P.LANDING_RETURN, "landing 3 — back to where it turned", FLOW, _return[1],
-    enter=_return[0], watches="front",
+    DriveWork, enter=_return[0], watches="front",
     to={P.CAL_LIFT: "reads where it turned (down the next flight's first step, or having "
                     "refused it): lift to turn back to the heading it came up the first "
                     "flight with",
         P.ERROR: FAULT})
 
 
-PHASES: tuple[PhaseDef, ...] = (SCAN, SCAN_LOWER, CENTRE, RETURN)
+PHASES: tuple[PhaseDef[Any], ...] = (SCAN, SCAN_LOWER, CENTRE, RETURN)

@@ -19,7 +19,7 @@ from weakref import WeakKeyDictionary
 import msgspec
 
 from stairbot.control.algorithm import landing, stability
-from stairbot.control.perception import quiet_range_m
+from stairbot.control.tolerances import quiet_range_m
 from stairbot.inputs.config import RobotConfig
 
 _MARGINS: WeakKeyDictionary[RobotConfig, float] = WeakKeyDictionary()
@@ -32,7 +32,7 @@ def square_range_m(cfg: RobotConfig) -> float:
     read the first riser alone (farther, the upper rays pass over it and
     the reading blends the risers beyond); and the pair's stated noise
     lets it square up to equal_tolerance
-    (:func:`~stairbot.control.perception.quiet_range_m`).  Infinite for level,
+    (:func:`~stairbot.control.tolerances.quiet_range_m`).  Infinite for level,
     quiet rays."""
     top = cfg.front_cone_top_rad
     cone = math.inf if top <= 0.0 else \

@@ -29,7 +29,7 @@ from __future__ import annotations
 import statistics
 
 from stairbot.control.algorithm.phase import Tick
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import SightWork
 
 FAR_TREAD_M = 0.5
 """A length_of_next_step longer than this: ascent 4, 6 and 9 drive by turns,
@@ -59,7 +59,7 @@ def near_length(t: Tick) -> float | None:
     return None if length is None or far(length) else length
 
 
-def growth(w: Work) -> float | None:
+def growth(w: SightWork) -> float | None:
     """How much the pair's readings moved over the lift: the larger of SFR's
     and SFL's last-third median less its first-third median, in magnitude;
     None with fewer than MIN_ROWS readings of either."""
@@ -78,7 +78,7 @@ def steady_m(t: Tick, distance_m: float) -> float:
     return max(STEADY_MIN_M, STEADY_SIGMAS * t.cfg.sensors.sigma(False, distance_m))
 
 
-def steady(t: Tick, w: Work, distance_m: float) -> tuple[bool, float | None]:
+def steady(t: Tick, w: SightWork, distance_m: float) -> tuple[bool, float | None]:
     """Whether the pair's readings of a riser ``distance_m`` away held over
     the lift, and by how much they moved (None: too few readings)."""
     grew = growth(w)

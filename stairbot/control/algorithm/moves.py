@@ -12,17 +12,21 @@ from __future__ import annotations
 
 import statistics
 from collections.abc import Callable
+from typing import Protocol, TypeVar
 
 from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
-from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import median_sigma
+from stairbot.control.algorithm.work import DriveWork, LiftWork, Work
+from stairbot.control.tolerances import median_sigma
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 
-Enter = Callable[[Tick, Work], None]
-StepFn = Callable[[Tick, Work], Step]
-Done = Callable[[Tick, Work], Step]
+W = TypeVar("W", bound=Work)
+D = TypeVar("D", bound=DriveWork)
+L = TypeVar("L", bound=LiftWork)
+Enter = Callable[[Tick, W], None]
+StepFn = Callable[[Tick, W], Step]
+Done = Callable[[Tick, W], Step]
 
 
 JUMP_M = 0.02
@@ -45,10 +49,10 @@ def reading_drive(
     direction: int,
     target: Callable[[Tick], float | None],
     fallback_turns: Callable[[Tick], float],
-    done: Done,
-    bound: Callable[[Tick, Work], float | None] | None = None,
+    done: Done[D],
+    bound: Callable[[Tick, D], float | None] | None = None,
     exact: bool = False,
-) -> tuple[Enter, StepFn]:
+) -> tuple[Enter[D], StepFn[D]]:
     """A drive (``direction`` +1 forward, -1 back) that ends when the mean
     SFR/SFL reading reaches ``target(t)`` metres.
 
@@ -63,11 +67,11 @@ def reading_drive(
     with ``exact``, the position it ends at.
     """
 
-    def enter(t: Tick, w: Work) -> None:
+    def enter(t: Tick, w: D) -> None:
         w.target_reading = target(t)
         w.target_wheel = w.entry_wheel + direction * fallback_turns(t)
 
-    def step(t: Tick, w: Work) -> Step:
+    def step(t: Tick, w: D) -> Step:
         cfg = t.cfg
         here = motion.wheel_position(t.snap)
         if w.target_reading is not None and not w.reading_lost \
@@ -120,22 +124,22 @@ def reading_drive(
 
 
 def turns_drive(direction: int, turns: Callable[[Tick], float],
-                done: Done) -> tuple[Enter, StepFn]:
+                done: Done[D]) -> tuple[Enter[D], StepFn[D]]:
     """A drive of ``turns(t)`` wheel turns (``direction`` +1 forward, -1 back)."""
     return reading_drive(direction, lambda _t: None, turns, done)
 
 
-def lift(deltas: Callable[[Tick, Work], dict[MotorId, float]],
-         done: Done) -> tuple[Enter, StepFn]:
+def lift(deltas: Callable[[Tick, L], dict[MotorId, float]],
+         done: Done[L]) -> tuple[Enter[L], StepFn[L]]:
     """Lifts to absolute counters, all at once: ``deltas(t, w)`` on entry gives
     them relative to the entry counters, as {MTF: delta, MTB: delta}."""
 
-    def enter(t: Tick, w: Work) -> None:
+    def enter(t: Tick, w: L) -> None:
         d = deltas(t, w)
         w.target_mtf = w.entry_mtf + d[MotorId.MTF] if MotorId.MTF in d else None
         w.target_mtb = w.entry_mtb + d[MotorId.MTB] if MotorId.MTB in d else None
 
-    def step(t: Tick, w: Work) -> Step:
+    def step(t: Tick, w: L) -> Step:
         speeds = motion.lifts_to(t.cfg, t.snap, w.lift_targets())
         if speeds is None:
             return done(t, w)
@@ -144,7 +148,13 @@ def lift(deltas: Callable[[Tick, Work], dict[MotorId, float]],
     return enter, step
 
 
-def stood(t: Tick, w: Work, seconds: float) -> bool:
+class Still(Protocol):
+    """A work that keeps when the robot stopped to stand still."""
+
+    still_since: float | None
+
+
+def stood(t: Tick, w: Still, seconds: float) -> bool:
     """Standing still since ``w.still_since`` (set now if unset) for
     ``seconds`` (a filter's settling time)."""
     if w.still_since is None:
@@ -152,12 +162,12 @@ def stood(t: Tick, w: Work, seconds: float) -> bool:
     return t.snap.time_s - w.still_since >= seconds - 1e-9  # (clocks round alike)
 
 
-def checked_first(check: Callable[[Tick, Work], Step | None], step: StepFn) -> StepFn:
+def checked_first(check: Callable[[Tick, W], Step | None], step: StepFn[W]) -> StepFn[W]:
     """``step``, with ``check`` run once before its first tick: a phase whose
     entry condition does not hold ends there (``check`` returns that Step)
     before anything moves."""
 
-    def first(t: Tick, w: Work) -> Step:
+    def first(t: Tick, w: W) -> Step:
         if not w.checked:
             w.checked = True
             stop = check(t, w)
@@ -171,24 +181,25 @@ def checked_first(check: Callable[[Tick, Work], Step | None], step: StepFn) -> S
 def drive_phase(phase: Phase, label: str, flow: str, direction: int,
                 target: Callable[[Tick], float | None],
                 fallback_turns: Callable[[Tick], float], then: Phase, reaches: str,
-                done: Done | None = None,
-                bound: Callable[[Tick, Work], float | None] | None = None) -> PhaseDef:
+                done: Done[D] | None = None,
+                bound: Callable[[Tick, D], float | None] | None = None, *,
+                work: type[D]) -> PhaseDef[D]:
     """A :func:`reading_drive` phase that goes on to ``then`` when it ``reaches``
     its target (``done``, if given, records what the end tells first, and
     returns the Step to ``then``; ``bound`` as the drive's); the front pair is
-    watched."""
+    watched; ``work``: the phase's work (a DriveWork)."""
     enter, step = reading_drive(direction, target, fallback_turns,
                                 done or (lambda _t, _w: go(then)), bound)
-    return PhaseDef(phase, label, flow, step, enter=enter, watches="front",
+    return PhaseDef(phase, label, flow, step, work, enter=enter, watches="front",
                     to={then: reaches, Phase.ERROR: FAULT})
 
 
 def lift_phase(phase: Phase, label: str, flow: str,
-               deltas: Callable[[Tick, Work], dict[MotorId, float]], then: Phase,
-               carried_by: tuple[int, ...]) -> PhaseDef:
+               deltas: Callable[[Tick, LiftWork], dict[MotorId, float]], then: Phase,
+               carried_by: tuple[int, ...]) -> PhaseDef[LiftWork]:
     """A :func:`lift` phase that goes on to ``then`` when the turns are made,
     the robot carried by the wheels of the segments ``carried_by``; the front
     pair is watched."""
     enter, step = lift(deltas, lambda _t, _w: go(then))
-    return PhaseDef(phase, label, flow, step, enter=enter, watches="front",
+    return PhaseDef(phase, label, flow, step, LiftWork, enter=enter, watches="front",
                     carried_by=carried_by, to={then: "turns made", Phase.ERROR: FAULT})

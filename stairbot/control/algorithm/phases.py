@@ -13,8 +13,9 @@ step 1 on later steps, descent step 1); the context says which.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from enum import Enum
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from stairbot.control.algorithm.phase import PhaseDef
@@ -79,7 +80,7 @@ class Phase(Enum):
     ERROR = "error"
 
     @property
-    def record(self) -> PhaseDef:
+    def record(self) -> PhaseDef[Any]:
         """The phase's record: seed name, flow, entry action, step, transitions."""
         return _records()[self]
 
@@ -102,16 +103,22 @@ class Phase(Enum):
         return self.label
 
 
-_RECORDS: dict[Phase, PhaseDef] = {}
+_RECORDS: dict[Phase, PhaseDef[Any]] = {}
+"""Every phase's record.  The records live with their flows (calibration.py,
+ascent.py...), which import this module: this module imports none of them.
+:mod:`~stairbot.control.algorithm.table` gathers them and binds them here
+(:func:`bind`) when it is imported, and the package imports it first."""
 
 
-def _records() -> dict[Phase, PhaseDef]:
-    # The records live with their flows (calibration.py, turns.py, ascent.py...), which
-    # import this module: they are gathered on first use.
-    if not _RECORDS:
-        from stairbot.control.algorithm.table import PHASES
+def bind(records: Mapping[Phase, PhaseDef[Any]]) -> None:
+    """Make ``records`` the phases' records (the table does, once)."""
+    missing = set(Phase) - set(records)
+    if missing:
+        raise RuntimeError(f"phases without a record: {sorted(p.value for p in missing)}")
+    _RECORDS.update(records)
 
-        _RECORDS.update(PHASES)
+
+def _records() -> dict[Phase, PhaseDef[Any]]:
     return _RECORDS
 
 

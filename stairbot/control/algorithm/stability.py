@@ -28,9 +28,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from itertools import combinations
+from typing import Any
 
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail
-from stairbot.control.algorithm.work import Work
+from stairbot.control.algorithm.work import LiftWork, Work
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 
@@ -130,7 +131,7 @@ def worst(cfg: RobotConfig, carried_by: tuple[int, ...], start: tuple[float, flo
                key=lambda b: b.margin)
 
 
-def carried_now(t: Tick, record: PhaseDef) -> tuple[int, ...]:
+def carried_now(t: Tick, record: PhaseDef[Any]) -> tuple[int, ...]:
     """The segments that carry the robot while ``record``'s lift moves: its
     ``carried_by``, less segment 3 while it hangs in the air over the step
     below (narrow steps: ``Context.third_in_air``)."""
@@ -140,7 +141,7 @@ def carried_now(t: Tick, record: PhaseDef) -> tuple[int, ...]:
     return carried
 
 
-def before_lift(t: Tick, record: PhaseDef, w: Work) -> Step | None:
+def before_lift(t: Tick, record: PhaseDef[Any], w: Work) -> Step | None:
     """Once, before ``record``'s first step (a phase that moves a lift): the
     error that ends the program if the lift from the present counters to the
     work's targets would bring the centre of mass within
@@ -149,6 +150,7 @@ def before_lift(t: Tick, record: PhaseDef, w: Work) -> Step | None:
     w.balanced = True
     if not record.carried_by:
         return None
+    assert isinstance(w, LiftWork)  # a phase that moves a lift
     cfg, snap = t.cfg, t.snap
     carried = carried_now(t, record)
     start = (snap.turns(MotorId.MTF), snap.turns(MotorId.MTB))

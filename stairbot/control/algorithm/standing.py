@@ -9,7 +9,7 @@ usable distance, and both the (filtered) difference and its smoothed value
 (:data:`~stairbot.control.algorithm.motion.DIFF_SMOOTHING`) must exceed their
 tolerances for DEBOUNCE_TICKS ticks in a row: what calibration may have left
 when it squared up, plus four sigmas of the difference from the sensors'
-stated noise (:func:`~stairbot.control.perception.standing_tolerance`).  Neither a
+stated noise (:func:`~stairbot.control.tolerances.standing_tolerance`).  Neither a
 short spike, sensor noise, nor a yaw calibration accepted stops the robot.
 
 :func:`watch` runs before an armed phase's step and returns the pause; the
@@ -20,12 +20,13 @@ error.  The controller does the bookkeeping of both.
 from __future__ import annotations
 
 import statistics
+from typing import Any
 
 from stairbot.control.algorithm import long_tread, motion
 from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import standing_tolerance
+from stairbot.control.tolerances import standing_tolerance
 
 BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
                            Phase.ASCENT_DRIVE_SECOND})
@@ -51,20 +52,20 @@ def _readings(t: Tick, back: bool) -> str:
 def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
     """Update the smoothed difference; True when it exceeds equal_tolerance
     (and, with ``raw_too``, the newest difference does as well)."""
-    ctx = t.ctx
+    watch = t.ctx.watch
     diff = motion.pair_difference(t.snap, t.cfg, back)
     if diff is None:
-        ctx.standing_diff = None
+        watch.diff = None
         return False
-    ctx.standing_diff = motion.smooth(ctx.standing_diff, diff)
+    watch.diff = motion.smooth(watch.diff, diff)
     right, left = motion.pair(t.snap, back)
     near = min(right.distance_m, left.distance_m)
     smoothed_tol = standing_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
-    return abs(ctx.standing_diff) > smoothed_tol and \
+    return abs(watch.diff) > smoothed_tol and \
         (not raw_too or abs(diff) > standing_tolerance(t.cfg, near, back=back))
 
 
-def watch(t: Tick, phase: PhaseDef) -> Step | None:
+def watch(t: Tick, phase: PhaseDef[Any]) -> Step | None:
     """In an armed phase: the Step that pauses the robot when the watched pair
     has disagreed long enough, else None.
 
@@ -90,10 +91,10 @@ def watch(t: Tick, phase: PhaseDef) -> Step | None:
     if not back and phase.phase in BY_TURNS_ONTO and long_tread.near_length(t) is None:
         return None
     if not _disagree(t, back):
-        ctx.disagree_ticks = 0
+        ctx.watch.ticks = 0
         return None
-    ctx.disagree_ticks += 1
-    if ctx.disagree_ticks < DEBOUNCE_TICKS:
+    ctx.watch.ticks += 1
+    if ctx.watch.ticks < DEBOUNCE_TICKS:
         return None
     return go(Phase.PAUSED,
               f"standing rule: {_pair_name(back)} disagree ({_readings(t, back)}) in "
@@ -107,9 +108,9 @@ over its last this many seconds decides."""
 
 
 def _paused(t: Tick, _w: Work) -> Step:
-    ctx = t.ctx
-    assert ctx.resume_phase is not None and ctx.pause_started_s is not None
-    resume = Phase(ctx.resume_phase).record
+    ctx, pause = t.ctx, t.ctx.pause
+    assert pause is not None
+    resume = Phase(pause.resume_phase).record
     back = resume.watches == "back"
     # Standing still, the difference over the wait decides, not one noisy tick
     # nor a smoothing that a burst at its end fills: the median of the wait's
@@ -121,22 +122,22 @@ def _paused(t: Tick, _w: Work) -> Step:
     disagree = _disagree(t, back, raw_too=False)
     diff = motion.pair_difference(t.snap, t.cfg, back)
     if diff is not None:
-        ctx.pause_diffs.append(diff)
-        del ctx.pause_diffs[:-max(1, round(MEDIAN_S / t.cfg.algorithm.tick))]
-    if t.snap.time_s - ctx.pause_started_s < t.cfg.algorithm.standing_wait:
+        pause.diffs.append(diff)
+        del pause.diffs[:-max(1, round(MEDIAN_S / t.cfg.algorithm.tick))]
+    if t.snap.time_s - pause.started_s < t.cfg.algorithm.standing_wait:
         return stay(NO_MOTION)
-    if diff is not None and ctx.pause_diffs:
-        recent = ctx.pause_diffs  # the last MEDIAN_S of ticks that gave a figure
+    if diff is not None and pause.diffs:
+        recent = pause.diffs  # the last MEDIAN_S of ticks that gave a figure
         right, left = motion.pair(t.snap, back)
         near = min(right.distance_m, left.distance_m)
         disagree = abs(statistics.median(recent)) > standing_tolerance(
             t.cfg, near, motion.DIFF_SMOOTHING, back)
     if not disagree:
-        ctx.disagree_ticks = 0
+        ctx.watch.ticks = 0
         return go(resume.phase, f"standing rule: {_pair_name(back)} agree again "
                                 f"({_readings(t, back)}): resuming {resume.label}")
-    ctx.disagree_ticks += 1
-    if ctx.disagree_ticks >= DEBOUNCE_TICKS:
+    ctx.watch.ticks += 1
+    if ctx.watch.ticks >= DEBOUNCE_TICKS:
         return fail(f"standing rule: {_pair_name(back)} still disagree after "
                     f"{t.cfg.algorithm.standing_wait:g} s ({_readings(t, back)}) in "
                     f"{resume.label}")
@@ -144,11 +145,11 @@ def _paused(t: Tick, _w: Work) -> Step:
 
 
 PAUSED = PhaseDef(
-    Phase.PAUSED, "standing rule — readings disagree: stopped, waiting", "end", _paused,
+    Phase.PAUSED, "standing rule — readings disagree: stopped, waiting", "end", _paused, Work,
     # the resumes, back to every armed phase, are added by the transition table
     to={Phase.ERROR: "readings still disagree after standing_wait; " + FAULT})
 
-DONE = PhaseDef(Phase.DONE, "end — program finished", "end", None)
-ERROR = PhaseDef(Phase.ERROR, "end — program ended with an error", "end", None)
+DONE = PhaseDef(Phase.DONE, "end — program finished", "end", None, Work)
+ERROR = PhaseDef(Phase.ERROR, "end — program ended with an error", "end", None, Work)
 
-PHASES: tuple[PhaseDef, ...] = (PAUSED, DONE, ERROR)
+PHASES: tuple[PhaseDef[Any], ...] = (PAUSED, DONE, ERROR)

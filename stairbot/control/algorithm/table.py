@@ -1,20 +1,22 @@
-"""Every phase's record, gathered from the modules of the flows."""
+"""Every phase's record, gathered from the modules of the flows and bound to
+the :class:`~stairbot.control.algorithm.phases.Phase` enum (whose ``record``,
+``label`` and ``flow`` read them).  The package imports this module first, so
+the records are bound before any phase is asked for one."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
+from typing import Any
 
 from stairbot.control.algorithm import ascent, calibration, descent, landing, standing, turns
 from stairbot.control.algorithm.phase import PhaseDef
-from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.phases import Phase, bind
 
-PHASES: Mapping[Phase, PhaseDef] = MappingProxyType(
+PHASES: Mapping[Phase, PhaseDef[Any]] = MappingProxyType(
     {d.phase: d for d in (*calibration.PHASES, *turns.PHASES, *ascent.PHASES, *descent.PHASES,
                            *landing.PHASES, *standing.PHASES)}
 )
 """phase -> its record, for every Phase."""
 
-missing = set(Phase) - set(PHASES)
-if missing:  # pragma: no cover - caught by the import in every test
-    raise RuntimeError(f"phases without a record: {sorted(p.value for p in missing)}")
+bind(PHASES)

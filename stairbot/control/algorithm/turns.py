@@ -7,11 +7,25 @@ the helpers both share: :mod:`~stairbot.control.algorithm.calibration`.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from stairbot.control.algorithm import motion
-from stairbot.control.algorithm.calibration import (
-    FLOW,
-    LANDING_PURPOSES,
+from stairbot.control.algorithm.calibration import FLOW
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase
+from stairbot.control.algorithm.phase import (
+    FAULT,
+    NO_MOTION,
+    PhaseDef,
+    Step,
+    Tick,
+    fail,
+    go,
+    stay,
+    where,
+)
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.squaring import (
     LANDING_TURN_MARGIN_RAD,
     MAX_AWAY_YAW_RAD,
     MAX_SQUARE_YAW_RAD,
@@ -30,20 +44,8 @@ from stairbot.control.algorithm.calibration import (
     settled,
     trimmed_mean,
 )
-from stairbot.control.algorithm.phase import (
-    FAULT,
-    NO_MOTION,
-    PhaseDef,
-    Step,
-    Tick,
-    fail,
-    go,
-    stay,
-    where,
-)
-from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.work import Work
-from stairbot.control.perception import pair_tolerance, still_samples, still_tolerance
+from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
+from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
 from stairbot.hardware import MotorId
 
 P = Phase
@@ -51,9 +53,9 @@ P = Phase
 
 # -- turning ---------------------------------------------------------------------------
 def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
-    made = abs(t.snap.turns(MotorId.MWR) - t.ctx.turn_origin)
+    made = abs(t.snap.turns(MotorId.MWR) - t.cal.turn_origin)
     limit = MAX_TURN_YAW_RAD
-    if t.ctx.purpose in LANDING_PURPOSES:
+    if t.cal.purpose in LANDING_PURPOSES:
         limit += LANDING_TURN_MARGIN_RAD  # a landing's turn is 90° by the odometer
     if motion.turn_yaw_rad(t.cfg, made) <= limit:
         return None
@@ -61,7 +63,7 @@ def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
                 f"{math.degrees(limit):.0f}° without finding SFR = SFL")
 
 
-def _turn_enter(t: Tick, w: Work) -> None:
+def _turn_enter(t: Tick, w: TurnWork) -> None:
     r, l_ = motion.pair(t.snap)
     sfr, sfl = r.distance_m, l_.distance_m
     # SFL < SFR: the left side is nearer, turn left (the seed's case 2 rule).
@@ -78,11 +80,11 @@ def _turn_enter(t: Tick, w: Work) -> None:
         # the larger of what the standing mean the case was chosen on says and
         # what the readings now say: one tick of a noisy pair (a Sharp pair at
         # 0.36 m) can read nearly square where the mean said 16 deg askew
-        diff = max(abs(sfl - sfr), abs(t.ctx.case_diff or 0.0))
+        diff = max(abs(sfl - sfr), abs(t.cal.case_diff or 0.0))
         w.turn_limit_rad = askew_rad(t.cfg, diff) + TURN_MARGIN_RAD
 
 
-def _turned_past_limit(t: Tick, w: Work) -> Step | None:
+def _turned_past_limit(t: Tick, w: TurnWork) -> Step | None:
     made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made <= w.turn_limit_rad:
         return None
@@ -92,10 +94,10 @@ def _turned_past_limit(t: Tick, w: Work) -> Step | None:
                 "not squaring up to something other than the riser")
 
 
-def _turn(t: Tick, w: Work) -> Step:
+def _turn(t: Tick, w: TurnWork) -> Step:
     cfg = t.cfg
     sfr, sfl = readings(t)
-    if w.checked:  # stopped at SFR = SFL: measuring standing still, once settled
+    if w.measuring:  # stopped at SFR = SFL: measuring standing still, once settled
         if not settled(t, w):
             return stay(NO_MOTION)
         # as long as it takes to know the difference to within equal_tolerance
@@ -106,7 +108,7 @@ def _turn(t: Tick, w: Work) -> Step:
             t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} readings "
                   f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
                   diff=diff)
-            t.ctx.squaring_turns += 1
+            t.cal.squaring_turns += 1
             return go(P.CAL_LOWER)
         # Not square yet: turn on, slowly, the way the difference says.
         direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
@@ -118,7 +120,7 @@ def _turn(t: Tick, w: Work) -> Step:
                             f"SFL − SFR reads {diff * 1000:+.1f} mm (SFR {sfr:.3f} m, SFL "
                             f"{sfl:.3f} m); a beam may be off the flight's side, or one "
                             "sensor reading long or short")
-        w.checked, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
+        w.measuring, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
         w.turn_direction = direction
         w.turn_diff = diff
     w.turn_diff = motion.smooth(w.turn_diff, sfl - sfr)
@@ -128,7 +130,7 @@ def _turn(t: Tick, w: Work) -> Step:
     # check it standing still.
     remaining = -w.turn_direction * w.turn_diff
     if remaining <= cfg.sensors.resolution / 20:
-        w.checked = True
+        w.measuring = True
         return stay(NO_MOTION)
     too_far = _turned_too_far(t, P.CAL_TURN) or _turned_past_limit(t, w)
     if too_far is not None:
@@ -138,16 +140,13 @@ def _turn(t: Tick, w: Work) -> Step:
 
 
 TURN = PhaseDef(
-    P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, enter=_turn_enter,
+    P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, TurnWork,
+    enter=_turn_enter, family=Calibration,
     to={P.CAL_LOWER: "SFR = SFL",
         P.ERROR: "turned too far, or more than its first readings allow; " + FAULT})
 
 
-def _probe_enter(t: Tick, w: Work) -> None:
-    w.probe_sfr, w.probe_sfl = readings(t)
-
-
-def _probe(t: Tick, w: Work) -> Step:
+def _probe(t: Tick, w: ProbeWork) -> Step:
     """Lifted, measure SFR and SFL standing still, then turn left and watch
     how they change.  Both ends of the comparison are means: the start the
     trimmed mean standing, now the mean of the last PROBE_TICKS ticks.  One
@@ -155,15 +154,15 @@ def _probe(t: Tick, w: Work) -> Step:
     corner (SFR growing and SFL shrinking by millimetres against a start
     reading long), and case 3B would turn far looking for a riser that is
     ahead."""
-    ctx, cfg = t.ctx, t.cfg
-    if not w.checked:
+    cal, cfg = t.cal, t.cfg
+    if not w.measured:
         if not settled(t, w) or not measured_standing(t, w, STILL_TICKS):
             return stay(NO_MOTION)
         if not w.standing:  # no tick gave both: now's readings, as the seed
             w.standing.append(readings(t))
         w.probe_sfr = trimmed_mean([r for r, _l in w.standing])
         w.probe_sfl = trimmed_mean([l_ for _r, l_ in w.standing])
-        w.checked = True
+        w.measured = True
     r, l_ = motion.pair(t.snap)
     both = r.ok and l_.ok and not motion.far(r, cfg) and not motion.far(l_, cfg)
     if both:
@@ -178,7 +177,7 @@ def _probe(t: Tick, w: Work) -> Step:
         sfr, sfl = readings(t)
     # a corner is decided on a full window of means only
     window_full = both and len(w.probe_recent) >= PROBE_TICKS
-    made = abs(t.snap.turns(MotorId.MWR) - ctx.turn_origin)
+    made = abs(t.snap.turns(MotorId.MWR) - cal.turn_origin)
     d_sfr, d_sfl = sfr - w.probe_sfr, sfl - w.probe_sfl
     # Half a resolution step off the readings' grid: whole-millimetre readings
     # that sum to the threshold exactly must not be decided by float rounding
@@ -194,8 +193,8 @@ def _probe(t: Tick, w: Work) -> Step:
     if unsure and motion.turn_yaw_rad(cfg, made) < PROBE_YAW_RAD:
         return stay(motion.turn(1, cfg))
     corner = cornerish and d_sfr - d_sfl >= corner_tol
-    ctx.calibration_case = "3B" if corner else "3A"
-    data = {"case": ctx.calibration_case, "dSFR": d_sfr, "dSFL": d_sfl}
+    cal.case = CalibrationCase.THREE_B if corner else CalibrationCase.THREE_A
+    data = {"case": cal.case.value, "dSFR": d_sfr, "dSFL": d_sfl}
     if corner:
         t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
               f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
@@ -206,15 +205,20 @@ def _probe(t: Tick, w: Work) -> Step:
 
 
 PROBE = PhaseDef(
-    P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe,
+    P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe, ProbeWork,
+    family=Calibration,
     to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
         P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
 
 
-def _corner(t: Tick, w: Work) -> Step:
+def _corner_enter(t: Tick, w: CornerWork) -> None:
+    w.largest_sfr = readings(t)[0]
+
+
+def _corner(t: Tick, w: CornerWork) -> Step:
     sfr, _sfl = readings(t)
-    w.probe_sfr = max(w.probe_sfr, sfr)  # the largest SFR seen while turning
-    if sfr < w.probe_sfr - t.cfg.algorithm.equal_tolerance:
+    w.largest_sfr = max(w.largest_sfr, sfr)
+    if sfr < w.largest_sfr - t.cfg.algorithm.equal_tolerance:
         t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
         return go(P.CAL_TURN)
     too_far = _turned_too_far(t, P.CAL_CORNER)
@@ -225,11 +229,11 @@ def _corner(t: Tick, w: Work) -> Step:
 
 CORNER = PhaseDef(
     P.CAL_CORNER, "calibration case 3B — turn left until both readings shrink", FLOW, _corner,
-    enter=_probe_enter,
+    CornerWork, enter=_corner_enter, family=Calibration,
     to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
 
 
-def _away_enter(t: Tick, w: Work) -> None:
+def _away_enter(t: Tick, w: AwayWork) -> None:
     sfr, sfl = readings(t)
     # The nearer beam sees a side wall: turn away from it (left when SFR is
     # the nearer), the opposite of case 2's rule, until it sees the riser.
@@ -238,7 +242,7 @@ def _away_enter(t: Tick, w: Work) -> None:
     w.turn_from = t.snap.turns(MotorId.MWR)
 
 
-def _away(t: Tick, w: Work) -> Step:
+def _away(t: Tick, w: AwayWork) -> Step:
     """Off the wall, the beam that saw it reads the riser: the pair flips
     (the other sensor is now the nearer, the robot still askew the same way)
     and the squaring turn goes on in the same direction.  Askew by less than
@@ -251,9 +255,9 @@ def _away(t: Tick, w: Work) -> Step:
     d = w.turn_diff
     seen = not motion.far(r, cfg) and not motion.far(l_, cfg)
     flipped = d * first < 0
-    w.checked = w.checked or flipped
+    w.flipped = w.flipped or flipped
     off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance
-    passed_square = w.checked and not flipped and abs(d) <= one_riser(cfg)
+    passed_square = w.flipped and not flipped and abs(d) <= one_riser(cfg)
     if seen and (off_wall or passed_square):
         t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
               "riser; squaring up", SFR=sfr, SFL=sfl)
@@ -268,16 +272,18 @@ def _away(t: Tick, w: Work) -> Step:
 
 AWAY = PhaseDef(
     P.CAL_AWAY, "calibration case 2W — turn away from the side wall until both see the riser",
-    FLOW, _away, enter=_away_enter,
+    FLOW, _away, AwayWork, enter=_away_enter, family=Calibration,
     to={P.CAL_TURN: "off the wall: the pair flipped (or flipped back, square)",
         P.ERROR: "turned too far; " + FAULT})
 
 
 # -- turn back to a heading (descent 1 and 7) ------------------------------------------
 def _turn_to(t: Tick, w: Work) -> Step:
-    """Turn on segment 2's wheels until the odometer's heading is ctx.turn_to."""
-    assert t.ctx.turn_to is not None  # set by whoever lifted for this turn
-    remaining = t.ctx.turn_to - motion.twist(t.snap)
+    """Turn on segment 2's wheels until the odometer's heading is the
+    calibration's ``turn_to``."""
+    turn_to = t.cal.turn_to
+    assert turn_to is not None  # set by whoever lifted for this turn
+    remaining = turn_to - motion.twist(t.snap)
     if abs(remaining) <= motion.WHEEL_DONE:
         return go(P.CAL_LOWER)
     too_far = _turned_too_far(t, P.CAL_TURN_TO)
@@ -289,7 +295,7 @@ def _turn_to(t: Tick, w: Work) -> Step:
 
 TURN_TO = PhaseDef(
     P.CAL_TURN_TO, "calibration — turn by the odometer to a heading", FLOW,
-    _turn_to,
+    _turn_to, Work, family=Calibration,
     to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
 
-PHASES: tuple[PhaseDef, ...] = (PROBE, CORNER, AWAY, TURN, TURN_TO)
+PHASES: tuple[PhaseDef[Any], ...] = (PROBE, CORNER, AWAY, TURN, TURN_TO)

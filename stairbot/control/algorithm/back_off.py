@@ -1,0 +1,236 @@
+"""Descent 1: back off to a safe position, calibrate (case 2), back up to the
+edge -- the back pair's edge watch bounding both backings
+(:mod:`~stairbot.control.algorithm.edge`).  In a continuous descent the back
+pair squares the robot up to the edge instead of calibration.
+"""
+
+from __future__ import annotations
+
+import math
+
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.edge import (
+    edge_bound,
+    narrow_bound,
+    refind,
+)
+from stairbot.control.algorithm.modes import Outcome, Purpose
+from stairbot.control.algorithm.moves import (
+    checked_first,
+    reading_drive,
+)
+from stairbot.control.algorithm.phase import (
+    FAULT,
+    PhaseDef,
+    Step,
+    Tick,
+    calibrate,
+    end,
+    fail,
+    go,
+)
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.step_down import narrow_here, step_tab, step_tread
+from stairbot.control.algorithm.work import (
+    EdgeWork,
+)
+
+P = Phase
+FLOW = "descent"
+
+
+# -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
+def _backed_off(t: Tick, w: EdgeWork) -> Step:
+    if w.edge_stop is not None:
+        return fail(w.edge_stop)
+    if w.square_yaw is not None:
+        return _turn_square(t, w)
+    if t.ctx.from_top:
+        # squared up to the edge by the back pair instead: the front pair
+        # faces risers the robot did not climb, and one too low for its cone
+        # reads as nothing ahead, which calibration takes for case 1
+        return go(P.DESCENT_BACK_TO_EDGE)
+    return calibrate(Purpose.DESCENT)
+
+
+def _back_off_enter(t: Tick, w: EdgeWork) -> None:
+    t.ctx.descent.edge_wheel = None  # a new step: its edge not seen yet, nor turned back
+    t.ctx.descent.turned_back = t.ctx.descent.edge_squared = False
+    _back_off_drive[0](t, w)
+
+
+def _back_off_target(t: Tick) -> float | None:
+    """None (the seed's turns), or, on a narrow step, tab_length_to_edge: the
+    robot does not fit on the tread, and backing off the seed's approach
+    turns would take segment 2's wheels over the edge.  Its segment 3 hangs
+    over the step below already; where segment 2's rear wheels stand on the
+    edge is where ascent 7 read the tab."""
+    return step_tab(t) if narrow_here(t) else None
+
+
+def _edge_or_tab(t: Tick, w: EdgeWork, refind: bool) -> float | None:
+    """The edge watch's bound (:func:`~stairbot.control.algorithm.edge.edge_bound`);
+    on a narrow step, the tab read on the way up places the robot (the back
+    pair is over the step below, segment 3 in the air), bounded by
+    :func:`~stairbot.control.algorithm.edge.narrow_bound`."""
+    if not narrow_here(t):
+        return edge_bound(t, w, refind)
+    limit = narrow_bound(t, w)
+    if limit is None or w.target_wheel is None:
+        return limit
+    # a limit, not where the drive ends (backing up to the edge is exact to its bound)
+    return max(limit, w.target_wheel)
+
+
+def _narrow_tab_known(t: Tick, _w: EdgeWork) -> Step | None:
+    if narrow_here(t) and step_tab(t) is None:
+        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured on "
+                    "a narrow step: the robot cannot be placed on a tread it does not fit on")
+    return None
+
+
+def _back_off_turns(t: Tick) -> float:
+    """The seed's approach turns; on a narrow step, while the front pair
+    cannot read (descent 6 left it nearer the riser than it reads from),
+    the tab less the approach's gap, where descent 5 left segment 1's front
+    face: on a tread shorter than the robot the seed's turns (0.1 m) take
+    segment 2's rear wheels over the edge, and the robot tips back."""
+    tab = step_tab(t)
+    if narrow_here(t) and tab is not None:
+        return t.cfg.wheel_turns(max(0.0, tab - t.cfg.algorithm.approach_gap))
+    return t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
+
+
+_back_off_drive = reading_drive(-1, _back_off_target, _back_off_turns,
+                                _backed_off, lambda t, w: _edge_or_tab(t, w, refind=False))
+BACK_OFF = PhaseDef(
+    P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW,
+    checked_first(_narrow_tab_known, _back_off_drive[1]), EdgeWork,
+    enter=_back_off_enter, watches="front",
+    to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
+                     "edge; on a narrow step, reads tab_length_to_edge[i]: calibrate "
+                     "(case 2)",
+        P.DESCENT_BACK_TO_EDGE: "continuous descent: the same, not calibrating (the back "
+                                "pair squares up at the edge)",
+        P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
+                    "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
+        P.ERROR: "one back sensor reads the drop and the other not within "
+                 "MAX_EDGE_YAW_RAD; a narrow step's tab_length_to_edge unknown; " + FAULT})
+
+
+def edge_search_m(t: Tick) -> float:
+    """Continuous descent: how far backing up to the edge looks for it before
+    taking what the robot stands on for the floor.  From the start on the top,
+    LENGTH_OF_INFINITY (the operator set the robot down near the edge); on a
+    step below, LENGTH_OF_A_ROBOT + SAFE_LENGTH past where the back-off and
+    calibration left it, so that a tread up to about twice the shortest the
+    robot enters, and the back-off's length, is a step, and a longer one
+    the floor (or a landing)."""
+    cfg = t.cfg
+    if t.ctx.steps_descended == 0:
+        return cfg.LENGTH_OF_INFINITY
+    return cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
+
+
+def _edge_by_watch(t: Tick) -> bool:
+    """Backing up to the edge goes by the back pair's edge watch alone: in a
+    continuous descent, and on a climbed step whose tab_length_to_edge was
+    not measured (the riser ahead about LENGTH_OF_INFINITY away, which one
+    beam reached and the other not: ascent 7 read nothing, ascent 8 read a
+    riser, and the robot went on).  Not on a narrow step, whose tab places
+    the robot."""
+    return t.ctx.from_top or (step_tab(t) is None and not narrow_here(t))
+
+
+def unmeasured_search_m(t: Tick) -> float:
+    """A climbed step whose tab was not measured: how far backing up to the
+    edge looks for it, the tread as ascent 3 measured it (the robot stands
+    on it), or LENGTH_OF_INFINITY."""
+    tread = step_tread(t)
+    return tread if tread is not None and math.isfinite(tread) else t.cfg.LENGTH_OF_INFINITY
+
+
+def _edge_fallback(t: Tick) -> float:
+    if t.ctx.from_top:
+        return t.cfg.wheel_turns(edge_search_m(t))
+    if _edge_by_watch(t):
+        return t.cfg.wheel_turns(unmeasured_search_m(t))
+    # Descent 1 backed off to SAFE_DISTANCE_IN_FRONT_OF_STEP before calibrating.
+    tab = step_tab(t) or t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
+    return t.cfg.wheel_turns(max(0.0, tab - t.cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP))
+
+
+# Once the back pair has crossed the edge, the backing ends edge_clearance_m
+# past it, wherever tab_length_to_edge would stop it: the tab, read on the
+# way up where segment 3 was lifted over the edge, can leave segment 3's
+# front wheels on the edge's corner, and lowered there segment 3 stays up
+# while the lift pitches the robot.
+def _at_edge(t: Tick, w: EdgeWork) -> Step:
+    """Backed up to the edge.  In a continuous descent, backing the whole
+    search without seeing an edge is the floor.  (Its tab_length_to_edge stay
+    unknown, and descent 3 and 5 go by the seed's turn counts: the front pair
+    looks back up at risers the robot did not climb, and a cone sees over a
+    low one as the robot backs away from it, so its reading jumps to the
+    riser beyond; a drive by it would end at once, and segment 1, lowered on
+    the edge, would pitch the robot nose up.)"""
+    ctx = t.ctx
+    searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
+    if not ctx.from_top and ctx.descent.edge_wheel is None and _edge_by_watch(t):
+        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured, and "
+                    f"SBR/SBL saw no edge backing {searched:.2f} m (the tread measured, or "
+                    "LENGTH_OF_INFINITY): the edge of the step cannot be found")
+    if not ctx.from_top or ctx.descent.edge_wheel is not None:
+        return go(P.DESCENT_LOWER_THIRD)
+    if ctx.steps_descended == 0:
+        return end(Outcome.STOPPED, f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
+                              f"backing from the start (at most LENGTH_OF_INFINITY = "
+                              f"{t.cfg.LENGTH_OF_INFINITY} m): not on the top of a flight")
+    return end(Outcome.COMPLETED, f"on the floor, or a landing: no edge within {searched:.2f} m "
+                            f"behind step {ctx.steps_descended} from the top, the last "
+                            "descended")
+
+
+_to_edge = reading_drive(-1, step_tab, _edge_fallback, _at_edge,
+                         lambda t, w: _edge_or_tab(t, w, refind=True), exact=True)
+
+
+def _to_edge_step(t: Tick, w: EdgeWork) -> Step:
+    if w.refind_from is None:
+        step = _to_edge[1](t, w)
+        if w.edge_stop is not None:
+            return fail(w.edge_stop)
+        if w.square_yaw is not None:
+            return _turn_square(t, w)
+        if w.refind_from is None:
+            return step
+        # the watch found the pair past an edge it did not see crossed: this
+        # tick's step (which may have ended the backing) is not taken
+    return refind(t, w)
+
+
+def _turn_square(t: Tick, w: EdgeWork) -> Step:
+    """Lift segments 1 and 3 and turn on segment 2's wheels by the odometer
+    (calibration's turn to a heading), square to the edge; then back up to
+    it again, finding the floor first (the pair is past the edge now)."""
+    assert w.square_yaw is not None
+    t.ctx.descent.edge_squared = True
+    return calibrate(Purpose.EDGE, motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw),
+                     f"turning {math.degrees(w.square_yaw):+.1f}° square to the edge")
+
+
+BACK_TO_EDGE = PhaseDef(
+    P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
+    _to_edge_step, EdgeWork, enter=_to_edge[0], watches="front",
+    to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
+                                "edge (driving forward first until they read the floor, "
+                                "if they were past it unseen); or, not crossed yet, reads "
+                                "tab_length_to_edge[i]; on a narrow step, reads it (no "
+                                "edge watch)",
+        P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
+                    "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
+        P.DONE: "continuous descent: no edge within the search (edge_search_m): on the "
+                "floor; or, from the start, not on the top of a flight; or the floor not "
+                "found again: the tread is shorter than the robot (stopped)",
+        P.ERROR: "tab_length_to_edge[i] unknown and no edge seen within the tread; the floor "
+                 "not found again; one back "
+                 "sensor reads the drop and the other not within MAX_EDGE_YAW_RAD; " + FAULT})

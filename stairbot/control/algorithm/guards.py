@@ -1,0 +1,98 @@
+"""What the controller checks whatever the phase decides: how long a phase
+may last, which sensors a phase needs (a sensor that reads as ERROR stands
+the robot, and ends the program if it lasts), what the link lost during such
+a hold, and that a restored context's state is its phase's.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from stairbot.control.algorithm import motion, squaring
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.transitions import BACK_PAIR_PHASES
+from stairbot.errors import InputError
+from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, SensorId
+from stairbot.inputs.config import RobotConfig
+
+SENSOR_WAIT_S = 1.0
+"""How long the robot stands, lifts holding, for a sensor it needs that reads
+as ERROR (errors, or stale) to come back before the program ends with the
+error."""
+
+PHASE_TIMEOUT_S = 60.0
+"""A phase (other than the standing rule's wait) that lasts longer than this,
+in controller time, ends the program with an error: something is stuck.  A
+robot with slow motors gets longer: :func:`phase_timeout_s`."""
+
+
+def phase_timeout_s(config: RobotConfig) -> float:
+    """How long one phase may last: twice the longest motion a phase makes at
+    the config's speeds (a lift over its whole stroke, a drive of
+    LENGTH_OF_INFINITY, a calibration turn of its largest yaw), and at least
+    PHASE_TIMEOUT_S."""
+    m = config.motors
+    lift_s = 2 * config.MAX_OF_VERTICAL_TURNS / m.lift_speed
+    drive_s = config.wheel_turns(config.LENGTH_OF_INFINITY) / m.wheel_speed
+    turn = squaring.MAX_TURN_YAW_RAD * config.geometry.track_width / 2
+    turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
+    return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
+
+def check_restored(ctx: Context) -> None:
+    """A restored context's work and family are the present phase's kinds
+    (while the standing rule waits, the phase it resumes); InputError naming
+    the key when not."""
+    phase = BY_VALUE[ctx.phase]
+    if phase is Phase.PAUSED and ctx.pause is not None:
+        phase = BY_VALUE[ctx.pause.resume_phase]
+    if phase.terminal:
+        return
+    record = phase.record
+    if type(ctx.work) is not record.work:
+        raise InputError("context", "work.kind", f"{ctx.work.KIND} is not the work of "
+                         f"{phase.value} ({record.work.KIND})")
+    if record.family is not None and type(ctx.family) is not record.family:
+        raise InputError("context", "family.kind", f"{type(ctx.family).__name__} is not the "
+                         f"family of {phase.value} ({record.family.__name__})")
+
+
+def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
+    """The sensors whose ERROR status (errors, or stale) stands the robot in
+    ``phase``, and ends the program if it lasts."""
+    if phase is Phase.PAUSED and ctx.pause is not None:
+        phase = Phase(ctx.pause.resume_phase)
+    if phase.terminal:
+        return ()
+    if ctx.from_top and phase.flow != "ascent":
+        return BACK_SENSORS  # a continuous descent steers by the back pair alone
+    if phase in _EDGE_WATCH:
+        return FRONT_SENSORS + BACK_SENSORS
+    if phase is Phase.LANDING_SCAN:
+        # The scan moves segment 3 alone, and steers nothing: a side pair that
+        # reads no distance there is no flight (the landing is refused, the
+        # robot goes home), not a reason to end the program on the landing.
+        return ()
+    return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
+
+
+_EDGE_WATCH = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
+"""Descent 1's phases watch the back pair for the edge as they back: a back
+sensor that reports errors, or stops measuring, would hide it (the edge is
+where both read the drop), and backing from the top of a flight the robot
+would go over the edge unseen."""
+
+
+LINK_TROUBLE = ("retries", "timeouts", "lost", "revived")
+"""The link figures (Snapshot.health) that say frames went missing."""
+
+
+def link_meanwhile(before: Mapping[str, float], now: Mapping[str, float]) -> str:
+    """What the link counted during a sensor hold, when it lost frames: a
+    reading goes stale on a wire that loses its replies too, and the error
+    says so (empty for a robot with no link, or a link that lost nothing)."""
+    grown = {k: now[k] - before.get(k, 0.0) for k in LINK_TROUBLE if k in now}
+    if not any(v > 0 for v in grown.values()):
+        return ""
+    counts = ", ".join(f"{v:.0f} {k}" for k, v in grown.items() if v > 0)
+    return f"; meanwhile the link lost frames ({counts}): the readings were stale on the wire"

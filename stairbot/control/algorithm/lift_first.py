@@ -1,0 +1,274 @@
+"""Ascent 3: lift segment 1 until the front sensors see over the step, then
+number_of_vertical_turns more, measuring the tread past the riser; h
+(number_of_turns_for_step_height) is the total.  A step too high (a wall), a
+tread too short, or a rise too low for the tread the front cone measures
+ends the ascent: segment 1 is lowered again (the obstacle).  The phases
+share :class:`~stairbot.control.algorithm.families.LiftFirst`.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+
+from stairbot.control.algorithm import landing, limits, long_tread, motion
+from stairbot.control.algorithm.families import LiftFirst
+from stairbot.control.algorithm.modes import AscentEnd
+from stairbot.control.algorithm.moves import lift
+from stairbot.control.algorithm.phase import FAULT, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import LiftWork, SightWork
+from stairbot.hardware import MotorId
+from stairbot.inputs.config import RobotConfig
+
+P = Phase
+FLOW = "ascent"
+
+SIGHT_JUMP_M = 0.05
+"""Ascent 3: the front sensors see over the riser when both read at least this
+much past it (or nothing ahead).  No tread is this short, and it is ten
+times the sensors' noise: a noisy reading of the riser never passes for it."""
+
+
+# -- ascent 3: lift segment 1 -------------------------------------------------------------
+def _lf(t: Tick) -> LiftFirst:
+    return t.ctx.family_of(LiftFirst)
+
+
+def _lift_first_enter(t: Tick, w: LiftWork) -> None:
+    ctx, cfg = t.ctx, t.cfg
+    _lf(t).return_mtf = w.entry_mtf
+    w.target_mtf = w.entry_mtf + cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
+
+
+def _gap(t: Tick) -> float:
+    gap = _lf(t).riser_gap
+    return t.cfg.algorithm.approach_gap if gap is None else gap
+
+
+def tread_seen(t: Tick) -> float | None:
+    """The tread past the riser, once both front sensors see over it: the
+    nearer reading less the gap to the riser; +inf for nothing ahead; None
+    while either still sees the riser."""
+    gap, cfg = _gap(t), t.cfg
+    readings = motion.pair(t.snap)
+    if not all(motion.far(r, cfg) or (r.ok and r.distance_m >= gap + SIGHT_JUMP_M)
+               for r in readings):
+        return None
+    near = [r.distance_m for r in readings if not motion.far(r, cfg)]
+    return min(near) - gap if near else float("inf")
+
+
+def _lift_first(t: Tick, w: LiftWork) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    if tread_seen(t) is not None:
+        sfr, sfl = (r.distance_m for r in motion.pair(t.snap))
+        lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
+        rise = lifted * cfg.motors.lift_travel_per_turn + cfg.sensors.front_height
+        t.say(f"segment 1 sees over step {ctx.number_of_steps + 1} after {lifted:.1f} MTF turns "
+              f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m", rise=rise)
+        if rise >= limits.min_step_rise_m(cfg):
+            return go(P.ASCENT_LIFT_FIRST_MORE)
+        ctx.ascent_end = AscentEnd.OBSTACLE
+        t.say(f"step {ctx.number_of_steps + 1} is too low to climb: rise about {rise:.3f} m < "
+              f"{limits.min_step_rise_m(cfg):.3f} m (lifting on, the sensors could see past "
+              "the next riser); the ascent ends (obstacle)", ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE, "rise lower than the robot measures")
+    assert w.target_mtf is not None
+    speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
+    if speed is None:
+        ctx.ascent_end = AscentEnd.OBSTACLE
+        _lf(t).wall_ahead = True
+        allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
+        t.say(f"step {ctx.number_of_steps + 1} too high: the front sensors did not see over "
+              f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
+              ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE)
+    return stay({MotorId.MTF: speed})
+
+
+LIFT_FIRST = PhaseDef(
+    P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, LiftWork,
+    enter=_lift_first_enter, carried_by=(2, 3), family=LiftFirst,
+    to={P.ASCENT_LIFT_FIRST_MORE: "sees over the riser (reads ≥ gap + SIGHT_JUMP_M)",
+        P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
+                                 "step too high; or sees over a rise < min_step_rise_m",
+        P.ERROR: FAULT})
+
+
+def narrow(cfg: RobotConfig, tread: float | None) -> bool:
+    """A tread the robot does not fit on: shorter than LENGTH_OF_A_ROBOT +
+    SAFE_LENGTH (climbed only with ``[algorithm] narrow_steps``: min_tread_m)."""
+    return tread is not None and tread < cfg.LENGTH_OF_A_ROBOT + cfg.SAFE_LENGTH
+
+
+def _lifted_first(t: Tick, w: SightWork) -> Step:
+    ctx, cfg = t.ctx, t.cfg
+    need = limits.min_tread_m(cfg)
+    # Measured over the second half of the lift, clear of the edge: at the
+    # first sight over it the beam still grazes the step's own tread and
+    # reads short.
+    tread = _tread_measured(t, w)
+    ahead = "nothing ahead" if tread is None or tread == float("inf") \
+        else f"tread {tread:.3f} m"
+    t.say(f"step {ctx.number_of_steps + 1}: {ahead} (the reading less {_gap(t):.3f} m to the "
+          "riser)", tread=None if tread is None or tread == float("inf") else tread)
+    if tread is not None and tread < need:
+        ctx.ascent_end = AscentEnd.OBSTACLE
+        t.say(f"the tread of step {ctx.number_of_steps + 1} is too short: {tread:.3f} m < "
+              f"min_tread_m = {need:.3f} m; the ascent ends (obstacle)",
+              ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than min_tread_m")
+    lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
+    rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
+        + cfg.sensors.front_height
+    if tread is not None and tread != float("inf") and rise < cfg.min_rise_for(tread) \
+            and not _held(t, w, tread):
+        # A cone looking up sees over the next riser (as high as this one, we
+        # assume) this far away: the readings mix what lies beyond it.
+        ctx.ascent_end = AscentEnd.OBSTACLE
+        t.say(f"step {ctx.number_of_steps + 1} is too low for its tread: rise about {rise:.3f} "
+              f"m < {cfg.min_rise_for(tread):.3f} m (the front cone's top, "
+              f"{math.degrees(cfg.front_cone_top_rad):.1f}° up, would see over the next riser "
+              f"{tread:.3f} m away); the ascent ends (obstacle)", ascent_end="obstacle")
+        return go(P.ASCENT_LOWER_OBSTACLE, "rise too low for the tread the front cone measures")
+    ctx.number_of_turns_for_step_height = lifted
+    if ctx.number_of_steps < len(ctx.tread_length):
+        ctx.tread_length[ctx.number_of_steps] = \
+            None if tread is None or tread == float("inf") else tread
+    if narrow(cfg, tread):
+        t.say(f"step {ctx.number_of_steps + 1} is narrow: tread {tread:.3f} m < "
+              f"LENGTH_OF_A_ROBOT + SAFE_LENGTH: segment 3 stays in the air over the step "
+              "below until segment 1 is on the next (narrow_steps)")
+    _measure_next_step(t, w)
+    t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
+          f"(step {ctx.number_of_steps + 1})",
+          number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
+    return go(P.ASCENT_DRIVE_FIRST)
+
+
+def _held(t: Tick, w: SightWork, tread: float) -> bool:
+    """A tread past FAR_TREAD_M whose rise is below min_rise_for: whether the
+    pair's readings held as segment 1 rose (a wall, or a riser the cone
+    sees whole: climbed), said either way
+    (:mod:`~stairbot.control.algorithm.long_tread`)."""
+    if not long_tread.far(tread):
+        return False
+    reading = tread + _gap(t)
+    held, moved = long_tread.steady(t, w, reading)
+    limit = long_tread.steady_m(t, reading)
+    lift_mm = t.ctx.number_of_vertical_turns * t.cfg.motors.lift_travel_per_turn * 1000
+    if moved is None:
+        t.say(f"step {t.ctx.number_of_steps + 1}: too few readings past the riser over the "
+              f"last {lift_mm:.0f} mm of lift to tell whether they held")
+    else:
+        t.say(f"step {t.ctx.number_of_steps + 1}: the front pair's readings of the riser "
+              f"{reading:.3f} m ahead moved {moved * 1000:.0f} mm as segment 1 rose "
+              f"{lift_mm:.0f} mm ({'within' if held else 'more than'} {limit * 1000:.0f} mm): "
+              + ("a wall, or a riser the whole cone sees" if held
+                 else "the cone sees over it"), tread_moved=moved)
+    return held
+
+
+def _sample_sight(t: Tick, w: SightWork) -> None:
+    """Over the lift past the sight-over, keep each front reading that still
+    sees past the riser in ``w.rise_rows`` (the long tread's rule), and over
+    its second half in ``w.sights`` too."""
+    second_half = (t.snap.turns(MotorId.MTF) - w.entry_mtf
+                   >= t.ctx.number_of_vertical_turns / 2.0)
+    gap, cfg = _gap(t), t.cfg
+    for i, r in enumerate(motion.pair(t.snap)):
+        if r.ok and not motion.far(r, cfg) and r.distance_m >= gap + SIGHT_JUMP_M:
+            w.rise_rows[i].append(r.distance_m)
+            if second_half:
+                w.sights[i].append(r.distance_m)
+
+
+def _sight_medians(t: Tick, w: SightWork) -> list[float | None]:
+    """SFR's and SFL's readings past the riser: each one's median over the
+    lift's second half where it has them, else its reading now; None for a
+    sensor that reads nothing ahead now.  The median, not the mean: stray
+    measurements that pass perception's median can hold a reading
+    centimetres off for many ticks of the lift; in a mean they make
+    length_of_next_step that much long, segment 2 stops short of the edge,
+    and lifting segment 3 pitches the robot nose up."""
+    out: list[float | None] = []
+    for i, r in enumerate(motion.pair(t.snap)):
+        sights = w.sights[i]
+        out.append(None if motion.far(r, t.cfg) else
+                   statistics.median(sights) if sights else r.distance_m)
+    return out
+
+
+def _tread_measured(t: Tick, w: SightWork) -> float | None:
+    """:func:`tread_seen` now, on :func:`_sight_medians`."""
+    tread = tread_seen(t)
+    if tread is None or tread == float("inf"):
+        return tread
+    return min(m for m in _sight_medians(t, w) if m is not None) - _gap(t)
+
+
+_more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_vertical_turns},
+                               _lifted_first)
+
+
+def _more_step(t: Tick, w: SightWork) -> Step:
+    _sample_sight(t, w)
+    return _lift_more(t, w)
+
+
+LIFT_FIRST_MORE = PhaseDef(
+    P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
+    _more_step, SightWork, enter=_more_enter, carried_by=(2, 3), family=LiftFirst,
+    to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ min_tread_m: "
+                              "number_of_turns_for_step_height stored",
+        P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < min_tread_m: "
+                                 "tread too short; or a rise too low for the tread "
+                                 "(min_rise_for; past FAR_TREAD_M, only if the readings "
+                                 "grew as segment 1 rose)",
+        P.ERROR: FAULT})
+
+
+def _lowered_obstacle(t: Tick, _w: LiftWork) -> Step:
+    if landing.can_scan(t, _lf(t).wall_ahead):
+        # a wall ahead at the top of a flight may be a landing's: look sideways first
+        return go(P.LANDING_SCAN)
+    if landing.turned_here(t):
+        # the next flight's first step refused: back where it turned, and turn back
+        return go(P.LANDING_RETURN)
+    return go(P.DESCENT_BACK_OFF if t.ctx.number_of_steps > 0 else P.DESCENT_FINISH)
+
+
+_obstacle_enter, _obstacle_step = lift(
+    lambda t, w: {MotorId.MTF: _lf(t).return_mtf - w.entry_mtf}, _lowered_obstacle)
+LOWER_OBSTACLE = PhaseDef(
+    P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
+    LiftWork, enter=_obstacle_enter, carried_by=(2, 3), family=LiftFirst,
+    to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
+        P.LANDING_SCAN: "lowered; number_of_steps > 0, [algorithm] landings and no landing "
+                        "scanned yet: look sideways for the next flight",
+        P.LANDING_RETURN: "lowered; the first step after a landing's turn: back to where it "
+                          "turned",
+        P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
+
+
+def _measure_next_step(t: Tick, w: SightWork) -> None:
+    """Ascent 4's "store the reading in length_of_next_step", on the pair's
+    medians over ascent 3's last lift (:func:`_sight_medians`) rather than one
+    reading: a Sharp's single reading at 0.35 m is 8 mm off one time in
+    five, and segment 2 would stop that short of the edge."""
+    ctx = t.ctx
+    medians = _sight_medians(t, w)
+    if motion.measurable(t.snap, t.cfg) and None not in medians:
+        ctx.length_of_next_step = sum(m for m in medians if m is not None) / 2.0
+        far = long_tread.far(ctx.length_of_next_step)
+        t.say(f"length_of_next_step = {ctx.length_of_next_step:.3f} m"
+              + (f" (past FAR_TREAD_M = {long_tread.FAR_TREAD_M} m: the drives onto the step "
+                 "go by turns)" if far else ""),
+              length_of_next_step=ctx.length_of_next_step)
+        return
+    ctx.length_of_next_step = None
+    t.say("length_of_next_step not measurable (nothing ahead within LENGTH_OF_INFINITY): "
+          "driving NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE turns", length_of_next_step=None)
+
+
