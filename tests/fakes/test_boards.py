@@ -434,7 +434,7 @@ def test_a_lease_released_or_lapsed_can_be_taken(rig: tuple,
     # The sensor board's holder falls silent: its lease (lockstep: wall time)
     # lapses after the longer of the lease and the watchdog.
     clock = [1000.0]
-    monkeypatch.setattr(sensor, "_lease_clock", lambda: clock[0])
+    monkeypatch.setattr(sensor.lease, "_clock", lambda: clock[0])
     sensor.handle([m.Claim(m.LEASE_MS, NONCE)], HOST)
     clock[0] += m.LEASE_MS / 1000 - 0.01
     (held,) = sensor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)
