@@ -25,6 +25,7 @@ from collections.abc import Sequence
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
+from stairbot.fakes import sim_messages as sim
 from stairbot.fakes.board_lease import Lease
 from stairbot.fakes.board_world import BoardWorld
 
@@ -34,7 +35,7 @@ DEFAULT_WATCHDOG_MS = 250
 # What only the holder of a live lease may send; anyone may query, stop or
 # brake (Stop, Brake) and latch the emergency stop.
 OWNED: tuple[type[m.Message], ...] = (
-    m.SetWatchdog, m.Clear, m.SetWheelSpeeds, m.SetLiftSpeeds, m.Run, m.Move, m.StepTo)
+    m.SetWatchdog, m.Clear, m.SetWheelSpeeds, m.SetLiftSpeeds, m.Run, m.Move, sim.StepTo)
 
 
 class Board:
@@ -257,13 +258,13 @@ class MotorBoard(Board):
             return self._motion(msg, {msg.channel: sp(msg.speed_mtps)})
         if isinstance(msg, m.Move):
             return self._move(msg)
-        if isinstance(msg, m.StepTo):  # the simulation's messages go to the motor board
+        if isinstance(msg, sim.StepTo):  # the simulation's messages go to the motor board
             if not self.world.lockstep:
                 return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
             done = self.world.step_to(msg.time_us)
             self.after_step()
-            return [m.StepDone(done & 0xFFFFFFFF)]
-        if isinstance(msg, m.GetTruth):
+            return [sim.StepDone(done & 0xFFFFFFFF)]
+        if isinstance(msg, sim.GetTruth):
             return [self.world.truth()]
         if isinstance(msg, m.Stop | m.Brake):
             if msg.mask & ~m.ALL_MOTORS_MASK:
