@@ -34,9 +34,10 @@ from typing import Any
 
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import ESTOP_CONFIRM_S, BoardRobot
+from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import CanFrame
+from stairbot.drivers.estop import ESTOP_CONFIRM_S
 from stairbot.errors import HardwareError
 from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import make_boards

@@ -30,7 +30,11 @@ Two modes:
   a loaded machine a host that falls behind trips a watchdog.  Boards that
   fall behind pause their world (``Pacer``) and say so on exit; such a run
   is marked ``boards fell behind real time`` and was not real time
-  throughout.  Run a clean run (``--p 0``) at X first, on a quiet machine.
+  throughout.  A host that falls behind says so in its ``--json``
+  (``host_behind``: ticks that began more than one tick late, and the
+  longest lateness, in seconds of the robot's clock); such a run is marked
+  ``host fell behind``.  Run a clean run (``--p 0``) at X first, on a quiet
+  machine.
 """
 
 from __future__ import annotations
@@ -67,6 +71,16 @@ class Outcome:
     wall_s: float
     error: str | None
     behind: str = ""  # the boards' "fell behind real time ..." on exit, if they did
+    host_ticks: int = 0  # the host's ticks that began more than one tick late
+    host_longest_s: float = 0.0  # the longest of those latenesses (robot clock)
+
+    @property
+    def host_behind(self) -> str:
+        """'' unless the host fell behind its ticks; else how far."""
+        if not self.host_ticks:
+            return ""
+        return (f"fell behind {self.host_ticks} tick(s), the longest "
+                f"{self.host_longest_s * 1e3:.0f} ms late")
 
     @property
     def ok(self) -> bool:
@@ -121,10 +135,12 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
         return Outcome(mode, wire, fault, seed, f"exit {host.returncode}", 0, 0, False, {}, wall,
                        last, lagged)
     link = r.get("link") or {}
+    host_behind = r.get("host_behind") or {}  # absent on a simulated clock (lockstep)
     return Outcome(mode, wire, fault, seed, r["outcome"], r["steps_climbed"], r["steps_descended"],
                    bool(r["fell"]), {k: int(v) for k, v in link.items()
                                      if isinstance(v, (int, float)) and not isinstance(v, bool)},
-                   wall, r.get("error"), lagged)
+                   wall, r.get("error"), lagged, int(host_behind.get("ticks", 0)),
+                   float(host_behind.get("longest_s", 0.0)))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -164,7 +180,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{o.mode}: {o.wire:6} {o.fault:9} seed {o.seed:2}: {o.outcome:9} up {o.climbed} "
                   f"down {o.descended} fell {o.fell!s:5} {o.wall_s:5.0f} s  {counts}"
                   + (f"  error: {o.error}" if o.error else "")
-                  + (f"  boards {o.behind}" if o.behind else ""), flush=True)
+                  + (f"  boards {o.behind}" if o.behind else "")
+                  + (f"  host {o.host_behind}" if o.host_behind else ""), flush=True)
     print()
     bad = 0
     for w in wires:
@@ -173,10 +190,14 @@ def main(argv: list[str] | None = None) -> int:
             good = sum(o.ok for o in group)
             bad += len(group) - good
             lagged = sum(bool(o.behind) for o in group)
+            slow = [o for o in group if o.host_ticks]
             print(f"{mode}: {w:6} {f:9} {args.p:.0%}: {good}/{len(group)} completed, "
                   f"fell {sum(o.fell for o in group)}"
                   + (f"; in {lagged} the boards fell behind real time (the machine did not "
-                     "keep up)" if lagged else ""))
+                     "keep up)" if lagged else "")
+                  + (f"; in {len(slow)} the host fell behind its ticks ("
+                     f"{sum(o.host_ticks for o in slow)} late, the longest "
+                     f"{max(o.host_longest_s for o in slow) * 1e3:.0f} ms)" if slow else ""))
     return 1 if bad else 0
 
 

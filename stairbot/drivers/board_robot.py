@@ -3,15 +3,15 @@
 :class:`BoardRobot` implements the Robot protocol on a
 :class:`~stairbot.drivers.link.BoardLink` (the serial link, the CAN link):
 ``read()`` is one ReadAll to each board (both in flight at once; the replies
-become the snapshot in ``telemetry.py``: the four base sensors, and the side
-pair SSR/SSL on a robot whose config has one), ``command()``
-one SetWheelSpeeds + SetLiftSpeeds whose Ack is collected on the next call,
-the handshake identifies the boards, takes their leases (one host owns the
-robot: docs/protocol.md, section 3) and sets their watchdogs, a keepalive
-thread feeds them and renews the leases while the robot stands idle, and link health goes into
-``Snapshot.health``, ``diagnostics()`` and LINK events (``attach_sink``).  A
-lost link raises LinkLostError; a board that never answers while opening,
-NoBoardError.
+become the snapshot in ``board_replies.py``), ``command()`` one
+SetWheelSpeeds + SetLiftSpeeds whose Ack is collected on the next call.
+Opening the robot identifies the boards, takes their leases and sets their
+watchdogs (``handshake.py``); a keepalive thread feeds them and renews the
+leases while the robot stands idle (``keepalive.py``); the emergency stop is
+``estop.py``'s.  Link health goes into ``Snapshot.health``,
+``diagnostics()`` and LINK events (``attach_sink``).  A lost link raises
+LinkLostError saying what became of the motors (``link_loss.py``); a board
+that never answers while opening, NoBoardError.
 
 Fake boards in lockstep are a simulation, not a robot on a wire: their clock,
 StepTo, truth and falls belong to the fakes, which register their robot
@@ -25,34 +25,28 @@ import functools
 import secrets
 import threading
 import time
-from collections.abc import Callable, Sequence
-from typing import Any, Concatenate, Final, ParamSpec, TypeVar
+from collections.abc import Callable, Iterator, Sequence
+from typing import Concatenate, Final, NoReturn, ParamSpec, TypeVar
 
 from stairbot.clock import WallClock
+from stairbot.drivers import estop, link_loss, telemetry
 from stairbot.drivers import messages as m
-from stairbot.drivers import telemetry
 from stairbot.drivers import units as u
-from stairbot.drivers.handshake import LATCHES, open_board, release_board
+from stairbot.drivers.board_replies import ReplyReader, identity, vars_of
+from stairbot.drivers.handshake import LATCHES, check_owned, open_boards, release_board
 from stairbot.drivers.health import HealthReport
+from stairbot.drivers.keepalive import Keepalive
 from stairbot.drivers.link import BoardLink, BusFaultError, Reply, Request
-from stairbot.drivers.telemetry import K, T, V
-from stairbot.errors import BoardMismatchError, BoardOwnedError, HardwareError, LinkLostError
+from stairbot.errors import HardwareError, LinkLostError
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import Clock, Imu, SensorId, SensorReading, Snapshot, Speeds
+from stairbot.hardware import Clock, Imu, Snapshot, Speeds
 
-# The emergency stop (docs/protocol.md, "Emergency stop"): each press puts
-# ESTOP_COPIES EStop frames to each board on the wire at once, sends the
-# unanswered ones again every ESTOP_RESEND_S, and gives up on a board that has
-# not confirmed within ESTOP_CONFIRM_S (a LINK event says so).
 # A speed command keeps its motors running for at most COMMAND_HOLD_MS of
 # wall time (scaled like the watchdog) without a newer one: a host that falls
 # silent mid-drive has its motors stopped after that, well before its
 # watchdog latches (docs/protocol.md, "Command hold").  Five control ticks:
 # a lost command frame or two is ridden out.
 COMMAND_HOLD_MS = 100
-ESTOP_COPIES = 3
-ESTOP_RESEND_S = 0.02
-ESTOP_CONFIRM_S = 0.5
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -100,18 +94,13 @@ class BoardRobot:
         self.sink = sink
         self.clock: Clock = clock or WallClock(
             monotonic=lambda: monotonic() * time_scale, sleep=lambda s: time.sleep(s / time_scale))
-        self.idents: dict[int, m.Ident] = {}
-        self.status: dict[int, m.Status] = {}
-        self.boots: dict[int, int] = {}  # board -> boot id (its Owner reply)
         self.nonce = secrets.randbits(32)  # tells this host's leases from another's
         self._time_scale = time_scale
-        self.imu_read = telemetry.ImuRead(None, "unknown")  # the IMU as last read
-        self.imu_rejected = 0  # replies whose IMU broke the protocol
+        self.replies = ReplyReader(url, side_pair, self._check_status)
         self.report = HealthReport(link.stats, monotonic)
         self._monotonic = monotonic
         self._commands: list[Request] = []
         self._closed = False
-        self._estopped = False
         self._link_lost = False
         self._last_tx: dict[int, float] = {}
         self.watchdog_ms = watchdog_ms  # in ms of the robot's clock
@@ -122,42 +111,20 @@ class BoardRobot:
         self.board_hold_ms = COMMAND_HOLD_MS
         self.lease_ms = m.LEASE_MS  # in ms of the robot's clock, as the watchdog
         self._lock = threading.RLock()
-        self.latched: dict[int, int] = {}  # board -> latch flags found when opening
-        try:
-            self._handshake(allow_latched)
-        except BaseException:
-            for board in self.boots:  # the leases taken so far
-                release_board(self.link, m.Board(board), self.nonce)
-            raise
-        # A robot opened and left idle (a console before its run starts) must
-        # neither trip the boards' watchdogs nor let its leases lapse: a daemon
-        # thread sends Heartbeats to any board the host has not addressed for
-        # a quarter of the shorter of the two.
-        self._stop = threading.Event()
-        self._keepalive: threading.Thread | None = None
-        if keepalive:
-            self._keepalive = threading.Thread(target=self._keep_alive, daemon=True,
-                                               name=f"{link.wire} robot keepalive")
-            self._keepalive.start()
+        opened = open_boards(
+            link, url, lockstep=self.LOCKSTEP, watchdog_ms=self.board_watchdog_ms,
+            hold_ms=self.board_hold_ms, nonce=self.nonce, lease_ms=self.board_lease_ms,
+            wait_s=self._wait_board_s, allow_latched=allow_latched, side_pair=side_pair,
+            opened=self._sent_to)
+        self.idents, self.status, self.boots = opened.idents, opened.status, opened.boots
+        self.latched = {b: s.flags & LATCHES for b, s in self.status.items() if s.flags & LATCHES}
+        # an e-stop latch found when opening is this host's to hold
+        self._estopped = any(s.flags & m.StatusFlag.ESTOP for s in self.status.values())
+        # Heartbeats to any board the host has not addressed for ``feed_s``.
+        self._keepalive = (Keepalive(f"{link.wire} robot keepalive", lambda: self.feed_s,
+                                     self._keep_alive) if keepalive else None)
 
     # -- setting up ------------------------------------------------------------
-    def _handshake(self, allow_latched: bool) -> None:
-        for board in m.Board:
-            self.idents[board], status, owner = open_board(
-                self.link, self.url, board, lockstep=self.LOCKSTEP,
-                watchdog_ms=self.board_watchdog_ms, hold_ms=self.board_hold_ms,
-                nonce=self.nonce,
-                lease_ms=self.board_lease_ms, wait_s=self._wait_board_s,
-                allow_latched=allow_latched, side_pair=self.side_pair)
-            self.boots[board] = owner.boot
-            if status is not None:
-                self.status[board] = status
-                if status.flags & LATCHES:
-                    self.latched[board] = status.flags & LATCHES
-                if status.flags & m.StatusFlag.ESTOP:
-                    self._estopped = True  # this host holds the latch it found
-            self._last_tx[board] = self._monotonic()
-
     @property
     def board_lease_ms(self) -> int:
         """The lease asked of the boards, in their ms (the robot's, as the watchdog)."""
@@ -174,15 +141,8 @@ class BoardRobot:
         return min(self.watchdog_ms or self.lease_ms, self.lease_ms) / 4000 / self._time_scale
 
     def identity(self) -> dict[str, dict[str, int]]:
-        """Each board's serial number, uptime (ms, from its last Status) and
-        boot id (drawn by the board at power-up): what a journal keeps, and
-        what tells a resumed run whether these are the same boards, still
-        running since (their counters still valid)."""
-        return {m.Board(b).name.lower(): {
-                    "serial": ident.serial,
-                    "uptime_ms": self.status[b].uptime_ms if b in self.status else -1,
-                    "boot": self.boots.get(b, 0)}
-                for b, ident in self.idents.items()}
+        """Each board's serial number, uptime and boot id (``board_replies.identity``)."""
+        return identity(self.idents, self.status, self.boots)
 
     @property
     def simulated(self) -> bool:
@@ -213,10 +173,9 @@ class BoardRobot:
         self._link_lost = False  # both boards answered: any earlier loss is over
         now = self.clock.now()
         transit = max(0.0, now - sent)
-        motors = self._read_all(m.Board.MOTOR, fm.messages, m.MotorTelemetry,
-                                m.MOTOR_CHANNELS, u.state_from_wire)
-        sensors = self._read_sensors(fs.messages, transit)
-        imu = self._read_imu(fs.messages, transit, now)
+        motors = self.replies.motors(fm.messages)
+        sensors = self.replies.sensors(fs.messages, transit)
+        imu = self.replies.imu(fs.messages, transit, now, self.sink)
         health = self.health()
         self.report.maybe_event(health, now, self.sink)
         return Snapshot(now, sensors, motors, health, imu)
@@ -265,61 +224,17 @@ class BoardRobot:
 
     def estop(self) -> None:
         """Latch the emergency stop: here at once (``command`` sends only
-        zeros from now on), and on both boards.  Callable from any thread, it
-        does not wait for the robot's lock: ESTOP_COPIES EStop frames to each
-        board (broadcast frames on CAN) go on the wire at once, between the
-        retries of a read in progress; the unanswered ones are sent again
-        every ESTOP_RESEND_S until each board has confirmed (its Status), for
-        at most ESTOP_CONFIRM_S.  Never raises: a board that does not confirm
-        is a LINK event naming it."""
+        zeros from now on), and on both boards (``estop.press``).  Callable
+        from any thread, it does not wait for the robot's lock.  Never
+        raises: a board that does not confirm is a LINK event naming it."""
         self._estopped = True
         if self._closed:
             return
-        t0 = self._monotonic()
-        try:
-            reqs = self.link.urgent(m.EStop(), copies=ESTOP_COPIES)
-        except Exception as exc:  # noqa: BLE001 - the Robot protocol: estop never raises
-            self._estop_unconfirmed(list(m.Board), f"cannot send it: {exc}")
-            return
-        sent = t0
-        while True:
-            waiting = {r.board for r in reqs} - {r.board for r in reqs if r.reply is not None}
-            if not waiting:
-                break
-            now = self._monotonic()
-            if now - t0 >= ESTOP_CONFIRM_S:
-                self.link.forget(reqs)
-                self._estop_unconfirmed(sorted(m.Board(b) for b in waiting),
-                                        f"no Status within {ESTOP_CONFIRM_S * 1e3:.0f} ms of "
-                                        f"{sum(r.attempts for r in reqs)} EStop frames")
-                return
-            if now - sent >= ESTOP_RESEND_S:
-                sent = now
-                # a write that fails: keep trying till the end
-                with contextlib.suppress(Exception):
-                    self.link.resend_urgent([r for r in reqs if r.board in waiting])
-            # Whoever holds the lock (a read in progress) takes in the replies;
-            # when nobody does, this thread does.
-            if self._lock.acquire(blocking=False):
-                try:
-                    self.link.poll()
-                except Exception:  # noqa: BLE001 - a read that fails is a later read()'s news
-                    pass
-                finally:
-                    self._lock.release()
-            time.sleep(0.001)
-        self.link.forget(reqs, lost=False)  # the spare copies: their replies count as late
-
-    def _estop_unconfirmed(self, boards: Sequence[m.Board], why: str) -> None:
-        names = " and ".join(f"the {b.name.lower()} board" for b in boards)
-        # What the host knows: not whether the board stopped, only what a
-        # working board's watchdog is set to do.
-        watchdog = (f"; this host cannot tell whether it stopped (a board that still runs "
-                    f"stops its motors {self.watchdog_ms} ms after it last heard the host)"
-                    if self.watchdog_ms else "; the watchdogs are off (watchdog=0)")
-        self.sink(Event(self.clock.now(), EventKind.LINK,
-                        f"emergency stop not confirmed by {names}: {why}{watchdog}", None,
-                        self.health()))
+        unconfirmed = estop.press(self.link, self._lock, self._monotonic)
+        if unconfirmed is not None:
+            self.sink(Event(self.clock.now(), EventKind.LINK,
+                            estop.unconfirmed_text(unconfirmed.boards, unconfirmed.why,
+                                                   self.watchdog_ms), None, self.health()))
 
     @locked
     def clear(self, mask: int = m.ClearMask.ALL) -> None:
@@ -327,19 +242,9 @@ class BoardRobot:
         e-stop latch once both boards confirm.  LinkLostError if they do not;
         BoardOwnedError if a board refuses (another host took its lease)."""
         for reply in self._wait(self._broadcast(m.Clear(mask))):
-            self._check_owned(reply, "Clear")
+            check_owned(self.url, reply, "Clear")
         if mask & m.ClearMask.ESTOP:
             self._estopped = False
-
-    def _check_owned(self, reply: Reply, what: str) -> None:
-        """BoardOwnedError when a board answered ``what`` with Ack(NOT_OWNER)."""
-        for msg in reply.messages:
-            if isinstance(msg, m.Ack) and msg.result == m.AckResult.NOT_OWNER:
-                raise BoardOwnedError(
-                    f"{self.url}: the {m.Board(reply.board).name.lower()} board refused "
-                    f"{what}: this host no longer holds its lease (another host took it, "
-                    "or this one fell silent for longer than the lease); one host owns "
-                    "the robot")
 
     @property
     def estopped(self) -> bool:
@@ -361,24 +266,20 @@ class BoardRobot:
         return {"url": self.url, **self.link.describe(), "link": self.health(),
                 "boards": {m.Board(b).name.lower(): vars_of(i)
                            for b, i in self.idents.items()},
-                "imu": {"state": self.imu_read.state, "problem": self.imu_read.problem,
-                        "rejected": self.imu_rejected}}
+                "imu": self.replies.diagnostics()}
 
-    def _keep_alive(self) -> None:
-        while not self._stop.wait(self.feed_s):
-            try:
-                with self._lock:
-                    if self._closed:
-                        return
-                    self.heartbeat()
-                    self._reap()
-            except Exception:  # noqa: BLE001 - link trouble shows on the next read()
-                continue
+    @locked
+    def _keep_alive(self) -> bool:
+        """One beat of the keepalive; False once the robot is closed."""
+        if self._closed:
+            return False
+        self.heartbeat()
+        self._reap()
+        return True
 
     def close(self) -> None:
-        self._stop.set()
-        if self._keepalive is not None and self._keepalive is not threading.current_thread():
-            self._keepalive.join(1.0)
+        if self._keepalive is not None:
+            self._keepalive.stop()
         self._close()
 
     @locked
@@ -410,37 +311,43 @@ class BoardRobot:
         return self.report.refused
 
     # -- internals ---------------------------------------------------------------
-    def _request(self, board: int, msgs: list[m.Message], send: bool = True) -> Request:
-        self._last_tx[board] = self._monotonic()
+    @contextlib.contextmanager
+    def _on_link(self) -> Iterator[None]:
+        """A LinkLostError of the link (no reply, or the wire itself failed:
+        a port that went away, bus-off) becomes this robot's (``_lost``)."""
         try:
-            return self.link.request(board, msgs, send=send)
-        except LinkLostError as exc:  # the wire itself failed (a port that went away)
+            yield
+        except LinkLostError as exc:
             self._lost(str(exc), latch=isinstance(exc, BusFaultError))
-            raise  # unreachable: _lost raises
+
+    def _sent_to(self, board: int) -> None:
+        self._last_tx[board] = self._monotonic()
+
+    def _request(self, board: int, msgs: list[m.Message], send: bool = True) -> Request:
+        self._sent_to(board)
+        with self._on_link():
+            return self.link.request(board, msgs, send=send)
 
     def _broadcast(self, msg: m.Message) -> Sequence[Request]:
-        try:
+        with self._on_link():
             return self.link.broadcast(msg)
-        except LinkLostError as exc:  # the wire itself failed
-            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
-            raise  # unreachable: _lost raises
 
     def _wait(self, requests: Sequence[Request]) -> list[Reply]:
         try:
-            return self.link.wait(requests)
-        except LinkLostError as exc:
-            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
-            raise  # unreachable: _lost raises
+            with self._on_link():
+                return self.link.wait(requests)
         except HardwareError as exc:  # a board that broke the protocol
+            if isinstance(exc, LinkLostError):
+                raise
             raise HardwareError(f"{self.url}: {exc}") from None
 
-    def _lost(self, reason: str, boards_stopped: bool = False, latch: bool = False) -> None:
+    def _lost(self, reason: str, boards_stopped: bool = False, latch: bool = False) -> NoReturn:
         """Report the lost link (a LINK event, the first time only: the stop,
         truth and close that follow a loss would each report it again) and
-        raise LinkLostError saying what became of the motors, and what is
-        wrong with the wire itself if the link knows (``bus_trouble``).  A
-        failed wire (``latch``: bus-off, a flood) first latches this robot's
-        emergency stop."""
+        raise LinkLostError saying what became of the motors
+        (``link_loss.consequence``), and what is wrong with the wire itself if
+        the link knows (``bus_trouble``).  A failed wire (``latch``: bus-off,
+        a flood) first latches this robot's emergency stop."""
         if latch:
             self.estop()  # never raises; the boards may not hear it
         else:
@@ -451,25 +358,13 @@ class BoardRobot:
             self._link_lost = True
             self.sink(Event(self.clock.now(), EventKind.LINK, f"link lost: {reason}", None,
                             self.health()))
-        if latch:
-            after = ("; this host's emergency stop is latched (EStop frames sent; a board "
-                     "that did not hear them stops its motors when its watchdog runs out)")
-        elif boards_stopped:
-            after = ""
-        elif self.watchdog_ms:
-            # What the host cannot know it does not say: whether the boards
-            # are alive, and so whether their watchdogs have stopped anything.
-            after = (f"; a board that hears nothing more stops its motors when its "
-                     f"watchdog ({self.watchdog_ms} ms) runs out")
-        else:
-            after = "; the boards' watchdogs are off (watchdog=0): motors may still run"
+        after = link_loss.consequence(self.watchdog_ms, latch=latch,
+                                      boards_stopped=boards_stopped)
         raise LinkLostError(f"{self.url}: link lost: {reason}{after}")
 
     def _reap(self) -> None:
-        try:
+        with self._on_link():
             self.link.poll()
-        except LinkLostError as exc:  # the wire itself failed
-            self._lost(str(exc), latch=isinstance(exc, BusFaultError))
         still = []
         done_now = []
         for p in self._commands:
@@ -483,7 +378,7 @@ class BoardRobot:
         self._commands = still
         for p in done_now:
             if p.reply is not None:
-                self._check_owned(p.reply, "a command")
+                check_owned(self.url, p.reply, "a command")
 
     def _check_status(self, board: m.Board, status: m.Status) -> None:
         self.status[board] = status
@@ -502,50 +397,3 @@ class BoardRobot:
     def _world_failed(self, board: m.Board) -> None:
         """Fake boards say the simulated world behind them failed (a fall)."""
         raise HardwareError(f"the {board.name.lower()} board's simulated world failed")
-
-    def _read_all(self, board: m.Board, msgs: tuple[Any, ...], kind: type[T],
-                  ids: Sequence[K], convert: Callable[[T], V]) -> dict[K, V]:
-        """A ReadAll reply -- Status, then one ``kind`` telemetry per channel --
-        as ``{ids[channel]: convert(telemetry)}``, after checking the Status.
-        HardwareError when the reply is not that."""
-        self._check_reply_status(board, msgs)
-        return telemetry.channels(board, msgs[1:], kind, ids, convert)
-
-    def _read_sensors(self, msgs: tuple[Any, ...], transit_s: float
-                      ) -> dict[SensorId, SensorReading]:
-        """The sensor board's ReadAll reply as readings, after checking its
-        Status: the base four, and the side pair on a robot that has one
-        (``telemetry.sensors_of``).  HardwareError when the reply is not that;
-        BoardMismatchError (naming this URL) when the side pair lacks."""
-        self._check_reply_status(m.Board.SENSOR, msgs)
-        try:
-            return telemetry.sensors_of(msgs[1:], lambda t: u.reading_from_wire(t, transit_s),
-                                        self.side_pair)
-        except BoardMismatchError as exc:
-            raise BoardMismatchError(f"{self.url}: {exc}") from None
-
-    def _check_reply_status(self, board: m.Board, msgs: tuple[Any, ...]) -> None:
-        """HardwareError unless a ReadAll reply starts with a Status; check it."""
-        if not msgs or not isinstance(msgs[0], m.Status):
-            raise HardwareError(f"the {board.name.lower()} board answered ReadAll with "
-                                f"{msgs!r}")
-        self._check_status(board, msgs[0])
-
-    def _read_imu(self, msgs: tuple[Any, ...], transit_s: float, now: float) -> Imu | None:
-        """The IMU of the sensor board's ReadAll reply (None unless it is
-        there, OK and valid).  A board that breaks the protocol is counted
-        (``imu_rejected``) and told once, as a WARNING, until it mends (a
-        value that changes every tick is one trouble, not one a tick)."""
-        got = telemetry.imu_of(msgs, transit_s)
-        if got.broken:
-            self.imu_rejected += 1
-            if got.state != self.imu_read.state:
-                self.sink(Event(now, EventKind.WARNING, f"sensor board IMU read as none: "
-                                f"{got.problem}", None, {"imu": got.state}))
-        self.imu_read = got
-        return got.imu
-
-
-def vars_of(ident: m.Ident) -> dict[str, int]:
-    return {"protocol": ident.protocol_major * 256 + ident.protocol_minor,
-            "firmware": ident.firmware, "serial": ident.serial, "channels": ident.channels}

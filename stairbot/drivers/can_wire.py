@@ -1,8 +1,11 @@
 """The boards' messages on CAN: one message per classic data frame, 29-bit ids.
 
-Every frame, its id and its signals are in ``stairbot.dbc`` (shipped beside
-this module); this module reads the DBC with cantools and maps its frames onto
-the transport-independent messages of :mod:`stairbot.drivers.messages`:
+Every frame of the real boards, its id and its signals are in
+``stairbot.dbc`` (shipped beside this module); the DBCs registered with the
+codec (``messages.register``: the fakes' simulation-only frames, once
+``stairbot.fakes`` is imported) add to it.  This module reads them with
+cantools and maps their frames onto the transport-independent messages of
+:mod:`stairbot.drivers.messages`:
 
 * id = ``base << 18 | session << 8 | seq`` (an extended identifier, protocol
   4.0).  ``base = kind << 4 | board`` comes first, so arbitration still goes
@@ -102,7 +105,8 @@ class CanWire:
             board = BOARD_SUFFIX.get(suffix)
             if cls is None or board is None:
                 raise ValueError(f"{DBC_NAME}: frame {frame.name} is not <Message>_<Motor|"
-                                 "Sensor|All> for a message of drivers/messages.py")
+                                 "Sensor|All> for a message the codec knows "
+                                 "(drivers/messages.py, or one registered with it)")
             base, seq_bits = frame.frame_id >> BASE_SHIFT, frame.frame_id & ~FRAME_ID_MASK
             if not frame.is_extended_frame or seq_bits or base > BASE_MAX or base & 0x0F != board:
                 raise ValueError(f"{DBC_NAME}: {frame.name} has id 0x{frame.frame_id:08X}; "
@@ -249,7 +253,15 @@ def load_dbc(path: str | None = None) -> Any:
                                        frame_id_mask=FRAME_ID_MASK)
 
 
-@lru_cache(maxsize=1)
 def wire() -> CanWire:
-    """The shared CanWire of the shipped DBC (loaded once per process)."""
-    return CanWire(load_dbc())
+    """The shared CanWire of the shipped DBC and the DBCs registered with
+    the codec so far (``messages.registered_dbcs``): loaded once per set."""
+    return _wire(m.registered_dbcs())
+
+
+@lru_cache(maxsize=4)
+def _wire(extra: tuple[str, ...]) -> CanWire:
+    db = load_dbc()
+    for text in extra:
+        db.add_dbc_string(text)
+    return CanWire(db)

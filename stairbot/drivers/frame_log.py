@@ -6,7 +6,9 @@
   ``.log`` candump ``-L`` (``can.CanutilsLogWriter``), ``.asc`` Vector ASC
   (``can.ASCWriter``), ``.trc`` PCAN-View, ``.csv``.  Each reads back with
   ``can.LogReader`` and replays with ``can.Player``; a ``.log`` decodes with
-  ``python -m cantools decode -m 0x1FFC0000 stairbot/drivers/stairbot.dbc < FILE``.
+  ``python -m cantools decode -m 0x1FFC0000 stairbot/drivers/stairbot.dbc < FILE``
+  (a lockstep run's with ``stairbot/fakes/stairbot_sim.dbc`` appended to the
+  DBC: docs/protocol.md, "Decoding captured traffic").
 * serial: one line per frame, ``TIME DIR HEX``: the wall time (seconds since
   the epoch, to the microsecond), ``TX`` (host to boards) or ``RX``, and the
   frame's bytes on the line, COBS-stuffed, its 0x00 delimiter included

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.link import BoardLink, CountsReplies, ProbesOldBoards, Reply
@@ -205,3 +206,49 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
                               "took its lease; one host owns the robot")
     return ident, last if isinstance(last, m.Status) else None, owner
 
+
+
+@dataclass
+class OpenedBoards:
+    """What opening both boards found: each board's Ident, its Status after
+    set-up (when it sent one) and its boot id (its Owner reply)."""
+
+    idents: dict[int, m.Ident] = field(default_factory=dict)
+    status: dict[int, m.Status] = field(default_factory=dict)
+    boots: dict[int, int] = field(default_factory=dict)
+
+
+def open_boards(link: BoardLink, url: str, *, lockstep: bool, watchdog_ms: int, hold_ms: int,
+                nonce: int, lease_ms: int, wait_s: Callable[[float], None],
+                allow_latched: bool = False, side_pair: str | None = None,
+                opened: Callable[[m.Board], None] = lambda board: None) -> OpenedBoards:
+    """Every board opened in turn (``open_board``); ``opened`` is told each
+    board once it is.  Raises what ``open_board`` raises, after giving up
+    the leases taken so far."""
+    out = OpenedBoards()
+    try:
+        for board in m.Board:
+            out.idents[board], status, owner = open_board(
+                link, url, board, lockstep=lockstep, watchdog_ms=watchdog_ms,
+                hold_ms=hold_ms, nonce=nonce, lease_ms=lease_ms, wait_s=wait_s,
+                allow_latched=allow_latched, side_pair=side_pair)
+            out.boots[board] = owner.boot
+            if status is not None:
+                out.status[board] = status
+            opened(board)
+    except BaseException:
+        for taken in out.boots:  # the leases taken so far
+            release_board(link, m.Board(taken), nonce)
+        raise
+    return out
+
+
+def check_owned(url: str, reply: Reply, what: str) -> None:
+    """BoardOwnedError when a board answered ``what`` with Ack(NOT_OWNER)."""
+    for msg in reply.messages:
+        if isinstance(msg, m.Ack) and msg.result == m.AckResult.NOT_OWNER:
+            raise BoardOwnedError(
+                f"{url}: the {m.Board(reply.board).name.lower()} board refused "
+                f"{what}: this host no longer holds its lease (another host took it, "
+                "or this one fell silent for longer than the lease); one host owns "
+                "the robot")

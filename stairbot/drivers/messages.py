@@ -10,10 +10,15 @@ firmware author reads; this package is its executable twin:
 
 * ``codes.py``        -- protocol version, boards, channels, code tables;
 * ``records.py``      -- the real boards' messages (host -> board, board -> host);
-* ``sim_messages.py`` -- the fake boards' simulation-only messages (StepTo,
-  GetTruth and their replies), on the same wire;
-* this module        -- one namespace for all of them (``from stairbot.drivers
-  import messages as m``) and the codec.
+* this module        -- one namespace for them (``from stairbot.drivers import
+  messages as m``) and the codec.
+
+The codec knows the real boards' messages and nothing else.  The fake
+boards' simulation-only messages (StepTo, GetTruth and their replies) travel
+on the same wire, but only a process that imports the fakes knows them:
+``stairbot.fakes.sim_messages`` adds them, with the DBC of their CAN frames,
+by :func:`register`.  To a host that never imports the fakes a StepTo is an
+unknown type, as it is to a real board.
 
 Units on the wire are integers: speeds in milli-turns/s (int16), turn counters
 in milli-turns (int32), distances in millimetres (uint16), times and ages in ms
@@ -90,19 +95,46 @@ from stairbot.drivers.records import (
     Stop,
     TelemetryValueError,
 )
-from stairbot.drivers.sim_messages import GetTruth, StepDone, StepTo, Truth
 
 MESSAGES: dict[int, type[Message]] = {
     cls.TYPE: cls
     for cls in (
         Identify, Heartbeat, GetStatus, SetWatchdog, EStop, Clear, ReadAll, GetMotor,
-        GetSensor, GetImu, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, StepTo,
-        GetTruth, Ident, Status, MotorTelemetry, SensorTelemetry, ImuTelemetry, Ack, StepDone,
-        Truth, Claim, Owner,
+        GetSensor, GetImu, SetWheelSpeeds, SetLiftSpeeds, Run, Move, Stop, Brake, Ident,
+        Status, MotorTelemetry, SensorTelemetry, ImuTelemetry, Ack, Claim, Owner,
     )
 }
+"""Every message the codec knows, by type code: the real boards', and those
+added by :func:`register`."""
 _STRUCTS: dict[int, struct.Struct] = {t: struct.Struct(c.FORMAT) for t, c in MESSAGES.items()}
 assert all(s.size <= MAX_PAYLOAD for s in _STRUCTS.values())
+_DBCS: list[str] = []  # the registered DBC texts, in order
+
+
+def register(*classes: type[Message], dbc: str | None = None) -> None:
+    """Add messages to the codec, and ``dbc`` (the text of a DBC naming
+    their CAN frames, ``<Message>_<Motor|Sensor|All>``) to the CAN wire
+    (``can_wire.wire``).  The fakes add their simulation-only messages so.
+    Registering the same classes and DBC again changes nothing; a type code
+    another class holds, or a payload longer than MAX_PAYLOAD, raises
+    ValueError."""
+    for cls in classes:
+        held = MESSAGES.get(cls.TYPE)
+        if held is not None and held is not cls:
+            raise ValueError(f"type 0x{cls.TYPE:02X} is {held.__name__}'s, not {cls.__name__}'s")
+        layout = struct.Struct(cls.FORMAT)
+        if layout.size > MAX_PAYLOAD:
+            raise ValueError(f"{cls.__name__}: payload of {layout.size} bytes, more than "
+                             f"{MAX_PAYLOAD}")
+    for cls in classes:
+        MESSAGES[cls.TYPE], _STRUCTS[cls.TYPE] = cls, struct.Struct(cls.FORMAT)
+    if dbc is not None and dbc not in _DBCS:
+        _DBCS.append(dbc)
+
+
+def registered_dbcs() -> tuple[str, ...]:
+    """The DBC texts :func:`register` added, in order (the shipped DBC not among them)."""
+    return tuple(_DBCS)
 
 
 def read_all_reply(board: int, channels: int | None = None) -> tuple[type[Message], ...]:
@@ -162,10 +194,10 @@ __all__ = [
     "MAX_PAYLOAD", "MESSAGES", "MOTOR_CHANNELS", "PROTOCOL_MAJOR", "PROTOCOL_MINOR",
     "READ_ALL_REPLY", "SENSOR_CHANNELS", "SIDE_SENSOR_CHANNELS", "Ack", "AckResult", "Board",
     "Brake", "Claim", "ClaimResult", "Clear", "ClearMask", "CodecError", "EStop", "GetImu",
-    "GetMotor", "GetSensor", "GetStatus", "GetTruth", "Heartbeat", "Ident", "Identify",
+    "GetMotor", "GetSensor", "GetStatus", "Heartbeat", "Ident", "Identify",
     "ImuAxis", "ImuCode", "ImuTelemetry", "Message", "MotorFault", "MotorMode",
     "MotorTelemetry", "Move", "Owner", "RawMessage", "ReadAll", "Run", "SensorCode",
     "SensorTelemetry", "SetLiftSpeeds", "SetWatchdog", "SetWheelSpeeds", "Status", "StatusFlag",
-    "StepDone", "StepTo", "Stop", "TelemetryValueError", "Truth", "decode", "encode",
-    "payload_size", "read_all_reply",
+    "Stop", "TelemetryValueError", "decode", "encode", "payload_size", "read_all_reply",
+    "register", "registered_dbcs",
 ]

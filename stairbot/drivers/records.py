@@ -7,7 +7,7 @@ its TYPE, its payload layout (FORMAT, struct, little-endian), whether a board
 sends it (REPLY), whether a host may send it again (IDEMPOTENT) and, for a
 host's message, the reply it is answered with (ANSWER).  ``messages.py`` is
 the namespace everyone imports and the codec; the simulation's own messages
-are in ``sim_messages.py``.
+are the fakes' (``stairbot.fakes.sim_messages`` adds them to the codec).
 """
 
 from __future__ import annotations

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from stairbot.drivers import messages as m
 from stairbot.errors import HardwareError
+from stairbot.fakes import sim_messages as sim
 from stairbot.hardware import Clock, HasTruth, MotorId, Robot, Snapshot
 
 if TYPE_CHECKING:
@@ -88,7 +89,7 @@ class BoardWorld:
         if not self.lockstep:
             self._time_us = round(self.clock.now() * 1e6)
 
-    def truth(self) -> m.Truth:
+    def truth(self) -> sim.Truth:
         """GetTruth's answer: the world's own truth (a robot without it, such
         as a test's stub, reports zeros), and a fall the world failed on."""
         fell, pitch, offset = False, 0.0, 0.0
@@ -96,7 +97,7 @@ class BoardWorld:
             t = self.robot.truth()
             fell, pitch, offset = t.fell, t.max_pitch_deg or 0.0, t.offset_m or 0.0
         fell = fell or (self.failure is not None and "fell" in self.failure.lower())
-        return m.Truth(
+        return sim.Truth(
             1 if fell else 0,
             max(-32767, min(32767, round(pitch * 100))),
             max(-(2**31) + 1, min(2**31 - 1, round(offset * 1000))),

@@ -21,10 +21,12 @@ from __future__ import annotations
 
 import secrets
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
+from stairbot.fakes import sim_messages as sim
+from stairbot.fakes.board_lease import Lease
 from stairbot.fakes.board_world import BoardWorld
 
 FIRMWARE_VERSION = 0x0100
@@ -33,7 +35,7 @@ DEFAULT_WATCHDOG_MS = 250
 # What only the holder of a live lease may send; anyone may query, stop or
 # brake (Stop, Brake) and latch the emergency stop.
 OWNED: tuple[type[m.Message], ...] = (
-    m.SetWatchdog, m.Clear, m.SetWheelSpeeds, m.SetLiftSpeeds, m.Run, m.Move, m.StepTo)
+    m.SetWatchdog, m.Clear, m.SetWheelSpeeds, m.SetLiftSpeeds, m.Run, m.Move, sim.StepTo)
 
 
 class Board:
@@ -55,16 +57,8 @@ class Board:
         self._start = world.now()
         self.handled = 0
         self.boot = secrets.randbits(32) or 1  # drawn at power-up (Owner.boot)
-        # The lease: the holder's session and nonce, the lease it asked for,
-        # and when its last frame came (on the lease clock).  In lockstep the
-        # world's time stands still while the host is away, so the lease is
-        # counted in wall time there; otherwise on the board's own clock.
-        self.owner: int | None = None
-        self.owner_nonce = 0
-        self.lease_ms = 0
-        self._owner_seen = 0.0
-        self._lease_clock: Callable[[], float] = (time.monotonic if world.lockstep
-                                                  else world.now)
+        self.lease = Lease(time.monotonic if world.lockstep else world.now,
+                           lambda: self.watchdog_ms, self.boot)
 
     # -- status ----------------------------------------------------------------
     def flags(self) -> int:
@@ -112,36 +106,15 @@ class Board:
         """Stop every motor this board drives (nothing on the sensor board)."""
 
     # -- the lease ---------------------------------------------------------------
-    def _lease_left_s(self) -> float:
-        """How long the lease lasts without another frame from its holder
-        (0 when there is none); at least as long as the watchdog."""
-        if self.owner is None:
-            return 0.0
-        span = max(self.lease_ms, self.watchdog_ms) / 1000
-        return max(0.0, span - (self._lease_clock() - self._owner_seen))
-
     def owns(self, session: int) -> bool:
         """Whether ``session`` holds a live lease of this board."""
-        return self.owner == session and self._lease_left_s() > 0
-
-    def _owner(self, result: m.ClaimResult) -> m.Owner:
-        left = self._lease_left_s()
-        return m.Owner(int(result), self.owner if left > 0 and self.owner else 0,
-                       min(255, round(left * 100)), self.boot)
+        return self.lease.owns(session)
 
     def _claim(self, msg: m.Claim, session: int) -> m.Owner:
-        live = self._lease_left_s() > 0
-        if live and (self.owner, self.owner_nonce) != (session, msg.nonce):
-            return self._owner(m.ClaimResult.HELD)
-        if msg.lease_ms == 0:
-            if not live:
-                return self._owner(m.ClaimResult.FREE)
-            self.owner = None
-            return self._owner(m.ClaimResult.RELEASED)
-        self.owner, self.owner_nonce, self.lease_ms = session, msg.nonce, msg.lease_ms
-        self._owner_seen = self._lease_clock()
-        self._last_feed = self.world.now()  # the watchdog is armed from now on
-        return self._owner(m.ClaimResult.GRANTED)
+        granted = self.lease.claim(msg, session)
+        if granted.result == m.ClaimResult.GRANTED:
+            self._last_feed = self.world.now()  # the watchdog is armed from now on
+        return granted
 
     # -- messages --------------------------------------------------------------
     def handle(self, msgs: Sequence[m.Message | m.RawMessage], session: int
@@ -153,7 +126,7 @@ class Board:
         self.poll()  # a frame that comes too late does not un-trip the watchdog
         if self.owns(session):
             self._last_feed = self.world.now()
-            self._owner_seen = self._lease_clock()
+            self.lease.renew()
         self.handled += 1
         out: list[m.Message] = []
         for msg in msgs:
@@ -285,13 +258,13 @@ class MotorBoard(Board):
             return self._motion(msg, {msg.channel: sp(msg.speed_mtps)})
         if isinstance(msg, m.Move):
             return self._move(msg)
-        if isinstance(msg, m.StepTo):  # the simulation's messages go to the motor board
+        if isinstance(msg, sim.StepTo):  # the simulation's messages go to the motor board
             if not self.world.lockstep:
                 return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
             done = self.world.step_to(msg.time_us)
             self.after_step()
-            return [m.StepDone(done & 0xFFFFFFFF)]
-        if isinstance(msg, m.GetTruth):
+            return [sim.StepDone(done & 0xFFFFFFFF)]
+        if isinstance(msg, sim.GetTruth):
             return [self.world.truth()]
         if isinstance(msg, m.Stop | m.Brake):
             if msg.mask & ~m.ALL_MOTORS_MASK:

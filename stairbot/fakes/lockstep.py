@@ -27,9 +27,9 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot, locked
 from stairbot.drivers.board_session import register_lockstep
 from stairbot.drivers.link import BoardLink, Reply, Request
-from stairbot.drivers.sim_messages import FELL
 from stairbot.errors import HardwareError, RobotFellError
 from stairbot.events import EventSink, discard
+from stairbot.fakes import sim_messages as sim
 from stairbot.hardware import Truth
 
 
@@ -72,10 +72,10 @@ class LockstepRobot(BoardRobot):
                          allow_latched=allow_latched, side_pair=side_pair)
         # The world may have run before this host opened it (a resumed run):
         # the clock starts where the world stands (StepTo 0 steps nothing).
-        (done,) = self._wait([self._request(m.Board.MOTOR, [m.StepTo(0)])])
+        (done,) = self._wait([self._request(m.Board.MOTOR, [sim.StepTo(0)])])
         self._check_step(done)
         step = done.messages[0]
-        if isinstance(step, m.StepDone) and isinstance(self.clock, LockstepClock):
+        if isinstance(step, sim.StepDone) and isinstance(self.clock, LockstepClock):
             self.clock.start_at(step.time_us)
 
     @property
@@ -92,7 +92,7 @@ class LockstepRobot(BoardRobot):
         switch, the dearest part of a tick).  Otherwise waits here."""
         if self._step is not None:
             self._check_step(self._wait([self._step])[0])
-        self._step = self._request(m.Board.MOTOR, [m.StepTo(time_us)],
+        self._step = self._request(m.Board.MOTOR, [sim.StepTo(time_us)],
                                    send=not self.PIPELINED_STEP)
         if not self.PIPELINED_STEP:
             step, self._step = self._step, None
@@ -115,7 +115,7 @@ class LockstepRobot(BoardRobot):
         return replies
 
     def _check_step(self, reply: Reply) -> None:
-        if not reply.messages or not isinstance(reply.messages[0], m.StepDone):
+        if not reply.messages or not isinstance(reply.messages[0], sim.StepDone):
             raise HardwareError(f"the motor board refused StepTo: {reply.messages}")
 
     @locked
@@ -126,11 +126,11 @@ class LockstepRobot(BoardRobot):
         HardwareError when the boards cannot answer (a lost link, closed)."""
         if self._closed:
             raise HardwareError(f"{self.url}: closed; the fake boards cannot be asked")
-        (reply,) = self._wait([self._request(m.Board.MOTOR, [m.GetTruth()])])
+        (reply,) = self._wait([self._request(m.Board.MOTOR, [sim.GetTruth()])])
         truth = reply.messages[0] if reply.messages else None
-        if not isinstance(truth, m.Truth):
+        if not isinstance(truth, sim.Truth):
             raise HardwareError(f"the motor board answered GetTruth with {reply.messages}")
-        return Truth(fell=bool(truth.flags & FELL), fall_reason=None,
+        return Truth(fell=bool(truth.flags & sim.FELL), fall_reason=None,
                      pitch_deg=None, max_pitch_deg=truth.max_pitch_cdeg / 100,
                      offset_m=truth.offset_mm / 1000)
 

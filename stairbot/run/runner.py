@@ -17,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
+from stairbot.clock import CountsLateTicks, HostBehind
 from stairbot.control.algorithm.controller import Controller, phase_timeout_s
 from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
@@ -138,9 +139,17 @@ class RunResult:
     """The first wall (or riser) the robot's body touched, where the robot can
     tell (a simulation's top view: a landing's walls as it turns); None:
     none, or it cannot tell."""
+    host_behind: HostBehind | None = None
+    """The ticks of the run that began more than one tick late, and the
+    longest such lateness, on a clock that waits for real time (a loaded
+    machine, a stalled host); None on a simulated clock, which cannot fall
+    behind (``to_dict`` then leaves the key out)."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
+        out.pop("host_behind")
+        if self.host_behind is not None:
+            out["host_behind"] = self.host_behind.to_dict()
         for key in ("max_pitch_deg", "final_offset_m", "sim_time_s", "wall_time_s",
                     "realtime_factor", "clear_of_stairs_m"):
             if isinstance(out[key], float):
@@ -185,6 +194,8 @@ def run(
     if isinstance(robot, ReportsEvents):  # wired robots report link health as LINK events
         robot.attach_sink(sink)
     tick = config.algorithm.tick
+    if isinstance(clock, CountsLateTicks):
+        clock.begin_loop()
     t0, wall0 = clock.now(), wall()
     fell = False
     fault: str | None = None
@@ -258,6 +269,7 @@ def run(
         reason=res.reason,
         clear_of_stairs_m=truth.clear_of_stairs_m if truth is not None else None,
         wall_contact=truth.wall_contact if truth is not None else None,
+        host_behind=clock.host_behind() if isinstance(clock, CountsLateTicks) else None,
     )
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands

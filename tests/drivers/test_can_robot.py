@@ -18,10 +18,10 @@ import pytest
 import stairbot.fakes.lockstep  # noqa: F401 - registers the lockstep robot with the drivers
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.board_robot import ESTOP_COPIES
 from stairbot.drivers.can_link import CanLink
 from stairbot.drivers.can_robot import open_bus, open_can_robot, parse_can_url, resolve_bus_config
 from stairbot.drivers.can_wire import make_id, split_id
+from stairbot.drivers.estop import ESTOP_COPIES
 from stairbot.errors import HardwareError, LinkLostError, NoBoardError, RobotUrlError
 from stairbot.events import Event
 from stairbot.fakes.board_world import BoardWorld
@@ -416,11 +416,9 @@ def test_a_read_all_reply_without_every_channel_is_a_hardware_error(rig: Rig) ->
     status = m.Status(0x40, 0, 250, 0)
     tel = tuple(m.MotorTelemetry(c, 1, 0, 1000, 5) for c in range(5))  # MTB missing
     with pytest.raises(HardwareError, match="motor board's ReadAll reply lacks channels"):
-        rig.robot._read_all(m.Board.MOTOR, (status, *tel), m.MotorTelemetry,
-                            m.MOTOR_CHANNELS, lambda t: t)  # type: ignore[arg-type,return-value]
+        rig.robot.replies.motors((status, *tel))
     with pytest.raises(HardwareError, match="sensor board answered ReadAll with"):
-        rig.robot._read_all(m.Board.SENSOR, tel, m.SensorTelemetry, m.SENSOR_CHANNELS,
-                            lambda t: t)  # type: ignore[arg-type,return-value]
+        rig.robot.replies.sensors(tel, 0.0)
 
 
 def test_every_frame_twice_reads_every_channel_once_and_counts_the_copies() -> None:

@@ -305,8 +305,10 @@ def test_a_protocol_3_can_board_is_refused_with_one_line() -> None:
 def test_a_captured_run_decodes_with_the_masked_dbc_and_no_unknown_frame(
         tmp_path: Path) -> None:
     """Every frame of a short lockstep run (open, ticks, an e-stop, a clear,
-    close) in a candump log: ``cantools decode -m 0x1FFC0000`` with the shipped
-    DBC knows each one; without the mask it knows none."""
+    close) in a candump log: ``cantools decode -m 0x1FFC0000`` with the real
+    boards' DBC and the simulation's concatenated (as docs/protocol.md says)
+    knows each one; with the real DBC alone only the simulation's frames are
+    unknown; without the mask it knows none."""
     channel = f"seq-capture-{next(_names)}"
     world = make_world(load_config(), load_scenario(), True)
     server = CanBoardServer(can.Bus(interface="virtual", channel=channel), world,
@@ -329,17 +331,24 @@ def test_a_captured_run_decodes_with_the_masked_dbc_and_no_unknown_frame(
     writer.stop()
     spy.shutdown()
     server.bus.shutdown()
-    dbc = str(resources.files("stairbot.drivers").joinpath("stairbot.dbc"))
+    real = resources.files("stairbot.drivers").joinpath("stairbot.dbc").read_text()
+    sim = resources.files("stairbot.fakes").joinpath("stairbot_sim.dbc").read_text()
+    (tmp_path / "stairbot.dbc").write_text(real)
+    (tmp_path / "lockstep.dbc").write_text(real + sim)  # cat stairbot.dbc stairbot_sim.dbc
     lines = log.read_text().splitlines()
     assert len(lines) > 100
 
-    def decode(*mask: str) -> list[str]:
+    def decode(*mask: str, dbc: str = "lockstep.dbc") -> list[str]:
         out = subprocess.run([sys.executable, "-m", "cantools", "decode", "--single-line",
-                              *mask, dbc], input=log.read_text(), capture_output=True,
-                             text=True, check=True).stdout.splitlines()
+                              *mask, str(tmp_path / dbc)], input=log.read_text(),
+                             capture_output=True, text=True, check=True).stdout.splitlines()
         assert len(out) == len(lines)
         return out
 
+    sim_bases = {0x0F1, 0x101, 0x251, 0x261}  # StepTo, GetTruth, StepDone, Truth
+    unknown = [x for x in decode("-m", "0x1FFC0000", dbc="stairbot.dbc")
+               if "Unknown frame id" in x]
+    assert unknown and {int(x.split()[2].split("#")[0], 16) >> 18 for x in unknown} <= sim_bases
     masked = decode("-m", "0x1FFC0000")
     assert not [x for x in masked if "Unknown frame id" in x]
     names = {x.split(" :: ")[1].split("(")[0] for x in masked}

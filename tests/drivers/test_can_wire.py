@@ -33,29 +33,42 @@ from stairbot.drivers.can_wire import (
     split_id,
     wire,
 )
+from stairbot.fakes import sim_messages as sim
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
 from stairbot.inputs.scenario import load_scenario
 
-VECTORS: list[dict[str, Any]] = json.loads(
-    resources.files("stairbot.drivers").joinpath("vectors_can.json").read_text())["vectors"]
+# The real boards' vectors, then the simulation's (their frames are in the
+# fakes' DBC, which importing the fakes adds to the wire).
+VECTORS: list[dict[str, Any]] = [
+    *json.loads(resources.files("stairbot.drivers").joinpath("vectors_can.json")
+                .read_text())["vectors"],
+    *json.loads(resources.files("stairbot.fakes").joinpath("vectors_sim_can.json")
+                .read_text())["vectors"]]
+SIM_TYPES = {sim.StepTo.TYPE, sim.GetTruth.TYPE, sim.StepDone.TYPE, sim.Truth.TYPE}
+DBC_PATH = str(resources.files("stairbot.drivers").joinpath("stairbot.dbc"))
+SIM_DBC_PATH = str(resources.files("stairbot.fakes").joinpath(sim.DBC_NAME))
 
 
 def message_of(v: dict[str, Any]) -> m.Message:
-    cls: type[m.Message] = getattr(m, v["message"])
+    cls = {c.__name__: c for c in m.MESSAGES.values()}[v["message"]]
     return cls(**v["fields"])
 
 
 def test_the_dbc_loads_and_every_message_has_a_frame() -> None:
-    db = cantools.database.load_file(
-        str(resources.files("stairbot.drivers").joinpath("stairbot.dbc")), strict=True)
+    db = cantools.database.load_file(DBC_PATH, strict=True)
     ids = [f.frame_id for f in db.messages]
     assert len(ids) == len(set(ids))
     assert all(f.is_extended_frame and f.frame_id & ~FRAME_ID_MASK == 0 and f.length <= 8
                for f in db.messages)
     w = CanWire(db)
-    assert set(w.kinds) == set(m.MESSAGES)
+    assert set(w.kinds) == set(m.MESSAGES) - SIM_TYPES  # the real boards' messages alone
+    db.add_dbc_file(SIM_DBC_PATH)  # the fakes' frames: every message the codec knows
+    assert set(CanWire(db).kinds) == set(m.MESSAGES)
+    assert {f.name for f in cantools.database.load_file(SIM_DBC_PATH).messages} == {
+        "StepTo_Motor", "GetTruth_Motor", "StepDone_Motor", "Truth_Motor"}
+    assert set(wire().kinds) == set(m.MESSAGES)  # the shared wire has them added
     assert db.get_message_by_frame_id(0x00F << 18).name == "EStop_All"
     assert min(ids) == w.frame_id(m.Board.MOTOR, m.EStop)  # e-stop wins arbitration
 
@@ -150,7 +163,8 @@ def test_frame_bits_worst_case_stuffing() -> None:
 
 def test_captured_traffic_is_decoded_by_cantools(tmp_path: Path) -> None:
     """A session's frames logged by python-can to an ASC file, read back, and
-    every one decoded from the DBC alone."""
+    every one decoded from the DBCs alone (the real boards', with the
+    simulation's added for its StepTo and StepDone)."""
     config, scenario = load_config(), load_scenario()
     world = make_world(config, scenario, True)
     server = CanBoardServer(can.Bus(interface="virtual", channel="capture"), world,
@@ -160,7 +174,7 @@ def test_captured_traffic_is_decoded_by_cantools(tmp_path: Path) -> None:
     link = CanLink(host, timeout_s=1.0)
     for board in m.Board:
         link.exchange(board, [m.Identify(), m.Claim(m.LEASE_MS, 1), m.ReadAll()])
-    link.exchange(1, [m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.StepTo(20000)])
+    link.exchange(1, [m.SetWheelSpeeds(1000, 1000, 1000, 1000), sim.StepTo(20000)])
     log = tmp_path / "capture.asc"
     with can.ASCWriter(str(log)) as writer:
         frame = spy.recv(0)
@@ -168,6 +182,7 @@ def test_captured_traffic_is_decoded_by_cantools(tmp_path: Path) -> None:
             writer.on_message_received(frame)
             frame = spy.recv(0)
     db = load_dbc()
+    db.add_dbc_file(SIM_DBC_PATH)
     names = []
     for frame in can.LogReader(str(log)):
         # get_message_by_frame_id applies the mask (decode_message, in

@@ -15,9 +15,9 @@ import pytest
 from test_can_run import ONE_STEP
 
 from stairbot.control.robot_config import load_config
-from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.can_link import CanLink
+from stairbot.fakes import sim_messages as sim
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
@@ -127,7 +127,7 @@ def test_a_read_after_a_lost_stepto_sees_the_stepped_world(scenario_file: Path) 
     drop_next_step = [False]
 
     def lose_one_stepto(frame: can.Message) -> None:
-        if isinstance(server.codec.from_can(frame).message, m.StepTo) and drop_next_step[0]:
+        if isinstance(server.codec.from_can(frame).message, sim.StepTo) and drop_next_step[0]:
             drop_next_step[0] = False
             return
         receive(frame)

@@ -32,7 +32,9 @@ from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotSession, open_robot
 
 _names = itertools.count()
-DBC = str(resources.files("stairbot.drivers").joinpath("stairbot.dbc"))
+# a lockstep run's log: the real boards' DBC and the simulation's, concatenated
+LOCKSTEP_DBC = (resources.files("stairbot.drivers").joinpath("stairbot.dbc").read_text()
+                + resources.files("stairbot.fakes").joinpath("stairbot_sim.dbc").read_text())
 
 
 def drive(session: RobotSession, ticks: int = 10) -> BoardRobot:
@@ -76,8 +78,11 @@ def test_a_can_run_logged_as_candump_decodes_with_cantools_every_frame_known(
     lines = log.read_text().splitlines()
     sent = [x for x in lines if x.endswith(" T")]
     assert len(sent) == link.stats.frames_tx and len(lines) - len(sent) >= link.stats.frames_rx
+    dbc = tmp_path / "lockstep.dbc"
+    dbc.write_text(LOCKSTEP_DBC)
     decoded = subprocess.run(
-        [sys.executable, "-m", "cantools", "decode", "--single-line", "-m", "0x1FFC0000", DBC],
+        [sys.executable, "-m", "cantools", "decode", "--single-line", "-m", "0x1FFC0000",
+         str(dbc)],
         input=log.read_text(), capture_output=True, text=True, check=True).stdout.splitlines()
     assert len(decoded) == len(lines)
     assert [x for x in decoded if "Unknown frame id" in x] == []

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
+from stairbot.fakes import sim_messages as sim
 from stairbot.hardware import Imu, MotorId, SensorReading, SensorStatus
 
 RANGES = {"B": (0, 255), "H": (0, 65535), "h": (-32768, 32767), "I": (0, 2**32 - 1),
@@ -65,8 +66,8 @@ def test_padding_that_is_not_zero_is_refused() -> None:
     # Truth has a pad byte; hypothesis once found that decoding dropped it
     # silently, so a frame's bytes and the message it became disagreed
     with pytest.raises(m.CodecError, match="Truth: padding bytes must be zero"):
-        m.decode(m.Truth.TYPE, b"\x00\x01" + b"\x00" * 6)
-    assert m.decode(m.Truth.TYPE, b"\x01\x00" + b"\x00" * 6) == m.Truth(1, 0, 0)
+        m.decode(sim.Truth.TYPE, b"\x00\x01" + b"\x00" * 6)
+    assert m.decode(sim.Truth.TYPE, b"\x01\x00" + b"\x00" * 6) == sim.Truth(1, 0, 0)
 
 
 @given(st.integers(0, 255), st.binary(max_size=12))
@@ -164,7 +165,7 @@ def test_every_host_message_declares_a_reply_a_board_sends() -> None:
         if not cls.REPLY:
             answer = m.MESSAGES[cls.ANSWER]
             assert answer.REPLY, cls.__name__
-    assert m.MESSAGES[m.StepTo.ANSWER] is m.StepDone
-    assert m.MESSAGES[m.GetTruth.ANSWER] is m.Truth
+    assert m.MESSAGES[sim.StepTo.ANSWER] is sim.StepDone
+    assert m.MESSAGES[sim.GetTruth.ANSWER] is sim.Truth
     assert m.MESSAGES[m.ReadAll.ANSWER] is m.Status  # then the telemetry
     assert m.MESSAGES[m.SetWheelSpeeds.ANSWER] is m.Ack

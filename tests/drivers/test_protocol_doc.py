@@ -13,14 +13,14 @@ from typing import Any
 import pytest
 
 from stairbot.drivers import messages as m
+from stairbot.fakes import sim_messages  # noqa: F401 - the doc's tables have them too
 
 DOC_PATH = Path(__file__).resolve().parents[2] / "docs" / "protocol.md"
 pytestmark = pytest.mark.skipif(not DOC_PATH.exists(), reason="needs the source checkout's docs/")
 
 
-def _json(name: str) -> dict[str, Any]:
-    data: dict[str, Any] = json.loads(
-        resources.files("stairbot.drivers").joinpath(name).read_text())
+def _json(name: str, package: str = "stairbot.drivers") -> dict[str, Any]:
+    data: dict[str, Any] = json.loads(resources.files(package).joinpath(name).read_text())
     return data
 
 
@@ -47,7 +47,8 @@ def test_can_vectors_in_the_doc_are_the_json_ones() -> None:
                       r"(?:`([0-9a-f ]+)`|—) \| (\w+) \| (.+) \|$", text, re.M)
     assert rows == [(v["id"], v["base"], str(v["session"]), str(v["seq"]),
                      bytes.fromhex(v["data"]).hex(" "), v["frame"], v["meaning"])
-                    for v in _json("vectors_can.json")["vectors"]]
+                    for v in [*_json("vectors_can.json")["vectors"],
+                              *_json("vectors_sim_can.json", "stairbot.fakes")["vectors"]]]
 
 
 def test_every_message_is_in_the_doc_with_its_type_code() -> None:

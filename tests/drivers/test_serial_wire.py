@@ -29,6 +29,7 @@ from stairbot.drivers.serial_wire import (
     frame_body,
     parse_body,
 )
+from stairbot.fakes import sim_messages as sim
 
 VECTORS: dict[str, Any] = json.loads(
     resources.files("stairbot.drivers").joinpath("vectors_serial.json").read_text())
@@ -36,7 +37,8 @@ REFERENCE_CRC = Calculator(Crc16.IBM_3740)  # = CRC-16/CCITT-FALSE
 
 
 def frame_of(spec: dict[str, Any]) -> Frame:
-    msgs = tuple(getattr(m, x["type"])(**x["fields"]) for x in spec["messages"])
+    by_name = {c.__name__: c for c in m.MESSAGES.values()}  # the fakes' messages too (sim)
+    msgs = tuple(by_name[x["type"]](**x["fields"]) for x in spec["messages"])
     return Frame(spec["board"], spec["seq"], msgs, spec["from_board"], spec["session"])
 
 
@@ -134,7 +136,7 @@ messages_st = st.sampled_from([
     m.SetWheelSpeeds(1000, -1000, 0, 5), m.SetLiftSpeeds(10000, -10000),
     m.MotorTelemetry(3, 1, 0, -250, -123456), m.SensorTelemetry(2, 1, 1300, 65535, 65535),
     m.ImuTelemetry(1, 0, -18000, -32767, 7), m.GetImu(0),
-    m.Status(0xC0, 0, 250, 2**32 - 1), m.Ack(0x20, 1), m.StepTo(20000), m.Move(5, -19000, 10000),
+    m.Status(0xC0, 0, 250, 2**32 - 1), m.Ack(0x20, 1), sim.StepTo(20000), m.Move(5, -19000, 10000),
 ])
 
 

@@ -59,12 +59,12 @@ def test_ages_and_imu_arrive_to_the_wires_resolution(kind: str) -> None:
 def test_no_imu_and_a_failed_imu_read_as_none(kind: str) -> None:
     with wired(kind) as (host, robot, events):
         assert host.read().imu is None  # the world has no IMU: the board says ABSENT
-        assert host.imu_read.state == "absent"
+        assert host.replies.imu_read.state == "absent"
         robot.imu = replace(IMU, roll_deg=float("nan"))  # the board says ERROR
         host.clock.advance(0.02)
         assert host.read().imu is None
-        assert host.imu_read.state == "error"
-        assert host.imu_rejected == 0 and not events  # the board kept the protocol
+        assert host.replies.imu_read.state == "error"
+        assert host.replies.imu_rejected == 0 and not events  # the board kept the protocol
 
 
 def test_the_age_counts_the_time_the_reply_took() -> None:
@@ -197,7 +197,7 @@ def test_an_unknown_imu_status_reads_as_a_failed_imu(kind: str) -> None:
     boards = sensor_boards_sending(lambda a: m.ImuTelemetry(int(a), 7, 20000, -32768, 0))
     with wired(kind, boards) as (host, _, events):
         assert host.read().imu is None
-        assert host.imu_read.state == "error" and not events
+        assert host.replies.imu_read.state == "error" and not events
 
 
 def test_a_serial_reply_without_an_imu_axis_reads_as_no_imu() -> None:
@@ -205,9 +205,9 @@ def test_a_serial_reply_without_an_imu_axis_reads_as_no_imu() -> None:
     boards = sensor_boards_sending(lambda a: ok_axis(a) if a == m.ImuAxis.PITCH else None)
     with wired("serial", boards) as (host, _, events):
         assert host.read().imu is None
-        assert host.imu_read.state == "missing"
-        assert host.imu_read.problem == ("the sensor board's ReadAll reply has no ImuTelemetry "
-                                    "for roll")
+        assert host.replies.imu_read.state == "missing"
+        assert host.replies.imu_read.problem == (
+            "the sensor board's ReadAll reply has no ImuTelemetry for roll")
         assert len(events) == 1
 
 

@@ -10,6 +10,7 @@ import pytest
 from stairbot.drivers import messages as m
 from stairbot.drivers.messages import RawMessage
 from stairbot.errors import RobotFellError
+from stairbot.fakes import sim_messages as sim
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import MotorBoard, SensorBoard, make_boards
 from stairbot.hardware import (
@@ -123,7 +124,7 @@ def test_speeds_reach_the_robot_and_telemetry_follows(rig: tuple) -> None:
     acks = motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(-2000, 0)], HOST)
     assert acks == [m.Ack(0x20, 0), m.Ack(0x21, 0)]
     assert robot.speeds[MotorId.MWF] == 1.0 and robot.speeds[MotorId.MTF] == -2.0
-    motor.handle([m.StepTo(200_000)], HOST)  # within the 250 ms watchdog
+    motor.handle([sim.StepTo(200_000)], HOST)  # within the 250 ms watchdog
     tel = motor.handle([m.ReadAll()], HOST)[1:]
     assert tel[0] == m.MotorTelemetry(0, m.MotorMode.RUN, 0, 1000, 200)
     assert tel[4] == m.MotorTelemetry(4, m.MotorMode.RUN, 0, -2000, -400)
@@ -177,7 +178,7 @@ def test_move_stops_after_the_turns(rig: tuple) -> None:
     assert motor.handle([m.Move(5, -1500, 1000)], HOST) == [m.Ack(0x23, 0)]
     assert robot.speeds[MotorId.MTB] == -1.0
     for _ in range(10):
-        motor.handle([m.StepTo(round(world.now() * 1e6) + 200_000)], HOST)
+        motor.handle([sim.StepTo(round(world.now() * 1e6) + 200_000)], HOST)
     assert robot.speeds[MotorId.MTB] == 0.0
     tel = motor.handle([m.GetMotor(5)], HOST)[0]
     assert tel.mode == m.MotorMode.IDLE and tel.turns_mt == -1600  # stopped at the next poll
@@ -209,22 +210,22 @@ def test_refusals_and_unknown_messages(rig: tuple) -> None:
 def test_step_to_is_idempotent_and_lockstep_only(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     # the simulation's messages are the motor board's (docs/protocol.md, section 2)
-    assert sensor.handle([m.StepTo(20_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
-    assert sensor.handle([m.GetTruth()], HOST) == [m.Ack(0x7D, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([sim.StepTo(20_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    assert sensor.handle([sim.GetTruth()], HOST) == [m.Ack(0x7D, m.AckResult.NOT_SUPPORTED)]
     assert robot.t == 0.0
-    assert motor.handle([m.StepTo(20_000)], HOST) == [m.StepDone(20_000)]
-    assert motor.handle([m.StepTo(20_000)], HOST) == [m.StepDone(20_000)]
-    assert motor.handle([m.StepTo(10_000)], HOST) == [m.StepDone(20_000)]
+    assert motor.handle([sim.StepTo(20_000)], HOST) == [sim.StepDone(20_000)]
+    assert motor.handle([sim.StepTo(20_000)], HOST) == [sim.StepDone(20_000)]
+    assert motor.handle([sim.StepTo(10_000)], HOST) == [sim.StepDone(20_000)]
     assert robot.t == pytest.approx(0.02)
     world.lockstep = False
-    assert motor.handle([m.StepTo(40_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    assert motor.handle([sim.StepTo(40_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
 
 
 def test_sensor_sample_counter_advances_with_new_measurements(rig: tuple) -> None:
     _, world, motor, sensor = rig
     a = sensor.handle([m.GetSensor(0)], HOST)[0].sample
     assert sensor.handle([m.GetSensor(1)], HOST)[0].sample == a
-    motor.handle([m.StepTo(20_000)], HOST)
+    motor.handle([sim.StepTo(20_000)], HOST)
     assert sensor.handle([m.GetSensor(0)], HOST)[0].sample == (a + 1) & 0xFFFF
 
 
@@ -234,7 +235,7 @@ def test_a_repeated_reading_keeps_its_sample_number(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     sfr, sfl = (sensor.handle([m.GetSensor(ch)], HOST)[0].sample for ch in (0, 1))
     robot.ages[SensorId.SFR] = 0.02  # the same measurement, 20 ms older
-    motor.handle([m.StepTo(20_000)], HOST)
+    motor.handle([sim.StepTo(20_000)], HOST)
     assert sensor.handle([m.GetSensor(0)], HOST)[0] == m.SensorTelemetry(0, 0, 500, sfr, 20)
     assert sensor.handle([m.GetSensor(1)], HOST)[0].sample == (sfl + 1) & 0xFFFF
 
@@ -271,11 +272,11 @@ def test_an_imu_value_the_wire_cannot_carry_goes_as_error_or_saturates(
 def test_a_failed_world_is_a_latched_simulation_fault(rig: tuple) -> None:
     robot, world, motor, sensor = rig
     robot.fail = True
-    motor.handle([m.StepTo(20_000)], HOST)
+    motor.handle([sim.StepTo(20_000)], HOST)
     status = sensor.handle([m.ReadAll()], HOST)[0]
     assert status.fault == m.MotorFault.SIMULATION and status.flags & m.StatusFlag.FAULT
-    truth = motor.handle([m.GetTruth()], HOST)[0]
-    assert truth == m.Truth(1, 325, 12)
+    truth = motor.handle([sim.GetTruth()], HOST)[0]
+    assert truth == sim.Truth(1, 325, 12)
 
 
 def test_the_pacer_keeps_the_world_up_with_the_wall_clock_one_step_at_a_time(
@@ -385,7 +386,7 @@ def test_a_second_host_cannot_command_set_the_watchdog_clear_or_step(rig: tuple)
     assert (held.result, held.session, held.boot) == (m.ClaimResult.HELD, HOST, motor.boot)
     for msg in (m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(500, 0),
                 m.Run(0, 100), m.Move(0, 100, 100), m.SetWatchdog(0), m.Clear(),
-                m.StepTo(round(world.now() * 1e6) + 20_000)):
+                sim.StepTo(round(world.now() * 1e6) + 20_000)):
         assert motor.handle([msg], OTHER) == [m.Ack(msg.TYPE, m.AckResult.NOT_OWNER)]
     assert sensor.handle([m.SetWatchdog(0)], OTHER) == [
         m.Ack(m.SetWatchdog.TYPE, m.AckResult.NOT_OWNER)]
@@ -434,7 +435,7 @@ def test_a_lease_released_or_lapsed_can_be_taken(rig: tuple,
     # The sensor board's holder falls silent: its lease (lockstep: wall time)
     # lapses after the longer of the lease and the watchdog.
     clock = [1000.0]
-    monkeypatch.setattr(sensor, "_lease_clock", lambda: clock[0])
+    monkeypatch.setattr(sensor.lease, "_clock", lambda: clock[0])
     sensor.handle([m.Claim(m.LEASE_MS, NONCE)], HOST)
     clock[0] += m.LEASE_MS / 1000 - 0.01
     (held,) = sensor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)

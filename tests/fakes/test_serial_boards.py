@@ -16,6 +16,7 @@ from test_boards import StubClock, StubRobot
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_link import FdChannel, SerialLink
 from stairbot.drivers.serial_wire import FRAMING_3, Frame, FrameReader, crc16, encode_frame
+from stairbot.fakes import sim_messages as sim
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import SerialBoardServer
@@ -76,7 +77,7 @@ def test_arbitrary_messages_in_valid_frames_never_crash_a_board(
         server: tuple, board: int, seq: int, msgs: list[tuple[int, bytes]]) -> None:
     srv, r = server
     # keep the stub world's time small: a StepTo to an hour would be obeyed
-    msgs = [(c, p) for c, p in msgs if c != m.StepTo.TYPE]
+    msgs = [(c, p) for c, p in msgs if c != sim.StepTo.TYPE]
     payload = b"".join(bytes((c, len(p))) + p for c, p in msgs)
     body = bytes((board | FRAMING_3, 0x5A, seq, len(payload))) + payload
     body += crc16(body).to_bytes(2, "big")

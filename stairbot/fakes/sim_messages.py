@@ -1,18 +1,22 @@
 """The motor board's simulation-only messages (docs/protocol.md, section 2).
 
-Only fake boards (``stairbot.fakes``) answer them, and only the simulation's
-side of the host (``stairbot.fakes.lockstep``) sends them; a real board answers
-each with Ack(NOT_SUPPORTED).  They are defined here, beside the real boards'
-messages, because they travel on the same wire: the codec and the CAN
-database know their type codes and ids, so one wire serves both.  The host's
-real driver path (``board_robot``, the links) never names them.
+Only fake boards answer them, and only the simulation's side of the host
+(``stairbot.fakes.lockstep``) sends them; a real board answers each with
+Ack(NOT_SUPPORTED).  They travel on the same wire as the real boards'
+messages: importing this module adds them to the codec, and their CAN frames
+(``stairbot_sim.dbc``, beside this module) to the CAN wire
+(:func:`stairbot.drivers.messages.register`).  A process that never imports
+the fakes does not know them: the real driver path never names them.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from importlib import resources
 
-from stairbot.drivers.records import Message
+from stairbot.drivers.messages import Message, register
+
+DBC_NAME = "stairbot_sim.dbc"
 
 STEP_DONE, TRUTH = 0xFE, 0xFD
 FELL = 0x01  # Truth.flags: the simulated robot fell
@@ -60,3 +64,7 @@ class Truth(Message):
     flags: int
     max_pitch_cdeg: int
     offset_mm: int
+
+
+register(StepTo, GetTruth, StepDone, Truth,
+         dbc=resources.files("stairbot.fakes").joinpath(DBC_NAME).read_text())
