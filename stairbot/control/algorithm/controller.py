@@ -18,6 +18,7 @@ The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 from stairbot.control.algorithm import motion, stability, standing
@@ -94,6 +95,7 @@ class Controller:
         self._tilt = self._supervisor.tilt
         self._sensor_since: float | None = None
         self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
+        self._phase_link: Mapping[str, float] = {}  # ... when the present phase began
         self._now_key: tuple[str, str | None] | None = None  # see _present
         self._now: tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]] | None = None
 
@@ -239,7 +241,8 @@ class Controller:
         started = self._ctx.phase_started_s
         if phase is not _PAUSED and started is not None \
                 and snap.time_s - started > self._timeout:
-            return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
+            return (f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
+                    f"{link_meanwhile(self._phase_link, snap.health)}")
         return None
 
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
@@ -273,8 +276,10 @@ class Controller:
         if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
             return True
         self._sensor_since = None
-        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
-                         f"{link_meanwhile(self._sensor_link, snap.health)}"), snap)
+        stale = link_meanwhile(self._sensor_link, snap.health,
+                               "the readings were stale on the wire")
+        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}{stale}"),
+                    snap)
         return True
 
     def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
@@ -336,6 +341,7 @@ class Controller:
         if fresh:
             record = phase.record
             ctx.phase_started_s = snap.time_s
+            self._phase_link = dict(snap.health)
             ctx.work = record.work.at_entry(snap)
             if begin is not None:
                 assert record.family is not None and isinstance(begin, record.family), begin

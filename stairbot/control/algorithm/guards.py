@@ -87,12 +87,15 @@ LINK_TROUBLE = ("retries", "timeouts", "lost", "revived")
 """The link figures (Snapshot.health) that say frames went missing."""
 
 
-def link_meanwhile(before: Mapping[str, float], now: Mapping[str, float]) -> str:
-    """What the link counted during a sensor hold, when it lost frames: a
-    reading goes stale on a wire that loses its replies too, and the error
-    says so (empty for a robot with no link, or a link that lost nothing)."""
+def link_meanwhile(before: Mapping[str, float], now: Mapping[str, float],
+                   consequence: str = "") -> str:
+    """What the link counted between two of its figures (a sensor hold, a
+    phase), when it lost frames, and ``consequence`` after a colon: a reading
+    goes stale, and a phase runs long, on a wire that loses frames, and the
+    error says so (empty for a robot with no link, or a link that lost nothing)."""
     grown = {k: now[k] - before.get(k, 0.0) for k in LINK_TROUBLE if k in now}
     if not any(v > 0 for v in grown.values()):
         return ""
     counts = ", ".join(f"{v:.0f} {k}" for k, v in grown.items() if v > 0)
-    return f"; meanwhile the link lost frames ({counts}): the readings were stale on the wire"
+    tail = f": {consequence}" if consequence else ""
+    return f"; meanwhile the link lost frames ({counts}){tail}"
