@@ -3,16 +3,18 @@
     python benchmarks/soak_faults.py [--seeds N] [--first-seed S] [--wire serial|can]
                                      [--fault drop|corrupt|late|duplicate]
                                      [--p 0.05] [-j 2] [--url-options OPTS]
-                                     [--realtime [--time-scale X]]
+                                     [--realtime [--time-scale X]] [--keep DIR]
 
 For each wire, fault and seed it starts ``stairbot fake-boards`` with that
 fault at probability P on every frame the boards send or take
 (``--fault-seed`` = the seed), then ``stairbot run --robot URL --json`` with
 the URL's default options, and prints one line per run (outcome, steps,
 fell, what the link counted) and a count per wire and fault, each saying
-its mode.  Serial boards sit on a pseudo-terminal, CAN boards on
-``udp_multicast`` on loopback, each run on a group of its own.  Exit status
-1 if any run did not complete or fell.
+its mode.  ``--keep DIR`` keeps each run's record (``stairbot run
+--record``, JSON lines: every event and tick) and what the boards said,
+named by mode, wire, fault and seed.  Serial boards sit on a
+pseudo-terminal, CAN boards on ``udp_multicast`` on loopback, each run on a
+group of its own.  Exit status 1 if any run did not complete or fell.
 
 Two modes:
 
@@ -95,14 +97,17 @@ def mode_name(time_scale: float | None) -> str:
 
 
 def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
-            time_scale: float | None = None) -> Outcome:
+            time_scale: float | None = None, keep: Path | None = None) -> Outcome:
     """One default run; ``time_scale`` None: lockstep, else free-running
-    boards paced at that many times real time."""
+    boards paced at that many times real time; ``keep``: a folder for the
+    run's record and the boards' output."""
     t0 = time.monotonic()
     where = ["--serial"] if wire == "serial" else [
         "--can", f"udp_multicast/239.74.164.{next(_groups) % 250 + 1}?port={_PORT}"]
     pace = ["--lockstep"] if time_scale is None else ["--time-scale", f"{time_scale:g}"]
     mode = mode_name(time_scale)
+    name = f"{mode.replace(' ', '')}_{wire}_{fault}_p{p:g}_seed{seed}"
+    record = [] if keep is None else ["--record", str(keep / f"{name}.jsonl")]
     boards = subprocess.Popen(
         [sys.executable, "-m", "stairbot", "fake-boards", *where, *pace,
          f"--{fault}", str(p), "--fault-seed", str(seed)],
@@ -117,7 +122,7 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
         with tempfile.TemporaryDirectory() as tmp:
             host = subprocess.run([sys.executable, "-m", "stairbot", "run", "--robot", url,
                                    "--journal", str(Path(tmp) / "journal.jsonl"), "--json",
-                                   "-q"], capture_output=True, text=True, timeout=1800)
+                                   "-q", *record], capture_output=True, text=True, timeout=1800)
     finally:
         boards.terminate()
         try:
@@ -126,6 +131,8 @@ def one_run(wire: str, fault: str, p: float, seed: int, url_options: str,
             boards.kill()
             _, said = boards.communicate()
     wall = time.monotonic() - t0
+    if keep is not None:
+        (keep / f"{name}.boards.txt").write_text(said or "")
     behind = re.search(r"fell behind real time \d+ time\(s\), [\d.]+ s let go", said or "")
     lagged = behind.group(0).strip() if behind else ""
     try:
@@ -156,7 +163,11 @@ def main(argv: list[str] | None = None) -> int:
                     help="free-running boards (not lockstep): the watchdogs count real time")
     ap.add_argument("--time-scale", type=float, default=1.0,
                     help="with --realtime: boards and host paced at X times real time")
+    ap.add_argument("--keep", type=Path, metavar="DIR",
+                    help="keep each run's record (JSON lines) and the boards' output in DIR")
     args = ap.parse_args(argv)
+    if args.keep is not None:
+        args.keep.mkdir(parents=True, exist_ok=True)
     if args.time_scale != 1.0 and not args.realtime:
         ap.error("--time-scale needs --realtime (lockstep runs as fast as it can)")
     scale = args.time_scale if args.realtime else None
@@ -169,7 +180,8 @@ def main(argv: list[str] | None = None) -> int:
           f"seeds {seeds.start}..{seeds.stop - 1}, {args.j} at once", flush=True)
     results: list[Outcome] = []
     with ThreadPoolExecutor(args.j) as pool:
-        futures = [pool.submit(one_run, w, f, args.p, s, args.url_options, scale)
+        futures = [pool.submit(one_run, w, f, args.p, s, args.url_options, scale,
+                               args.keep)
                    for w, f, s in jobs]
         for fut in futures:
             o = fut.result()
