@@ -129,6 +129,32 @@ def test_a_tilt_mid_run_stops_every_motor_at_the_next_tick(phase: Phase) -> None
     assert_stopped_for_good(ctrl, robot)
 
 
+def test_a_tilt_stop_on_a_link_that_lost_frames_in_the_phase_names_the_link() -> None:
+    """Found by the real-time soak at 20 % (serial, frames dropped): a run
+    ended on the tilt limit in descent and the error did not say that the
+    wire had been losing frames all through the phase."""
+    ctrl, robot, _ = start()
+    read = robot.read
+    figures = {"retries": 4.0, "lost": 1.0}
+
+    def lossy() -> Snapshot:
+        figures["retries"] += 2
+        return replace(read(), health=dict(figures))
+
+    robot.read = lossy  # type: ignore[method-assign]
+    run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_DRIVE_SECOND)
+    at_entry = figures["retries"]
+    for _ in range(10):
+        ctrl.tick(robot.read())
+        robot.advance(TICK)
+    robot.imu = Imu(-15.2, 0.0, -40.0)
+    ctrl.tick(robot.read())
+    error = str(ctrl.result.error)
+    assert error.startswith("tilt: segment 2's pitch is -15.2°"), error
+    grown = round(figures["retries"] - at_entry)
+    assert error.endswith(f"; meanwhile the link lost frames ({grown} retries)"), error
+
+
 def test_an_imu_that_stops_answering_stops_the_robot() -> None:
     ctrl, robot, _ = start()
     run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)

@@ -189,8 +189,8 @@ class Controller:
         ctx = self._ctx
         phase, record, needed = self._present()
         fault = self._fault(snap, phase, needed) or self._supervisor.check(snap)
-        if fault is not None:
-            self._apply(fail(fault), snap)
+        if fault is not None:  # and what the link lost in the phase, if it lost frames
+            self._apply(fail(fault + link_meanwhile(self._phase_link, snap.health)), snap)
             return _zeros()
         if self._sensor_hold(snap, phase, needed):
             self._supervisor.commanded({})
@@ -241,8 +241,7 @@ class Controller:
         started = self._ctx.phase_started_s
         if phase is not _PAUSED and started is not None \
                 and snap.time_s - started > self._timeout:
-            return (f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
-                    f"{link_meanwhile(self._phase_link, snap.health)}")
+            return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
         return None
 
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
