@@ -29,8 +29,10 @@ from stairbot.control.algorithm.moves import (
     lift_phase,
 )
 from stairbot.control.algorithm.phase import (
+    FAILED,
     FAULT,
     NO_MOTION,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -76,7 +78,7 @@ def _approach(t: Tick, w: ApproachWork) -> Step:
     reading = _riser_ahead(t, w)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     if reading <= safe:
-        return go(P.ASCENT_APPROACH_TURNS)
+        return go("at_safe_distance")
     remaining = cfg.wheel_turns(reading - safe) + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
     return stay(motion.drive(cfg, 1, remaining))
 
@@ -110,8 +112,10 @@ def _riser_ahead(t: Tick, w: ApproachWork) -> float:
 APPROACH = PhaseDef(
     P.ASCENT_APPROACH, "ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", FLOW, _approach,
     ApproachWork, watches="front",
-    to={P.ASCENT_APPROACH_TURNS: "reads SAFE_DISTANCE_IN_FRONT_OF_STEP",
-        P.ERROR: "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); " + FAULT})
+    on={"at_safe_distance": Exit(P.ASCENT_APPROACH_TURNS, "reads "
+                                                         "SAFE_DISTANCE_IN_FRONT_OF_STEP"),
+        FAILED: Exit(P.ERROR, "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); "
+                              + FAULT)})
 
 
 def _approach_turns_enter(t: Tick, w: ApproachTurnsWork) -> None:
@@ -154,14 +158,14 @@ def _approach_turns(t: Tick, w: ApproachTurnsWork) -> Step:
         driven = (here - w.entry_wheel) * t.cfg.wheel_circumference
         gap = max(0.0, w.start_reading - driven)
         t.say(f"at the riser: {gap:.3f} m from it", riser_gap=gap)
-        return go(P.ASCENT_LIFT_FIRST, begin=LiftFirst(riser_gap=gap))
+        return go("at_riser", begin=LiftFirst(riser_gap=gap))
     return stay(motion.drive(t.cfg, 1, remaining))
 
 
 APPROACH_TURNS = PhaseDef(
     P.ASCENT_APPROACH_TURNS, "ascent 2 — approach: NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH more",
     FLOW, _approach_turns, ApproachTurnsWork, enter=_approach_turns_enter, watches="front",
-    to={P.ASCENT_LIFT_FIRST: "turns made", P.ERROR: FAULT})
+    on={"at_riser": Exit(P.ASCENT_LIFT_FIRST, "turns made"), FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- ascent 4-7: segment by segment onto the step -------------------------------------------
@@ -198,7 +202,7 @@ def _driven_first(t: Tick, _w: DriveWork) -> Step:
     # segment 3, in the air over the step below if that is narrow, has rolled on with the
     # robot onto the tread behind the riser just climbed: it carries again
     t.ctx.third_in_air = False
-    return go(P.ASCENT_LIFT_SECOND)
+    return go("reached")
 
 
 DRIVE_FIRST = drive_phase(
@@ -231,15 +235,16 @@ def _lifted_third(t: Tick, _w: LiftWork) -> Step:
               "step drives by turns", index=i, tab_length_to_edge=None)
     ctx.number_of_steps += 1
     t.say(f"number_of_steps = {ctx.number_of_steps}", number_of_steps=ctx.number_of_steps)
-    return go(P.ASCENT_CHECK)
+    return go("turns_made")
 
 
 _lift3 = lift(lambda t, _w: {MotorId.MTB: _h(t)}, _lifted_third)
 LIFT_THIRD = PhaseDef(
     P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], LiftWork, enter=_lift3[0],
     watches="front", carried_by=(1, 2),
-    to={P.ASCENT_CHECK: "turns made; tab_length_to_edge[i] stored, number_of_steps + 1",
-        P.ERROR: FAULT})
+    on={"turns_made": Exit(P.ASCENT_CHECK, "turns made; tab_length_to_edge[i] stored, "
+                                           "number_of_steps + 1"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- ascent 8-9: the top, or the next step ------------------------------------------------------
@@ -255,7 +260,7 @@ def _check(t: Tick, w: WaitWork) -> Step:
         ctx.ascent_end = AscentEnd.TOP_REACHED
         t.say(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
               "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
-        return go(P.DESCENT_LOWER_THIRD)
+        return go("top_reached")
     tab = _tab_again(t, w)
     if tab is not None:
         return tab
@@ -263,8 +268,8 @@ def _check(t: Tick, w: WaitWork) -> Step:
         ctx.ascent_end = AscentEnd.STEP_LIMIT
         t.say(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
               "the descent begins", ascent_end="step_limit")
-        return go(P.DESCENT_LOWER_THIRD)
-    return go(P.ASCENT_DRIVE_THIRD)
+        return go("step_limit")
+    return go("next_step")
 
 
 def _tab_again(t: Tick, w: WaitWork) -> Step | None:
@@ -302,10 +307,10 @@ def _tab_again(t: Tick, w: WaitWork) -> Step | None:
 CHECK = PhaseDef(
     P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, WaitWork,
     watches="front",
-    to={P.DESCENT_LOWER_THIRD: "reads ≥ LENGTH_OF_INFINITY (top reached) "
-                               "or number_of_steps = max_steps",
-        P.ASCENT_DRIVE_THIRD: "otherwise",
-        P.ERROR: FAULT})
+    on={"top_reached": Exit(P.DESCENT_LOWER_THIRD, "reads ≥ LENGTH_OF_INFINITY (top reached)"),
+        "step_limit": Exit(P.DESCENT_LOWER_THIRD, "number_of_steps = max_steps"),
+        "next_step": Exit(P.ASCENT_DRIVE_THIRD, "otherwise"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _driven_third(t: Tick, w: DriveWork) -> Step:
@@ -315,7 +320,7 @@ def _driven_third(t: Tick, w: DriveWork) -> Step:
         # where the last readings put the riser: ascent 2 starts from it if
         # the sensors cannot read that near
         t.ctx.riser_wheel = w.target_wheel + t.cfg.wheel_turns(w.target_reading)
-    return calibrate(Purpose.ASCENT)
+    return calibrate("reached", Purpose.ASCENT)
 
 
 DRIVE_THIRD = drive_phase(

@@ -32,7 +32,10 @@ from stairbot.control.algorithm.moves import (
     lift_phase,
 )
 from stairbot.control.algorithm.phase import (
+    ENDED,
+    FAILED,
     FAULT,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -82,7 +85,7 @@ def _refuse_because(t: Tick, why: str) -> Step:
     """Refuse the drop below (``why`` is said, and kept for the end)."""
     t.say(why)
     _lt(t).refused = why
-    return go(P.DESCENT_REFUSE, why)
+    return go("refused", why)
 
 
 def lowerable_m(cfg: RobotConfig, mtb: float) -> float:
@@ -158,7 +161,7 @@ def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
         t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
               f"{ctx.number_of_turns_for_step_height:.2f} ({where(ctx, P.DESCENT_LOWER_THIRD)})",
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
-        return go(P.DESCENT_DRIVE_SECOND)
+        return go("on_step_below")
     assert w.target_mtb is not None
     limit = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
     if limit is None:
@@ -176,13 +179,13 @@ LOWER_THIRD = PhaseDef(
     checked_first(lambda t, w: _over_an_edge(t, w) or _deep_drop(t, w), _lower_third),
     LowerThirdWork,
     enter=_lower_third_enter, watches="back", carried_by=(1, 2), family=LowerThird,
-    to={P.DESCENT_DRIVE_SECOND: "SBR/SBL read BACK_CLEARANCE: "
-                                "number_of_turns_for_step_height stored",
-        P.DESCENT_REFUSE: "continuous descent: SBR/SBL read a drop deeper than segment 3 "
-                          "can be lowered, or nothing in range; or the floor not found "
-                          "within MAX_OF_VERTICAL_TURNS",
-        P.ERROR: "reads ≤ BACK_CLEARANCE at the start, or floor not found "
-                 "within MAX_OF_VERTICAL_TURNS; " + FAULT})
+    on={"on_step_below": Exit(P.DESCENT_DRIVE_SECOND, "SBR/SBL read BACK_CLEARANCE: "
+                                                      "number_of_turns_for_step_height stored"),
+        "refused": Exit(P.DESCENT_REFUSE, "continuous descent: SBR/SBL read a drop deeper than "
+                                          "segment 3 can be lowered, or nothing in range; or "
+                                          "the floor not found within MAX_OF_VERTICAL_TURNS"),
+        FAILED: Exit(P.ERROR, "reads ≤ BACK_CLEARANCE at the start, or floor not found "
+                              "within MAX_OF_VERTICAL_TURNS; " + FAULT)})
 
 
 # -- descent 2, refused: segment 3 up again, and the robot back onto the step -------------------
@@ -213,9 +216,10 @@ def _refuse(t: Tick, w: RefuseWork) -> Step:
 REFUSE = PhaseDef(
     P.DESCENT_REFUSE, "descent 2 — refused: raise segment 3, drive back onto the step", FLOW,
     _refuse, RefuseWork, enter=_refuse_enter, carried_by=(1, 2), family=LowerThird,
-    to={P.DONE: "segment 3 raised to where descent 2 began, and driven forward "
-                "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step (stopped)",
-        P.ERROR: FAULT})
+    on={ENDED: Exit(P.DONE, "segment 3 raised to where descent 2 began, and driven forward "
+                            "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step "
+                            "(stopped)"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- descent 3-6: segment by segment off the step ----------------------------------------------
@@ -290,7 +294,7 @@ def _first_bound(t: Tick, w: EdgeWork) -> float | None:
 def _driven_first(t: Tick, _w: EdgeWork) -> Step:
     # on a narrow tread below, segment 3 has backed off its edge: in the air over the next
     t.ctx.third_in_air = narrow_here(t, t.descent_index - 1)
-    return go(P.DESCENT_LOWER_FIRST)
+    return go("reached")
 
 
 DRIVE_FIRST = drive_phase(
@@ -307,15 +311,15 @@ def _lowered_first(t: Tick, _w: LiftWork) -> Step:
     if ctx.from_top:
         t.say(f"step {ctx.steps_descended} from the top descended",
               steps_descended=ctx.steps_descended)
-        return go(P.DESCENT_BACK_OFF)
+        return go("steps_remain")
     t.say(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
           f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
     if landing.returns_here(t):
-        return go(P.LANDING_RETURN)
+        return go("back_to_turn")
     if ctx.steps_descended < ctx.number_of_steps:
-        return go(P.DESCENT_BACK_OFF)
+        return go("steps_remain")
     ctx.descent.turned_back = False  # descent 7 turns back to the floor's heading once
-    return go(P.DESCENT_FINISH)
+    return go("all_descended")
 
 
 _lower1 = lift(lambda t, _w: {MotorId.MTF: -height(t)}, _lowered_first)
@@ -323,10 +327,13 @@ LOWER_FIRST = PhaseDef(
     P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], LiftWork,
     enter=_lower1[0],
     carried_by=(2, 3),
-    to={P.DESCENT_BACK_OFF: "turns made; steps remain (a continuous descent: always)",
-        P.LANDING_RETURN: "turns made; down the first step of the flight after a landing's "
-                          "turn: back to where it turned",
-        P.DESCENT_FINISH: "turns made; all number_of_steps descended", P.ERROR: FAULT})
+    on={"steps_remain": Exit(P.DESCENT_BACK_OFF, "turns made; steps remain (a continuous "
+                                                 "descent: always)"),
+        "back_to_turn": Exit(P.LANDING_RETURN, "turns made; down the first step of the flight "
+                                               "after a landing's turn: back to where it "
+                                               "turned"),
+        "all_descended": Exit(P.DESCENT_FINISH, "turns made; all number_of_steps descended"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 PHASES: tuple[PhaseDef[Any], ...] = (

@@ -41,7 +41,9 @@ from stairbot.control.algorithm.landing_scan import LEFT, RIGHT, SCAN
 from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.moves import lift, reading_drive
 from stairbot.control.algorithm.phase import (
+    FAILED,
     FAULT,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -146,7 +148,7 @@ def _decide(t: Tick, _w: LiftWork) -> Step:
     t.say(f"landing: the next flight is to the {'left' if side == LEFT else 'right'}; "
           f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
           "centring to turn", side=side, depth=depth)
-    return go(P.LANDING_CENTRE)
+    return go("room_to_turn")
 
 
 def landing_depth(t: Tick) -> float | None:
@@ -174,17 +176,18 @@ def _said(d: float | None) -> str:
 def _refuse(t: Tick, why: AscentEnd, message: str) -> Step:
     t.ctx.ascent_end = why
     t.say(message + "; the ascent ends, the descent begins", ascent_end=why.value)
-    return go(P.DESCENT_BACK_OFF)
+    return go("refused")
 
 
 _scan_lower = lift(_lower_deltas, _decide)
 SCAN_LOWER = PhaseDef(
     P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
     _scan_lower[1], LiftWork, enter=_scan_lower[0], carried_by=(1, 2), family=LandingTurn,
-    to={P.LANDING_CENTRE: "lowered; a side seen over, and room to turn",
-        P.DESCENT_BACK_OFF: "lowered; no side seen over (landing_closed), or too little "
-                            "room to turn (landing_too_small): the descent begins",
-        P.ERROR: FAULT})
+    on={"room_to_turn": Exit(P.LANDING_CENTRE, "lowered; a side seen over, and room to turn"),
+        "refused": Exit(P.DESCENT_BACK_OFF, "lowered; no side seen over (landing_closed), or "
+                                            "too little room to turn (landing_too_small): the "
+                                            "descent begins"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- landing 2: centre, then turn --------------------------------------------------------------
@@ -206,7 +209,7 @@ def _centred(t: Tick, _w: DriveWork) -> Step:
     landing = t.ctx.landing
     landing.twist = motion.twist(t.snap)
     yaw = landing.side * math.pi / 2.0
-    return calibrate(Purpose.LANDING, landing.twist + motion.yaw_turns(t.cfg, yaw),
+    return calibrate("centred", Purpose.LANDING, landing.twist + motion.yaw_turns(t.cfg, yaw),
                      f"centred on the landing: turning {math.degrees(yaw):+.0f}° towards the "
                      "next flight")
 
@@ -215,9 +218,9 @@ _centre = reading_drive(-1, _centre_target, _centre_turns, _centred)
 CENTRE = PhaseDef(
     P.LANDING_CENTRE, "landing 2 — back to the landing's middle", FLOW, _centre[1],
     DriveWork, enter=_centre[0], watches="front", family=LandingTurn,
-    to={P.CAL_LIFT: "reads half the landing's depth less the front face's reach: lift "
-                    "to turn 90° towards the next flight",
-        P.ERROR: FAULT})
+    on={"centred": Exit(P.CAL_LIFT, "reads half the landing's depth less the front face's "
+                                    "reach: lift to turn 90° towards the next flight"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def turned(t: Tick) -> Step:
@@ -229,12 +232,21 @@ def turned(t: Tick) -> Step:
         ctx.landing.step = ctx.number_of_steps
         t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
               landing_step=ctx.landing.step)
-        return calibrate(Purpose.ASCENT)
+        return calibrate("onto_next_flight", Purpose.ASCENT)
     # descent 1 of the first flight's top step, as its back-off would begin it:
     # that step's edge not seen yet (the edge watch's mark is the last step's)
     ctx.descent.edge_wheel = None
     ctx.descent.turned_back = ctx.descent.edge_squared = False
-    return calibrate(Purpose.DESCENT)
+    return calibrate("back_to_first_flight", Purpose.DESCENT)
+
+
+TURNED: dict[str, Exit] = {
+    "onto_next_flight": Exit(P.CAL_CHECK, "lowered after a landing's turn: calibrate on the "
+                                          "next flight's first riser"),
+    "back_to_first_flight": Exit(P.CAL_CHECK, "lowered, turned back on a landing: calibrate on "
+                                              "the wall ahead (descent 1)"),
+}
+"""The outcomes of :func:`turned`, in calibration's lowering's record."""
 
 
 def after_calibration(t: Tick) -> None:
@@ -292,7 +304,7 @@ def _return_turns(t: Tick) -> float:
 def _returned(t: Tick, _w: DriveWork) -> Step:
     twist = t.ctx.landing.twist
     assert twist is not None  # set before the turn
-    return calibrate(Purpose.LANDING_BACK, twist,
+    return calibrate("returned", Purpose.LANDING_BACK, twist,
                      "back where it turned: turning back to the first flight")
 
 
@@ -300,10 +312,10 @@ _return = reading_drive(-1, _return_target, _return_turns, _returned)
 RETURN = PhaseDef(
     P.LANDING_RETURN, "landing 3 — back to where it turned", FLOW, _return[1],
     DriveWork, enter=_return[0], watches="front",
-    to={P.CAL_LIFT: "reads where it turned (down the next flight's first step, or having "
-                    "refused it): lift to turn back to the heading it came up the first "
-                    "flight with",
-        P.ERROR: FAULT})
+    on={"returned": Exit(P.CAL_LIFT, "reads where it turned (down the next flight's first "
+                                     "step, or having refused it): lift to turn back to the "
+                                     "heading it came up the first flight with"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 PHASES: tuple[PhaseDef[Any], ...] = (SCAN, SCAN_LOWER, CENTRE, RETURN)

@@ -15,7 +15,7 @@ from stairbot.control.algorithm import landing, limits, long_tread, motion
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.modes import AscentEnd
 from stairbot.control.algorithm.moves import lift
-from stairbot.control.algorithm.phase import FAULT, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phase import FAILED, FAULT, Exit, PhaseDef, Step, Tick, go, stay
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.work import LiftWork, SightWork
 from stairbot.hardware import MotorId
@@ -68,12 +68,12 @@ def _lift_first(t: Tick, w: LiftWork) -> Step:
         t.say(f"segment 1 sees over step {ctx.number_of_steps + 1} after {lifted:.1f} MTF turns "
               f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m", rise=rise)
         if rise >= limits.min_step_rise_m(cfg):
-            return go(P.ASCENT_LIFT_FIRST_MORE)
+            return go("sees_over")
         ctx.ascent_end = AscentEnd.OBSTACLE
         t.say(f"step {ctx.number_of_steps + 1} is too low to climb: rise about {rise:.3f} m < "
               f"{limits.min_step_rise_m(cfg):.3f} m (lifting on, the sensors could see past "
               "the next riser); the ascent ends (obstacle)", ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "rise lower than the robot measures")
+        return go("rise_too_low", "rise lower than the robot measures")
     assert w.target_mtf is not None
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
@@ -83,17 +83,19 @@ def _lift_first(t: Tick, w: LiftWork) -> Step:
         t.say(f"step {ctx.number_of_steps + 1} too high: the front sensors did not see over "
               f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
               ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE)
+        return go("too_high")
     return stay({MotorId.MTF: speed})
 
 
 LIFT_FIRST = PhaseDef(
     P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, LiftWork,
     enter=_lift_first_enter, carried_by=(2, 3), family=LiftFirst,
-    to={P.ASCENT_LIFT_FIRST_MORE: "sees over the riser (reads ≥ gap + SIGHT_JUMP_M)",
-        P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
-                                 "step too high; or sees over a rise < min_step_rise_m",
-        P.ERROR: FAULT})
+    on={"sees_over": Exit(P.ASCENT_LIFT_FIRST_MORE, "sees over the riser (reads ≥ gap + "
+                                                    "SIGHT_JUMP_M)"),
+        "too_high": Exit(P.ASCENT_LOWER_OBSTACLE, "MAX_OF_VERTICAL_TURNS − "
+                                                  "number_of_vertical_turns made: step too high"),
+        "rise_too_low": Exit(P.ASCENT_LOWER_OBSTACLE, "sees over a rise < min_step_rise_m"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def narrow(cfg: RobotConfig, tread: float | None) -> bool:
@@ -118,7 +120,7 @@ def _lifted_first(t: Tick, w: SightWork) -> Step:
         t.say(f"the tread of step {ctx.number_of_steps + 1} is too short: {tread:.3f} m < "
               f"min_tread_m = {need:.3f} m; the ascent ends (obstacle)",
               ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than min_tread_m")
+        return go("tread_too_short", "tread shorter than min_tread_m")
     lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
     rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
         + cfg.sensors.front_height
@@ -131,7 +133,7 @@ def _lifted_first(t: Tick, w: SightWork) -> Step:
               f"m < {cfg.min_rise_for(tread):.3f} m (the front cone's top, "
               f"{math.degrees(cfg.front_cone_top_rad):.1f}° up, would see over the next riser "
               f"{tread:.3f} m away); the ascent ends (obstacle)", ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "rise too low for the tread the front cone measures")
+        return go("too_low_for_tread", "rise too low for the tread the front cone measures")
     ctx.number_of_turns_for_step_height = lifted
     if ctx.number_of_steps < len(ctx.tread_length):
         ctx.tread_length[ctx.number_of_steps] = \
@@ -144,7 +146,7 @@ def _lifted_first(t: Tick, w: SightWork) -> Step:
     t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
           f"(step {ctx.number_of_steps + 1})",
           number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
-    return go(P.ASCENT_DRIVE_FIRST)
+    return go("measured")
 
 
 def _held(t: Tick, w: SightWork, tread: float) -> bool:
@@ -220,23 +222,25 @@ def _more_step(t: Tick, w: SightWork) -> Step:
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
     _more_step, SightWork, enter=_more_enter, carried_by=(2, 3), family=LiftFirst,
-    to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ min_tread_m: "
-                              "number_of_turns_for_step_height stored",
-        P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < min_tread_m: "
-                                 "tread too short; or a rise too low for the tread "
-                                 "(min_rise_for; past FAR_TREAD_M, only if the readings "
-                                 "grew as segment 1 rose)",
-        P.ERROR: FAULT})
+    on={"measured": Exit(P.ASCENT_DRIVE_FIRST, "turns made; reading − gap ≥ min_tread_m: "
+                                               "number_of_turns_for_step_height stored"),
+        "tread_too_short": Exit(P.ASCENT_LOWER_OBSTACLE, "turns made; reading − gap < "
+                                                         "min_tread_m: tread too short"),
+        "too_low_for_tread": Exit(P.ASCENT_LOWER_OBSTACLE, "turns made; a rise too low for the "
+                                                           "tread (min_rise_for; past "
+                                                           "FAR_TREAD_M, only if the readings "
+                                                           "grew as segment 1 rose)"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _lowered_obstacle(t: Tick, _w: LiftWork) -> Step:
     if landing.can_scan(t, _lf(t).wall_ahead):
         # a wall ahead at the top of a flight may be a landing's: look sideways first
-        return go(P.LANDING_SCAN)
+        return go("wall_at_top")
     if landing.turned_here(t):
         # the next flight's first step refused: back where it turned, and turn back
-        return go(P.LANDING_RETURN)
-    return go(P.DESCENT_BACK_OFF if t.ctx.number_of_steps > 0 else P.DESCENT_FINISH)
+        return go("refused_after_turn")
+    return go("steps_climbed" if t.ctx.number_of_steps > 0 else "no_step_climbed")
 
 
 _obstacle_enter, _obstacle_step = lift(
@@ -244,12 +248,14 @@ _obstacle_enter, _obstacle_step = lift(
 LOWER_OBSTACLE = PhaseDef(
     P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
     LiftWork, enter=_obstacle_enter, carried_by=(2, 3), family=LiftFirst,
-    to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
-        P.LANDING_SCAN: "lowered; number_of_steps > 0, [algorithm] landings and no landing "
-                        "scanned yet: look sideways for the next flight",
-        P.LANDING_RETURN: "lowered; the first step after a landing's turn: back to where it "
-                          "turned",
-        P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
+    on={"steps_climbed": Exit(P.DESCENT_BACK_OFF, "lowered; number_of_steps > 0"),
+        "wall_at_top": Exit(P.LANDING_SCAN, "lowered; number_of_steps > 0, [algorithm] "
+                                            "landings and no landing scanned yet: look "
+                                            "sideways for the next flight"),
+        "refused_after_turn": Exit(P.LANDING_RETURN, "lowered; the first step after a "
+                                                     "landing's turn: back to where it turned"),
+        "no_step_climbed": Exit(P.DESCENT_FINISH, "lowered; number_of_steps = 0"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _measure_next_step(t: Tick, w: SightWork) -> None:

@@ -14,8 +14,10 @@ from stairbot.control.algorithm.calibration import FLOW
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase
 from stairbot.control.algorithm.phase import (
+    FAILED,
     FAULT,
     NO_MOTION,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -109,7 +111,7 @@ def _turn(t: Tick, w: TurnWork) -> Step:
                   f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
                   diff=diff)
             t.cal.squaring_turns += 1
-            return go(P.CAL_LOWER)
+            return go("square")
         # Not square yet: turn on, slowly, the way the difference says.
         direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
         if direction != w.turn_direction:
@@ -142,8 +144,9 @@ def _turn(t: Tick, w: TurnWork) -> Step:
 TURN = PhaseDef(
     P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, TurnWork,
     enter=_turn_enter, family=Calibration,
-    to={P.CAL_LOWER: "SFR = SFL",
-        P.ERROR: "turned too far, or more than its first readings allow; " + FAULT})
+    on={"square": Exit(P.CAL_LOWER, "SFR = SFL"),
+        FAILED: Exit(P.ERROR, "turned too far, or more than its first readings allow; "
+                              + FAULT)})
 
 
 def _probe(t: Tick, w: ProbeWork) -> Step:
@@ -198,17 +201,18 @@ def _probe(t: Tick, w: ProbeWork) -> Step:
     if corner:
         t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
               f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
-        return go(P.CAL_CORNER)
+        return go("case_3b")
     t.say(f"calibration case 3A: square to the riser (turning left, SFR changed "
           f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
-    return go(P.CAL_TURN)
+    return go("case_3a")
 
 
 PROBE = PhaseDef(
     P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe, ProbeWork,
     family=Calibration,
-    to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
-        P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
+    on={"case_3b": Exit(P.CAL_CORNER, "SFR grew, SFL shrank: case 3B"),
+        "case_3a": Exit(P.CAL_TURN, "otherwise: case 3A, turn back right"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _corner_enter(t: Tick, w: CornerWork) -> None:
@@ -220,7 +224,7 @@ def _corner(t: Tick, w: CornerWork) -> Step:
     w.largest_sfr = max(w.largest_sfr, sfr)
     if sfr < w.largest_sfr - t.cfg.algorithm.equal_tolerance:
         t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
-        return go(P.CAL_TURN)
+        return go("both_shrink")
     too_far = _turned_too_far(t, P.CAL_CORNER)
     if too_far is not None:
         return too_far
@@ -230,7 +234,8 @@ def _corner(t: Tick, w: CornerWork) -> Step:
 CORNER = PhaseDef(
     P.CAL_CORNER, "calibration case 3B — turn left until both readings shrink", FLOW, _corner,
     CornerWork, enter=_corner_enter, family=Calibration,
-    to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
+    on={"both_shrink": Exit(P.CAL_TURN, "both readings shrink"),
+        FAILED: Exit(P.ERROR, "turned too far; " + FAULT)})
 
 
 def _away_enter(t: Tick, w: AwayWork) -> None:
@@ -261,7 +266,7 @@ def _away(t: Tick, w: AwayWork) -> Step:
     if seen and (off_wall or passed_square):
         t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
               "riser; squaring up", SFR=sfr, SFL=sfl)
-        return go(P.CAL_TURN)
+        return go("off_wall")
     made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made > MAX_AWAY_YAW_RAD:
         return fail(f"calibration ({where(t.ctx, P.CAL_AWAY)}) turned "
@@ -273,8 +278,9 @@ def _away(t: Tick, w: AwayWork) -> Step:
 AWAY = PhaseDef(
     P.CAL_AWAY, "calibration case 2W — turn away from the side wall until both see the riser",
     FLOW, _away, AwayWork, enter=_away_enter, family=Calibration,
-    to={P.CAL_TURN: "off the wall: the pair flipped (or flipped back, square)",
-        P.ERROR: "turned too far; " + FAULT})
+    on={"off_wall": Exit(P.CAL_TURN, "off the wall: the pair flipped (or flipped back, "
+                                     "square)"),
+        FAILED: Exit(P.ERROR, "turned too far; " + FAULT)})
 
 
 # -- turn back to a heading (descent 1 and 7) ------------------------------------------
@@ -285,7 +291,7 @@ def _turn_to(t: Tick, w: Work) -> Step:
     assert turn_to is not None  # set by whoever lifted for this turn
     remaining = turn_to - motion.twist(t.snap)
     if abs(remaining) <= motion.WHEEL_DONE:
-        return go(P.CAL_LOWER)
+        return go("turned")
     too_far = _turned_too_far(t, P.CAL_TURN_TO)
     if too_far is not None:
         return too_far
@@ -296,6 +302,7 @@ def _turn_to(t: Tick, w: Work) -> Step:
 TURN_TO = PhaseDef(
     P.CAL_TURN_TO, "calibration — turn by the odometer to a heading", FLOW,
     _turn_to, Work, family=Calibration,
-    to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
+    on={"turned": Exit(P.CAL_LOWER, "turned to it"),
+        FAILED: Exit(P.ERROR, "turned too far; " + FAULT)})
 
 PHASES: tuple[PhaseDef[Any], ...] = (PROBE, CORNER, AWAY, TURN, TURN_TO)
