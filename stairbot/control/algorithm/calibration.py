@@ -47,6 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork, StandingWork
 from stairbot.control.tolerances import still_samples, still_tolerance
 from stairbot.hardware import MotorId
@@ -82,9 +83,7 @@ def _check(t: Tick, w: StandingWork) -> Step:
             if abs(off) > HEADING_TOLERANCE_RAD:
                 cal.turn_to = climbed
                 ctx.descent.turned_back = True  # once a step: then the seed's check
-                t.say(f"descent 1, step {t.descent_index + 1}: turned {math.degrees(off):+.2f}° "
-                      "from the heading it climbed this step with (by the odometer); turning "
-                      "back to it", off_deg=math.degrees(off))
+                t.say(say.off_climb_heading(t.descent_index, off), off_deg=math.degrees(off))
                 return go("off_climb_heading")
     # Standing still, the pair is averaged over STILL_TICKS before it is
     # called equal or not: one noisy reading must not choose the case; and
@@ -102,22 +101,18 @@ def _check(t: Tick, w: StandingWork) -> Step:
         return _verify(t, w)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         if cal.purpose is not Purpose.START:
-            return fail(f"nothing ahead at {where(ctx, P.CAL_CHECK)}: SFR {sfr.distance_m:.3f} m, "
-                        f"SFL {sfl.distance_m:.3f} m where a riser should be")
+            return fail(say.nothing_ahead_where_riser(where(ctx, P.CAL_CHECK), sfr.distance_m,
+                                                      sfl.distance_m))
         cal.case = CalibrationCase.ONE
-        t.say("calibration case 1: nothing ahead (SFR and SFL read at least "
-              f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
-        return end(Outcome.STOPPED, "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
+        t.say(say.case_one(cfg.LENGTH_OF_INFINITY), case="1")
+        return end(Outcome.STOPPED, say.CASE_ONE_END)
     if cal.purpose is Purpose.START:
         if ctx.start.home_wheel is None:
             ctx.start.home_wheel = motion.wheel_position(t.snap)
             ctx.start.home_twist = motion.twist(t.snap)
         near = _nearer(t)
         if near is not None and near > limits.square_range_m(cfg) + cfg.algorithm.equal_tolerance:
-            t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
-                  f"farther than square_range_m ({limits.square_range_m(cfg):.3f} m), where the "
-                  "front cones see over the first riser or the pair's noise allows only a loose "
-                  "square; closing in before squaring up",
+            t.say(say.closing_in(sfr.distance_m, sfl.distance_m, limits.square_range_m(cfg)),
                   SFR=sfr.distance_m, SFL=sfl.distance_m)
             return go("too_far")
     diff = mean_diff(t, w)
@@ -136,12 +131,8 @@ def _check(t: Tick, w: StandingWork) -> Step:
     cal.case = CalibrationCase.THREE if equal else (
         CalibrationCase.TWO_W if wall else CalibrationCase.TWO)
     cal.case_diff = diff
-    said = ("equal, case 3" if equal else
-            "too far apart for one riser within "
-            f"{math.degrees(MAX_SQUARE_YAW_RAD):.0f}°: the nearer sees a side wall, case 2W"
-            if wall else "not equal, case 2")
-    t.say(f"calibration ({where(ctx, P.CAL_CHECK)}): SFR {sfr.distance_m:.3f} m, "
-          f"SFL {sfl.distance_m:.3f} m: {said}",
+    t.say(say.case_chosen(where(ctx, P.CAL_CHECK), sfr.distance_m, sfl.distance_m, equal, wall,
+                          MAX_SQUARE_YAW_RAD),
           case=cal.case.value, SFR=sfr.distance_m, SFL=sfl.distance_m)
     return go("case_found")
 
@@ -159,29 +150,21 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     sfr, sfl = r.distance_m, l_.distance_m
     if motion.far(r, cfg) or motion.far(l_, cfg):
         # no figure to square to, nor a riser where it squared up: stop
-        return fail(f"calibration ({where(ctx, P.CAL_CHECK)}): squared up, but standing on "
-                    f"all wheels SFR reads {sfr:.3f} m and SFL {sfl:.3f} m: at least one sees "
-                    "nothing ahead where the riser should be")
+        return fail(say.nothing_ahead_squared(where(ctx, P.CAL_CHECK), sfr, sfl))
     diff = mean_diff(t, w)
     if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
-        t.say(f"square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
-              f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)",
-              SFR=sfr, SFL=sfl, diff=diff)
+        t.say(say.square_on_all_wheels(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)
         cal.squaring_turns = 0
         return _squared(t, w)
     if cal.squaring_turns >= MAX_SQUARING_TURNS:
-        return fail(f"calibration ({where(ctx, P.CAL_CHECK)}) cannot square up: after "
-                    f"{cal.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
-                    f"standing (SFR {sfr:.3f} m, SFL {sfl:.3f} m): the beams do not see one "
-                    "flat riser alike (a riser too low for them, or its edge)")
+        return fail(say.cannot_square(where(ctx, P.CAL_CHECK), cal.squaring_turns, diff, sfr, sfl))
     # SFL farther than SFR: turned left of square, turn right (and the other way).
     yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
     cal.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
     cal.squaring_turns += 1
-    t.say(f"not square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
-          f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m): turning "
-          f"{math.degrees(yaw):+.1f}° by the odometer", SFR=sfr, SFL=sfl, diff=diff)
+    t.say(say.not_square_on_all_wheels(diff, len(w.diffs), sfr, sfl, yaw),
+          SFR=sfr, SFL=sfl, diff=diff)
     return go("not_square")
 
 
@@ -196,16 +179,14 @@ def _squared(t: Tick, w: StandingWork) -> Step:
             start.reading = (trimmed_mean([r for r, _l in w.standing])
                              + trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
             start.wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {start.reading:.3f} m (their means "
-                  f"over {len(w.standing)} ticks standing still)",
+            t.say(say.start_position_standing(start.reading, len(w.standing)),
                   start_reading=start.reading)
         elif motion.measurable(t.snap, cfg):
             start.reading = motion.mean_distance(t.snap)
             start.wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {start.reading:.3f} m",
-                  start_reading=start.reading)
+            t.say(say.start_position(start.reading), start_reading=start.reading)
         if t.mode is Mode.CALIBRATE_ONLY:
-            return end(Outcome.COMPLETED, "calibrate-only: calibration done")
+            return end(Outcome.COMPLETED, say.CALIBRATE_ONLY_END)
     return _after_calibration(t)
 
 
@@ -254,8 +235,7 @@ def _close_in(t: Tick, w: DriveWork) -> Step:
     remaining = w.target_wheel - motion.wheel_position(t.snap)
     square = limits.square_range_m(t.cfg)
     if remaining <= motion.WHEEL_DONE or (near is not None and near <= square):
-        return go("closed_in", f"closed in: SFR/SFL nearer reads "
-                               f"{'nothing' if near is None else f'{near:.3f} m'}")
+        return go("closed_in", say.closed_in(near))
     return stay(motion.drive(t.cfg, 1, remaining))
 
 

@@ -6,7 +6,6 @@ the helpers both share: :mod:`~stairbot.control.algorithm.calibration`.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from stairbot.control.algorithm import motion
@@ -46,6 +45,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
 from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
 from stairbot.hardware import MotorId
@@ -61,8 +61,7 @@ def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
         limit += LANDING_TURN_MARGIN_RAD  # a landing's turn is 90° by the odometer
     if motion.turn_yaw_rad(t.cfg, made) <= limit:
         return None
-    return fail(f"calibration ({where(t.ctx, phase)}) turned "
-                f"{math.degrees(limit):.0f}° without finding SFR = SFL")
+    return fail(say.turned_too_far(where(t.ctx, phase), limit))
 
 
 def _turn_enter(t: Tick, w: TurnWork) -> None:
@@ -90,10 +89,7 @@ def _turned_past_limit(t: Tick, w: TurnWork) -> Step | None:
     made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made <= w.turn_limit_rad:
         return None
-    return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned {math.degrees(made):.0f}° "
-                f"without finding SFR = SFL, more than the "
-                f"{math.degrees(w.turn_limit_rad):.0f}° its first readings allow: "
-                "not squaring up to something other than the riser")
+    return fail(say.turned_past_first_readings(where(t.ctx, P.CAL_TURN), made, w.turn_limit_rad))
 
 
 def _turn(t: Tick, w: TurnWork) -> Step:
@@ -107,9 +103,7 @@ def _turn(t: Tick, w: TurnWork) -> Step:
             return stay(NO_MOTION)
         diff = mean_diff(t, w)
         if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
-            t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} readings "
-                  f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
-                  diff=diff)
+            t.say(say.squared_up(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)
             t.cal.squaring_turns += 1
             return go("square")
         # Not square yet: turn on, slowly, the way the difference says.
@@ -117,11 +111,8 @@ def _turn(t: Tick, w: TurnWork) -> Step:
         if direction != w.turn_direction:
             w.turn_flips += 1
             if w.turn_flips > MAX_TURN_FLIPS:
-                return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned back and forth "
-                            f"{MAX_TURN_FLIPS} times without finding SFR = SFL: standing, "
-                            f"SFL − SFR reads {diff * 1000:+.1f} mm (SFR {sfr:.3f} m, SFL "
-                            f"{sfl:.3f} m); a beam may be off the flight's side, or one "
-                            "sensor reading long or short")
+                return fail(say.turned_back_and_forth(where(t.ctx, P.CAL_TURN), MAX_TURN_FLIPS,
+                                                      diff, sfr, sfl))
         w.measuring, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
         w.turn_direction = direction
         w.turn_diff = diff
@@ -199,11 +190,9 @@ def _probe(t: Tick, w: ProbeWork) -> Step:
     cal.case = CalibrationCase.THREE_B if corner else CalibrationCase.THREE_A
     data = {"case": cal.case.value, "dSFR": d_sfr, "dSFL": d_sfl}
     if corner:
-        t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
-              f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
+        t.say(say.case_3b(d_sfr, d_sfl), **data)
         return go("case_3b")
-    t.say(f"calibration case 3A: square to the riser (turning left, SFR changed "
-          f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
+    t.say(say.case_3a(d_sfr, d_sfl), **data)
     return go("case_3a")
 
 
@@ -223,7 +212,7 @@ def _corner(t: Tick, w: CornerWork) -> Step:
     sfr, _sfl = readings(t)
     w.largest_sfr = max(w.largest_sfr, sfr)
     if sfr < w.largest_sfr - t.cfg.algorithm.equal_tolerance:
-        t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
+        t.say(say.corner_shrinks(sfr))
         return go("both_shrink")
     too_far = _turned_too_far(t, P.CAL_CORNER)
     if too_far is not None:
@@ -264,14 +253,11 @@ def _away(t: Tick, w: AwayWork) -> Step:
     off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance
     passed_square = w.flipped and not flipped and abs(d) <= one_riser(cfg)
     if seen and (off_wall or passed_square):
-        t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
-              "riser; squaring up", SFR=sfr, SFL=sfl)
+        t.say(say.off_side_wall(sfr, sfl), SFR=sfr, SFL=sfl)
         return go("off_wall")
     made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made > MAX_AWAY_YAW_RAD:
-        return fail(f"calibration ({where(t.ctx, P.CAL_AWAY)}) turned "
-                    f"{math.degrees(MAX_AWAY_YAW_RAD):.0f}° away from the side wall and the "
-                    f"readings still do not fit one riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")
+        return fail(say.away_too_far(where(t.ctx, P.CAL_AWAY), MAX_AWAY_YAW_RAD, sfr, sfl))
     return stay(motion.turn(w.turn_direction, cfg))
 
 
