@@ -42,6 +42,7 @@ from stairbot.control.algorithm.phase import (
     stay,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import ascent as say
 from stairbot.control.algorithm.work import (
     ApproachTurnsWork,
     ApproachWork,
@@ -71,9 +72,8 @@ def _approach(t: Tick, w: ApproachWork) -> Step:
             w.still_since = t.snap.time_s
         if t.snap.time_s - w.still_since < RISER_LOST_WAIT_S:
             return stay(NO_MOTION)
-        return fail(f"riser lost during the approach (step {ctx.number_of_steps + 1}): "
-                    f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead "
-                    f"for {RISER_LOST_WAIT_S:g} s")
+        return fail(say.riser_lost(ctx.number_of_steps, sfr.distance_m, sfl.distance_m,
+                                   RISER_LOST_WAIT_S))
     w.still_since = None
     reading = _riser_ahead(t, w)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
@@ -157,7 +157,7 @@ def _approach_turns(t: Tick, w: ApproachTurnsWork) -> Step:
         # The sensors read "too near" from here on: the gap is dead reckoned.
         driven = (here - w.entry_wheel) * t.cfg.wheel_circumference
         gap = max(0.0, w.start_reading - driven)
-        t.say(f"at the riser: {gap:.3f} m from it", riser_gap=gap)
+        t.say(say.at_riser(gap), riser_gap=gap)
         return go("at_riser", begin=LiftFirst(riser_gap=gap))
     return stay(motion.drive(t.cfg, 1, remaining))
 
@@ -226,15 +226,13 @@ def _lifted_third(t: Tick, _w: LiftWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps
     if motion.measurable(t.snap, cfg):
-        ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
-        t.say(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m",
-              index=i, tab_length_to_edge=ctx.tab_length_to_edge[i])
+        tab = ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
+        t.say(say.tab_length(i, tab), index=i, tab_length_to_edge=tab)
     else:
         ctx.tab_length_to_edge[i] = None
-        t.say(f"tab_length_to_edge[{i}] not measurable (nothing ahead): the descent of this "
-              "step drives by turns", index=i, tab_length_to_edge=None)
+        t.say(say.tab_not_measurable(i), index=i, tab_length_to_edge=None)
     ctx.number_of_steps += 1
-    t.say(f"number_of_steps = {ctx.number_of_steps}", number_of_steps=ctx.number_of_steps)
+    t.say(say.number_of_steps(ctx.number_of_steps), number_of_steps=ctx.number_of_steps)
     return go("turns_made")
 
 
@@ -258,16 +256,14 @@ def _check(t: Tick, w: WaitWork) -> Step:
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         ctx.ascent_end = AscentEnd.TOP_REACHED
-        t.say(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
-              "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
+        t.say(say.top_reached(ctx.number_of_steps), ascent_end="top_reached")
         return go("top_reached")
     tab = _tab_again(t, w)
     if tab is not None:
         return tab
     if ctx.number_of_steps >= cfg.algorithm.max_steps:
         ctx.ascent_end = AscentEnd.STEP_LIMIT
-        t.say(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
-              "the descent begins", ascent_end="step_limit")
+        t.say(say.step_limit(cfg.algorithm.max_steps), ascent_end="step_limit")
         return go("step_limit")
     return go("next_step")
 
@@ -288,19 +284,15 @@ def _tab_again(t: Tick, w: WaitWork) -> Step | None:
     if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:
         return None
     if motion.measurable(t.snap, cfg):
-        ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
-        t.say(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m (read standing at "
-              "ascent 8: ascent 7 read nothing ahead)", index=i,
-              tab_length_to_edge=ctx.tab_length_to_edge[i])
+        tab = ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
+        t.say(say.tab_read_standing(i, tab), index=i, tab_length_to_edge=tab)
         return None
     if w.still_since is None:
         w.still_since = t.snap.time_s
     if t.snap.time_s - w.still_since < TAB_WAIT_S:
         return stay(NO_MOTION)
     sfr, sfl = motion.pair(t.snap)
-    t.say(f"tab_length_to_edge[{i}] not measured: SFR/SFL read {sfr.distance_m:.3f}/"
-          f"{sfl.distance_m:.3f} m for {TAB_WAIT_S:g} s, not both a riser nor both nothing "
-          "ahead; going on (the descent of this step finds its edge by the back pair alone)")
+    t.say(say.tab_not_measured(i, sfr.distance_m, sfl.distance_m, TAB_WAIT_S))
     return None  # the phase goes on this tick
 
 
