@@ -34,6 +34,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.step_down import narrow_here, step_tab, step_tread
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import (
     EdgeWork,
 )
@@ -93,8 +94,7 @@ def _edge_or_tab(t: Tick, w: EdgeWork, refind: bool) -> float | None:
 
 def _narrow_tab_known(t: Tick, _w: EdgeWork) -> Step | None:
     if narrow_here(t) and step_tab(t) is None:
-        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured on "
-                    "a narrow step: the robot cannot be placed on a tread it does not fit on")
+        return fail(say.narrow_tab_unknown(t.descent_index))
     return None
 
 
@@ -186,18 +186,12 @@ def _at_edge(t: Tick, w: EdgeWork) -> Step:
     ctx = t.ctx
     searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
     if not ctx.from_top and ctx.descent.edge_wheel is None and _edge_by_watch(t):
-        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured, and "
-                    f"SBR/SBL saw no edge backing {searched:.2f} m (the tread measured, or "
-                    "LENGTH_OF_INFINITY): the edge of the step cannot be found")
+        return fail(say.edge_not_found(t.descent_index, searched))
     if not ctx.from_top or ctx.descent.edge_wheel is not None:
         return go("at_edge")
     if ctx.steps_descended == 0:
-        return end(Outcome.STOPPED, f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
-                              f"backing from the start (at most LENGTH_OF_INFINITY = "
-                              f"{t.cfg.LENGTH_OF_INFINITY} m): not on the top of a flight")
-    return end(Outcome.COMPLETED, f"on the floor, or a landing: no edge within {searched:.2f} m "
-                            f"behind step {ctx.steps_descended} from the top, the last "
-                            "descended")
+        return end(Outcome.STOPPED, say.not_on_top(searched, t.cfg.LENGTH_OF_INFINITY))
+    return end(Outcome.COMPLETED, say.on_the_floor(searched, ctx.steps_descended))
 
 
 _to_edge = reading_drive(-1, step_tab, _edge_fallback, _at_edge,
@@ -226,7 +220,7 @@ def _turn_square(t: Tick, w: EdgeWork) -> Step:
     t.ctx.descent.edge_squared = True
     return calibrate("askew_to_edge", Purpose.EDGE,
                      motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw),
-                     f"turning {math.degrees(w.square_yaw):+.1f}° square to the edge")
+                     say.turning_square_to_edge(w.square_yaw))
 
 
 BACK_TO_EDGE = PhaseDef(

@@ -47,6 +47,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.step_down import height, narrow_here, step_tab, step_tread
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import (
     DriveWork,
     EdgeWork,
@@ -75,9 +76,7 @@ def _over_an_edge(t: Tick, _w: LowerThirdWork) -> Step | None:
     cfg = t.cfg
     reading = motion.mean_distance(t.snap, back=True)
     if reading <= cfg.BACK_CLEARANCE + floor_tolerance(cfg):
-        return fail(f"floor not found: SBR/SBL read {reading:.3f} m, at or below BACK_CLEARANCE "
-                    f"({cfg.BACK_CLEARANCE} m), before segment 3 was lowered (step "
-                    f"{t.descent_index + 1}): segment 3 is not over an edge")
+        return fail(say.not_over_an_edge(reading, cfg.BACK_CLEARANCE, t.descent_index))
     return None
 
 
@@ -108,17 +107,13 @@ def _deep_drop(t: Tick, w: LowerThirdWork) -> Step | None:
     if all(r.ok for r in backs):
         depth = min(r.distance_m for r in backs) - cfg.BACK_CLEARANCE
         if depth > most + floor_tolerance(cfg):
-            return _refuse_because(t, f"the drop below step {t.ctx.steps_descended + 1} from "
-                                   f"the top is {depth:.3f} m (SBR/SBL), deeper than segment "
-                                   f"3 can be lowered ({most:.3f} m): refused")
+            return _refuse_because(t, say.drop_too_deep(t.ctx.steps_descended, depth, most))
     elif all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
              for r in backs):
         reach = cfg.sensors.range(back=True)[1] - cfg.BACK_CLEARANCE
         if reach > most:
-            return _refuse_because(t, f"nothing within SBR/SBL's range below step "
-                                   f"{t.ctx.steps_descended + 1} from the top: the drop is "
-                                   f"deeper than {reach:.3f} m, more than segment 3 can be "
-                                   f"lowered ({most:.3f} m): refused")
+            return _refuse_because(t, say.nothing_in_range_below(t.ctx.steps_descended, reach,
+                                                                 most))
     return None
 
 
@@ -128,12 +123,8 @@ def _floor_not_found(t: Tick, reading: float) -> Step:
     continuous descent (the drop is deeper than the lift)."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.from_top:
-        return _refuse_because(t, f"floor not found below step {ctx.steps_descended + 1} "
-                               f"from the top within MTB's stroke (-MAX_OF_VERTICAL_TURNS): "
-                               f"SBR/SBL read {reading:.3f} m: refused")
-    return fail(f"floor not found when descending step {t.descent_index + 1}: MTB reached "
-                f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL "
-                f"still read {reading:.3f} m")
+        return _refuse_because(t, say.floor_beyond_stroke(ctx.steps_descended, reading))
+    return fail(say.floor_not_found(t.descent_index, cfg.MAX_OF_VERTICAL_TURNS, reading))
 
 
 def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
@@ -158,8 +149,8 @@ def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
         ctx.number_of_turns_for_step_height = _lt(t).return_mtb - t.snap.turns(MotorId.MTB)
         ctx.third_in_air = False  # on the step below
         ctx.descent.narrow_edge_wheel = None  # the next edge's, if narrow, is watched for
-        t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
-              f"{ctx.number_of_turns_for_step_height:.2f} ({where(ctx, P.DESCENT_LOWER_THIRD)})",
+        t.say(say.on_step_below(ctx.number_of_turns_for_step_height,
+                                where(ctx, P.DESCENT_LOWER_THIRD)),
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
         return go("on_step_below")
     assert w.target_mtb is not None
@@ -208,8 +199,8 @@ def _refuse(t: Tick, w: RefuseWork) -> Step:
         w.target_wheel = here + cfg.wheel_turns(edge_clearance_m(cfg) + RETREAT_MARGIN_M)
     remaining = w.target_wheel - here
     if remaining <= motion.WHEEL_DONE:
-        why = _lt(t).refused or f"refused the drop below step {t.ctx.steps_descended + 1}"
-        return end(Outcome.STOPPED, f"{why}; segment 3 raised again, the robot back on the step")
+        why = _lt(t).refused or say.refused_drop(t.ctx.steps_descended)
+        return end(Outcome.STOPPED, say.back_on_the_step(why))
     return stay(motion.drive(cfg, 1, remaining))
 
 
@@ -309,11 +300,10 @@ def _lowered_first(t: Tick, _w: LiftWork) -> Step:
     ctx = t.ctx
     ctx.steps_descended += 1
     if ctx.from_top:
-        t.say(f"step {ctx.steps_descended} from the top descended",
-              steps_descended=ctx.steps_descended)
+        t.say(say.descended_from_top(ctx.steps_descended), steps_descended=ctx.steps_descended)
         return go("steps_remain")
-    t.say(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
-          f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
+    t.say(say.step_descended(ctx.number_of_steps, ctx.steps_descended),
+          steps_descended=ctx.steps_descended)
     if landing.returns_here(t):
         return go("back_to_turn")
     if ctx.steps_descended < ctx.number_of_steps:

@@ -27,6 +27,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.squaring import HEADING_TOLERANCE_RAD, heading_off_rad
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import (
     DriveWork,
 )
@@ -74,7 +75,7 @@ def _at_start_position(t: Tick, _w: DriveWork) -> Step:
     back the distance."""
     home_twist = t.ctx.start.home_twist
     if _closed_in_turns(t) <= motion.WHEEL_DONE:
-        return end(Outcome.COMPLETED, "back at the start position")
+        return end(Outcome.COMPLETED, say.BACK_AT_START)
     if home_twist is None or abs(heading_off_rad(t, home_twist)) <= HEADING_TOLERANCE_RAD:
         return go("closed_in")
     return calibrate("off_start_heading", Purpose.HOME, home_twist)
@@ -96,8 +97,7 @@ def _floor_heading(t: Tick, _w: DriveWork) -> Step | None:
     off = heading_off_rad(t, floor)
     if abs(off) <= HEADING_TOLERANCE_RAD:
         return None
-    t.say(f"descent 7: turned {math.degrees(off):+.2f}° from the heading it crossed the floor "
-          "with (by the odometer); turning back to it", off_deg=math.degrees(off))
+    t.say(say.off_floor_heading(off), off_deg=math.degrees(off))
     return calibrate("off_floor_heading", Purpose.FLOOR, floor)
 
 
@@ -120,7 +120,7 @@ FINISH = PhaseDef(
 
 
 _floor = turns_drive(-1, _closed_in_turns,
-                     lambda _t, _w: end(Outcome.COMPLETED, "back where the program began"))
+                     lambda _t, _w: end(Outcome.COMPLETED, say.BACK_WHERE_BEGAN))
 FINISH_FLOOR = PhaseDef(
     P.DESCENT_FINISH_FLOOR, "descent 7 — finish: back the distance calibration closed in",
     FLOW, _floor[1], DriveWork, enter=_floor[0],
