@@ -51,6 +51,7 @@ from stairbot.control.algorithm.phase import (
     go,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import landing as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
@@ -119,35 +120,25 @@ def _decide(t: Tick, _w: LiftWork) -> Step:
     right, left = landing.right_m, landing.left_m
     opened = turn.open
     if not opened:
-        return _refuse(t, AscentEnd.LANDING_CLOSED,
-                       "landing: no next flight to either side (SSR "
-                       f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
-                       "3's whole stroke does not see over)")
+        return _refuse(t, AscentEnd.LANDING_CLOSED, say.no_next_flight(right, left))
     room = turn_room_m(cfg)
     depth = landing_depth(t)
     if depth is None:
-        return _refuse(t, AscentEnd.LANDING_TOO_SMALL,
-                       "landing: its depth was not measured (neither the tread past the "
-                       "last riser nor tab_length_to_edge read the wall ahead): no room to "
-                       "turn is known")
+        return _refuse(t, AscentEnd.LANDING_TOO_SMALL, say.DEPTH_NOT_MEASURED)
     turn.depth_m = depth
-    short = [f"{name} {_said(have)}" for name, have in
+    short = [(name, have) for name, have in
              (("right", right), ("left", left), ("depth/2", depth / 2.0))
              if have is None or have < room]
     if short:
         return _refuse(t, AscentEnd.LANDING_TOO_SMALL,
-                       f"landing too small to turn in: the robot's turning circle needs "
-                       f"{room:.3f} m from its centre on every side (radius "
-                       f"{turning_radius(cfg):.3f} m + {TURN_ROOM_MARGIN} m), it has "
-                       + ", ".join(short))
+                       say.too_small(room, turning_radius(cfg), TURN_ROOM_MARGIN, short))
+    assert right is not None and left is not None  # unmeasured, a side is short
     side = LEFT if LEFT in opened else RIGHT
     if len(opened) == 2:
         # both open: the lower first riser (the side seen over first)
         side = LEFT if (turn.rise_m[1] or 0.0) <= (turn.rise_m[0] or 0.0) else RIGHT
     landing.side = side
-    t.say(f"landing: the next flight is to the {'left' if side == LEFT else 'right'}; "
-          f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
-          "centring to turn", side=side, depth=depth)
+    t.say(say.next_flight(side == LEFT, depth, right, left), side=side, depth=depth)
     return go("room_to_turn")
 
 
@@ -169,13 +160,9 @@ def landing_depth(t: Tick) -> float | None:
     return min(seen) - DEPTH_MARGIN if seen else None
 
 
-def _said(d: float | None) -> str:
-    return "nothing in range" if d is None else f"{d:.3f} m"
-
-
 def _refuse(t: Tick, why: AscentEnd, message: str) -> Step:
     t.ctx.ascent_end = why
-    t.say(message + "; the ascent ends, the descent begins", ascent_end=why.value)
+    t.say(say.ascent_ends(message), ascent_end=why.value)
     return go("refused")
 
 
@@ -210,8 +197,7 @@ def _centred(t: Tick, _w: DriveWork) -> Step:
     landing.twist = motion.twist(t.snap)
     yaw = landing.side * math.pi / 2.0
     return calibrate("centred", Purpose.LANDING, landing.twist + motion.yaw_turns(t.cfg, yaw),
-                     f"centred on the landing: turning {math.degrees(yaw):+.0f}° towards the "
-                     "next flight")
+                     say.centred(yaw))
 
 
 _centre = reading_drive(-1, _centre_target, _centre_turns, _centred)
@@ -230,8 +216,7 @@ def turned(t: Tick) -> Step:
     ctx = t.ctx
     if t.cal.purpose is Purpose.LANDING:
         ctx.landing.step = ctx.number_of_steps
-        t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
-              landing_step=ctx.landing.step)
+        t.say(say.onto_next_flight(ctx.number_of_steps), landing_step=ctx.landing.step)
         return calibrate("onto_next_flight", Purpose.ASCENT)
     # descent 1 of the first flight's top step, as its back-off would begin it:
     # that step's edge not seen yet (the edge watch's mark is the last step's)
@@ -259,8 +244,7 @@ def after_calibration(t: Tick) -> None:
             or landing.riser_m is not None or not motion.measurable(t.snap, t.cfg):
         return
     landing.riser_m = motion.mean_distance(t.snap)
-    t.say(f"where it turned: SFR/SFL read {landing.riser_m:.3f} m to the next flight's "
-          "first riser", landing_riser_m=landing.riser_m)
+    t.say(say.where_turned(landing.riser_m), landing_riser_m=landing.riser_m)
 
 
 # -- landing 3: back to where it turned, turn back ------------------------------------------
@@ -305,7 +289,7 @@ def _returned(t: Tick, _w: DriveWork) -> Step:
     twist = t.ctx.landing.twist
     assert twist is not None  # set before the turn
     return calibrate("returned", Purpose.LANDING_BACK, twist,
-                     "back where it turned: turning back to the first flight")
+                     say.BACK_WHERE_TURNED)
 
 
 _return = reading_drive(-1, _return_target, _return_turns, _returned)

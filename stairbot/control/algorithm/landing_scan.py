@@ -21,6 +21,7 @@ from stairbot.control.algorithm.phase import (
     stay,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import landing as say
 from stairbot.control.algorithm.work import ScanWork
 from stairbot.control.tolerances import side_settle_s
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
@@ -140,10 +141,10 @@ def _record(t: Tick, w: ScanWork) -> Step:
     turn.open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
     for i, sid in enumerate(SIDE_SENSORS):
         if opened[i]:
-            name = "right" if i == 0 else "left"
-            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
-                  f"({bases[i]:.3f} m) with segment 3 lifted {seen_at[i]:.3f} m, and "
-                  f"standing at the top: the next flight", sensor=sid.value, base=bases[i])
+            base = bases[i]
+            assert base is not None  # opened only on a side seen
+            t.say(say.side_sees_over(sid.value, i == 0, base, seen_at[i]),
+                  sensor=sid.value, base=base)
     return go("scanned")
 
 
