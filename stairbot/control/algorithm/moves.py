@@ -28,6 +28,7 @@ from stairbot.control.algorithm.phase import (
     go,
     stay,
 )
+from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork, Work
 from stairbot.control.tolerances import median_sigma
 from stairbot.hardware import MotorId
@@ -100,9 +101,7 @@ def reading_drive(
                 # edge, or onto a side wall): the wheels carry on to the last
                 # target the readings gave.
                 w.reading_lost = True
-                t.say(f"SFR/SFL jumped {jump * 1000:+.0f} mm from what the wheels explain "
-                      f"(reading {reading:.3f} m): the rest of the drive goes by turns",
-                      jump=jump)
+                t.say(say.reading_jumped(jump, reading), jump=jump)
             else:
                 # The target from the median of the last KEY_TICKS keys, not
                 # from this tick's reading alone: two stray HC-SR04

@@ -36,6 +36,7 @@ from stairbot.control.algorithm.phase import (
     stay,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import Work
 from stairbot.control.tolerances import standing_tolerance
 
@@ -62,13 +63,10 @@ DEBOUNCE_TICKS = 3
 the wait, before the program ends with an error)."""
 
 
-def _pair_name(back: bool) -> str:
-    return "SBR/SBL" if back else "SFR/SFL"
-
-
-def _readings(t: Tick, back: bool) -> str:
+def _readings(t: Tick, back: bool) -> tuple[float, float]:
+    """The watched pair's readings (right, left), as the standing rule says them."""
     r, left = motion.pair(t.snap, back)
-    return f"{r.distance_m:.3f} m / {left.distance_m:.3f} m"
+    return r.distance_m, left.distance_m
 
 
 def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
@@ -118,10 +116,8 @@ def watch(t: Tick, phase: PhaseDef[Any]) -> Step | None:
     ctx.watch.ticks += 1
     if ctx.watch.ticks < DEBOUNCE_TICKS:
         return None
-    return go(DISAGREE,
-              f"standing rule: {_pair_name(back)} disagree ({_readings(t, back)}) in "
-              f"{phase.label}: all motors stopped, measuring again in "
-              f"{t.cfg.algorithm.standing_wait:g} s")
+    return go(DISAGREE, say.disagree(back, _readings(t, back), phase.label,
+                                     t.cfg.algorithm.standing_wait))
 
 
 MEDIAN_S = 1.0
@@ -156,13 +152,11 @@ def _paused(t: Tick, _w: Work) -> Step:
             t.cfg, near, motion.DIFF_SMOOTHING, back)
     if not disagree:
         ctx.watch.ticks = 0
-        return go(resumed(resume.phase), f"standing rule: {_pair_name(back)} agree again "
-                                f"({_readings(t, back)}): resuming {resume.label}")
+        return go(resumed(resume.phase), say.agree_again(back, _readings(t, back), resume.label))
     ctx.watch.ticks += 1
     if ctx.watch.ticks >= DEBOUNCE_TICKS:
-        return fail(f"standing rule: {_pair_name(back)} still disagree after "
-                    f"{t.cfg.algorithm.standing_wait:g} s ({_readings(t, back)}) in "
-                    f"{resume.label}")
+        return fail(say.still_disagree(back, t.cfg.algorithm.standing_wait, _readings(t, back),
+                                       resume.label))
     return stay(NO_MOTION)
 
 
