@@ -14,7 +14,8 @@ from kinematic import KinematicRobot, run
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.stability import UNSTABLE, UNSTABLE_EDGE, balance, worst
+from stairbot.control.algorithm.stability import UNSTABLE_EDGE, balance, worst
+from stairbot.control.algorithm.texts.shared import UNSTABLE
 from stairbot.control.algorithm.transitions import TRANSITIONS
 from stairbot.control.robot_config import load_config
 from stairbot.hardware import LIFT_MOTORS, MotorId

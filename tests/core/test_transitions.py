@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import ast
 import math
 import re
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -13,11 +15,13 @@ from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import CalibrationCase
-from stairbot.control.algorithm.phase import Step, Tick, go
+from stairbot.control.algorithm.phase import ENDED, FAILED, Step, Tick, go
 from stairbot.control.algorithm.phases import FLOWS, Mode, Phase
 from stairbot.control.algorithm.squaring import STILL_TICKS
+from stairbot.control.algorithm.standing import DISAGREE, resumed
 from stairbot.control.algorithm.transitions import (
     BACK_PAIR_PHASES,
+    EXITS,
     STANDING_ARMED,
     TRANSITIONS,
     TransitionError,
@@ -67,11 +71,49 @@ def test_the_table_covers_every_phase_and_every_active_phase_has_a_step() -> Non
         else:
             assert phase.record.step is not None, phase
             assert Phase.ERROR in TRANSITIONS[phase], phase  # faults end anywhere
+            assert EXITS[phase][FAILED].phase is Phase.ERROR, phase
 
 
-def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
-    """A phase's step is a function of (context, readings): it says what comes
-    next; only the controller makes it so."""
+def test_every_outcome_of_every_record_leads_to_a_phase_the_table_allows() -> None:
+    """Each record's outcomes, and the pauses and resumes the table adds, lead
+    where the transition table (and so the flowcharts) says; ERROR only on
+    a failure, DONE only on an end, and a failure always to ERROR."""
+    for phase in Phase:
+        for happened, ex in phase.record.on.items():
+            assert allowed(phase, ex.phase), (phase, happened)
+            assert ex.when in TRANSITIONS[phase][ex.phase], (phase, happened)
+            assert (ex.phase is Phase.ERROR) is (happened == FAILED), (phase, happened)
+            assert (ex.phase is Phase.DONE) is (happened == ENDED), (phase, happened)
+            assert EXITS[phase][happened].phase is ex.phase
+        for happened, ex in EXITS[phase].items():
+            assert allowed(phase, ex.phase), (phase, happened)
+            assert happened in phase.record.on or happened == DISAGREE or (
+                phase is Phase.PAUSED and happened == resumed(ex.phase)), (phase, happened)
+        # every transition of the table comes from an outcome
+        assert set(TRANSITIONS[phase]) == {ex.phase for ex in EXITS[phase].values()}
+
+
+def test_every_outcome_a_step_names_is_listed_by_a_record() -> None:
+    """An outcome spelled in a step (``go("...")``, ``calibrate("...", ...)``)
+    that no record lists would raise TransitionError only when that branch
+    runs: every such literal in the algorithm's modules is some record's."""
+    listed = {happened for phase in Phase for happened in phase.record.on}
+    package = Path(phases.__file__).parent
+    named = set()
+    for module in package.glob("*.py"):
+        for node in ast.walk(ast.parse(module.read_text("utf-8"))):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                    and node.func.id in ("go", "calibrate") and node.args \
+                    and isinstance(node.args[0], ast.Constant):
+                named.add((module.name, node.args[0].value))
+    assert len(named) > 40
+    assert {(m, h) for m, h in named if h not in listed} == set()
+
+
+def test_a_step_returns_what_happened_and_enters_nothing_itself() -> None:
+    """A phase's step is a function of (context, readings): it says what
+    happened; the table says where that leads, and only the controller
+    enters it."""
     ctx = Context(phase=Phase.CAL_CHECK.value, family=Calibration())
     said: list[str] = []
     sensors = {SensorId.SFR: SensorReading(0.50), SensorId.SFL: SensorReading(0.53),
@@ -88,9 +130,10 @@ def test_a_step_returns_the_next_phase_and_enters_nothing_itself() -> None:
         tick = Tick(snap, CFG, ctx, Mode.FULL, lambda message, **_: said.append(message))
         steps.append(record.step(tick, work))
     assert all(isinstance(s, Step) and not s.speeds for s in steps)
-    assert [s.next for s in steps[:-1]] == [None] * (ticks - 1)
+    assert [s.happened for s in steps[:-1]] == [None] * (ticks - 1)
     step = steps[-1]
-    assert step.next is Phase.CAL_LIFT
+    assert step.happened == "case_found"
+    assert EXITS[Phase.CAL_CHECK]["case_found"].phase is Phase.CAL_LIFT
     assert ctx.phase == Phase.CAL_CHECK.value  # not entered by the step
     # the calibration's state and a message
     assert ctx.family_of(Calibration).case is CalibrationCase.TWO and said
@@ -118,8 +161,8 @@ def test_standing_rule_is_armed_where_the_table_says_and_not_while_turning_or_ri
         assert allowed(Phase.PAUSED, phase)
 
 
-@pytest.mark.parametrize("bad", [go(Phase.DESCENT_FINISH), Step(next=Phase.DONE)])
-def test_a_step_that_returns_a_change_outside_the_table_raises(
+@pytest.mark.parametrize("bad", [go("no_step_climbed"), go("squared"), Step(happened=ENDED)])
+def test_a_step_that_returns_an_outcome_its_phase_does_not_list_raises(
         monkeypatch: pytest.MonkeyPatch, bad: Step) -> None:
     ctrl = Controller(CFG)
     n = 0
@@ -129,7 +172,7 @@ def test_a_step_that_returns_a_change_outside_the_table_raises(
         assert n < 100
     rogue = replace(Phase.CAL_LIFT.record, step=lambda _t, _w: bad)
     monkeypatch.setitem(phases._records(), Phase.CAL_LIFT, rogue)
-    with pytest.raises(TransitionError, match="cal_lift -> "):
+    with pytest.raises(TransitionError, match=f"{bad.happened!r} is not an outcome of cal_lift"):
         ctrl.tick(snapshot(n * CFG.algorithm.tick))
     assert ctrl.phase is Phase.CAL_LIFT
 

@@ -21,7 +21,7 @@ import pytest
 
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.stability import UNSTABLE
+from stairbot.control.algorithm.texts.shared import UNSTABLE
 from stairbot.control.robot_config import load_config
 from stairbot.hardware import ZERO_SPEEDS, HasTruth, MotorId
 from stairbot.inputs.config import RobotConfig

@@ -29,8 +29,10 @@ from stairbot.control.algorithm.moves import (
     lift_phase,
 )
 from stairbot.control.algorithm.phase import (
+    FAILED,
     FAULT,
     NO_MOTION,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -40,6 +42,7 @@ from stairbot.control.algorithm.phase import (
     stay,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import ascent as say
 from stairbot.control.algorithm.work import (
     ApproachTurnsWork,
     ApproachWork,
@@ -69,14 +72,13 @@ def _approach(t: Tick, w: ApproachWork) -> Step:
             w.still_since = t.snap.time_s
         if t.snap.time_s - w.still_since < RISER_LOST_WAIT_S:
             return stay(NO_MOTION)
-        return fail(f"riser lost during the approach (step {ctx.number_of_steps + 1}): "
-                    f"SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m, nothing ahead "
-                    f"for {RISER_LOST_WAIT_S:g} s")
+        return fail(say.riser_lost(ctx.number_of_steps, sfr.distance_m, sfl.distance_m,
+                                   RISER_LOST_WAIT_S))
     w.still_since = None
     reading = _riser_ahead(t, w)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     if reading <= safe:
-        return go(P.ASCENT_APPROACH_TURNS)
+        return go("at_safe_distance")
     remaining = cfg.wheel_turns(reading - safe) + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
     return stay(motion.drive(cfg, 1, remaining))
 
@@ -110,8 +112,10 @@ def _riser_ahead(t: Tick, w: ApproachWork) -> float:
 APPROACH = PhaseDef(
     P.ASCENT_APPROACH, "ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", FLOW, _approach,
     ApproachWork, watches="front",
-    to={P.ASCENT_APPROACH_TURNS: "reads SAFE_DISTANCE_IN_FRONT_OF_STEP",
-        P.ERROR: "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); " + FAULT})
+    on={"at_safe_distance": Exit(P.ASCENT_APPROACH_TURNS, "reads "
+                                                         "SAFE_DISTANCE_IN_FRONT_OF_STEP"),
+        FAILED: Exit(P.ERROR, "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); "
+                              + FAULT)})
 
 
 def _approach_turns_enter(t: Tick, w: ApproachTurnsWork) -> None:
@@ -153,15 +157,15 @@ def _approach_turns(t: Tick, w: ApproachTurnsWork) -> Step:
         # The sensors read "too near" from here on: the gap is dead reckoned.
         driven = (here - w.entry_wheel) * t.cfg.wheel_circumference
         gap = max(0.0, w.start_reading - driven)
-        t.say(f"at the riser: {gap:.3f} m from it", riser_gap=gap)
-        return go(P.ASCENT_LIFT_FIRST, begin=LiftFirst(riser_gap=gap))
+        t.say(say.at_riser(gap), riser_gap=gap)
+        return go("at_riser", begin=LiftFirst(riser_gap=gap))
     return stay(motion.drive(t.cfg, 1, remaining))
 
 
 APPROACH_TURNS = PhaseDef(
     P.ASCENT_APPROACH_TURNS, "ascent 2 — approach: NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH more",
     FLOW, _approach_turns, ApproachTurnsWork, enter=_approach_turns_enter, watches="front",
-    to={P.ASCENT_LIFT_FIRST: "turns made", P.ERROR: FAULT})
+    on={"at_riser": Exit(P.ASCENT_LIFT_FIRST, "turns made"), FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- ascent 4-7: segment by segment onto the step -------------------------------------------
@@ -198,7 +202,7 @@ def _driven_first(t: Tick, _w: DriveWork) -> Step:
     # segment 3, in the air over the step below if that is narrow, has rolled on with the
     # robot onto the tread behind the riser just climbed: it carries again
     t.ctx.third_in_air = False
-    return go(P.ASCENT_LIFT_SECOND)
+    return go("reached")
 
 
 DRIVE_FIRST = drive_phase(
@@ -222,24 +226,23 @@ def _lifted_third(t: Tick, _w: LiftWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps
     if motion.measurable(t.snap, cfg):
-        ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
-        t.say(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m",
-              index=i, tab_length_to_edge=ctx.tab_length_to_edge[i])
+        tab = ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
+        t.say(say.tab_length(i, tab), index=i, tab_length_to_edge=tab)
     else:
         ctx.tab_length_to_edge[i] = None
-        t.say(f"tab_length_to_edge[{i}] not measurable (nothing ahead): the descent of this "
-              "step drives by turns", index=i, tab_length_to_edge=None)
+        t.say(say.tab_not_measurable(i), index=i, tab_length_to_edge=None)
     ctx.number_of_steps += 1
-    t.say(f"number_of_steps = {ctx.number_of_steps}", number_of_steps=ctx.number_of_steps)
-    return go(P.ASCENT_CHECK)
+    t.say(say.number_of_steps(ctx.number_of_steps), number_of_steps=ctx.number_of_steps)
+    return go("turns_made")
 
 
 _lift3 = lift(lambda t, _w: {MotorId.MTB: _h(t)}, _lifted_third)
 LIFT_THIRD = PhaseDef(
     P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], LiftWork, enter=_lift3[0],
     watches="front", carried_by=(1, 2),
-    to={P.ASCENT_CHECK: "turns made; tab_length_to_edge[i] stored, number_of_steps + 1",
-        P.ERROR: FAULT})
+    on={"turns_made": Exit(P.ASCENT_CHECK, "turns made; tab_length_to_edge[i] stored, "
+                                           "number_of_steps + 1"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- ascent 8-9: the top, or the next step ------------------------------------------------------
@@ -253,18 +256,16 @@ def _check(t: Tick, w: WaitWork) -> Step:
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         ctx.ascent_end = AscentEnd.TOP_REACHED
-        t.say(f"top reached after {ctx.number_of_steps} steps: SFR/SFL read at least "
-              "LENGTH_OF_INFINITY; the descent begins", ascent_end="top_reached")
-        return go(P.DESCENT_LOWER_THIRD)
+        t.say(say.top_reached(ctx.number_of_steps), ascent_end="top_reached")
+        return go("top_reached")
     tab = _tab_again(t, w)
     if tab is not None:
         return tab
     if ctx.number_of_steps >= cfg.algorithm.max_steps:
         ctx.ascent_end = AscentEnd.STEP_LIMIT
-        t.say(f"number_of_steps reached {cfg.algorithm.max_steps}: the ascent ends; "
-              "the descent begins", ascent_end="step_limit")
-        return go(P.DESCENT_LOWER_THIRD)
-    return go(P.ASCENT_DRIVE_THIRD)
+        t.say(say.step_limit(cfg.algorithm.max_steps), ascent_end="step_limit")
+        return go("step_limit")
+    return go("next_step")
 
 
 def _tab_again(t: Tick, w: WaitWork) -> Step | None:
@@ -283,29 +284,25 @@ def _tab_again(t: Tick, w: WaitWork) -> Step | None:
     if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:
         return None
     if motion.measurable(t.snap, cfg):
-        ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
-        t.say(f"tab_length_to_edge[{i}] = {ctx.tab_length_to_edge[i]:.3f} m (read standing at "
-              "ascent 8: ascent 7 read nothing ahead)", index=i,
-              tab_length_to_edge=ctx.tab_length_to_edge[i])
+        tab = ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
+        t.say(say.tab_read_standing(i, tab), index=i, tab_length_to_edge=tab)
         return None
     if w.still_since is None:
         w.still_since = t.snap.time_s
     if t.snap.time_s - w.still_since < TAB_WAIT_S:
         return stay(NO_MOTION)
     sfr, sfl = motion.pair(t.snap)
-    t.say(f"tab_length_to_edge[{i}] not measured: SFR/SFL read {sfr.distance_m:.3f}/"
-          f"{sfl.distance_m:.3f} m for {TAB_WAIT_S:g} s, not both a riser nor both nothing "
-          "ahead; going on (the descent of this step finds its edge by the back pair alone)")
+    t.say(say.tab_not_measured(i, sfr.distance_m, sfl.distance_m, TAB_WAIT_S))
     return None  # the phase goes on this tick
 
 
 CHECK = PhaseDef(
     P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, WaitWork,
     watches="front",
-    to={P.DESCENT_LOWER_THIRD: "reads ≥ LENGTH_OF_INFINITY (top reached) "
-                               "or number_of_steps = max_steps",
-        P.ASCENT_DRIVE_THIRD: "otherwise",
-        P.ERROR: FAULT})
+    on={"top_reached": Exit(P.DESCENT_LOWER_THIRD, "reads ≥ LENGTH_OF_INFINITY (top reached)"),
+        "step_limit": Exit(P.DESCENT_LOWER_THIRD, "number_of_steps = max_steps"),
+        "next_step": Exit(P.ASCENT_DRIVE_THIRD, "otherwise"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _driven_third(t: Tick, w: DriveWork) -> Step:
@@ -315,7 +312,7 @@ def _driven_third(t: Tick, w: DriveWork) -> Step:
         # where the last readings put the riser: ascent 2 starts from it if
         # the sensors cannot read that near
         t.ctx.riser_wheel = w.target_wheel + t.cfg.wheel_turns(w.target_reading)
-    return calibrate(Purpose.ASCENT)
+    return calibrate("reached", Purpose.ASCENT)
 
 
 DRIVE_THIRD = drive_phase(

@@ -20,7 +20,10 @@ from stairbot.control.algorithm.moves import (
     reading_drive,
 )
 from stairbot.control.algorithm.phase import (
+    ENDED,
+    FAILED,
     FAULT,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -31,12 +34,19 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.step_down import narrow_here, step_tab, step_tread
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import (
     EdgeWork,
 )
 
 P = Phase
 FLOW = "descent"
+
+ASKEW_TO_EDGE: dict[str, Exit] = {
+    "askew_to_edge": Exit(P.CAL_LIFT, "continuous descent: SBR and SBL read the drop more than "
+                                      "EDGE_SQUARE_RAD apart: lift to turn square to the edge")}
+"""The outcome of :func:`_turn_square` (segments 1 and 3 lift, to turn
+square to the edge), in both backings' records."""
 
 
 # -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
@@ -49,8 +59,8 @@ def _backed_off(t: Tick, w: EdgeWork) -> Step:
         # squared up to the edge by the back pair instead: the front pair
         # faces risers the robot did not climb, and one too low for its cone
         # reads as nothing ahead, which calibration takes for case 1
-        return go(P.DESCENT_BACK_TO_EDGE)
-    return calibrate(Purpose.DESCENT)
+        return go("backed_off_from_top")
+    return calibrate("backed_off", Purpose.DESCENT)
 
 
 def _back_off_enter(t: Tick, w: EdgeWork) -> None:
@@ -84,8 +94,7 @@ def _edge_or_tab(t: Tick, w: EdgeWork, refind: bool) -> float | None:
 
 def _narrow_tab_known(t: Tick, _w: EdgeWork) -> Step | None:
     if narrow_here(t) and step_tab(t) is None:
-        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured on "
-                    "a narrow step: the robot cannot be placed on a tread it does not fit on")
+        return fail(say.narrow_tab_unknown(t.descent_index))
     return None
 
 
@@ -107,15 +116,16 @@ BACK_OFF = PhaseDef(
     P.DESCENT_BACK_OFF, "descent 1 — back off to a safe position", FLOW,
     checked_first(_narrow_tab_known, _back_off_drive[1]), EdgeWork,
     enter=_back_off_enter, watches="front",
-    to={P.CAL_CHECK: "turns made, or backed edge_clearance_m past where SBR/SBL saw the "
-                     "edge; on a narrow step, reads tab_length_to_edge[i]: calibrate "
-                     "(case 2)",
-        P.DESCENT_BACK_TO_EDGE: "continuous descent: the same, not calibrating (the back "
-                                "pair squares up at the edge)",
-        P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
-                    "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
-        P.ERROR: "one back sensor reads the drop and the other not within "
-                 "MAX_EDGE_YAW_RAD; a narrow step's tab_length_to_edge unknown; " + FAULT})
+    on={"backed_off": Exit(P.CAL_CHECK, "turns made, or backed edge_clearance_m past where "
+                                        "SBR/SBL saw the edge; on a narrow step, reads "
+                                        "tab_length_to_edge[i]: calibrate (case 2)"),
+        "backed_off_from_top": Exit(P.DESCENT_BACK_TO_EDGE, "continuous descent: the same, "
+                                                            "not calibrating (the back pair "
+                                                            "squares up at the edge)"),
+        **ASKEW_TO_EDGE,
+        FAILED: Exit(P.ERROR, "one back sensor reads the drop and the other not within "
+                              "MAX_EDGE_YAW_RAD; a narrow step's tab_length_to_edge unknown; "
+                              + FAULT)})
 
 
 def edge_search_m(t: Tick) -> float:
@@ -176,18 +186,12 @@ def _at_edge(t: Tick, w: EdgeWork) -> Step:
     ctx = t.ctx
     searched = (w.entry_wheel - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
     if not ctx.from_top and ctx.descent.edge_wheel is None and _edge_by_watch(t):
-        return fail(f"descent 1: tab_length_to_edge[{t.descent_index}] was not measured, and "
-                    f"SBR/SBL saw no edge backing {searched:.2f} m (the tread measured, or "
-                    "LENGTH_OF_INFINITY): the edge of the step cannot be found")
+        return fail(say.edge_not_found(t.descent_index, searched))
     if not ctx.from_top or ctx.descent.edge_wheel is not None:
-        return go(P.DESCENT_LOWER_THIRD)
+        return go("at_edge")
     if ctx.steps_descended == 0:
-        return end(Outcome.STOPPED, f"no edge behind: SBR/SBL read the floor for {searched:.2f} m "
-                              f"backing from the start (at most LENGTH_OF_INFINITY = "
-                              f"{t.cfg.LENGTH_OF_INFINITY} m): not on the top of a flight")
-    return end(Outcome.COMPLETED, f"on the floor, or a landing: no edge within {searched:.2f} m "
-                            f"behind step {ctx.steps_descended} from the top, the last "
-                            "descended")
+        return end(Outcome.STOPPED, say.not_on_top(searched, t.cfg.LENGTH_OF_INFINITY))
+    return end(Outcome.COMPLETED, say.on_the_floor(searched, ctx.steps_descended))
 
 
 _to_edge = reading_drive(-1, step_tab, _edge_fallback, _at_edge,
@@ -214,23 +218,25 @@ def _turn_square(t: Tick, w: EdgeWork) -> Step:
     it again, finding the floor first (the pair is past the edge now)."""
     assert w.square_yaw is not None
     t.ctx.descent.edge_squared = True
-    return calibrate(Purpose.EDGE, motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw),
-                     f"turning {math.degrees(w.square_yaw):+.1f}° square to the edge")
+    return calibrate("askew_to_edge", Purpose.EDGE,
+                     motion.twist(t.snap) + motion.yaw_turns(t.cfg, w.square_yaw),
+                     say.turning_square_to_edge(w.square_yaw))
 
 
 BACK_TO_EDGE = PhaseDef(
     P.DESCENT_BACK_TO_EDGE, "descent 1 — back up to the edge", FLOW,
     _to_edge_step, EdgeWork, enter=_to_edge[0], watches="front",
-    to={P.DESCENT_LOWER_THIRD: "backed edge_clearance_m past where SBR/SBL crossed the "
-                                "edge (driving forward first until they read the floor, "
-                                "if they were past it unseen); or, not crossed yet, reads "
-                                "tab_length_to_edge[i]; on a narrow step, reads it (no "
-                                "edge watch)",
-        P.CAL_LIFT: "continuous descent: SBR and SBL read the drop more than "
-                    "EDGE_SQUARE_RAD apart: lift to turn square to the edge",
-        P.DONE: "continuous descent: no edge within the search (edge_search_m): on the "
-                "floor; or, from the start, not on the top of a flight; or the floor not "
-                "found again: the tread is shorter than the robot (stopped)",
-        P.ERROR: "tab_length_to_edge[i] unknown and no edge seen within the tread; the floor "
-                 "not found again; one back "
-                 "sensor reads the drop and the other not within MAX_EDGE_YAW_RAD; " + FAULT})
+    on={"at_edge": Exit(P.DESCENT_LOWER_THIRD, "backed edge_clearance_m past where SBR/SBL "
+                                               "crossed the edge (driving forward first until "
+                                               "they read the floor, if they were past it "
+                                               "unseen); or, not crossed yet, reads "
+                                               "tab_length_to_edge[i]; on a narrow step, reads "
+                                               "it (no edge watch)"),
+        **ASKEW_TO_EDGE,
+        ENDED: Exit(P.DONE, "continuous descent: no edge within the search (edge_search_m): on "
+                            "the floor; or, from the start, not on the top of a flight; or the "
+                            "floor not found again: the tread is shorter than the robot "
+                            "(stopped)"),
+        FAILED: Exit(P.ERROR, "tab_length_to_edge[i] unknown and no edge seen within the "
+                              "tread; the floor not found again; one back sensor reads the "
+                              "drop and the other not within MAX_EDGE_YAW_RAD; " + FAULT)})

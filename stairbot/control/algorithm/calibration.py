@@ -19,8 +19,11 @@ from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
 from stairbot.control.algorithm.moves import lift
 from stairbot.control.algorithm.phase import (
+    ENDED,
+    FAILED,
     FAULT,
     NO_MOTION,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -44,6 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork, StandingWork
 from stairbot.control.tolerances import still_samples, still_tolerance
 from stairbot.hardware import MotorId
@@ -54,12 +58,12 @@ FLOW = "calibration"
 def _after_calibration(t: Tick) -> Step:
     ctx = t.ctx
     if t.cal.purpose is Purpose.DESCENT:
-        return go(P.DESCENT_BACK_TO_EDGE)
+        return go("square_to_descend")
     if ctx.number_of_steps < len(ctx.climb_twist):
         # the heading this step is climbed with: descent 1 comes back to it
         ctx.climb_twist[ctx.number_of_steps] = motion.twist(t.snap)
     landing.after_calibration(t)
-    return go(P.ASCENT_APPROACH)
+    return go("square_to_climb")
 
 
 # -- check the readings --------------------------------------------------------------
@@ -79,10 +83,8 @@ def _check(t: Tick, w: StandingWork) -> Step:
             if abs(off) > HEADING_TOLERANCE_RAD:
                 cal.turn_to = climbed
                 ctx.descent.turned_back = True  # once a step: then the seed's check
-                t.say(f"descent 1, step {t.descent_index + 1}: turned {math.degrees(off):+.2f}° "
-                      "from the heading it climbed this step with (by the odometer); turning "
-                      "back to it", off_deg=math.degrees(off))
-                return go(P.CAL_LIFT)
+                t.say(say.off_climb_heading(t.descent_index, off), off_deg=math.degrees(off))
+                return go("off_climb_heading")
     # Standing still, the pair is averaged over STILL_TICKS before it is
     # called equal or not: one noisy reading must not choose the case; and
     # only once the filter has settled (a full window of measurements taken
@@ -99,24 +101,20 @@ def _check(t: Tick, w: StandingWork) -> Step:
         return _verify(t, w)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         if cal.purpose is not Purpose.START:
-            return fail(f"nothing ahead at {where(ctx, P.CAL_CHECK)}: SFR {sfr.distance_m:.3f} m, "
-                        f"SFL {sfl.distance_m:.3f} m where a riser should be")
+            return fail(say.nothing_ahead_where_riser(where(ctx, P.CAL_CHECK), sfr.distance_m,
+                                                      sfl.distance_m))
         cal.case = CalibrationCase.ONE
-        t.say("calibration case 1: nothing ahead (SFR and SFL read at least "
-              f"LENGTH_OF_INFINITY = {cfg.LENGTH_OF_INFINITY} m)", case="1")
-        return end(Outcome.STOPPED, "nothing ahead: SFR and SFL read at least LENGTH_OF_INFINITY")
+        t.say(say.case_one(cfg.LENGTH_OF_INFINITY), case="1")
+        return end(Outcome.STOPPED, say.CASE_ONE_END)
     if cal.purpose is Purpose.START:
         if ctx.start.home_wheel is None:
             ctx.start.home_wheel = motion.wheel_position(t.snap)
             ctx.start.home_twist = motion.twist(t.snap)
         near = _nearer(t)
         if near is not None and near > limits.square_range_m(cfg) + cfg.algorithm.equal_tolerance:
-            t.say(f"calibration (start): SFR {sfr.distance_m:.3f} m, SFL {sfl.distance_m:.3f} m: "
-                  f"farther than square_range_m ({limits.square_range_m(cfg):.3f} m), where the "
-                  "front cones see over the first riser or the pair's noise allows only a loose "
-                  "square; closing in before squaring up",
+            t.say(say.closing_in(sfr.distance_m, sfl.distance_m, limits.square_range_m(cfg)),
                   SFR=sfr.distance_m, SFL=sfl.distance_m)
-            return go(P.CAL_CLOSE_IN)
+            return go("too_far")
     diff = mean_diff(t, w)
     equal = abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)),
                                          min(sfr.distance_m, sfl.distance_m))
@@ -133,14 +131,10 @@ def _check(t: Tick, w: StandingWork) -> Step:
     cal.case = CalibrationCase.THREE if equal else (
         CalibrationCase.TWO_W if wall else CalibrationCase.TWO)
     cal.case_diff = diff
-    said = ("equal, case 3" if equal else
-            "too far apart for one riser within "
-            f"{math.degrees(MAX_SQUARE_YAW_RAD):.0f}°: the nearer sees a side wall, case 2W"
-            if wall else "not equal, case 2")
-    t.say(f"calibration ({where(ctx, P.CAL_CHECK)}): SFR {sfr.distance_m:.3f} m, "
-          f"SFL {sfl.distance_m:.3f} m: {said}",
+    t.say(say.case_chosen(where(ctx, P.CAL_CHECK), sfr.distance_m, sfl.distance_m, equal, wall,
+                          MAX_SQUARE_YAW_RAD),
           case=cal.case.value, SFR=sfr.distance_m, SFL=sfl.distance_m)
-    return go(P.CAL_LIFT)
+    return go("case_found")
 
 
 def _verify(t: Tick, w: StandingWork) -> Step:
@@ -156,30 +150,22 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     sfr, sfl = r.distance_m, l_.distance_m
     if motion.far(r, cfg) or motion.far(l_, cfg):
         # no figure to square to, nor a riser where it squared up: stop
-        return fail(f"calibration ({where(ctx, P.CAL_CHECK)}): squared up, but standing on "
-                    f"all wheels SFR reads {sfr:.3f} m and SFL {sfl:.3f} m: at least one sees "
-                    "nothing ahead where the riser should be")
+        return fail(say.nothing_ahead_squared(where(ctx, P.CAL_CHECK), sfr, sfl))
     diff = mean_diff(t, w)
     if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
-        t.say(f"square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
-              f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)",
-              SFR=sfr, SFL=sfl, diff=diff)
+        t.say(say.square_on_all_wheels(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)
         cal.squaring_turns = 0
         return _squared(t, w)
     if cal.squaring_turns >= MAX_SQUARING_TURNS:
-        return fail(f"calibration ({where(ctx, P.CAL_CHECK)}) cannot square up: after "
-                    f"{cal.squaring_turns} turns SFL − SFR still reads {diff * 1000:+.1f} mm "
-                    f"standing (SFR {sfr:.3f} m, SFL {sfl:.3f} m): the beams do not see one "
-                    "flat riser alike (a riser too low for them, or its edge)")
+        return fail(say.cannot_square(where(ctx, P.CAL_CHECK), cal.squaring_turns, diff, sfr, sfl))
     # SFL farther than SFR: turned left of square, turn right (and the other way).
     yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
     cal.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
     cal.squaring_turns += 1
-    t.say(f"not square on all wheels: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} "
-          f"readings standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m): turning "
-          f"{math.degrees(yaw):+.1f}° by the odometer", SFR=sfr, SFL=sfl, diff=diff)
-    return go(P.CAL_LIFT)
+    t.say(say.not_square_on_all_wheels(diff, len(w.diffs), sfr, sfl, yaw),
+          SFR=sfr, SFL=sfl, diff=diff)
+    return go("not_square")
 
 
 def _squared(t: Tick, w: StandingWork) -> Step:
@@ -193,16 +179,14 @@ def _squared(t: Tick, w: StandingWork) -> Step:
             start.reading = (trimmed_mean([r for r, _l in w.standing])
                              + trimmed_mean([l_ for _r, l_ in w.standing])) / 2.0
             start.wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {start.reading:.3f} m (their means "
-                  f"over {len(w.standing)} ticks standing still)",
+            t.say(say.start_position_standing(start.reading, len(w.standing)),
                   start_reading=start.reading)
         elif motion.measurable(t.snap, cfg):
             start.reading = motion.mean_distance(t.snap)
             start.wheel = motion.wheel_position(t.snap)
-            t.say(f"start position: SFR/SFL read {start.reading:.3f} m",
-                  start_reading=start.reading)
+            t.say(say.start_position(start.reading), start_reading=start.reading)
         if t.mode is Mode.CALIBRATE_ONLY:
-            return end(Outcome.COMPLETED, "calibrate-only: calibration done")
+            return end(Outcome.COMPLETED, say.CALIBRATE_ONLY_END)
     return _after_calibration(t)
 
 
@@ -215,18 +199,22 @@ def _nearer(t: Tick) -> float | None:
 CHECK = PhaseDef(
     P.CAL_CHECK, "calibration — check the readings (case 1?)", FLOW, _check, StandingWork,
     family=Calibration,
-    to={
-        P.DONE: "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead); calibrate-only: "
-                "squared up (checked)",
-        P.CAL_CLOSE_IN: "start: the nearer reads farther than square_range_m",
-        P.CAL_LIFT: "start: case 2 (SFR ≠ SFL), 2W (too far apart for one riser) or case 3 "
-                    "(SFR = SFL); later: SFR ≠ SFL; descent 1: turned from the heading the "
-                    "step was climbed with; a squaring turn checked and not square: correct it",
-        P.ASCENT_APPROACH: "ascent 1 on a later step: SFR = SFL; or squared up (checked)",
-        P.DESCENT_BACK_TO_EDGE: "descent 1: SFR = SFL; or squared up (checked)",
-        P.ERROR: "case 1: sensor error; later: nothing ahead where a riser should be; "
-                 "checking a squaring turn: nothing ahead, or still not square after "
-                 "MAX_SQUARING_TURNS turns",
+    on={
+        ENDED: Exit(P.DONE, "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead); "
+                            "calibrate-only: squared up (checked)"),
+        "too_far": Exit(P.CAL_CLOSE_IN, "start: the nearer reads farther than square_range_m"),
+        "case_found": Exit(P.CAL_LIFT, "start: case 2 (SFR ≠ SFL), 2W (too far apart for one "
+                                       "riser) or case 3 (SFR = SFL); later: SFR ≠ SFL"),
+        "off_climb_heading": Exit(P.CAL_LIFT, "descent 1: turned from the heading the step "
+                                              "was climbed with"),
+        "not_square": Exit(P.CAL_LIFT, "a squaring turn checked and not square: correct it"),
+        "square_to_climb": Exit(P.ASCENT_APPROACH, "ascent 1 on a later step: SFR = SFL; or "
+                                                   "squared up (checked)"),
+        "square_to_descend": Exit(P.DESCENT_BACK_TO_EDGE, "descent 1: SFR = SFL; or squared up "
+                                                          "(checked)"),
+        FAILED: Exit(P.ERROR, "case 1: sensor error; later: nothing ahead where a riser should "
+                              "be; checking a squaring turn: nothing ahead, or still not square "
+                              "after MAX_SQUARING_TURNS turns"),
     })
 
 
@@ -247,16 +235,16 @@ def _close_in(t: Tick, w: DriveWork) -> Step:
     remaining = w.target_wheel - motion.wheel_position(t.snap)
     square = limits.square_range_m(t.cfg)
     if remaining <= motion.WHEEL_DONE or (near is not None and near <= square):
-        return go(P.CAL_CHECK, f"closed in: SFR/SFL nearer reads "
-                               f"{'nothing' if near is None else f'{near:.3f} m'}")
+        return go("closed_in", say.closed_in(near))
     return stay(motion.drive(t.cfg, 1, remaining))
 
 
 CLOSE_IN = PhaseDef(
     P.CAL_CLOSE_IN, "calibration — close in to square_range_m (start)", FLOW, _close_in,
     DriveWork, enter=_close_in_enter, family=Calibration,
-    to={P.CAL_CHECK: "the nearer reads square_range_m, or the first reading's distance driven",
-        P.ERROR: FAULT})
+    on={"closed_in": Exit(P.CAL_CHECK, "the nearer reads square_range_m, or the first "
+                                       "reading's distance driven"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- lift segments 1 and 3 for clearance -----------------------------------------------
@@ -275,21 +263,22 @@ def _lifted(t: Tick, _w: LiftWork) -> Step:
         # MAX_TURN_YAW_RAD
         cal.turn_origin = t.snap.turns(MotorId.MWR)
     if cal.turn_to is not None:
-        return go(P.CAL_TURN_TO)
+        return go("to_heading")
     case = cal.case
-    return go(P.CAL_TURN if case is CalibrationCase.TWO
-              else P.CAL_AWAY if case is CalibrationCase.TWO_W else P.CAL_PROBE)
+    return go("case_2" if case is CalibrationCase.TWO
+              else "case_2w" if case is CalibrationCase.TWO_W else "case_3")
 
 
 _lift_enter, _lift_step = lift(_lift_deltas, _lifted)
 LIFT = PhaseDef(
     P.CAL_LIFT, "calibration — lift segments 1 and 3 for clearance", FLOW, _lift_step,
     LiftWork, enter=_lift_enter, carried_by=(2,), family=Calibration,
-    to={P.CAL_TURN: "lifted; case 2", P.CAL_AWAY: "lifted; case 2W",
-        P.CAL_PROBE: "lifted; case 3",
-        P.CAL_TURN_TO: "lifted; a correction of the squaring turn, or descent 1 or 7 "
-                       "turning back to a heading it had",
-        P.ERROR: FAULT})
+    on={"case_2": Exit(P.CAL_TURN, "lifted; case 2"),
+        "case_2w": Exit(P.CAL_AWAY, "lifted; case 2W"),
+        "case_3": Exit(P.CAL_PROBE, "lifted; case 3"),
+        "to_heading": Exit(P.CAL_TURN_TO, "lifted; a correction of the squaring turn, or "
+                                          "descent 1 or 7 turning back to a heading it had"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- lower segments 1 and 3 --------------------------------------------------------------
@@ -302,11 +291,11 @@ def _lowered(t: Tick, _w: LiftWork) -> Step:
     cal = t.cal
     cal.turn_to = None
     if cal.purpose is Purpose.HOME:
-        return go(P.DESCENT_FINISH_FLOOR)
+        return go("home")
     if cal.purpose is Purpose.FLOOR:
-        return go(P.DESCENT_FINISH)
+        return go("floor")
     if cal.purpose is Purpose.EDGE:
-        return go(P.DESCENT_BACK_TO_EDGE)
+        return go("edge")
     if cal.purpose in LANDING_PURPOSES:
         return landing.turned(t)
     # Check standing on all wheels, once the filter has settled there (the
@@ -315,20 +304,22 @@ def _lowered(t: Tick, _w: LiftWork) -> Step:
     # settling onto its wheels pitches the beams down for a moment, and a
     # cone then reads the floor (the reference robot took its start reading there,
     # 0.202 m for 0.327 m, and came home 0.125 m short).
-    return go(P.CAL_CHECK)
+    return go("lowered")
 
 
 _lower_enter, _lower_step = lift(_lower_deltas, _lowered)
 LOWER = PhaseDef(
     P.CAL_LOWER, "calibration — lower segments 1 and 3", FLOW, _lower_step, LiftWork,
     enter=_lower_enter, carried_by=(2,), family=Calibration,
-    to={P.DESCENT_FINISH_FLOOR: "lowered (descent 7, turned back to where the program began)",
-        P.DESCENT_FINISH: "lowered (descent 7, turned back to the floor's heading)",
-        P.DESCENT_BACK_TO_EDGE: "lowered (continuous descent, turned square to the edge)",
-        P.CAL_CHECK: "lowered: check standing on all wheels; after a landing's turn, "
-                     "calibrate on the next flight's first riser (or, turned back, on the "
-                     "wall ahead: descent 1)",
-        P.ERROR: FAULT})
+    on={"home": Exit(P.DESCENT_FINISH_FLOOR, "lowered (descent 7, turned back to where the "
+                                             "program began)"),
+        "floor": Exit(P.DESCENT_FINISH, "lowered (descent 7, turned back to the floor's "
+                                        "heading)"),
+        "edge": Exit(P.DESCENT_BACK_TO_EDGE, "lowered (continuous descent, turned square to "
+                                             "the edge)"),
+        "lowered": Exit(P.CAL_CHECK, "lowered: check standing on all wheels"),
+        **landing.TURNED,
+        FAILED: Exit(P.ERROR, FAULT)})
 
 PHASES: tuple[PhaseDef[Any], ...] = (CHECK, CLOSE_IN, LIFT, LOWER)
 """This module's phases; the turns' are in :mod:`~stairbot.control.algorithm.turns`."""

@@ -9,9 +9,10 @@ standing rule, then -- once, before a lift phase's first step -- the
 static-stability check (:mod:`~stairbot.control.algorithm.stability`), then the
 phase's step.
 Whichever decides returns a :class:`~stairbot.control.algorithm.phase.Step`; if it
-names a next phase, :meth:`Controller._apply` enters it — the one place a
-phase is entered, at most once a tick — after checking the change against
-:data:`~stairbot.control.algorithm.transitions.TRANSITIONS`, and tells it as an event.
+says what happened, :meth:`Controller._apply` looks the outcome up in
+:data:`~stairbot.control.algorithm.transitions.EXITS` and enters the phase it
+leads to — the one place a phase is entered, at most once a tick — and tells
+it as an event.
 The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 """
 
@@ -35,11 +36,7 @@ from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.control.algorithm.result import OUTCOMES, ControllerResult
-from stairbot.control.algorithm.transitions import (
-    TRANSITIONS,
-    TransitionError,
-    allowed,
-)
+from stairbot.control.algorithm.transitions import exit_of
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
 from stairbot.events import Event, EventKind, EventSink, discard
@@ -203,7 +200,7 @@ class Controller:
         if step is None:
             assert record.step is not None  # only DONE and ERROR have none
             step = record.step(t, ctx.work)
-        if step.next is not None:
+        if step.happened is not None:
             self._apply(step, snap)
             speeds = _zeros()
         else:
@@ -299,12 +296,13 @@ class Controller:
 
     # -- phase changes: the one place a phase is entered ----------------------------------
     def _apply(self, step: Step, snap: Snapshot) -> None:
-        """Enter ``step.next``; raises TransitionError when the table does not
-        allow the change (a bug in a phase)."""
-        nxt, src, ctx = step.next, self.phase, self._ctx
-        assert nxt is not None
-        if not allowed(src, nxt):
-            raise TransitionError(f"{src.value} -> {nxt.value} is not in the transition table")
+        """Enter the phase ``step.happened`` leads to from the present one;
+        raises TransitionError when the present phase does not list that
+        outcome (a bug in a phase)."""
+        src, ctx = self.phase, self._ctx
+        assert step.happened is not None
+        exit_ = exit_of(src, step.happened)
+        nxt = exit_.phase
         if nxt is Phase.ERROR:
             self._finish(Phase.ERROR, Outcome.ERROR, step.reason or "error", snap.time_s)
         elif nxt is Phase.DONE:
@@ -315,7 +313,7 @@ class Controller:
             ctx.pauses += 1
             self._emit(EventKind.PAUSE, step.reason or "paused", snap.time_s,
                        {"resume_phase": ctx.pause.resume_phase})
-            self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
+            self._enter(nxt, exit_.when, snap, fresh=False)
         elif src is Phase.PAUSED:
             assert ctx.pause is not None
             if ctx.phase_started_s is not None:
@@ -323,9 +321,9 @@ class Controller:
             ctx.pause = None
             self._emit(EventKind.RESUME, step.reason or "resumed", snap.time_s,
                        {"phase": nxt.value})
-            self._enter(nxt, TRANSITIONS[src][nxt], snap, fresh=False)
+            self._enter(nxt, exit_.when, snap, fresh=False)
         else:
-            self._enter(nxt, step.reason or TRANSITIONS[src][nxt], snap, begin=step.begin)
+            self._enter(nxt, step.reason or exit_.when, snap, begin=step.begin)
 
     def _enter(self, phase: Phase, why: str, snap: Snapshot, fresh: bool = True,
                begin: Family | None = None) -> None:

@@ -32,7 +32,10 @@ from stairbot.control.algorithm.moves import (
     lift_phase,
 )
 from stairbot.control.algorithm.phase import (
+    ENDED,
+    FAILED,
     FAULT,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -44,6 +47,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.step_down import height, narrow_here, step_tab, step_tread
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import (
     DriveWork,
     EdgeWork,
@@ -72,9 +76,7 @@ def _over_an_edge(t: Tick, _w: LowerThirdWork) -> Step | None:
     cfg = t.cfg
     reading = motion.mean_distance(t.snap, back=True)
     if reading <= cfg.BACK_CLEARANCE + floor_tolerance(cfg):
-        return fail(f"floor not found: SBR/SBL read {reading:.3f} m, at or below BACK_CLEARANCE "
-                    f"({cfg.BACK_CLEARANCE} m), before segment 3 was lowered (step "
-                    f"{t.descent_index + 1}): segment 3 is not over an edge")
+        return fail(say.not_over_an_edge(reading, cfg.BACK_CLEARANCE, t.descent_index))
     return None
 
 
@@ -82,7 +84,7 @@ def _refuse_because(t: Tick, why: str) -> Step:
     """Refuse the drop below (``why`` is said, and kept for the end)."""
     t.say(why)
     _lt(t).refused = why
-    return go(P.DESCENT_REFUSE, why)
+    return go("refused", why)
 
 
 def lowerable_m(cfg: RobotConfig, mtb: float) -> float:
@@ -105,17 +107,13 @@ def _deep_drop(t: Tick, w: LowerThirdWork) -> Step | None:
     if all(r.ok for r in backs):
         depth = min(r.distance_m for r in backs) - cfg.BACK_CLEARANCE
         if depth > most + floor_tolerance(cfg):
-            return _refuse_because(t, f"the drop below step {t.ctx.steps_descended + 1} from "
-                                   f"the top is {depth:.3f} m (SBR/SBL), deeper than segment "
-                                   f"3 can be lowered ({most:.3f} m): refused")
+            return _refuse_because(t, say.drop_too_deep(t.ctx.steps_descended, depth, most))
     elif all(r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
              for r in backs):
         reach = cfg.sensors.range(back=True)[1] - cfg.BACK_CLEARANCE
         if reach > most:
-            return _refuse_because(t, f"nothing within SBR/SBL's range below step "
-                                   f"{t.ctx.steps_descended + 1} from the top: the drop is "
-                                   f"deeper than {reach:.3f} m, more than segment 3 can be "
-                                   f"lowered ({most:.3f} m): refused")
+            return _refuse_because(t, say.nothing_in_range_below(t.ctx.steps_descended, reach,
+                                                                 most))
     return None
 
 
@@ -125,12 +123,8 @@ def _floor_not_found(t: Tick, reading: float) -> Step:
     continuous descent (the drop is deeper than the lift)."""
     cfg, ctx = t.cfg, t.ctx
     if ctx.from_top:
-        return _refuse_because(t, f"floor not found below step {ctx.steps_descended + 1} "
-                               f"from the top within MTB's stroke (-MAX_OF_VERTICAL_TURNS): "
-                               f"SBR/SBL read {reading:.3f} m: refused")
-    return fail(f"floor not found when descending step {t.descent_index + 1}: MTB reached "
-                f"-MAX_OF_VERTICAL_TURNS ({-cfg.MAX_OF_VERTICAL_TURNS:.0f}) and SBR/SBL "
-                f"still read {reading:.3f} m")
+        return _refuse_because(t, say.floor_beyond_stroke(ctx.steps_descended, reading))
+    return fail(say.floor_not_found(t.descent_index, cfg.MAX_OF_VERTICAL_TURNS, reading))
 
 
 def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
@@ -155,10 +149,10 @@ def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
         ctx.number_of_turns_for_step_height = _lt(t).return_mtb - t.snap.turns(MotorId.MTB)
         ctx.third_in_air = False  # on the step below
         ctx.descent.narrow_edge_wheel = None  # the next edge's, if narrow, is watched for
-        t.say(f"segment 3 on the step below: number_of_turns_for_step_height = "
-              f"{ctx.number_of_turns_for_step_height:.2f} ({where(ctx, P.DESCENT_LOWER_THIRD)})",
+        t.say(say.on_step_below(ctx.number_of_turns_for_step_height,
+                                where(ctx, P.DESCENT_LOWER_THIRD)),
               number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
-        return go(P.DESCENT_DRIVE_SECOND)
+        return go("on_step_below")
     assert w.target_mtb is not None
     limit = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)
     if limit is None:
@@ -176,13 +170,13 @@ LOWER_THIRD = PhaseDef(
     checked_first(lambda t, w: _over_an_edge(t, w) or _deep_drop(t, w), _lower_third),
     LowerThirdWork,
     enter=_lower_third_enter, watches="back", carried_by=(1, 2), family=LowerThird,
-    to={P.DESCENT_DRIVE_SECOND: "SBR/SBL read BACK_CLEARANCE: "
-                                "number_of_turns_for_step_height stored",
-        P.DESCENT_REFUSE: "continuous descent: SBR/SBL read a drop deeper than segment 3 "
-                          "can be lowered, or nothing in range; or the floor not found "
-                          "within MAX_OF_VERTICAL_TURNS",
-        P.ERROR: "reads ≤ BACK_CLEARANCE at the start, or floor not found "
-                 "within MAX_OF_VERTICAL_TURNS; " + FAULT})
+    on={"on_step_below": Exit(P.DESCENT_DRIVE_SECOND, "SBR/SBL read BACK_CLEARANCE: "
+                                                      "number_of_turns_for_step_height stored"),
+        "refused": Exit(P.DESCENT_REFUSE, "continuous descent: SBR/SBL read a drop deeper than "
+                                          "segment 3 can be lowered, or nothing in range; or "
+                                          "the floor not found within MAX_OF_VERTICAL_TURNS"),
+        FAILED: Exit(P.ERROR, "reads ≤ BACK_CLEARANCE at the start, or floor not found "
+                              "within MAX_OF_VERTICAL_TURNS; " + FAULT)})
 
 
 # -- descent 2, refused: segment 3 up again, and the robot back onto the step -------------------
@@ -205,17 +199,18 @@ def _refuse(t: Tick, w: RefuseWork) -> Step:
         w.target_wheel = here + cfg.wheel_turns(edge_clearance_m(cfg) + RETREAT_MARGIN_M)
     remaining = w.target_wheel - here
     if remaining <= motion.WHEEL_DONE:
-        why = _lt(t).refused or f"refused the drop below step {t.ctx.steps_descended + 1}"
-        return end(Outcome.STOPPED, f"{why}; segment 3 raised again, the robot back on the step")
+        why = _lt(t).refused or say.refused_drop(t.ctx.steps_descended)
+        return end(Outcome.STOPPED, say.back_on_the_step(why))
     return stay(motion.drive(cfg, 1, remaining))
 
 
 REFUSE = PhaseDef(
     P.DESCENT_REFUSE, "descent 2 — refused: raise segment 3, drive back onto the step", FLOW,
     _refuse, RefuseWork, enter=_refuse_enter, carried_by=(1, 2), family=LowerThird,
-    to={P.DONE: "segment 3 raised to where descent 2 began, and driven forward "
-                "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step (stopped)",
-        P.ERROR: FAULT})
+    on={ENDED: Exit(P.DONE, "segment 3 raised to where descent 2 began, and driven forward "
+                            "edge_clearance_m and RETREAT_MARGIN_M: the robot on the step "
+                            "(stopped)"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- descent 3-6: segment by segment off the step ----------------------------------------------
@@ -290,7 +285,7 @@ def _first_bound(t: Tick, w: EdgeWork) -> float | None:
 def _driven_first(t: Tick, _w: EdgeWork) -> Step:
     # on a narrow tread below, segment 3 has backed off its edge: in the air over the next
     t.ctx.third_in_air = narrow_here(t, t.descent_index - 1)
-    return go(P.DESCENT_LOWER_FIRST)
+    return go("reached")
 
 
 DRIVE_FIRST = drive_phase(
@@ -305,17 +300,16 @@ def _lowered_first(t: Tick, _w: LiftWork) -> Step:
     ctx = t.ctx
     ctx.steps_descended += 1
     if ctx.from_top:
-        t.say(f"step {ctx.steps_descended} from the top descended",
-              steps_descended=ctx.steps_descended)
-        return go(P.DESCENT_BACK_OFF)
-    t.say(f"step {ctx.number_of_steps - ctx.steps_descended + 1} descended "
-          f"({ctx.steps_descended} of {ctx.number_of_steps})", steps_descended=ctx.steps_descended)
+        t.say(say.descended_from_top(ctx.steps_descended), steps_descended=ctx.steps_descended)
+        return go("steps_remain")
+    t.say(say.step_descended(ctx.number_of_steps, ctx.steps_descended),
+          steps_descended=ctx.steps_descended)
     if landing.returns_here(t):
-        return go(P.LANDING_RETURN)
+        return go("back_to_turn")
     if ctx.steps_descended < ctx.number_of_steps:
-        return go(P.DESCENT_BACK_OFF)
+        return go("steps_remain")
     ctx.descent.turned_back = False  # descent 7 turns back to the floor's heading once
-    return go(P.DESCENT_FINISH)
+    return go("all_descended")
 
 
 _lower1 = lift(lambda t, _w: {MotorId.MTF: -height(t)}, _lowered_first)
@@ -323,10 +317,13 @@ LOWER_FIRST = PhaseDef(
     P.DESCENT_LOWER_FIRST, "descent 6 — lower segment 1", FLOW, _lower1[1], LiftWork,
     enter=_lower1[0],
     carried_by=(2, 3),
-    to={P.DESCENT_BACK_OFF: "turns made; steps remain (a continuous descent: always)",
-        P.LANDING_RETURN: "turns made; down the first step of the flight after a landing's "
-                          "turn: back to where it turned",
-        P.DESCENT_FINISH: "turns made; all number_of_steps descended", P.ERROR: FAULT})
+    on={"steps_remain": Exit(P.DESCENT_BACK_OFF, "turns made; steps remain (a continuous "
+                                                 "descent: always)"),
+        "back_to_turn": Exit(P.LANDING_RETURN, "turns made; down the first step of the flight "
+                                               "after a landing's turn: back to where it "
+                                               "turned"),
+        "all_descended": Exit(P.DESCENT_FINISH, "turns made; all number_of_steps descended"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 PHASES: tuple[PhaseDef[Any], ...] = (

@@ -18,6 +18,7 @@ import math
 from stairbot.control.algorithm import limits, motion
 from stairbot.control.algorithm.modes import Outcome
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import EdgeWork
 from stairbot.control.tolerances import measurement_period, median_sigma, window
 from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorId, SensorStatus
@@ -177,11 +178,7 @@ def square_to_edge(t: Tick, w: EdgeWork) -> str | None:
         most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
         if lag > most:
             other = SensorId.SBL if right else SensorId.SBR
-            return (f"descent 1: {first} reads the drop, {other} still the floor "
-                        f"after backing {lag * 1000:.0f} mm more (at most {most * 1000:.0f} mm: "
-                        f"{math.degrees(MAX_EDGE_YAW_RAD):.0f}° from square to the edge): "
-                        "turned too far from the edge, the edge not straight, or a back "
-                        "sensor reading wrong")
+            return say.edge_askew(first, other, lag, most, MAX_EDGE_YAW_RAD)
         return None
     if not ctx.from_top:
         return None
@@ -191,9 +188,7 @@ def square_to_edge(t: Tick, w: EdgeWork) -> str | None:
         if yaw > EDGE_SQUARE_RAD:
             # SBR first: its side is further back, the robot turned right: turn left
             w.square_yaw = yaw if w.edge_first is SensorId.SBR else -yaw
-            t.say(f"{w.edge_first} read the drop {lag * 1000:.0f} mm before the other: "
-                  f"{math.degrees(yaw):.1f}° from square to the edge; turning "
-                  f"{'left' if w.square_yaw > 0 else 'right'} to square up",
+            t.say(say.drop_read_first(w.edge_first, lag, yaw, w.square_yaw),
                   edge_yaw_deg=math.degrees(w.square_yaw))
     return None
 
@@ -243,15 +238,13 @@ def edge_bound(t: Tick, w: EdgeWork, refind: bool) -> float | None:
             if refind:
                 w.refind_from = motion.wheel_position(t.snap)
                 w.refind_floor = 0
-                t.say("SBR/SBL read past the edge, but they were not seen crossing it: "
-                      "driving forward until they read the floor again")
+                t.say(say.NOT_SEEN_CROSSING)
                 return None
             return motion.wheel_position(t.snap)  # the back-off ends here
         else:
             step.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
             more = max(0.0, edge_clearance_m(cfg) - sight)
-            t.say(f"SBR/SBL see the edge (read {motion.mean_distance(t.snap, back=True):.3f} m, "
-                  f"about {sight * 1000:.0f} mm past it): backing at most {more:.3f} m more")
+            t.say(say.sees_edge(motion.mean_distance(t.snap, back=True), sight, more))
     if step.edge_wheel is None:
         return None
     return step.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
@@ -328,19 +321,14 @@ def refind(t: Tick, w: EdgeWork) -> Step:
     w.refind_floor = 0 if sees_drop(t) else w.refind_floor + 1
     if w.refind_floor >= REFIND_TICKS and driven_m >= edge_sight_m(cfg, cfg.wheel_speed_m_s,
                                                                    t.ctx.from_top):
-        t.say(f"SBR/SBL read the floor again {driven_m * 1000:.0f} mm forward: backing up "
-              "to the edge")
+        t.say(say.floor_again(driven_m))
         w.refind_from = w.edge_blind_until = w.edge_first_wheel = w.edge_first = None
         w.edge_watch_s = w.edge_floor_s = t.snap.time_s
         return stay(NO_MOTION)
     most = refind_max_m(cfg)
     if driven_m >= most and t.ctx.from_top:
-        return end(Outcome.STOPPED, f"refused: SBR/SBL read past an edge from the start of step "
-                              f"{t.ctx.steps_descended + 1} from the top, and still after "
-                              f"driving {driven_m * 1000:.0f} mm forward: the tread is shorter "
-                              "than the robot")
+        return end(Outcome.STOPPED, say.tread_shorter_than_robot(t.ctx.steps_descended,
+                                                                 driven_m))
     if driven_m >= most:
-        return fail(f"descent 1: SBR/SBL still read past the edge after driving "
-                    f"{driven_m * 1000:.0f} mm forward to find the floor again (at most "
-                    f"{most * 1000:.0f} mm): the edge of the step cannot be found")
+        return fail(say.floor_not_refound(driven_m, most))
     return stay(motion.drive(cfg, 1, cfg.wheel_turns(most - driven_m)))

@@ -14,7 +14,10 @@ from stairbot.control.algorithm.moves import (
     turns_drive,
 )
 from stairbot.control.algorithm.phase import (
+    ENDED,
+    FAILED,
     FAULT,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -24,6 +27,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.squaring import HEADING_TOLERANCE_RAD, heading_off_rad
+from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import (
     DriveWork,
 )
@@ -71,10 +75,10 @@ def _at_start_position(t: Tick, _w: DriveWork) -> Step:
     back the distance."""
     home_twist = t.ctx.start.home_twist
     if _closed_in_turns(t) <= motion.WHEEL_DONE:
-        return end(Outcome.COMPLETED, "back at the start position")
+        return end(Outcome.COMPLETED, say.BACK_AT_START)
     if home_twist is None or abs(heading_off_rad(t, home_twist)) <= HEADING_TOLERANCE_RAD:
-        return go(P.DESCENT_FINISH_FLOOR)
-    return calibrate(Purpose.HOME, home_twist)
+        return go("closed_in")
+    return calibrate("off_start_heading", Purpose.HOME, home_twist)
 
 
 def _floor_heading(t: Tick, _w: DriveWork) -> Step | None:
@@ -93,9 +97,8 @@ def _floor_heading(t: Tick, _w: DriveWork) -> Step | None:
     off = heading_off_rad(t, floor)
     if abs(off) <= HEADING_TOLERANCE_RAD:
         return None
-    t.say(f"descent 7: turned {math.degrees(off):+.2f}° from the heading it crossed the floor "
-          "with (by the odometer); turning back to it", off_deg=math.degrees(off))
-    return calibrate(Purpose.FLOOR, floor)
+    t.say(say.off_floor_heading(off), off_deg=math.degrees(off))
+    return calibrate("off_floor_heading", Purpose.FLOOR, floor)
 
 
 _finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start.reading,
@@ -103,19 +106,23 @@ _finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.
 FINISH = PhaseDef(
     P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW,
     checked_first(_floor_heading, _finish[1]), DriveWork, enter=_finish[0], watches="front",
-    to={P.DONE: "reads the start reading (or turns made; with no step climbed: back by the "
-                "odometer to the start position)",
-        P.CAL_LIFT: "turned from the heading it crossed the floor with: lift to turn back to "
-                    "it; or, the first calibration closed in, turned from the heading the "
-                    "program began with: lift to turn back",
-        P.DESCENT_FINISH_FLOOR: "the first calibration closed in; turned within "
-                                "HEADING_TOLERANCE_RAD of the heading it began with",
-        P.ERROR: FAULT})
+    on={ENDED: Exit(P.DONE, "reads the start reading (or turns made; with no step climbed: "
+                            "back by the odometer to the start position)"),
+        "off_floor_heading": Exit(P.CAL_LIFT, "turned from the heading it crossed the floor "
+                                              "with: lift to turn back to it"),
+        "off_start_heading": Exit(P.CAL_LIFT, "the first calibration closed in, turned from "
+                                              "the heading the program began with: lift to "
+                                              "turn back"),
+        "closed_in": Exit(P.DESCENT_FINISH_FLOOR, "the first calibration closed in; turned "
+                                                  "within HEADING_TOLERANCE_RAD of the heading "
+                                                  "it began with"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 _floor = turns_drive(-1, _closed_in_turns,
-                     lambda _t, _w: end(Outcome.COMPLETED, "back where the program began"))
+                     lambda _t, _w: end(Outcome.COMPLETED, say.BACK_WHERE_BEGAN))
 FINISH_FLOOR = PhaseDef(
     P.DESCENT_FINISH_FLOOR, "descent 7 — finish: back the distance calibration closed in",
     FLOW, _floor[1], DriveWork, enter=_floor[0],
-    to={P.DONE: "turns made: where the program began", P.ERROR: FAULT})
+    on={ENDED: Exit(P.DONE, "turns made: where the program began"),
+        FAILED: Exit(P.ERROR, FAULT)})

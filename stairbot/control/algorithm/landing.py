@@ -41,7 +41,9 @@ from stairbot.control.algorithm.landing_scan import LEFT, RIGHT, SCAN
 from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.moves import lift, reading_drive
 from stairbot.control.algorithm.phase import (
+    FAILED,
     FAULT,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -49,6 +51,7 @@ from stairbot.control.algorithm.phase import (
     go,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import landing as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
@@ -117,36 +120,26 @@ def _decide(t: Tick, _w: LiftWork) -> Step:
     right, left = landing.right_m, landing.left_m
     opened = turn.open
     if not opened:
-        return _refuse(t, AscentEnd.LANDING_CLOSED,
-                       "landing: no next flight to either side (SSR "
-                       f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
-                       "3's whole stroke does not see over)")
+        return _refuse(t, AscentEnd.LANDING_CLOSED, say.no_next_flight(right, left))
     room = turn_room_m(cfg)
     depth = landing_depth(t)
     if depth is None:
-        return _refuse(t, AscentEnd.LANDING_TOO_SMALL,
-                       "landing: its depth was not measured (neither the tread past the "
-                       "last riser nor tab_length_to_edge read the wall ahead): no room to "
-                       "turn is known")
+        return _refuse(t, AscentEnd.LANDING_TOO_SMALL, say.DEPTH_NOT_MEASURED)
     turn.depth_m = depth
-    short = [f"{name} {_said(have)}" for name, have in
+    short = [(name, have) for name, have in
              (("right", right), ("left", left), ("depth/2", depth / 2.0))
              if have is None or have < room]
     if short:
         return _refuse(t, AscentEnd.LANDING_TOO_SMALL,
-                       f"landing too small to turn in: the robot's turning circle needs "
-                       f"{room:.3f} m from its centre on every side (radius "
-                       f"{turning_radius(cfg):.3f} m + {TURN_ROOM_MARGIN} m), it has "
-                       + ", ".join(short))
+                       say.too_small(room, turning_radius(cfg), TURN_ROOM_MARGIN, short))
+    assert right is not None and left is not None  # unmeasured, a side is short
     side = LEFT if LEFT in opened else RIGHT
     if len(opened) == 2:
         # both open: the lower first riser (the side seen over first)
         side = LEFT if (turn.rise_m[1] or 0.0) <= (turn.rise_m[0] or 0.0) else RIGHT
     landing.side = side
-    t.say(f"landing: the next flight is to the {'left' if side == LEFT else 'right'}; "
-          f"{depth:.3f} m deep, {right:.3f} m right and {left:.3f} m left of the centre: "
-          "centring to turn", side=side, depth=depth)
-    return go(P.LANDING_CENTRE)
+    t.say(say.next_flight(side == LEFT, depth, right, left), side=side, depth=depth)
+    return go("room_to_turn")
 
 
 def landing_depth(t: Tick) -> float | None:
@@ -167,24 +160,21 @@ def landing_depth(t: Tick) -> float | None:
     return min(seen) - DEPTH_MARGIN if seen else None
 
 
-def _said(d: float | None) -> str:
-    return "nothing in range" if d is None else f"{d:.3f} m"
-
-
 def _refuse(t: Tick, why: AscentEnd, message: str) -> Step:
     t.ctx.ascent_end = why
-    t.say(message + "; the ascent ends, the descent begins", ascent_end=why.value)
-    return go(P.DESCENT_BACK_OFF)
+    t.say(say.ascent_ends(message), ascent_end=why.value)
+    return go("refused")
 
 
 _scan_lower = lift(_lower_deltas, _decide)
 SCAN_LOWER = PhaseDef(
     P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
     _scan_lower[1], LiftWork, enter=_scan_lower[0], carried_by=(1, 2), family=LandingTurn,
-    to={P.LANDING_CENTRE: "lowered; a side seen over, and room to turn",
-        P.DESCENT_BACK_OFF: "lowered; no side seen over (landing_closed), or too little "
-                            "room to turn (landing_too_small): the descent begins",
-        P.ERROR: FAULT})
+    on={"room_to_turn": Exit(P.LANDING_CENTRE, "lowered; a side seen over, and room to turn"),
+        "refused": Exit(P.DESCENT_BACK_OFF, "lowered; no side seen over (landing_closed), or "
+                                            "too little room to turn (landing_too_small): the "
+                                            "descent begins"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- landing 2: centre, then turn --------------------------------------------------------------
@@ -206,18 +196,17 @@ def _centred(t: Tick, _w: DriveWork) -> Step:
     landing = t.ctx.landing
     landing.twist = motion.twist(t.snap)
     yaw = landing.side * math.pi / 2.0
-    return calibrate(Purpose.LANDING, landing.twist + motion.yaw_turns(t.cfg, yaw),
-                     f"centred on the landing: turning {math.degrees(yaw):+.0f}° towards the "
-                     "next flight")
+    return calibrate("centred", Purpose.LANDING, landing.twist + motion.yaw_turns(t.cfg, yaw),
+                     say.centred(yaw))
 
 
 _centre = reading_drive(-1, _centre_target, _centre_turns, _centred)
 CENTRE = PhaseDef(
     P.LANDING_CENTRE, "landing 2 — back to the landing's middle", FLOW, _centre[1],
     DriveWork, enter=_centre[0], watches="front", family=LandingTurn,
-    to={P.CAL_LIFT: "reads half the landing's depth less the front face's reach: lift "
-                    "to turn 90° towards the next flight",
-        P.ERROR: FAULT})
+    on={"centred": Exit(P.CAL_LIFT, "reads half the landing's depth less the front face's "
+                                    "reach: lift to turn 90° towards the next flight"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def turned(t: Tick) -> Step:
@@ -227,14 +216,22 @@ def turned(t: Tick) -> Step:
     ctx = t.ctx
     if t.cal.purpose is Purpose.LANDING:
         ctx.landing.step = ctx.number_of_steps
-        t.say(f"turned onto the next flight: its steps count on from {ctx.number_of_steps + 1}",
-              landing_step=ctx.landing.step)
-        return calibrate(Purpose.ASCENT)
+        t.say(say.onto_next_flight(ctx.number_of_steps), landing_step=ctx.landing.step)
+        return calibrate("onto_next_flight", Purpose.ASCENT)
     # descent 1 of the first flight's top step, as its back-off would begin it:
     # that step's edge not seen yet (the edge watch's mark is the last step's)
     ctx.descent.edge_wheel = None
     ctx.descent.turned_back = ctx.descent.edge_squared = False
-    return calibrate(Purpose.DESCENT)
+    return calibrate("back_to_first_flight", Purpose.DESCENT)
+
+
+TURNED: dict[str, Exit] = {
+    "onto_next_flight": Exit(P.CAL_CHECK, "lowered after a landing's turn: calibrate on the "
+                                          "next flight's first riser"),
+    "back_to_first_flight": Exit(P.CAL_CHECK, "lowered, turned back on a landing: calibrate on "
+                                              "the wall ahead (descent 1)"),
+}
+"""The outcomes of :func:`turned`, in calibration's lowering's record."""
 
 
 def after_calibration(t: Tick) -> None:
@@ -247,8 +244,7 @@ def after_calibration(t: Tick) -> None:
             or landing.riser_m is not None or not motion.measurable(t.snap, t.cfg):
         return
     landing.riser_m = motion.mean_distance(t.snap)
-    t.say(f"where it turned: SFR/SFL read {landing.riser_m:.3f} m to the next flight's "
-          "first riser", landing_riser_m=landing.riser_m)
+    t.say(say.where_turned(landing.riser_m), landing_riser_m=landing.riser_m)
 
 
 # -- landing 3: back to where it turned, turn back ------------------------------------------
@@ -292,18 +288,18 @@ def _return_turns(t: Tick) -> float:
 def _returned(t: Tick, _w: DriveWork) -> Step:
     twist = t.ctx.landing.twist
     assert twist is not None  # set before the turn
-    return calibrate(Purpose.LANDING_BACK, twist,
-                     "back where it turned: turning back to the first flight")
+    return calibrate("returned", Purpose.LANDING_BACK, twist,
+                     say.BACK_WHERE_TURNED)
 
 
 _return = reading_drive(-1, _return_target, _return_turns, _returned)
 RETURN = PhaseDef(
     P.LANDING_RETURN, "landing 3 — back to where it turned", FLOW, _return[1],
     DriveWork, enter=_return[0], watches="front",
-    to={P.CAL_LIFT: "reads where it turned (down the next flight's first step, or having "
-                    "refused it): lift to turn back to the heading it came up the first "
-                    "flight with",
-        P.ERROR: FAULT})
+    on={"returned": Exit(P.CAL_LIFT, "reads where it turned (down the next flight's first "
+                                     "step, or having refused it): lift to turn back to the "
+                                     "heading it came up the first flight with"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 PHASES: tuple[PhaseDef[Any], ...] = (SCAN, SCAN_LOWER, CENTRE, RETURN)

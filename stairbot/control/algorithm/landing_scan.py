@@ -9,8 +9,19 @@ import statistics
 from stairbot.control.algorithm import limits, motion
 from stairbot.control.algorithm.families import LandingTurn
 from stairbot.control.algorithm.moves import stood
-from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phase import (
+    FAILED,
+    FAULT,
+    NO_MOTION,
+    Exit,
+    PhaseDef,
+    Step,
+    Tick,
+    go,
+    stay,
+)
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import landing as say
 from stairbot.control.algorithm.work import ScanWork
 from stairbot.control.tolerances import side_settle_s
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
@@ -130,16 +141,16 @@ def _record(t: Tick, w: ScanWork) -> Step:
     turn.open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
     for i, sid in enumerate(SIDE_SENSORS):
         if opened[i]:
-            name = "right" if i == 0 else "left"
-            t.say(f"landing: {sid.value} sees over what it saw on the {name} "
-                  f"({bases[i]:.3f} m) with segment 3 lifted {seen_at[i]:.3f} m, and "
-                  f"standing at the top: the next flight", sensor=sid.value, base=bases[i])
-    return go(P.LANDING_SCAN_LOWER)
+            base = bases[i]
+            assert base is not None  # opened only on a side seen
+            t.say(say.side_sees_over(sid.value, i == 0, base, seen_at[i]),
+                  sensor=sid.value, base=base)
+    return go("scanned")
 
 
 SCAN = PhaseDef(
     P.LANDING_SCAN, "landing 1 — lift segment 3, looking sideways for the next flight", FLOW,
     _scan, ScanWork, enter=_scan_enter, carried_by=(1, 2), family=LandingTurn,
-    to={P.LANDING_SCAN_LOWER: "segment 3 at the top of its stroke (or both sides seen over), "
-                              "read standing there",
-        P.ERROR: FAULT})
+    on={"scanned": Exit(P.LANDING_SCAN_LOWER, "segment 3 at the top of its stroke (or both "
+                                              "sides seen over), read standing there"),
+        FAILED: Exit(P.ERROR, FAULT)})

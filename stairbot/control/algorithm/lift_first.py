@@ -8,15 +8,15 @@ share :class:`~stairbot.control.algorithm.families.LiftFirst`.
 
 from __future__ import annotations
 
-import math
 import statistics
 
 from stairbot.control.algorithm import landing, limits, long_tread, motion
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.modes import AscentEnd
 from stairbot.control.algorithm.moves import lift
-from stairbot.control.algorithm.phase import FAULT, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phase import FAILED, FAULT, Exit, PhaseDef, Step, Tick, go, stay
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import ascent as say
 from stairbot.control.algorithm.work import LiftWork, SightWork
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
@@ -65,35 +65,33 @@ def _lift_first(t: Tick, w: LiftWork) -> Step:
         sfr, sfl = (r.distance_m for r in motion.pair(t.snap))
         lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
         rise = lifted * cfg.motors.lift_travel_per_turn + cfg.sensors.front_height
-        t.say(f"segment 1 sees over step {ctx.number_of_steps + 1} after {lifted:.1f} MTF turns "
-              f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m", rise=rise)
+        t.say(say.sees_over(ctx.number_of_steps, lifted, rise, sfr, sfl), rise=rise)
         if rise >= limits.min_step_rise_m(cfg):
-            return go(P.ASCENT_LIFT_FIRST_MORE)
+            return go("sees_over")
         ctx.ascent_end = AscentEnd.OBSTACLE
-        t.say(f"step {ctx.number_of_steps + 1} is too low to climb: rise about {rise:.3f} m < "
-              f"{limits.min_step_rise_m(cfg):.3f} m (lifting on, the sensors could see past "
-              "the next riser); the ascent ends (obstacle)", ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "rise lower than the robot measures")
+        t.say(say.too_low_to_climb(ctx.number_of_steps, rise, limits.min_step_rise_m(cfg)),
+              ascent_end="obstacle")
+        return go("rise_too_low", say.RISE_TOO_LOW)
     assert w.target_mtf is not None
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
         ctx.ascent_end = AscentEnd.OBSTACLE
         _lf(t).wall_ahead = True
         allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
-        t.say(f"step {ctx.number_of_steps + 1} too high: the front sensors did not see over "
-              f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)",
-              ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE)
+        t.say(say.too_high(ctx.number_of_steps, allowed), ascent_end="obstacle")
+        return go("too_high")
     return stay({MotorId.MTF: speed})
 
 
 LIFT_FIRST = PhaseDef(
     P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, LiftWork,
     enter=_lift_first_enter, carried_by=(2, 3), family=LiftFirst,
-    to={P.ASCENT_LIFT_FIRST_MORE: "sees over the riser (reads ≥ gap + SIGHT_JUMP_M)",
-        P.ASCENT_LOWER_OBSTACLE: "MAX_OF_VERTICAL_TURNS − number_of_vertical_turns made: "
-                                 "step too high; or sees over a rise < min_step_rise_m",
-        P.ERROR: FAULT})
+    on={"sees_over": Exit(P.ASCENT_LIFT_FIRST_MORE, "sees over the riser (reads ≥ gap + "
+                                                    "SIGHT_JUMP_M)"),
+        "too_high": Exit(P.ASCENT_LOWER_OBSTACLE, "MAX_OF_VERTICAL_TURNS − "
+                                                  "number_of_vertical_turns made: step too high"),
+        "rise_too_low": Exit(P.ASCENT_LOWER_OBSTACLE, "sees over a rise < min_step_rise_m"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def narrow(cfg: RobotConfig, tread: float | None) -> bool:
@@ -109,16 +107,12 @@ def _lifted_first(t: Tick, w: SightWork) -> Step:
     # first sight over it the beam still grazes the step's own tread and
     # reads short.
     tread = _tread_measured(t, w)
-    ahead = "nothing ahead" if tread is None or tread == float("inf") \
-        else f"tread {tread:.3f} m"
-    t.say(f"step {ctx.number_of_steps + 1}: {ahead} (the reading less {_gap(t):.3f} m to the "
-          "riser)", tread=None if tread is None or tread == float("inf") else tread)
+    t.say(say.tread_ahead(ctx.number_of_steps, tread, _gap(t)),
+          tread=None if tread is None or tread == float("inf") else tread)
     if tread is not None and tread < need:
         ctx.ascent_end = AscentEnd.OBSTACLE
-        t.say(f"the tread of step {ctx.number_of_steps + 1} is too short: {tread:.3f} m < "
-              f"min_tread_m = {need:.3f} m; the ascent ends (obstacle)",
-              ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "tread shorter than min_tread_m")
+        t.say(say.tread_too_short(ctx.number_of_steps, tread, need), ascent_end="obstacle")
+        return go("tread_too_short", say.TREAD_TOO_SHORT)
     lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
     rise = (lifted - ctx.number_of_vertical_turns) * cfg.motors.lift_travel_per_turn \
         + cfg.sensors.front_height
@@ -127,24 +121,20 @@ def _lifted_first(t: Tick, w: SightWork) -> Step:
         # A cone looking up sees over the next riser (as high as this one, we
         # assume) this far away: the readings mix what lies beyond it.
         ctx.ascent_end = AscentEnd.OBSTACLE
-        t.say(f"step {ctx.number_of_steps + 1} is too low for its tread: rise about {rise:.3f} "
-              f"m < {cfg.min_rise_for(tread):.3f} m (the front cone's top, "
-              f"{math.degrees(cfg.front_cone_top_rad):.1f}° up, would see over the next riser "
-              f"{tread:.3f} m away); the ascent ends (obstacle)", ascent_end="obstacle")
-        return go(P.ASCENT_LOWER_OBSTACLE, "rise too low for the tread the front cone measures")
+        t.say(say.too_low_for_tread(ctx.number_of_steps, rise, cfg.min_rise_for(tread),
+                                    cfg.front_cone_top_rad, tread), ascent_end="obstacle")
+        return go("too_low_for_tread", say.TOO_LOW_FOR_TREAD)
     ctx.number_of_turns_for_step_height = lifted
     if ctx.number_of_steps < len(ctx.tread_length):
         ctx.tread_length[ctx.number_of_steps] = \
             None if tread is None or tread == float("inf") else tread
     if narrow(cfg, tread):
-        t.say(f"step {ctx.number_of_steps + 1} is narrow: tread {tread:.3f} m < "
-              f"LENGTH_OF_A_ROBOT + SAFE_LENGTH: segment 3 stays in the air over the step "
-              "below until segment 1 is on the next (narrow_steps)")
+        assert tread is not None  # narrow only on a measured tread
+        t.say(say.narrow_step(ctx.number_of_steps, tread))
     _measure_next_step(t, w)
-    t.say(f"number_of_turns_for_step_height = {ctx.number_of_turns_for_step_height:.2f} "
-          f"(step {ctx.number_of_steps + 1})",
+    t.say(say.step_height(ctx.number_of_turns_for_step_height, ctx.number_of_steps),
           number_of_turns_for_step_height=ctx.number_of_turns_for_step_height)
-    return go(P.ASCENT_DRIVE_FIRST)
+    return go("measured")
 
 
 def _held(t: Tick, w: SightWork, tread: float) -> bool:
@@ -157,16 +147,12 @@ def _held(t: Tick, w: SightWork, tread: float) -> bool:
     reading = tread + _gap(t)
     held, moved = long_tread.steady(t, w, reading)
     limit = long_tread.steady_m(t, reading)
-    lift_mm = t.ctx.number_of_vertical_turns * t.cfg.motors.lift_travel_per_turn * 1000
+    lift_m = t.ctx.number_of_vertical_turns * t.cfg.motors.lift_travel_per_turn
     if moved is None:
-        t.say(f"step {t.ctx.number_of_steps + 1}: too few readings past the riser over the "
-              f"last {lift_mm:.0f} mm of lift to tell whether they held")
+        t.say(say.too_few_readings(t.ctx.number_of_steps, lift_m))
     else:
-        t.say(f"step {t.ctx.number_of_steps + 1}: the front pair's readings of the riser "
-              f"{reading:.3f} m ahead moved {moved * 1000:.0f} mm as segment 1 rose "
-              f"{lift_mm:.0f} mm ({'within' if held else 'more than'} {limit * 1000:.0f} mm): "
-              + ("a wall, or a riser the whole cone sees" if held
-                 else "the cone sees over it"), tread_moved=moved)
+        t.say(say.readings_held(t.ctx.number_of_steps, reading, moved, lift_m, held, limit),
+              tread_moved=moved)
     return held
 
 
@@ -220,23 +206,25 @@ def _more_step(t: Tick, w: SightWork) -> Step:
 LIFT_FIRST_MORE = PhaseDef(
     P.ASCENT_LIFT_FIRST_MORE, "ascent 3 — lift segment 1: number_of_vertical_turns more", FLOW,
     _more_step, SightWork, enter=_more_enter, carried_by=(2, 3), family=LiftFirst,
-    to={P.ASCENT_DRIVE_FIRST: "turns made; reading − gap ≥ min_tread_m: "
-                              "number_of_turns_for_step_height stored",
-        P.ASCENT_LOWER_OBSTACLE: "turns made; reading − gap < min_tread_m: "
-                                 "tread too short; or a rise too low for the tread "
-                                 "(min_rise_for; past FAR_TREAD_M, only if the readings "
-                                 "grew as segment 1 rose)",
-        P.ERROR: FAULT})
+    on={"measured": Exit(P.ASCENT_DRIVE_FIRST, "turns made; reading − gap ≥ min_tread_m: "
+                                               "number_of_turns_for_step_height stored"),
+        "tread_too_short": Exit(P.ASCENT_LOWER_OBSTACLE, "turns made; reading − gap < "
+                                                         "min_tread_m: tread too short"),
+        "too_low_for_tread": Exit(P.ASCENT_LOWER_OBSTACLE, "turns made; a rise too low for the "
+                                                           "tread (min_rise_for; past "
+                                                           "FAR_TREAD_M, only if the readings "
+                                                           "grew as segment 1 rose)"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _lowered_obstacle(t: Tick, _w: LiftWork) -> Step:
     if landing.can_scan(t, _lf(t).wall_ahead):
         # a wall ahead at the top of a flight may be a landing's: look sideways first
-        return go(P.LANDING_SCAN)
+        return go("wall_at_top")
     if landing.turned_here(t):
         # the next flight's first step refused: back where it turned, and turn back
-        return go(P.LANDING_RETURN)
-    return go(P.DESCENT_BACK_OFF if t.ctx.number_of_steps > 0 else P.DESCENT_FINISH)
+        return go("refused_after_turn")
+    return go("steps_climbed" if t.ctx.number_of_steps > 0 else "no_step_climbed")
 
 
 _obstacle_enter, _obstacle_step = lift(
@@ -244,12 +232,14 @@ _obstacle_enter, _obstacle_step = lift(
 LOWER_OBSTACLE = PhaseDef(
     P.ASCENT_LOWER_OBSTACLE, "ascent 3 — step too high: lower segment 1", FLOW, _obstacle_step,
     LiftWork, enter=_obstacle_enter, carried_by=(2, 3), family=LiftFirst,
-    to={P.DESCENT_BACK_OFF: "lowered; number_of_steps > 0",
-        P.LANDING_SCAN: "lowered; number_of_steps > 0, [algorithm] landings and no landing "
-                        "scanned yet: look sideways for the next flight",
-        P.LANDING_RETURN: "lowered; the first step after a landing's turn: back to where it "
-                          "turned",
-        P.DESCENT_FINISH: "lowered; number_of_steps = 0", P.ERROR: FAULT})
+    on={"steps_climbed": Exit(P.DESCENT_BACK_OFF, "lowered; number_of_steps > 0"),
+        "wall_at_top": Exit(P.LANDING_SCAN, "lowered; number_of_steps > 0, [algorithm] "
+                                            "landings and no landing scanned yet: look "
+                                            "sideways for the next flight"),
+        "refused_after_turn": Exit(P.LANDING_RETURN, "lowered; the first step after a "
+                                                     "landing's turn: back to where it turned"),
+        "no_step_climbed": Exit(P.DESCENT_FINISH, "lowered; number_of_steps = 0"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _measure_next_step(t: Tick, w: SightWork) -> None:
@@ -262,13 +252,10 @@ def _measure_next_step(t: Tick, w: SightWork) -> None:
     if motion.measurable(t.snap, t.cfg) and None not in medians:
         ctx.length_of_next_step = sum(m for m in medians if m is not None) / 2.0
         far = long_tread.far(ctx.length_of_next_step)
-        t.say(f"length_of_next_step = {ctx.length_of_next_step:.3f} m"
-              + (f" (past FAR_TREAD_M = {long_tread.FAR_TREAD_M} m: the drives onto the step "
-                 "go by turns)" if far else ""),
+        t.say(say.length_of_next_step(ctx.length_of_next_step, far, long_tread.FAR_TREAD_M),
               length_of_next_step=ctx.length_of_next_step)
         return
     ctx.length_of_next_step = None
-    t.say("length_of_next_step not measurable (nothing ahead within LENGTH_OF_INFINITY): "
-          "driving NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE turns", length_of_next_step=None)
+    t.say(say.LENGTH_NOT_MEASURABLE, length_of_next_step=None)
 
 

@@ -2,10 +2,11 @@
 reading (with the seed's turn-count fallback), and lifts to counter targets.
 
 Each builder returns the (enter, step) pair of a :class:`PhaseDef`; ``done``
-chooses the :class:`Step` that ends the phase (usually ``go(next)``).
-:func:`drive_phase` and :func:`lift_phase` build the whole record of the
-plainest ones, which end by going on to one next phase (the ascent's and
-descent's mirrored drives and lifts of segments 1 and 2).
+chooses the :class:`Step` that ends the phase (what happened: usually
+``go("reached")``).  :func:`drive_phase` and :func:`lift_phase` build the
+whole record of the plainest ones, which end on one outcome, "reached" and
+"turns_made", leading to one next phase (the ascent's and descent's mirrored
+drives and lifts of segments 1 and 2).
 """
 
 from __future__ import annotations
@@ -15,7 +16,19 @@ from collections.abc import Callable
 from typing import Protocol, TypeVar
 
 from stairbot.control.algorithm import motion
-from stairbot.control.algorithm.phase import FAULT, NO_MOTION, Phase, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.phase import (
+    FAILED,
+    FAULT,
+    NO_MOTION,
+    Exit,
+    Phase,
+    PhaseDef,
+    Step,
+    Tick,
+    go,
+    stay,
+)
+from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork, Work
 from stairbot.control.tolerances import median_sigma
 from stairbot.hardware import MotorId
@@ -88,9 +101,7 @@ def reading_drive(
                 # edge, or onto a side wall): the wheels carry on to the last
                 # target the readings gave.
                 w.reading_lost = True
-                t.say(f"SFR/SFL jumped {jump * 1000:+.0f} mm from what the wheels explain "
-                      f"(reading {reading:.3f} m): the rest of the drive goes by turns",
-                      jump=jump)
+                t.say(say.reading_jumped(jump, reading), jump=jump)
             else:
                 # The target from the median of the last KEY_TICKS keys, not
                 # from this tick's reading alone: two stray HC-SR04
@@ -184,22 +195,23 @@ def drive_phase(phase: Phase, label: str, flow: str, direction: int,
                 done: Done[D] | None = None,
                 bound: Callable[[Tick, D], float | None] | None = None, *,
                 work: type[D]) -> PhaseDef[D]:
-    """A :func:`reading_drive` phase that goes on to ``then`` when it ``reaches``
-    its target (``done``, if given, records what the end tells first, and
-    returns the Step to ``then``; ``bound`` as the drive's); the front pair is
-    watched; ``work``: the phase's work (a DriveWork)."""
+    """A :func:`reading_drive` phase whose outcome "reached" (it ``reaches``
+    its target) leads to ``then`` (``done``, if given, records what the end
+    tells first, and returns that Step; ``bound`` as the drive's); the front
+    pair is watched; ``work``: the phase's work (a DriveWork)."""
     enter, step = reading_drive(direction, target, fallback_turns,
-                                done or (lambda _t, _w: go(then)), bound)
+                                done or (lambda _t, _w: go("reached")), bound)
     return PhaseDef(phase, label, flow, step, work, enter=enter, watches="front",
-                    to={then: reaches, Phase.ERROR: FAULT})
+                    on={"reached": Exit(then, reaches), FAILED: Exit(Phase.ERROR, FAULT)})
 
 
 def lift_phase(phase: Phase, label: str, flow: str,
                deltas: Callable[[Tick, LiftWork], dict[MotorId, float]], then: Phase,
                carried_by: tuple[int, ...]) -> PhaseDef[LiftWork]:
-    """A :func:`lift` phase that goes on to ``then`` when the turns are made,
-    the robot carried by the wheels of the segments ``carried_by``; the front
-    pair is watched."""
-    enter, step = lift(deltas, lambda _t, _w: go(then))
+    """A :func:`lift` phase whose outcome "turns_made" leads to ``then``, the
+    robot carried by the wheels of the segments ``carried_by``; the front pair
+    is watched."""
+    enter, step = lift(deltas, lambda _t, _w: go("turns_made"))
     return PhaseDef(phase, label, flow, step, LiftWork, enter=enter, watches="front",
-                    carried_by=carried_by, to={then: "turns made", Phase.ERROR: FAULT})
+                    carried_by=carried_by,
+                    on={"turns_made": Exit(then, "turns made"), FAILED: Exit(Phase.ERROR, FAULT)})

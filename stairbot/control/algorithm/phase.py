@@ -2,17 +2,19 @@
 returns (:class:`Step`).
 
 A phase is one record: its seed name, its flow, its entry action, its step and
-its transitions (the next phases it may return, each with the condition that
-makes it).  The transition table and the flowcharts are drawn from these
-records (:mod:`stairbot.control.algorithm.transitions`).
+its outcomes (what its step may say happened, each with the :class:`Exit` it
+leads to: the next phase and the condition, in words).  The transition table
+and the flowcharts are drawn from these records
+(:mod:`stairbot.control.algorithm.transitions`).
 
 A step is a function of (the tick's readings and context, the phase's work)
 that returns a :class:`Step`: the motor speeds to command and, when the phase
-is over, which phase comes next.  Only the controller enters a phase, once per
-tick at most, in one place.  A step may update the seed's variables and
-the run's progress in the context (``number_of_steps``,
-``tab_length_to_edge``...), its family's state and its own work; nothing
-else.
+is over, what happened (an outcome its record lists).  The step never names
+the next phase: the controller looks the outcome up in the table and enters
+the phase it leads to, once per tick at most, in one place.  A step may
+update the seed's variables and the run's progress in the context
+(``number_of_steps``, ``tab_length_to_edge``...), its family's state and its
+own work; nothing else.
 """
 
 from __future__ import annotations
@@ -40,19 +42,36 @@ NO_MOTION: Speeds = MappingProxyType({})
 """A step that commands nothing: every motor stops (lifts hold)."""
 
 
+FAILED = "failed"
+"""The outcome of :func:`fail`: every record lists it (faults end anywhere)."""
+ENDED = "ended"
+"""The outcome of :func:`end`, in the records of the phases that may end the
+program."""
+
+
+@dataclass(frozen=True, slots=True)
+class Exit:
+    """Where an outcome of a phase leads: the next phase, and ``when``, the
+    condition in words (the flowcharts' edge label, the transition's "why")."""
+
+    phase: Phase
+    when: str
+
+
 @dataclass(frozen=True, slots=True)
 class Step:
     """What one tick of a phase decides.
 
-    ``next`` is None while the phase goes on.  Entering ERROR or DONE ends the
-    program: ``reason`` says why, and ``outcome`` (COMPLETED or STOPPED)
-    what DONE means.  For any other phase ``reason`` overrides the table's
-    condition in the event that tells the transition.  ``begin``: the state
-    the next phase's family begins with (see
-    :mod:`~stairbot.control.algorithm.families`)."""
+    ``happened`` is None while the phase goes on; else the outcome that ends
+    it, which the phase's record maps to the next phase (:class:`Exit`).
+    Ending in ERROR or DONE ends the program: ``reason`` says why, and
+    ``outcome`` (COMPLETED or STOPPED) what DONE means.  For any other
+    phase ``reason`` overrides the exit's condition in the event that tells
+    the transition.  ``begin``: the state the next phase's family begins
+    with (see :mod:`~stairbot.control.algorithm.families`)."""
 
     speeds: Speeds = field(default_factory=lambda: NO_MOTION)
-    next: Phase | None = None
+    happened: str | None = None
     reason: str | None = None
     outcome: Outcome | None = None
     begin: Family | None = None
@@ -63,28 +82,29 @@ def stay(speeds: Speeds) -> Step:
     return Step(speeds)
 
 
-def go(phase: Phase, reason: str | None = None, begin: Family | None = None) -> Step:
-    """End this phase (every motor stops for this tick) and enter ``phase``
-    (its family beginning with ``begin``, if given)."""
-    return Step(NO_MOTION, phase, reason, begin=begin)
+def go(happened: str, reason: str | None = None, begin: Family | None = None) -> Step:
+    """End this phase on the outcome ``happened`` (every motor stops for this
+    tick); the next phase's family begins with ``begin``, if given."""
+    return Step(NO_MOTION, happened, reason, begin=begin)
 
 
-def calibrate(purpose: Purpose, turn_to: float | None = None,
+def calibrate(happened: str, purpose: Purpose, turn_to: float | None = None,
               reason: str | None = None) -> Step:
-    """Enter calibration for ``purpose``: its check, or, to turn to the
-    heading ``turn_to``, its lift."""
-    phase = Phase.CAL_CHECK if turn_to is None else Phase.CAL_LIFT
-    return go(phase, reason, Calibration(purpose, turn_to))
+    """End this phase on ``happened``, whose exit is calibration for
+    ``purpose``: its check (CAL_CHECK), or, to turn to the heading
+    ``turn_to``, its lift (CAL_LIFT)."""
+    return go(happened, reason, Calibration(purpose, turn_to))
 
 
 def fail(reason: str) -> Step:
-    """End the program with an error."""
-    return Step(NO_MOTION, Phase.ERROR, reason)
+    """End the program with an error (the outcome :data:`FAILED`)."""
+    return Step(NO_MOTION, FAILED, reason)
 
 
 def end(outcome: Outcome, reason: str) -> Step:
-    """End the program with ``outcome`` (COMPLETED or STOPPED)."""
-    return Step(NO_MOTION, Phase.DONE, reason, outcome)
+    """End the program with ``outcome`` (COMPLETED or STOPPED; the phase's
+    outcome :data:`ENDED`)."""
+    return Step(NO_MOTION, ENDED, reason, outcome)
 
 
 Say = Callable[..., None]
@@ -131,18 +151,20 @@ class PhaseDef(Generic[W]):
     that enters it: ``Step.begin``).  ``watches`` names the sensor pair the
     standing rule watches in this phase ("front" or "back"; None: not armed);
     an armed phase may be paused, and is resumed from the pause, without
-    saying so in ``to``.  ``carried_by`` names the segments (1, 2, 3) whose
+    saying so in ``on``.  ``carried_by`` names the segments (1, 2, 3) whose
     wheels carry the robot while the phase moves its lifts: the
     static-stability check runs before its first step
     (:mod:`stairbot.control.algorithm.stability`), and its error is added to
-    the edge to ERROR, also without saying so in ``to``; empty: no lift moves."""
+    the condition of :data:`FAILED`, also without saying so in ``on``; empty:
+    no lift moves.  ``on``: outcome -> :class:`Exit`, every outcome the step
+    may return."""
 
     phase: Phase
     label: str
     flow: str
     step: Callable[[Tick, W], Step] | None
     work: type[W]
-    to: Mapping[Phase, str] = field(default_factory=dict)
+    on: Mapping[str, Exit] = field(default_factory=dict)
     enter: Callable[[Tick, W], None] = _no_entry
     watches: str | None = None
     carried_by: tuple[int, ...] = ()

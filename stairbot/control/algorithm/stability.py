@@ -31,12 +31,11 @@ from itertools import combinations
 from typing import Any
 
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail
+from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import LiftWork, Work
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 
-UNSTABLE = "unstable lift"
-"""How the reason of a refused lift begins (as "sensor error", "motor fault")."""
 UNSTABLE_EDGE = "the lift would put the centre of mass outside the carrying wheels"
 """The condition on a lift phase's edge to the error, in the flowcharts."""
 
@@ -163,13 +162,5 @@ def before_lift(t: Tick, record: PhaseDef[Any], w: Work) -> Step | None:
     need = cfg.safety.stability_margin
     if b.margin >= need:
         return None
-    who = " and ".join(str(i) for i in carried)
-    plural = "s" if len(carried) > 1 else ""
-    side = "outside" if b.margin < 0 else "inside"
-    return fail(
-        f"{UNSTABLE}: {record.label} would leave the centre of mass {abs(b.margin) * 1000:.1f} mm "
-        f"{side} the wheels that carry the robot (segment{plural} {who}: {b.rear_x * 1000:+.1f} "
-        f"to {b.front_x * 1000:+.1f} mm about segment 2's centre, the centre of mass at "
-        f"{b.centre_x * 1000:+.1f} mm, pitch {pitch:+.1f}°), less than [safety] "
-        f"stability_margin {need * 1000:g} mm: refused before moving, every motor stopped, "
-        "lifts holding")
+    return fail(say.unstable_lift(record.label, b.margin, carried, b.rear_x, b.front_x,
+                                  b.centre_x, pitch, need))

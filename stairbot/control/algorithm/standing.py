@@ -23,8 +23,20 @@ import statistics
 from typing import Any
 
 from stairbot.control.algorithm import long_tread, motion
-from stairbot.control.algorithm.phase import FAULT, NO_MOTION, PhaseDef, Step, Tick, fail, go, stay
+from stairbot.control.algorithm.phase import (
+    FAILED,
+    FAULT,
+    NO_MOTION,
+    Exit,
+    PhaseDef,
+    Step,
+    Tick,
+    fail,
+    go,
+    stay,
+)
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import Work
 from stairbot.control.tolerances import standing_tolerance
 
@@ -35,18 +47,26 @@ None), the front pair's rule is not armed.  It is in ascent 7, where the pair
 reads the tab: unarmed there, one sensor reading short would go unseen, the
 tab would be stored short, and descent 1 would stop segment 3 short of the
 edge."""
+DISAGREE = "disagree"
+"""The outcome of :func:`watch`: the pause, which the transition table adds to
+every armed phase."""
+
+
+def resumed(phase: Phase) -> str:
+    """The PAUSED phase's outcome that resumes ``phase`` (the table adds one
+    for every armed phase)."""
+    return f"resume_{phase.value}"
+
+
 DEBOUNCE_TICKS = 3
 """Ticks in a row a disagreement must last before the robot stops (and, after
 the wait, before the program ends with an error)."""
 
 
-def _pair_name(back: bool) -> str:
-    return "SBR/SBL" if back else "SFR/SFL"
-
-
-def _readings(t: Tick, back: bool) -> str:
+def _readings(t: Tick, back: bool) -> tuple[float, float]:
+    """The watched pair's readings (right, left), as the standing rule says them."""
     r, left = motion.pair(t.snap, back)
-    return f"{r.distance_m:.3f} m / {left.distance_m:.3f} m"
+    return r.distance_m, left.distance_m
 
 
 def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
@@ -96,10 +116,8 @@ def watch(t: Tick, phase: PhaseDef[Any]) -> Step | None:
     ctx.watch.ticks += 1
     if ctx.watch.ticks < DEBOUNCE_TICKS:
         return None
-    return go(Phase.PAUSED,
-              f"standing rule: {_pair_name(back)} disagree ({_readings(t, back)}) in "
-              f"{phase.label}: all motors stopped, measuring again in "
-              f"{t.cfg.algorithm.standing_wait:g} s")
+    return go(DISAGREE, say.disagree(back, _readings(t, back), phase.label,
+                                     t.cfg.algorithm.standing_wait))
 
 
 MEDIAN_S = 1.0
@@ -134,20 +152,18 @@ def _paused(t: Tick, _w: Work) -> Step:
             t.cfg, near, motion.DIFF_SMOOTHING, back)
     if not disagree:
         ctx.watch.ticks = 0
-        return go(resume.phase, f"standing rule: {_pair_name(back)} agree again "
-                                f"({_readings(t, back)}): resuming {resume.label}")
+        return go(resumed(resume.phase), say.agree_again(back, _readings(t, back), resume.label))
     ctx.watch.ticks += 1
     if ctx.watch.ticks >= DEBOUNCE_TICKS:
-        return fail(f"standing rule: {_pair_name(back)} still disagree after "
-                    f"{t.cfg.algorithm.standing_wait:g} s ({_readings(t, back)}) in "
-                    f"{resume.label}")
+        return fail(say.still_disagree(back, t.cfg.algorithm.standing_wait, _readings(t, back),
+                                       resume.label))
     return stay(NO_MOTION)
 
 
 PAUSED = PhaseDef(
     Phase.PAUSED, "standing rule — readings disagree: stopped, waiting", "end", _paused, Work,
     # the resumes, back to every armed phase, are added by the transition table
-    to={Phase.ERROR: "readings still disagree after standing_wait; " + FAULT})
+    on={FAILED: Exit(Phase.ERROR, "readings still disagree after standing_wait; " + FAULT)})
 
 DONE = PhaseDef(Phase.DONE, "end — program finished", "end", None, Work)
 ERROR = PhaseDef(Phase.ERROR, "end — program ended with an error", "end", None, Work)

@@ -1,8 +1,11 @@
 """The transition table: every phase change the controller may make, with the
-condition that makes it, drawn from the phases' records (each record's ``to``;
-an armed phase's pause and the resume back into it).  The controller refuses
-any change not listed here, and the flowcharts in docs/algorithm.md are drawn
-from it (``python -m stairbot.control.algorithm.transitions``).
+condition that makes it, drawn from the phases' records: each record's
+outcomes (``on``: outcome -> next phase and condition), an armed phase's
+pause (:data:`~stairbot.control.algorithm.standing.DISAGREE`) and the resume
+back into it.  The controller looks each outcome a step returns up here
+(:func:`exit_of`) and refuses one its phase does not list; the flowcharts in
+docs/algorithm.md are drawn from it
+(``python -m stairbot.control.algorithm.transitions``).
 """
 
 from __future__ import annotations
@@ -10,44 +13,62 @@ from __future__ import annotations
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from stairbot.control.algorithm.phase import BACK_DISAGREE, FRONT_DISAGREE
+from stairbot.control.algorithm.phase import BACK_DISAGREE, FAILED, FRONT_DISAGREE, Exit
 from stairbot.control.algorithm.phases import FLOWS, Phase
 from stairbot.control.algorithm.stability import UNSTABLE_EDGE
+from stairbot.control.algorithm.standing import DISAGREE, resumed
 from stairbot.control.algorithm.table import PHASES
 
 P = Phase
 
 
 class TransitionError(RuntimeError):
-    """The controller tried a phase change the table does not list: a bug."""
+    """A step returned an outcome its phase does not list: a bug."""
 
 
-def _table() -> dict[Phase, dict[Phase, str]]:
-    """Every record's transitions; an armed phase also pauses (before its
+def _table() -> dict[Phase, dict[str, Exit]]:
+    """Every record's outcomes; an armed phase also pauses (before its
     error, as the flowcharts read), and the pause resumes into it; a lift
     phase's error names the stability check first."""
-    table: dict[Phase, dict[Phase, str]] = {}
-    resumes: dict[Phase, str] = {}
+    table: dict[Phase, dict[str, Exit]] = {}
+    resumes: dict[str, Exit] = {}
     for phase, record in PHASES.items():
-        nexts = dict(record.to)
+        exits = dict(record.on)
         if record.carried_by:
-            nexts[P.ERROR] = f"{UNSTABLE_EDGE}; {nexts[P.ERROR]}"
+            failed = exits[FAILED]
+            exits[FAILED] = Exit(failed.phase, f"{UNSTABLE_EDGE}; {failed.when}")
         if record.watches is not None:
-            error = nexts.pop(P.ERROR, None)
-            nexts[P.PAUSED] = BACK_DISAGREE if record.watches == "back" else FRONT_DISAGREE
+            error = exits.pop(FAILED, None)
+            exits[DISAGREE] = Exit(P.PAUSED, BACK_DISAGREE if record.watches == "back"
+                                   else FRONT_DISAGREE)
             if error is not None:
-                nexts[P.ERROR] = error
-            resumes[phase] = "readings agree after standing_wait: resume"
-        table[phase] = nexts
-    error = table[P.PAUSED].pop(P.ERROR)
-    table[P.PAUSED] = {**resumes, P.ERROR: error}
+                exits[FAILED] = error
+            resumes[resumed(phase)] = Exit(phase, "readings agree after standing_wait: resume")
+        table[phase] = exits
+    error = table[P.PAUSED].pop(FAILED)
+    table[P.PAUSED] = {**resumes, FAILED: error}
     return table
 
 
-TRANSITIONS: Mapping[Phase, Mapping[Phase, str]] = MappingProxyType(
-    {src: MappingProxyType(nexts) for src, nexts in _table().items()}
+EXITS: Mapping[Phase, Mapping[str, Exit]] = MappingProxyType(
+    {src: MappingProxyType(exits) for src, exits in _table().items()}
 )
-"""phase -> {next phase: the condition, in words}."""
+"""phase -> {outcome: where it leads (the next phase, the condition in words)}."""
+
+
+def _joined(exits: Mapping[str, Exit]) -> dict[Phase, str]:
+    """Each next phase with the conditions of the outcomes leading to it,
+    joined by "; or " in the record's order."""
+    out: dict[Phase, list[str]] = {}
+    for ex in exits.values():
+        out.setdefault(ex.phase, []).append(ex.when)
+    return {dst: "; or ".join(whens) for dst, whens in out.items()}
+
+
+TRANSITIONS: Mapping[Phase, Mapping[Phase, str]] = MappingProxyType(
+    {src: MappingProxyType(_joined(exits)) for src, exits in EXITS.items()}
+)
+"""phase -> {next phase: the conditions that lead there, in words}."""
 
 STANDING_ARMED: frozenset[Phase] = frozenset(
     src for src, nexts in TRANSITIONS.items() if P.PAUSED in nexts
@@ -58,6 +79,18 @@ BACK_PAIR_PHASES: frozenset[Phase] = frozenset(
     src for src in STANDING_ARMED if PHASES[src].watches == "back"
 )
 """Armed phases watching SBR/SBL rather than SFR/SFL."""
+
+
+def exit_of(src: Phase, happened: str) -> Exit:
+    """Where the outcome ``happened`` of ``src`` leads.  Raises
+    TransitionError when ``src`` does not list it (a bug in a phase)."""
+    exits = EXITS.get(src, {})
+    found = exits.get(happened)
+    if found is None:
+        raise TransitionError(f"{src.value} -> ?: {happened!r} is not an outcome of "
+                              f"{src.value} in the transition table (it lists "
+                              f"{', '.join(exits) or 'none'})")
+    return found
 
 
 def allowed(src: Phase, dst: Phase) -> bool:

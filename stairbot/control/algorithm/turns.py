@@ -6,7 +6,6 @@ the helpers both share: :mod:`~stairbot.control.algorithm.calibration`.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from stairbot.control.algorithm import motion
@@ -14,8 +13,10 @@ from stairbot.control.algorithm.calibration import FLOW
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase
 from stairbot.control.algorithm.phase import (
+    FAILED,
     FAULT,
     NO_MOTION,
+    Exit,
     PhaseDef,
     Step,
     Tick,
@@ -44,6 +45,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
 from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
 from stairbot.hardware import MotorId
@@ -59,8 +61,7 @@ def _turned_too_far(t: Tick, phase: Phase) -> Step | None:
         limit += LANDING_TURN_MARGIN_RAD  # a landing's turn is 90° by the odometer
     if motion.turn_yaw_rad(t.cfg, made) <= limit:
         return None
-    return fail(f"calibration ({where(t.ctx, phase)}) turned "
-                f"{math.degrees(limit):.0f}° without finding SFR = SFL")
+    return fail(say.turned_too_far(where(t.ctx, phase), limit))
 
 
 def _turn_enter(t: Tick, w: TurnWork) -> None:
@@ -88,10 +89,7 @@ def _turned_past_limit(t: Tick, w: TurnWork) -> Step | None:
     made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made <= w.turn_limit_rad:
         return None
-    return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned {math.degrees(made):.0f}° "
-                f"without finding SFR = SFL, more than the "
-                f"{math.degrees(w.turn_limit_rad):.0f}° its first readings allow: "
-                "not squaring up to something other than the riser")
+    return fail(say.turned_past_first_readings(where(t.ctx, P.CAL_TURN), made, w.turn_limit_rad))
 
 
 def _turn(t: Tick, w: TurnWork) -> Step:
@@ -105,21 +103,16 @@ def _turn(t: Tick, w: TurnWork) -> Step:
             return stay(NO_MOTION)
         diff = mean_diff(t, w)
         if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
-            t.say(f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {len(w.diffs)} readings "
-                  f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)", SFR=sfr, SFL=sfl,
-                  diff=diff)
+            t.say(say.squared_up(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)
             t.cal.squaring_turns += 1
-            return go(P.CAL_LOWER)
+            return go("square")
         # Not square yet: turn on, slowly, the way the difference says.
         direction = 1 if diff < 0 else -1  # as on entry: SFL nearer, turn left
         if direction != w.turn_direction:
             w.turn_flips += 1
             if w.turn_flips > MAX_TURN_FLIPS:
-                return fail(f"calibration ({where(t.ctx, P.CAL_TURN)}) turned back and forth "
-                            f"{MAX_TURN_FLIPS} times without finding SFR = SFL: standing, "
-                            f"SFL − SFR reads {diff * 1000:+.1f} mm (SFR {sfr:.3f} m, SFL "
-                            f"{sfl:.3f} m); a beam may be off the flight's side, or one "
-                            "sensor reading long or short")
+                return fail(say.turned_back_and_forth(where(t.ctx, P.CAL_TURN), MAX_TURN_FLIPS,
+                                                      diff, sfr, sfl))
         w.measuring, w.diffs, w.diff_skipped, w.still_since = False, [], 0, None
         w.turn_direction = direction
         w.turn_diff = diff
@@ -142,8 +135,9 @@ def _turn(t: Tick, w: TurnWork) -> Step:
 TURN = PhaseDef(
     P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, TurnWork,
     enter=_turn_enter, family=Calibration,
-    to={P.CAL_LOWER: "SFR = SFL",
-        P.ERROR: "turned too far, or more than its first readings allow; " + FAULT})
+    on={"square": Exit(P.CAL_LOWER, "SFR = SFL"),
+        FAILED: Exit(P.ERROR, "turned too far, or more than its first readings allow; "
+                              + FAULT)})
 
 
 def _probe(t: Tick, w: ProbeWork) -> Step:
@@ -196,19 +190,18 @@ def _probe(t: Tick, w: ProbeWork) -> Step:
     cal.case = CalibrationCase.THREE_B if corner else CalibrationCase.THREE_A
     data = {"case": cal.case.value, "dSFR": d_sfr, "dSFL": d_sfl}
     if corner:
-        t.say(f"calibration case 3B: a corner (turning left, SFR grew {d_sfr * 1000:.1f} mm, "
-              f"SFL shrank {-d_sfl * 1000:.1f} mm); turning on until both shrink", **data)
-        return go(P.CAL_CORNER)
-    t.say(f"calibration case 3A: square to the riser (turning left, SFR changed "
-          f"{d_sfr * 1000:+.1f} mm, SFL {d_sfl * 1000:+.1f} mm); turning back", **data)
-    return go(P.CAL_TURN)
+        t.say(say.case_3b(d_sfr, d_sfl), **data)
+        return go("case_3b")
+    t.say(say.case_3a(d_sfr, d_sfl), **data)
+    return go("case_3a")
 
 
 PROBE = PhaseDef(
     P.CAL_PROBE, "calibration case 3 — probe turn left (A or B?)", FLOW, _probe, ProbeWork,
     family=Calibration,
-    to={P.CAL_CORNER: "SFR grew, SFL shrank: case 3B",
-        P.CAL_TURN: "otherwise: case 3A, turn back right", P.ERROR: FAULT})
+    on={"case_3b": Exit(P.CAL_CORNER, "SFR grew, SFL shrank: case 3B"),
+        "case_3a": Exit(P.CAL_TURN, "otherwise: case 3A, turn back right"),
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _corner_enter(t: Tick, w: CornerWork) -> None:
@@ -219,8 +212,8 @@ def _corner(t: Tick, w: CornerWork) -> Step:
     sfr, _sfl = readings(t)
     w.largest_sfr = max(w.largest_sfr, sfr)
     if sfr < w.largest_sfr - t.cfg.algorithm.equal_tolerance:
-        t.say(f"case 3B: SFR shrinks again ({sfr:.3f} m): both see the riser")
-        return go(P.CAL_TURN)
+        t.say(say.corner_shrinks(sfr))
+        return go("both_shrink")
     too_far = _turned_too_far(t, P.CAL_CORNER)
     if too_far is not None:
         return too_far
@@ -230,7 +223,8 @@ def _corner(t: Tick, w: CornerWork) -> Step:
 CORNER = PhaseDef(
     P.CAL_CORNER, "calibration case 3B — turn left until both readings shrink", FLOW, _corner,
     CornerWork, enter=_corner_enter, family=Calibration,
-    to={P.CAL_TURN: "both readings shrink", P.ERROR: "turned too far; " + FAULT})
+    on={"both_shrink": Exit(P.CAL_TURN, "both readings shrink"),
+        FAILED: Exit(P.ERROR, "turned too far; " + FAULT)})
 
 
 def _away_enter(t: Tick, w: AwayWork) -> None:
@@ -259,22 +253,20 @@ def _away(t: Tick, w: AwayWork) -> Step:
     off_wall = flipped and abs(d) >= cfg.algorithm.equal_tolerance
     passed_square = w.flipped and not flipped and abs(d) <= one_riser(cfg)
     if seen and (off_wall or passed_square):
-        t.say(f"case 2W: off the side wall, SFR {sfr:.3f} m and SFL {sfl:.3f} m see the "
-              "riser; squaring up", SFR=sfr, SFL=sfl)
-        return go(P.CAL_TURN)
+        t.say(say.off_side_wall(sfr, sfl), SFR=sfr, SFL=sfl)
+        return go("off_wall")
     made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made > MAX_AWAY_YAW_RAD:
-        return fail(f"calibration ({where(t.ctx, P.CAL_AWAY)}) turned "
-                    f"{math.degrees(MAX_AWAY_YAW_RAD):.0f}° away from the side wall and the "
-                    f"readings still do not fit one riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")
+        return fail(say.away_too_far(where(t.ctx, P.CAL_AWAY), MAX_AWAY_YAW_RAD, sfr, sfl))
     return stay(motion.turn(w.turn_direction, cfg))
 
 
 AWAY = PhaseDef(
     P.CAL_AWAY, "calibration case 2W — turn away from the side wall until both see the riser",
     FLOW, _away, AwayWork, enter=_away_enter, family=Calibration,
-    to={P.CAL_TURN: "off the wall: the pair flipped (or flipped back, square)",
-        P.ERROR: "turned too far; " + FAULT})
+    on={"off_wall": Exit(P.CAL_TURN, "off the wall: the pair flipped (or flipped back, "
+                                     "square)"),
+        FAILED: Exit(P.ERROR, "turned too far; " + FAULT)})
 
 
 # -- turn back to a heading (descent 1 and 7) ------------------------------------------
@@ -285,7 +277,7 @@ def _turn_to(t: Tick, w: Work) -> Step:
     assert turn_to is not None  # set by whoever lifted for this turn
     remaining = turn_to - motion.twist(t.snap)
     if abs(remaining) <= motion.WHEEL_DONE:
-        return go(P.CAL_LOWER)
+        return go("turned")
     too_far = _turned_too_far(t, P.CAL_TURN_TO)
     if too_far is not None:
         return too_far
@@ -296,6 +288,7 @@ def _turn_to(t: Tick, w: Work) -> Step:
 TURN_TO = PhaseDef(
     P.CAL_TURN_TO, "calibration — turn by the odometer to a heading", FLOW,
     _turn_to, Work, family=Calibration,
-    to={P.CAL_LOWER: "turned to it", P.ERROR: "turned too far; " + FAULT})
+    on={"turned": Exit(P.CAL_LOWER, "turned to it"),
+        FAILED: Exit(P.ERROR, "turned too far; " + FAULT)})
 
 PHASES: tuple[PhaseDef[Any], ...] = (PROBE, CORNER, AWAY, TURN, TURN_TO)

@@ -1,0 +1,136 @@
+"""What the ascent says: its approach, lifting segment 1 over the riser and
+measuring the tread, the tab and the top
+(:mod:`~stairbot.control.algorithm.ascent`,
+:mod:`~stairbot.control.algorithm.lift_first`).  ``steps`` is
+number_of_steps, the steps climbed so far: the one being climbed is
+``steps + 1``."""
+
+from __future__ import annotations
+
+import math
+
+
+# -- ascent 2: the approach -------------------------------------------------------------
+def riser_lost(steps: int, sfr: float, sfl: float, wait_s: float) -> str:
+    return (f"riser lost during the approach (step {steps + 1}): "
+            f"SFR {sfr:.3f} m, SFL {sfl:.3f} m, nothing ahead "
+            f"for {wait_s:g} s")
+
+
+def at_riser(gap: float) -> str:
+    return f"at the riser: {gap:.3f} m from it"
+
+
+# -- ascent 3: lift segment 1 -----------------------------------------------------------
+def sees_over(steps: int, lifted: float, rise: float, sfr: float, sfl: float) -> str:
+    return (f"segment 1 sees over step {steps + 1} after {lifted:.1f} MTF turns "
+            f"(rise about {rise:.3f} m): SFR/SFL read {sfr:.3f}/{sfl:.3f} m")
+
+
+def too_low_to_climb(steps: int, rise: float, min_rise: float) -> str:
+    return (f"step {steps + 1} is too low to climb: rise about {rise:.3f} m < "
+            f"{min_rise:.3f} m (lifting on, the sensors could see past "
+            "the next riser); the ascent ends (obstacle)")
+
+
+RISE_TOO_LOW = "rise lower than the robot measures"
+
+
+def too_high(steps: int, allowed: float) -> str:
+    return (f"step {steps + 1} too high: the front sensors did not see over "
+            f"it within {allowed:.1f} MTF turns; the ascent ends (obstacle)")
+
+
+def tread_ahead(steps: int, tread: float | None, gap: float) -> str:
+    ahead = "nothing ahead" if tread is None or tread == float("inf") \
+        else f"tread {tread:.3f} m"
+    return f"step {steps + 1}: {ahead} (the reading less {gap:.3f} m to the riser)"
+
+
+def tread_too_short(steps: int, tread: float, need: float) -> str:
+    return (f"the tread of step {steps + 1} is too short: {tread:.3f} m < "
+            f"min_tread_m = {need:.3f} m; the ascent ends (obstacle)")
+
+
+TREAD_TOO_SHORT = "tread shorter than min_tread_m"
+
+
+def too_low_for_tread(steps: int, rise: float, min_rise: float, cone_top_rad: float,
+                      tread: float) -> str:
+    return (f"step {steps + 1} is too low for its tread: rise about {rise:.3f} "
+            f"m < {min_rise:.3f} m (the front cone's top, "
+            f"{math.degrees(cone_top_rad):.1f}° up, would see over the next riser "
+            f"{tread:.3f} m away); the ascent ends (obstacle)")
+
+
+TOO_LOW_FOR_TREAD = "rise too low for the tread the front cone measures"
+
+
+def narrow_step(steps: int, tread: float) -> str:
+    return (f"step {steps + 1} is narrow: tread {tread:.3f} m < "
+            f"LENGTH_OF_A_ROBOT + SAFE_LENGTH: segment 3 stays in the air over the step "
+            "below until segment 1 is on the next (narrow_steps)")
+
+
+def step_height(turns: float, steps: int) -> str:
+    return f"number_of_turns_for_step_height = {turns:.2f} (step {steps + 1})"
+
+
+def too_few_readings(steps: int, lift_m: float) -> str:
+    return (f"step {steps + 1}: too few readings past the riser over the "
+            f"last {lift_m * 1000:.0f} mm of lift to tell whether they held")
+
+
+def readings_held(steps: int, reading: float, moved: float, lift_m: float, held: bool,
+                  limit: float) -> str:
+    return (f"step {steps + 1}: the front pair's readings of the riser "
+            f"{reading:.3f} m ahead moved {moved * 1000:.0f} mm as segment 1 rose "
+            f"{lift_m * 1000:.0f} mm ({'within' if held else 'more than'} "
+            f"{limit * 1000:.0f} mm): "
+            + ("a wall, or a riser the whole cone sees" if held
+               else "the cone sees over it"))
+
+
+def length_of_next_step(length: float, far: bool, far_tread_m: float) -> str:
+    return (f"length_of_next_step = {length:.3f} m"
+            + (f" (past FAR_TREAD_M = {far_tread_m} m: the drives onto the step "
+               "go by turns)" if far else ""))
+
+
+LENGTH_NOT_MEASURABLE = ("length_of_next_step not measurable (nothing ahead within "
+                         "LENGTH_OF_INFINITY): driving "
+                         "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE turns")
+
+
+# -- ascent 7-8: the tab, the top -------------------------------------------------------
+def tab_length(i: int, tab: float) -> str:
+    return f"tab_length_to_edge[{i}] = {tab:.3f} m"
+
+
+def tab_not_measurable(i: int) -> str:
+    return (f"tab_length_to_edge[{i}] not measurable (nothing ahead): the descent of this "
+            "step drives by turns")
+
+
+def number_of_steps(steps: int) -> str:
+    return f"number_of_steps = {steps}"
+
+
+def top_reached(steps: int) -> str:
+    return (f"top reached after {steps} steps: SFR/SFL read at least "
+            "LENGTH_OF_INFINITY; the descent begins")
+
+
+def step_limit(max_steps: int) -> str:
+    return f"number_of_steps reached {max_steps}: the ascent ends; the descent begins"
+
+
+def tab_read_standing(i: int, tab: float) -> str:
+    return (f"tab_length_to_edge[{i}] = {tab:.3f} m (read standing at "
+            "ascent 8: ascent 7 read nothing ahead)")
+
+
+def tab_not_measured(i: int, sfr: float, sfl: float, wait_s: float) -> str:
+    return (f"tab_length_to_edge[{i}] not measured: SFR/SFL read {sfr:.3f}/"
+            f"{sfl:.3f} m for {wait_s:g} s, not both a riser nor both nothing "
+            "ahead; going on (the descent of this step finds its edge by the back pair alone)")
