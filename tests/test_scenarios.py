@@ -63,16 +63,11 @@ def assert_one_phase_entry_a_tick(events: list[Event]) -> None:
     assert not twice, f"more than one phase entered at t = {twice}"
 
 
-ROBOT_FOR = {"narrow_steps": load_config("heavy_middle"),
-             **{name: load_config("landings") for name in (
-                 "landing_left", "landing_right", "landing_too_small", "landing_wall")}}
-"""A scenario written for another robot than the reference one."""
-
-
 @pytest.mark.parametrize("name", shipped())
 def test_every_shipped_scenario_ends_as_it_expects(name: str) -> None:
+    """On the robot the scenario names (its ``robot``), else the reference robot."""
     scenario = load_scenario(name)
-    result, events = run_sim(scenario, ROBOT_FOR.get(name, CONFIG))
+    result, events = run_sim(scenario, load_config(scenario.robot))
     assert expectation_mismatches(scenario.expect, result.to_dict()) == [], result.to_dict()
     assert not result.fell
     must, must_not = PATHS.get(name, (set(), set()))

@@ -58,7 +58,9 @@ ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N
 SCENARIO_HELP = ("scenario TOML file, or the name of a shipped scenario (see "
                  "`stairbot scenario list`); default: five residential steps")
 CONFIG_HELP = ("robot config TOML file, or a shipped robot's name (reference, ideal, sonar, ir, "
-               "heavy_middle); default: the reference robot")
+               "heavy_middle, landings); default: the reference robot")
+RUN_CONFIG_HELP = CONFIG_HELP.replace("default: ", "default: the robot the scenario names "
+                                      "(its `robot` key), else ")
 
 
 class _Formatter(argparse.RawDescriptionHelpFormatter):
@@ -86,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument("--robot", metavar="URL", default="sim://", help=ROBOT_HELP)
     r.add_argument("--scenario", metavar="FILE|NAME", help=SCENARIO_HELP)
-    r.add_argument("--config", metavar="FILE", help=CONFIG_HELP)
+    r.add_argument("--config", metavar="FILE", help=RUN_CONFIG_HELP)
     r.add_argument("--json", action="store_true",
                    help="print one JSON object (the result) on stdout; progress goes to stderr")
     r.add_argument("--realtime", action="store_true",

@@ -18,7 +18,7 @@ from typing import Any, TextIO
 
 from stairbot.cli.common import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_MISMATCH, EXIT_OK, PROG, ask
 from stairbot.control.algorithm import limits
-from stairbot.control.robot_config import load_config
+from stairbot.control.robot_config import config_for
 from stairbot.errors import HardwareError, InputError, LatchedError, NoBoardError
 from stairbot.events import Event, EventKind
 from stairbot.inputs.config import RobotConfig
@@ -29,7 +29,14 @@ from stairbot.text import printable
 
 
 def _load_inputs(args: argparse.Namespace) -> tuple[RobotConfig, Scenario]:
-    return load_config(args.config), load_scenario(args.scenario)
+    """The scenario, and the robot config: ``--config``, else the scenario's
+    ``robot``, else the reference robot (a note on stderr when ``--config``
+    overrides the scenario's robot with another)."""
+    scenario = load_scenario(args.scenario)
+    config, note = config_for(args.config, scenario)
+    if note is not None:
+        print(f"{PROG}: {note}", file=sys.stderr, flush=True)
+    return config, scenario
 
 
 @contextmanager
@@ -261,7 +268,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                "as_expected": not mismatches, "mismatches": mismatches}
         print(json.dumps(out, sort_keys=True))
     else:
-        _print_summary(data, scenario, args.robot, mismatches)
+        _print_summary(data, scenario, args.robot, config.source, mismatches)
     if interrupted:
         print(f"{PROG}: interrupted: emergency stop latched, every motor stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -287,12 +294,13 @@ def _link_line(link: dict[str, Any]) -> str:
         f"{k.replace('_', ' ')} {link[k]:g}" for k in keys if k in link)
 
 
-def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str,
+def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str, config: str,
                    mismatches: list[str]) -> None:
     rtf = d.get("realtime_factor")
     lines = [
         "",
         f"summary ({scenario.name} on {robot})",
+        f"  robot config      {config}",
         f"  outcome           {d['outcome']}"
         + (f" (ascent ended: {d['ascent_end']})" if d.get("ascent_end") else ""),
         f"  steps             climbed {d['steps_climbed']}, descended {d['steps_descended']}",

@@ -63,7 +63,8 @@ def _describe(s: Scenario) -> str:
             ("outcome", exp.outcome), ("ascent_end", exp.ascent_end),
             ("steps_climbed", exp.steps_climbed), ("steps_descended", exp.steps_descended),
             ("pauses", exp.pauses)) if v is not None)
-    return f"{stairs}; {len(s.faults)} fault(s); expects {want}"
+    robot = f"; robot {printable(s.robot)}" if s.robot is not None else ""
+    return f"{stairs}; {len(s.faults)} fault(s){robot}; expects {want}"
 
 
 def cmd_scenario_check(args: argparse.Namespace) -> int:

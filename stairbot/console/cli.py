@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from collections.abc import Sequence
 from urllib.parse import urlsplit
 
 from stairbot.console.robot_holder import SPEEDS
 from stairbot.console.serve import parse_bind, serve
-from stairbot.control.robot_config import load_config
+from stairbot.control.robot_config import config_for
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
 from stairbot.inputs.scenario import load_scenario
@@ -41,7 +42,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "can://INTERFACE/CHANNEL?bitrate=N")
     p.add_argument("--scenario", metavar="FILE|NAME",
                    help="scenario TOML file or shipped scenario name (default stairs)")
-    p.add_argument("--config", metavar="FILE", help="robot config TOML file")
+    p.add_argument("--config", metavar="FILE",
+                   help="robot config TOML file or shipped robot's name (default: the "
+                        "scenario's robot, else the reference robot)")
     p.add_argument("--record", metavar="FILE",
                    help="record to FILE: FILE.mcap as MCAP (every tick and event, for "
                         "Foxglove), any other name the event stream, one JSON object a line")
@@ -94,8 +97,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.speed is None:
         args.speed = "1x"
     bind = parse_bind(args.serve) if args.serve is not None else None
-    config = load_config(args.config)
-    load_scenario(args.scenario)  # a bad scenario fails here, not behind the screen
+    # a bad scenario or config fails here, not behind the screen
+    config, note = config_for(args.config, load_scenario(args.scenario))
+    if note is not None:
+        print(f"stairbot console: {note}", file=sys.stderr, flush=True)
     _check_url(args.robot)
     if args.record:
         check_record(args.record)

@@ -28,7 +28,7 @@ from collections.abc import Callable
 from importlib import import_module
 
 from stairbot.args import bounded
-from stairbot.control.robot_config import load_config
+from stairbot.control.robot_config import config_for
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
@@ -49,7 +49,8 @@ def build_parser() -> argparse.ArgumentParser:
                       help="serve on a CAN bus, e.g. udp_multicast/239.74.163.2: on loopback "
                       "only (127.0.0.1, TTL 0) unless the URL adds ?lan=1")
     p.add_argument("--scenario", help="scenario TOML file or shipped scenario name")
-    p.add_argument("--config", help="robot config TOML file")
+    p.add_argument("--config", help="robot config TOML file or shipped robot's name "
+                   "(default: the scenario's robot, else the reference robot)")
     pace = p.add_mutually_exclusive_group()
     pace.add_argument("--time-scale", type=bounded(TIME_SCALE_MIN, TIME_SCALE_MAX),
                       default=1.0, metavar="X",
@@ -112,8 +113,10 @@ def main(argv: list[str]) -> int:
         can_main = import_module("stairbot.fakes.can_boards").main
         code: int = can_main(argv)
         return code
-    config = load_config(args.config)
     scenario = load_scenario(args.scenario)
+    config, note = config_for(args.config, scenario)
+    if note is not None:
+        print(f"stairbot fake-boards: {note}", file=sys.stderr, flush=True)
     world = make_world(config, scenario, args.lockstep)
     pty = PtyPair()
     server = SerialBoardServer(pty.master, world, make_boards(world), faults_from(args),

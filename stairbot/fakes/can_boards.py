@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import can
 from can.interfaces.udp_multicast import UdpMulticastBus
 
-from stairbot.control.robot_config import load_config
+from stairbot.control.robot_config import config_for
 from stairbot.drivers import messages as m
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import BROADCAST, CanFrame, CanWire, wire
@@ -237,8 +237,10 @@ def main(argv: list[str]) -> int:
     if spec.interface == "virtual":
         raise RobotUrlError(url, "interface", "a virtual bus lives inside one process; "
                             "serve other processes with udp_multicast/GROUP")
-    config = load_config(args.config)
     scenario = load_scenario(args.scenario)
+    config, note = config_for(args.config, scenario)
+    if note is not None:
+        print(f"stairbot fake-boards: {note}", file=sys.stderr, flush=True)
     world = make_world(config, scenario, args.lockstep)
     bus = open_bus(spec)
     server = CanBoardServer(bus, world, make_boards(world), faults_from(args),

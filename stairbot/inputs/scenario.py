@@ -17,6 +17,8 @@ from typing import Annotated, Any, Literal
 import msgspec
 
 from stairbot.errors import ScenarioError
+from stairbot.files import is_file, shown
+from stairbot.inputs.config import shipped_configs
 from stairbot.inputs.schema import convert, load_toml, read_named, shipped
 from stairbot.text import check_line, printable
 
@@ -121,6 +123,7 @@ class Expect(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 class ScenarioFile(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     name: str | None = None
     description: str | None = None
+    robot: str | None = None
     stairs: Stairs = msgspec.field(default_factory=Stairs)
     start: Start = msgspec.field(default_factory=Start)
     sensors: Sensors = msgspec.field(default_factory=Sensors)
@@ -147,6 +150,11 @@ class Scenario:
     landing: TurnLanding | None = None
     """A quarter-turn landing at the top of the flight, or None: the flight
     ends on a straight landing (``top``)."""
+    robot: str | None = None
+    """The robot config the scenario is written for, as ``--config`` takes it:
+    a shipped robot's name, or a config file's path (one relative to the
+    scenario's folder made whole).  A run without ``--config`` uses it; None:
+    the reference robot."""
 
 
 DEFAULT_COUNT, DEFAULT_RISE, DEFAULT_TREAD = 5, 0.17, 0.28
@@ -163,6 +171,7 @@ def parse_scenario(text: str, source: str) -> Scenario:
 def _resolve(data: ScenarioFile, source: str) -> Scenario:
     check_line(data.name, source, "name", ScenarioError)
     check_line(data.description, source, "description", ScenarioError)
+    robot = _robot(data.robot, source)
     st = data.stairs
     if st.steps is not None:
         if st.count is not None or st.rise is not None or st.tread is not None:
@@ -226,7 +235,30 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
         faults=tuple(data.faults),
         expect=data.expect,
         landing=landing,
+        robot=robot,
     )
+
+
+def _robot(value: str | None, source: str) -> str | None:
+    """The scenario's ``robot``: a shipped robot's name as given, or the path
+    of a config file (relative to the scenario's folder when the scenario is
+    a file, else to the working directory).  Raises ScenarioError when it is
+    neither; the config itself is read when a run loads it."""
+    if value is None:
+        return None
+    check_line(value, source, "robot", ScenarioError)
+    allowed = ("allowed: a shipped robot's name (" + ", ".join(shipped_configs())
+               + ") or a robot config file's path (relative to the scenario's folder)")
+    folder = Path(source).parent if is_file(source) else Path()
+    path = folder / value
+    if value and is_file(path) and not path.is_dir():
+        return str(path)
+    if value in shipped_configs():
+        return value
+    named = "/" not in value and "\\" not in value and not value.endswith(".toml")
+    what = ("empty" if not value else "neither a shipped robot nor a file" if named
+            else f"no such file ({shown(path)})")
+    raise ScenarioError(source, "robot", f"{printable(repr(value))}: {what}; {allowed}")
 
 
 def _landing(data: ScenarioFile, steps: tuple[Step, ...], source: str) -> TurnLanding | None:

@@ -7,7 +7,8 @@ A spec is a TOML file (docs/envelope.md)::
     seed = 7                 # master seed of every sampled axis
     cases = 4                # samples per grid point (with sampled axes)
     scenario = "default"     # base scenario: a file (relative to the spec) or a shipped name
-    config = "robot.toml"    # base robot config (default: the reference robot)
+    config = "robot.toml"    # base robot config (default: the robot the base scenario
+                             # names, else the reference robot)
 
     [axes]                   # dotted paths into the scenario, or config.SECTION.KEY
     "stairs.rise" = { range = [0.18, 0.22, 0.005] }   # grid: start, stop, step
@@ -218,7 +219,8 @@ def _known_type(path: str) -> Any:
         return "virtual"
     if path.startswith("config."):
         return _type_at(ConfigFile, _tokens("." + path.removeprefix("config.")))
-    if path.split(".")[0].split("[")[0] in ("expect", "name", "description"):
+    # the robot is the spec's (sweep.config, or the base scenario's robot), not an axis
+    if path.split(".")[0].split("[")[0] in ("expect", "name", "description", "robot"):
         return None
     return _type_at(ScenarioFile, _tokens("." + path))
 
@@ -318,14 +320,31 @@ def _base_text(spec_dir: Path, name: str | None, src: str, key: str, default: st
                     + (", nor a shipped scenario" if folder else ""))
 
 
-def _config_text(spec_dir: Path, name: str, src: str) -> str:
+def _config_text(spec_dir: Path, name: str, src: str, key: str = "sweep.config") -> str:
     """The robot config a spec names (a file beside it, or a shipped robot), as
     one TOML document with what it extends laid in."""
     beside = spec_dir / name
     try:
         return tomlw.dumps(config_table(beside if beside.is_file() else name))
     except ConfigError as exc:
-        raise SpecError(src, "sweep.config", str(exc)) from None
+        raise SpecError(src, key, str(exc)) from None
+
+
+def _scenario_robot(spec_dir: Path, name: str | None, text: str,
+                    src: str) -> tuple[str, str | None]:
+    """The base scenario's text without its ``robot`` key, and that robot's
+    config as :func:`_config_text` gives it (None: the scenario names none).
+    A robot file is read beside the base scenario."""
+    raw = load_toml(text, src, SpecError)
+    robot = raw.pop("robot", None)
+    if robot is None:
+        return text, None
+    if not isinstance(robot, str) or not robot:
+        raise SpecError(src, "sweep.scenario", f"its robot {robot!r} is not allowed; allowed: "
+                        "a shipped robot's name or a robot config file's path")
+    folder = (spec_dir / name).parent if name is not None and (spec_dir / name).is_file() \
+        else spec_dir
+    return tomlw.dumps(raw), _config_text(folder, robot, src, "sweep.scenario")
 
 
 def with_config(spec: Spec, name: str) -> Spec:
@@ -359,7 +378,9 @@ def parse_spec(text: str, source: str, spec_dir: Path | None = None) -> Spec:
     s = data.sweep
     scenario_text = _base_text(spec_dir, s.scenario, source, "scenario",
                                "default_scenario.toml", "scenarios")
-    config_text = None if s.config is None else _config_text(spec_dir, s.config, source)
+    # the robot the base scenario names runs the cases, unless the spec names one
+    scenario_text, robot_text = _scenario_robot(spec_dir, s.scenario, scenario_text, source)
+    config_text = robot_text if s.config is None else _config_text(spec_dir, s.config, source)
     v = data.verdict
     spec = Spec(source=source, name=s.name or printable(Path(source).stem),
                 description=s.description, seed=s.seed, samples=s.cases, axes=tuple(axes),

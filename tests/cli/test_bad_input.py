@@ -81,6 +81,12 @@ CASES = [
      ["expect.toml", "expect.outcome", "'great'", "'completed'"]),
     ("top_key.toml", "colour = 'red'\n", "--scenario",
      ["top_key.toml", "colour", "unknown key", "stairs, start, sensors"]),
+    ("robot_name.toml", "robot = 'spider'\n", "--scenario",
+     ["robot_name.toml: robot", "'spider'", "neither a shipped robot nor a file",
+      "landings", "robot config file's path"]),
+    ("robot_path.toml", "robot = 'robots/none.toml'\n", "--scenario",
+     ["robot_path.toml: robot", "no such file", "none.toml", "a shipped robot's name"]),
+    ("robot_type.toml", "robot = 3\n", "--scenario", ["robot_type.toml: robot", "text"]),
 ]
 
 

@@ -11,6 +11,7 @@ import subprocess
 import sys
 import threading
 import time
+from importlib import resources
 from pathlib import Path
 
 import pytest
@@ -146,3 +147,47 @@ def test_record_to_an_existing_file_never_overwrites_it(
     assert json.loads(beside.read_text().splitlines()[-1])["kind"] == "summary"
     err = capsys.readouterr().err
     assert f"{record} exists (not overwritten): recording to {beside}" in err
+
+
+def test_a_shipped_landing_scenario_runs_on_the_robot_it_names(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """landing_wall says robot = "landings" (the side pair): without --config
+    the run is on that robot and ends as its [expect] says."""
+    assert main(["run", "--json", "-q", "--scenario", "landing_wall"]) == 0
+    out, err = capsys.readouterr()
+    data = json.loads(out)
+    assert data["config"] == "<robot landings>" and data["as_expected"] is True
+    assert data["ascent_end"] == "landing_closed"
+    assert "note" not in err
+
+
+OPEN_FLOOR_FOR = "robot = {robot!r}\n[stairs]\ncount = 0\n[expect]\noutcome = 'stopped'\n"
+
+
+def test_a_scenario_robot_path_is_read_beside_the_scenario(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "robots").mkdir()
+    ideal = resources.files("stairbot.inputs").joinpath("configs", "ideal.toml")
+    (tmp_path / "robots" / "mine.toml").write_text(ideal.read_text("utf-8"))
+    scenario = tmp_path / "open.toml"
+    scenario.write_text(OPEN_FLOOR_FOR.format(robot="robots/mine.toml"))
+    assert main(["run", "--json", "-q", "--scenario", str(scenario)]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["config"] == str(tmp_path / "robots" / "mine.toml")
+
+
+def test_config_overrides_the_scenario_robot_with_a_note(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scenario = tmp_path / "open.toml"
+    scenario.write_text(OPEN_FLOOR_FOR.format(robot="ideal"))
+    assert main(["run", "--json", "-q", "--scenario", str(scenario),
+                 "--config", "reference"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["config"] == "<default default_robot.toml>"
+    notes = [line for line in err.splitlines() if "note" in line]
+    assert notes == ["stairbot: note: --config reference overrides the robot open is "
+                     "written for (ideal): its [expect] may not hold"]
+    # the same robot by --config: nothing to note
+    assert main(["run", "--json", "-q", "--scenario", str(scenario), "--config", "ideal"]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["config"] == "<robot ideal>" and "note" not in err

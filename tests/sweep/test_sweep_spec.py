@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from stairbot.cli import main
-from stairbot.control.robot_config import load_config
+from stairbot.control.robot_config import load_config, parse_config
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.sweep.cases import build_case, check_spec
 from stairbot.sweep.execute import open_executor
@@ -211,3 +211,21 @@ def test_a_measured_tread_asks_its_own_riser_to_reach_min_rise_for_it() -> None:
     assert zone(long_wall, reference, rules)[0] == "outside"
     assert zone(parse_scenario(text.format(tread=0.38, top="landing"), "x"), reference,
                 rules)[0] == "inside"
+
+
+def test_the_base_scenarios_robot_runs_the_cases_unless_the_spec_names_one(
+        tmp_path: Path) -> None:
+    """A base scenario's ``robot`` (here a file beside the scenario) becomes the
+    cases' robot config and leaves the cases' scenario; ``sweep.config`` wins."""
+    (tmp_path / "scen").mkdir()
+    (tmp_path / "scen" / "mine.toml").write_text('extends = "ideal"\n', encoding="utf-8")
+    (tmp_path / "scen" / "base.toml").write_text('robot = "mine.toml"\n[stairs]\ncount = 2\n',
+                                                 encoding="utf-8")
+    spec_text = '[sweep]\nscenario = "scen/base.toml"\n[axes]\n"stairs.rise" = [0.15]\n'
+    case = build_case(parse_spec(spec_text, str(tmp_path / "s.toml")), 0)
+    assert case.config_text is not None and "robot" not in case.scenario_text
+    assert load_config("ideal").sensors == parse_config(case.config_text, "c").sensors
+    chosen = parse_spec(spec_text.replace("[axes]", 'config = "sonar"\n[axes]'),
+                        str(tmp_path / "s.toml"))
+    assert parse_config(build_case(chosen, 0).config_text or "", "c").sensors == \
+        load_config("sonar").sensors
