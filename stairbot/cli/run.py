@@ -21,7 +21,7 @@ from stairbot.control.algorithm import limits
 from stairbot.control.robot_config import config_for
 from stairbot.errors import HardwareError, InputError, LatchedError, NoBoardError
 from stairbot.events import Event, EventKind
-from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.config import RobotConfig, robot_shown
 from stairbot.inputs.scenario import Scenario, expectation_mismatches, load_scenario
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
 from stairbot.run.paths import unused_path
@@ -300,7 +300,7 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str, config: st
     lines = [
         "",
         f"summary ({scenario.name} on {robot})",
-        f"  robot config      {config}",
+        f"  robot config      {robot_shown(config)}",
         f"  outcome           {d['outcome']}"
         + (f" (ascent ended: {d['ascent_end']})" if d.get("ascent_end") else ""),
         f"  steps             climbed {d['steps_climbed']}, descended {d['steps_descended']}",

@@ -161,6 +161,15 @@ def test_a_shipped_landing_scenario_runs_on_the_robot_it_names(
     assert "note" not in err
 
 
+def test_the_summary_names_the_robot_as_a_person_reads_it(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scenario = tmp_path / "open.toml"
+    scenario.write_text("[stairs]\ncount = 0\n[expect]\noutcome = 'stopped'\n")
+    for given, shown in (([], "reference (shipped)"), (["--config", "ir"], "ir (shipped)")):
+        assert main(["run", "-q", "--scenario", str(scenario), *given]) == 0
+        assert f"  robot config      {shown}\n" in capsys.readouterr().out
+
+
 OPEN_FLOOR_FOR = "robot = {robot!r}\n[stairs]\ncount = 0\n[expect]\noutcome = 'stopped'\n"
 
 
