@@ -33,7 +33,8 @@ from stairbot.inputs.scenario import (
 )
 from stairbot.inputs.schema import _tokens
 from stairbot.sweep import tomlw
-from stairbot.sweep.spec import VIRTUAL, Axis, Spec, SpecError, case_rng
+from stairbot.sweep.axes import VIRTUAL, Axis, SpecError, case_rng
+from stairbot.sweep.spec import Spec
 from stairbot.sweep.zones import zone
 
 DIGITS = 6  # drawn values are rounded to a micrometre (or a micro-degree) before use
