@@ -86,10 +86,10 @@ def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
 
 
 def edge_lag_s(cfg: RobotConfig) -> float:
-    """How long after the back pair crosses an edge perception reports the
-    drop: the sensor's latency, then the median's majority of the window,
-    one period each, the first of them half a period after the crossing on
-    average."""
+    """How long after the back pair's distance changes (it crosses an edge,
+    or segment 3 is lowered) perception reports it: the sensor's latency,
+    then the median's majority of the window, one period each, the first of
+    them half a period after the change on average."""
     return cfg.sensors.spec(True).latency_s \
         + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
 

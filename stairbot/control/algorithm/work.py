@@ -235,6 +235,9 @@ class LowerThirdWork(LiftWork):
     finishing: bool = False
     """The back pair reads BACK_CLEARANCE within its noise; the rest of the
     lowering goes by turns to ``target_mtb``."""
+    mtb_recent: list[tuple[float, float]] = field(default_factory=list)
+    """(time, MTB's counter) on the phase's ticks, back to the back pair's lag:
+    how far segment 3 was lowered since what its filtered reading stands for."""
 
 
 @dataclass
