@@ -7,13 +7,16 @@ is left drives it on, lifting segment 2 off its supports."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
 from kinematic import KinematicRobot
 
+from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.work import LowerThirdWork
 from stairbot.control.robot_config import load_config
 from stairbot.hardware import BACK_SENSORS, MotorId, SensorReading, Snapshot
 
@@ -95,3 +98,13 @@ def test_lowering_segment_3_on_a_slow_back_pair_stops_at_the_floor() -> None:
         == pytest.approx(0.10, abs=0.0015)
     assert robot.counters[MotorId.MTB] * SONAR.motors.lift_travel_per_turn \
         == pytest.approx(-0.10, abs=0.0015)
+
+
+def test_the_lowering_s_recent_turns_survive_a_journal_round_trip() -> None:
+    """A host killed while segment 3 is lowered resumes with the turns the
+    lag still needs: the work's (time, MTB) pairs come back as they were."""
+    ctx = Context()
+    ctx.work = LowerThirdWork(mtb_recent=[(10.0, 3.25), (10.02, 3.2)])
+    back = Context.from_dict(json.loads(json.dumps(ctx.to_dict())))
+    assert isinstance(back.work, LowerThirdWork)
+    assert back.work.mtb_recent == [(10.0, 3.25), (10.02, 3.2)]
