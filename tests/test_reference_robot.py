@@ -183,7 +183,7 @@ def test_backing_to_an_edge_stops_where_the_back_pair_saw_it(
     step 6, read on the way up, was 1.4 cm long; backing up to it, the
     robot tipped back 15 deg off segment 2's rear wheels.  The back pair
     now bounds the backing: edge_clearance_m past where it saw the drop."""
-    from stairbot.control.algorithm.edge import edge_clearance_m
+    from stairbot.control.algorithm.edge_measure import edge_clearance_m
 
     assert edge_clearance_m(REFERENCE) == pytest.approx(0.075 - 0.01 - 0.0185 + 0.016 + 0.006
                                                        + REFERENCE.wheel_speed_m_s * 0.030)

@@ -73,7 +73,7 @@ class DescentStep:
     """The odometer where the back pair crossed the edge of the step it
     stands on (where it read the drop, less how far the robot backed while
     the reading came through:
-    :func:`~stairbot.control.algorithm.edge.edge_sight_m`)."""
+    :func:`~stairbot.control.algorithm.edge_measure.edge_sight_m`)."""
     edge_squared: bool = False
     """Continuous descent: the robot turned square to this step's edge by
     its back pair (once a step)."""

@@ -17,11 +17,11 @@ from typing import Any
 
 from stairbot.control.algorithm import landing, long_tread, motion
 from stairbot.control.algorithm.back_off import BACK_OFF, BACK_TO_EDGE
-from stairbot.control.algorithm.edge import (
+from stairbot.control.algorithm.edge import narrow_bound
+from stairbot.control.algorithm.edge_measure import (
     edge_clearance_m,
     edge_lag_s,
     floor_tolerance,
-    narrow_bound,
 )
 from stairbot.control.algorithm.families import LowerThird
 from stairbot.control.algorithm.homing import FINISH, FINISH_FLOOR
