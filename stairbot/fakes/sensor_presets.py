@@ -7,8 +7,8 @@ figures, cited there); here is what only a simulation needs, each figure
 saying where it comes from: how many rays stand for the cone, how they
 combine, outlier and dropout rates ("assumed": the datasheets do not give
 them, and they are deliberately modest), weak-signal and incidence limits.
-The robot config may narrow a cone (a ToF's ROI) and tilt a mount:
-:func:`model_for`.
+The robot config may narrow a cone (a ToF's ROI), choose a multizone
+sensor's rows of zones, and tilt a mount: :func:`model_for`.
 """
 
 from __future__ import annotations
@@ -62,7 +62,28 @@ HCSR04 = _from(specs.HCSR04, rays=7, rays_across=3, aggregate="nearest",
 GP2Y0A21 = _from(specs.GP2Y0A21, rays=3, rays_across=1, aggregate="weighted",
                  outlier_rate=0.002)
 
-PRESETS: dict[str, SensorModel] = {m.name: m for m in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21)}
+# VL53L5CX, 8x8: the sensor board publishes, per sensor, one distance from a
+# block of zones -- the robot config's rows (front_fov_deg tall, its axis
+# front_tilt_deg up on a level mount; config_checks keeps them on the grid)
+# by the two central columns, 11.25 degrees across.  Each zone is a rectangle
+# of rays, two per zone and one more at the far edge each way (3 up a row,
+# 5 across two columns), the rows' zones mixed as the VL53L1X's cone
+# ("weighted"): pessimistic, since the sensor can tell targets apart within
+# a zone.  Zones are taken with hard edges (AN5894: a zone's edge is a
+# convention; their blur is not modelled).  Assumed: weak beyond 3 m (ST
+# quotes 4 m for the sensor); 0.2 % outliers and 0.5 % dropouts (a target
+# status other than valid), as the VL53L1X.
+VL53L5CX_COLUMNS = 2
+"""Central columns of zones the board publishes."""
+RAYS_PER_ZONE = 2
+
+VL53L5CX = _from(specs.VL53L5CX, fov_across_deg=VL53L5CX_COLUMNS * specs.VL53L5CX.zone_deg,
+                 rays=RAYS_PER_ZONE * specs.VL53L5CX.zones + 1,
+                 rays_across=RAYS_PER_ZONE * VL53L5CX_COLUMNS + 1, aggregate="weighted",
+                 outlier_rate=0.002, dropout_rate=0.005, weak_range=3.0)
+
+PRESETS: dict[str, SensorModel] = {m.name: m for m in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21,
+                                                       VL53L5CX)}
 
 
 def preset(name: str) -> SensorModel:
@@ -81,7 +102,10 @@ def model_for(sensors: Sensors, back: bool) -> SensorModel:
     fov = sensors.back_fov_deg if back else sensors.front_fov_deg
     tilt = sensors.back_tilt_deg if back else sensors.front_tilt_deg
     model = preset(name)
-    if fov is not None:
+    zone = specs.SPECS[name].zone_deg
+    if fov is not None and zone > 0.0:  # rows of zones: the rays per zone the preset has
+        model = replace(model, fov_deg=fov, rays=RAYS_PER_ZONE * round(fov / zone) + 1)
+    elif fov is not None:
         model = replace(model, fov_deg=fov)
     if tilt:
         model = replace(model, tilt_deg=tilt)
