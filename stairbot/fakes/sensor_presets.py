@@ -13,6 +13,7 @@ sensor's rows of zones, and tilt a mount: :func:`model_for`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -110,3 +111,35 @@ def model_for(sensors: Sensors, back: bool) -> SensorModel:
     if tilt:
         model = replace(model, tilt_deg=tilt)
     return model
+
+
+ROW_SWITCH_PITCH_DEG = 2.0
+"""Pitched nose down by more than this (segment 2, as the sensor board's IMU
+reads it), the board publishes a multizone pair's block of zones moved up
+by whole rows (:func:`rows_up`): a level row pitched down looks at the
+tread or floor ahead (5 degrees down from 3 cm: 0.34 m), as happens from
+ascent 5 to 7.  Within it, the lowest rays meet the floor beyond 0.86 m at
+a grazing angle: too weak a return to read."""
+
+
+def rows_up(pitch_deg: float, zone_deg: float) -> int:
+    """Rows the board moves a block of zones up at ``pitch_deg`` (+ nose
+    up): none within :data:`ROW_SWITCH_PITCH_DEG` of level, else one per
+    ``zone_deg`` of nose-down pitch beyond it, rounded up."""
+    if pitch_deg >= -ROW_SWITCH_PITCH_DEG:
+        return 0
+    return math.ceil((-pitch_deg - ROW_SWITCH_PITCH_DEG) / zone_deg)
+
+
+def front_blocks(sensors: Sensors) -> tuple[SensorModel, ...]:
+    """The front pair's model as mounted (:func:`model_for`), then, for a
+    multizone sensor, the same block moved up 1, 2, ... rows while it stays
+    within the sensor's field: what :func:`rows_up` chooses from."""
+    model = model_for(sensors, back=False)
+    spec = specs.SPECS[sensors.front_model]
+    if not spec.zones:
+        return (model,)
+    top = model.tilt_deg + model.fov_deg / 2.0
+    return tuple(replace(model, tilt_deg=model.tilt_deg + k * spec.zone_deg)
+                 for k in range(spec.zones)
+                 if top + k * spec.zone_deg <= spec.fov_deg / 2.0 + 1e-6)

@@ -12,7 +12,13 @@ import pytest
 from stairbot.control.robot_config import parse_config
 from stairbot.errors import ConfigError
 from stairbot.fakes.sensor_model import Cause, SensorModel, combine
-from stairbot.fakes.sensor_presets import VL53L5CX, model_for
+from stairbot.fakes.sensor_presets import (
+    ROW_SWITCH_PITCH_DEG,
+    VL53L5CX,
+    front_blocks,
+    model_for,
+    rows_up,
+)
 from stairbot.inputs.sensor_specs import SPECS
 
 ROW_ABOVE_AXIS = """extends = "reference"
@@ -127,3 +133,17 @@ def test_the_rows_above_the_axis_are_accepted() -> None:
                 f"front_fov_deg = {fov}\nfront_tilt_deg = {fov / 2}\n")
         cfg = parse_config(text, "robot.toml")
         assert cfg.front_cone_top_rad == pytest.approx(math.radians(fov))
+
+
+def test_pitched_nose_down_the_board_moves_the_row_up_so_no_ray_looks_at_the_floor() -> None:
+    assert [rows_up(p, 5.625) for p in (3.0, 0.0, -ROW_SWITCH_PITCH_DEG, -2.1, -6.2,
+                                         -7.625, -7.7)] == [0, 0, 0, 1, 1, 1, 2]
+    blocks = front_blocks(parse_config(ROW_ABOVE_AXIS, "zone.toml").sensors)
+    assert [b.tilt_deg for b in blocks] == [2.8125 + k * 5.625 for k in range(4)]  # to 22.5
+    assert {b.cone for b in blocks} == {blocks[0].cone}  # the same rays, turned up
+    for pitch in (-2.1, -4.9, -6.2, -9.0):  # the block's lowest ray, in the world
+        block = blocks[rows_up(pitch, 5.625)]
+        lowest = pitch + block.tilt_deg - block.fov_deg / 2
+        assert -ROW_SWITCH_PITCH_DEG <= lowest < 5.625
+    vl53l1x = 'extends = "reference"\n[sensors]\nfront_model = "vl53l1x"\nfront_fov_deg = 15.0\n'
+    assert len(front_blocks(parse_config(vl53l1x, "cone.toml").sensors)) == 1
