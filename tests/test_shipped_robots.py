@@ -20,8 +20,10 @@ from stairbot.inputs.scenario import expectation_mismatches, load_scenario, pars
 
 def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:
     robots = [load_config(name) for name in shipped_configs()]
-    used = {r.sensors.front_model for r in robots} | {r.sensors.back_model for r in robots}
-    assert used == {"ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"}
+    used = {model for r in robots for model in (r.sensors.front_model, r.sensors.back_model,
+                                                r.sensors.side_model)} - {"none"}
+    assert used == {"ideal", "vl53l5cx", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"}
+    assert "vl53l1x" in {r.sensors.side_model for r in robots}  # landings' side pair
 
 
 @pytest.mark.parametrize("name", shipped_configs())

@@ -73,7 +73,7 @@ seed = 5
 "stairs.count" = 1
 "config.masses.second_module" = { uniform = [1.2, 1.4] }
 "sensors.seed" = { randint = [1, 1000] }
-"faults" = [[{ at = 20.0, sensor = "SFR", kind = "error" }]]
+"faults" = [[{ at = 30.0, sensor = "SFR", kind = "error" }]]
 """
 
 
