@@ -88,7 +88,8 @@ def describe_result(result: RunResult) -> tuple[str, str]:
     if result.ascent_end:
         parts.append(result.ascent_end.replace("_", " "))
     parts.append(f"climbed {result.steps_climbed}, descended {result.steps_descended}")
-    severity = {"completed": "good", "stopped": "warning"}.get(result.outcome, "error")
+    severity = {"completed": "good", "stopped": "warning",
+                "came_home_degraded": "warning"}.get(result.outcome, "error")
     return " · ".join(parts), severity
 
 

@@ -223,16 +223,17 @@ def check_attitude(url: str, imu: Imu | None, config: RobotConfig) -> None:
 
 
 def carry_on(plan: ResumePlan, session: RobotSession, config: RobotConfig,
-             sink: EventSink) -> Resumed:
-    """Once the operator has confirmed ``plan``: the restored controller and
-    the journal, appended to (its resume record written), and only then the
+             sink: EventSink, limp_home: bool = False) -> Resumed:
+    """Once the operator has confirmed ``plan``: the restored controller
+    (``limp_home``: consent to limp home if a sensor is lost) and the
+    journal, appended to (its resume record written), and only then the
     boards' latches cleared."""
     robot = session.robot
     now = session.clock.now()
     state = plan.state
     ctx = restored_context(state, now, config.algorithm.max_steps)
     mode = Mode(state.start.get("mode", Mode.FULL.value))
-    controller = Controller(config, sink, mode, context=ctx)
+    controller = Controller(config, sink, mode, context=ctx, limp_home=limp_home)
     writer = JournalWriter(plan.path, fresh=False, tail=state.tail)
     try:
         writer.resume(str(state.start["run_id"]), board_identity(robot), now)
@@ -251,7 +252,8 @@ def resume(path: Path | None, url: str, session: RobotSession, config: RobotConf
     believes it is, and -- once the operator confirms (``yes``, or
     ``confirm`` answers the question true; ``stairbot run`` asks on the
     terminal) -- clear the boards' latches and hand back the restored
-    controller.  ResumeRefused (one line) otherwise; nothing has moved then."""
+    controller (``yes`` also consents to limp home if a sensor is lost).
+    ResumeRefused (one line) otherwise; nothing has moved then."""
     plan = plan_resume(path, url, session, config)
     for line in plan.lines:
         print(f"resume: {printable(line)}", file=out)
@@ -261,4 +263,4 @@ def resume(path: Path | None, url: str, session: RobotSession, config: RobotConf
     if not yes and not confirm(question):
         raise NotConfirmed("not resumed: no confirmation (answer y on a terminal, or add "
                            "--yes); nothing moved")
-    return carry_on(plan, session, config, sink)
+    return carry_on(plan, session, config, sink, limp_home=yes)

@@ -157,6 +157,10 @@ class RunResult:
         return out
 
 
+_HOME = ("completed", "stopped", "came_home_degraded")
+"""The outcomes that leave the robot where the program began (or, stopped,
+where it was asked to stop): every other latches the emergency stop."""
+
 def run(
     session: RobotSession,
     config: RobotConfig,
@@ -170,6 +174,7 @@ def run(
     on_tick: Callable[[Controller, Snapshot], None] | None = None,
     journal: JournalWriter | None = None,
     tap: TickTap | None = None,
+    limp_home: bool = False,
 ) -> RunResult:
     """Run the program on ``session`` until the controller finishes.
 
@@ -179,6 +184,9 @@ def run(
     emergency stop (``robot.estop()``): boards keep it until cleared.
     ``on_tick(controller, snapshot)`` is called after each tick (for a console);
     ``tap(snapshot, sent)`` too, with the speeds sent (for a record).
+    ``limp_home``: the operator's consent, given before the run, to limp home
+    on the sensors that remain when one is lost on the stairs (a controller
+    given as ``controller`` has its own).
     A run longer than ``max_sim_time_s`` of robot time ends with an error (by
     default an hour, or 60 phase timeouts for a robot whose slow motors make
     that longer).  Fell, pitch and offset in the result come from the robot's
@@ -188,7 +196,7 @@ def run(
     an OutputError -- ends the run with an error, the robot stopped.
     """
     robot, clock = session.robot, session.clock
-    ctl = controller or Controller(config, sink, mode)
+    ctl = controller or Controller(config, sink, mode, limp_home=limp_home)
     if max_sim_time_s is None:
         max_sim_time_s = max(3600.0, 60 * phase_timeout_s(config))
     if isinstance(robot, ReportsEvents):  # wired robots report link health as LINK events
@@ -239,7 +247,7 @@ def run(
         if control is not None:  # presses the loop did not come round to
             with contextlib.suppress(HardwareError):  # a clear on a lost link
                 _latch(control, robot)
-        if fell or ctl.result.outcome not in ("completed", "stopped"):
+        if fell or ctl.result.outcome not in _HOME:
             # An error -- a fall, a lost link, the supervisor, a phase's own
             # check, anything unforeseen -- latches the emergency stop: the
             # robot may stand part way up a step, and nothing moves it until
