@@ -28,6 +28,7 @@ from typing import TextIO
 from stairbot.control.algorithm import limits
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.lost import awaits_consent
 from stairbot.control.algorithm.phases import Mode
 from stairbot.events import EventSink
 from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
@@ -185,6 +186,10 @@ def plan_resume(path: Path | None, url: str, session: RobotSession,
     if isinstance(robot, HasAttitude):
         check_attitude(url, robot.attitude(), config)
     lines = describe(state)
+    if awaits_consent(context) and context.limp is not None:
+        lines.append(f"a sensor was lost ({', '.join(context.limp.lost)}) in "
+                     f"{context.limp.where}: resuming lets the robot limp home on the "
+                     "sensors that remain")
     latched = _latches(robot)
     if latched:
         lines.append(f"the boards hold latches ({len(latched)} board(s)); resuming "
@@ -258,9 +263,11 @@ def resume(path: Path | None, url: str, session: RobotSession, config: RobotConf
     for line in plan.lines:
         print(f"resume: {printable(line)}", file=out)
     out.flush()
+    home = awaits_consent(plan.context)
     question = ("Look at the robot: does it stand where the lines above say?  Resume and "
-                "let it move? [y/N] ")
+                + ("let it limp home? [y/N] " if home else "let it move? [y/N] "))
     if not yes and not confirm(question):
         raise NotConfirmed("not resumed: no confirmation (answer y on a terminal, or add "
                            "--yes); nothing moved")
-    return carry_on(plan, session, config, sink, limp_home=yes)
+    # confirming the resume of a degraded stop is consenting to limp home
+    return carry_on(plan, session, config, sink, limp_home=yes or home)

@@ -19,6 +19,7 @@ from typing import Any, Literal
 
 from stairbot.clock import CountsLateTicks, HostBehind
 from stairbot.control.algorithm.controller import Controller, phase_timeout_s
+from stairbot.control.algorithm.lost import awaits_consent
 from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
@@ -282,9 +283,11 @@ def run(
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands
             # a lost link stopped the program, not the program itself: the
-            # journal offers --resume once the wire is back
+            # journal offers --resume once the wire is back; so does a degraded
+            # stop the operator did not consent to limp home from (yet)
             journal.end(result.outcome, result.error, clock.now(),
-                        resumable=fault == "link" and not fell)
+                        resumable=(fault == "link" or awaits_consent(ctl.context))
+                        and not fell)
     sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
 

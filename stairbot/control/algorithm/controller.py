@@ -78,6 +78,9 @@ class Controller:
                 context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
         elif context.phase_started_s is not None:
+            if limp_home and lost.reopen(context):
+                sink(Event(context.phase_started_s, EventKind.RESUME, say_limp.REOPENED,
+                           BY_VALUE[context.phase].label, {"limp": context.to_dict()["limp"]}))
             check_restored(context)
         self._ctx = context
         self._started = context.phase_started_s is not None
@@ -274,6 +277,8 @@ class Controller:
         self._emit(EventKind.WARNING, say_limp.stopped_at(
             why, phase.label, stop.where, stop.lifts, stop.steps_climbed,
             stop.steps_descended) + ": " + stop.why, snap.time_s, {"degraded": stop.to_dict()})
+        if stop.then == "no_consent":
+            lost.start_limping(ctx, stop, snap.time_s, phase.label)
         if stop.then != "limp_home":
             self._apply(fail(say_limp.lost_sensor_end(why, SENSOR_WAIT_S, phase.label, stop.why)
                              + stale), snap)

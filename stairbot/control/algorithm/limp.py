@@ -39,14 +39,20 @@ PAIR_NAMES = {SensorId.SFR: "front", SensorId.SFL: "front",
 
 @dataclass
 class Limp:
-    """The run's progress once the robot limps home: the sensors lost (each
-    the survivor of its pair stands in for), when and where."""
+    """The run's progress once a sensor is lost off the floor and the robot
+    could come down on the rest: the sensors lost (each the survivor of its
+    pair stands in for), when and where, and whether the operator consented
+    (not yet: the program ended there, and a resume with consent carries it
+    on from ``stopped_in``)."""
 
     lost: list[str] = field(default_factory=list)
     """The lost sensors' names (SensorId values)."""
     since_s: float = 0.0
     where: str = ""
     """The phase (and step) the first was lost in, as the operator was told."""
+    consented: bool = True
+    stopped_in: str = ""
+    """Not consented: the phase the program stopped in (a Phase value)."""
 
 
 def mirrored(snap: Snapshot, lost: Sequence[str]) -> Snapshot:

@@ -66,13 +66,36 @@ def _plan(ctx: Context, phase: Phase, purpose: Purpose | None) -> str:
 
 def start_limping(ctx: Context, stop: limp.DegradedStop, time_s: float,
                   label: str) -> None:
-    """Record in the context that the robot limps home without the sensors
-    ``stop`` lost."""
+    """Record in the context that the robot could limp home without the
+    sensors ``stop`` lost: it does, or (``stop.then`` "no_consent") will
+    once the operator consents (:func:`reopen`)."""
+    consented = stop.then == "limp_home"
     if ctx.limp is None:
         at = f"{label} ({stop.where})" if stop.where else label
-        ctx.limp = limp.Limp(list(stop.lost), time_s, at)
+        ctx.limp = limp.Limp(list(stop.lost), time_s, at, consented,
+                             "" if consented else ctx.phase)
     else:
         ctx.limp.lost = list(stop.lost)
+
+
+def awaits_consent(ctx: Context) -> bool:
+    """Whether the program ended on a degraded stop the robot could limp home
+    from, had the operator consented."""
+    return ctx.phase == Phase.ERROR.value and ctx.limp is not None \
+        and not ctx.limp.consented and ctx.limp.stopped_in in BY_VALUE
+
+
+def reopen(ctx: Context) -> bool:
+    """Given the operator's consent now, a program ended on such a stop
+    (:func:`awaits_consent`) goes on from the phase it stopped in, limping
+    home; True if it does."""
+    if not awaits_consent(ctx):
+        return False
+    assert ctx.limp is not None
+    ctx.phase = ctx.limp.stopped_in
+    ctx.outcome = ctx.error = ctx.end_reason = None
+    ctx.limp.consented, ctx.limp.stopped_in = True, ""
+    return True
 
 
 LIMP = "a sensor lost on the stairs, limping home (consented)"
