@@ -41,8 +41,9 @@ def test_a_pair_with_no_survivor_the_imu_missing_or_a_landing_stop_the_limp() ->
                                         turned_at_landing=True))
 
 
-def test_only_squaring_up_at_the_start_counts_as_on_the_floor() -> None:
-    assert on_the_floor(Phase.CAL_TURN, Purpose.START, 0, Mode.FULL)
+def test_only_squaring_up_before_the_start_is_measured_counts_as_on_the_floor() -> None:
+    assert on_the_floor(Phase.CAL_CHECK, Purpose.START, 0, Mode.FULL, began=False)
+    assert not on_the_floor(Phase.CAL_TURN, Purpose.START, 0, Mode.FULL, began=True)
     assert on_the_floor(Phase.CAL_TURN, Purpose.START, 0, Mode.CALIBRATE_ONLY)
     assert not on_the_floor(Phase.ASCENT_APPROACH, None, 0, Mode.FULL)  # descent 7 backs home
     assert not on_the_floor(Phase.CAL_CHECK, Purpose.ASCENT, 1, Mode.FULL)

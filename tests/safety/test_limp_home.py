@@ -143,7 +143,18 @@ def test_the_second_back_sensor_lost_while_limping_stays_stopped() -> None:
     assert stops == ["limp_home", "stranded"]
 
 
-def test_a_sensor_lost_squaring_up_at_the_start_ends_the_run_as_before() -> None:
-    r, events = run(faulted((7.0, "SFR", "error")))
+def test_a_sensor_lost_before_the_start_is_measured_ends_the_run_as_before() -> None:
+    r, events = run(faulted((0.0, "SFR", "error")))
     assert r.outcome == "error" and r.steps_climbed == 0, r.to_dict()
+    assert r.final_offset_m is not None and r.final_offset_m < 0.01, r.to_dict()
     assert not [e for e in events if "degraded" in e.data]
+
+
+def test_a_sensor_lost_squaring_up_after_closing_in_backs_to_where_it_began() -> None:
+    r, events = run(faulted((7.0, "SFR", "error")))  # calibration's case-2 turn
+    assert (r.outcome, r.steps_climbed) == ("came_home_degraded", 0), r.to_dict()
+    assert home(r), r.to_dict()
+    after = phases_after(events, 7.0)
+    assert after[after.index("cal_check") + 1] == "descent_finish", after
+    infos = [e.message for e in events if e.kind is EventKind.INFO and e.time_s > 8.2]
+    assert infos and all(m.endswith("[limping: SFR reads SFL's value]") for m in infos)

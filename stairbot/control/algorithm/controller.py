@@ -353,6 +353,9 @@ class Controller:
             phase.record.enter(Tick(snap, self.config, ctx, self.mode, self._say), ctx.work)
 
     def _say(self, message: str, **data: Any) -> None:
+        limping = self._ctx.limp
+        if limping is not None and limping.consented:  # a pair's figures are one sensor's
+            message += say_limp.stand_ins(limping.lost)
         self._emit(EventKind.INFO, message, self._time, data)
 
     def _finish(self, phase: Phase, outcome: Outcome, reason: str, time_s: float) -> None:

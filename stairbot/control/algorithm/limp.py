@@ -68,16 +68,17 @@ def mirrored(snap: Snapshot, lost: Sequence[str]) -> Snapshot:
 
 
 def on_the_floor(phase: Phase, purpose: Purpose | None, steps_climbed: int,
-                 mode: Mode) -> bool:
-    """Whether the robot is still squaring up on the floor it started from
-    (the start's calibration, or a calibration-only run): a sensor lost there
-    ends the run where the robot stands, as it always has.  From the first
-    approach on, descent 7 knows the way back (the start position)."""
+                 mode: Mode, began: bool = True) -> bool:
+    """Whether the robot still stands where it started, on the floor: a
+    calibration-only run, or the start's calibration before it measured
+    where the program began (``began`` false).  A sensor lost there ends the
+    run where the robot stands, as it always has.  Once the start is
+    measured, descent 7 knows the way back to it."""
     if mode is Mode.CALIBRATE_ONLY:
         return True
     if mode is Mode.DESCEND or steps_climbed > 0:
         return False
-    return phase.flow == "calibration" and purpose is Purpose.START
+    return phase.flow == "calibration" and purpose is Purpose.START and not began
 
 
 def cannot_limp(lost: Iterable[SensorId], phase: Phase, purpose: Purpose | None,

@@ -26,7 +26,8 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
     if phase is Phase.PAUSED and ctx.pause is not None:  # lost while the standing rule waits
         phase = BY_VALUE[ctx.pause.resume_phase]
     purpose = ctx.family.purpose if isinstance(ctx.family, Calibration) else None
-    if limp.on_the_floor(phase, purpose, ctx.number_of_steps, mode):
+    if limp.on_the_floor(phase, purpose, ctx.number_of_steps, mode,
+                         began=ctx.start.home_wheel is not None):
         return None
     known = [SensorId(s) for s in ctx.limp.lost] if ctx.limp is not None else []
     lost = sorted(set(known) | set(errors), key=lambda s: s.value)
@@ -58,7 +59,7 @@ def _plan(ctx: Context, phase: Phase, purpose: Purpose | None) -> str:
         return say.plan("down", 0, 0)
     if phase in _UNDO:
         return say.plan("undo", n + 1, n)
-    if phase in _TURN_BACK or purpose is Purpose.ASCENT:
+    if phase in _TURN_BACK or purpose in (Purpose.ASCENT, Purpose.START):
         return say.plan("turn_back", n + 1, n)
     counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
     return say.plan("finish", n if counted else n + 1, n if counted else n + 1)

@@ -55,6 +55,12 @@ def stranded(why: str) -> str:
     return f"it cannot come down on what remains ({why}): staying stopped, lifts holding"
 
 
+def stand_ins(lost: Sequence[str]) -> str:
+    """What a message says of the pair's readings while limping home."""
+    pairs = {"SFR": "SFL", "SFL": "SFR", "SBR": "SBL", "SBL": "SBR"}
+    return " [limping: " + ", ".join(f"{s} reads {pairs[s]}'s value" for s in lost) + "]"
+
+
 def lost_sensor_end(failed: str, wait_s: float, label: str, then: str) -> str:
     """The reason the program ends with on a degraded stop it does not limp
     home from: the sensor error as it always read, then what followed."""
@@ -63,4 +69,4 @@ def lost_sensor_end(failed: str, wait_s: float, label: str, then: str) -> str:
 
 def limp_down(steps: int) -> str:
     return (f"limp home: the ascent ends here; down the {steps} step(s) climbed"
-            if steps else "limp home: segment 1 lowered again; back to the start")
+            if steps else "limp home: the ascent ends here; back to the start")
