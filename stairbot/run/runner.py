@@ -112,7 +112,7 @@ class RunControl:
 class RunResult:
     """The summary of one run (``stairbot run --json`` prints ``to_dict()``)."""
 
-    outcome: str  # completed | stopped | error | fell
+    outcome: str  # completed | stopped | error | fell | came_home_degraded
     ascent_end: str | None
     steps_climbed: int
     steps_descended: int

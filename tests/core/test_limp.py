@@ -48,3 +48,4 @@ def test_only_squaring_up_before_the_start_is_measured_counts_as_on_the_floor() 
     assert not on_the_floor(Phase.ASCENT_APPROACH, None, 0, Mode.FULL)  # descent 7 backs home
     assert not on_the_floor(Phase.CAL_CHECK, Purpose.ASCENT, 1, Mode.FULL)
     assert not on_the_floor(Phase.DESCENT_BACK_TO_EDGE, None, 0, Mode.DESCEND)
+
