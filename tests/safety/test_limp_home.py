@@ -158,3 +158,12 @@ def test_a_sensor_lost_squaring_up_after_closing_in_backs_to_where_it_began() ->
     assert after[after.index("cal_check") + 1] == "descent_finish", after
     infos = [e.message for e in events if e.kind is EventKind.INFO and e.time_s > 8.2]
     assert infos and all(m.endswith("[limping: SFR reads SFL's value]") for m in infos)
+
+
+def test_a_sensor_of_the_other_pair_lost_while_limping_limps_on_with_both_stand_ins() -> None:
+    r, events = run(faulted((42.0, "SFR", "error"), (58.0, "SBL", "freeze")))
+    assert r.outcome == "came_home_degraded" and home(r), r.to_dict()
+    stops = [e.data["degraded"] for e in events if "degraded" in e.data]
+    assert [(s["lost"], s["then"]) for s in stops] == [
+        (["SFR"], "limp_home"), (["SBL", "SFR"], "limp_home")]
+    assert stops[1]["survivors"] == ["SBR", "SFL"]
