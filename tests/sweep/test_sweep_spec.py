@@ -233,3 +233,15 @@ def test_the_base_scenarios_robot_runs_the_cases_unless_the_spec_names_one(
                         str(tmp_path / "s.toml"))
     assert parse_config(build_case(chosen, 0).config_text or "", "c").sensors == \
         load_config("sonar").sensors
+
+
+def test_a_field_axis_inside_a_list_axis_leaves_the_list_axis_values_alone() -> None:
+    """``faults`` then ``faults[0].at``: each case's fault gets its own time,
+    and the ``faults`` axis's values (recorded with every case) are not
+    changed by the cases built before."""
+    spec = parse_spec("[axes]\nfaults = [[{ at = 0.0, sensor = \"SFR\", kind = \"error\" }]]\n"
+                      "\"faults[0].at\" = [7.0, 14.5]\n", "x.toml")
+    first, second = build_case(spec, 0), build_case(spec, 1)
+    assert "at = 7.0" in first.scenario_text and "at = 14.5" in second.scenario_text
+    assert first.axes["faults"] == [{"at": 0.0, "sensor": "SFR", "kind": "error"}]
+    assert second.axes["faults"] == first.axes["faults"]

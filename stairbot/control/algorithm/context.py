@@ -21,6 +21,7 @@ from typing import Any, TypeVar, Union, get_args, get_origin, get_type_hints
 
 from stairbot.control.algorithm import families, work
 from stairbot.control.algorithm.families import Family
+from stairbot.control.algorithm.limp import Limp
 from stairbot.control.algorithm.modes import AscentEnd, Outcome
 from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.control.algorithm.work import Work
@@ -193,6 +194,8 @@ class Context:
     start: StartPosition = field(default_factory=StartPosition)
     descent: DescentStep = field(default_factory=DescentStep)
     landing: Landing = field(default_factory=Landing)
+    limp: Limp | None = None
+    """Present once a sensor was lost and the robot limps home."""
 
     # -- the standing rule -----------------------------------------------------------
     watch: Watch = field(default_factory=Watch)
