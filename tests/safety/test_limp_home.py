@@ -78,12 +78,12 @@ def test_a_front_sensor_lost_lifting_segment_3_finishes_the_step_and_comes_home(
 
 
 def test_a_front_sensor_lost_lifting_segment_1_undoes_the_step() -> None:
-    r, events = run(faulted((53.0, "SFL", "freeze")))  # ascent 3 of step 2
+    r, events = run(faulted((56.0, "SFL", "freeze")))  # ascent 3 of step 2
     assert (r.outcome, r.steps_climbed, r.steps_descended) == (
         "came_home_degraded", 1, 1), r.to_dict()
     assert home(r), r.to_dict()
     assert "undoing step 2" in degraded(events)["why"]
-    after = phases_after(events, 53.0)
+    after = phases_after(events, 56.0)
     assert after[:2] == ["ascent_lower_obstacle", "descent_back_off"], after
 
 
