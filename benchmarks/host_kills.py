@@ -3,7 +3,9 @@ first, middle and last tick, on each wire, and resume
 (stairbot/fakes/host_kills.py); print one line a kill and the counts:
 resumed (the run completed), refused before any Clear (the boards still
 latched), UNSAFE (latches cleared and the resume failed, or a resumed run
-that did not complete).
+that did not complete), not killed (the run ended before the kill's tick:
+its outcome and error said; the flight is the same every time in lockstep,
+so a host that timed out on a machine past its cores, or changed code).
 
     python benchmarks/host_kills.py [-j 1] [--wire can|serial] [--phase NAME] [--point P]
 

@@ -81,8 +81,7 @@ def test_the_side_wall_reproduction_climbs_all_three_with_ideal_sensors() -> Non
     """Issue 10's side-wall case as the issue states it: on the robot it was
     found on (ideal sensors, one level ray) it squares up to the riser, not
     the wall, climbs all three (the wall at the top ends the ascent) and comes
-    home.  The reference robot refuses its first rise by design (the shipped
-    scenario's [expect])."""
+    home, as the reference robot does (the shipped scenario's [expect])."""
     result, events = run_sim(load_scenario("side_wall_square"), IDEAL)
     assert (result.outcome, result.ascent_end, result.steps_climbed,
             result.steps_descended) == ("completed", "obstacle", 3, 3), result.to_dict()

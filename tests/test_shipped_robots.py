@@ -20,8 +20,10 @@ from stairbot.inputs.scenario import expectation_mismatches, load_scenario, pars
 
 def test_every_sensor_preset_rides_on_a_shipped_robot() -> None:
     robots = [load_config(name) for name in shipped_configs()]
-    used = {r.sensors.front_model for r in robots} | {r.sensors.back_model for r in robots}
-    assert used == {"ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"}
+    used = {model for r in robots for model in (r.sensors.front_model, r.sensors.back_model,
+                                                r.sensors.side_model)} - {"none"}
+    assert used == {"ideal", "vl53l5cx", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"}
+    assert "vl53l1x" in {r.sensors.side_model for r in robots}  # landings' side pair
 
 
 @pytest.mark.parametrize("name", shipped_configs())
@@ -96,7 +98,7 @@ def test_the_sonar_robot_places_each_edge_where_its_pair_crossed_it() -> None:
     edge_clearance_m from where it saw the drop, the robot tipped back.
     The edge is now placed where the pair crossed it (edge_sight_m), and
     segment 3's front wheels stop clear of the edge's corner."""
-    from stairbot.control.algorithm.edge import edge_clearance_m, edge_sight_m
+    from stairbot.control.algorithm.edge_measure import edge_clearance_m, edge_sight_m
     sonar, reference = load_config("sonar"), load_config("reference")
     full = sonar.motors.wheel_speed * sonar.wheel_circumference
     # backing at full speed: its latency, then half a period and two more
@@ -220,7 +222,7 @@ def test_the_sonar_robot_places_the_riser_on_many_readings_not_one() -> None:
     lifting segment 3 over the step pitched the robot 15° nose up.  The
     approach now places the riser by the median of its last ticks' readings
     plus the odometer."""
-    from stairbot.control.algorithm.edge import edge_clearance_m, edge_doubt_m
+    from stairbot.control.algorithm.edge_measure import edge_clearance_m, edge_doubt_m
 
     sonar = load_config("sonar")
     # and the edge: one HC-SR04 period of backing at full speed more clearance

@@ -118,7 +118,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "the boards are the same and did not restart, says where the robot "
                         "believes it is, and asks before anything moves")
     r.add_argument("--yes", action="store_true",
-                   help="with --resume: resume without asking (you have looked at the robot)")
+                   help="answer yes for a headless run: let the robot limp home on the "
+                        "sensors that remain if one is lost on the stairs (else it stays "
+                        "stopped, lifts holding); with --resume: resume without asking (you "
+                        "have looked at the robot)")
     r.add_argument("--discard-journal", action="store_true",
                    help="start a new run although the journal holds one that did not finish "
                         "(you have checked the robot stands at a start position again); the "

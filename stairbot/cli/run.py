@@ -233,7 +233,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         try:
             with _ctrl_c_stops(control.request_stop, session.robot.estop):
                 result = run(session, config, sink=sink, mode=mode, control=control,
-                             controller=controller, journal=journal, tap=tap)
+                             controller=controller, journal=journal, tap=tap,
+                             limp_home=args.yes)
         except KeyboardInterrupt:
             session.robot.estop()
             session.robot.stop_all()

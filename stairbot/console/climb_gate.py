@@ -27,6 +27,10 @@ from stairbot.run.runner import RunResult
 CLIMB_FLOWS = ("ascent", "descent", "landing")
 
 
+HOME = ("completed", "came_home_degraded")
+"""The outcomes that end a run where it began (a limp home's too)."""
+
+
 @dataclass(frozen=True)
 class MidClimb:
     """Why the robot is believed to stand part way up: ``lines`` for the
@@ -39,7 +43,7 @@ def after_run(result: RunResult, last_flow: str, last_label: str) -> MidClimb | 
     """Mid-climb after a run that ended with ``result`` whose last phase
     before the end was ``last_label`` in ``last_flow``; None when it completed
     or never left calibration."""
-    if result.outcome == "completed" or last_flow not in CLIMB_FLOWS:
+    if result.outcome in HOME or last_flow not in CLIMB_FLOWS:
         return None
     why = f": {result.error}" if result.error else ""
     return MidClimb((f"the last run ended ({result.outcome}{why})",
@@ -67,7 +71,7 @@ def from_journal(path: Path | None, boards: dict[str, dict[str, int]] | None) ->
         then = was.get(name)
         if isinstance(then, dict) and then.get("serial") != now.get("serial"):
             return None
-    if state.end is not None and state.end.get("outcome") == "completed":
+    if state.end is not None and state.end.get("outcome") in HOME:
         return None
     phase = BY_VALUE.get(str(state.last.get("phase")))
     if phase is None or phase.flow == "calibration":

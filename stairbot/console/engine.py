@@ -21,6 +21,7 @@ from stairbot.console.climb_gate import MidClimb, after_run
 from stairbot.console.robot_holder import LATCH_HINT, OpenFn, RobotHolder, default_open
 from stairbot.console.state import LiveState
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.lost import awaits_consent
 from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import StairbotError
 from stairbot.events import Event, EventKind, EventSink
@@ -88,7 +89,8 @@ def describe_result(result: RunResult) -> tuple[str, str]:
     if result.ascent_end:
         parts.append(result.ascent_end.replace("_", " "))
     parts.append(f"climbed {result.steps_climbed}, descended {result.steps_descended}")
-    severity = {"completed": "good", "stopped": "warning"}.get(result.outcome, "error")
+    severity = {"completed": "good", "stopped": "warning",
+                "came_home_degraded": "warning"}.get(result.outcome, "error")
     return " · ".join(parts), severity
 
 
@@ -192,7 +194,10 @@ class ConsoleEngine(RobotHolder):
         if session is None or self.in_process or scenario is None:
             return RunPlan()
         if resume is not None:
-            resumed = carry_on(resume, session, self.config, self._sink)
+            # the resume's lines say a degraded stop resumes limping home: the
+            # operator who confirms it consents to that (as `--resume` and y do)
+            resumed = carry_on(resume, session, self.config, self._sink,
+                               limp_home=awaits_consent(resume.context))
             return RunPlan(resumed.journal, resumed.controller)
         return RunPlan(start_journal(default_path(session.url), session.url, session,
                                      self.config, scenario.name, _mode(mode)))

@@ -10,7 +10,9 @@ tick repeats its last value, and the board says how old it is
   only when CONFIRM measurements in a row agree on the new one (hysteresis):
   a dropout, a spike or a lone "out of range" decides nothing.
 * **distance**: the median of the last WINDOW OK measurements (5) -- no
-  two outliers among them move it.  The front sensors look
+  two outliers among them move it.  While the kind seen is not OK, only the
+  current run of OK measurements is kept: a lone OK one among out-of-range
+  ones is a stray, and must not be in the median when OK comes back.  The front sensors look
   along the drive: each older measurement is carried forward by the distance
   the wheels have driven since it was taken, so the median of a moving robot
   is today's distance.
@@ -165,6 +167,11 @@ class Perception:
             kind = Kind.NEAR if reading.distance_m < track.midpoint else Kind.FAR
         else:
             kind = Kind.ERROR
+        if kind is not Kind.OK and track.kind is not Kind.OK:
+            # OK measurements since the kind seen left OK that a bad one ends
+            # came too few in a row to bring OK back: lone strays, not for
+            # the median when it comes back
+            track.ok_keys.clear()
         track.newest, track.taken_s = reading, taken
         track.last_of_kind[kind] = reading
         if kind is track.run_kind:

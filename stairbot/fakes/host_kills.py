@@ -55,6 +55,18 @@ POINTS = ("first", "middle", "last")
 """Where in a phase's ticks the host is killed."""
 
 
+class EndedBeforeKill(Exception):
+    """The run to be killed ended first: the flight in lockstep is the same
+    every time, so the wire (a reply later than the host's timeout on a
+    machine past its cores) or the code changed it."""
+
+    def __init__(self, ticks: int, tick: int, outcome: str, error: str | None,
+                 fell: bool) -> None:
+        self.fell = fell
+        super().__init__(f"the run ended ({outcome}{': ' + error if error else ''}) after "
+                         f"{ticks} ticks, before tick {tick}")
+
+
 @dataclass
 class Killed:
     """A host killed on fake boards: the boards (latched by now), its
@@ -83,7 +95,7 @@ def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
     :func:`~stairbot.run.journaled.default_path`), the host killed after tick
     ``tick``, the world run on
     :data:`HOST_DEAD_S` and the boards listening again; closed when the
-    block ends.  AssertionError when the run ends before that tick."""
+    block ends.  EndedBeforeKill when the run ends before that tick."""
     config = load_config()
     scenario = parse_scenario(SCENARIO, "<host kills>")
     world = make_world(config, scenario, lockstep=True)
@@ -105,11 +117,11 @@ def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
                 raise HostKilled
 
         try:
-            run(session, config, on_tick=kill, journal=writer)
+            result = run(session, config, on_tick=kill, journal=writer)
         except HostKilled:
             pass
         else:
-            raise AssertionError(f"the run ended after {ticks} ticks, before tick {tick}")
+            raise EndedBeforeKill(ticks, tick, result.outcome, result.error, result.fell)
         finally:
             writer.close()
             with contextlib.suppress(HardwareError):
@@ -196,11 +208,17 @@ def run_kill(wire: str, phase: str, point: str, workdir: Path | None = None) -> 
     with contextlib.ExitStack() as stack:
         if workdir is None:
             workdir = Path(stack.enter_context(tempfile.TemporaryDirectory()))
-        with killed_host(wire, workdir / "journal.jsonl", kill_tick(wire, phase, point)) as k:
-            if k.last_phase() != phase:
-                cell.reason = f"killed in {k.last_phase()}, not {phase}"
-            else:
-                taken = resume_watched(k.boards, k.config, k.journal)
-                cell.verdict, cell.reason = taken.verdict, taken.reason
+        try:
+            with killed_host(wire, workdir / "journal.jsonl",
+                             kill_tick(wire, phase, point)) as k:
+                if k.last_phase() != phase:
+                    cell.reason = f"killed in {k.last_phase()}, not {phase}"
+                else:
+                    taken = resume_watched(k.boards, k.config, k.journal)
+                    cell.verdict, cell.reason = taken.verdict, taken.reason
+        except EndedBeforeKill as exc:
+            # not a kill: safe unless the run fell
+            cell.verdict = "UNSAFE" if exc.fell else "not killed"
+            cell.reason = str(exc)
     cell.wall_s = time.perf_counter() - t0
     return cell

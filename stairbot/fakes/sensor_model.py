@@ -78,7 +78,8 @@ class SensorModel:
     (ranges, resolution) or "the scenario's" (noise_a)."""
 
     name: str
-    fov_deg: float = 0.0  # full angle of the cone
+    fov_deg: float = 0.0  # full angle of the cone (of a rectangle: up and down)
+    fov_across_deg: float | None = None  # a rectangle's full angle across; None: a round cone
     rays: int = 1  # rays across the cone in the side view (vertical spread)
     rays_across: int = 1  # rays across it in the top view (front sensors only)
     aggregate: Literal["nearest", "weighted"] = "nearest"
@@ -106,7 +107,10 @@ class SensorModel:
     def cone(self) -> tuple[ConeRay, ...]:
         """The rays of a forward sensor's cone: a grid of ``rays`` x
         ``rays_across`` angles within the circle of half-angle fov/2, each
-        weighted 1 on the axis falling to 0.5 at the rim."""
+        weighted 1 on the axis falling to 0.5 at the rim; or, with
+        ``fov_across_deg``, a rectangle of them fov tall and fov_across wide,
+        each weighted 1 (a multizone sensor's block of zones, every direction
+        in it counted alike)."""
         return self._grid(self.rays_across)
 
     @cached_property
@@ -136,10 +140,13 @@ class SensorModel:
     def _grid(self, across: int) -> tuple[ConeRay, ...]:
         half = math.radians(self.fov_deg) / 2.0
 
-        def spread(n: int) -> list[float]:
+        def spread(n: int, half: float = half) -> list[float]:
             return [0.0] if n <= 1 or half == 0.0 else [
                 -half + 2.0 * half * i / (n - 1) for i in range(n)]
 
+        if self.fov_across_deg is not None:
+            wide = spread(across, math.radians(self.fov_across_deg) / 2.0)
+            return tuple((a, b, 1.0) for a in spread(self.rays) for b in wide)
         out: list[ConeRay] = []
         for a in spread(self.rays):
             for b in spread(across):

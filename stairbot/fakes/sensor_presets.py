@@ -7,12 +7,13 @@ figures, cited there); here is what only a simulation needs, each figure
 saying where it comes from: how many rays stand for the cone, how they
 combine, outlier and dropout rates ("assumed": the datasheets do not give
 them, and they are deliberately modest), weak-signal and incidence limits.
-The robot config may narrow a cone (a ToF's ROI) and tilt a mount:
-:func:`model_for`.
+The robot config may narrow a cone (a ToF's ROI), choose a multizone
+sensor's rows of zones, and tilt a mount: :func:`model_for`.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -62,7 +63,28 @@ HCSR04 = _from(specs.HCSR04, rays=7, rays_across=3, aggregate="nearest",
 GP2Y0A21 = _from(specs.GP2Y0A21, rays=3, rays_across=1, aggregate="weighted",
                  outlier_rate=0.002)
 
-PRESETS: dict[str, SensorModel] = {m.name: m for m in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21)}
+# VL53L5CX, 8x8: the sensor board publishes, per sensor, one distance from a
+# block of zones -- the robot config's rows (front_fov_deg tall, its axis
+# front_tilt_deg up on a level mount; config_checks keeps them on the grid)
+# by the two central columns, 11.25 degrees across.  Each zone is a rectangle
+# of rays, two per zone and one more at the far edge each way (3 up a row,
+# 5 across two columns), the rows' zones mixed as the VL53L1X's cone
+# ("weighted"): pessimistic, since the sensor can tell targets apart within
+# a zone.  Zones are taken with hard edges (AN5894: a zone's edge is a
+# convention; their blur is not modelled).  Assumed: weak beyond 3 m (ST
+# quotes 4 m for the sensor); 0.2 % outliers and 0.5 % dropouts (a target
+# status other than valid), as the VL53L1X.
+VL53L5CX_COLUMNS = 2
+"""Central columns of zones the board publishes."""
+RAYS_PER_ZONE = 2
+
+VL53L5CX = _from(specs.VL53L5CX, fov_across_deg=VL53L5CX_COLUMNS * specs.VL53L5CX.zone_deg,
+                 rays=RAYS_PER_ZONE * specs.VL53L5CX.zones + 1,
+                 rays_across=RAYS_PER_ZONE * VL53L5CX_COLUMNS + 1, aggregate="weighted",
+                 outlier_rate=0.002, dropout_rate=0.005, weak_range=3.0)
+
+PRESETS: dict[str, SensorModel] = {m.name: m for m in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21,
+                                                       VL53L5CX)}
 
 
 def preset(name: str) -> SensorModel:
@@ -81,8 +103,43 @@ def model_for(sensors: Sensors, back: bool) -> SensorModel:
     fov = sensors.back_fov_deg if back else sensors.front_fov_deg
     tilt = sensors.back_tilt_deg if back else sensors.front_tilt_deg
     model = preset(name)
-    if fov is not None:
+    zone = specs.SPECS[name].zone_deg
+    if fov is not None and zone > 0.0:  # rows of zones: the rays per zone the preset has
+        model = replace(model, fov_deg=fov, rays=RAYS_PER_ZONE * round(fov / zone) + 1)
+    elif fov is not None:
         model = replace(model, fov_deg=fov)
     if tilt:
         model = replace(model, tilt_deg=tilt)
     return model
+
+
+ROW_SWITCH_PITCH_DEG = 2.0
+"""Pitched nose down by more than this (segment 2, as the sensor board's IMU
+reads it), the board publishes a multizone pair's block of zones moved up
+by whole rows (:func:`rows_up`): a level row pitched down looks at the
+tread or floor ahead (5 degrees down from 3 cm: 0.34 m), as happens from
+ascent 5 to 7.  Within it, the lowest rays meet the floor beyond 0.86 m at
+a grazing angle: too weak a return to read."""
+
+
+def rows_up(pitch_deg: float, zone_deg: float) -> int:
+    """Rows the board moves a block of zones up at ``pitch_deg`` (+ nose
+    up): none within :data:`ROW_SWITCH_PITCH_DEG` of level, else one per
+    ``zone_deg`` of nose-down pitch beyond it, rounded up."""
+    if pitch_deg >= -ROW_SWITCH_PITCH_DEG:
+        return 0
+    return math.ceil((-pitch_deg - ROW_SWITCH_PITCH_DEG) / zone_deg)
+
+
+def front_blocks(sensors: Sensors) -> tuple[SensorModel, ...]:
+    """The front pair's model as mounted (:func:`model_for`), then, for a
+    multizone sensor, the same block moved up 1, 2, ... rows while it stays
+    within the sensor's field: what :func:`rows_up` chooses from."""
+    model = model_for(sensors, back=False)
+    spec = specs.SPECS[sensors.front_model]
+    if not spec.zones:
+        return (model,)
+    top = model.tilt_deg + model.fov_deg / 2.0
+    return tuple(replace(model, tilt_deg=model.tilt_deg + k * spec.zone_deg)
+                 for k in range(spec.zones)
+                 if top + k * spec.zone_deg <= spec.fov_deg / 2.0 + 1e-6)

@@ -6,7 +6,9 @@ and SBR/SBL (under segment 3, looking down) from the pymunk side view
 (:mod:`stairbot.fakes.world`) and the top view (:mod:`stairbot.fakes.plan`)
 through the sensor models (:mod:`stairbot.fakes.sensor_model`, one preset per
 pair from the config's ``[sensors] front_model`` / ``back_model``; the cones'
-rays are cast by :mod:`stairbot.fakes.beams`).  A robot with the side pair
+rays are cast by :mod:`stairbot.fakes.beams`; a multizone front pair's board
+publishes its block of zones moved up a row or more while segment 2 pitches
+nose down, :func:`~stairbot.fakes.sensor_presets.rows_up`).  A robot with the side pair
 (``[sensors] side_model``) also reads SSR/SSL: one level ray each from
 segment 3 (``side_from_rear`` from its rear, ``side_height`` above its wheels'
 contact line: lifting segment 3 raises them), square to the heading, to the
@@ -33,8 +35,8 @@ from stairbot.errors import ScenarioError
 from stairbot.fakes.beams import down_fans, front_hits, total_weight
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.plan import Plan
-from stairbot.fakes.sensor_model import Hit, ModelSensor, combine
-from stairbot.fakes.sensor_presets import model_for, preset
+from stairbot.fakes.sensor_model import Hit, ModelSensor, SensorModel, combine
+from stairbot.fakes.sensor_presets import front_blocks, model_for, preset, rows_up
 from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.inputs.config import RobotConfig
@@ -92,6 +94,10 @@ class SimSensors:
                                         "([sensors] side_model): the fault would do nothing; "
                                         "allowed: SFR, SFL, SBR, SBL, or a robot with the pair")
         self.front_model, self.back_model = model_for(s, back=False), model_for(s, back=True)
+        # a multizone pair's block of zones, and the same moved up row by row,
+        # which the board publishes while pitched nose down (rows_up)
+        self._front_blocks = front_blocks(s)
+        self._zone_deg = s.spec(back=False).zone_deg
         self.sensors = {
             sid: ModelSensor(sid, model, lo, hi, s.resolution, n.noise, n.seed, scenario.faults,
                              n.outliers)
@@ -185,7 +191,7 @@ class SimSensors:
         """What SFR and SFL publish at ``t``: one ray each for a single-ray model,
         else their cones, cast only when a measurement is due."""
         right, left = self._pairs[0]
-        model = self.front_model
+        model = self._front_block()
         if self._front_single:
             sfr, sfl = self._front_truth()
             now = right.measure(sfr, t), left.measure(sfl, t)
@@ -240,7 +246,7 @@ class SimSensors:
         model, else the cone combined as the model combines it (None: nothing,
         or too weak an echo).  The sweep's verdict asks this of the start pose
         (is the first riser in sight?)."""
-        model = self.front_model
+        model = self._front_block()
         if model.single_ray:
             return self._front_truth()
         mx, my, a1, _c, _s, forward = self._front_origin()
@@ -248,6 +254,16 @@ class SimSensors:
                           self._front_laterals, self._front_mount[2])
         right, left = (combine(model, seen, self._front_weight)[0] for seen in hits)
         return right, left
+
+    def _front_block(self) -> SensorModel:
+        """The front model as the board publishes it now: a multizone pair's
+        block moved up by :func:`rows_up` rows at segment 2's pitch (as far
+        as the field goes); any other, as mounted."""
+        blocks = self._front_blocks
+        if len(blocks) == 1:
+            return blocks[0]
+        up = rows_up(self.world.pitch_deg(IMU_SEGMENT), self._zone_deg)
+        return blocks[min(up, len(blocks) - 1)]
 
     def _front_origin(self) -> tuple[float, float, float, float, float, float]:
         """The front mount in the side view (x, y), segment 1's angle, its cos

@@ -5,6 +5,7 @@ allowed."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -97,6 +98,7 @@ def check_consistency(cfg: RobotConfig, min_step_rise_m: Callable[[RobotConfig],
                               f"{fov} degrees, but the {s.spec(back).name} model is one ray; "
                               "allowed: 0, one ray along the mount (say so when the config "
                               "it extends gives a cone)")
+    check_zones(cfg)
     if a.SAFE_DISTANCE_IN_FRONT_OF_STEP <= a.approach_gap:
         raise ConfigError(src, "algorithm.SAFE_DISTANCE_IN_FRONT_OF_STEP",
                           f"must exceed approach_gap ({a.approach_gap} m)")
@@ -122,3 +124,54 @@ def check_consistency(cfg: RobotConfig, min_step_rise_m: Callable[[RobotConfig],
     if a.LENGTH_OF_INFINITY <= cfg.LENGTH_OF_A_ROBOT + a.SAFE_LENGTH:
         raise ConfigError(src, "algorithm.LENGTH_OF_INFINITY",
                           "must exceed LENGTH_OF_A_ROBOT + SAFE_LENGTH")
+
+
+ZONE_GRID_TOLERANCE_DEG = 1e-6
+"""How near a block of zones' edges must lie to the grid's lines."""
+
+
+def check_zones(cfg: RobotConfig) -> None:
+    """Raise ConfigError unless a multizone sensor (one whose datasheet gives
+    ``zones``) is on the front pair only, mounted level, with the rows it
+    publishes on its grid: ``front_fov_deg`` a whole number of rows tall,
+    ``front_tilt_deg`` the block's axis, its lowest ray level or above
+    (lower, it meets the floor ahead, which reads as a riser)."""
+    src, s = cfg.source, cfg.sensors
+    for field, model, spec in (("back_model", s.back_model, s.spec(back=True)),
+                               ("side_model", s.side_model, s.side_spec())):
+        if spec.zones:
+            raise ConfigError(src, f"sensors.{field}",
+                              f"{model!r}: a multizone sensor is modelled on the front pair "
+                              "only (a block of its zones looking forward); allowed: a "
+                              "single-zone model here")
+    spec = s.spec(back=False)
+    if not spec.zones:
+        return
+    zone, full = spec.zone_deg, spec.fov_deg
+    fov = full if s.front_fov_deg is None else s.front_fov_deg
+    rows = fov / zone
+    if round(rows) < 1 or abs(rows - round(rows)) * zone > ZONE_GRID_TOLERANCE_DEG:
+        allowed = ", ".join(f"{k * zone:g}" for k in range(1, spec.zones + 1))
+        raise ConfigError(src, "sensors.front_fov_deg",
+                          f"{fov:g} degrees is not a whole number of the {spec.name}'s "
+                          f"{zone:g}-degree rows of zones; allowed: {allowed}")
+    bottom, top = s.front_tilt_deg - fov / 2.0, s.front_tilt_deg + fov / 2.0
+    lines = (bottom + full / 2.0) / zone  # the block's lowest edge, in rows from the grid's
+    if (abs(lines - round(lines)) * zone > ZONE_GRID_TOLERANCE_DEG
+            or bottom < -full / 2.0 - ZONE_GRID_TOLERANCE_DEG
+            or top > full / 2.0 + ZONE_GRID_TOLERANCE_DEG):
+        first = -full / 2.0 + fov / 2.0
+        raise ConfigError(src, "sensors.front_tilt_deg",
+                          f"{s.front_tilt_deg:g} degrees puts the {fov:g}-degree block off the "
+                          f"{spec.name}'s grid of {zone:g}-degree rows (mounted level, from "
+                          f"{-full / 2.0:g} to {full / 2.0:g} degrees); allowed: {first:g} "
+                          f"plus a whole number of {zone:g} up to {-first:g} (the block's "
+                          "axis)")
+    if bottom < -ZONE_GRID_TOLERANCE_DEG:
+        floor = s.front_height / math.tan(math.radians(-bottom))
+        raise ConfigError(src, "sensors.front_tilt_deg",
+                          f"{s.front_tilt_deg:g} degrees: the block's lowest rays look "
+                          f"{-bottom:g} degrees down and meet the floor {floor:.3f} m ahead "
+                          f"of a sensor {s.front_height:g} m above it (front_height), which "
+                          f"reads as a riser; allowed: at least {fov / 2.0:g} (half of "
+                          "front_fov_deg: the lowest ray level)")

@@ -28,7 +28,7 @@ Rise = Annotated[float, msgspec.Meta(ge=0.005, le=1.0)]
 Tread = Annotated[float, msgspec.Meta(ge=0.01, le=10.0)]
 Seconds = Annotated[float, msgspec.Meta(ge=0, le=86400.0)]
 SensorName = Literal["SFR", "SFL", "SBR", "SBL", "SSR", "SSL"]
-Outcome = Literal["completed", "stopped", "error", "fell"]
+Outcome = Literal["completed", "stopped", "error", "fell", "came_home_degraded"]
 AscentEnd = Literal["top_reached", "obstacle", "step_limit", "landing_closed",
                     "landing_too_small"]
 

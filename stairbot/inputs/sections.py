@@ -23,7 +23,7 @@ Mass = Annotated[float, msgspec.Meta(ge=0.001, le=1000.0)]
 TurnsPerSecond = Annotated[float, msgspec.Meta(ge=0.01, le=1000.0)]
 
 # The kinds of distance sensor (stairbot.inputs.sensor_specs; the names must agree)
-SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21"]
+SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21", "vl53l5cx"]
 
 
 class Geometry(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

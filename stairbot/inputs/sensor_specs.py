@@ -39,6 +39,14 @@ class SensorSpec:
     first_echo: bool = False
     """It reports the nearest surface anywhere in its cone (an ultrasonic
     ranger's first echo), not a mean over the cone."""
+    zones: int = 0
+    """A multizone sensor's zones along each side of its square field (8: an
+    8x8 grid, each zone ``fov_deg / zones`` square); 0: one zone, the cone."""
+
+    @property
+    def zone_deg(self) -> float:
+        """The angle of one zone (0: not a multizone sensor)."""
+        return self.fov_deg / self.zones if self.zones else 0.0
 
     def sigma(self, distance_m: float, stated_noise: float) -> float:
         """The stated sigma of a reading at ``distance_m``."""
@@ -91,4 +99,22 @@ GP2Y0A21 = SensorSpec(name="gp2y0a21", period_s=0.0383, latency_s=0.0383, noise_
                       noise_b=0.02, resolution=0.001, min_range=0.10, max_range=0.80,
                       fov_deg=4.0)
 
-SPECS: dict[str, SensorSpec] = {s.name: s for s in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21)}
+# ST VL53L5CX multizone time-of-flight ranger, 8x8 zones.
+# - ST product text (the VL53L5CX page, quoted in the SparkFun and
+#   ironsheep driver repositories): 8x8 zones, a 63-degree diagonal square
+#   field of view, ranging up to 400 cm, several targets per zone.  Taken as
+#   45 x 45 degrees, zones of 5.625 (derived: ST's diagonal is the side times
+#   sqrt 2, 63.6; the VL53L8CX, whose user manual UM3109 states a 45 x 45
+#   square, is quoted at 65 diagonal in DS14161).
+# - ST ULD API (STSW-IMG023) example 1: "Using 8x8, min frequency is 1Hz and
+#   max is 15Hz": a frame every 1/15 s, published at the frame's end
+#   (latency one period, as the VL53L1X here).
+# - Assumed (the datasheet DS13754's accuracy table and minimum distance
+#   were not retrieved): sigma = 3 mm + 0.5 % of the distance, as the
+#   VL53L1X; from 2 cm; reported in mm.
+VL53L5CX = SensorSpec(name="vl53l5cx", period_s=1.0 / 15.0, latency_s=1.0 / 15.0,
+                      noise_a=0.003, noise_b=0.005, resolution=0.001, min_range=0.02,
+                      max_range=4.0, fov_deg=45.0, zones=8)
+
+SPECS: dict[str, SensorSpec] = {s.name: s for s in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21,
+                                                   VL53L5CX)}

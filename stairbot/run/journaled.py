@@ -28,6 +28,7 @@ from typing import TextIO
 from stairbot.control.algorithm import limits
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.controller import Controller
+from stairbot.control.algorithm.lost import awaits_consent
 from stairbot.control.algorithm.phases import Mode
 from stairbot.events import EventSink
 from stairbot.hardware import HasAttitude, HoldsLatches, Imu, Robot
@@ -185,6 +186,10 @@ def plan_resume(path: Path | None, url: str, session: RobotSession,
     if isinstance(robot, HasAttitude):
         check_attitude(url, robot.attitude(), config)
     lines = describe(state)
+    if awaits_consent(context) and context.limp is not None:
+        lines.append(f"a sensor was lost ({', '.join(context.limp.lost)}) in "
+                     f"{context.limp.where}: resuming lets the robot limp home on the "
+                     "sensors that remain")
     latched = _latches(robot)
     if latched:
         lines.append(f"the boards hold latches ({len(latched)} board(s)); resuming "
@@ -223,16 +228,17 @@ def check_attitude(url: str, imu: Imu | None, config: RobotConfig) -> None:
 
 
 def carry_on(plan: ResumePlan, session: RobotSession, config: RobotConfig,
-             sink: EventSink) -> Resumed:
-    """Once the operator has confirmed ``plan``: the restored controller and
-    the journal, appended to (its resume record written), and only then the
+             sink: EventSink, limp_home: bool = False) -> Resumed:
+    """Once the operator has confirmed ``plan``: the restored controller
+    (``limp_home``: consent to limp home if a sensor is lost) and the
+    journal, appended to (its resume record written), and only then the
     boards' latches cleared."""
     robot = session.robot
     now = session.clock.now()
     state = plan.state
     ctx = restored_context(state, now, config.algorithm.max_steps)
     mode = Mode(state.start.get("mode", Mode.FULL.value))
-    controller = Controller(config, sink, mode, context=ctx)
+    controller = Controller(config, sink, mode, context=ctx, limp_home=limp_home)
     writer = JournalWriter(plan.path, fresh=False, tail=state.tail)
     try:
         writer.resume(str(state.start["run_id"]), board_identity(robot), now)
@@ -251,14 +257,17 @@ def resume(path: Path | None, url: str, session: RobotSession, config: RobotConf
     believes it is, and -- once the operator confirms (``yes``, or
     ``confirm`` answers the question true; ``stairbot run`` asks on the
     terminal) -- clear the boards' latches and hand back the restored
-    controller.  ResumeRefused (one line) otherwise; nothing has moved then."""
+    controller (``yes`` also consents to limp home if a sensor is lost).
+    ResumeRefused (one line) otherwise; nothing has moved then."""
     plan = plan_resume(path, url, session, config)
     for line in plan.lines:
         print(f"resume: {printable(line)}", file=out)
     out.flush()
+    home = awaits_consent(plan.context)
     question = ("Look at the robot: does it stand where the lines above say?  Resume and "
-                "let it move? [y/N] ")
+                + ("let it limp home? [y/N] " if home else "let it move? [y/N] "))
     if not yes and not confirm(question):
         raise NotConfirmed("not resumed: no confirmation (answer y on a terminal, or add "
                            "--yes); nothing moved")
-    return carry_on(plan, session, config, sink)
+    # confirming the resume of a degraded stop is consenting to limp home
+    return carry_on(plan, session, config, sink, limp_home=yes or home)

@@ -19,6 +19,7 @@ from typing import Any, Literal
 
 from stairbot.clock import CountsLateTicks, HostBehind
 from stairbot.control.algorithm.controller import Controller, phase_timeout_s
+from stairbot.control.algorithm.lost import awaits_consent
 from stairbot.control.algorithm.phases import Mode
 from stairbot.errors import HardwareError, LinkLostError, OutputError, RobotFellError
 from stairbot.events import Event, EventKind, EventSink, discard
@@ -111,7 +112,7 @@ class RunControl:
 class RunResult:
     """The summary of one run (``stairbot run --json`` prints ``to_dict()``)."""
 
-    outcome: str  # completed | stopped | error | fell
+    outcome: str  # completed | stopped | error | fell | came_home_degraded
     ascent_end: str | None
     steps_climbed: int
     steps_descended: int
@@ -157,6 +158,10 @@ class RunResult:
         return out
 
 
+_HOME = ("completed", "stopped", "came_home_degraded")
+"""The outcomes that leave the robot where the program began (or, stopped,
+where it was asked to stop): every other latches the emergency stop."""
+
 def run(
     session: RobotSession,
     config: RobotConfig,
@@ -170,6 +175,7 @@ def run(
     on_tick: Callable[[Controller, Snapshot], None] | None = None,
     journal: JournalWriter | None = None,
     tap: TickTap | None = None,
+    limp_home: bool = False,
 ) -> RunResult:
     """Run the program on ``session`` until the controller finishes.
 
@@ -179,6 +185,9 @@ def run(
     emergency stop (``robot.estop()``): boards keep it until cleared.
     ``on_tick(controller, snapshot)`` is called after each tick (for a console);
     ``tap(snapshot, sent)`` too, with the speeds sent (for a record).
+    ``limp_home``: the operator's consent, given before the run, to limp home
+    on the sensors that remain when one is lost on the stairs (a controller
+    given as ``controller`` has its own).
     A run longer than ``max_sim_time_s`` of robot time ends with an error (by
     default an hour, or 60 phase timeouts for a robot whose slow motors make
     that longer).  Fell, pitch and offset in the result come from the robot's
@@ -188,7 +197,7 @@ def run(
     an OutputError -- ends the run with an error, the robot stopped.
     """
     robot, clock = session.robot, session.clock
-    ctl = controller or Controller(config, sink, mode)
+    ctl = controller or Controller(config, sink, mode, limp_home=limp_home)
     if max_sim_time_s is None:
         max_sim_time_s = max(3600.0, 60 * phase_timeout_s(config))
     if isinstance(robot, ReportsEvents):  # wired robots report link health as LINK events
@@ -239,7 +248,7 @@ def run(
         if control is not None:  # presses the loop did not come round to
             with contextlib.suppress(HardwareError):  # a clear on a lost link
                 _latch(control, robot)
-        if fell or ctl.result.outcome not in ("completed", "stopped"):
+        if fell or ctl.result.outcome not in _HOME:
             # An error -- a fall, a lost link, the supervisor, a phase's own
             # check, anything unforeseen -- latches the emergency stop: the
             # robot may stand part way up a step, and nothing moves it until
@@ -274,9 +283,11 @@ def run(
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands
             # a lost link stopped the program, not the program itself: the
-            # journal offers --resume once the wire is back
+            # journal offers --resume once the wire is back; so does a degraded
+            # stop the operator did not consent to limp home from (yet)
             journal.end(result.outcome, result.error, clock.now(),
-                        resumable=fault == "link" and not fell)
+                        resumable=(fault == "link" or awaits_consent(ctl.context))
+                        and not fell)
     sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
 

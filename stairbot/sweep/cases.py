@@ -131,7 +131,8 @@ def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) 
             for k in ("count", "rise", "tread"):
                 scen.setdefault("stairs", {}).pop(k, None)
         try:
-            _set(target, sub, value)
+            # a copy: a later axis may set a field inside it (faults, then faults[0].at)
+            _set(target, sub, copy.deepcopy(value))
         except IndexError as exc:
             raise SpecError(spec.source, f"axes.{path}", str(exc)) from None
     _jitter(spec, index, scen.setdefault("stairs", {}), values)

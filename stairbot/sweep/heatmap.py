@@ -15,8 +15,10 @@ from stairbot.sweep.verdict import SEVERITY, VERDICTS
 from stairbot.text import printable
 
 COLOURS = {"climbed": "#2ca02c", "descended": "#17becf", "refused": "#1f77b4",
+           "came_home": "#8c564b",
            "stranded": "#ffbf00", "wrong": "#b03ab0", "unsafe": "#d62728", "error": "#000000"}
-LETTERS = {"climbed": "C", "descended": "D", "refused": "R", "stranded": "S", "wrong": "W",
+LETTERS = {"climbed": "C", "descended": "D", "refused": "R", "came_home": "H", "stranded": "S",
+           "wrong": "W",
            "unsafe": "U", "error": "E"}
 RISE_AXES, TREAD_AXES = ("stairs.rise", "max_rise_m"), ("stairs.tread", "min_tread_m")
 COMFORT = (0.59, 0.65)  # 2R + T, m: DIN 18065 / IBC / IRC comfort rule (docs/envelope.md)

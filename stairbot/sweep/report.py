@@ -26,7 +26,8 @@ from stairbot.sweep import heatmap
 from stairbot.sweep.verdict import SEVERITY, VERDICTS
 from stairbot.text import printable
 
-STYLE = {"climbed": "green", "descended": "cyan", "refused": "blue", "stranded": "yellow",
+STYLE = {"climbed": "green", "descended": "cyan", "refused": "blue", "came_home": "bright_green",
+         "stranded": "yellow",
          "wrong": "magenta", "unsafe": "red", "error": "bold red"}
 
 

@@ -139,7 +139,8 @@ class ResultStore:
     def write_failure(self, record: dict[str, Any], case: Case) -> str:
         stem = self.folder / FAILURES / f"case-{case.index:06d}"
         scen, robot = stem.with_suffix(".toml"), Path(f"{stem}.robot.toml")
-        cmd = f"stairbot run --scenario {scen}"
+        # the sweep consents to limp home on a lost sensor, as --yes does
+        cmd = f"stairbot run{' --yes' if case.facts.get('faults') else ''} --scenario {scen}"
         if case.config_text is not None:
             with writing(robot, "a failing case's robot config"):
                 robot.write_text(case.config_text, "utf-8")

@@ -28,6 +28,9 @@ Verdicts, first match wins:
                (min(steps, max_steps)), home: right inside and in the band
 * ``refused``  home, as many steps down as up, fewer than the flight: right
                outside and in the band, and wherever the scenario injects faults
+* ``came_home`` home, as many steps down as up, outcome ``came_home_degraded``:
+               a sensor was lost on the stairs and the robot came down on the
+               ones that remained (only where the scenario injects faults)
 * ``wrong``    inside but refused, or outside but climbed
 """
 
@@ -36,10 +39,11 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-VERDICTS = ("climbed", "descended", "refused", "unsafe", "stranded", "wrong", "error")
-PASSING = ("climbed", "descended", "refused")
+VERDICTS = ("climbed", "descended", "refused", "came_home", "unsafe", "stranded", "wrong",
+            "error")
+PASSING = ("climbed", "descended", "refused", "came_home")
 SEVERITY = {"error": 5, "unsafe": 4, "wrong": 3, "stranded": 2, "refused": 0, "climbed": 0,
-            "descended": 0}
+            "descended": 0, "came_home": 0}
 FLOOR_CLEAR_M = 0.0
 """A continuous descent has reached the floor when the robot's front face
 stands at least this far before the first riser (the whole robot off the
@@ -71,6 +75,10 @@ def judge(result: Mapping[str, Any], facts: Mapping[str, Any],
         return "stranded", f"ended on the stairs: climbed {up}, descended {down}"
     if offset is None or offset > home_m:
         return "stranded", f"ended {offset} m from the start (home is within {home_m} m)"
+    if result.get("outcome") == "came_home_degraded":
+        if not facts.get("faults"):
+            return "wrong", f"limped home after {up} step(s) with no fault injected"
+        return "came_home", f"a sensor lost: came home on the rest after {up} step(s)"
     climbed = result.get("outcome") == "completed" and up == expected
     if climbed:
         if zone == "outside":
@@ -98,6 +106,9 @@ def judge_descent(result: Mapping[str, Any], facts: Mapping[str, Any]) -> tuple[
     zone = str(facts.get("zone", "inside"))
     clear = result.get("clear_of_stairs_m")
     outcome = result.get("outcome")
+    if outcome == "came_home_degraded" and down == count and clear is not None \
+            and clear >= FLOOR_CLEAR_M and facts.get("faults"):
+        return "came_home", f"a sensor lost: descended {down} step(s) on the rest"
     if outcome == "completed" and down == count and clear is not None \
             and clear >= FLOOR_CLEAR_M:
         if zone == "outside":

@@ -226,7 +226,7 @@ def _first_flight_zone(scenario: Scenario, config: RobotConfig, rules: Rules
 def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
                  ) -> tuple[str, float, float]:
     """A continuous descent's zone: every rise from the least drop the back
-    pair reads as one (:func:`~stairbot.control.algorithm.edge.edge_drop_m` less
+    pair reads as one (:func:`~stairbot.control.algorithm.edge_measure.edge_drop_m` less
     BACK_CLEARANCE) to max_step_rise_m, and every tread it steps down onto (all
     but the top one, which runs on into the landing it starts on) at least
     LENGTH_OF_A_ROBOT + SAFE_LENGTH (narrow steps or not), give or take the
@@ -238,7 +238,9 @@ def descent_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     before it steps down onto it: one shorter than min_tread_m it descends
     while its back pair still reads the tread after the step, and refuses
     once it reads past the next edge.)"""
-    from stairbot.control.algorithm.edge import edge_drop_m  # the sweep runs the controller anyway
+    from stairbot.control.algorithm.edge_measure import (
+        edge_drop_m,  # the sweep runs the controller anyway
+    )
 
     steps = scenario.steps
     low = edge_drop_m(config, from_top=True) - config.BACK_CLEARANCE  # the least drop seen

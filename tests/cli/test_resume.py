@@ -266,3 +266,50 @@ def test_a_resume_drops_a_line_cut_short_and_carries_the_chain_on(tmp_path: Path
     assert again.resumes == 1 and again.last["time_s"] == 5.0
     assert b'"pr{' not in path.read_bytes()
     assert json.loads(mark_path(path).read_bytes())["seq"] == 3
+
+
+LOST_MID_CLIMB = """
+[stairs]
+count = 2
+[[faults]]
+at = 42.0
+sensor = "SFR"
+kind = "error"
+"""
+
+
+def test_a_sensor_lost_mid_climb_without_consent_stops_and_resume_yes_limps_home(
+        env: dict[str, str], tmp_path: Path) -> None:
+    scenario = tmp_path / "lost.toml"
+    scenario.write_text(LOST_MID_CLIMB, "utf-8")
+    journal = tmp_path / "run.jsonl"
+    with lockstep_boards(tmp_path, env, scenario=str(scenario)) as served:
+        url = served.url
+        first = stairbot("run", "--robot", url, "--journal", str(journal), "--json",
+                         env=env, cwd=tmp_path)
+        out, err = first.communicate(timeout=600)
+        assert first.returncode == 1, err[-2000:]
+        result = json.loads(out)
+        assert result["outcome"] == "error" and result["steps_descended"] == 0
+        assert "stairbot run --resume --yes" in result["error"]
+        end = read_journal(journal).end
+        assert end is not None and end.get("resumable") is True, end
+
+        # A resume shows why, and moves nothing without the consent.
+        asked = stairbot("run", "--robot", url, "--journal", str(journal), "--resume",
+                         env=env, cwd=tmp_path)
+        out, err = asked.communicate(timeout=60)
+        assert asked.returncode == 2, err
+        assert "a sensor was lost (SFR) in ascent 7 — lift segment 3 (step 1)" in out
+
+        home = stairbot("run", "--robot", url, "--journal", str(journal), "--resume", "--yes",
+                        "--json", env=env, cwd=tmp_path)
+        out, err = home.communicate(timeout=600)
+        assert home.returncode == 1, err[-2000:]  # the default [expect]: completed
+        result = json.loads(out)
+        assert (result["outcome"], result["ascent_end"], result["steps_climbed"],
+                result["steps_descended"], result["fell"]) == (
+            "came_home_degraded", "sensor_lost", 1, 1, False), result
+        assert "limp home (consented on resuming)" in err
+        end = read_journal(journal).end
+        assert end is not None and end["outcome"] == "came_home_degraded", end

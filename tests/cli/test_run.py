@@ -200,3 +200,34 @@ def test_config_overrides_the_scenario_robot_with_a_note(
     assert main(["run", "--json", "-q", "--scenario", str(scenario), "--config", "ideal"]) == 0
     out, err = capsys.readouterr()
     assert json.loads(out)["config"] == "<robot ideal>" and "note" not in err
+
+
+LOST_MID_CLIMB = """
+[stairs]
+count = 2
+[[faults]]
+at = 42.0
+sensor = "SFR"
+kind = "error"
+[expect]
+outcome = "came_home_degraded"
+steps_climbed = 1
+steps_descended = 1
+max_final_offset_m = 0.05
+"""
+
+
+def test_yes_lets_the_robot_limp_home_on_a_sensor_lost_mid_climb(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scenario = tmp_path / "lost.toml"
+    scenario.write_text(LOST_MID_CLIMB, "utf-8")
+    assert main(["run", "--yes", "--json", "--scenario", str(scenario)]) == 0
+    out, err = capsys.readouterr()
+    data = json.loads(out)
+    assert (data["outcome"], data["ascent_end"]) == ("came_home_degraded", "sensor_lost")
+    assert "degraded stop: SFR" in err and "limp home (consented)" in err
+    assert main(["run", "--json", "--scenario", str(scenario)]) == 1
+    out, err = capsys.readouterr()
+    data = json.loads(out)
+    assert data["outcome"] == "error" and "stairbot run --yes" in data["error"]
+    assert "degraded stop: SFR" in err

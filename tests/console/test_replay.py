@@ -99,7 +99,7 @@ def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[st
         app = replay_app(path, Clock(), playing=False)
         async with app.run_test(size=(80, 24)) as pilot:
             await press(pilot, "right", "right", "right")  # 3 x 1 s
-            await until(pilot, lambda: "t = 3.0 s / 13.4 s" in app.banner.plain, "at 3 s")
+            await until(pilot, lambda: "t = 3.0 s / 13.8 s" in app.banner.plain, "at 3 s")
             s, m = at(sensors, 3.0), at(motors, 3.0)
             assert s["time_s"] == 3.0
             screen = shown(app.sensors)
@@ -113,7 +113,7 @@ def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[st
             assert app.state.view().scene is not None  # the recorded pose, drawn
             assert "recorded on sim://" in str(app.picture.border_title)
             await press(pilot, "end")
-            await until(pilot, lambda: "t = 13.4 s / 13.4 s" in app.banner.plain, "at the end")
+            await until(pilot, lambda: "t = 13.8 s / 13.8 s" in app.banner.plain, "at the end")
             last = sensors[-1]
             assert f"SFR {last['SFR']['distance_m']:5.3f} m" in shown(app.sensors)
     run(go)
@@ -221,7 +221,7 @@ def test_seek_keys_go_to_the_right_time_and_back_replays_the_events(
         async with app.run_test(size=(100, 40)) as pilot:
             await press(pilot, "end")
             end = app.player.end_s
-            assert end == events[-1]["time_s"] == 13.36
+            assert end == events[-1]["time_s"] == 13.76
             await until(pilot, lambda: len(app.log_panel._kept) == len(events), "every event")
             assert said(app) == [e["message"] for e in events]  # the whole list, in order
             await press(pilot, "left")

@@ -105,13 +105,16 @@ def test_length_of_a_robot_equal_to_the_segments_is_accepted() -> None:
          "sensors.back_height", "read from 0.1 m: the floor would be out of range"),
         (with_change("sensors", "front_model", '"gp2y0a21"'),
          "algorithm.LENGTH_OF_INFINITY", "(gp2y0a21) read at most 0.8 m"),
+        (with_change("sensors", "front_fov_deg", "50"),
+         "sensors.front_fov_deg", "wider than the vl53l5cx's 45.0-degree cone"),
         (with_change("sensors", "front_fov_deg", "40"),
-         "sensors.front_fov_deg", "wider than the vl53l1x's 27.0-degree cone"),
+         "sensors.front_fov_deg", "40 degrees is not a whole number of the vl53l5cx's "
+         "5.625-degree rows of zones; allowed: 5.625, 11.25"),
         (with_change("sensors", "front_fov_deg", "-1.0"),
          "sensors.front_fov_deg", "-1.0 is not allowed; allowed: a number >= 0 and <= 90"),
-        (with_change("sensors", "front_model", '"ideal"'),  # the 15-degree ROI left on one ray
+        (with_change("sensors", "front_model", '"ideal"'),  # the row of zones left on one ray
          "sensors.front_fov_deg",
-         "15.0 degrees, but the ideal model is one ray; allowed: 0, one ray along the mount"),
+         "5.625 degrees, but the ideal model is one ray; allowed: 0, one ray along the mount"),
         (with_change("sensors", "front_tilt_deg", "60"),
          "sensors.front_tilt_deg", "<= 45"),
     ],
@@ -148,21 +151,21 @@ def test_the_default_file_is_valid_toml_with_seed_names() -> None:
 
 def test_a_shipped_robot_by_name_and_a_config_that_extends_another(tmp_path: Path) -> None:
     reference = load_config("reference")
-    assert (reference.sensors.front_model, reference.sensors.back_model) == ("vl53l1x", "vl53l0x")
-    assert (reference.sensors.front_fov_deg, reference.sensors.front_tilt_deg) == (15.0, 7.5)
+    assert (reference.sensors.front_model, reference.sensors.back_model) == ("vl53l5cx", "vl53l0x")
+    assert (reference.sensors.front_fov_deg, reference.sensors.front_tilt_deg) == (5.625, 2.8125)
     assert reference.sensors == load_config().sensors
     ideal = load_config("ideal")
     assert (ideal.sensors.front_model, ideal.sensors.back_model) == ("ideal", "ideal")
-    assert ideal.front_cone_top_rad == 0.0  # one level ray: the ROI's cone and tilt taken back
+    assert ideal.front_cone_top_rad == 0.0  # one level ray: the row's cone and tilt taken back
     assert ideal.geometry == load_config().geometry  # the rest is the reference robot's
     mine = tmp_path / "mine.toml"
-    mine.write_text('extends = "reference"\n[sensors]\nfront_tilt_deg = 5.0\n')
+    mine.write_text('extends = "reference"\n[sensors]\nfront_tilt_deg = 8.4375\n')
     cfg = load_config(mine)
-    assert (cfg.sensors.front_model, cfg.sensors.front_tilt_deg) == ("vl53l1x", 5.0)
+    assert (cfg.sensors.front_model, cfg.sensors.front_tilt_deg) == ("vl53l5cx", 8.4375)
     beside = tmp_path / "beside.toml"
     beside.write_text('extends = "mine.toml"\n[algorithm]\nmax_steps = 3\n')
     cfg = load_config(beside)
-    assert (cfg.sensors.front_tilt_deg, cfg.algorithm.max_steps) == (5.0, 3)
+    assert (cfg.sensors.front_tilt_deg, cfg.algorithm.max_steps) == (8.4375, 3)
 
 
 @pytest.mark.parametrize(("text", "words"), [

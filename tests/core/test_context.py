@@ -18,6 +18,7 @@ from stairbot.control.algorithm.context import (
 )
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.families import Calibration, LandingTurn
+from stairbot.control.algorithm.limp import Limp
 from stairbot.control.algorithm.modes import AscentEnd, CalibrationCase, Purpose
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.work import EdgeWork, LiftWork, ProbeWork, SightWork, StandingWork
@@ -112,6 +113,7 @@ def test_every_field_round_trips_through_json() -> None:
         start=StartPosition(reading=0.2, home_twist=0.1),
         landing=Landing(step=2, side=-1), watch=Watch(3, 0.01),
         pause=Pause("cal_probe", 4.0, [0.01, 0.02]),
+        limp=Limp(["SFR"], 46.1, "ascent 7 — lift segment 3 (step 1)"),
         family=Calibration(Purpose.DESCENT, case=CalibrationCase.THREE_B, squaring_turns=1),
         work=ProbeWork(entry_wheel=3.0, probe_recent=[(0.1, 0.2)], standing=[(0.3, 0.3)]))
     ctx.tab_length_to_edge[1] = 0.14

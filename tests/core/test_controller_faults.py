@@ -9,13 +9,14 @@ from dataclasses import replace
 import pytest
 from kinematic import Fault, KinematicRobot, run
 
+from stairbot.control.algorithm import guards
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.guards import PHASE_TIMEOUT_S, SENSOR_WAIT_S, phase_timeout_s
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.perception import CONFIRM
 from stairbot.control.robot_config import load_config, parse_config
 from stairbot.events import Event, EventKind
-from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
+from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for
 STEPS = [(0.17, 0.28)] * 2
@@ -366,8 +367,11 @@ def test_a_reading_or_a_counter_that_is_not_a_number_ends_with_an_error() -> Non
 def test_a_speed_that_is_not_a_number_is_commanded_as_zero() -> None:
     ctrl, robot, _ = start()
     run(ctrl, robot, until=lambda c: c.phase is Phase.ASCENT_APPROACH)
-    limited = ctrl._limit({MotorId.MWF: math.nan, MotorId.MWB: -math.inf, MotorId.MTF: 99.0},
-                          robot.read())
+    vmax = {m: CFG.motors.lift_speed if m in LIFT_MOTORS else CFG.motors.wheel_speed
+            for m in MotorId}
+    limited = guards.limit_speeds({MotorId.MWF: math.nan, MotorId.MWB: -math.inf,
+                                   MotorId.MTF: 99.0}, robot.read(), vmax,
+                                  CFG.MAX_OF_VERTICAL_TURNS)
     assert limited[MotorId.MWF] == 0.0 and limited[MotorId.MWB] == 0.0
     assert limited[MotorId.MTF] == CFG.motors.lift_speed
 

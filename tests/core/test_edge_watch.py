@@ -6,7 +6,8 @@ from __future__ import annotations
 import pytest
 
 from stairbot.control.algorithm.context import Context
-from stairbot.control.algorithm.edge import edge_bound, edge_clearance_m, edge_doubt_m, edge_sight_m
+from stairbot.control.algorithm.edge import edge_bound
+from stairbot.control.algorithm.edge_measure import edge_clearance_m, edge_doubt_m, edge_sight_m
 from stairbot.control.algorithm.phase import Tick
 from stairbot.control.algorithm.phases import Mode, Phase
 from stairbot.control.algorithm.work import EdgeWork

@@ -57,6 +57,15 @@ def test_a_new_kind_needs_confirm_measurements_in_a_row() -> None:
     assert seen[-1].status is OOR and seen[-2].status is OK
 
 
+def test_lone_ok_strays_among_near_readings_are_not_in_the_median_when_ok_returns() -> None:
+    near = SensorReading(0.03, OOR)
+    strays = [near] * CONFIRM + [SensorReading(0.77), near, near, SensorReading(0.85), near]
+    back = [SensorReading(0.037), SensorReading(0.25), SensorReading(0.049)]
+    seen = feed(Perception(CFG), [SensorReading(0.3)] * 3 + strays + back)
+    assert seen[-2].status is OOR
+    assert seen[-1].status is OK and seen[-1].distance_m == pytest.approx(0.049)
+
+
 def test_a_repeated_measurement_counts_once() -> None:
     # a 50 ms sensor read every 20 ms: two error measurements shown over five ticks
     cfg = with_models("vl53l1x", "vl53l0x")

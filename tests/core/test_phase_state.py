@@ -23,7 +23,7 @@ SEED = ("length_of_next_step", "number_of_vertical_turns", "number_of_turns_for_
         "number_of_steps", "tab_length_to_edge")
 PROGRESS = ("phase", "phase_started_s", "from_top", "steps_descended", "pauses", "ascent_end",
             "outcome", "error", "end_reason", "tread_length", "climb_twist", "third_in_air",
-            "riser_wheel", "start", "descent", "landing", "watch", "pause")
+            "riser_wheel", "start", "descent", "landing", "limp", "watch", "pause")
 PRESENT = ("family", "work")
 
 

@@ -32,7 +32,7 @@ def model_sensor(model: SensorModel, noise: float = 0.0, seed: int = 1,
 def test_the_presets_are_the_names_the_config_allows() -> None:
     assert set(PRESETS) == set(get_args(SensorModelName))
     reference, ideal = load_config().sensors, load_config("ideal").sensors
-    assert (reference.front_model, reference.back_model) == ("vl53l1x", "vl53l0x")
+    assert (reference.front_model, reference.back_model) == ("vl53l5cx", "vl53l0x")
     assert (ideal.front_model, ideal.back_model) == ("ideal", "ideal")
     with pytest.raises(KeyError, match="allowed: ideal, vl53l1x"):
         preset("lidar")

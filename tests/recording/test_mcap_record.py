@@ -121,7 +121,8 @@ def test_the_tick_messages_say_what_the_robot_did(default_run: dict[str, Any]) -
     heights = [next(t.translation.z for t in p.decoded_message.transforms
                     if t.child_frame_id == "segment2") for p in poses]
     assert heights[0] == pytest.approx(0.016, abs=0.005)  # the axle: a wheel's radius up
-    assert max(heights) == pytest.approx(0.016 + 5 * 0.17, abs=0.01)
+    # (lifted past the top tread by the drive clearance and the sight-over's lag)
+    assert 0.016 + 5 * 0.17 - 0.005 < max(heights) < 0.016 + 5 * 0.17 + 0.02
     assert heights[-1] == pytest.approx(heights[0], abs=0.005)
     assert [t.child_frame_id for t in poses[0].decoded_message.transforms] == list(SEGMENT_FRAMES)
     assert {t.parent_frame_id for t in poses[0].decoded_message.transforms} == {"world"}

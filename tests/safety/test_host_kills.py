@@ -13,7 +13,7 @@ import pytest
 
 from stairbot.control.algorithm.work import ProbeWork, StandingWork
 from stairbot.control.robot_config import load_config
-from stairbot.fakes.host_kills import kill_tick, recorded, run_kill
+from stairbot.fakes.host_kills import EndedBeforeKill, kill_tick, killed_host, recorded, run_kill
 from stairbot.run.journal import JournalState, mark_path, read_journal
 from stairbot.run.resume import check, restored_context
 
@@ -57,3 +57,10 @@ def test_a_host_killed_inside_a_phase_is_resumed_to_the_end(
     assert kill_tick(wire, phase, point) > kill_tick(wire, phase, "first")
     cell = run_kill(wire, phase, point)
     assert cell.verdict == "resumed", cell.reason
+
+
+def test_a_run_that_ends_before_the_kill_says_how_it_ended(tmp_path: Path) -> None:
+    ended = r"the run ended \(completed\) after \d+ ticks"
+    with pytest.raises(EndedBeforeKill, match=ended), \
+            killed_host("can", tmp_path / "journal.jsonl", 10**7):
+        pass

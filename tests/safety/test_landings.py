@@ -70,7 +70,10 @@ def test_a_landing_it_cannot_turn_on_is_refused_and_the_robot_comes_home(
 def test_a_landing_too_narrow_to_turn_in_is_refused() -> None:
     """0.34 m wide: 0.17 m either side of the centre line, where the robot's
     turning circle needs 0.174 m (0.40 m deep: room enough that way)."""
-    scenario = parse_scenario(landing(width=0.34, depth=0.40), "narrow.toml")
+    # seed 2: the climb ends within the side pair's range of both walls (nearer
+    # than side_min_range to one, SSR/SSL see no flight: landing_closed)
+    scenario = parse_scenario(landing(width=0.34, depth=0.40, extra="[sensors]\nseed = 2\n"),
+                              "narrow.toml")
     events: list[Event] = []
     result = simrun.run_sim(LANDINGS, scenario, events)
     assert (result.ascent_end, result.steps_climbed, result.steps_descended) == (
@@ -152,17 +155,17 @@ FAULTS = "[[faults]]\nat = {at}\nsensor = 'SSR'\nkind = '{kind}'\n{more}"
 @pytest.mark.parametrize(("width", "turn", "fault", "end", "steps"), [
     # SSR 0.3 m long from the scan on, a flight 0.6 m wide between walls: the way
     # down backed to where the side pair said the turn was, turned back into a wall
-    (0.6, "right", FAULTS.format(at=141, kind="offset", more="offset = 0.3\n"),
+    (0.6, "right", FAULTS.format(at=143.2, kind="offset", more="offset = 0.3\n"),
      "top_reached", 6),
     # SSR (the wall's side) 1 m long from 10 mm up: read past its range at the
     # top, it was taken for the flight; the robot turned to the wall
-    (1.0, "left", FAULTS.format(at=141, kind="offset", more="offset = 1.0\n"),
+    (1.0, "left", FAULTS.format(at=143.8, kind="offset", more="offset = 1.0\n"),
      "top_reached", 6),
     # SSR failing for 3 s during the scan ended the program on the landing
-    (1.0, "left", FAULTS.format(at=145, kind="error", more="duration = 3.0\n"),
+    (1.0, "left", FAULTS.format(at=147.2, kind="error", more="duration = 3.0\n"),
      "top_reached", 6),
     # the open side's sensor failing for good during the scan: no flight seen, home
-    (1.0, "right", FAULTS.format(at=145, kind="error", more=""), "landing_closed", 3),
+    (1.0, "right", FAULTS.format(at=147.2, kind="error", more=""), "landing_closed", 3),
 ])
 def test_a_side_sensor_that_fails_or_reads_wrong_during_the_scan_is_no_reason_to_stop(
         width: float, turn: str, fault: str, end: str, steps: int) -> None:

@@ -5,6 +5,9 @@ tread by turns."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
 import simrun
 
 from stairbot.control.robot_config import load_config
@@ -12,6 +15,7 @@ from stairbot.events import Event, EventKind
 from stairbot.inputs.scenario import parse_scenario
 
 REFERENCE = load_config("reference")
+VL53L1X_FRONT = load_config(str(Path(__file__).parents[1] / "robots" / "vl53l1x_front.toml"))
 
 
 def flight(rise: float, tread: float, top: str = "landing", seed: int = 1) -> str:
@@ -23,11 +27,17 @@ def infos(events: list[Event]) -> list[str]:
     return [e.message for e in events if e.kind is EventKind.INFO]
 
 
-def test_a_long_tread_before_a_riser_the_whole_cone_sees_is_climbed_by_turns() -> None:
-    """0.17 m risers 0.7 m apart: min_rise_for(0.7) is 0.24 m, which refused
-    them before; the readings hold, and the drives go by turns."""
+@pytest.mark.parametrize(("robot", "rise"), [("reference", 0.11), ("vl53l1x_front", 0.17)])
+def test_a_long_tread_before_a_riser_the_whole_cone_sees_is_climbed_by_turns(
+        robot: str, rise: float) -> None:
+    """Risers 0.7 m apart, lower than min_rise_for(0.7) asks (0.118 m of the
+    reference robot's row of zones, 0.24 m of the VL53L1X's 15-degree cone),
+    which refused them before: the readings hold, and the drives go by
+    turns."""
+    config = REFERENCE if robot == "reference" else VL53L1X_FRONT
+    assert rise < config.min_rise_for(0.7)
     events: list[Event] = []
-    result = simrun.run_sim(REFERENCE, parse_scenario(flight(0.17, 0.7), "<t>"), events)
+    result = simrun.run_sim(config, parse_scenario(flight(rise, 0.7), "<t>"), events)
     assert (result.outcome, result.steps_climbed, result.steps_descended) == \
         ("completed", 3, 3), result.to_dict()
     assert result.final_offset_m is not None and result.final_offset_m < 0.05
@@ -37,13 +47,18 @@ def test_a_long_tread_before_a_riser_the_whole_cone_sees_is_climbed_by_turns() -
     assert sum("the drives onto the step go by turns" in m for m in told) == 2
 
 
-def test_a_long_tread_before_a_riser_the_cone_sees_over_is_refused() -> None:
-    """0.14 m risers 0.6 m apart: the top of the cone takes in what lies
-    beyond, the reading is 38 mm long, and it grows as segment 1 rises."""
+@pytest.mark.parametrize(("robot", "rise"), [("reference", 0.09), ("vl53l1x_front", 0.14)])
+def test_a_long_tread_before_a_riser_the_cone_sees_over_is_refused(
+        robot: str, rise: float) -> None:
+    """Risers 0.6 m apart, lower than min_rise_for(0.6): the top of the
+    view takes in what lies beyond, the reading is centimetres long, and it
+    grows as segment 1 rises."""
+    config = REFERENCE if robot == "reference" else VL53L1X_FRONT
+    assert rise < config.min_rise_for(0.6)
     for seed in (1, 2):
         events: list[Event] = []
-        scenario = parse_scenario(flight(0.14, 0.6, seed=seed), "<t>")
-        result = simrun.run_sim(REFERENCE, scenario, events)
+        scenario = parse_scenario(flight(rise, 0.6, seed=seed), "<t>")
+        result = simrun.run_sim(config, scenario, events)
         assert (result.outcome, result.ascent_end, result.steps_climbed) == \
             ("completed", "obstacle", 0), result.to_dict()
         assert any("the cone sees over it" in m for m in infos(events))
@@ -68,7 +83,7 @@ def test_a_tab_ascent_7_missed_is_found_by_the_back_pair_on_the_way_down() -> No
     finds step 1's edge by the back pair alone (it stopped with "the edge of
     the step cannot be found" before)."""
     text = ("[stairs]\ncount = 2\nrise = 0.17\ntread = 0.28\n"
-            "[[faults]]\nat = 46.0\nsensor = 'SFR'\nkind = 'offset'\noffset = 1.5\n"
+            "[[faults]]\nat = 47.6\nsensor = 'SFR'\nkind = 'offset'\noffset = 1.5\n"
             "duration = 3.5\n")
     events: list[Event] = []
     result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"), events)

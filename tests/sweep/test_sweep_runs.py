@@ -61,9 +61,10 @@ def test_quick_spec_end_to_end(tmp_path: Path) -> None:
     assert "stairs.rise" in rep.stdout and (tmp_path / "map.png").stat().st_size > 10_000
 
 
-# SFR fails for good half way up the step, so every case ends "stranded" (by
-# design: the robot stops there, lifts holding) -- with a robot config
-# override, to write both files.
+# SFR and SFL fail for good half way up the step, so every case ends
+# "stranded" (by design: with no front sensor left the robot cannot limp
+# home; it stops there, lifts holding) -- with a robot config override, to
+# write both files.
 STRANDED = """
 [sweep]
 name = "stranded"
@@ -73,7 +74,8 @@ seed = 5
 "stairs.count" = 1
 "config.masses.second_module" = { uniform = [1.2, 1.4] }
 "sensors.seed" = { randint = [1, 1000] }
-"faults" = [[{ at = 20.0, sensor = "SFR", kind = "error" }]]
+"faults" = [[{ at = 30.0, sensor = "SFR", kind = "error" },
+             { at = 30.0, sensor = "SFL", kind = "error" }]]
 """
 
 
@@ -87,8 +89,10 @@ def test_a_failing_case_reproduces_its_verdict_with_stairbot_run(tmp_path: Path)
         assert rec["verdict"] == "stranded", rec
         scen = out / "failures" / f"case-{rec['case']:06d}.toml"
         robot = out / "failures" / f"case-{rec['case']:06d}.robot.toml"
-        run = subprocess.run([sys.executable, "-m", "stairbot", "run", "--scenario", str(scen),
-                              "--config", str(robot), "--json", "-q"], cwd=ROOT, env=ENV,
+        assert rec["reproduce"].startswith("stairbot run --yes --scenario "), rec
+        run = subprocess.run([sys.executable, "-m", "stairbot", "run", "--yes", "--scenario",
+                              str(scen), "--config", str(robot), "--json", "-q"], cwd=ROOT,
+                             env=ENV,
                              capture_output=True, text=True, timeout=120)
         got = json.loads(run.stdout)
         assert judge(got, rec["facts"])[0] == rec["verdict"]

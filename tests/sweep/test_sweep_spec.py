@@ -17,6 +17,8 @@ from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec
 from stairbot.sweep.zones import first_sight, zone
 
+VL53L1X_FRONT = load_config(str(Path(__file__).parents[1] / "robots" / "vl53l1x_front.toml"))
+
 GOOD = """
 [sweep]
 name = "t"
@@ -188,28 +190,30 @@ def test_shipped_specs_are_valid_and_quick_stays_small() -> None:
 
 def test_a_cone_that_looks_up_sees_the_first_riser_nearer_than_a_level_ray() -> None:
     """In sight is what the simulated beams read at the start pose: 0.95 m
-    from a 0.15 m riser, the reference robot's cone (tilted 7.5 deg up) takes in
-    the risers beyond and reads past LENGTH_OF_INFINITY; the ideal robot's level
-    ray does not."""
+    from a 0.15 m riser, a VL53L1X cone tilted 7.5 deg up takes in the risers
+    beyond and reads past LENGTH_OF_INFINITY; the ideal robot's level ray
+    does not, nor does the reference robot's row of zones (level to 5.6 deg
+    up)."""
     rules = Rules()
     scen = parse_scenario("[stairs]\ncount = 4\nrise = 0.15\ntread = 0.3\n"
                           "[start]\ndistance = 0.95\n", "x")
     assert first_sight(scen, load_config("ideal")) == pytest.approx(0.95, abs=0.002)
-    assert first_sight(scen, load_config("reference")) > 1.0
+    assert first_sight(scen, VL53L1X_FRONT) > 1.0
+    assert first_sight(scen, load_config("reference")) == pytest.approx(0.95, abs=0.005)
     assert zone(scen, load_config("ideal"), rules)[0] == "inside"
-    assert zone(scen, load_config("reference"), rules)[0] == "outside"
+    assert zone(scen, VL53L1X_FRONT, rules)[0] == "outside"
 
 
 def test_a_measured_tread_asks_its_own_riser_to_reach_min_rise_for_it() -> None:
     """The robot takes the next riser to be as high as the one it climbs
     (ascent 3), so a tread it measures (a wall on top, not a landing) needs
     its own riser at min_rise_for(tread)."""
-    reference, rules = load_config("reference"), Rules()
+    cone, rules = VL53L1X_FRONT, Rules()
     text = "[stairs]\ncount = 1\nrise = 0.135\ntread = {tread}\ntop = '{top}'\n"
     long_wall = parse_scenario(text.format(tread=0.38, top="wall"), "x")
-    assert 0.135 < reference.min_rise_for(0.38) - rules.rise_margin_m
-    assert zone(long_wall, reference, rules)[0] == "outside"
-    assert zone(parse_scenario(text.format(tread=0.38, top="landing"), "x"), reference,
+    assert 0.135 < cone.min_rise_for(0.38) - rules.rise_margin_m
+    assert zone(long_wall, cone, rules)[0] == "outside"
+    assert zone(parse_scenario(text.format(tread=0.38, top="landing"), "x"), cone,
                 rules)[0] == "inside"
 
 
@@ -229,3 +233,15 @@ def test_the_base_scenarios_robot_runs_the_cases_unless_the_spec_names_one(
                         str(tmp_path / "s.toml"))
     assert parse_config(build_case(chosen, 0).config_text or "", "c").sensors == \
         load_config("sonar").sensors
+
+
+def test_a_field_axis_inside_a_list_axis_leaves_the_list_axis_values_alone() -> None:
+    """``faults`` then ``faults[0].at``: each case's fault gets its own time,
+    and the ``faults`` axis's values (recorded with every case) are not
+    changed by the cases built before."""
+    spec = parse_spec("[axes]\nfaults = [[{ at = 0.0, sensor = \"SFR\", kind = \"error\" }]]\n"
+                      "\"faults[0].at\" = [7.0, 14.5]\n", "x.toml")
+    first, second = build_case(spec, 0), build_case(spec, 1)
+    assert "at = 7.0" in first.scenario_text and "at = 14.5" in second.scenario_text
+    assert first.axes["faults"] == [{"at": 0.0, "sensor": "SFR", "kind": "error"}]
+    assert second.axes["faults"] == first.axes["faults"]

@@ -31,6 +31,13 @@ def result(outcome: str = "completed", up: int = 3, down: int = 3, offset: float
     (result(), "inside", 0, ("MTF",), "unsafe"),
     (result(outcome="error", up=2, down=0, offset=0.6), "inside", 0, (), "stranded"),
     (result(up=3, down=3, offset=0.2), "inside", 0, (), "stranded"),
+    # a sensor lost on the stairs, the robot limped home
+    (result(outcome="came_home_degraded", up=1, down=1), "inside", 1, (), "came_home"),
+    (result(outcome="came_home_degraded", up=1, down=1), "inside", 0, (), "wrong"),
+    (result(outcome="came_home_degraded", up=2, down=1, offset=0.4), "inside", 1, (),
+     "stranded"),
+    (result(outcome="came_home_degraded", up=1, down=1, offset=0.2), "inside", 1, (),
+     "stranded"),
 ])
 def test_judge(res: dict[str, object], zone: str, faults: int, moving: tuple[str, ...],
                want: str) -> None:
@@ -65,6 +72,7 @@ def descent(outcome: str = "completed", down: int = 4, clear: float | None = 0.3
     ({**descent(outcome="error", down=0, clear=-0.5), "fell": True,
       "fell_after": "segment 1 pitched 38 deg"}, "inside", 1, (), "unsafe"),
     (descent(outcome="error", down=1, clear=-0.5), "inside", 1, (), "refused"),  # a fault
+    (descent(outcome="came_home_degraded"), "inside", 1, (), "came_home"),
 ])
 def test_judge_a_descent_from_the_top(res: dict[str, object], zone: str, faults: int,
                                       moving: tuple[str, ...], want: str) -> None:

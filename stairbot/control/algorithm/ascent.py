@@ -13,7 +13,7 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import long_tread, motion
+from stairbot.control.algorithm import long_tread, lost, motion
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.lift_first import (
     LIFT_FIRST,
@@ -55,6 +55,11 @@ from stairbot.hardware import MotorId, SensorStatus
 P = Phase
 FLOW = "ascent"
 
+LIMP_DOWN = {
+    "limp_home": Exit(P.DESCENT_BACK_OFF, lost.LIMP + ": down the steps climbed"),
+    "limp_home_floor": Exit(P.DESCENT_FINISH, lost.LIMP + ": none climbed, back to the start"),
+}
+
 # -- ascent 2: approach --------------------------------------------------------------------
 RISER_LOST_WAIT_S = 0.5
 """Ascent 2: a beam that reads "nothing ahead" stops the approach; the riser
@@ -63,6 +68,8 @@ is lost (an error) only if it still does after this long standing still."""
 
 def _approach(t: Tick, w: ApproachWork) -> Step:
     cfg, ctx = t.cfg, t.ctx
+    if lost.limping(t):
+        return lost.limp_down(t)
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) or motion.far(sfl, cfg):
         # A riser does not vanish from in front of a robot on the floor: stand
@@ -114,6 +121,7 @@ APPROACH = PhaseDef(
     ApproachWork, watches="front",
     on={"at_safe_distance": Exit(P.ASCENT_APPROACH_TURNS, "reads "
                                                          "SAFE_DISTANCE_IN_FRONT_OF_STEP"),
+        **LIMP_DOWN,
         FAILED: Exit(P.ERROR, "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); "
                               + FAULT)})
 
@@ -150,6 +158,8 @@ def _reckoned_riser(t: Tick, w: ApproachTurnsWork) -> float | None:
 
 
 def _approach_turns(t: Tick, w: ApproachTurnsWork) -> Step:
+    if lost.limping(t):
+        return lost.limp_down(t)
     assert w.target_wheel is not None and w.start_reading is not None  # set on entry
     here = motion.wheel_position(t.snap)
     remaining = w.target_wheel - here
@@ -165,7 +175,8 @@ def _approach_turns(t: Tick, w: ApproachTurnsWork) -> Step:
 APPROACH_TURNS = PhaseDef(
     P.ASCENT_APPROACH_TURNS, "ascent 2 — approach: NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH more",
     FLOW, _approach_turns, ApproachTurnsWork, enter=_approach_turns_enter, watches="front",
-    on={"at_riser": Exit(P.ASCENT_LIFT_FIRST, "turns made"), FAILED: Exit(P.ERROR, FAULT)})
+    on={"at_riser": Exit(P.ASCENT_LIFT_FIRST, "turns made"), **LIMP_DOWN,
+        FAILED: Exit(P.ERROR, FAULT)})
 
 
 # -- ascent 4-7: segment by segment onto the step -------------------------------------------
@@ -253,6 +264,8 @@ measurable while the pair does not read "nothing ahead" either."""
 
 def _check(t: Tick, w: WaitWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
+    if lost.limping(t):
+        return go("limp_home")
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) and motion.far(sfl, cfg):
         ctx.ascent_end = AscentEnd.TOP_REACHED
@@ -301,6 +314,7 @@ CHECK = PhaseDef(
     watches="front",
     on={"top_reached": Exit(P.DESCENT_LOWER_THIRD, "reads ≥ LENGTH_OF_INFINITY (top reached)"),
         "step_limit": Exit(P.DESCENT_LOWER_THIRD, "number_of_steps = max_steps"),
+        "limp_home": Exit(P.DESCENT_LOWER_THIRD, lost.LIMP + ": the step finished, down it"),
         "next_step": Exit(P.ASCENT_DRIVE_THIRD, "otherwise"),
         FAILED: Exit(P.ERROR, FAULT)})
 

@@ -14,6 +14,7 @@ from stairbot.control.algorithm.edge import (
     narrow_bound,
     refind,
 )
+from stairbot.control.algorithm.edge_measure import slow_backing
 from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.moves import (
     checked_first,
@@ -31,6 +32,7 @@ from stairbot.control.algorithm.phase import (
     end,
     fail,
     go,
+    stay,
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.step_down import narrow_here, step_tab, step_tread
@@ -206,10 +208,19 @@ def _to_edge_step(t: Tick, w: EdgeWork) -> Step:
         if w.square_yaw is not None:
             return _turn_square(t, w)
         if w.refind_from is None:
-            return step
+            return _slowed(t, w, step)
         # the watch found the pair past an edge it did not see crossed: this
         # tick's step (which may have ended the backing) is not taken
     return refind(t, w)
+
+
+def _slowed(t: Tick, w: EdgeWork, step: Step) -> Step:
+    """After finding the floor again, the backing at
+    :func:`~stairbot.control.algorithm.edge_measure.slow_backing`."""
+    if not w.edge_slow or step.happened is not None:
+        return step
+    slow = slow_backing(t.cfg)
+    return stay({m: v * slow for m, v in step.speeds.items()})
 
 
 def _turn_square(t: Tick, w: EdgeWork) -> Step:

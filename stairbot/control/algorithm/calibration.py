@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stairbot.control.algorithm import landing, limits, motion
+from stairbot.control.algorithm import landing, limits, lost, motion
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
 from stairbot.control.algorithm.moves import lift
@@ -69,6 +69,11 @@ def _after_calibration(t: Tick) -> Step:
 # -- check the readings --------------------------------------------------------------
 def _check(t: Tick, w: StandingWork) -> Step:
     cfg, ctx, cal = t.cfg, t.ctx, t.cal
+    if cal.purpose is Purpose.START and lost.limping(t):
+        # squaring up cannot go on one sensor: back to where the program began
+        if ctx.start.wheel is None:
+            ctx.start.wheel = motion.wheel_position(t.snap)
+        return lost.limp_down(t)
     sfr, sfl = motion.pair(t.snap)
     if cal.purpose is Purpose.DESCENT and cal.squaring_turns == 0 \
             and not ctx.descent.turned_back:
@@ -212,6 +217,8 @@ CHECK = PhaseDef(
                                                    "squared up (checked)"),
         "square_to_descend": Exit(P.DESCENT_BACK_TO_EDGE, "descent 1: SFR = SFL; or squared up "
                                                           "(checked)"),
+        "limp_home_floor": Exit(P.DESCENT_FINISH, lost.LIMP + ": start, back to where the "
+                                                  "program began"),
         FAILED: Exit(P.ERROR, "case 1: sensor error; later: nothing ahead where a riser should "
                               "be; checking a squaring turn: nothing ahead, or still not square "
                               "after MAX_SQUARING_TURNS turns"),

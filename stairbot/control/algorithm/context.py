@@ -21,6 +21,7 @@ from typing import Any, TypeVar, Union, get_args, get_origin, get_type_hints
 
 from stairbot.control.algorithm import families, work
 from stairbot.control.algorithm.families import Family
+from stairbot.control.algorithm.limp import Limp
 from stairbot.control.algorithm.modes import AscentEnd, Outcome
 from stairbot.control.algorithm.phases import BY_VALUE
 from stairbot.control.algorithm.work import Work
@@ -73,7 +74,7 @@ class DescentStep:
     """The odometer where the back pair crossed the edge of the step it
     stands on (where it read the drop, less how far the robot backed while
     the reading came through:
-    :func:`~stairbot.control.algorithm.edge.edge_sight_m`)."""
+    :func:`~stairbot.control.algorithm.edge_measure.edge_sight_m`)."""
     edge_squared: bool = False
     """Continuous descent: the robot turned square to this step's edge by
     its back pair (once a step)."""
@@ -193,6 +194,8 @@ class Context:
     start: StartPosition = field(default_factory=StartPosition)
     descent: DescentStep = field(default_factory=DescentStep)
     landing: Landing = field(default_factory=Landing)
+    limp: Limp | None = None
+    """Present once a sensor was lost and the robot limps home."""
 
     # -- the standing rule -----------------------------------------------------------
     watch: Watch = field(default_factory=Watch)

@@ -18,11 +18,10 @@ The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
-from stairbot.control.algorithm import motion, stability, standing
+from stairbot.control.algorithm import guards, limp, lost, motion, stability, standing
 from stairbot.control.algorithm.context import Context, Pause, Watch
 from stairbot.control.algorithm.families import Calibration, Family
 from stairbot.control.algorithm.guards import (
@@ -35,7 +34,8 @@ from stairbot.control.algorithm.guards import (
 from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.phase import PhaseDef, Step, Tick, fail, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
-from stairbot.control.algorithm.result import OUTCOMES, ControllerResult
+from stairbot.control.algorithm.result import ControllerResult
+from stairbot.control.algorithm.texts import limp as say_limp
 from stairbot.control.algorithm.transitions import exit_of
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
@@ -44,9 +44,7 @@ from stairbot.hardware import (
     LIFT_MOTORS,
     MotorId,
     SensorId,
-    SensorStatus,
     Snapshot,
-    Speeds,
 )
 from stairbot.inputs.config import RobotConfig
 
@@ -59,14 +57,17 @@ class Controller:
     for the operator and must be called from the thread that ticks.
     ``check_stability=False`` skips the static-stability check before the
     lifts (:mod:`stairbot.control.algorithm.stability`): only for a test that shows
-    what the supervisor does without it.
+    what the supervisor does without it.  ``limp_home``: the operator's
+    consent, given before the run, to limp home on the sensors that remain
+    when one is lost on the stairs (:mod:`~stairbot.control.algorithm.limp`).
     """
 
     def __init__(self, config: RobotConfig, sink: EventSink = discard,
                  mode: Mode = Mode.FULL, context: Context | None = None, *,
-                 check_stability: bool = True) -> None:
+                 check_stability: bool = True, limp_home: bool = False) -> None:
         self.config = config
         self.mode = mode
+        self.limp_home = limp_home
         self.check_stability = check_stability
         self._sink = sink
         if context is None:
@@ -77,6 +78,9 @@ class Controller:
                 context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
         elif context.phase_started_s is not None:
+            if limp_home and lost.reopen(context):
+                sink(Event(context.phase_started_s, EventKind.RESUME, say_limp.REOPENED,
+                           BY_VALUE[context.phase].label, {"limp": context.to_dict()["limp"]}))
             check_restored(context)
         self._ctx = context
         self._started = context.phase_started_s is not None
@@ -85,6 +89,7 @@ class Controller:
         self._time = context.phase_started_s or 0.0
         m = config.motors
         self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
+        self._vmax_limp = {mo: v * limp.LIMP_SPEED for mo, v in self._vmax.items()}
         self._stroke = config.MAX_OF_VERTICAL_TURNS
         self._timeout = phase_timeout_s(config)
         self._perception = Perception(config)
@@ -152,8 +157,9 @@ class Controller:
         value); every later tick commands zero.  Outside the transition table
         on purpose: it is the operator's (or the run loop's) decision, not the
         algorithm's."""
-        if outcome not in OUTCOMES and not isinstance(outcome, Outcome):
-            raise ValueError(f"outcome {outcome!r}; allowed: {', '.join(OUTCOMES)}")
+        if outcome not in _OUTCOMES or Outcome(outcome) not in _ABORTS:
+            raise ValueError(f"outcome {outcome!r}; allowed: "
+                             f"{', '.join(o.value for o in _ABORTS)}")
         if self.finished:
             return
         ends = Outcome(outcome)
@@ -169,6 +175,8 @@ class Controller:
         if self.finished:
             return _zeros()
         snap = self._perception.see(snap)
+        if self._ctx.limp is not None:
+            snap = limp.mirrored(snap, self._ctx.limp.lost)
         if self._held is not None:
             if self._held_since is None:
                 self._held_since = snap.time_s
@@ -185,7 +193,8 @@ class Controller:
             return _zeros()
         ctx = self._ctx
         phase, record, needed = self._present()
-        fault = self._fault(snap, phase, needed) or self._supervisor.check(snap)
+        fault = guards.fault(snap, phase, needed, ctx.phase_started_s, self._timeout_now()) \
+            or self._supervisor.check(snap)
         if fault is not None:  # and what the link lost in the phase, if it lost frames
             self._apply(fail(fault + link_meanwhile(self._phase_link, snap.health)), snap)
             return _zeros()
@@ -204,9 +213,14 @@ class Controller:
             self._apply(step, snap)
             speeds = _zeros()
         else:
-            speeds = self._limit(step.speeds, snap)
+            speeds = guards.limit_speeds(step.speeds, snap, self._vmax if ctx.limp is None
+                                         else self._vmax_limp, self._stroke)
         self._supervisor.commanded(speeds)
         return speeds
+
+    def _timeout_now(self) -> float:
+        """How long the present phase may last (longer while limping home, slower)."""
+        return self._timeout if self._ctx.limp is None else self._timeout / limp.LIMP_SPEED
 
     def _present(self) -> tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]]:
         """The present phase, its record and :func:`_needed_sensors`, looked up
@@ -219,27 +233,6 @@ class Controller:
             now = self._now = (phase, phase.record, needed_sensors(phase, ctx))
             self._now_key = key
         return now
-
-    def _fault(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> str | None:
-        """A motor fault, a sensor ``needed`` that reads no number, or the
-        phase's timeout, in words; None when there is none."""
-        isfinite = math.isfinite
-        for motor, state in snap.motors.items():
-            if state.fault:
-                return f"motor fault: {motor} reports {state.fault!r} in {phase.label}"
-            if not isfinite(state.turns):
-                return f"motor fault: {motor} counts {state.turns} turns in {phase.label}"
-        sensors = snap.sensors
-        for sensor in needed:
-            # an ERROR reading's distance means nothing; any other must be a number
-            reading = sensors[sensor]
-            if reading.status is not _ERROR and not isfinite(reading.distance_m):
-                return f"sensor error: {sensor} reads {reading.distance_m} m in {phase.label}"
-        started = self._ctx.phase_started_s
-        if phase is not _PAUSED and started is not None \
-                and snap.time_s - started > self._timeout:
-            return f"phase timeout: {phase.label} took longer than {self._timeout:g} s"
-        return None
 
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
         """While a sensor the phase needs (``needed``) reads as ERROR (it reports
@@ -271,28 +264,30 @@ class Controller:
             return True
         if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
             return True
-        self._sensor_since = None
+        since, self._sensor_since = self._sensor_since, None
         stale = link_meanwhile(self._sensor_link, snap.health,
                                "the readings were stale on the wire")
-        self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}{stale}"),
-                    snap)
-        return True
-
-    def _limit(self, speeds: Speeds, snap: Snapshot) -> dict[MotorId, float]:
-        """Every motor gets a speed within its maximum; a lift at the end of its
-        stroke is not driven further."""
-        stroke, vmax_of, isfinite = self._stroke, self._vmax, math.isfinite
-        out = _zeros()
-        for motor, v in speeds.items():
-            vmax = vmax_of[motor]
-            # min/max pass a NaN through as a full-speed limit: it stops instead
-            v = max(-vmax, min(vmax, v)) if isfinite(v) else 0.0
-            if motor in LIFT_MOTORS:
-                turns = snap.motors[motor].turns
-                if (v > 0 and turns >= stroke) or (v < 0 and turns <= -stroke):
-                    v = 0.0
-            out[motor] = v
-        return out
+        stop = None if imu is not None else lost.degraded_stop(
+            ctx, snap, phase, errors, why, mode=self.mode, consent=self.limp_home,
+            tilt_watched=self._tilt.watched)
+        if stop is None:
+            self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
+                             f"{stale}"), snap)
+            return True
+        self._emit(EventKind.WARNING, say_limp.stopped_at(
+            why, phase.label, stop.where, stop.lifts, stop.steps_climbed,
+            stop.steps_descended) + ": " + stop.why, snap.time_s, {"degraded": stop.to_dict()})
+        if stop.then == "no_consent":
+            lost.start_limping(ctx, stop, snap.time_s, phase.label)
+        if stop.then != "limp_home":
+            self._apply(fail(say_limp.lost_sensor_end(why, SENSOR_WAIT_S, phase.label, stop.why)
+                             + stale), snap)
+            return True
+        lost.start_limping(ctx, stop, snap.time_s, phase.label)
+        self._shift_timers(snap.time_s - since)
+        self._emit(EventKind.RESUME, f"limping home: resuming {phase.label}", snap.time_s,
+                   {"phase": phase.value, "limp": list(stop.lost)})
+        return True  # from the next tick on the survivors stand in for the lost
 
     # -- phase changes: the one place a phase is entered ----------------------------------
     def _apply(self, step: Step, snap: Snapshot) -> None:
@@ -306,8 +301,10 @@ class Controller:
         if nxt is Phase.ERROR:
             self._finish(Phase.ERROR, Outcome.ERROR, step.reason or "error", snap.time_s)
         elif nxt is Phase.DONE:
-            self._finish(Phase.DONE, step.outcome or Outcome.COMPLETED, step.reason or "done",
-                         snap.time_s)
+            outcome = step.outcome or Outcome.COMPLETED
+            if outcome is Outcome.COMPLETED and ctx.limp is not None:
+                outcome = Outcome.CAME_HOME_DEGRADED
+            self._finish(Phase.DONE, outcome, step.reason or "done", snap.time_s)
         elif nxt is Phase.PAUSED:
             ctx.pause = Pause(src.value, snap.time_s)
             ctx.pauses += 1
@@ -356,6 +353,9 @@ class Controller:
             phase.record.enter(Tick(snap, self.config, ctx, self.mode, self._say), ctx.work)
 
     def _say(self, message: str, **data: Any) -> None:
+        limping = self._ctx.limp
+        if limping is not None and limping.consented:  # a pair's figures are one sensor's
+            message += say_limp.stand_ins(limping.lost)
         self._emit(EventKind.INFO, message, self._time, data)
 
     def _finish(self, phase: Phase, outcome: Outcome, reason: str, time_s: float) -> None:
@@ -379,14 +379,16 @@ class Controller:
         if ctx.pause is not None:
             ctx.pause.started_s += delta
 
-
     def _emit(self, kind: EventKind, message: str, time_s: float,
               data: dict[str, Any]) -> None:
         phase = self.phase.label
         self._sink(Event(time_s, kind, message, phase, data))
 
 
-_PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
+_OUTCOMES = (*Outcome, *(o.value for o in Outcome))
+_ABORTS = (Outcome.COMPLETED, Outcome.STOPPED, Outcome.ERROR)
+"""What :meth:`Controller.abort` may end a program with (not CAME_HOME_DEGRADED:
+only a limp home that reaches the start ends so)."""
 ALL_MOTORS: tuple[MotorId, ...] = tuple(MotorId)
 _ZEROS: dict[MotorId, float] = dict.fromkeys(ALL_MOTORS, 0.0)
 _TERMINAL: dict[str, bool] = {p.value: p.terminal for p in Phase}

@@ -17,10 +17,11 @@ from typing import Any
 
 from stairbot.control.algorithm import landing, long_tread, motion
 from stairbot.control.algorithm.back_off import BACK_OFF, BACK_TO_EDGE
-from stairbot.control.algorithm.edge import (
+from stairbot.control.algorithm.edge import narrow_bound
+from stairbot.control.algorithm.edge_measure import (
     edge_clearance_m,
+    edge_lag_s,
     floor_tolerance,
-    narrow_bound,
 )
 from stairbot.control.algorithm.families import LowerThird
 from stairbot.control.algorithm.homing import FINISH, FINISH_FLOOR
@@ -127,10 +128,32 @@ def _floor_not_found(t: Tick, reading: float) -> Step:
     return fail(say.floor_not_found(t.descent_index, cfg.MAX_OF_VERTICAL_TURNS, reading))
 
 
+def lowered_unseen_m(t: Tick, w: LowerThirdWork) -> float:
+    """How far MTB has lowered segment 3 since the measurements the back
+    pair's filtered reading stands for were taken (:func:`edge_lag_s` ago:
+    the sensor's latency, then the median's majority of the window): the
+    reading is that much long.  Keeps ``w.mtb_recent`` back to then.  An
+    HC-SR04 pair's reading lags 0.175 s, 3.5 mm at the lift's full speed,
+    more than :func:`floor_tolerance`: uncounted, the lift meets the floor
+    near full speed and the finish pushes on by the lag; the push pitches
+    segment 2 nose down and raises segment 3's back, its sensors read
+    longer, and the reading may never come within the tolerance."""
+    now, mtb = t.snap.time_s, t.snap.turns(MotorId.MTB)
+    recent = w.mtb_recent
+    recent.append((now, mtb))
+    then = now - edge_lag_s(t.cfg)
+    while len(recent) > 2 and recent[1][0] <= then:
+        del recent[0]
+    (t0, m0), (t1, m1) = recent[0], recent[min(1, len(recent) - 1)]
+    if t0 < then < t1:
+        m0 += (m1 - m0) * (then - t0) / (t1 - t0)
+    return max(0.0, m0 - mtb) * t.cfg.motors.lift_travel_per_turn
+
+
 def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     reading = motion.mean_distance(t.snap, back=True)
-    to_go = reading - cfg.BACK_CLEARANCE
+    to_go = reading - cfg.BACK_CLEARANCE - (0.0 if w.finishing else lowered_unseen_m(t, w))
     if not w.finishing and to_go <= floor_tolerance(cfg):
         # Within the noise of BACK_CLEARANCE: the rest the reading says, by
         # turns, and no further (an unbiased finish, never a push on the floor).

@@ -15,105 +15,21 @@ from __future__ import annotations
 
 import math
 
-from stairbot.control.algorithm import limits, motion
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.edge_measure import (
+    edge_clearance_m,
+    edge_doubt_m,
+    edge_drop_m,
+    edge_lag_s,
+    edge_sight_m,
+)
 from stairbot.control.algorithm.modes import Outcome
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
 from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import EdgeWork
-from stairbot.control.tolerances import measurement_period, median_sigma, window
+from stairbot.control.tolerances import max_age, measurement_period, window
 from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
-
-FLOOR_SIGMAS = 2.0
-"""Descent 2: SBR/SBL "read BACK_CLEARANCE" within this many sigmas of their
-filtered mean (and half a resolution step)."""
-
-
-def floor_tolerance(cfg: RobotConfig) -> float:
-    """How far above BACK_CLEARANCE the pair's mean may read and segment 3
-    stand on the floor: half a resolution step, and FLOOR_SIGMAS sigmas of
-    the mean of two filtered readings there.  Without the sigmas, a noisy
-    pair (or a cone, whose slanted rays read a little long) that reads above
-    BACK_CLEARANCE standing keeps the lift pushing segment 3 down, and
-    segment 2 tips nose down."""
-    sigma = median_sigma(cfg, True, cfg.BACK_CLEARANCE) / math.sqrt(2.0)
-    return cfg.sensors.resolution / 2 + FLOOR_SIGMAS * sigma
-
-
-EDGE_MARGIN_M = 0.006
-"""Segment 3's front wheels stop this far clear of the edge's corner."""
-
-
-def edge_clearance_m(cfg: RobotConfig) -> float:
-    """How far the robot backs after its back pair (``back_from_rear`` from
-    segment 3's rear) crossed the edge until segment 3's front wheels are
-    clear of it, their front EDGE_MARGIN_M past its corner: over the step
-    below, and not yet so far that the robot tips back off segment 2's rear
-    wheels.  The wheels' front, not their centre, is what must clear the
-    corner: wheels whose centre is only a wheel radius past it stand on it,
-    segment 3 stays up when lowered, and the lift pitches segment 2 nose
-    down."""
-    g = cfg.geometry
-    return (g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear - g.wheel_inset
-            + g.wheel_radius + EDGE_MARGIN_M + edge_doubt_m(cfg))
-
-
-def edge_doubt_m(cfg: RobotConfig) -> float:
-    """How far off :func:`edge_sight_m` may place the crossing: the distance
-    backed at full speed in one of the back pair's measurement periods (the
-    crossing falls anywhere between two measurements, and the median's
-    majority may take one more).  Added to the clearance, so that a slow
-    pair (an HC-SR04 measures every 60 ms, about 10 mm of backing) still
-    stops segment 3's front wheels past the corner, not on it, where
-    lowering segment 3 would pitch the robot nose down."""
-    return cfg.wheel_speed_m_s * measurement_period(cfg, True)
-
-
-LOW_DROP_M = 0.015
-"""A continuous descent takes a drop this much past BACK_CLEARANCE (and its
-noise) for an edge: it has not climbed the flight, so any rise may come,
-and one lower than half min_step_rise_m, unseen, would be backed off wheels
-first and tip the robot back.  0.015 m is under a 32 mm wheel's radius, a
-drop the wheels roll down."""
-
-
-def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
-    """The back pair reads "past the edge" beyond this: more than half the
-    lowest rise below BACK_CLEARANCE (and its noise); in a continuous
-    descent, LOW_DROP_M more than BACK_CLEARANCE (and its noise)."""
-    low = LOW_DROP_M if from_top else limits.min_step_rise_m(cfg) / 2
-    return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + low
-
-
-def edge_lag_s(cfg: RobotConfig) -> float:
-    """How long after the back pair crosses an edge perception reports the
-    drop: the sensor's latency, then the median's majority of the window,
-    one period each, the first of them half a period after the crossing on
-    average."""
-    return cfg.sensors.spec(True).latency_s \
-        + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
-
-
-def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> float:
-    """How far past an edge the back pair's sensors are when perception first
-    reports the drop, backing at ``speed_mps``: the distance backed while
-    the measurements came through (the sensor's latency, then the median's
-    majority of the window, one period each, the first of them half a
-    period after the crossing on average), and for a sensor that reports
-    the first echo in its cone, the riser's face below the edge that the
-    cone's back half keeps seeing, nearer than the drop, until the sensor
-    is ``edge_drop_m`` x sin(half the cone) past it.  For a wide cone this
-    is centimetres (an HC-SR04 pair sees the drop about 2.4 cm past the
-    edge), and the backing that follows subtracts it from
-    edge_clearance_m: counted from the sighting instead, it would tip the
-    robot back."""
-    spec = cfg.sensors.spec(True)
-    sight = abs(speed_mps) * edge_lag_s(cfg)
-    if spec.first_echo:
-        fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
-        sight += edge_drop_m(cfg, from_top) * math.sin(math.radians(fov) / 2)
-    return sight
-
 
 EDGE_GAP_TICKS = 2.5
 """The edge watch missed a stretch when two of its ticks are further apart
@@ -224,17 +140,16 @@ def edge_bound(t: Tick, w: EdgeWork, refind: bool) -> float | None:
             # the step wrapper ends the program, or turns square first (the
             # back-off ends here and turns)
             return None if refind else motion.wheel_position(t.snap)
+        here = motion.wheel_position(t.snap)
         if w.edge_watch_s is not None \
                 and now - w.edge_watch_s > EDGE_GAP_TICKS * cfg.algorithm.tick:
-            # a stretch unwatched: the floor read before it no longer counts,
-            # nor one read until perception's lag has passed
-            w.edge_floor_s = w.edge_first_wheel = w.edge_first = None
-            w.edge_blind_until = now + edge_lag_s(cfg) + measurement_period(cfg, True)
-        w.edge_watch_s = now
+            _missed_stretch(t, w, here)
+        w.edge_watch_s, w.edge_watch_wheel = now, here
+        _remember(t, w, here)
         if not sees_drop(t):
             if w.edge_blind_until is None or now > w.edge_blind_until:
-                w.edge_floor_s = now
-        elif w.edge_floor_s is None:
+                _floor_read(t, w, here)
+        elif w.edge_floor_s is None or w.edge_floor_held and not held_crossing_known(t, w):
             if refind:
                 w.refind_from = motion.wheel_position(t.snap)
                 w.refind_floor = 0
@@ -243,11 +158,115 @@ def edge_bound(t: Tick, w: EdgeWork, refind: bool) -> float | None:
             return motion.wheel_position(t.snap)  # the back-off ends here
         else:
             step.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
+            if w.edge_floor_held:
+                step.edge_wheel = held_crossing(t, w, step.edge_wheel)
+                sight = (step.edge_wheel - here) * cfg.wheel_circumference
             more = max(0.0, edge_clearance_m(cfg) - sight)
             t.say(say.sees_edge(motion.mean_distance(t.snap, back=True), sight, more))
     if step.edge_wheel is None:
         return None
     return step.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
+
+
+def _wheel_speed_m_s(t: Tick) -> float:
+    speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
+    return speed * t.cfg.wheel_circumference
+
+
+def floor_known_s(t: Tick) -> float:
+    """How long ago, at the latest, the measurements behind the back pair's
+    present floor reading put both sensors on the floor: its newest
+    measurement's age (the boards' count, perception's), then the older half
+    of the median's window, one period each.  Past that the pair may have
+    crossed unseen."""
+    cfg = t.cfg
+    age = max(t.snap.sensors[s].age_s for s in BACK_SENSORS)
+    return age + (window(cfg, True) // 2) * measurement_period(cfg, True)
+
+
+def _history_s(cfg: RobotConfig) -> float:
+    """How far back the watch keeps the odometer: the oldest a floor reading
+    can stand for (:func:`floor_known_s` at the stale limit), and a tick."""
+    return max_age(cfg, True) + (window(cfg, True) // 2 + 1) * measurement_period(cfg, True) \
+        + cfg.algorithm.tick
+
+
+def _remember(t: Tick, w: EdgeWork, here: float) -> None:
+    recent, now = w.edge_recent, t.snap.time_s
+    recent.append((now, here))
+    while len(recent) > 2 and recent[1][0] <= now - _history_s(t.cfg):
+        del recent[0]
+
+
+def _wheel_at(w: EdgeWork, at: float) -> float:
+    """The odometer at time ``at`` from the watch's history (linear between
+    its ticks; the oldest kept if older)."""
+    recent = w.edge_recent
+    later: tuple[float, float] | None = None
+    for when, wheel in reversed(recent):
+        if when <= at:
+            if later is None or later[0] == when:
+                return wheel
+            return wheel + (later[1] - wheel) * (at - when) / (later[0] - when)
+        later = (when, wheel)
+    return recent[0][1]
+
+
+def _floor_read(t: Tick, w: EdgeWork, here: float) -> None:
+    """The pair reads the floor on a watched tick: a crossing seen from here
+    on is placed as it happens; and where the pair was when its measurements
+    last put it on the floor (``edge_floor_at``) bounds a crossing read after
+    a stretch the robot stood through."""
+    w.edge_floor_s = t.snap.time_s
+    w.edge_floor_at = _wheel_at(w, t.snap.time_s - floor_known_s(t))
+    w.edge_floor_held = False
+
+
+def _missed_stretch(t: Tick, w: EdgeWork, here: float) -> None:
+    """The watch missed a stretch (a tick came late, a hold).  What
+    perception says of the pair until its lag has passed still comes from
+    measurements taken before or in it: a floor read until then does not
+    count.  If the wheels moved through the stretch no further than the
+    crossing's own doubt (:func:`edge_doubt_m`) -- the robot stood, every
+    motor stopped -- the floor read before it still bounds where the pair
+    can have crossed (``edge_floor_held``).  Otherwise the robot ran on
+    unwatched, and that floor no longer counts either."""
+    cfg = t.cfg
+    w.edge_blind_until = t.snap.time_s + edge_lag_s(cfg) + measurement_period(cfg, True)
+    moved = abs(here - (w.edge_watch_wheel if w.edge_watch_wheel is not None else here))
+    if w.edge_watch_wheel is not None and moved * cfg.wheel_circumference <= edge_doubt_m(cfg):
+        w.edge_floor_held = w.edge_floor_s is not None
+        return
+    w.edge_floor_s = w.edge_floor_at = w.edge_first_wheel = w.edge_first = None
+    w.edge_floor_held = False
+
+
+def held_crossing_known(t: Tick, w: EdgeWork) -> bool:
+    """A drop read after a stretch the robot stood through: the crossing lies
+    between where the floor reading before it put the pair and here.  Known
+    well enough when that span is within the crossing's doubt
+    (:func:`edge_doubt_m`, which the clearance carries): the crossing is then
+    placed at the span's far end (:func:`held_crossing`), never further back
+    than it can be, and the robot stops short of where a watched crossing
+    would stop it by no more than that doubt.  Backing at full speed the
+    span is the pair's lag's worth of backing, more than the doubt; backing
+    slowly after finding the floor again
+    (:func:`~stairbot.control.algorithm.edge_measure.slow_backing`), less."""
+    if w.edge_floor_at is None:
+        return False
+    span = (w.edge_floor_at - motion.wheel_position(t.snap)) * t.cfg.wheel_circumference
+    return span <= edge_doubt_m(t.cfg)
+
+
+def held_crossing(t: Tick, w: EdgeWork, crossed: float) -> float:
+    """The crossing of a drop read after a stretch the robot stood through:
+    ``crossed`` (where a watched crossing would be placed), or the far end of
+    the span the floor reading before the stretch leaves, if further
+    forward: that reading's position plus, for a first-echo sensor, the
+    riser's face it keeps seeing (:func:`edge_sight_m` standing)."""
+    assert w.edge_floor_at is not None
+    face = t.cfg.wheel_turns(edge_sight_m(t.cfg, 0.0, t.ctx.from_top))
+    return max(crossed, w.edge_floor_at + face)
 
 
 def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
@@ -322,8 +341,12 @@ def refind(t: Tick, w: EdgeWork) -> Step:
     if w.refind_floor >= REFIND_TICKS and driven_m >= edge_sight_m(cfg, cfg.wheel_speed_m_s,
                                                                    t.ctx.from_top):
         t.say(say.floor_again(driven_m))
+        w.edge_slow = True
         w.refind_from = w.edge_blind_until = w.edge_first_wheel = w.edge_first = None
-        w.edge_watch_s = w.edge_floor_s = t.snap.time_s
+        here = motion.wheel_position(t.snap)
+        w.edge_watch_s, w.edge_watch_wheel = t.snap.time_s, here
+        _remember(t, w, here)
+        _floor_read(t, w, here)
         return stay(NO_MOTION)
     most = refind_max_m(cfg)
     if driven_m >= most and t.ctx.from_top:

@@ -6,6 +6,7 @@ a hold, and that a restored context's state is its phase's.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 from stairbot.control.algorithm import motion, squaring
@@ -13,7 +14,16 @@ from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
 from stairbot.control.algorithm.transitions import BACK_PAIR_PHASES
 from stairbot.errors import InputError
-from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, SensorId
+from stairbot.hardware import (
+    BACK_SENSORS,
+    FRONT_SENSORS,
+    LIFT_MOTORS,
+    MotorId,
+    SensorId,
+    SensorStatus,
+    Snapshot,
+    Speeds,
+)
 from stairbot.inputs.config import RobotConfig
 
 SENSOR_WAIT_S = 1.0
@@ -38,6 +48,49 @@ def phase_timeout_s(config: RobotConfig) -> float:
     turn = squaring.MAX_TURN_YAW_RAD * config.geometry.track_width / 2
     turn_s = config.wheel_turns(turn) / min(motion.TURN_SPEED, m.wheel_speed)
     return max(PHASE_TIMEOUT_S, 2 * max(lift_s, drive_s, turn_s))
+
+def fault(snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...],
+          started_s: float | None, timeout_s: float) -> str | None:
+    """A motor fault, a sensor ``needed`` that reads no number, or the
+    phase (begun at ``started_s``) lasting longer than ``timeout_s``, in
+    words; None when there is none."""
+    isfinite = math.isfinite
+    for motor, state in snap.motors.items():
+        if state.fault:
+            return f"motor fault: {motor} reports {state.fault!r} in {phase.label}"
+        if not isfinite(state.turns):
+            return f"motor fault: {motor} counts {state.turns} turns in {phase.label}"
+    sensors = snap.sensors
+    for sensor in needed:
+        # an ERROR reading's distance means nothing; any other must be a number
+        reading = sensors[sensor]
+        if reading.status is not _ERROR and not isfinite(reading.distance_m):
+            return f"sensor error: {sensor} reads {reading.distance_m} m in {phase.label}"
+    if phase is not _PAUSED and started_s is not None and snap.time_s - started_s > timeout_s:
+        return f"phase timeout: {phase.label} took longer than {timeout_s:g} s"
+    return None
+
+
+def limit_speeds(speeds: Speeds, snap: Snapshot, vmax: Mapping[MotorId, float],
+                 stroke: float) -> dict[MotorId, float]:
+    """Every motor gets a speed within its ``vmax``; a lift at the end of its
+    ``stroke`` is not driven further."""
+    isfinite = math.isfinite
+    out = dict.fromkeys(MotorId, 0.0)
+    for motor, v in speeds.items():
+        top = vmax[motor]
+        # min/max pass a NaN through as a full-speed limit: it stops instead
+        v = max(-top, min(top, v)) if isfinite(v) else 0.0
+        if motor in LIFT_MOTORS:
+            turns = snap.motors[motor].turns
+            if (v > 0 and turns >= stroke) or (v < 0 and turns <= -stroke):
+                v = 0.0
+        out[motor] = v
+    return out
+
+
+_PAUSED, _ERROR = Phase.PAUSED, SensorStatus.ERROR  # bound once: looked at every tick
+
 
 def check_restored(ctx: Context) -> None:
     """A restored context's work and family are the present phase's kinds

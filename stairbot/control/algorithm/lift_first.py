@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import statistics
 
-from stairbot.control.algorithm import landing, limits, long_tread, motion
+from stairbot.control.algorithm import landing, limits, long_tread, lost, motion
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.modes import AscentEnd
 from stairbot.control.algorithm.moves import lift
@@ -29,6 +29,9 @@ SIGHT_JUMP_M = 0.05
 much past it (or nothing ahead).  No tread is this short, and it is ten
 times the sensors' noise: a noisy reading of the riser never passes for it."""
 
+
+LIMP_UNDO = {"limp_home": Exit(P.ASCENT_LOWER_OBSTACLE, lost.LIMP + ": undo the step, "
+                                                                 "lower segment 1")}
 
 # -- ascent 3: lift segment 1 -------------------------------------------------------------
 def _lf(t: Tick) -> LiftFirst:
@@ -61,6 +64,8 @@ def tread_seen(t: Tick) -> float | None:
 
 def _lift_first(t: Tick, w: LiftWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
+    if lost.limping(t):
+        return go("limp_home")
     if tread_seen(t) is not None:
         sfr, sfl = (r.distance_m for r in motion.pair(t.snap))
         lifted = t.snap.turns(MotorId.MTF) - _lf(t).return_mtf
@@ -91,6 +96,7 @@ LIFT_FIRST = PhaseDef(
         "too_high": Exit(P.ASCENT_LOWER_OBSTACLE, "MAX_OF_VERTICAL_TURNS − "
                                                   "number_of_vertical_turns made: step too high"),
         "rise_too_low": Exit(P.ASCENT_LOWER_OBSTACLE, "sees over a rise < min_step_rise_m"),
+        **LIMP_UNDO,
         FAILED: Exit(P.ERROR, FAULT)})
 
 
@@ -199,6 +205,8 @@ _more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_verti
 
 
 def _more_step(t: Tick, w: SightWork) -> Step:
+    if lost.limping(t):
+        return go("limp_home")
     _sample_sight(t, w)
     return _lift_more(t, w)
 
@@ -214,11 +222,12 @@ LIFT_FIRST_MORE = PhaseDef(
                                                            "tread (min_rise_for; past "
                                                            "FAR_TREAD_M, only if the readings "
                                                            "grew as segment 1 rose)"),
+        **LIMP_UNDO,
         FAILED: Exit(P.ERROR, FAULT)})
 
 
 def _lowered_obstacle(t: Tick, _w: LiftWork) -> Step:
-    if landing.can_scan(t, _lf(t).wall_ahead):
+    if t.ctx.limp is None and landing.can_scan(t, _lf(t).wall_ahead):
         # a wall ahead at the top of a flight may be a landing's: look sideways first
         return go("wall_at_top")
     if landing.turned_here(t):

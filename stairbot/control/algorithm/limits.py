@@ -105,6 +105,19 @@ def narrow_steps_safe(cfg: RobotConfig) -> bool:
     return cfg.algorithm.narrow_steps and narrow_steps_refusal(cfg) is None
 
 
+REACH_TREADS_M = (0.26, 0.30, 0.33, 0.36, 0.40, 0.50)
+"""Treads ``config show`` gives the lowest riser behind
+(``min_rise_behind_<tread>_m``): residential treads to the long ones of
+landings and split levels."""
+
+
+def reach(cfg: RobotConfig) -> dict[str, float]:
+    """The lowest next riser the robot measures each of :data:`REACH_TREADS_M`
+    against (:meth:`~stairbot.inputs.config.RobotConfig.min_rise_for`), keyed
+    ``min_rise_behind_<tread>_m``."""
+    return {f"min_rise_behind_{t:.2f}_m": cfg.min_rise_for(t) for t in REACH_TREADS_M}
+
+
 def derived(cfg: RobotConfig) -> dict[str, float]:
     """Everything that follows from the file, for ``config show``."""
     names = ("LENGTH_OF_A_ROBOT", "BACK_CLEARANCE", "MAX_OF_VERTICAL_TURNS",
@@ -120,6 +133,7 @@ def derived(cfg: RobotConfig) -> dict[str, float]:
     out["max_step_rise_m"] = float(cfg.max_step_rise_m)
     out["min_tread_m"] = float(min_tread_m(cfg))
     out["min_step_rise_m"] = float(min_step_rise_m(cfg))
+    out.update(reach(cfg))
     out["max_drop_m"] = float(cfg.max_drop_m)
     if cfg.algorithm.narrow_steps:
         out["narrow_steps_margin_m"] = narrow_steps_margin_m(cfg)

@@ -53,6 +53,9 @@ class AscentEnd(Enum):
     STEP_LIMIT = "step_limit"
     LANDING_CLOSED = "landing_closed"
     LANDING_TOO_SMALL = "landing_too_small"
+    SENSOR_LOST = "sensor_lost"
+    """A sensor was lost on the stairs and the operator let the robot limp
+    home: the step in progress finished or undone, it goes down."""
 
 
 class Outcome(Enum):
@@ -61,3 +64,6 @@ class Outcome(Enum):
     COMPLETED = "completed"
     STOPPED = "stopped"
     ERROR = "error"
+    CAME_HOME_DEGRADED = "came_home_degraded"
+    """A sensor was lost on the stairs, and the robot came back down to where
+    it began on the sensors that remained (limp home)."""

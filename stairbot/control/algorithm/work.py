@@ -98,11 +98,23 @@ class EdgeWork(DriveWork):
     the back pair's edge watch (:mod:`~stairbot.control.algorithm.edge`)."""
 
     edge_watch_s: float | None = None
-    """The last tick the watch looked at the back pair."""
+    edge_watch_wheel: float | None = None
+    """The last tick the watch looked at the back pair, and the odometer then."""
     edge_floor_s: float | None = None
     """The last tick the back pair read the floor while the watch looked (None:
-    not yet, or not since it missed a stretch): a crossing is placed only
-    after one."""
+    not yet, or not since it missed a stretch the robot moved through): a
+    crossing is placed only after one."""
+    edge_floor_at: float | None = None
+    """Where the pair was, on the odometer, when its measurements last put it
+    on the floor (:func:`~stairbot.control.algorithm.edge.floor_known_s`
+    before that tick).  The crossing came after (backing: at a lower count)."""
+    edge_recent: list[tuple[float, float]] = field(default_factory=list)
+    """(time, odometer) on the watch's ticks, back as far as a floor reading
+    can stand for."""
+    edge_floor_held: bool = False
+    """The watch missed a stretch since that floor reading, the robot standing
+    through it (a hold stops every motor): the crossing lies between there
+    and here."""
     edge_blind_until: float | None = None
     """After a stretch the watch missed (a tick that came late, a hold), what
     perception says of the pair until then still comes from measurements
@@ -111,6 +123,9 @@ class EdgeWork(DriveWork):
     """Backing up to the edge: the odometer where the robot began driving
     forward to find the floor again (None: not doing that)."""
     refind_floor: int = 0
+    edge_slow: bool = False
+    """Found the floor again: backing up to the edge goes on at
+    :func:`~stairbot.control.algorithm.edge_measure.slow_backing`."""
     """Ticks in a row the back pair has read the floor on that drive."""
     edge_first_wheel: float | None = None
     edge_first: SensorId | None = None
@@ -235,6 +250,9 @@ class LowerThirdWork(LiftWork):
     finishing: bool = False
     """The back pair reads BACK_CLEARANCE within its noise; the rest of the
     lowering goes by turns to ``target_mtb``."""
+    mtb_recent: list[tuple[float, float]] = field(default_factory=list)
+    """(time, MTB's counter) on the phase's ticks, back to the back pair's lag:
+    how far segment 3 was lowered since what its filtered reading stands for."""
 
 
 @dataclass

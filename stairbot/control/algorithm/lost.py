@@ -1,0 +1,122 @@
+"""A sensor lost for good: the controller's decision when a sensor the phase
+needs has read as ERROR for SENSOR_WAIT_S (:mod:`~stairbot.control.algorithm.limp`
+says what limping home is)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from stairbot.control.algorithm import limp
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import AscentEnd, Purpose
+from stairbot.control.algorithm.phase import Step, Tick, go, where
+from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
+from stairbot.control.algorithm.texts import limp as say
+from stairbot.hardware import SensorId, Snapshot
+
+
+def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[SensorId],
+                  failed: str, *, mode: Mode, consent: bool,
+                  tilt_watched: bool) -> limp.DegradedStop | None:
+    """What follows the loss of the sensors ``errors`` in ``phase`` (``failed``
+    says what they report): None on the floor where the program began (the
+    run ends on the sensor error, as it always has), else a degraded stop
+    whose ``then`` says whether the robot limps home."""
+    if phase is Phase.PAUSED and ctx.pause is not None:  # lost while the standing rule waits
+        phase = BY_VALUE[ctx.pause.resume_phase]
+    purpose = ctx.family.purpose if isinstance(ctx.family, Calibration) else None
+    if limp.on_the_floor(phase, purpose, ctx.number_of_steps, mode,
+                         began=ctx.start.home_wheel is not None):
+        return None
+    known = [SensorId(s) for s in ctx.limp.lost] if ctx.limp is not None else []
+    lost = sorted(set(known) | set(errors), key=lambda s: s.value)
+    why = limp.cannot_limp(lost, phase, purpose, tilt_watched,
+                           turned_at_landing=ctx.landing.step is not None)
+    if why is not None:
+        then, told = "stranded", say.stranded(why)
+    elif not consent:
+        then, told = "no_consent", say.NO_CONSENT
+    else:
+        then, told = "limp_home", say.limping(_plan(ctx, phase, purpose),
+                                              limp.survivors(lost), limp.LIMP_SPEED)
+    return limp.DegradedStop(
+        lost=tuple(s.value for s in lost), failed=failed, phase=phase.value,
+        where=where(ctx, phase), steps_climbed=ctx.number_of_steps,
+        steps_descended=ctx.steps_descended, lifts=limp.lifts(snap), then=then, why=told,
+        survivors=limp.survivors(lost))
+
+
+_UNDO = (Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_LOWER_OBSTACLE)
+_TURN_BACK = (Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS)
+
+
+def _plan(ctx: Context, phase: Phase, purpose: Purpose | None) -> str:
+    """What the limp home does from ``phase``, in words."""
+    n = ctx.number_of_steps
+    if ctx.ascent_end is not None or ctx.from_top or phase.flow == "descent" \
+            or purpose not in (None, Purpose.START, Purpose.ASCENT):
+        return say.plan("down", 0, 0)
+    if phase in _UNDO:
+        return say.plan("undo", n + 1, n)
+    if phase in _TURN_BACK or purpose in (Purpose.ASCENT, Purpose.START):
+        return say.plan("turn_back", n + 1, n)
+    counted = phase in (Phase.ASCENT_CHECK, Phase.ASCENT_DRIVE_THIRD)
+    return say.plan("finish", n if counted else n + 1, n if counted else n + 1)
+
+
+def start_limping(ctx: Context, stop: limp.DegradedStop, time_s: float,
+                  label: str) -> None:
+    """Record in the context that the robot could limp home without the
+    sensors ``stop`` lost: it does, or (``stop.then`` "no_consent") will
+    once the operator consents (:func:`reopen`)."""
+    consented = stop.then == "limp_home"
+    if ctx.limp is None:
+        at = f"{label} ({stop.where})" if stop.where else label
+        ctx.limp = limp.Limp(list(stop.lost), time_s, at, consented,
+                             "" if consented else ctx.phase)
+    else:
+        ctx.limp.lost = list(stop.lost)
+
+
+def awaits_consent(ctx: Context) -> bool:
+    """Whether the program ended on a degraded stop the robot could limp home
+    from, had the operator consented."""
+    return ctx.phase == Phase.ERROR.value and ctx.limp is not None \
+        and not ctx.limp.consented and ctx.limp.stopped_in in BY_VALUE
+
+
+def reopen(ctx: Context) -> bool:
+    """Given the operator's consent now, a program ended on such a stop
+    (:func:`awaits_consent`) goes on from the phase it stopped in, limping
+    home; True if it does."""
+    if not awaits_consent(ctx):
+        return False
+    assert ctx.limp is not None
+    ctx.phase = ctx.limp.stopped_in
+    ctx.outcome = ctx.error = ctx.end_reason = None
+    ctx.limp.consented, ctx.limp.stopped_in = True, ""
+    return True
+
+
+LIMP = "a sensor lost on the stairs, limping home (consented)"
+"""The condition of the exits a limp home takes, for the flowcharts."""
+
+
+def limping(t: Tick) -> bool:
+    """Whether the robot limps home: the ascent phases that turn it back
+    (ascent 2 and 3 undo the step in progress, ascent 8 ends the ascent
+    once it is done) end the ascent and say so, once."""
+    ctx = t.ctx
+    if ctx.limp is None:
+        return False
+    if ctx.ascent_end is None:
+        ctx.ascent_end = AscentEnd.SENSOR_LOST
+        t.say(say.limp_down(ctx.number_of_steps), ascent_end=AscentEnd.SENSOR_LOST.value)
+    return True
+
+
+def limp_down(t: Tick) -> Step:
+    """Ascent 2 while limping home: down the steps climbed (descent 1), or,
+    none climbed, back to the start (descent 7)."""
+    return go("limp_home" if t.ctx.number_of_steps > 0 else "limp_home_floor")

@@ -1,0 +1,72 @@
+"""What a degraded stop and the limp home say
+(:mod:`~stairbot.control.algorithm.limp`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+
+def _lifts(lifts: Mapping[str, float]) -> str:
+    return ", ".join(f"{motor} {round(turns, 1) + 0.0:+.1f} turns"
+                     for motor, turns in lifts.items())
+
+
+def stopped_at(failed: str, label: str, where: str, lifts: Mapping[str, float],
+               climbed: int, descended: int) -> str:
+    """``failed``: what was lost and why ("SFR 3 measurements in a row report
+    an error"); ``where``: the step (may be empty)."""
+    at = f"{label} ({where})" if where else label
+    return (f"degraded stop: {failed} in {at}; lifts {_lifts(lifts)}; {climbed} step(s) "
+            f"climbed, {descended} descended: all motors stopped, lifts holding")
+
+
+def limping(plan: str, survivors: Sequence[str], speed: float) -> str:
+    """``plan``: what it does with the step in progress (:func:`plan`)."""
+    stand_in = (", ".join(f"{s} for its pair" for s in survivors) + ", ") if survivors else ""
+    return (f"limp home (consented): {plan}, on {stand_in}odometry and the IMU, at "
+            f"{speed:.0%} speed")
+
+
+def plan(kind: str, step: int, down: int) -> str:
+    """What the limp home does from where the robot stands: ``kind`` "undo"
+    (the step it lifts segment 1 onto), "finish" (the step it climbs),
+    "turn_back" (before the step it approaches) or "down" (it was going
+    down); ``step``: the step in progress (1-based); ``down``: the steps to
+    go down after it."""
+    head = {"undo": f"undoing step {step} (segment 1 lowered again), then ",
+            "finish": f"finishing step {step}, then ",
+            "turn_back": f"turning back before step {step}, then ",
+            "down": "carrying on "}[kind]
+    steps = (f"down the {down} step(s) climbed by the treads and tabs measured on the way "
+             "up, then " if down else "")
+    return f"{head}{steps}back to the start"
+
+
+NO_CONSENT = ("it can come down on the sensors that remain, but only with the operator's "
+              "consent: `stairbot run --resume --yes` carries this run on home from its "
+              "journal (`stairbot run --yes` consents before a run); until then it stays "
+              "stopped, lifts holding, or a person brings it down")
+
+REOPENED = ("limp home (consented on resuming): the program stopped on a lost sensor goes "
+            "on from where it stopped, on the sensors that remain")
+
+
+def stranded(why: str) -> str:
+    return f"it cannot come down on what remains ({why}): staying stopped, lifts holding"
+
+
+def stand_ins(lost: Sequence[str]) -> str:
+    """What a message says of the pair's readings while limping home."""
+    pairs = {"SFR": "SFL", "SFL": "SFR", "SBR": "SBL", "SBL": "SBR"}
+    return " [limping: " + ", ".join(f"{s} reads {pairs[s]}'s value" for s in lost) + "]"
+
+
+def lost_sensor_end(failed: str, wait_s: float, label: str, then: str) -> str:
+    """The reason the program ends with on a degraded stop it does not limp
+    home from: the sensor error as it always read, then what followed."""
+    return f"sensor error: {failed} for {wait_s:g} s in {label}; {then}"
+
+
+def limp_down(steps: int) -> str:
+    return (f"limp home: the ascent ends here; down the {steps} step(s) climbed"
+            if steps else "limp home: the ascent ends here; back to the start")
