@@ -21,6 +21,7 @@ from pathlib import Path
 from rich.console import Console
 
 from stairbot.errors import OutputError
+from stairbot.inputs.config import shipped_configs
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.spec import SpecError
 from stairbot.sweep.verdict import passing
@@ -69,7 +70,7 @@ def run_parser() -> argparse.ArgumentParser:
     p.add_argument("--limit", metavar="N", type=_jobs, help="run only the first N cases")
     p.add_argument("--config", metavar="FILE|NAME",
                    help="run the cases on this robot config (a file, or a shipped robot: "
-                        "reference, ideal, sonar, ir, heavy_middle) instead of the spec's")
+                        f"{', '.join(shipped_configs())}) instead of the spec's")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress, no tables")
     _plot_options(p)
     return p
