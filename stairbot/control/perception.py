@@ -33,6 +33,7 @@ from collections import deque
 from collections.abc import Iterable
 from enum import IntEnum
 
+from stairbot.control.timeline import value_at
 from stairbot.control.tolerances import WINDOW, max_age, spec_max_age, window
 from stairbot.hardware import (
     BACK_SENSORS,
@@ -144,7 +145,7 @@ class Perception:
                         continue
                 self._measured(track, reading, now, odometer)
             elif now - age > track.taken_s + 1e-9:
-                self._measured(track, reading, now - age, self._odometer_at(now - age))
+                self._measured(track, reading, now - age, value_at(self._odometer, now - age))
             sensors[sid] = self._verdict(sid, track, now, odometer)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
@@ -183,17 +184,6 @@ class Perception:
                 # a fresh median when it comes back
                 track.ok_keys.clear()
             track.kind = kind
-
-    def _odometer_at(self, t: float) -> float:
-        """The odometer at time ``t`` (linear between ticks; the oldest kept if older)."""
-        later: tuple[float, float] | None = None
-        for at, odo in reversed(self._odometer):
-            if at <= t:
-                if later is None or later[0] == at:
-                    return odo
-                return odo + (later[1] - odo) * (t - at) / (later[0] - at)
-            later = (at, odo)
-        return self._odometer[0][1]
 
     def _verdict(self, sid: SensorId, track: _Track, now: float, odometer: float
                  ) -> SensorReading:

@@ -56,6 +56,7 @@ from stairbot.control.algorithm.work import (
     LowerThirdWork,
     RefuseWork,
 )
+from stairbot.control.timeline import keep_since, value_at
 from stairbot.hardware import BACK_SENSORS, MotorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
@@ -142,12 +143,8 @@ def lowered_unseen_m(t: Tick, w: LowerThirdWork) -> float:
     recent = w.mtb_recent
     recent.append((now, mtb))
     then = now - edge_lag_s(t.cfg)
-    while len(recent) > 2 and recent[1][0] <= then:
-        del recent[0]
-    (t0, m0), (t1, m1) = recent[0], recent[min(1, len(recent) - 1)]
-    if t0 < then < t1:
-        m0 += (m1 - m0) * (then - t0) / (t1 - t0)
-    return max(0.0, m0 - mtb) * t.cfg.motors.lift_travel_per_turn
+    keep_since(recent, then)
+    return max(0.0, value_at(recent, then) - mtb) * t.cfg.motors.lift_travel_per_turn
 
 
 def _lower_third(t: Tick, w: LowerThirdWork) -> Step:

@@ -27,6 +27,7 @@ from stairbot.control.algorithm.modes import Outcome
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
 from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import EdgeWork
+from stairbot.control.timeline import keep_since, value_at
 from stairbot.control.tolerances import max_age, measurement_period, window
 from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
@@ -168,11 +169,6 @@ def edge_bound(t: Tick, w: EdgeWork, refind: bool) -> float | None:
     return step.edge_wheel - cfg.wheel_turns(edge_clearance_m(cfg))
 
 
-def _wheel_speed_m_s(t: Tick) -> float:
-    speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
-    return speed * t.cfg.wheel_circumference
-
-
 def floor_known_s(t: Tick) -> float:
     """How long ago, at the latest, the measurements behind the back pair's
     present floor reading put both sensors on the floor: its newest
@@ -192,24 +188,8 @@ def _history_s(cfg: RobotConfig) -> float:
 
 
 def _remember(t: Tick, w: EdgeWork, here: float) -> None:
-    recent, now = w.edge_recent, t.snap.time_s
-    recent.append((now, here))
-    while len(recent) > 2 and recent[1][0] <= now - _history_s(t.cfg):
-        del recent[0]
-
-
-def _wheel_at(w: EdgeWork, at: float) -> float:
-    """The odometer at time ``at`` from the watch's history (linear between
-    its ticks; the oldest kept if older)."""
-    recent = w.edge_recent
-    later: tuple[float, float] | None = None
-    for when, wheel in reversed(recent):
-        if when <= at:
-            if later is None or later[0] == when:
-                return wheel
-            return wheel + (later[1] - wheel) * (at - when) / (later[0] - when)
-        later = (when, wheel)
-    return recent[0][1]
+    w.edge_recent.append((t.snap.time_s, here))
+    keep_since(w.edge_recent, t.snap.time_s - _history_s(t.cfg))
 
 
 def _floor_read(t: Tick, w: EdgeWork, here: float) -> None:
@@ -218,7 +198,7 @@ def _floor_read(t: Tick, w: EdgeWork, here: float) -> None:
     last put it on the floor (``edge_floor_at``) bounds a crossing read after
     a stretch the robot stood through."""
     w.edge_floor_s = t.snap.time_s
-    w.edge_floor_at = _wheel_at(w, t.snap.time_s - floor_known_s(t))
+    w.edge_floor_at = value_at(w.edge_recent, t.snap.time_s - floor_known_s(t))
     w.edge_floor_held = False
 
 
@@ -233,8 +213,8 @@ def _missed_stretch(t: Tick, w: EdgeWork, here: float) -> None:
     unwatched, and that floor no longer counts either."""
     cfg = t.cfg
     w.edge_blind_until = t.snap.time_s + edge_lag_s(cfg) + measurement_period(cfg, True)
-    moved = abs(here - (w.edge_watch_wheel if w.edge_watch_wheel is not None else here))
-    if w.edge_watch_wheel is not None and moved * cfg.wheel_circumference <= edge_doubt_m(cfg):
+    last = w.edge_watch_wheel
+    if last is not None and abs(here - last) * cfg.wheel_circumference <= edge_doubt_m(cfg):
         w.edge_floor_held = w.edge_floor_s is not None
         return
     w.edge_floor_s = w.edge_floor_at = w.edge_first_wheel = w.edge_first = None
