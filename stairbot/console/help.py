@@ -14,6 +14,29 @@ from textual.widgets import Static
 
 WIDTH = 64
 
+# (action, palette title, palette help) for every operator action.
+COMMANDS: tuple[tuple[str, str, str], ...] = (
+    ("estop", "EMERGENCY STOP", "Stop every motor now (key: space)"),
+    ("clear_estop", "Clear emergency stop", "Allow motion again; resume with p (key: c)"),
+    ("start('full')", "Start full run", "Calibrate, climb, descend (key: s)"),
+    ("start('calibrate')", "Calibrate only", "Run the calibration and stop (key: k)"),
+    ("pause", "Pause / resume", "Hold the run where it is, or go on (key: p)"),
+    ("stop_run", "Stop the run", "End the run, motors stopped (key: x)"),
+    ("limp_home", "Limp home", "After a degraded stop: come home on the remaining "
+                               "sensors, once you consent (key: l)"),
+    ("reset", "Reset the simulated scenario", "Reopen the simulation at its start (key: r)"),
+    ("choose_robot", "Choose robot URL", "sim://, serial://PORT, can://IF/CH (key: u)"),
+    ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
+    ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
+    ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
+                                "the events as JSON lines (key: w)"),
+    ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+    ("top_view", "Top view / side view", "The stairwell and the robot seen from above, or "
+                                         "the side view again (key: t)"),
+    ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
+    ("help", "Help", "Every key, and how to read the screen (key: ?)"),
+)
+
 HELP = """\
 KEYS
   space   EMERGENCY STOP: every motor stops at once, from any
