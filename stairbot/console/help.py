@@ -1,4 +1,5 @@
-"""The help screen (``?``): every key, and how to read the screen.
+"""The help screen (``?``): every key, and how to read the screen; and
+every action by name, for the command palette (:data:`COMMANDS`).
 
 Its lines fit :data:`WIDTH` columns: the dialog's width (``.help`` in
 console.tcss, 72) less its border, padding and scroll bar; a longer one
@@ -45,6 +46,9 @@ KEYS
           robot)
   s       start the full run      k  calibrate only
   p       pause / resume          x  stop the run
+  l       limp home: after a degraded stop (a sensor lost on the
+          stairs), asks whether the robot may come down on the
+          sensors that remain; the console asks at the stop
   q       quit (mid-run: the robot stops first, then it asks);
           Ctrl+Q and Ctrl-C do the same
   u       robot URL               o  scenario
@@ -60,15 +64,18 @@ KEYS
 
 READING THE SCREEN
   Banner: the state (READY, RUNNING, PAUSED, ENDED, FAULT),
-  E-STOP and who latched it (operator, or automatic: why), then
-  what to know now, whole.
+  E-STOP and who latched it (operator, or automatic: why),
+  DEGRADED while a run limps home on the sensors that remain
+  (which is out, the survivor its pair runs on, the speed) and
+  after it, then what to know now, whole.
   Every panel says how old its values are; values not read for
   1.5 s are dimmed and marked STALE: they are not live.
   Sensors: front R/L look ahead (SFR, SFL), back R/L look down
   (SBR, SBL); side R/L look right and left (SSR, SSL), on a
   robot with the side pair only; ok, out (of range: the value
   is the sensor's limit), old (the sensor's own reading is
-  stale), ERROR, none (no reading of it).
+  stale), ERROR, none (no reading of it); LOST: a limp home goes
+  without it, its pair runs on the other ("runs on SFL").
   Motors: ▶ forward ◀ back; a lift shows the segment that moves:
   1▲ segment 1 rises, 2▼ segment 2 sinks (segments 1 front, 2
   middle, 3 back, coloured as in the picture).  With no run
