@@ -94,9 +94,9 @@ def degraded_title(v: StateView) -> str:
     how it ended ("": it does not)."""
     if not v.limping:
         return ""
-    if v.result is not None:
-        return "CAME HOME DEGRADED" if v.result.outcome == "came_home_degraded" else "DEGRADED"
-    return "DEGRADED" if v.flow == "end" else "LIMPING HOME"
+    if not v.limp_end:
+        return "LIMPING HOME"
+    return "CAME HOME DEGRADED" if v.limp_end == "came_home_degraded" else "DEGRADED"
 
 
 def show_top(app: StairbotConsole, v: StateView) -> None:

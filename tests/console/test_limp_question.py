@@ -18,7 +18,7 @@ from textual.widgets import Label
 
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.limp_question import LimpQuestion, StopNotice
-from stairbot.console.modals import ConfirmScreen
+from stairbot.console.modals import ChoiceScreen, ConfirmScreen
 from stairbot.console.state import LiveState
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event
@@ -128,9 +128,21 @@ def test_refusing_leaves_the_robot_stopped_and_says_how_to_bring_it_home(
             assert "stays stopped, lifts holding" in banner(app)
             assert "l asks again" in banner(app)
             assert "not moved (stay stopped)" in said(app)
-            # later: l asks again, and the consent then brings it home
+            # later: l asks again; or, the stop's latch cleared (c), s offers it
             await press(pilot, "l")
             await until(pilot, lambda: isinstance(app.screen, LimpQuestion), "asked again")
+            await press(pilot, "n")
+            await until(pilot, lambda: len(app.screen_stack) == 1, "refused again")
+            await press(pilot, "c")
+            await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "clear?")
+            await press(pilot, "y")
+            await until(pilot, lambda: not app.state.view().status.estopped, "cleared")
+            assert spy.motion(n) == []
+            await press(pilot, "s")
+            await until(pilot, lambda: isinstance(app.screen, ChoiceScreen), "the choices")
+            assert "Limp home asks whether it may come down" in dialog(app)
+            await press(pilot, "l")
+            await until(pilot, lambda: isinstance(app.screen, LimpQuestion), "asked from s")
             await press(pilot, "y")
             await until(pilot, lambda: outcome(app) == "came_home_degraded",
                         "came home degraded")
@@ -209,6 +221,7 @@ def test_the_limp_is_followed_by_the_run_events_alone_as_a_replay_has_them() -> 
     assert view.limping == ("SFR",) and view.degraded is not None
     assert view.degraded.data["degraded"]["then"] == "limp_home"
     assert limping_from == view.degraded.time_s  # from the stop on
+    assert view.limp_end == "came_home_degraded"
     state.on_event(next(e for e in events if e.data.get("why") == "program start"))
     assert state.view().limping == () and state.view().degraded is None  # a new run
 
