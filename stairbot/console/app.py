@@ -232,7 +232,8 @@ class StairbotConsole(App[None]):
         if result is None:
             return
         self._tell(f"run {result.outcome}", "information")
-        if self.engine.limp_offer is not None or stranded(self.state.view().degraded):
+        if self.engine.limp_offer is not None or self.engine.limp_refused \
+                or stranded(self.state.view().degraded):
             self.call_from_thread(limp_question.after_stop, self)
 
     def _tell(self, message: str, severity: str) -> None:

@@ -118,6 +118,9 @@ class ConsoleEngine(RobotHolder):
         self._last_ctx = -1.0
         self._last_flow, self._last_label = "", ""  # the run's last phase before its end
         self._last_tick_s = 0.0  # the robot's clock at the run's last tick
+        self.limp_refused = ""
+        """Why the last run's degraded stop, which the robot could limp home
+        from, cannot be carried on by this console ("": it can, or none)."""
 
     # -- the run (worker thread) -----------------------------------------------
     def run(self, mode: str = "full", resume: ResumePlan | None = None,
@@ -185,17 +188,19 @@ class ConsoleEngine(RobotHolder):
         self.mid_climb = after_run(result, self._last_flow, self._last_label)
         self.robot.refresh_scene()
         self.state.on_result(result)
+        self.limp_refused = ""
         try:
             self.limp_offer = limp_gate.offer_after(
                 result, self._controller, self.state.view().degraded, mode, self._last_tick_s,
                 None if self.in_process else self.plan_resume)
         except StairbotError as exc:  # the journal's run does not check: no question
-            self.limp_offer = None
+            self.limp_offer, self.limp_refused = None, str(exc)
             self.state.note(f"limp home cannot be offered: {exc}", "error")
         line, severity = describe_result(result, self.state.view().limping)
         stop = self.state.view().degraded
         if result.outcome == "error" and stop is not None and stop.time_s >= began_s:
-            line = limp_gate.banner_line(stop, self.limp_offer is not None)  # this run's stop
+            line = limp_gate.banner_line(stop, self.limp_offer is not None,  # this run's stop
+                                         self.limp_refused)
         if self.robot.estopped:
             line += " · EMERGENCY STOP latched: c clears it"
             if not self.latched:  # the run latched it (an error): the console holds it too

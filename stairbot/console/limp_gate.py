@@ -110,6 +110,13 @@ def _lost(rec: Mapping[str, Any]) -> str:
     return failed + (f" ({', '.join(before)} lost before)" if before else "")
 
 
+def cannot(refused: str) -> str:
+    """A stop the robot could limp home from that this console cannot carry
+    on (``refused``: why)."""
+    return (f"it could come down on the sensors that remain, but this console cannot carry "
+            f"the run on ({refused}): it stays stopped, lifts holding")
+
+
 def stop_lines(stop: Event, per_turn_m: float) -> list[str]:
     """The degraded stop, plainly: what failed, where the robot stands (as
     the stop recorded it, at its time: not live), the lifts holding."""
@@ -122,12 +129,14 @@ def stop_lines(stop: Event, per_turn_m: float) -> list[str]:
     ]
 
 
-def banner_line(stop: Event, offered: bool) -> str:
+def banner_line(stop: Event, offered: bool, refused: str = "") -> str:
     """The banner after a degraded stop: what failed, where, and what now
-    (``offered``: the operator is asked whether it may limp home)."""
+    (``offered``: the operator is asked whether it may limp home;
+    ``refused``: why this console cannot carry the run on)."""
     rec = stop.data["degraded"]
     then = ("it can come down on the sensors that remain, once you consent: answer the "
-            "question (l asks again)" if offered else str(rec.get("why", "")))
+            "question (l asks again)" if offered else cannot(refused) if refused
+            else str(rec.get("why", "")))
     return (f"DEGRADED STOP: {_lost(rec)} in {_at(rec)}; every motor stopped, lifts "
             f"holding; {then}")
 

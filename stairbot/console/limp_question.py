@@ -85,13 +85,14 @@ def after_stop(app: StairbotConsole) -> None:
     stop = app.state.view().degraded
     if app.engine.limp_offer is not None:
         ask(app)
-    elif limp_gate.stranded(stop) and stop is not None:
+    elif stop is not None and (app.engine.limp_refused or limp_gate.stranded(stop)):
         per_turn = app.engine.config.motors.lift_travel_per_turn
-        rec = stop.data["degraded"]
+        refused = app.engine.limp_refused
+        why = limp_gate.cannot(refused) if refused else stop.data["degraded"].get("why", "")
         lines = limp_gate.stop_lines(stop, per_turn)
         app.push_screen(StopNotice("\n".join(
-            [*lines, "", f"No question to ask: {rec.get('why', '')}.  A person brings it "
-             "down (look at the robot first); c clears the emergency stop."])))
+            [*lines, "", f"No question to ask: {why}.  A person brings it down (look at the "
+             "robot first); c clears the emergency stop."])))
 
 
 def ask(app: StairbotConsole) -> None:

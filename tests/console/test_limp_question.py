@@ -16,6 +16,7 @@ from pilot import SpyRobot, banner, press, ready, said, shown, spied_open, until
 from simrun import run_sim
 from textual.widgets import Label
 
+from stairbot.console import limp_gate
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.limp_question import LimpQuestion, StopNotice
 from stairbot.console.modals import ChoiceScreen, ConfirmScreen
@@ -25,6 +26,7 @@ from stairbot.events import Event
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.journal import read_journal
 from stairbot.run.journaled import default_path
+from stairbot.run.resume import ResumeRefused
 
 LOST_MID_CLIMB = """
 name = "sfr-lost-ascent7"
@@ -253,3 +255,25 @@ def test_boards_come_home_from_the_question_through_their_journal(
         asyncio.run(go())
     end = read_journal(journal).end
     assert end is not None and end["outcome"] == "came_home_degraded", end
+
+
+def test_no_question_when_the_console_cannot_carry_the_run_on(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Boards whose journal no longer checks (here: made to refuse) cannot be
+    carried on: the stop is told, and no question asked."""
+    def refused(*_args: object) -> None:
+        raise ResumeRefused("the boards restarted since the journal")
+
+    monkeypatch.setattr(limp_gate, "offer_after", refused)
+
+    async def go() -> None:
+        app = build_app(scenario=scenario(tmp_path), speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            await press(pilot, "s")
+            await until(pilot, lambda: isinstance(app.screen, StopNotice), "the notice")
+            text = dialog(app)
+            assert "this console cannot carry the run on (the boards restarted" in text, text
+            assert "cannot carry the run on" in banner(app)
+            assert "stairbot run --resume --yes" not in banner(app)
+    asyncio.run(go())
