@@ -246,12 +246,15 @@ def test_boards_come_home_from_the_question_through_their_journal(
                 await press(pilot, "s")
                 await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "start?")
                 await press(pilot, "y")
-                await until(pilot, lambda: isinstance(app.screen, LimpQuestion), "the question")
+                await until(pilot, lambda: isinstance(app.screen, LimpQuestion)
+                            or outcome(app) is not None, "the question", bound_s=600)
+                assert isinstance(app.screen, LimpQuestion), banner(app)
                 assert "(boards on a wire)" in dialog(app)
                 end = read_journal(journal).end
                 assert end is not None and end["resumable"] is True
                 await press(pilot, "y")
-                await until(pilot, lambda: outcome(app) == "came_home_degraded", "home")
+                await until(pilot, lambda: outcome(app) == "came_home_degraded", "home",
+                            bound_s=600)
         asyncio.run(go())
     end = read_journal(journal).end
     assert end is not None and end["outcome"] == "came_home_degraded", end
