@@ -248,7 +248,8 @@ def test_boards_come_home_from_the_question_through_their_journal(
                 await press(pilot, "y")
                 await until(pilot, lambda: isinstance(app.screen, LimpQuestion)
                             or outcome(app) is not None, "the question", bound_s=600)
-                assert isinstance(app.screen, LimpQuestion), banner(app)
+                await app.workers.wait_for_complete()  # the run's worker asks at its end
+                assert isinstance(app.screen, LimpQuestion), app.state.view().result
                 assert "(boards on a wire)" in dialog(app)
                 end = read_journal(journal).end
                 assert end is not None and end["resumable"] is True
