@@ -83,7 +83,9 @@ def test_the_degraded_stop_is_shown_and_consent_carries_the_run_home(tmp_path: P
                           "finishing step 1, then down the 1 step(s) climbed",
                           "on SFL for the front pair", "at most 50% of its speed"):
                 assert words in text, text
-            assert "DEGRADED STOP" in banner(app) and "run error" not in banner(app)
+            # the banner repaints on the stop's event, which may come a frame after the question
+            await until(pilot, lambda: "DEGRADED STOP" in banner(app), "the banner's stop")
+            assert "run error" not in banner(app)
             spy = spies[-1]
             assert spy.inner.estopped  # stopped, latched, while it asks
             await press(pilot, "y")
@@ -278,6 +280,6 @@ def test_no_question_when_the_console_cannot_carry_the_run_on(
             await until(pilot, lambda: isinstance(app.screen, StopNotice), "the notice")
             text = dialog(app)
             assert "this console cannot carry the run on (the boards restarted" in text, text
-            assert "cannot carry the run on" in banner(app)
+            await until(pilot, lambda: "cannot carry the run on" in banner(app), "the banner")
             assert "stairbot run --resume --yes" not in banner(app)
     asyncio.run(go())
