@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 from pathlib import Path
 
+import lost_sensor
 import pytest
 from lockstep_boards import lockstep_boards
 from pilot import SpyRobot, banner, press, ready, said, shown, spied_open, until
@@ -28,17 +29,7 @@ from stairbot.run.journal import read_journal
 from stairbot.run.journaled import default_path
 from stairbot.run.resume import ResumeRefused
 
-LOST_MID_CLIMB = """
-name = "sfr-lost-ascent7"
-[stairs]
-count = 2
-[[faults]]
-at = 42.0
-sensor = "SFR"
-kind = "error"
-"""
-"""SFR errs from 42 s, in ascent 7 of step 1 (segment 3 rising) on the
-reference robot: a degraded stop the robot can limp home from on SFL."""
+LOST_MID_CLIMB = 'name = "sfr-lost-ascent7"\n' + lost_sensor.LOST_MID_CLIMB
 
 BOTH_FRONT_LOST = LOST_MID_CLIMB + """
 [[faults]]
