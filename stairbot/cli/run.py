@@ -273,11 +273,27 @@ def cmd_run(args: argparse.Namespace) -> int:
     if interrupted:
         print(f"{PROG}: interrupted: emergency stop latched, every motor stopped", file=sys.stderr)
         return EXIT_INTERRUPTED
+    if result.awaits_consent:
+        print(f"{PROG}: {_how_to_consent(args.robot, args.journal)}",
+              file=sys.stderr)
     if mismatches:
         print(f"{PROG}: the run did not end as {printable(scenario.source)} expects: "
               + printable("; ".join(mismatches)), file=sys.stderr)
         return EXIT_MISMATCH
     return EXIT_OK
+
+
+def _how_to_consent(url: str, journal: str | None) -> str:
+    """How the operator consents to the limp home a run ended waiting for:
+    boards carry the run on from its journal; a simulated robot ends with its
+    run, so only a new run consents (before it starts)."""
+    if url.startswith("sim:"):
+        return ("the robot could limp home on the sensors that remain: a simulated run "
+                f"ends here; `{PROG} run --yes` consents before a run")
+    given = f" --journal {journal}" if journal else ""
+    return printable(f"the robot can limp home on the sensors that remain: "
+                     f"`{PROG} run --robot {url}{given} --resume --yes` carries this run on "
+                     "home from its journal")
 
 
 def _fmt(value: Any, unit: str = "", digits: int = 3) -> str:

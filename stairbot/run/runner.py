@@ -140,6 +140,10 @@ class RunResult:
     """The first wall (or riser) the robot's body touched, where the robot can
     tell (a simulation's top view: a landing's walls as it turns); None:
     none, or it cannot tell."""
+    awaits_consent: bool = False
+    """Whether the program ended on a degraded stop the robot could limp home
+    from, had the operator consented (``--yes``): the front end says how to
+    give the consent where it is given (a journal's resume on boards)."""
     host_behind: HostBehind | None = None
     """The ticks of the run that began more than one tick late, and the
     longest such lateness, on a clock that waits for real time (a loaded
@@ -278,6 +282,7 @@ def run(
         reason=res.reason,
         clear_of_stairs_m=truth.clear_of_stairs_m if truth is not None else None,
         wall_contact=truth.wall_contact if truth is not None else None,
+        awaits_consent=awaits_consent(ctl.context) and not fell,
         host_behind=clock.host_behind() if isinstance(clock, CountsLateTicks) else None,
     )
     if journal is not None:
@@ -286,8 +291,7 @@ def run(
             # journal offers --resume once the wire is back; so does a degraded
             # stop the operator did not consent to limp home from (yet)
             journal.end(result.outcome, result.error, clock.now(),
-                        resumable=(fault == "link" or awaits_consent(ctl.context))
-                        and not fell)
+                        resumable=(fault == "link" and not fell) or result.awaits_consent)
     sink(Event(clock.now(), EventKind.SUMMARY, _summary_line(result), None, result.to_dict()))
     return result
 

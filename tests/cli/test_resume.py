@@ -282,7 +282,9 @@ def test_a_sensor_lost_mid_climb_without_consent_stops_and_resume_yes_limps_home
         assert first.returncode == 1, err[-2000:]
         result = json.loads(out)
         assert result["outcome"] == "error" and result["steps_descended"] == 0
-        assert "stairbot run --resume --yes" in result["error"]
+        assert result["awaits_consent"] is True, result
+        assert (f"`stairbot run --robot {url} --journal {journal} --resume --yes` carries "
+                "this run on home") in err, err[-2000:]
         end = read_journal(journal).end
         assert end is not None and end.get("resumable") is True, end
 

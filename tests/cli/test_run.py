@@ -224,5 +224,8 @@ def test_yes_lets_the_robot_limp_home_on_a_sensor_lost_mid_climb(
     assert main(["run", "--json", "--scenario", str(scenario)]) == 1
     out, err = capsys.readouterr()
     data = json.loads(out)
-    assert data["outcome"] == "error" and "stairbot run --yes" in data["error"]
+    assert (data["outcome"], data["awaits_consent"]) == ("error", True), data
     assert "degraded stop: SFR" in err
+    # a simulated robot ends with its run: the consent is given before one,
+    # never by a resume the simulation would refuse
+    assert "`stairbot run --yes` consents before a run" in err and "--resume" not in err

@@ -43,9 +43,8 @@ def plan(kind: str, step: int, down: int) -> str:
 
 
 NO_CONSENT = ("it can come down on the sensors that remain, but only with the operator's "
-              "consent: `stairbot run --resume --yes` carries this run on home from its "
-              "journal (`stairbot run --yes` consents before a run); until then it stays "
-              "stopped, lifts holding, or a person brings it down")
+              "consent; until then it stays stopped, lifts holding, or a person brings it "
+              "down")
 
 REOPENED = ("limp home (consented on resuming): the program stopped on a lost sensor goes "
             "on from where it stopped, on the sensors that remain")
