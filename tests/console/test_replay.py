@@ -94,12 +94,13 @@ def run(go: Callable[[], Any]) -> None:
 def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[str, Path]) -> None:
     path = recorded["mcap"]
     sensors, motors = messages(path, topics.SENSORS), messages(path, topics.MOTORS)
+    length = json.loads(recorded["jsonl"].read_text().splitlines()[-1])["time_s"]
 
     async def go() -> None:
         app = replay_app(path, Clock(), playing=False)
         async with app.run_test(size=(80, 24)) as pilot:
             await press(pilot, "right", "right", "right")  # 3 x 1 s
-            await until(pilot, lambda: "t = 3.0 s / 13.8 s" in app.banner.plain, "at 3 s")
+            await until(pilot, lambda: f"t = 3.0 s / {length:.1f} s" in app.banner.plain, "at 3 s")
             s, m = at(sensors, 3.0), at(motors, 3.0)
             assert s["time_s"] == 3.0
             screen = shown(app.sensors)
@@ -221,7 +222,7 @@ def test_seek_keys_go_to_the_right_time_and_back_replays_the_events(
         async with app.run_test(size=(100, 40)) as pilot:
             await press(pilot, "end")
             end = app.player.end_s
-            assert end == events[-1]["time_s"] == 13.76
+            assert end == events[-1]["time_s"] > 6.0  # the recording's last event
             await until(pilot, lambda: len(app.log_panel._kept) == len(events), "every event")
             assert said(app) == [e["message"] for e in events]  # the whole list, in order
             await press(pilot, "left")
