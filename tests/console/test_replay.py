@@ -114,7 +114,8 @@ def test_seeking_shows_the_recorded_sensors_motors_and_picture(recorded: dict[st
             assert app.state.view().scene is not None  # the recorded pose, drawn
             assert "recorded on sim://" in str(app.picture.border_title)
             await press(pilot, "end")
-            await until(pilot, lambda: "t = 13.8 s / 13.8 s" in app.banner.plain, "at the end")
+            await until(pilot, lambda: f"t = {length:.1f} s / {length:.1f} s"
+                        in app.banner.plain, "at the end")
             last = sensors[-1]
             assert f"SFR {last['SFR']['distance_m']:5.3f} m" in shown(app.sensors)
     run(go)
