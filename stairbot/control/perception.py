@@ -152,7 +152,7 @@ class Perception:
             elif now - age > track.taken_s + 1e-9:
                 self._measured(track, reading, now - age, value_at(self._odometer, now - age))
             sensors[sid] = self._verdict(sid, track, now, odometer)
-        self._stuck.judge(snap, odometer, sensors, self._why)
+        self._stuck.judge(snap, sensors, self._why)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
     def why(self, sensor: SensorId) -> str | None:

@@ -65,4 +65,4 @@ def test_a_back_sensor_stuck_lowering_segment_3_is_lost_and_the_robot_comes_home
     assert (stop["lost"], stop["survivors"], stop["phase"]) == (
         ["SBR"], ["SBL"], "descent_lower_third")
     assert stop["failed"].startswith("SBR stuck at 0.2"), stop
-    assert "SBL's reading went from" in stop["failed"] and "the lifts moved" in stop["failed"]
+    assert "SBL's reading went from" in stop["failed"] and "as MTB moved" in stop["failed"]
