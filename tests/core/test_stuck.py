@@ -123,3 +123,18 @@ def test_a_noisy_sensor_driving_is_never_stuck_by_chance() -> None:
                                    SBL: 0.04 + rng.gauss(0.0, 0.004)},
                   speed=0.02, ticks=1000)
     assert all(errors(seen, sid) == [] for sid in (SFR, SFL, SBR, SBL))
+
+
+def test_a_partner_that_steps_by_itself_does_not_make_this_one_stuck() -> None:
+    # SBL's reading steps 10 mm (a bias setting in) while MTB lifts segment 2
+    # and segment 3 stands: SBR, right, holds; which of the two is wrong is
+    # not known, so neither is judged
+    seen, _ = run(lambda i, d, h: {SFR: 0.3, SFL: 0.3, SBR: 0.04,
+                                   SBL: 0.04 if i < 60 else 0.05},
+                  lift_speed=0.02, ticks=200)
+    assert errors(seen, SBR) == [] and errors(seen, SBL) == []
+    # nor the front pair, whose reading a lift does not move: SFL steps 5 cm
+    seen, _ = run(lambda i, d, h: {SFR: 0.3, SFL: 0.3 if i < 60 else 0.35,
+                                   SBR: 0.04 + h, SBL: 0.04 + h},
+                  lift_speed=0.02, ticks=200)
+    assert errors(seen, SFR) == [] and errors(seen, SFL) == []
