@@ -36,8 +36,9 @@ reads the same value for as long as it likes: neither rule fires, since
 nothing moved.  A sensor reading "nothing within range" or an error is not
 judged (it has no value to be stuck at); nor is the front pair by its
 partner (a lift does not move what it reads; a partner whose reading moves
-and this one's not may as well be the one that is wrong).  Judged stuck, a sensor reads as
-ERROR (:meth:`StuckWatch.judge`), with why, until its value changes: a
+and this one's not may as well be the one that is wrong).  Judged stuck, a
+sensor reads as ERROR (:meth:`StuckWatch.judge`), with why, until its value
+changes: a
 sensor the phase needs then stands the robot and, if it stays so, is lost
 (the limp home of :mod:`~stairbot.control.algorithm.limp`).  The side pair
 is not judged (nothing limps home on it).
@@ -94,7 +95,7 @@ have followed: small, and within what the standing rule allows the back
 pair in descent 2 beyond the pair's noise (judged later, the rule stops the
 robot first, and the run ends there)."""
 HISTORY = 32
-"""Ticks of odometer and motion kept to place a measurement the board
+"""Ticks of odometer and MTB travel kept to place a measurement the board
 publishes late (0.64 s at 20 ms, as perception's odometer)."""
 
 _PARTNER = {SensorId.SFR: SensorId.SFL, SensorId.SFL: SensorId.SFR,
