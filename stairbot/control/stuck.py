@@ -7,7 +7,7 @@ it.  What gives it away is a value that stays the same (the very value, after
 the sensor's rounding) for REPEATS measurements in a row or more while the
 robot moved what it looks at:
 
-* **the drive** (SFR, SFL, with segment 2 level: LEVEL_DEG): the front pair
+* **the drive** (SFR, SFL, on a riser or a wall: LEVEL_DEG): the front pair
   looks along the drive, and driving d towards (or away from) any flat
   surface a beam meets shortens (lengthens) that beam by d; a cone's mix, or
   a nearest echo, moves with it.  So a value that stays the same while the
@@ -76,14 +76,16 @@ while the truth moves 8 mm comes about once in 10^7 (worst at a sigma of
 3 mm; a quieter sensor cannot hide the move, a noisier one seldom
 repeats)."""
 LEVEL_DEG = 1.5
-"""The drive rule holds only while segment 2 (the IMU) pitches less than
-this: pitched, segment 1's beam may meet a tread ahead at a graze, where a
-pitch that changes as the robot drives moves the reading as much as the
-drive does, the other way (the ideal robot, noiseless, pitched 3.5 degrees
-nose down in ascent 6 onto the top step: its SFL read 0.493 m while the
-drive moved 12 mm).  Level, a beam meets risers and walls, which the drive
-moves it along.  Without an IMU the pitch is not known: the rule does not
-hold."""
+"""Within this pitch of segment 2 (the IMU) the front beams meet risers and
+walls, which the drive moves them along.  Pitched nose down, a beam may
+meet the tread ahead, whose distance the robot driving along the treads does
+not change (the ideal robot, noiseless, pitched 3.4 degrees nose down in
+ascent 6 onto the top step: SFL read 0.493 m, the landing 3 cm below its
+beam, while the drive moved 12 mm): then the rule holds only for a value
+nearer than FLOOR_SHARE of the distance at which the lowest ray would meet
+the floor the robot stands on (:meth:`StuckWatch._floor_m`).  Without an
+IMU the pitch is not known: the rule does not hold."""
+FLOOR_SHARE = 0.8
 PARTNER_JUMP_M = 0.02
 """A partner's filtered reading that moves more than this from one tick to
 the next jumped (onto another surface, or its own fault began): its moves
@@ -125,14 +127,15 @@ class _Run:
                  "last_lift", "partner", "partner_last", "settled_s", "lift_from", "evidence",
                  "why")
 
-    def __init__(self, value: Value, taken_s: float, odometer: float, level: bool,
+    def __init__(self, value: Value, taken_s: float, odometer: float, clear: bool,
                  lift: float, settled_s: float) -> None:
         self.value = value
         self.count = 1
         self.first_s = self.taken_s = taken_s
-        self.odometer: float | None = odometer if level else None
+        self.odometer: float | None = odometer if clear else None
         """The odometer from which the drive counts: at the run's first
-        measurement taken level since the last one pitched (None: pitched)."""
+        measurement that was a riser's or a wall's since the last that may
+        not have been (None: may not be)."""
         self.last_odometer = odometer
         self.last_lift = lift
         """MTB's travel (any direction) at the latest measurement."""
@@ -168,7 +171,12 @@ class StuckWatch:
         self._turns: tuple[float, ...] | None = None
         self._odometer = 0.0
         self._lift = 0.0
-        self._level = False
+        self._clear = -1.0
+        """A front value nearer than this is a riser's or a wall's (-1: none is)."""
+        s = cfg.sensors
+        fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
+        self._lowest_deg = s.front_tilt_deg - fov / 2.0
+        self._beam_m = s.front_height
         self._odometers: deque[tuple[float, float]] = deque(maxlen=HISTORY)
         self._lifts: deque[tuple[float, float]] = deque(maxlen=HISTORY)
 
@@ -212,9 +220,20 @@ class StuckWatch:
                     self._odometer += alike * self._wheel_m
         self._turns = turns
         imu = snap.imu
-        self._level = imu is not None and abs(imu.pitch_deg) <= LEVEL_DEG
+        self._clear = -1.0 if imu is None else self._floor_m(imu.pitch_deg)
         self._odometers.append((now, self._odometer))
         self._lifts.append((now, self._lift))
+
+    def _floor_m(self, pitch_deg: float) -> float:
+        """How near a front value must be to be a riser's or a wall's, at
+        segment 2's pitch: level, any; pitched, nearer than FLOOR_SHARE of
+        where the lowest ray meets the floor (infinite if no ray looks down)."""
+        if abs(pitch_deg) <= LEVEL_DEG:
+            return math.inf
+        down = -(pitch_deg + self._lowest_deg)
+        if down <= 0.0:
+            return math.inf
+        return FLOOR_SHARE * self._beam_m / math.sin(math.radians(min(down, 90.0)))
 
     def _value(self, sid: SensorId, reading: SensorReading | None) -> Value | None:
         """What a reading says for this watch (None: an error, no value)."""
@@ -239,9 +258,10 @@ class StuckWatch:
             self._runs[sid] = None
             return None
         odometer, lift = value_at(self._odometers, taken), value_at(self._lifts, taken)
+        clear = value[0] < self._clear  # a riser's or a wall's: the drive moves it
         if run is not None and value == run.value:
             run.taken_s, run.last_odometer, run.last_lift = taken, odometer, lift
-            if not self._level:
+            if not clear:
                 run.odometer = None
             elif run.odometer is None:
                 run.odometer = odometer
@@ -249,7 +269,7 @@ class StuckWatch:
             return run
         # the partner's median may be settling on a surface it jumped onto
         # just before: its moves count from when it has
-        run = _Run(value, taken, odometer, self._level, lift, self._now + self._settle)
+        run = _Run(value, taken, odometer, clear, lift, self._now + self._settle)
         self._runs[sid] = run
         return run
 
