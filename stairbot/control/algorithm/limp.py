@@ -115,12 +115,15 @@ class DegradedStop:
     then: str
     why: str
     survivors: tuple[str, ...] = ()
+    plan: str = ""
+    """What limping home would do from here, in words ("": it cannot)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"lost": list(self.lost), "failed": self.failed, "phase": self.phase,
                 "where": self.where, "steps_climbed": self.steps_climbed,
                 "steps_descended": self.steps_descended, "lifts": dict(self.lifts),
-                "then": self.then, "why": self.why, "survivors": list(self.survivors)}
+                "then": self.then, "why": self.why, "survivors": list(self.survivors),
+                "plan": self.plan}
 
 
 def lifts(snap: Snapshot) -> dict[str, float]:
