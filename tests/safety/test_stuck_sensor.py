@@ -64,5 +64,5 @@ def test_a_back_sensor_stuck_lowering_segment_3_is_lost_and_the_robot_comes_home
     assert home(r), r.to_dict()
     assert (stop["lost"], stop["survivors"], stop["phase"]) == (
         ["SBR"], ["SBL"], "descent_lower_third")
-    assert stop["failed"].startswith("SBR stuck at 0.2"), stop
+    assert stop["failed"].startswith("SBR stuck at 0."), stop
     assert "SBL's reading went from" in stop["failed"] and "as MTB moved" in stop["failed"]
