@@ -19,6 +19,9 @@ tick repeats its last value, and the board says how old it is
 * **staleness**: a sensor whose newest measurement is older than its
   datasheet's latency plus STALE_PERIODS periods (a frozen sensor, a board
   that stopped updating it) reads as ERROR: it is not used.
+* **stuck**: a sensor whose fresh measurements keep one value while the
+  robot's motion says it must have changed reads as ERROR too
+  (:mod:`stairbot.control.stuck`).
   :meth:`Perception.why` says which.
 
 Its timings, and the tolerances decisions that compare two sensors use, come
@@ -33,6 +36,7 @@ from collections import deque
 from collections.abc import Iterable
 from enum import IntEnum
 
+from stairbot.control.stuck import StuckWatch
 from stairbot.control.timeline import value_at
 from stairbot.control.tolerances import WINDOW, max_age, spec_max_age, window
 from stairbot.hardware import (
@@ -110,6 +114,7 @@ class Perception:
                 self._tracks[sid] = _Track(False, WINDOW, age, (lo + hi) / 2.0)
         self._odometer: deque[tuple[float, float]] = deque(maxlen=ODOMETER_HISTORY)
         self._why: dict[SensorId, str] = {}
+        self._stuck = StuckWatch(cfg)
 
     def see(self, snap: Snapshot) -> Snapshot:
         """The snapshot as the algorithm should see it."""
@@ -147,6 +152,7 @@ class Perception:
             elif now - age > track.taken_s + 1e-9:
                 self._measured(track, reading, now - age, value_at(self._odometer, now - age))
             sensors[sid] = self._verdict(sid, track, now, odometer)
+        self._stuck.judge(snap, sensors, self._why)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
     def why(self, sensor: SensorId) -> str | None:

@@ -25,6 +25,11 @@ What a reading goes through:
   dropouts -- so the same run gives the same readings bit for bit;
 * scenario faults: an ``offset`` fault adds to the measurement taken while it
   is active; an ``error`` fault makes every reading ERROR while it is active;
+  a ``freeze`` fault stops the measurements (the last one is published on,
+  growing old); a ``stuck`` fault lets them go on, on time and fresh, but
+  each is the last one taken before the fault began, as it was (the noise,
+  outlier and dropout draws are still made, so the readings after the fault
+  are those of the same run without it);
 * a dropout makes one measurement ERROR or OUT_OF_RANGE (even odds); an
   outlier replaces it with a uniform value within range;
 * no target, echo lost or too weak: OUT_OF_RANGE at the maximum; beyond the
@@ -47,7 +52,7 @@ from enum import StrEnum
 from functools import cached_property
 from typing import Literal
 
-from stairbot.fakes.sensors import active_faults, frozen, sensor_rng
+from stairbot.fakes.sensors import active_faults, frozen, sensor_rng, stuck
 from stairbot.hardware import SensorId, SensorReading, SensorStatus
 from stairbot.inputs.scenario import Fault
 
@@ -66,7 +71,7 @@ class Cause(StrEnum):
     FAR = "far"
     DROPOUT = "dropout"
     OUTLIER = "outlier"
-    FAULT = "fault"  # a scenario fault (error) is active
+    FAULT = "fault"  # a scenario fault (error, stuck) is active
 
 
 _OK, _NOTHING = Cause.OK, Cause.NOTHING  # bound once: an enum's member is a slow look-up
@@ -213,6 +218,10 @@ class ModelSensor:
         self._gauss, self._uniform = rng.gauss, rng.random
         self.faults = tuple(f for f in faults if f.sensor == sensor.value)
         self._freezes = tuple(f for f in self.faults if f.kind == "freeze")
+        self._stucks = tuple(f for f in self.faults if f.kind == "stuck")
+        self._held: SensorReading | None = None
+        """The last measurement taken while no stuck fault was active: what a
+        stuck sensor repeats."""
         self._far = SensorReading(self.max_range, SensorStatus.OUT_OF_RANGE)
         self._near = SensorReading(self.min_range, SensorStatus.OUT_OF_RANGE)
         self._error = SensorReading(0.0, SensorStatus.ERROR)
@@ -246,6 +255,13 @@ class ModelSensor:
         if period > 0.0:  # the next whole multiple of the period (0: every read)
             self._next = (math.floor(t / period + 1e-9) + 1) * period
         reading, cause = self._measure(distance, seen, t)
+        if self._stucks:
+            if not stuck(self._stucks, t):
+                self._held = reading
+            else:  # stuck from before its first measurement: stuck on the first
+                if self._held is None:
+                    self._held = reading
+                reading, cause = self._held, Cause.FAULT
         self.measurements += 1
         if self._current is None or self._latency <= 0.0:
             self._current = (t, reading, cause)

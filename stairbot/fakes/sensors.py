@@ -5,9 +5,10 @@ The sensor itself is :class:`~stairbot.fakes.sensor_model.ModelSensor`; its
 ``ideal`` preset reads as the reference robot's sensors always have: scenario
 faults first (an ``offset`` fault adds its offset, an ``error`` fault makes the
 sensor report ERROR, a ``freeze`` fault stops it measuring -- its last reading
-repeats and grows old -- each for ``at <= t < at + duration``), one Gaussian draw
-per reading, OUT_OF_RANGE at the limits, otherwise OK rounded to the
-resolution.
+repeats and grows old --, a ``stuck`` fault makes every measurement the one
+taken last before it -- fresh, but the same value --, each for ``at <= t < at +
+duration``), one Gaussian draw per reading, OUT_OF_RANGE at the limits,
+otherwise OK rounded to the resolution.
 """
 
 from __future__ import annotations
@@ -41,4 +42,12 @@ def frozen(faults: Iterable[Fault], t: float) -> bool:
     """Whether a freeze fault is active at ``t``: the sensor takes no new
     measurement (the board repeats the last one, and knows its age)."""
     return any(f.kind == "freeze" and t >= f.at and (f.duration is None or t < f.at + f.duration)
+               for f in faults)
+
+
+def stuck(faults: Iterable[Fault], t: float) -> bool:
+    """Whether a stuck fault is active at ``t``: the sensor measures on, fresh,
+    but every measurement is the one it took last before the fault (a frozen
+    ADC, firmware that repeats its last value as new)."""
+    return any(f.kind == "stuck" and t >= f.at and (f.duration is None or t < f.at + f.duration)
                for f in faults)

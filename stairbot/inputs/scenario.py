@@ -105,7 +105,7 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
 class Fault(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     at: Seconds
     sensor: SensorName
-    kind: Literal["offset", "error", "freeze"]
+    kind: Literal["offset", "error", "freeze", "stuck"]
     offset: Annotated[float, msgspec.Meta(ge=-10.0, le=10.0)] = 0.0
     duration: Annotated[float, msgspec.Meta(gt=0, le=86400.0)] | None = None
 
@@ -195,8 +195,9 @@ def _resolve(data: ScenarioFile, source: str) -> Scenario:
         if fault.kind != "offset" and fault.offset != 0.0:
             raise ScenarioError(source, f"faults[{fi}].offset",
                                 f"only an 'offset' fault takes an offset; an '{fault.kind}' "
-                                "fault makes the sensor report ERROR ('error') or stop "
-                                "measuring ('freeze'); leave offset out")
+                                "fault makes the sensor report ERROR ('error'), stop "
+                                "measuring ('freeze') or repeat its last measurement as "
+                                "new ('stuck'); leave offset out")
     if data.start.on == "top":
         if not steps:
             raise ScenarioError(source, "start.on",

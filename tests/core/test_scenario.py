@@ -52,6 +52,14 @@ def test_the_schema_example_of_the_issue_parses() -> None:
     assert s.expect is not None and s.expect.steps_climbed == 5
 
 
+def test_a_stuck_fault_parses_with_or_without_a_duration() -> None:
+    s = parse_scenario("[[faults]]\nat = 20.0\nsensor = 'SBR'\nkind = 'stuck'\n"
+                       "[[faults]]\nat = 30.0\nsensor = 'SFL'\nkind = 'stuck'\n"
+                       "duration = 2.5\n", "stuck.toml")
+    assert [(f.sensor, f.kind, f.at, f.duration, f.offset) for f in s.faults] == [
+        ("SBR", "stuck", 20.0, None, 0.0), ("SFL", "stuck", 30.0, 2.5, 0.0)]
+
+
 def test_default_is_five_residential_steps_then_a_landing() -> None:
     s = load_scenario()
     assert [(st.rise, st.tread) for st in s.steps] == [(0.17, 0.28)] * 5
@@ -111,6 +119,12 @@ def test_a_path_is_read_as_a_file(tmp_path: Path) -> None:
         ("[[faults]]\nat = 1.0\nsensor = 'SFL'\n", "faults[0].kind", "required"),
         ("[[faults]]\nat = 1.0\nsensor = 'SFL'\nkind = 'offset'\n", "faults[0].offset",
          "non-zero"),
+        ("[[faults]]\nat = 1.0\nsensor = 'SFL'\nkind = 'stuck'\noffset = 0.02\n",
+         "faults[0].offset", "repeat its last measurement as new ('stuck')"),
+        ("[[faults]]\nat = 1.0\nsensor = 'SFL'\nkind = 'stuk'\n", "faults[0].kind",
+         "'stuck'"),
+        ("[[faults]]\nat = 1.0\nsensor = 'SFL'\nkind = 'stuck'\nduration = 0.0\n",
+         "faults[0].duration", "> 0"),
         ("[expect]\noutcome = 'won'\n", "expect.outcome", "'completed'"),
         ("speed = 3\n", "speed", "allowed keys here: name, description"),
     ],

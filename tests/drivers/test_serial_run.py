@@ -41,3 +41,38 @@ def test_full_ascent_and_descent_over_a_pty_ends_as_sim_does(fake_boards_url: st
     assert wire.sim_time_s == pytest.approx(sim.sim_time_s, abs=1.0)
     assert wire.final_offset_m is not None and wire.final_offset_m < 0.05
     assert isinstance(health, dict) and health["lost"] == 0 and health["crc_errors"] == 0
+
+
+STUCK = """
+[stairs]
+count = 2
+rise = 0.17
+tread = 0.28
+[sensors]
+noise = 0.001
+seed = 5
+[[faults]]
+at = 42.0
+sensor = "SFR"
+kind = "stuck"
+"""
+
+
+def test_a_stuck_sensor_reads_stuck_over_the_wire_and_the_run_ends_as_sim_does(
+        tmp_path: Path) -> None:
+    # the fake boards publish the simulation's sensor model: a stuck SFR sends
+    # fresh frames of one value, which the host judges stuck as on sim://
+    path = tmp_path / "stuck.toml"
+    path.write_text(STUCK)
+    config, scenario = load_config(), load_scenario(path)
+    sim = run(open_robot("sim://", config, RobotOptions(world=scenario)), config,
+              limp_home=True)
+    with lockstep_boards(tmp_path, stop=signal.SIGTERM, scenario=str(path)) as boards:
+        session = open_robot(boards.url + "&timeout=2", config)
+        try:
+            wire: RunResult = run(session, config, limp_home=True)
+        finally:
+            session.close()
+    assert sim.outcome == "came_home_degraded" and sim.ascent_end == "sensor_lost"
+    assert {k: getattr(wire, k) for k in SAME} == {k: getattr(sim, k) for k in SAME}
+    assert wire.final_offset_m is not None and wire.final_offset_m < 0.05

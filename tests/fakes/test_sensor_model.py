@@ -8,7 +8,7 @@ import random
 import pytest
 
 from stairbot.fakes.plan import Plan
-from stairbot.fakes.sensor_model import ModelSensor
+from stairbot.fakes.sensor_model import Cause, ModelSensor, SensorModel
 from stairbot.fakes.sensor_presets import IDEAL
 from stairbot.fakes.stairs import StairsProfile
 from stairbot.hardware import SensorId, SensorStatus
@@ -68,6 +68,45 @@ def test_error_fault_without_duration_lasts_to_the_end() -> None:
     assert s.measure(0.4, 0.5).status is SensorStatus.OK
     for t in (1.0, 10.0, 1000.0):
         assert s.measure(0.4, t).status is SensorStatus.ERROR
+
+
+def test_a_stuck_sensor_repeats_its_last_measurement_fresh_then_reads_on() -> None:
+    fault = Fault(at=1.0, sensor="SFL", kind="stuck", duration=1.0)
+    s, healthy = sensor(0.002, seed=3, faults=(fault,)), sensor(0.002, seed=3)
+    got, want = [], []
+    for i in range(300):  # every 10 ms the truth comes 1 mm nearer
+        t, truth = round(i * 0.01, 9), 0.6 - i * 0.001
+        s.measure(truth, t)
+        got.append((t, s.published(t)))
+        want.append(healthy.measure(truth, t))
+    before = [r for t, r in got if t < 1.0]
+    during = [r for t, r in got if 1.0 <= t < 2.0]
+    after = [r for t, r in got if t >= 2.0]
+    assert before == want[:100] and len(set(before)) > 50  # noisy, and moving
+    assert {r for r in during} == {before[-1]}  # the last one before, as it was
+    assert all(r.ok and r.age_s == 0.0 for r in during)  # fresh: measured at every read
+    assert after == want[200:]  # the same draws were made: the same readings after
+
+
+def test_a_slow_stuck_sensor_publishes_on_time_fresh_and_constant() -> None:
+    model = SensorModel(name="slow", period_s=0.05, latency_s=0.02)
+    s = ModelSensor(SensorId.SFR, model, 0.03, 1.3, 0.001, 0.0, 1,
+                    (Fault(at=0.5, sensor="SFR", kind="stuck"),))
+    seen = []
+    for i in range(200):  # reads every 10 ms; the truth moves 1 mm per read
+        t = round(i * 0.01, 9)
+        s.measure(0.8 - i * 0.001, t)
+        seen.append((t, s.published(t)))
+    assert s.measurements == 40  # one every 50 ms, fault or not
+    stuck = [r for t, r in seen if t >= 0.52]  # measured from 0.5 on, published 20 ms later
+    assert {r.distance_m for r in stuck} == {0.755}  # measured at 0.45: 0.8 - 0.045
+    assert max(r.age_s for r in stuck) <= 0.05 + 0.02 + 1e-9  # never older than fresh
+    assert s.cause is Cause.FAULT
+
+
+def test_a_sensor_stuck_from_the_start_repeats_its_first_measurement() -> None:
+    s = sensor(faults=(Fault(at=0.0, sensor="SFL", kind="stuck"),))
+    assert [s.measure(0.5 - i * 0.01, i * 0.02).distance_m for i in range(5)] == [0.5] * 5
 
 
 def test_faults_of_other_sensors_do_not_apply() -> None:

@@ -1,0 +1,68 @@
+"""A stuck distance sensor (issue 33): fresh measurements, one value, while
+the robot moves what it looks at.  Perception judges it stuck and it reads as
+ERROR, so it is lost as an erroring sensor is, and the robot limps home on
+its partner.  Before the judgement the host trusted it (it is fresh): a
+front sensor stuck lifting segment 3 ended the run on the stairs
+(calibration could not square up to the riser on the way down), a back
+sensor stuck lowering segment 3 ended it by the standing rule.  Faults at
+robot times that fall in the named phases of a fault-free run of the same
+stairs (tests/safety/test_limp_home.py)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from simrun import run_sim
+
+from stairbot.control.robot_config import load_config
+from stairbot.events import Event, EventKind
+from stairbot.inputs.scenario import parse_scenario
+from stairbot.run.runner import RunResult
+
+CONFIG = load_config()
+TWO_STEPS = """
+[stairs]
+count = 2
+rise = 0.17
+tread = 0.28
+[sensors]
+noise = 0.001
+seed = 5
+"""
+
+
+def stuck(at: float, sensor: str) -> tuple[RunResult, dict[str, Any]]:
+    """TWO_STEPS with ``sensor`` stuck from ``at`` on, consented: the result
+    and the one degraded stop."""
+    text = TWO_STEPS + f'[[faults]]\nat = {at}\nsensor = "{sensor}"\nkind = "stuck"\n'
+    events: list[Event] = []
+    r = run_sim(CONFIG, parse_scenario(text, "<stuck>"), events, limp_home=True)
+    stops = [e.data["degraded"] for e in events
+             if e.kind is EventKind.WARNING and "degraded" in e.data]
+    assert len(stops) == 1, (r.to_dict(), stops)
+    return r, stops[0]
+
+
+def home(r: RunResult) -> bool:
+    return (not r.fell and r.steps_climbed == r.steps_descended
+            and r.final_offset_m is not None and r.final_offset_m <= 0.05)
+
+
+def test_a_front_sensor_stuck_mid_climb_is_lost_and_the_robot_comes_home() -> None:
+    r, stop = stuck(42.0, "SFR")  # ascent 7 of step 1: it holds the tab it read
+    assert (r.outcome, r.ascent_end, r.steps_climbed) == (
+        "came_home_degraded", "sensor_lost", 1), r.to_dict()
+    assert home(r), r.to_dict()
+    assert (stop["lost"], stop["survivors"], stop["then"]) == (["SFR"], ["SFL"], "limp_home")
+    assert stop["failed"].startswith("SFR stuck at 0.1"), stop
+    assert "while the drive moved" in stop["failed"] and "toward the riser" in stop["failed"]
+
+
+def test_a_back_sensor_stuck_lowering_segment_3_is_lost_and_the_robot_comes_home() -> None:
+    r, stop = stuck(84.0, "SBR")  # descent 2 of step 2, segment 3 over the edge
+    assert (r.outcome, r.steps_climbed) == ("came_home_degraded", 2), r.to_dict()
+    assert home(r), r.to_dict()
+    assert (stop["lost"], stop["survivors"], stop["phase"]) == (
+        ["SBR"], ["SBL"], "descent_lower_third")
+    assert stop["failed"].startswith("SBR stuck at 0."), stop
+    assert "SBL's reading went from" in stop["failed"] and "as MTB moved" in stop["failed"]
