@@ -8,15 +8,20 @@ the named phases of a fault-free run of the same stairs."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from simrun import run_sim
 
+from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.limp import LIMP_SPEED
+from stairbot.control.algorithm.lost import awaits_consent
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import WHEEL_MOTORS, Snapshot, Speeds
 from stairbot.inputs.scenario import parse_scenario
+from stairbot.run import runner
+from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
@@ -168,3 +173,26 @@ def test_a_sensor_of_the_other_pair_lost_while_limping_limps_on_with_both_stand_
     assert [(s["lost"], s["then"]) for s in stops] == [
         (["SFR"], "limp_home"), (["SBL", "SFR"], "limp_home")]
     assert stops[1]["survivors"] == ["SBR", "SFL"]
+
+
+def test_a_program_reopened_to_limp_home_says_so_at_its_first_tick() -> None:
+    """The consent after the stop (a resume, the console's question) reopens
+    the program: the event that says so carries the time it was given, not
+    the time the stopped phase began (as it was stamped before)."""
+    snaps: list[Snapshot] = []
+    ended: list[Controller] = []
+    session = open_robot("sim://", CONFIG, RobotOptions(
+        world=parse_scenario(faulted((42.0, "SFR", "error")), "<limp>")))
+    try:
+        runner.run(session, CONFIG, on_tick=lambda ctl, snap: ended.append(ctl),
+                   tap=lambda snap, sent: snaps.append(snap))
+    finally:
+        session.close()
+    assert awaits_consent(ended[-1].context)
+    later = replace(snaps[-1], time_s=snaps[-1].time_s + 5.0)
+    events: list[Event] = []
+    reopened = Controller(CONFIG, events.append, context=ended[-1].context, limp_home=True)
+    reopened.tick(later)
+    said = [e for e in events if e.kind is EventKind.RESUME]
+    assert [(e.time_s, e.message.split(":")[0]) for e in said] == [
+        (later.time_s, "limp home (consented on resuming)")], events

@@ -77,11 +77,12 @@ class Controller:
                 context.from_top = True
                 context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
-        elif context.phase_started_s is not None:
-            if limp_home and lost.reopen(context):
-                sink(Event(context.phase_started_s, EventKind.RESUME, say_limp.REOPENED,
-                           BY_VALUE[context.phase].label, {"limp": context.to_dict()["limp"]}))
+        reopened = False
+        if context.phase_started_s is not None:
+            reopened = limp_home and lost.reopen(context)
             check_restored(context)
+        self._reopened = reopened
+        """A program reopened to limp home: said at the first tick, on its time."""
         self._ctx = context
         self._started = context.phase_started_s is not None
         self._held: str | None = None
@@ -175,6 +176,10 @@ class Controller:
         if self.finished:
             return _zeros()
         snap = self._perception.see(snap)
+        if self._reopened:
+            self._reopened = False
+            self._emit(EventKind.RESUME, say_limp.REOPENED, snap.time_s,
+                       {"limp": self._ctx.to_dict()["limp"]})
         if self._ctx.limp is not None:
             snap = limp.mirrored(snap, self._ctx.limp.lost)
         if self._held is not None:
