@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from stairbot.control.algorithm import guards, limp, lost, motion, stability, standing
+from stairbot.control.algorithm import bias, guards, limp, lost, motion, stability, standing
 from stairbot.control.algorithm.context import Context, Pause, Watch
 from stairbot.control.algorithm.families import Calibration, Family
 from stairbot.control.algorithm.guards import (
@@ -93,6 +93,7 @@ class Controller:
         self._stroke = config.MAX_OF_VERTICAL_TURNS
         self._timeout = phase_timeout_s(config)
         self._perception = Perception(config)
+        self._bias = bias.BiasWatch(config)
         self._supervisor = Supervisor(config)
         self._tilt = self._supervisor.tilt
         self._sensor_since: float | None = None
@@ -175,6 +176,8 @@ class Controller:
         if self.finished:
             return _zeros()
         snap = self._perception.see(snap)
+        self._bias.see(snap, self._ctx)
+        snap = self._bias.marked(snap)  # a sensor judged biased reads as ERROR: it is lost
         if self._ctx.limp is not None:
             snap = limp.mirrored(snap, self._ctx.limp.lost)
         if self._held is not None:
@@ -251,7 +254,7 @@ class Controller:
                 self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
                            f"{phase.label}", snap.time_s, {"phase": phase.value})
             return False
-        why = "; ".join([f"{s} {self._perception.why(s) or 'reports an error'}"
+        why = "; ".join([f"{s} {self._bias.why(s) or self._perception.why(s) or 'reports an error'}"
                          for s in errors] + ([imu] if imu is not None else []))
         if self._sensor_since is None:
             self._sensor_since = snap.time_s
@@ -262,7 +265,8 @@ class Controller:
                        snap.time_s, {"resume_phase": phase.value, "sensors": list(errors),
                                          "imu_stale": imu is not None})
             return True
-        if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
+        if snap.time_s - self._sensor_since < SENSOR_WAIT_S and \
+                not all(s in self._bias.judged for s in errors):  # no use waiting for those
             return True
         since, self._sensor_since = self._sensor_since, None
         stale = link_meanwhile(self._sensor_link, snap.health,

@@ -71,6 +71,8 @@ def start_limping(ctx: Context, stop: limp.DegradedStop, time_s: float,
     sensors ``stop`` lost: it does, or (``stop.then`` "no_consent") will
     once the operator consents (:func:`reopen`)."""
     consented = stop.then == "limp_home"
+    if ctx.pause is not None:  # the standing rule's wait decides on the stand-in's figures
+        ctx.pause.diffs.clear()
     if ctx.limp is None:
         at = f"{label} ({stop.where})" if stop.where else label
         ctx.limp = limp.Limp(list(stop.lost), time_s, at, consented,

@@ -1,0 +1,327 @@
+"""Bias: a distance sensor that keeps measuring but reads wrong by a constant
+offset (not in the seed, which has no sensor faults).
+
+Two sensors of a pair that disagree cannot say which of them is wrong; the
+host knows more than the pair: how far the drive moved and turned (the
+odometer), and when.  A bias that sets in is a *jump*: one sensor's reading
+moves by more than the motion since explains, while its partner's follows
+the motion.  :class:`BiasWatch` looks at every tick's filtered readings,
+pair by pair, and finds such onsets:
+
+* each reading is *compensated* for the motion the host knows: a front
+  sensor looks along the drive, so its reading plus the odometer stays put
+  while the robot drives at a riser, and turning left lengthens SFL and
+  shortens SFR by front_lateral per radian (the odometer's yaw); a back
+  sensor looks down, and driving on a floor does not move what it reads;
+* the compensated readings' means over a window (:data:`WINDOW_SETTLES`
+  filter settle times) are compared with their means over the window
+  before it, a settle time earlier (the gap the filter's median takes to
+  come round to a new level): the pair's difference *steps* when they
+  differ by more than :data:`STEP_SIGMAS` of the pair's tolerance
+  (:func:`~stairbot.control.tolerances.pair_tolerance`);
+* a step is an *onset* of the one sensor that moved when its partner's
+  compensated reading held (it moved less than ATTRIBUTE_SHARE of the step):
+  a front cone seeing over a riser, a back pair crossing an edge, a lift
+  moving segment 3 move both, and name nobody.  A later step of the partner
+  the same way (both saw the world change) cancels it.
+
+An onset is evidence, not yet a verdict.  A sensor is *judged* biased, and
+reads as ERROR from then on (:meth:`BiasWatch.marked`), only where the
+evidence decides something:
+
+* at the end of the standing rule's wait, when the pair it watches still
+  disagrees by what the onsets say (within the standing tolerance, or
+  MATCH_SHARE of the disagreement): the onset names the sensor;
+* in calibration, facing a riser (its check, the squaring turn, closing
+  in, case 3's probe): the robot steers by the pair's difference there,
+  and a squaring turn that goes on to square up to one sensor's offset
+  leaves it askew by atan(offset / (2 front_lateral)) (17 deg for 3 cm),
+  so a front onset there is judged at once.
+
+A judged sensor reads as ERROR: the controller stops the robot and treats
+it as lost (:mod:`~stairbot.control.algorithm.limp`): on the floor where
+the program began the run ends on it; elsewhere a degraded stop, and with
+the operator's consent the partner stands in for it on the way home.
+Where no onset names one of two sensors that disagree, the standing rule
+ends the program, as it always has.
+
+Pure Python, on the controller's clock (the snapshots' times); it keeps no
+state in the context (a resumed run starts with no evidence).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.bias_evidence import (
+    MountHeights,
+    Onset,
+    Onsets,
+    Sample,
+    StartReference,
+    Step,
+)
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import Purpose
+from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.texts import bias as say
+from stairbot.control.tolerances import pair_tolerance, settle_s, standing_tolerance
+from stairbot.hardware import (
+    BACK_SENSORS,
+    FRONT_SENSORS,
+    WHEEL_MOTORS,
+    SensorId,
+    SensorReading,
+    SensorStatus,
+    Snapshot,
+)
+from stairbot.inputs.config import RobotConfig
+
+MIN_WINDOW_TICKS = 5
+"""Each of the two windows whose means are compared spans the pair's settle
+time (:func:`~stairbot.control.tolerances.settle_s`), and at least this many
+ticks; so does the gap between them (the filter's median comes round to a
+new level within it)."""
+STEP_SIGMAS = 1.5
+"""A step counts when the pair's difference moves by more than this many of
+its pair tolerance (itself four sigmas of one tick's difference): the means
+of two windows are quieter than one tick, and a fault-free run must not
+take its noise for an onset."""
+ATTRIBUTE_SHARE = 0.4
+"""A step is one sensor's onset when its partner's compensated reading moved
+less than this share of the step (or half the threshold, if more)."""
+MATCH_SHARE = 0.35
+"""Evidence matches the standing rule's disagreement within the standing
+tolerance, or this share of the disagreement if more."""
+STILL_M = 0.001
+STILL_RAD = math.radians(0.2)
+
+JUDGED_IN_CALIBRATION = frozenset({Phase.CAL_CHECK, Phase.CAL_CLOSE_IN, Phase.CAL_PROBE,
+                                   Phase.CAL_TURN})
+"""The calibration phases in which a front onset is judged at once: the front
+pair faces the riser, and the robot stands, closes in or turns on segment 2's
+wheels (not its lifts and lowerings, where the sensors rise and fall by a
+clearance and a cone may see over a low riser)."""
+_RISER_PURPOSES = (Purpose.START, Purpose.ASCENT, Purpose.DESCENT)
+ON_A_SURFACE = frozenset({
+    Phase.CAL_CLOSE_IN, Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
+    Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_DRIVE_FIRST,
+    Phase.DESCENT_DRIVE_SECOND, Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST,
+    Phase.DESCENT_LOWER_FIRST, Phase.DESCENT_FINISH})
+"""The phases in which segment 3 stands on a surface and moves on it, away
+from its edge: its sensors read their mount height (BACK_CLEARANCE)."""
+FACING_THE_FIRST_RISER = frozenset({Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
+                                    Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
+"""With no step climbed, the front pair faces the first riser in these
+phases: the start position and the odometer say where it stands."""
+
+
+class BiasWatch:
+    """Gathers the evidence and judges biased sensors (see the module
+    docstring).  One per controller, told every tick's filtered snapshot."""
+
+    def __init__(self, cfg: RobotConfig) -> None:
+        self._cfg = cfg
+        self._lateral = cfg.sensors.front_lateral
+        self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
+        self._near = (cfg.sensors.range(False)[0], cfg.sensors.range(True)[0])
+        self._pairs: list[Onsets] = []
+        for back, (right, left) in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
+            ticks = max(MIN_WINDOW_TICKS, round(settle_s(cfg, back) / cfg.algorithm.tick))
+            self._pairs.append(Onsets(right, left, back, ticks, ticks))
+        self._mount = MountHeights(cfg.BACK_CLEARANCE, self._near[1])
+        self._start: StartReference | None = None
+        self._judged: dict[SensorId, str] = {}
+
+    @property
+    def judged(self) -> dict[SensorId, str]:
+        """The sensors judged biased, each with the evidence in words."""
+        return self._judged
+
+    def why(self, sensor: SensorId) -> str | None:
+        return self._judged.get(sensor)
+
+    def onsets(self, back: bool) -> list[Onset]:
+        """The pair's onsets not cancelled, oldest first."""
+        return list(self._pairs[1 if back else 0].found)
+
+    def see(self, snap: Snapshot, ctx: Context) -> None:
+        """Take this tick's filtered snapshot (before any stand-in); judge
+        where the evidence decides (module docstring)."""
+        phase = BY_VALUE[ctx.phase]
+        family = ctx.family
+        riser = isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES
+        odometer = sum(snap.turns(m) for m in WHEEL_MOTORS) * self._metres_per_turn
+        yaw = motion.turn_yaw_rad(self._cfg, motion.twist(snap))
+        for track in self._pairs:
+            self._track(track, snap, odometer, yaw,
+                        riser and phase in JUDGED_IN_CALIBRATION and not track.back)
+        if phase in ON_A_SURFACE and not ctx.from_top:
+            self._mount.add(*self._back_readings(snap))
+        else:
+            self._mount.end()
+        if self._start is None and ctx.start.reading is not None \
+                and ctx.start.wheel is not None and ctx.climb_twist[0] is not None:
+            self._start = StartReference(
+                ctx.start.reading + ctx.start.wheel * self._metres_per_turn * len(WHEEL_MOTORS),
+                motion.turn_yaw_rad(self._cfg, ctx.climb_twist[0]))
+        if phase is Phase.PAUSED and ctx.pause is not None:
+            self._judge_pause(snap, ctx, odometer, yaw)
+
+    def marked(self, snap: Snapshot) -> Snapshot:
+        """``snap`` with every judged sensor reading as ERROR."""
+        if not self._judged:
+            return snap
+        sensors = dict(snap.sensors)
+        for sid in self._judged:
+            r = sensors[sid]
+            sensors[sid] = SensorReading(r.distance_m, SensorStatus.ERROR, r.age_s)
+        return replace(snap, sensors=sensors)
+
+    # -- gathering ------------------------------------------------------------------------
+    def _distance(self, r: SensorReading, back: bool) -> float | None:
+        """A reading's distance: OK, or too near to measure (its clamp, the
+        nearest it can tell); None for an error or nothing in range."""
+        if r.ok:
+            return r.distance_m
+        if r.status is SensorStatus.OUT_OF_RANGE and r.distance_m <= self._near[back] + 1e-9:
+            return r.distance_m
+        return None
+
+    def _back_readings(self, snap: Snapshot) -> tuple[float | None, float | None, bool, bool]:
+        r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
+        return (self._distance(r, True), self._distance(left, True), not r.ok, not left.ok)
+
+    def _track(self, track: Onsets, snap: Snapshot, odometer: float, yaw: float,
+               judgeable: bool) -> None:
+        sensors, back = snap.sensors, track.back
+        r, left = sensors[track.right], sensors[track.left]
+        dr, dl = self._distance(r, back), self._distance(left, back)
+        if dr is None or dl is None or track.right in self._judged \
+                or track.left in self._judged or (not back and max(dr, dl)
+                                                  >= self._cfg.LENGTH_OF_INFINITY):
+            track.clear()
+            return
+        if not back:  # looking along the drive: plus the odometer, less the turn
+            turn = self._lateral * yaw
+            dr, dl = dr + odometer + turn, dl + odometer - turn
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw), judgeable)
+        if moved is None:
+            return
+        moved_r, moved_l = moved
+        step = moved_l - moved_r
+        near = min(r.distance_m, left.distance_m)
+        threshold = STEP_SIGMAS * pair_tolerance(self._cfg, near, back=back)
+        pending = track.pending
+        if abs(step) > threshold and (pending is None or abs(step) >= pending.size):
+            at = track.buf[track.window + track.gap // 2][0]
+            track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
+            return
+        if pending is not None:
+            self._decide(track, pending, track.judgeable >= track.size)
+            track.clear()
+
+    def _decide(self, track: Onsets, step: Step, judge_now: bool) -> None:
+        share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
+        what = _motion(*track.windows())
+        if abs(step.moved_right) <= share:
+            onset = Onset(track.left, step.moved_left, step.moved_right, step.at_s, what)
+        elif abs(step.moved_left) <= share:
+            onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what)
+        else:
+            return  # both moved: the world changed, or nobody can tell
+        if track.record(onset, step.threshold) and judge_now:
+            partner = track.right if onset.sensor is track.left else track.left
+            if abs(track.offsets[partner]) < step.threshold / 2:
+                self._judged[onset.sensor] = say.judged_in_calibration(onset)
+
+    # -- the standing rule's wait ends -----------------------------------------------------
+    def _judge_pause(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:
+        pause = ctx.pause
+        assert pause is not None
+        cfg = self._cfg
+        if snap.time_s - pause.started_s < cfg.algorithm.standing_wait - cfg.algorithm.tick / 2 \
+                or not pause.diffs:
+            return
+        resume = BY_VALUE[pause.resume_phase]
+        back = resume.record.watches == "back"
+        diffs = sorted(pause.diffs)
+        disagree = diffs[len(diffs) // 2]  # left − right
+        r, left = motion.pair(snap, back)
+        near = min(r.distance_m, left.distance_m)
+        tolerance = standing_tolerance(cfg, near, back=back)
+        if abs(disagree) <= tolerance:
+            return
+        match = max(tolerance, MATCH_SHARE * abs(disagree))
+        threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
+        track = self._pairs[1 if back else 0]
+        found = self._by_onsets(track, disagree, match, threshold)
+        if found is None and back:
+            found = self._by_mount(disagree, match, threshold)
+        if found is None and not back and ctx.number_of_steps == 0 \
+                and resume in FACING_THE_FIRST_RISER and ctx.landing.step is None:
+            found = self._by_start(snap, odometer, yaw, disagree, match, tolerance)
+        if found is not None:
+            sensor, evidence = found
+            self._judged[sensor] = evidence
+
+    def _by_onsets(self, track: Onsets, disagree: float, match: float,
+                   threshold: float) -> tuple[SensorId, str] | None:
+        offsets = track.offsets
+        if not track.found or abs(offsets[track.left] - offsets[track.right] - disagree) > match:
+            return None
+        for sensor, partner in ((track.left, track.right), (track.right, track.left)):
+            if abs(offsets[sensor]) >= threshold and abs(offsets[partner]) < threshold / 2:
+                onsets = [o for o in track.found if o.sensor is sensor]
+                return sensor, say.judged_by_onsets(onsets, partner, _signed(disagree, sensor))
+        return None
+
+    def _by_mount(self, disagree: float, match: float,
+                  threshold: float) -> tuple[SensorId, str] | None:
+        last = self._mount.last
+        if last is None:
+            return None
+        for sensor, partner, (off, near), (p_off, p_near) in (
+                (SensorId.SBL, SensorId.SBR, last[1], last[0]),
+                (SensorId.SBR, SensorId.SBL, last[0], last[1])):
+            said = _signed(disagree, sensor)
+            if p_near or abs(p_off) > threshold / 2:
+                continue
+            # read too near to measure, it reads at least that much short
+            if (near and said <= off) or (not near and abs(off) >= threshold
+                                          and abs(off - p_off - said) <= match):
+                return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said,
+                                                   self._cfg.BACK_CLEARANCE)
+        return None
+
+    def _by_start(self, snap: Snapshot, odometer: float, yaw: float, disagree: float,
+                  match: float, tolerance: float) -> tuple[SensorId, str] | None:
+        start = self._start
+        if start is None:
+            return None
+        turn = self._lateral * (yaw - start.yaw_rad)
+        expected_r = start.position_m - odometer - turn
+        expected_l = start.position_m - odometer + turn
+        r, left = motion.pair(snap)
+        off_r, off_l = r.distance_m - expected_r, left.distance_m - expected_l
+        for sensor, partner, off, p_off in ((SensorId.SFL, SensorId.SFR, off_l, off_r),
+                                            (SensorId.SFR, SensorId.SFL, off_r, off_l)):
+            said = _signed(disagree, sensor)
+            if abs(p_off) <= tolerance and abs(off - said) <= match:
+                return sensor, say.judged_by_start(sensor, partner, off, p_off, said)
+        return None
+
+
+def _signed(disagree: float, sensor: SensorId) -> float:
+    """The disagreement (left − right) as how far ``sensor`` reads past its partner."""
+    return disagree if sensor in (SensorId.SFL, SensorId.SBL) else -disagree
+
+
+def _motion(before: list[Sample], after: list[Sample]) -> str:
+    """What the robot did between two windows, by the odometer, in words."""
+    drove = sum(s[3] for s in after) / len(after) - sum(s[3] for s in before) / len(before)
+    turned = sum(s[4] for s in after) / len(after) - sum(s[4] for s in before) / len(before)
+    return say.motion(drove, turned, abs(drove) < STILL_M and abs(turned) < STILL_RAD)

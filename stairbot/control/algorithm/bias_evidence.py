@@ -1,0 +1,168 @@
+"""The evidence :class:`~stairbot.control.algorithm.bias.BiasWatch` judges a
+biased sensor on, each kind kept as it comes, tick by tick:
+
+* :class:`Onsets`: a pair's readings, compensated for the motion the host
+  knows, whose difference *steps* because one of them moved and its partner
+  held (the module docstring of :mod:`~stairbot.control.algorithm.bias`);
+* :class:`MountHeights`: what each back sensor reads while segment 3 stands
+  on a surface (BACK_CLEARANCE, the mount height, when it reads right);
+* :class:`StartReference`: where the first riser stands by the drive's
+  odometer, from the start position the first calibration measured.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+from stairbot.hardware import SensorId
+
+Sample = tuple[float, float, float, float, float]
+"""(time, right, left, odometer m, yaw rad): one tick of a pair, its readings
+compensated for the motion."""
+
+
+@dataclass(frozen=True, slots=True)
+class Onset:
+    """One sensor's reading moved, by ``step_m`` (+ longer), more than the
+    motion explains, while its partner's moved by ``partner_m``; ``motion``
+    says what the robot did meanwhile, in words."""
+
+    sensor: SensorId
+    step_m: float
+    partner_m: float
+    at_s: float
+    motion: str
+
+
+@dataclass(frozen=True, slots=True)
+class Step:
+    """The largest step of a pair's difference seen since its last decision."""
+
+    size: float
+    moved_right: float
+    moved_left: float
+    threshold: float
+    at_s: float
+
+
+class Onsets:
+    """One pair's compensated readings over two windows and the gap between
+    them (running sums: a tick costs the same whatever the windows' length),
+    and the onsets found, not cancelled."""
+
+    __slots__ = ("right", "left", "back", "window", "gap", "size", "buf", "sums", "judgeable",
+                 "pending", "found", "offsets")
+
+    def __init__(self, right: SensorId, left: SensorId, back: bool, window: int,
+                 gap: int) -> None:
+        self.right, self.left, self.back = right, left, back
+        self.window, self.gap = window, gap
+        self.size = 2 * window + gap
+        self.buf: deque[Sample] = deque()
+        self.sums = [0.0, 0.0, 0.0, 0.0]
+        """The windows' sums: before right, before left, after right, after left."""
+        self.judgeable = 0
+        """Ticks in a row (up to now) taken where an onset is judged at once."""
+        self.pending: Step | None = None
+        self.found: list[Onset] = []
+        self.offsets = {right: 0.0, left: 0.0}
+        """How far each sensor has moved by the onsets not cancelled, m."""
+
+    def clear(self) -> None:
+        self.buf.clear()
+        self.judgeable = 0
+        self.pending = None
+
+    def add(self, sample: Sample, judgeable: bool) -> tuple[float, float] | None:
+        """Take one tick; once both windows are full, how far the right and
+        the left sensor moved between their means."""
+        buf, w, sums = self.buf, self.window, self.sums
+        if len(buf) == self.size:
+            old = buf.popleft()
+            enters = buf[w - 1]  # from the gap into the first window
+            leaves = buf[self.size - w - 1]  # from the second window into the gap
+            sums[0] += enters[1] - old[1]
+            sums[1] += enters[2] - old[2]
+            sums[2] += sample[1] - leaves[1]
+            sums[3] += sample[2] - leaves[2]
+            buf.append(sample)
+        else:
+            buf.append(sample)
+            if len(buf) < self.size:
+                self.judgeable = self.judgeable + 1 if judgeable else 0
+                return None
+            items = list(buf)
+            sums[0] = sum(s[1] for s in items[:w])
+            sums[1] = sum(s[2] for s in items[:w])
+            sums[2] = sum(s[1] for s in items[-w:])
+            sums[3] = sum(s[2] for s in items[-w:])
+        self.judgeable = self.judgeable + 1 if judgeable else 0
+        return (sums[2] - sums[0]) / w, (sums[3] - sums[1]) / w
+
+    def windows(self) -> tuple[list[Sample], list[Sample]]:
+        items = list(self.buf)
+        return items[:self.window], items[-self.window:]
+
+    def record(self, onset: Onset, threshold: float) -> bool:
+        """Keep ``onset``; False when it cancels what the pair's onsets said
+        (its partner moved the same way: both saw the world change)."""
+        self.found.append(onset)
+        self.offsets[onset.sensor] += onset.step_m
+        if abs(self.offsets[self.left] - self.offsets[self.right]) < threshold:
+            self.offsets = dict.fromkeys(self.offsets, 0.0)
+            self.found.clear()
+            return False
+        return True
+
+
+MOUNT_TICKS = 25
+"""A stretch of standing on a surface counts once it lasted this many ticks."""
+
+
+class MountHeights:
+    """What SBR and SBL read, less BACK_CLEARANCE, over the last stretch of
+    ticks segment 3 stood on a surface (its mean, and whether the sensor read
+    too near to measure on most of them: then the mean is at most what it
+    says)."""
+
+    __slots__ = ("clearance", "near_m", "ticks", "sums", "nears", "last")
+
+    def __init__(self, clearance: float, near_m: float) -> None:
+        self.clearance, self.near_m = clearance, near_m
+        self.ticks = 0
+        self.sums = [0.0, 0.0]
+        self.nears = [0, 0]
+        self.last: tuple[tuple[float, bool], tuple[float, bool]] | None = None
+        """(offset m, read too near) of SBR and SBL, the last stretch long enough."""
+
+    def add(self, right: float | None, left: float | None, right_near: bool,
+            left_near: bool) -> None:
+        """One tick on a surface (None: the sensor gave no distance: the
+        stretch ends)."""
+        if right is None or left is None:
+            self.end()
+            return
+        self.ticks += 1
+        self.sums[0] += right - self.clearance
+        self.sums[1] += left - self.clearance
+        self.nears[0] += right_near
+        self.nears[1] += left_near
+        if self.ticks >= MOUNT_TICKS:
+            n = self.ticks
+            self.last = ((self.sums[0] / n, 2 * self.nears[0] > n),
+                         (self.sums[1] / n, 2 * self.nears[1] > n))
+
+    def end(self) -> None:
+        self.ticks = 0
+        self.sums = [0.0, 0.0]
+        self.nears = [0, 0]
+
+
+@dataclass(frozen=True, slots=True)
+class StartReference:
+    """The first riser by the odometer: the start position's reading plus the
+    odometer there (m), and the heading there (rad)."""
+
+    position_m: float
+    yaw_rad: float
