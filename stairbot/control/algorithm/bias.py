@@ -52,6 +52,7 @@ state in the context (a resumed run starts with no evidence).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import replace
 
 from stairbot.control.algorithm import motion
@@ -73,6 +74,7 @@ from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
     WHEEL_MOTORS,
+    MotorId,
     SensorId,
     SensorReading,
     SensorStatus,
@@ -107,12 +109,17 @@ wheels (not its lifts and lowerings, where the sensors rise and fall by a
 clearance and a cone may see over a low riser)."""
 _RISER_PURPOSES = (Purpose.START, Purpose.ASCENT, Purpose.DESCENT)
 ON_A_SURFACE = frozenset({
-    Phase.CAL_CLOSE_IN, Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
+    Phase.CAL_CLOSE_IN, Phase.DESCENT_BACK_OFF, Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
     Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_DRIVE_FIRST,
     Phase.DESCENT_DRIVE_SECOND, Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST,
     Phase.DESCENT_LOWER_FIRST, Phase.DESCENT_FINISH})
-"""The phases in which segment 3 stands on a surface and moves on it, away
-from its edge: its sensors read their mount height (BACK_CLEARANCE)."""
+"""The phases in which segment 3 stands on a surface and moves on it: its
+sensors read their mount height (BACK_CLEARANCE), until one reads a drop
+(DROP_M more: descent 1 backs off towards the edge)."""
+DROP_M = 0.05
+HANGING = frozenset({Phase.ASCENT_LIFT_THIRD, Phase.DESCENT_LOWER_THIRD})
+"""The phases in which MTB lifts or lowers segment 3 in the air: what its
+sensors read moves with MTB's counter."""
 FACING_THE_FIRST_RISER = frozenset({Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
                                     Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
 """With no step climbed, the front pair faces the first riser in these
@@ -132,7 +139,8 @@ class BiasWatch:
         for back, (right, left) in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
             ticks = max(MIN_WINDOW_TICKS, round(settle_s(cfg, back) / cfg.algorithm.tick))
             self._pairs.append(Onsets(right, left, back, ticks, ticks))
-        self._mount = MountHeights(cfg.BACK_CLEARANCE, self._near[1])
+        self._mount = MountHeights(cfg.BACK_CLEARANCE)
+        self._lift_m = cfg.motors.lift_travel_per_turn
         self._start: StartReference | None = None
         self._judged: dict[SensorId, str] = {}
 
@@ -141,28 +149,34 @@ class BiasWatch:
         """The sensors judged biased, each with the evidence in words."""
         return self._judged
 
-    def why(self, sensor: SensorId) -> str | None:
-        return self._judged.get(sensor)
+    def why(self, sensor: SensorId, otherwise: str | None = None) -> str:
+        """Why ``sensor`` reads as ERROR: judged biased, else ``otherwise``
+        (perception's reason), else it reports an error."""
+        return self._judged.get(sensor) or otherwise or "reports an error"
+
+    def all_judged(self, sensors: Sequence[SensorId]) -> bool:
+        """Whether every one of ``sensors`` is judged biased: no use waiting
+        for them to come back."""
+        return all(s in self._judged for s in sensors)
 
     def onsets(self, back: bool) -> list[Onset]:
         """The pair's onsets not cancelled, oldest first."""
         return list(self._pairs[1 if back else 0].found)
 
-    def see(self, snap: Snapshot, ctx: Context) -> None:
-        """Take this tick's filtered snapshot (before any stand-in); judge
-        where the evidence decides (module docstring)."""
+    def see(self, snap: Snapshot, ctx: Context) -> Snapshot:
+        """Take this tick's filtered snapshot (before any stand-in), judge
+        where the evidence decides (module docstring); the snapshot with
+        every sensor judged biased reading as ERROR."""
         phase = BY_VALUE[ctx.phase]
         family = ctx.family
         riser = isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES
         odometer = sum(snap.turns(m) for m in WHEEL_MOTORS) * self._metres_per_turn
         yaw = motion.turn_yaw_rad(self._cfg, motion.twist(snap))
-        for track in self._pairs:
-            self._track(track, snap, odometer, yaw,
-                        riser and phase in JUDGED_IN_CALIBRATION and not track.back)
-        if phase in ON_A_SURFACE and not ctx.from_top:
-            self._mount.add(*self._back_readings(snap))
-        else:
-            self._mount.end()
+        front, back = self._pairs
+        self._track(front, snap, odometer, yaw, riser and phase in JUDGED_IN_CALIBRATION, 0.0)
+        self._track(back, snap, odometer, yaw, False,
+                    snap.turns(MotorId.MTB) * self._lift_m if phase in HANGING else 0.0)
+        self._on_a_surface(snap, phase in ON_A_SURFACE and not ctx.from_top)
         if self._start is None and ctx.start.reading is not None \
                 and ctx.start.wheel is not None and ctx.climb_twist[0] is not None:
             self._start = StartReference(
@@ -170,9 +184,6 @@ class BiasWatch:
                 motion.turn_yaw_rad(self._cfg, ctx.climb_twist[0]))
         if phase is Phase.PAUSED and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
-
-    def marked(self, snap: Snapshot) -> Snapshot:
-        """``snap`` with every judged sensor reading as ERROR."""
         if not self._judged:
             return snap
         sensors = dict(snap.sensors)
@@ -191,12 +202,17 @@ class BiasWatch:
             return r.distance_m
         return None
 
-    def _back_readings(self, snap: Snapshot) -> tuple[float | None, float | None, bool, bool]:
+    def _on_a_surface(self, snap: Snapshot, surface: bool) -> None:
         r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
-        return (self._distance(r, True), self._distance(left, True), not r.ok, not left.ok)
+        dr, dl = self._distance(r, True), self._distance(left, True)
+        drop = self._cfg.BACK_CLEARANCE + DROP_M
+        if not surface or dr is None or dl is None or max(dr, dl) > drop:
+            self._mount.end()
+        else:
+            self._mount.add(dr, dl, not r.ok, not left.ok)
 
     def _track(self, track: Onsets, snap: Snapshot, odometer: float, yaw: float,
-               judgeable: bool) -> None:
+               judgeable: bool, lifted_m: float) -> None:
         sensors, back = snap.sensors, track.back
         r, left = sensors[track.right], sensors[track.left]
         dr, dl = self._distance(r, back), self._distance(left, back)
@@ -208,7 +224,10 @@ class BiasWatch:
         if not back:  # looking along the drive: plus the odometer, less the turn
             turn = self._lateral * yaw
             dr, dl = dr + odometer + turn, dl + odometer - turn
-        moved = track.add((snap.time_s, dr, dl, odometer, yaw), judgeable)
+        else:  # looking down from segment 3: less what MTB lifted it
+            dr, dl = dr - lifted_m, dl - lifted_m
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok),
+                          judgeable)
         if moved is None:
             return
         moved_r, moved_l = moved
@@ -226,11 +245,14 @@ class BiasWatch:
 
     def _decide(self, track: Onsets, step: Step, judge_now: bool) -> None:
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
-        what = _motion(*track.windows())
+        before, after = track.windows()
+        what = _motion(before, after)
         if abs(step.moved_right) <= share:
-            onset = Onset(track.left, step.moved_left, step.moved_right, step.at_s, what)
+            near = any(s[6] for s in before) or any(s[6] for s in after)
+            onset = Onset(track.left, step.moved_left, step.moved_right, step.at_s, what, near)
         elif abs(step.moved_left) <= share:
-            onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what)
+            near = any(s[5] for s in before) or any(s[5] for s in after)
+            onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
         else:
             return  # both moved: the world changed, or nobody can tell
         if track.record(onset, step.threshold) and judge_now:
@@ -271,10 +293,14 @@ class BiasWatch:
     def _by_onsets(self, track: Onsets, disagree: float, match: float,
                    threshold: float) -> tuple[SensorId, str] | None:
         offsets = track.offsets
-        if not track.found or abs(offsets[track.left] - offsets[track.right] - disagree) > match:
+        if not track.found:
             return None
         for sensor, partner in ((track.left, track.right), (track.right, track.left)):
-            if abs(offsets[sensor]) >= threshold and abs(offsets[partner]) < threshold / 2:
+            off, said = offsets[sensor], _signed(disagree, sensor)
+            # an onset read too near to measure moved at least what it says
+            agrees = off * said > 0 and abs(said) >= abs(off) - match if track.at_least[sensor] \
+                else abs(off - said) <= match
+            if agrees and abs(off) >= threshold and abs(offsets[partner]) < threshold / 2:
                 onsets = [o for o in track.found if o.sensor is sensor]
                 return sensor, say.judged_by_onsets(onsets, partner, _signed(disagree, sensor))
         return None

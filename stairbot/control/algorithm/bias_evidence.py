@@ -17,22 +17,26 @@ from dataclasses import dataclass
 
 from stairbot.hardware import SensorId
 
-Sample = tuple[float, float, float, float, float]
-"""(time, right, left, odometer m, yaw rad): one tick of a pair, its readings
-compensated for the motion."""
+Sample = tuple[float, float, float, float, float, bool, bool]
+"""(time, right, left, odometer m, yaw rad, right too near, left too near):
+one tick of a pair, its readings compensated for the motion, and whether
+each read too near to measure (its clamp stands for it: a step it makes is
+at least what it says)."""
 
 
 @dataclass(frozen=True, slots=True)
 class Onset:
     """One sensor's reading moved, by ``step_m`` (+ longer), more than the
     motion explains, while its partner's moved by ``partner_m``; ``motion``
-    says what the robot did meanwhile, in words."""
+    says what the robot did meanwhile, in words; ``at_least``: it read too
+    near to measure on some of those ticks, and moved at least ``step_m``."""
 
     sensor: SensorId
     step_m: float
     partner_m: float
     at_s: float
     motion: str
+    at_least: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,7 +56,7 @@ class Onsets:
     and the onsets found, not cancelled."""
 
     __slots__ = ("right", "left", "back", "window", "gap", "size", "buf", "sums", "judgeable",
-                 "pending", "found", "offsets")
+                 "pending", "found", "offsets", "at_least")
 
     def __init__(self, right: SensorId, left: SensorId, back: bool, window: int,
                  gap: int) -> None:
@@ -68,6 +72,8 @@ class Onsets:
         self.found: list[Onset] = []
         self.offsets = {right: 0.0, left: 0.0}
         """How far each sensor has moved by the onsets not cancelled, m."""
+        self.at_least = {right: False, left: False}
+        """Whether an onset of the sensor's was at least what it says."""
 
     def clear(self) -> None:
         self.buf.clear()
@@ -109,54 +115,54 @@ class Onsets:
         (its partner moved the same way: both saw the world change)."""
         self.found.append(onset)
         self.offsets[onset.sensor] += onset.step_m
+        self.at_least[onset.sensor] |= onset.at_least
         if abs(self.offsets[self.left] - self.offsets[self.right]) < threshold:
             self.offsets = dict.fromkeys(self.offsets, 0.0)
+            self.at_least = dict.fromkeys(self.at_least, False)
             self.found.clear()
             return False
         return True
 
 
-MOUNT_TICKS = 25
-"""A stretch of standing on a surface counts once it lasted this many ticks."""
+MOUNT_TICKS = 50
+"""What the back pair reads on a surface is the mean of its last this many
+ticks there (1 s at the 20 ms tick), once it has as many."""
 
 
 class MountHeights:
-    """What SBR and SBL read, less BACK_CLEARANCE, over the last stretch of
-    ticks segment 3 stood on a surface (its mean, and whether the sensor read
-    too near to measure on most of them: then the mean is at most what it
-    says)."""
+    """What SBR and SBL read, less BACK_CLEARANCE, over the last MOUNT_TICKS
+    ticks segment 3 stood on a surface: their means, and whether the sensor
+    read too near to measure on most of them (its mean is then at most what
+    it says).  A tick off a surface ends the stretch; what the last stretch
+    long enough said is kept."""
 
-    __slots__ = ("clearance", "near_m", "ticks", "sums", "nears", "last")
+    __slots__ = ("clearance", "ticks", "sums", "nears", "last")
 
-    def __init__(self, clearance: float, near_m: float) -> None:
-        self.clearance, self.near_m = clearance, near_m
-        self.ticks = 0
-        self.sums = [0.0, 0.0]
-        self.nears = [0, 0]
+    def __init__(self, clearance: float) -> None:
+        self.clearance = clearance
+        self.ticks: deque[tuple[float, float, bool, bool]] = deque()
+        self.sums: list[float] = [0.0, 0.0, 0.0, 0.0]
         self.last: tuple[tuple[float, bool], tuple[float, bool]] | None = None
-        """(offset m, read too near) of SBR and SBL, the last stretch long enough."""
+        """(offset m, read too near) of SBR and SBL."""
 
-    def add(self, right: float | None, left: float | None, right_near: bool,
-            left_near: bool) -> None:
-        """One tick on a surface (None: the sensor gave no distance: the
-        stretch ends)."""
-        if right is None or left is None:
-            self.end()
-            return
-        self.ticks += 1
-        self.sums[0] += right - self.clearance
-        self.sums[1] += left - self.clearance
-        self.nears[0] += right_near
-        self.nears[1] += left_near
-        if self.ticks >= MOUNT_TICKS:
-            n = self.ticks
-            self.last = ((self.sums[0] / n, 2 * self.nears[0] > n),
-                         (self.sums[1] / n, 2 * self.nears[1] > n))
+    def add(self, right: float, left: float, right_near: bool, left_near: bool) -> None:
+        """One tick on a surface."""
+        ticks, sums = self.ticks, self.sums
+        sample = (right - self.clearance, left - self.clearance, right_near, left_near)
+        ticks.append(sample)
+        for k in range(4):
+            sums[k] += sample[k]
+        if len(ticks) > MOUNT_TICKS:
+            old = ticks.popleft()
+            for k in range(4):
+                sums[k] -= old[k]
+        n = len(ticks)
+        if n >= MOUNT_TICKS:
+            self.last = ((sums[0] / n, 2 * sums[2] > n), (sums[1] / n, 2 * sums[3] > n))
 
     def end(self) -> None:
-        self.ticks = 0
-        self.sums = [0.0, 0.0]
-        self.nears = [0, 0]
+        self.ticks.clear()
+        self.sums = [0.0, 0.0, 0.0, 0.0]
 
 
 @dataclass(frozen=True, slots=True)

@@ -40,12 +40,7 @@ from stairbot.control.algorithm.transitions import exit_of
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import (
-    LIFT_MOTORS,
-    MotorId,
-    SensorId,
-    Snapshot,
-)
+from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, Snapshot
 from stairbot.inputs.config import RobotConfig
 
 
@@ -176,8 +171,7 @@ class Controller:
         if self.finished:
             return _zeros()
         snap = self._perception.see(snap)
-        self._bias.see(snap, self._ctx)
-        snap = self._bias.marked(snap)  # a sensor judged biased reads as ERROR: it is lost
+        snap = self._bias.see(snap, self._ctx)  # a sensor judged biased reads as ERROR: lost
         if self._ctx.limp is not None:
             snap = limp.mirrored(snap, self._ctx.limp.lost)
         if self._held is not None:
@@ -254,7 +248,7 @@ class Controller:
                 self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
                            f"{phase.label}", snap.time_s, {"phase": phase.value})
             return False
-        why = "; ".join([f"{s} {self._bias.why(s) or self._perception.why(s) or 'reports an error'}"
+        why = "; ".join([f"{s} {self._bias.why(s, self._perception.why(s))}"
                          for s in errors] + ([imu] if imu is not None else []))
         if self._sensor_since is None:
             self._sensor_since = snap.time_s
@@ -265,8 +259,7 @@ class Controller:
                        snap.time_s, {"resume_phase": phase.value, "sensors": list(errors),
                                          "imu_stale": imu is not None})
             return True
-        if snap.time_s - self._sensor_since < SENSOR_WAIT_S and \
-                not all(s in self._bias.judged for s in errors):  # no use waiting for those
+        if snap.time_s - self._sensor_since < SENSOR_WAIT_S and not self._bias.all_judged(errors):
             return True
         since, self._sensor_since = self._sensor_since, None
         stale = link_meanwhile(self._sensor_link, snap.health,
