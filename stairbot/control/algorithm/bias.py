@@ -60,8 +60,8 @@ from stairbot.control.algorithm.bias_evidence import (
     MountHeights,
     Onset,
     Onsets,
+    Reference,
     Sample,
-    StartReference,
     Step,
 )
 from stairbot.control.algorithm.context import Context
@@ -98,6 +98,8 @@ less than this share of the step (or half the threshold, if more)."""
 MATCH_SHARE = 0.35
 """Evidence matches the standing rule's disagreement within the standing
 tolerance, or this share of the disagreement if more."""
+WARM_SETTLES = 3.0
+"""A pair is watched from this many of its settle times into the run on."""
 STILL_M = 0.001
 STILL_RAD = math.radians(0.2)
 
@@ -120,10 +122,13 @@ DROP_M = 0.05
 HANGING = frozenset({Phase.ASCENT_LIFT_THIRD, Phase.DESCENT_LOWER_THIRD})
 """The phases in which MTB lifts or lowers segment 3 in the air: what its
 sensors read moves with MTB's counter."""
-FACING_THE_FIRST_RISER = frozenset({Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
-                                    Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
-"""With no step climbed, the front pair faces the first riser in these
-phases: the start position and the odometer say where it stands."""
+ON_THE_TREAD = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE,
+                          Phase.DESCENT_LOWER_THIRD, Phase.DESCENT_DRIVE_SECOND,
+                          Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST})
+"""Descent 1 to 5 of a step: segment 1 stands on its tread and the front pair
+faces the riser above it, whose place the tab measured on the way up and
+the odometer since say (descent 6 lowers the pair past the tread)."""
+ON_THE_FLOOR = frozenset({Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
 
 
 class BiasWatch:
@@ -134,14 +139,18 @@ class BiasWatch:
         self._cfg = cfg
         self._lateral = cfg.sensors.front_lateral
         self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
+        self._wheel_m = cfg.wheel_circumference
         self._near = (cfg.sensors.range(False)[0], cfg.sensors.range(True)[0])
         self._pairs: list[Onsets] = []
         for back, (right, left) in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
             ticks = max(MIN_WINDOW_TICKS, round(settle_s(cfg, back) / cfg.algorithm.tick))
             self._pairs.append(Onsets(right, left, back, ticks, ticks))
+        self._warm = [WARM_SETTLES * settle_s(cfg, back) for back in (False, True)]
+        """Robot time from which each pair is watched."""
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
         self._lift_m = cfg.motors.lift_travel_per_turn
-        self._start: StartReference | None = None
+        self._risers: dict[int, Reference] = {}
+        """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
         self._judged: dict[SensorId, str] = {}
 
     @property
@@ -177,11 +186,7 @@ class BiasWatch:
         self._track(back, snap, odometer, yaw, False,
                     snap.turns(MotorId.MTB) * self._lift_m if phase in HANGING else 0.0)
         self._on_a_surface(snap, phase in ON_A_SURFACE and not ctx.from_top)
-        if self._start is None and ctx.start.reading is not None \
-                and ctx.start.wheel is not None and ctx.climb_twist[0] is not None:
-            self._start = StartReference(
-                ctx.start.reading + ctx.start.wheel * self._metres_per_turn * len(WHEEL_MOTORS),
-                motion.turn_yaw_rad(self._cfg, ctx.climb_twist[0]))
+        self._references(snap, ctx, odometer, yaw)
         if phase is Phase.PAUSED and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
         if not self._judged:
@@ -202,6 +207,23 @@ class BiasWatch:
             return r.distance_m
         return None
 
+    def _references(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:
+        """Note the start position (tread 0), and each tab_length_to_edge the
+        ascent stores (the tread it climbed onto), as the odometer places them,
+        when the pair read them alike."""
+        risers = self._risers
+        if 0 not in risers and ctx.start.reading is not None and ctx.start.wheel is not None \
+                and ctx.climb_twist[0] is not None:
+            risers[0] = Reference(ctx.start.reading + ctx.start.wheel * self._wheel_m,
+                                  motion.turn_yaw_rad(self._cfg, ctx.climb_twist[0]), 0)
+        k = ctx.number_of_steps
+        if 0 < k <= len(ctx.tab_length_to_edge) and k not in risers and ctx.landing.step is None:
+            tab = ctx.tab_length_to_edge[k - 1]
+            diff = motion.pair_difference(snap, self._cfg)
+            if tab is not None and diff is not None \
+                    and abs(diff) <= standing_tolerance(self._cfg, tab):
+                risers[k] = Reference(tab + odometer, yaw, k)
+
     def _on_a_surface(self, snap: Snapshot, surface: bool) -> None:
         r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
         dr, dl = self._distance(r, True), self._distance(left, True)
@@ -219,8 +241,12 @@ class BiasWatch:
         if dr is None or dl is None or track.right in self._judged \
                 or track.left in self._judged or (not back and max(dr, dl)
                                                   >= self._cfg.LENGTH_OF_INFINITY):
+            if track.pending is not None:  # a step seen before one of them stopped reading
+                self._decide(track, track.pending, False)
             track.clear()
             return
+        if snap.time_s < self._warm[back]:
+            return  # the filter's first medians are of its first few measurements
         if not back:  # looking along the drive: plus the odometer, less the turn
             turn = self._lateral * yaw
             dr, dl = dr + odometer + turn, dl + odometer - turn
@@ -283,9 +309,12 @@ class BiasWatch:
         found = self._by_onsets(track, disagree, match, threshold)
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
-        if found is None and not back and ctx.number_of_steps == 0 \
-                and resume in FACING_THE_FIRST_RISER and ctx.landing.step is None:
-            found = self._by_start(snap, odometer, yaw, disagree, match, tolerance)
+        tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
+            0 if resume in ON_THE_FLOOR else None
+        if found is None and not back and tread is not None and tread in self._risers \
+                and ctx.landing.step is None and not ctx.from_top:
+            found = self._by_riser(snap, self._risers[tread], odometer, yaw, disagree,
+                                   min(tolerance, match))
         if found is not None:
             sensor, evidence = found
             self._judged[sensor] = evidence
@@ -300,7 +329,8 @@ class BiasWatch:
             # an onset read too near to measure moved at least what it says
             agrees = off * said > 0 and abs(said) >= abs(off) - match if track.at_least[sensor] \
                 else abs(off - said) <= match
-            if agrees and abs(off) >= threshold and abs(offsets[partner]) < threshold / 2:
+            # (each onset counted when it was a step beyond the threshold there)
+            if agrees and off != 0.0 and abs(offsets[partner]) <= abs(off) / 2:
                 onsets = [o for o in track.found if o.sensor is sensor]
                 return sensor, say.judged_by_onsets(onsets, partner, _signed(disagree, sensor))
         return None
@@ -323,21 +353,19 @@ class BiasWatch:
                                                    self._cfg.BACK_CLEARANCE)
         return None
 
-    def _by_start(self, snap: Snapshot, odometer: float, yaw: float, disagree: float,
-                  match: float, tolerance: float) -> tuple[SensorId, str] | None:
-        start = self._start
-        if start is None:
-            return None
-        turn = self._lateral * (yaw - start.yaw_rad)
-        expected_r = start.position_m - odometer - turn
-        expected_l = start.position_m - odometer + turn
+    def _by_riser(self, snap: Snapshot, riser: Reference, odometer: float, yaw: float,
+                  disagree: float, within: float) -> tuple[SensorId, str] | None:
+        """The sensor the drive does not bear out: its partner reads where the
+        riser stands by the odometer, within ``within``."""
+        turn = self._lateral * (yaw - riser.yaw_rad)
         r, left = motion.pair(snap)
-        off_r, off_l = r.distance_m - expected_r, left.distance_m - expected_l
+        off_r = r.distance_m - (riser.position_m - odometer - turn)
+        off_l = left.distance_m - (riser.position_m - odometer + turn)
         for sensor, partner, off, p_off in ((SensorId.SFL, SensorId.SFR, off_l, off_r),
                                             (SensorId.SFR, SensorId.SFL, off_r, off_l)):
-            said = _signed(disagree, sensor)
-            if abs(p_off) <= tolerance and abs(off - said) <= match:
-                return sensor, say.judged_by_start(sensor, partner, off, p_off, said)
+            if abs(p_off) <= within < abs(off):
+                return sensor, say.judged_by_riser(sensor, partner, off, p_off, riser.tread,
+                                                   _signed(disagree, sensor))
         return None
 
 

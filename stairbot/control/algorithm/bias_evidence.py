@@ -6,8 +6,8 @@ biased sensor on, each kind kept as it comes, tick by tick:
   held (the module docstring of :mod:`~stairbot.control.algorithm.bias`);
 * :class:`MountHeights`: what each back sensor reads while segment 3 stands
   on a surface (BACK_CLEARANCE, the mount height, when it reads right);
-* :class:`StartReference`: where the first riser stands by the drive's
-  odometer, from the start position the first calibration measured.
+* :class:`Reference`: where a riser stands by the drive's odometer, from
+  the start position, or the tab_length_to_edge the ascent measured.
 """
 
 from __future__ import annotations
@@ -166,9 +166,10 @@ class MountHeights:
 
 
 @dataclass(frozen=True, slots=True)
-class StartReference:
-    """The first riser by the odometer: the start position's reading plus the
-    odometer there (m), and the heading there (rad)."""
+class Reference:
+    """Where the riser ahead of ``tread`` (0: the floor) stood: what the pair
+    read there plus the drive's odometer, m, and the heading, rad."""
 
     position_m: float
     yaw_rad: float
+    tread: int

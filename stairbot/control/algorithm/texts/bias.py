@@ -66,10 +66,11 @@ def judged_by_mount(sensor: SensorId, partner: SensorId, off_m: float, partner_o
             f"{_past(sensor, partner, said_m)}, as that says")
 
 
-def judged_by_start(sensor: SensorId, partner: SensorId, off_m: float, partner_off_m: float,
-                    said_m: float) -> str:
-    """At the standing rule's wait's end, facing the first riser: the odometer."""
+def judged_by_riser(sensor: SensorId, partner: SensorId, off_m: float, partner_off_m: float,
+                    tread: int, said_m: float) -> str:
+    """At the standing rule's wait's end: where the odometer puts the riser."""
+    where = "the start position's reading" if tread == 0 else \
+        f"tab_length_to_edge of step {tread}"
     return (f"judged biased: {sensor} reads {_cm(off_m)} {'more' if off_m > 0 else 'less'} "
-            f"than the drive says (the start position's reading and the odometer since), "
-            f"{partner} within {abs(partner_off_m) * 1000:.1f} mm of it; "
-            f"{_past(sensor, partner, said_m)}")
+            f"than the drive says ({where} and the odometer since), {partner} within "
+            f"{abs(partner_off_m) * 1000:.1f} mm of it; {_past(sensor, partner, said_m)}")
