@@ -296,6 +296,8 @@ class BiasWatch:
             return
         resume = BY_VALUE[pause.resume_phase]
         back = resume.record.watches == "back"
+        if motion.pair_difference(snap, cfg, back) is None:
+            return  # a pair that gives no figure now does not disagree (the standing rule)
         diffs = sorted(pause.diffs)
         disagree = diffs[len(diffs) // 2]  # left − right
         r, left = motion.pair(snap, back)

@@ -250,16 +250,18 @@ class Controller:
             return False
         why = "; ".join([f"{s} {self._bias.why(s, self._perception.why(s))}"
                          for s in errors] + ([imu] if imu is not None else []))
+        # a sensor judged biased does not come back: no use waiting for it
+        wait = 0.0 if imu is None and self._bias.all_judged(errors) else SENSOR_WAIT_S
         if self._sensor_since is None:
-            self._sensor_since = snap.time_s
-            self._sensor_link = dict(snap.health)
-            ctx.pauses += 1
-            self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
-                       f"stopped, lifts holding, waiting up to {SENSOR_WAIT_S:g} s",
-                       snap.time_s, {"resume_phase": phase.value, "sensors": list(errors),
-                                         "imu_stale": imu is not None})
-            return True
-        if snap.time_s - self._sensor_since < SENSOR_WAIT_S and not self._bias.all_judged(errors):
+            self._sensor_since, self._sensor_link = snap.time_s, dict(snap.health)
+            if wait > 0.0:
+                ctx.pauses += 1
+                self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
+                           f"stopped, lifts holding, waiting up to {wait:g} s", snap.time_s,
+                           {"resume_phase": phase.value, "sensors": list(errors),
+                            "imu_stale": imu is not None})
+                return True
+        if snap.time_s - self._sensor_since < wait:
             return True
         since, self._sensor_since = self._sensor_since, None
         stale = link_meanwhile(self._sensor_link, snap.health,
@@ -268,8 +270,7 @@ class Controller:
             ctx, snap, phase, errors, why, mode=self.mode, consent=self.limp_home,
             tilt_watched=self._tilt.watched)
         if stop is None:
-            self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
-                             f"{stale}"), snap)
+            self._apply(fail(say_limp.lost_sensor_end(why, wait, phase.label) + stale), snap)
             return True
         self._emit(EventKind.WARNING, say_limp.stopped_at(
             why, phase.label, stop.where, stop.lifts, stop.steps_climbed,
@@ -277,7 +278,7 @@ class Controller:
         if stop.then == "no_consent":
             lost.start_limping(ctx, stop, snap.time_s, phase.label)
         if stop.then != "limp_home":
-            self._apply(fail(say_limp.lost_sensor_end(why, SENSOR_WAIT_S, phase.label, stop.why)
+            self._apply(fail(say_limp.lost_sensor_end(why, wait, phase.label, stop.why)
                              + stale), snap)
             return True
         lost.start_limping(ctx, stop, snap.time_s, phase.label)
