@@ -63,6 +63,7 @@ from stairbot.control.algorithm.bias_evidence import (
     Reference,
     Sample,
     Step,
+    Unconfirmed,
 )
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
@@ -83,15 +84,23 @@ from stairbot.hardware import (
 from stairbot.inputs.config import RobotConfig
 
 MIN_WINDOW_TICKS = 5
-"""Each of the two windows whose means are compared spans the pair's settle
-time (:func:`~stairbot.control.tolerances.settle_s`), and at least this many
-ticks; so does the gap between them (the filter's median comes round to a
-new level within it)."""
-STEP_SIGMAS = 1.5
+"""The gap between the two windows whose means are compared spans the pair's
+settle time (:func:`~stairbot.control.tolerances.settle_s`: the filter's
+median comes round to a new level within it), and at least this many
+ticks."""
+WINDOW_SETTLES = 2.0
+"""Each of the two windows spans this many settle times: long enough that
+its mean is quieter than a tick by about the square root of the
+measurements it holds."""
+STEP_SIGMAS = 1.0
 """A step counts when the pair's difference moves by more than this many of
-its pair tolerance (itself four sigmas of one tick's difference): the means
-of two windows are quieter than one tick, and a fault-free run must not
-take its noise for an onset."""
+its pair tolerance (itself four sigmas of one tick's difference, so more
+sigmas of two windows' means): a fault-free run must not take its noise for
+an onset, and the next window must bear an onset out before it counts."""
+MAX_ONSET_M = 0.08
+"""A one-sided step larger than this is one sensor crossing an edge before its
+partner (the back pair askew over a drop, a front cone over a riser): not
+an onset.  (A bias as large is judged by the other evidence, or not at all.)"""
 ATTRIBUTE_SHARE = 0.4
 """A step is one sensor's onset when its partner's compensated reading moved
 less than this share of the step (or half the threshold, if more)."""
@@ -144,7 +153,7 @@ class BiasWatch:
         self._pairs: list[Onsets] = []
         for back, (right, left) in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
             ticks = max(MIN_WINDOW_TICKS, round(settle_s(cfg, back) / cfg.algorithm.tick))
-            self._pairs.append(Onsets(right, left, back, ticks, ticks))
+            self._pairs.append(Onsets(right, left, back, round(WINDOW_SETTLES * ticks), ticks))
         self._warm = [WARM_SETTLES * settle_s(cfg, back) for back in (False, True)]
         """Robot time from which each pair is watched."""
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
@@ -243,6 +252,9 @@ class BiasWatch:
                                                   >= self._cfg.LENGTH_OF_INFINITY):
             if track.pending is not None:  # a step seen before one of them stopped reading
                 self._decide(track, track.pending, False)
+            if track.unconfirmed is not None:
+                track.unconfirmed = replace(track.unconfirmed, judge_now=False)
+                self._confirm(track, True)
             track.clear()
             return
         if snap.time_s < self._warm[back]:
@@ -254,6 +266,13 @@ class BiasWatch:
             dr, dl = dr - lifted_m, dl - lifted_m
         moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok),
                           judgeable)
+        waiting = track.unconfirmed
+        if waiting is not None and len(track.buf) == track.window:
+            level = sum(x[2] - x[1] for x in track.buf) / track.window
+            if waiting.judge_now:  # still in calibration
+                waiting = replace(waiting, judge_now=track.judgeable >= track.window)
+                track.unconfirmed = waiting
+            self._confirm(track, abs(level - waiting.level) <= waiting.share)
         if moved is None:
             return
         moved_r, moved_l = moved
@@ -267,9 +286,13 @@ class BiasWatch:
             return
         if pending is not None:
             self._decide(track, pending, track.judgeable >= track.size)
-            track.clear()
+            track.clear()  # the pair's new level is the next windows' first
 
     def _decide(self, track: Onsets, step: Step, judge_now: bool) -> None:
+        """Attribute a step to the sensor that moved, if its partner held; the
+        onset counts once the next window bears it out (:meth:`_confirm`)."""
+        if step.size > MAX_ONSET_M:
+            return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
         what = _motion(before, after)
@@ -281,10 +304,22 @@ class BiasWatch:
             onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
         else:
             return  # both moved: the world changed, or nobody can tell
-        if track.record(onset, step.threshold) and judge_now:
-            partner = track.right if onset.sensor is track.left else track.left
-            if abs(track.offsets[partner]) < step.threshold / 2:
-                self._judged[onset.sensor] = say.judged_in_calibration(onset)
+        level = sum(s[2] - s[1] for s in before) / len(before) \
+            + step.moved_left - step.moved_right
+        track.unconfirmed = Unconfirmed(onset, level, share, step.threshold, judge_now)
+
+    def _confirm(self, track: Onsets, held: bool) -> None:
+        """Count the onset waiting for the next window if the pair's
+        difference held at its new level there (``held``; or the pair stopped
+        reading first: it may have); in calibration, judge it."""
+        waiting, track.unconfirmed = track.unconfirmed, None
+        assert waiting is not None
+        onset = waiting.onset
+        if not held or not track.record(onset, waiting.threshold) or not waiting.judge_now:
+            return
+        partner = track.right if onset.sensor is track.left else track.left
+        if abs(track.offsets[partner]) < waiting.threshold / 2:
+            self._judged[onset.sensor] = say.judged_in_calibration(onset)
 
     # -- the standing rule's wait ends -----------------------------------------------------
     def _judge_pause(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:

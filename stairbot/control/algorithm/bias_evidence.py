@@ -50,13 +50,25 @@ class Step:
     at_s: float
 
 
+@dataclass(frozen=True, slots=True)
+class Unconfirmed:
+    """An onset found, waiting for the next window to bear it out: the pair's
+    difference should hold at ``level``, within ``share``."""
+
+    onset: Onset
+    level: float
+    share: float
+    threshold: float
+    judge_now: bool
+
+
 class Onsets:
     """One pair's compensated readings over two windows and the gap between
     them (running sums: a tick costs the same whatever the windows' length),
     and the onsets found, not cancelled."""
 
     __slots__ = ("right", "left", "back", "window", "gap", "size", "buf", "sums", "judgeable",
-                 "pending", "found", "offsets", "at_least")
+                 "pending", "unconfirmed", "found", "offsets", "at_least")
 
     def __init__(self, right: SensorId, left: SensorId, back: bool, window: int,
                  gap: int) -> None:
@@ -69,6 +81,7 @@ class Onsets:
         self.judgeable = 0
         """Ticks in a row (up to now) taken where an onset is judged at once."""
         self.pending: Step | None = None
+        self.unconfirmed: Unconfirmed | None = None
         self.found: list[Onset] = []
         self.offsets = {right: 0.0, left: 0.0}
         """How far each sensor has moved by the onsets not cancelled, m."""
