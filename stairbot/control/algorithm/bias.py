@@ -400,7 +400,7 @@ class BiasWatch:
         off_l = left.distance_m - (riser.position_m - odometer + turn)
         for sensor, partner, off, p_off in ((SensorId.SFL, SensorId.SFR, off_l, off_r),
                                             (SensorId.SFR, SensorId.SFL, off_r, off_l)):
-            if abs(p_off) <= within < abs(off):
+            if abs(p_off) <= within < abs(off) and abs(off) >= 2 * abs(p_off):
                 return sensor, say.judged_by_riser(sensor, partner, off, p_off, riser.tread,
                                                    _signed(disagree, sensor))
         return None

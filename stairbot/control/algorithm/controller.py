@@ -272,8 +272,8 @@ class Controller:
         if stop is None:
             self._apply(fail(say_limp.lost_sensor_end(why, wait, phase.label) + stale), snap)
             return True
-        self._emit(EventKind.WARNING, say_limp.stopped_at(
-            why, phase.label, stop.where, stop.lifts, stop.steps_climbed,
+        self._emit(EventKind.WARNING, say_limp.stopped_at(  # (the phase a pause stopped in)
+            why, BY_VALUE[stop.phase].label, stop.where, stop.lifts, stop.steps_climbed,
             stop.steps_descended) + ": " + stop.why, snap.time_s, {"degraded": stop.to_dict()})
         if stop.then == "no_consent":
             lost.start_limping(ctx, stop, snap.time_s, phase.label)

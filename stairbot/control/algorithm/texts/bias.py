@@ -32,7 +32,8 @@ def motion(drove_m: float, turned_rad: float, still: bool) -> str:
 
 def _onset(o: Onset) -> str:
     longer = "longer" if o.step_m > 0 else "shorter"
-    return (f"{o.sensor} read {_cm(o.step_m)} {longer} from {o.at_s:.2f} s on, more than the "
+    size = f"at least {_cm(o.step_m)}" if o.at_least else _cm(o.step_m)  # read too near, clamped
+    return (f"{o.sensor} read {size} {longer} from {o.at_s:.2f} s on, more than the "
             f"motion explains ({o.motion}), while its partner moved {o.partner_m * 1000:+.1f} mm")
 
 
