@@ -112,13 +112,14 @@ WARM_SETTLES = 3.0
 STILL_M = 0.001
 STILL_RAD = math.radians(0.2)
 
-JUDGED_IN_CALIBRATION = frozenset({Phase.CAL_CHECK, Phase.CAL_CLOSE_IN, Phase.CAL_PROBE,
-                                   Phase.CAL_TURN})
-"""The calibration phases in which a front onset is judged at once: the front
-pair faces the riser, and the robot stands, closes in or turns on segment 2's
-wheels (not its lifts and lowerings, where the sensors rise and fall by a
-clearance and a cone may see over a low riser)."""
+STEERS_BY_THE_FRONT = frozenset({Phase.CAL_CHECK, Phase.CAL_CLOSE_IN, Phase.CAL_PROBE,
+                                 Phase.CAL_TURN})
+"""The calibration phases in which the robot squares up to a riser by the
+front pair's difference: its onsets are judged at once there."""
 _RISER_PURPOSES = (Purpose.START, Purpose.ASCENT, Purpose.DESCENT)
+STEERS_BY_THE_BACK = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
+"""Descent 1's phases, in which the back pair finds the edge (where both read
+the drop): its onsets are judged at once there."""
 ON_A_SURFACE = frozenset({
     Phase.CAL_CLOSE_IN, Phase.DESCENT_BACK_OFF, Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
     Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_DRIVE_FIRST,
@@ -186,18 +187,22 @@ class BiasWatch:
         where the evidence decides (module docstring); the snapshot with
         every sensor judged biased reading as ERROR."""
         phase = BY_VALUE[ctx.phase]
-        family = ctx.family
-        riser = isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES
         odometer = sum(snap.turns(m) for m in WHEEL_MOTORS) * self._metres_per_turn
         yaw = motion.turn_yaw_rad(self._cfg, motion.twist(snap))
         front, back = self._pairs
-        self._track(front, snap, odometer, yaw, riser and phase in JUDGED_IN_CALIBRATION, 0.0)
-        self._track(back, snap, odometer, yaw, False,
+        self._track(front, snap, odometer, yaw, 0.0)
+        self._track(back, snap, odometer, yaw,
                     snap.turns(MotorId.MTB) * self._lift_m if phase in HANGING else 0.0)
         self._on_a_surface(snap, phase in ON_A_SURFACE and not ctx.from_top)
         self._references(snap, ctx, odometer, yaw)
         if phase is Phase.PAUSED and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
+        elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
+            family = ctx.family
+            if isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES:
+                self._judge_at_once(front, snap)
+        elif phase in STEERS_BY_THE_BACK:
+            self._judge_at_once(back, snap)
         if not self._judged:
             return snap
         sensors = dict(snap.sensors)
@@ -243,7 +248,7 @@ class BiasWatch:
             self._mount.add(dr, dl, not r.ok, not left.ok)
 
     def _track(self, track: Onsets, snap: Snapshot, odometer: float, yaw: float,
-               judgeable: bool, lifted_m: float) -> None:
+               lifted_m: float) -> None:
         sensors, back = snap.sensors, track.back
         r, left = sensors[track.right], sensors[track.left]
         dr, dl = self._distance(r, back), self._distance(left, back)
@@ -251,9 +256,8 @@ class BiasWatch:
                 or track.left in self._judged or (not back and max(dr, dl)
                                                   >= self._cfg.LENGTH_OF_INFINITY):
             if track.pending is not None:  # a step seen before one of them stopped reading
-                self._decide(track, track.pending, False)
+                self._decide(track, track.pending)
             if track.unconfirmed is not None:
-                track.unconfirmed = replace(track.unconfirmed, judge_now=False)
                 self._confirm(track, True)
             track.clear()
             return
@@ -264,14 +268,10 @@ class BiasWatch:
             dr, dl = dr + odometer + turn, dl + odometer - turn
         else:  # looking down from segment 3: less what MTB lifted it
             dr, dl = dr - lifted_m, dl - lifted_m
-        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok),
-                          judgeable)
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
             level = sum(x[2] - x[1] for x in track.buf) / track.window
-            if waiting.judge_now:  # still in calibration
-                waiting = replace(waiting, judge_now=track.judgeable >= track.window)
-                track.unconfirmed = waiting
             self._confirm(track, abs(level - waiting.level) <= waiting.share)
         if moved is None:
             return
@@ -285,10 +285,10 @@ class BiasWatch:
             track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
             return
         if pending is not None:
-            self._decide(track, pending, track.judgeable >= track.size)
+            self._decide(track, pending)
             track.clear()  # the pair's new level is the next windows' first
 
-    def _decide(self, track: Onsets, step: Step, judge_now: bool) -> None:
+    def _decide(self, track: Onsets, step: Step) -> None:
         """Attribute a step to the sensor that moved, if its partner held; the
         onset counts once the next window bears it out (:meth:`_confirm`)."""
         if step.size > MAX_ONSET_M:
@@ -306,20 +306,32 @@ class BiasWatch:
             return  # both moved: the world changed, or nobody can tell
         level = sum(s[2] - s[1] for s in before) / len(before) \
             + step.moved_left - step.moved_right
-        track.unconfirmed = Unconfirmed(onset, level, share, step.threshold, judge_now)
+        track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
 
     def _confirm(self, track: Onsets, held: bool) -> None:
         """Count the onset waiting for the next window if the pair's
         difference held at its new level there (``held``; or the pair stopped
-        reading first: it may have); in calibration, judge it."""
+        reading first: it may have)."""
         waiting, track.unconfirmed = track.unconfirmed, None
         assert waiting is not None
-        onset = waiting.onset
-        if not held or not track.record(onset, waiting.threshold) or not waiting.judge_now:
+        if held:
+            track.record(waiting.onset, waiting.threshold)
+
+    def _judge_at_once(self, track: Onsets, snap: Snapshot) -> None:
+        """Where the robot steers by the pair: a sensor its onsets name, by
+        more than the standing rule tolerates, is judged now (steering on it
+        would leave the robot askew, or take the floor for the drop)."""
+        if not track.found:
             return
-        partner = track.right if onset.sensor is track.left else track.left
-        if abs(track.offsets[partner]) < waiting.threshold / 2:
-            self._judged[onset.sensor] = say.judged_in_calibration(onset)
+        offsets = track.offsets
+        for sensor, partner in ((track.left, track.right), (track.right, track.left)):
+            off = offsets[sensor]
+            reading = snap.sensors[sensor].distance_m
+            if abs(off) > standing_tolerance(self._cfg, reading, back=track.back) \
+                    and abs(offsets[partner]) <= abs(off) / 2:
+                onsets = [o for o in track.found if o.sensor is sensor]
+                self._judged[sensor] = say.judged_at_once(onsets, track.back)
+                return
 
     # -- the standing rule's wait ends -----------------------------------------------------
     def _judge_pause(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:

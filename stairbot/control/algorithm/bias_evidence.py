@@ -59,7 +59,6 @@ class Unconfirmed:
     level: float
     share: float
     threshold: float
-    judge_now: bool
 
 
 class Onsets:
@@ -67,8 +66,8 @@ class Onsets:
     them (running sums: a tick costs the same whatever the windows' length),
     and the onsets found, not cancelled."""
 
-    __slots__ = ("right", "left", "back", "window", "gap", "size", "buf", "sums", "judgeable",
-                 "pending", "unconfirmed", "found", "offsets", "at_least")
+    __slots__ = ("right", "left", "back", "window", "gap", "size", "buf", "sums", "pending",
+                 "unconfirmed", "found", "offsets", "at_least")
 
     def __init__(self, right: SensorId, left: SensorId, back: bool, window: int,
                  gap: int) -> None:
@@ -78,8 +77,6 @@ class Onsets:
         self.buf: deque[Sample] = deque()
         self.sums = [0.0, 0.0, 0.0, 0.0]
         """The windows' sums: before right, before left, after right, after left."""
-        self.judgeable = 0
-        """Ticks in a row (up to now) taken where an onset is judged at once."""
         self.pending: Step | None = None
         self.unconfirmed: Unconfirmed | None = None
         self.found: list[Onset] = []
@@ -90,10 +87,9 @@ class Onsets:
 
     def clear(self) -> None:
         self.buf.clear()
-        self.judgeable = 0
         self.pending = None
 
-    def add(self, sample: Sample, judgeable: bool) -> tuple[float, float] | None:
+    def add(self, sample: Sample) -> tuple[float, float] | None:
         """Take one tick; once both windows are full, how far the right and
         the left sensor moved between their means."""
         buf, w, sums = self.buf, self.window, self.sums
@@ -109,14 +105,12 @@ class Onsets:
         else:
             buf.append(sample)
             if len(buf) < self.size:
-                self.judgeable = self.judgeable + 1 if judgeable else 0
                 return None
             items = list(buf)
             sums[0] = sum(s[1] for s in items[:w])
             sums[1] = sum(s[2] for s in items[:w])
             sums[2] = sum(s[1] for s in items[-w:])
             sums[3] = sum(s[2] for s in items[-w:])
-        self.judgeable = self.judgeable + 1 if judgeable else 0
         return (sums[2] - sums[0]) / w, (sums[3] - sums[1]) / w
 
     def windows(self) -> tuple[list[Sample], list[Sample]]:

@@ -37,10 +37,11 @@ def _onset(o: Onset) -> str:
             f"motion explains ({o.motion}), while its partner moved {o.partner_m * 1000:+.1f} mm")
 
 
-def judged_in_calibration(o: Onset) -> str:
-    """A front onset in calibration, judged at once."""
-    return (f"judged biased: {_onset(o)}; squaring up to the riser on it would leave the robot "
-            f"askew")
+def judged_at_once(onsets: Sequence[Onset], back: bool) -> str:
+    """Where the robot steers by the pair: its onsets name the sensor."""
+    steer = ("finding the edge on it would take the floor for the drop, or the drop for the floor"
+             if back else "squaring up to the riser on it would leave the robot askew")
+    return f"judged biased: {'; '.join(_onset(o) for o in onsets)}; {steer}"
 
 
 def _past(sensor: SensorId, partner: SensorId, said_m: float) -> str:
