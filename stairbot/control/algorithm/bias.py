@@ -66,6 +66,7 @@ from stairbot.control.algorithm.bias_evidence import (
     Unconfirmed,
 )
 from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.edge_measure import floor_tolerance
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
@@ -200,9 +201,13 @@ class BiasWatch:
         elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
             family = ctx.family
             if isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES:
-                self._judge_at_once(front, snap)
+                self._judge_at_once(front, snap, None)
         elif phase in STEERS_BY_THE_BACK:
-            self._judge_at_once(back, snap)
+            self._judge_at_once(back, snap, None)
+        elif phase is Phase.DESCENT_LOWER_THIRD:
+            # lowered until the pair's mean reads BACK_CLEARANCE within the floor
+            # tolerance: one sensor off by twice that never gets there
+            self._judge_at_once(back, snap, 2 * floor_tolerance(self._cfg))
         if not self._judged:
             return snap
         sensors = dict(snap.sensors)
@@ -317,18 +322,20 @@ class BiasWatch:
         if held:
             track.record(waiting.onset, waiting.threshold)
 
-    def _judge_at_once(self, track: Onsets, snap: Snapshot) -> None:
+    def _judge_at_once(self, track: Onsets, snap: Snapshot, bar: float | None) -> None:
         """Where the robot steers by the pair: a sensor its onsets name, by
-        more than the standing rule tolerates, is judged now (steering on it
-        would leave the robot askew, or take the floor for the drop)."""
+        more than ``bar`` (None: than the standing rule tolerates), is judged
+        now (steering on it would leave the robot askew, take the floor for
+        the drop, or lower segment 3 past the floor)."""
         if not track.found:
             return
         offsets = track.offsets
         for sensor, partner in ((track.left, track.right), (track.right, track.left)):
             off = offsets[sensor]
             reading = snap.sensors[sensor].distance_m
-            if abs(off) > standing_tolerance(self._cfg, reading, back=track.back) \
-                    and abs(offsets[partner]) <= abs(off) / 2:
+            limit = standing_tolerance(self._cfg, reading, back=track.back) if bar is None \
+                else bar
+            if abs(off) > limit and abs(offsets[partner]) <= abs(off) / 2:
                 onsets = [o for o in track.found if o.sensor is sensor]
                 self._judged[sensor] = say.judged_at_once(onsets, track.back)
                 return

@@ -39,7 +39,7 @@ def _onset(o: Onset) -> str:
 
 def judged_at_once(onsets: Sequence[Onset], back: bool) -> str:
     """Where the robot steers by the pair: its onsets name the sensor."""
-    steer = ("finding the edge on it would take the floor for the drop, or the drop for the floor"
+    steer = ("steering segment 3 by it would find the edge or the floor below where they are not"
              if back else "squaring up to the riser on it would leave the robot askew")
     return f"judged biased: {'; '.join(_onset(o) for o in onsets)}; {steer}"
 
