@@ -186,7 +186,7 @@ def test_a_lasting_disagreement_no_evidence_explains_ends_with_an_error_after_th
 
 
 def test_a_lasting_disagreement_one_sensor_jumped_into_judges_it_after_the_wait() -> None:
-    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 5.0, offset=0.05)])
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 7.0, offset=0.05)])  # approaching
     run(ctrl, robot)
     r = ctrl.result
     # one pause (the standing rule's); then, without consent, a degraded stop

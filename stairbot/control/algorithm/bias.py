@@ -327,15 +327,20 @@ class BiasWatch:
         more than ``bar`` (None: than the standing rule tolerates), is judged
         now (steering on it would leave the robot askew, take the floor for
         the drop, or lower segment 3 past the floor)."""
-        if not track.found:
+        diff = motion.pair_difference(snap, self._cfg, track.back)
+        if not track.found or diff is None:
             return
         offsets = track.offsets
         for sensor, partner in ((track.left, track.right), (track.right, track.left)):
             off = offsets[sensor]
             reading = snap.sensors[sensor].distance_m
-            limit = standing_tolerance(self._cfg, reading, back=track.back) if bar is None \
-                else bar
-            if abs(off) > limit and abs(offsets[partner]) <= abs(off) / 2:
+            tolerance = standing_tolerance(self._cfg, reading, back=track.back)
+            # the pair still reads as far apart as the onsets say (an offset that
+            # ended unseen, while the pair read nothing, no longer does)
+            still = abs(_signed(diff, sensor) - off + offsets[partner]) \
+                <= max(tolerance, MATCH_SHARE * abs(off))
+            if abs(off) > (tolerance if bar is None else bar) and still \
+                    and abs(offsets[partner]) <= abs(off) / 2:
                 onsets = [o for o in track.found if o.sensor is sensor]
                 self._judged[sensor] = say.judged_at_once(onsets, track.back)
                 return
