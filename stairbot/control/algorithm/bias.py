@@ -160,6 +160,9 @@ class BiasWatch:
         """Robot time from which each pair is watched."""
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
         self._lift_m = cfg.motors.lift_travel_per_turn
+        self._yaw_per_turn = motion.turn_yaw_rad(cfg, 0.5)  # twist is half MWR less MWL
+        self._least_step = STEP_SIGMAS * cfg.algorithm.equal_tolerance
+        """No pair tolerance is less than equal_tolerance: a step below this is none."""
         self._risers: dict[int, Reference] = {}
         """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
         self._judged: dict[SensorId, str] = {}
@@ -188,14 +191,16 @@ class BiasWatch:
         where the evidence decides (module docstring); the snapshot with
         every sensor judged biased reading as ERROR."""
         phase = BY_VALUE[ctx.phase]
-        odometer = sum(snap.turns(m) for m in WHEEL_MOTORS) * self._metres_per_turn
-        yaw = motion.turn_yaw_rad(self._cfg, motion.twist(snap))
+        motors = snap.motors
+        odometer = sum(motors[m].turns for m in WHEEL_MOTORS) * self._metres_per_turn
+        yaw = (motors[MotorId.MWR].turns - motors[MotorId.MWL].turns) * self._yaw_per_turn
         front, back = self._pairs
         self._track(front, snap, odometer, yaw, 0.0)
         self._track(back, snap, odometer, yaw,
                     snap.turns(MotorId.MTB) * self._lift_m if phase in HANGING else 0.0)
         self._on_a_surface(snap, phase in ON_A_SURFACE and not ctx.from_top)
-        self._references(snap, ctx, odometer, yaw)
+        if ctx.number_of_steps not in self._risers:
+            self._references(snap, ctx, odometer, yaw)
         if phase is Phase.PAUSED and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
         elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
@@ -231,8 +236,8 @@ class BiasWatch:
         ascent stores (the tread it climbed onto), as the odometer places them,
         when the pair read them alike."""
         risers = self._risers
-        if 0 not in risers and ctx.start.reading is not None and ctx.start.wheel is not None \
-                and ctx.climb_twist[0] is not None:
+        if ctx.number_of_steps == 0 and ctx.start.reading is not None \
+                and ctx.start.wheel is not None and ctx.climb_twist[0] is not None:
             risers[0] = Reference(ctx.start.reading + ctx.start.wheel * self._wheel_m,
                                   motion.turn_yaw_rad(self._cfg, ctx.climb_twist[0]), 0)
         k = ctx.number_of_steps
@@ -244,10 +249,13 @@ class BiasWatch:
                 risers[k] = Reference(tab + odometer, yaw, k)
 
     def _on_a_surface(self, snap: Snapshot, surface: bool) -> None:
+        if not surface:
+            self._mount.end()
+            return
         r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
         dr, dl = self._distance(r, True), self._distance(left, True)
         drop = self._cfg.BACK_CLEARANCE + DROP_M
-        if not surface or dr is None or dl is None or max(dr, dl) > drop:
+        if dr is None or dl is None or max(dr, dl) > drop:
             self._mount.end()
         else:
             self._mount.add(dr, dl, not r.ok, not left.ok)
@@ -282,9 +290,11 @@ class BiasWatch:
             return
         moved_r, moved_l = moved
         step = moved_l - moved_r
+        pending = track.pending
+        if pending is None and abs(step) <= self._least_step:
+            return  # the common case, kept short
         near = min(r.distance_m, left.distance_m)
         threshold = STEP_SIGMAS * pair_tolerance(self._cfg, near, back=back)
-        pending = track.pending
         if abs(step) > threshold and (pending is None or abs(step) >= pending.size):
             at = track.buf[track.window + track.gap // 2][0]
             track.pending = Step(abs(step), moved_r, moved_l, threshold, at)

@@ -168,8 +168,9 @@ class MountHeights:
             self.last = ((sums[0] / n, 2 * sums[2] > n), (sums[1] / n, 2 * sums[3] > n))
 
     def end(self) -> None:
-        self.ticks.clear()
-        self.sums = [0.0, 0.0, 0.0, 0.0]
+        if self.ticks:
+            self.ticks.clear()
+            self.sums = [0.0, 0.0, 0.0, 0.0]
 
 
 @dataclass(frozen=True, slots=True)
