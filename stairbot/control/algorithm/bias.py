@@ -196,9 +196,10 @@ class BiasWatch:
         yaw = (motors[MotorId.MWR].turns - motors[MotorId.MWL].turns) * self._yaw_per_turn
         front, back = self._pairs
         self._track(front, snap, odometer, yaw, 0.0)
+        surface = phase in ON_A_SURFACE and not ctx.from_top
         self._track(back, snap, odometer, yaw,
-                    snap.turns(MotorId.MTB) * self._lift_m if phase in HANGING else 0.0)
-        self._on_a_surface(snap, phase in ON_A_SURFACE and not ctx.from_top)
+                    motors[MotorId.MTB].turns * self._lift_m if phase in HANGING else 0.0, surface)
+        self._on_a_surface(snap, surface)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
         if phase is Phase.PAUSED and ctx.pause is not None:
@@ -261,7 +262,9 @@ class BiasWatch:
             self._mount.add(dr, dl, not r.ok, not left.ok)
 
     def _track(self, track: Onsets, snap: Snapshot, odometer: float, yaw: float,
-               lifted_m: float) -> None:
+               lifted_m: float, surface: bool = True) -> None:
+        """One pair's tick (``surface``: for the back pair, segment 3 stands on
+        a surface, away from an edge; ``lifted_m``: what MTB lifted it)."""
         sensors, back = snap.sensors, track.back
         r, left = sensors[track.right], sensors[track.left]
         dr, dl = self._distance(r, back), self._distance(left, back)
@@ -281,7 +284,7 @@ class BiasWatch:
             dr, dl = dr + odometer + turn, dl + odometer - turn
         else:  # looking down from segment 3: less what MTB lifted it
             dr, dl = dr - lifted_m, dl - lifted_m
-        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok))
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, surface))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
             level = sum(x[2] - x[1] for x in track.buf) / track.window
@@ -310,6 +313,9 @@ class BiasWatch:
             return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
+        if track.back and not all(x[7] for x in before + after) \
+                and max(x[3] for x in before + after) - min(x[3] for x in before + after) > STILL_M:
+            return  # driving segment 3 near an edge: a cone crosses it a little at a time
         what = _motion(before, after)
         if abs(step.moved_right) <= share:
             near = any(s[6] for s in before) or any(s[6] for s in after)
@@ -345,12 +351,13 @@ class BiasWatch:
             off = offsets[sensor]
             reading = snap.sensors[sensor].distance_m
             tolerance = standing_tolerance(self._cfg, reading, back=track.back)
-            # the pair still reads as far apart as the onsets say (an offset that
+            limit = tolerance if bar is None else bar
+            # the pair reads as far apart now as the onsets say (an offset that
             # ended unseen, while the pair read nothing, no longer does)
-            still = abs(_signed(diff, sensor) - off + offsets[partner]) \
-                <= max(tolerance, MATCH_SHARE * abs(off))
-            if abs(off) > (tolerance if bar is None else bar) and still \
-                    and abs(offsets[partner]) <= abs(off) / 2:
+            said = _signed(diff, sensor)
+            still = abs(said) > limit and abs(said - off + offsets[partner]) <= max(
+                pair_tolerance(self._cfg, reading, back=track.back), MATCH_SHARE * abs(off))
+            if abs(off) > limit and still and abs(offsets[partner]) <= abs(off) / 2:
                 onsets = [o for o in track.found if o.sensor is sensor]
                 self._judged[sensor] = say.judged_at_once(onsets, track.back)
                 return
