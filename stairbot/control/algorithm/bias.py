@@ -2,48 +2,36 @@
 offset (not in the seed, which has no sensor faults).
 
 Two sensors of a pair that disagree cannot say which of them is wrong; the
-host knows more than the pair: how far the drive moved and turned (the
-odometer), and when.  A bias that sets in is a *jump*: one sensor's reading
-moves by more than the motion since explains, while its partner's follows
-the motion.  :class:`BiasWatch` looks at every tick's filtered readings,
-pair by pair, and finds such onsets:
+host knows more than the pair.  :class:`BiasWatch` keeps, every tick, the
+evidence (:mod:`~stairbot.control.algorithm.bias_evidence`):
 
-* each reading is *compensated* for the motion the host knows: a front
-  sensor looks along the drive, so its reading plus the odometer stays put
-  while the robot drives at a riser, and turning left lengthens SFL and
-  shortens SFR by front_lateral per radian (the odometer's yaw); a back
-  sensor looks down, and driving on a floor does not move what it reads;
-* the compensated readings' means over a window (:data:`WINDOW_SETTLES`
-  filter settle times) are compared with their means over the window
-  before it, a settle time earlier (the gap the filter's median takes to
-  come round to a new level): the pair's difference *steps* when they
-  differ by more than :data:`STEP_SIGMAS` of the pair's tolerance
-  (:func:`~stairbot.control.tolerances.pair_tolerance`);
-* a step is an *onset* of the one sensor that moved when its partner's
-  compensated reading held (it moved less than ATTRIBUTE_SHARE of the step):
-  a front cone seeing over a riser, a back pair crossing an edge, a lift
-  moving segment 3 move both, and name nobody.  A later step of the partner
-  the same way (both saw the world change) cancels it.
+* *onsets* (:mod:`~stairbot.control.algorithm.bias_onsets`): one sensor's
+  reading jumped by more than the motion since explains (the odometer, the
+  turn, MTB's travel) while its partner's followed the motion;
+* *mount heights*: what each back sensor read, less BACK_CLEARANCE, the last
+  second segment 3 stood on a surface away from an edge;
+* *risers*: where the start position and each tab_length_to_edge put the
+  riser ahead, by the odometer.
 
 An onset is evidence, not yet a verdict.  A sensor is *judged* biased, and
-reads as ERROR from then on (:meth:`BiasWatch.marked`), only where the
-evidence decides something:
+reads as ERROR from then on in the snapshot :meth:`BiasWatch.see` returns,
+only where the evidence decides something:
 
-* at the end of the standing rule's wait, when the pair it watches still
-  disagrees by what the onsets say (within the standing tolerance, or
-  MATCH_SHARE of the disagreement): the onset names the sensor;
-* in calibration, facing a riser (its check, the squaring turn, closing
-  in, case 3's probe): the robot steers by the pair's difference there,
-  and a squaring turn that goes on to square up to one sensor's offset
-  leaves it askew by atan(offset / (2 front_lateral)) (17 deg for 3 cm),
-  so a front onset there is judged at once.
+* at the end of the standing rule's wait, the pair still disagreeing: by the
+  onsets that say what the disagreement says; else, for the back pair, by
+  the mount heights; else, for the front pair on a tread or the floor on
+  the way down, by the riser the odometer places;
+* at once, where the robot steers by the pair (calibration squaring up to a
+  riser: the front pair; descent 1 finding the edge and descent 2 finding
+  the floor: the back pair), by the onsets, while the pair reads as far
+  apart as they say: squared up to one sensor's offset the robot would
+  stand atan(offset / (2 front_lateral)) askew (17 deg for 3 cm).
 
-A judged sensor reads as ERROR: the controller stops the robot and treats
-it as lost (:mod:`~stairbot.control.algorithm.limp`): on the floor where
-the program began the run ends on it; elsewhere a degraded stop, and with
-the operator's consent the partner stands in for it on the way home.
-Where no onset names one of two sensors that disagree, the standing rule
-ends the program, as it always has.
+A judged sensor is lost (:mod:`~stairbot.control.algorithm.limp`): on the
+floor where the program began the run ends on it; elsewhere a degraded
+stop, and with the operator's consent its partner stands in for it on the
+way home.  Where nothing names one of two sensors that disagree, the
+standing rule ends the program, as it always has.
 
 Pure Python, on the controller's clock (the snapshots' times); it keeps no
 state in the context (a resumed run starts with no evidence).
@@ -51,7 +39,6 @@ state in the context (a resumed run starts with no evidence).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -61,20 +48,16 @@ from stairbot.control.algorithm.bias_evidence import (
     Onset,
     Onsets,
     Reference,
-    Sample,
-    Step,
-    Unconfirmed,
 )
+from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.edge_measure import floor_tolerance
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
 from stairbot.control.algorithm.texts import bias as say
-from stairbot.control.tolerances import pair_tolerance, settle_s, standing_tolerance
+from stairbot.control.tolerances import pair_tolerance, standing_tolerance
 from stairbot.hardware import (
-    BACK_SENSORS,
-    FRONT_SENSORS,
     WHEEL_MOTORS,
     MotorId,
     SensorId,
@@ -84,35 +67,9 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import RobotConfig
 
-MIN_WINDOW_TICKS = 5
-"""The gap between the two windows whose means are compared spans the pair's
-settle time (:func:`~stairbot.control.tolerances.settle_s`: the filter's
-median comes round to a new level within it), and at least this many
-ticks."""
-WINDOW_SETTLES = 2.0
-"""Each of the two windows spans this many settle times: long enough that
-its mean is quieter than a tick by about the square root of the
-measurements it holds."""
-STEP_SIGMAS = 1.0
-"""A step counts when the pair's difference moves by more than this many of
-its pair tolerance (itself four sigmas of one tick's difference, so more
-sigmas of two windows' means): a fault-free run must not take its noise for
-an onset, and the next window must bear an onset out before it counts."""
-MAX_ONSET_M = 0.08
-"""A one-sided step larger than this is one sensor crossing an edge before its
-partner (the back pair askew over a drop, a front cone over a riser): not
-an onset.  (A bias as large is judged by the other evidence, or not at all.)"""
-ATTRIBUTE_SHARE = 0.4
-"""A step is one sensor's onset when its partner's compensated reading moved
-less than this share of the step (or half the threshold, if more)."""
 MATCH_SHARE = 0.35
 """Evidence matches the standing rule's disagreement within the standing
 tolerance, or this share of the disagreement if more."""
-WARM_SETTLES = 3.0
-"""A pair is watched from this many of its settle times into the run on."""
-STILL_M = 0.001
-STILL_RAD = math.radians(0.2)
-
 STEERS_BY_THE_FRONT = frozenset({Phase.CAL_CHECK, Phase.CAL_CLOSE_IN, Phase.CAL_PROBE,
                                  Phase.CAL_TURN})
 """The calibration phases in which the robot squares up to a riser by the
@@ -151,18 +108,13 @@ class BiasWatch:
         self._lateral = cfg.sensors.front_lateral
         self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
         self._wheel_m = cfg.wheel_circumference
-        self._near = (cfg.sensors.range(False)[0], cfg.sensors.range(True)[0])
-        self._pairs: list[Onsets] = []
-        for back, (right, left) in ((False, FRONT_SENSORS), (True, BACK_SENSORS)):
-            ticks = max(MIN_WINDOW_TICKS, round(settle_s(cfg, back) / cfg.algorithm.tick))
-            self._pairs.append(Onsets(right, left, back, round(WINDOW_SETTLES * ticks), ticks))
-        self._warm = [WARM_SETTLES * settle_s(cfg, back) for back in (False, True)]
-        """Robot time from which each pair is watched."""
+        self._near = cfg.sensors.range(True)[0]
+        self._watches = (PairWatch(cfg, SensorId.SFR, SensorId.SFL, False),
+                         PairWatch(cfg, SensorId.SBR, SensorId.SBL, True))
+        self._pairs = (self._watches[0].track, self._watches[1].track)
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
         self._lift_m = cfg.motors.lift_travel_per_turn
         self._yaw_per_turn = motion.turn_yaw_rad(cfg, 0.5)  # twist is half MWR less MWL
-        self._least_step = STEP_SIGMAS * cfg.algorithm.equal_tolerance
-        """No pair tolerance is less than equal_tolerance: a step below this is none."""
         self._risers: dict[int, Reference] = {}
         """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
         self._judged: dict[SensorId, str] = {}
@@ -195,10 +147,11 @@ class BiasWatch:
         odometer = sum(motors[m].turns for m in WHEEL_MOTORS) * self._metres_per_turn
         yaw = (motors[MotorId.MWR].turns - motors[MotorId.MWL].turns) * self._yaw_per_turn
         front, back = self._pairs
-        self._track(front, snap, odometer, yaw, 0.0)
+        judged = self._judged
+        self._watches[0].tick(snap, odometer, yaw, 0.0, True, judged)
         surface = phase in ON_A_SURFACE and not ctx.from_top
-        self._track(back, snap, odometer, yaw,
-                    motors[MotorId.MTB].turns * self._lift_m if phase in HANGING else 0.0, surface)
+        self._watches[1].tick(snap, odometer, yaw, motors[MotorId.MTB].turns * self._lift_m
+                              if phase in HANGING else 0.0, surface, judged)
         self._on_a_surface(snap, surface)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
@@ -223,15 +176,6 @@ class BiasWatch:
         return replace(snap, sensors=sensors)
 
     # -- gathering ------------------------------------------------------------------------
-    def _distance(self, r: SensorReading, back: bool) -> float | None:
-        """A reading's distance: OK, or too near to measure (its clamp, the
-        nearest it can tell); None for an error or nothing in range."""
-        if r.ok:
-            return r.distance_m
-        if r.status is SensorStatus.OUT_OF_RANGE and r.distance_m <= self._near[back] + 1e-9:
-            return r.distance_m
-        return None
-
     def _references(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:
         """Note the start position (tread 0), and each tab_length_to_edge the
         ascent stores (the tread it climbed onto), as the odometer places them,
@@ -254,89 +198,12 @@ class BiasWatch:
             self._mount.end()
             return
         r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
-        dr, dl = self._distance(r, True), self._distance(left, True)
+        dr, dl = distance(r, self._near), distance(left, self._near)
         drop = self._cfg.BACK_CLEARANCE + DROP_M
         if dr is None or dl is None or max(dr, dl) > drop:
             self._mount.end()
         else:
             self._mount.add(dr, dl, not r.ok, not left.ok)
-
-    def _track(self, track: Onsets, snap: Snapshot, odometer: float, yaw: float,
-               lifted_m: float, surface: bool = True) -> None:
-        """One pair's tick (``surface``: for the back pair, segment 3 stands on
-        a surface, away from an edge; ``lifted_m``: what MTB lifted it)."""
-        sensors, back = snap.sensors, track.back
-        r, left = sensors[track.right], sensors[track.left]
-        dr, dl = self._distance(r, back), self._distance(left, back)
-        if dr is None or dl is None or track.right in self._judged \
-                or track.left in self._judged or (not back and max(dr, dl)
-                                                  >= self._cfg.LENGTH_OF_INFINITY):
-            if track.pending is not None:  # a step seen before one of them stopped reading
-                self._decide(track, track.pending)
-            if track.unconfirmed is not None:
-                self._confirm(track, True)
-            track.clear()
-            return
-        if snap.time_s < self._warm[back]:
-            return  # the filter's first medians are of its first few measurements
-        if not back:  # looking along the drive: plus the odometer, less the turn
-            turn = self._lateral * yaw
-            dr, dl = dr + odometer + turn, dl + odometer - turn
-        else:  # looking down from segment 3: less what MTB lifted it
-            dr, dl = dr - lifted_m, dl - lifted_m
-        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, surface))
-        waiting = track.unconfirmed
-        if waiting is not None and len(track.buf) == track.window:
-            level = sum(x[2] - x[1] for x in track.buf) / track.window
-            self._confirm(track, abs(level - waiting.level) <= waiting.share)
-        if moved is None:
-            return
-        moved_r, moved_l = moved
-        step = moved_l - moved_r
-        pending = track.pending
-        if pending is None and abs(step) <= self._least_step:
-            return  # the common case, kept short
-        near = min(r.distance_m, left.distance_m)
-        threshold = STEP_SIGMAS * pair_tolerance(self._cfg, near, back=back)
-        if abs(step) > threshold and (pending is None or abs(step) >= pending.size):
-            at = track.buf[track.window + track.gap // 2][0]
-            track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
-            return
-        if pending is not None:
-            self._decide(track, pending)
-            track.clear()  # the pair's new level is the next windows' first
-
-    def _decide(self, track: Onsets, step: Step) -> None:
-        """Attribute a step to the sensor that moved, if its partner held; the
-        onset counts once the next window bears it out (:meth:`_confirm`)."""
-        if step.size > MAX_ONSET_M:
-            return  # one sensor crossed an edge before its partner: not a bias
-        share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
-        before, after = track.windows()
-        if track.back and not all(x[7] for x in before + after) \
-                and max(x[3] for x in before + after) - min(x[3] for x in before + after) > STILL_M:
-            return  # driving segment 3 near an edge: a cone crosses it a little at a time
-        what = _motion(before, after)
-        if abs(step.moved_right) <= share:
-            near = any(s[6] for s in before) or any(s[6] for s in after)
-            onset = Onset(track.left, step.moved_left, step.moved_right, step.at_s, what, near)
-        elif abs(step.moved_left) <= share:
-            near = any(s[5] for s in before) or any(s[5] for s in after)
-            onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
-        else:
-            return  # both moved: the world changed, or nobody can tell
-        level = sum(s[2] - s[1] for s in before) / len(before) \
-            + step.moved_left - step.moved_right
-        track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
-
-    def _confirm(self, track: Onsets, held: bool) -> None:
-        """Count the onset waiting for the next window if the pair's
-        difference held at its new level there (``held``; or the pair stopped
-        reading first: it may have)."""
-        waiting, track.unconfirmed = track.unconfirmed, None
-        assert waiting is not None
-        if held:
-            track.record(waiting.onset, waiting.threshold)
 
     def _judge_at_once(self, track: Onsets, snap: Snapshot, bar: float | None) -> None:
         """Where the robot steers by the pair: a sensor its onsets name, by
@@ -450,10 +317,3 @@ class BiasWatch:
 def _signed(disagree: float, sensor: SensorId) -> float:
     """The disagreement (left − right) as how far ``sensor`` reads past its partner."""
     return disagree if sensor in (SensorId.SFL, SensorId.SBL) else -disagree
-
-
-def _motion(before: list[Sample], after: list[Sample]) -> str:
-    """What the robot did between two windows, by the odometer, in words."""
-    drove = sum(s[3] for s in after) / len(after) - sum(s[3] for s in before) / len(before)
-    turned = sum(s[4] for s in after) / len(after) - sum(s[4] for s in before) / len(before)
-    return say.motion(drove, turned, abs(drove) < STILL_M and abs(turned) < STILL_RAD)

@@ -1,0 +1,162 @@
+"""Onsets: one pair's readings, compensated for the motion the host knows,
+whose difference steps because one of them moved and its partner held
+(:mod:`~stairbot.control.algorithm.bias` says what follows from them).
+
+A front sensor looks along the drive: its reading plus the odometer stays
+put while the robot drives at a riser, and turning left lengthens SFL and
+shortens SFR by front_lateral per radian of the odometer's yaw.  A back
+sensor looks down: driving on a floor does not move what it reads, and
+while MTB lifts segment 3 in the air its reading less MTB's travel stays
+put.  The compensated readings' means over two windows a settle time apart
+are compared: the pair's difference *steps* when they differ by more than
+STEP_SIGMAS pair tolerances; the step is an onset of the sensor that moved
+if its partner held, and counts once the next window bears it out."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Collection
+
+from stairbot.control.algorithm.bias_evidence import Onset, Onsets, Sample, Step, Unconfirmed
+from stairbot.control.algorithm.texts import bias as say
+from stairbot.control.tolerances import pair_tolerance, settle_s
+from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
+from stairbot.inputs.config import RobotConfig
+
+MIN_WINDOW_TICKS = 5
+"""The gap between the two windows whose means are compared spans the pair's
+settle time (:func:`~stairbot.control.tolerances.settle_s`: the filter's
+median comes round to a new level within it), and at least this many
+ticks."""
+WINDOW_SETTLES = 2.0
+"""Each of the two windows spans this many settle times: long enough that
+its mean is quieter than a tick by about the square root of the
+measurements it holds."""
+STEP_SIGMAS = 1.0
+"""A step counts when the pair's difference moves by more than this many of
+its pair tolerance (itself four sigmas of one tick's difference, so more
+sigmas of two windows' means): a fault-free run must not take its noise for
+an onset, and the next window must bear an onset out before it counts."""
+MAX_ONSET_M = 0.08
+"""A one-sided step larger than this is one sensor crossing an edge before its
+partner (the back pair askew over a drop, a front cone over a riser): not
+an onset.  (A bias as large is judged by the other evidence, or not at all.)"""
+ATTRIBUTE_SHARE = 0.4
+"""A step is one sensor's onset when its partner's compensated reading moved
+less than this share of the step (or half the threshold, if more)."""
+WARM_SETTLES = 3.0
+"""A pair is watched from this many of its settle times into the run on."""
+STILL_M = 0.001
+STILL_RAD = math.radians(0.2)
+
+
+class PairWatch:
+    """Finds one pair's onsets (:class:`Onsets` keeps them)."""
+
+    def __init__(self, cfg: RobotConfig, right: SensorId, left: SensorId, back: bool) -> None:
+        self._cfg = cfg
+        ticks = max(MIN_WINDOW_TICKS, round(settle_s(cfg, back) / cfg.algorithm.tick))
+        self.track = Onsets(right, left, back, round(WINDOW_SETTLES * ticks), ticks)
+        self._warm = WARM_SETTLES * settle_s(cfg, back)
+        """Robot time from which the pair is watched."""
+        self._near = cfg.sensors.range(back)[0]
+        self._lateral = cfg.sensors.front_lateral
+        self._least_step = STEP_SIGMAS * cfg.algorithm.equal_tolerance
+        """No pair tolerance is less than equal_tolerance: a step below this is none."""
+
+    def tick(self, snap: Snapshot, odometer: float, yaw: float, lifted_m: float,
+             surface: bool, judged: Collection[SensorId]) -> None:
+        """One tick (``surface``: for the back pair, segment 3 stands on a
+        surface, away from an edge; ``lifted_m``: what MTB lifted it; the
+        pair is not watched once one of it is ``judged``)."""
+        track = self.track
+        sensors, back = snap.sensors, track.back
+        r, left = sensors[track.right], sensors[track.left]
+        dr, dl = distance(r, self._near), distance(left, self._near)
+        if dr is None or dl is None or track.right in judged or track.left in judged \
+                or (not back and max(dr, dl) >= self._cfg.LENGTH_OF_INFINITY):
+            if track.pending is not None:  # a step seen before one of them stopped reading
+                self._decide(track.pending)
+            if track.unconfirmed is not None:
+                self._confirm(True)
+            track.clear()
+            return
+        if snap.time_s < self._warm:
+            return  # the filter's first medians are of its first few measurements
+        if not back:  # looking along the drive: plus the odometer, less the turn
+            turn = self._lateral * yaw
+            dr, dl = dr + odometer + turn, dl + odometer - turn
+        else:  # looking down from segment 3: less what MTB lifted it
+            dr, dl = dr - lifted_m, dl - lifted_m
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, surface))
+        waiting = track.unconfirmed
+        if waiting is not None and len(track.buf) == track.window:
+            level = sum(x[2] - x[1] for x in track.buf) / track.window
+            self._confirm(abs(level - waiting.level) <= waiting.share)
+        if moved is None:
+            return
+        moved_r, moved_l = moved
+        step = moved_l - moved_r
+        pending = track.pending
+        if pending is None and abs(step) <= self._least_step:
+            return  # the common case, kept short
+        near = min(r.distance_m, left.distance_m)
+        threshold = STEP_SIGMAS * pair_tolerance(self._cfg, near, back=back)
+        if abs(step) > threshold and (pending is None or abs(step) >= pending.size):
+            at = track.buf[track.window + track.gap // 2][0]
+            track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
+            return
+        if pending is not None:
+            self._decide(pending)
+            track.clear()  # the pair's new level is the next windows' first
+
+    def _decide(self, step: Step) -> None:
+        """Attribute a step to the sensor that moved, if its partner held; the
+        onset counts once the next window bears it out (:meth:`_confirm`)."""
+        track = self.track
+        if step.size > MAX_ONSET_M:
+            return  # one sensor crossed an edge before its partner: not a bias
+        share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
+        before, after = track.windows()
+        if track.back and not all(x[7] for x in before + after) \
+                and max(x[3] for x in before + after) - min(x[3] for x in before + after) > STILL_M:
+            return  # driving segment 3 near an edge: a cone crosses it a little at a time
+        what = _motion(before, after)
+        if abs(step.moved_right) <= share:
+            near = any(s[6] for s in before) or any(s[6] for s in after)
+            onset = Onset(track.left, step.moved_left, step.moved_right, step.at_s, what, near)
+        elif abs(step.moved_left) <= share:
+            near = any(s[5] for s in before) or any(s[5] for s in after)
+            onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
+        else:
+            return  # both moved: the world changed, or nobody can tell
+        level = sum(s[2] - s[1] for s in before) / len(before) \
+            + step.moved_left - step.moved_right
+        track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
+
+    def _confirm(self, held: bool) -> None:
+        """Count the onset waiting for the next window if the pair's
+        difference held at its new level there (``held``; or the pair stopped
+        reading first: it may have)."""
+        track = self.track
+        waiting, track.unconfirmed = track.unconfirmed, None
+        assert waiting is not None
+        if held:
+            track.record(waiting.onset, waiting.threshold)
+
+
+def distance(r: SensorReading, near_m: float) -> float | None:
+    """A reading's distance: OK, or too near to measure (its clamp, the
+    nearest it can tell, ``near_m``); None for an error or nothing in range."""
+    if r.ok:
+        return r.distance_m
+    if r.status is SensorStatus.OUT_OF_RANGE and r.distance_m <= near_m + 1e-9:
+        return r.distance_m
+    return None
+
+
+def _motion(before: list[Sample], after: list[Sample]) -> str:
+    """What the robot did between two windows, by the odometer, in words."""
+    drove = sum(s[3] for s in after) / len(after) - sum(s[3] for s in before) / len(before)
+    turned = sum(s[4] for s in after) / len(after) - sum(s[4] for s in before) / len(before)
+    return say.motion(drove, turned, abs(drove) < STILL_M and abs(turned) < STILL_RAD)
