@@ -278,8 +278,8 @@ class Controller:
         if stop.then == "no_consent":
             lost.start_limping(ctx, stop, snap.time_s, phase.label)
         if stop.then != "limp_home":
-            self._apply(fail(say_limp.lost_sensor_end(why, wait, phase.label, stop.why)
-                             + stale), snap)
+            self._apply(fail(say_limp.lost_sensor_end(why, wait, BY_VALUE[stop.phase].label,
+                                                      stop.why) + stale), snap)
             return True
         lost.start_limping(ctx, stop, snap.time_s, phase.label)
         self._shift_timers(snap.time_s - since)
