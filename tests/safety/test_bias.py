@@ -71,7 +71,8 @@ def test_a_front_sensor_biased_mid_squaring_is_found_and_the_robot_comes_home() 
     assert home(r), r.to_dict()
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 5.0, r.to_dict()
     stop = degraded(events)
-    assert (stop["lost"], stop["survivors"], stop["then"]) == (["SFL"], ["SFR"], "limp_home")
+    assert (stop["lost"], stop["biased"], stop["survivors"], stop["then"]) == (
+        ["SFL"], ["SFL"], ["SFR"], "limp_home")
     assert (stop["phase"], stop["steps_climbed"]) == ("cal_turn", 0)
     failed = stop["failed"]
     assert failed.startswith("SFL judged biased: SFL read "), failed

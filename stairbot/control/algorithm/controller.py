@@ -268,7 +268,7 @@ class Controller:
                                "the readings were stale on the wire")
         stop = None if imu is not None else lost.degraded_stop(
             ctx, snap, phase, errors, why, mode=self.mode, consent=self.limp_home,
-            tilt_watched=self._tilt.watched)
+            tilt_watched=self._tilt.watched, biased=tuple(self._bias.judged))
         if stop is None:
             self._apply(fail(say_limp.lost_sensor_end(why, wait, phase.label) + stale), snap)
             return True
