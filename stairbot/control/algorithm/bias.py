@@ -43,12 +43,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from stairbot.control.algorithm import motion
-from stairbot.control.algorithm.bias_evidence import (
-    MountHeights,
-    Onset,
-    Onsets,
-    Reference,
-)
+from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.edge_measure import floor_tolerance
@@ -133,10 +128,6 @@ class BiasWatch:
         """Whether every one of ``sensors`` is judged biased: no use waiting
         for them to come back."""
         return all(s in self._judged for s in sensors)
-
-    def onsets(self, back: bool) -> list[Onset]:
-        """The pair's onsets not cancelled, oldest first."""
-        return list(self._pairs[1 if back else 0].found)
 
     def see(self, snap: Snapshot, ctx: Context) -> Snapshot:
         """Take this tick's filtered snapshot (before any stand-in), judge
@@ -251,7 +242,7 @@ class BiasWatch:
         match = max(tolerance, MATCH_SHARE * abs(disagree))
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
         track = self._pairs[1 if back else 0]
-        found = self._by_onsets(track, disagree, match, threshold)
+        found = self._by_onsets(track, disagree, match)
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
         tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
@@ -264,8 +255,8 @@ class BiasWatch:
             sensor, evidence = found
             self._judged[sensor] = evidence
 
-    def _by_onsets(self, track: Onsets, disagree: float, match: float,
-                   threshold: float) -> tuple[SensorId, str] | None:
+    def _by_onsets(self, track: Onsets, disagree: float,
+                   match: float) -> tuple[SensorId, str] | None:
         offsets = track.offsets
         if not track.found:
             return None
