@@ -140,9 +140,12 @@ class BiasWatch:
         front, back = self._pairs
         judged = self._judged
         self._watches[0].tick(snap, odometer, yaw, 0.0, True, judged)
-        surface = phase in ON_A_SURFACE and not ctx.from_top
+        # the standing rule's wait stands where the phase it stopped in stood
+        where = BY_VALUE[ctx.pause.resume_phase] if phase is Phase.PAUSED \
+            and ctx.pause is not None else phase
+        surface = where in ON_A_SURFACE and not ctx.from_top
         self._watches[1].tick(snap, odometer, yaw, motors[MotorId.MTB].turns * self._lift_m
-                              if phase in HANGING else 0.0, surface, judged)
+                              if where in HANGING else 0.0, surface, judged)
         self._on_a_surface(snap, surface)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
