@@ -76,8 +76,9 @@ the drop): its onsets are judged at once there."""
 ON_A_SURFACE = frozenset({
     Phase.CAL_CLOSE_IN, Phase.DESCENT_BACK_OFF, Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
     Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_DRIVE_FIRST,
-    Phase.DESCENT_DRIVE_SECOND, Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST,
-    Phase.DESCENT_LOWER_FIRST, Phase.DESCENT_FINISH})
+    Phase.ASCENT_LIFT_SECOND, Phase.ASCENT_DRIVE_SECOND, Phase.DESCENT_DRIVE_SECOND,
+    Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST, Phase.DESCENT_LOWER_FIRST,
+    Phase.DESCENT_FINISH})
 """The phases in which segment 3 stands on a surface and moves on it: its
 sensors read their mount height (BACK_CLEARANCE), until one reads a drop
 (DROP_M more: descent 1 backs off towards the edge)."""
@@ -109,6 +110,11 @@ class BiasWatch:
         self._pairs = (self._watches[0].track, self._watches[1].track)
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
         self._lift_m = cfg.motors.lift_travel_per_turn
+        self._mtb: float | None = None
+        self._hung_m = 0.0
+        """How far MTB has moved segment 3 in the air (HANGING), summed over the
+        run: the back pair's readings less it stay put while it hangs, and
+        do not jump when it sets down or lifts off."""
         self._yaw_per_turn = motion.turn_yaw_rad(cfg, 0.5)  # twist is half MWR less MWL
         self._risers: dict[int, Reference] = {}
         """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
@@ -144,8 +150,11 @@ class BiasWatch:
         where = BY_VALUE[ctx.pause.resume_phase] if phase is Phase.PAUSED \
             and ctx.pause is not None else phase
         surface = where in ON_A_SURFACE and not ctx.from_top
-        self._watches[1].tick(snap, odometer, yaw, motors[MotorId.MTB].turns * self._lift_m
-                              if where in HANGING else 0.0, surface, judged)
+        mtb = motors[MotorId.MTB].turns
+        if where in HANGING and self._mtb is not None:
+            self._hung_m += (mtb - self._mtb) * self._lift_m
+        self._mtb = mtb
+        self._watches[1].tick(snap, odometer, yaw, self._hung_m, surface, judged)
         self._on_a_surface(snap, surface)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)

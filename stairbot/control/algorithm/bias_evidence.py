@@ -17,12 +17,12 @@ from dataclasses import dataclass
 
 from stairbot.hardware import SensorId
 
-Sample = tuple[float, float, float, float, float, bool, bool, bool]
-"""(time, right, left, odometer m, yaw rad, right too near, left too near, on
-a surface): one tick of a pair, its readings compensated for the motion,
-whether each read too near to measure (its clamp stands for it: a step it
-makes is at least what it says), and (the back pair) whether segment 3
-stood on a surface away from an edge."""
+Sample = tuple[float, float, float, float, float, bool, bool, bool, bool]
+"""(time, right, left, odometer m, yaw rad, right too near, left too near,
+right level, left level): one tick of a pair, its readings compensated for
+the motion, whether each read too near to measure (its clamp stands for it:
+a step it makes is at least what it says), and (the back pair) whether each
+read its mount height on a surface (no drop in sight)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -46,7 +46,11 @@ ATTRIBUTE_SHARE = 0.4
 less than this share of the step (or half the threshold, if more)."""
 WARM_SETTLES = 3.0
 """A pair is watched from this many of its settle times into the run on."""
+LEVEL_M = 0.01
+"""A back sensor reads its mount height on a surface when it reads no more
+than this over BACK_CLEARANCE: no drop in sight."""
 STILL_M = 0.001
+DRIVING_M = 0.0001
 STILL_RAD = math.radians(0.2)
 
 
@@ -61,14 +65,17 @@ class PairWatch:
         """Robot time from which the pair is watched."""
         self._near = cfg.sensors.range(back)[0]
         self._lateral = cfg.sensors.front_lateral
+        self._level_m = cfg.BACK_CLEARANCE + LEVEL_M
         self._least_step = STEP_SIGMAS * cfg.algorithm.equal_tolerance
         """No pair tolerance is less than equal_tolerance: a step below this is none."""
 
     def tick(self, snap: Snapshot, odometer: float, yaw: float, lifted_m: float,
              surface: bool, judged: Collection[SensorId]) -> None:
         """One tick (``surface``: for the back pair, segment 3 stands on a
-        surface, away from an edge; ``lifted_m``: what MTB lifted it; the
-        pair is not watched once one of it is ``judged``)."""
+        surface; ``lifted_m``: what MTB moved it in the air; the pair is not
+        watched once one of it is ``judged``).  A back onset while the drive
+        moved counts only if the sensor read its mount height before it, and
+        its partner throughout."""
         track = self.track
         sensors, back = snap.sensors, track.back
         r, left = sensors[track.right], sensors[track.left]
@@ -88,7 +95,13 @@ class PairWatch:
             dr, dl = dr + odometer + turn, dl + odometer - turn
         else:  # looking down from segment 3: less what MTB lifted it
             dr, dl = dr - lifted_m, dl - lifted_m
-        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, surface))
+        if back:  # each reads its mount height on a surface (no drop in sight)
+            level_r = surface and r.distance_m <= self._level_m
+            level_l = surface and left.distance_m <= self._level_m
+        else:
+            level_r = level_l = True
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, level_r,
+                           level_l))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
             level = sum(x[2] - x[1] for x in track.buf) / track.window
@@ -118,9 +131,6 @@ class PairWatch:
             return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
-        if track.back and not all(x[7] for x in before + after) \
-                and max(x[3] for x in before + after) - min(x[3] for x in before + after) > STILL_M:
-            return  # driving segment 3 near an edge: a cone crosses it a little at a time
         what = _motion(before, after)
         if abs(step.moved_right) <= share:
             near = any(s[6] for s in before) or any(s[6] for s in after)
@@ -130,6 +140,12 @@ class PairWatch:
             onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
         else:
             return  # both moved: the world changed, or nobody can tell
+        mine, partner = (8, 7) if onset.sensor is track.left else (7, 8)
+        if track.back and not (all(x[mine] for x in _driving(before))
+                               and all(x[partner] for x in _driving(before) + _driving(after))):
+            # segment 3 driven where a cone sees part of a drop: it crosses an
+            # edge a little at a time, and the sensor nearer it moves first
+            return
         level = sum(s[2] - s[1] for s in before) / len(before) \
             + step.moved_left - step.moved_right
         track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
@@ -143,6 +159,13 @@ class PairWatch:
         assert waiting is not None
         if held:
             track.record(waiting.onset, waiting.threshold)
+
+
+def _driving(samples: list[Sample]) -> list[Sample]:
+    """The ticks of ``samples`` on which the drive moved (by more than STILL_M
+    over a second at 20 ms: DRIVING_M a tick)."""
+    return [x for x, y in zip(samples[1:], samples[:-1], strict=False)
+            if abs(x[3] - y[3]) > DRIVING_M]
 
 
 def distance(r: SensorReading, near_m: float) -> float | None:
