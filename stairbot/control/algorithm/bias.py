@@ -82,7 +82,9 @@ ON_A_SURFACE = frozenset({
 """The phases in which segment 3 stands on a surface and moves on it: its
 sensors read their mount height (BACK_CLEARANCE), until one reads a drop
 (DROP_M more: descent 1 backs off towards the edge)."""
-DROP_M = 0.05
+DROP_M = 0.07
+"""A back sensor reading this much over BACK_CLEARANCE sees a drop (the lowest
+rise a flight has is about 0.08 m): a biased one reading 5 cm long does not."""
 HANGING = frozenset({Phase.ASCENT_LIFT_THIRD, Phase.DESCENT_LOWER_THIRD})
 """The phases in which MTB lifts or lowers segment 3 in the air: what its
 sensors read moves with MTB's counter."""
