@@ -82,14 +82,14 @@ def test_a_front_sensor_biased_mid_squaring_is_found_and_the_robot_comes_home() 
 def test_a_back_sensor_biased_on_the_floor_is_named_by_its_jump_on_the_way_down() -> None:
     # case 462: SBR 3 cm short from 7.0 s (too near to measure on the
     # floor); the pair disagreed in descent 2 and the robot stayed stopped
-    # on the top step.  Descent 2 lowers segment 3 by the pair: it is judged
-    # there, at once.
+    # on the top step.
     r, events = run(flight(277457, 7.0, "SBR", -0.03))
     assert home(r), r.to_dict()
     stop = degraded(events)
     assert (stop["lost"], stop["survivors"], stop["phase"]) == (
         ["SBR"], ["SBL"], "descent_lower_third")
     assert "SBR read at least" in stop["failed"] and "shorter from 7.0" in stop["failed"]
+    assert "standing still, SBR reads" in stop["failed"], stop["failed"]
 
 
 def test_a_back_sensor_biased_out_of_range_is_named_by_its_mount_height() -> None:

@@ -46,7 +46,6 @@ from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.context import Context
-from stairbot.control.algorithm.edge_measure import floor_tolerance
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
@@ -165,13 +164,9 @@ class BiasWatch:
         elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
             family = ctx.family
             if isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES:
-                self._judge_at_once(front, snap, None)
+                self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
-            self._judge_at_once(back, snap, None)
-        elif phase is Phase.DESCENT_LOWER_THIRD:
-            # lowered until the pair's mean reads BACK_CLEARANCE within the floor
-            # tolerance: one sensor off by twice that never gets there
-            self._judge_at_once(back, snap, 2 * floor_tolerance(self._cfg))
+            self._judge_at_once(back, snap)
         if not self._judged:
             return snap
         sensors = dict(snap.sensors)
@@ -210,11 +205,10 @@ class BiasWatch:
         else:
             self._mount.add(dr, dl, not r.ok, not left.ok)
 
-    def _judge_at_once(self, track: Onsets, snap: Snapshot, bar: float | None) -> None:
+    def _judge_at_once(self, track: Onsets, snap: Snapshot) -> None:
         """Where the robot steers by the pair: a sensor its onsets name, by
-        more than ``bar`` (None: than the standing rule tolerates), is judged
-        now (steering on it would leave the robot askew, take the floor for
-        the drop, or lower segment 3 past the floor)."""
+        more than the standing rule tolerates, is judged now (steering on it
+        would leave the robot askew, or take the floor for the drop)."""
         diff = motion.pair_difference(snap, self._cfg, track.back)
         if not track.found or diff is None:
             return
@@ -222,8 +216,7 @@ class BiasWatch:
         for sensor, partner in ((track.left, track.right), (track.right, track.left)):
             off = offsets[sensor]
             reading = snap.sensors[sensor].distance_m
-            tolerance = standing_tolerance(self._cfg, reading, back=track.back)
-            limit = tolerance if bar is None else bar
+            limit = standing_tolerance(self._cfg, reading, back=track.back)
             # the pair reads as far apart now as the onsets say (an offset that
             # ended unseen, while the pair read nothing, no longer does)
             said = _signed(diff, sensor)
