@@ -131,6 +131,12 @@ class PairWatch:
             return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
+        yaws = [x[4] for x in before + after]
+        if not track.back and max(yaws) - min(yaws) > STILL_RAD:
+            # turning, a beam's reading follows the shape of what it sees, not
+            # only the odometer's yaw: at a corner each beam sees another wall,
+            # and one switching walls between the windows looks like a jump
+            return
         what = _motion(before, after)
         if abs(step.moved_right) <= share:
             near = any(s[6] for s in before) or any(s[6] for s in after)
