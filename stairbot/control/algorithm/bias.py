@@ -94,6 +94,10 @@ ON_THE_TREAD = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE,
 faces the riser above it, whose place the tab measured on the way up and
 the odometer since say (descent 6 lowers the pair past the tread)."""
 ON_THE_FLOOR = frozenset({Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
+ONTO_THE_TREAD = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
+                            Phase.ASCENT_DRIVE_SECOND, Phase.ASCENT_LIFT_THIRD})
+"""Ascent 4 to 7: the robot goes onto the tread length_of_next_step measured
+(ascent 3); limping home it finishes the step by it."""
 
 
 class BiasWatch:
@@ -120,6 +124,8 @@ class BiasWatch:
         self._risers: dict[int, Reference] = {}
         """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
         self._judged: dict[SensorId, str] = {}
+        self._tread: tuple[float | None, float] = (None, -1.0)
+        """length_of_next_step as last seen, and when it was measured."""
 
     @property
     def judged(self) -> dict[SensorId, str]:
@@ -157,6 +163,8 @@ class BiasWatch:
         self._mtb = mtb
         self._watches[1].tick(snap, odometer, yaw, self._hung_m, surface, judged)
         self._on_a_surface(snap, surface)
+        if ctx.length_of_next_step != self._tread[0]:
+            self._tread = (ctx.length_of_next_step, snap.time_s)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
         if phase is Phase.PAUSED and ctx.pause is not None:
@@ -250,6 +258,12 @@ class BiasWatch:
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
         track = self._pairs[1 if back else 0]
         found = self._by_onsets(track, disagree, match)
+        if found is not None and not back and resume in ONTO_THE_TREAD \
+                and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
+            # it went wrong before the tread ahead was measured on it: finishing
+            # the step by that figure is not safe, and the standing rule ends
+            # the program, as it always has (case 531 climbed on and tipped)
+            return
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
         tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
