@@ -129,3 +129,15 @@ def test_a_biased_sensor_without_consent_stays_stopped_and_says_what_was_judged(
     assert (stop["lost"], stop["then"]) == (["SBR"], "no_consent")
     assert r.error is not None and r.error.startswith("sensor error: SBR judged biased")
     assert "still disagree" not in r.error
+
+
+def test_a_front_sensor_gone_wrong_before_the_tread_was_measured_is_not_climbed_on() -> None:
+    # case 531: SFR 5 cm long from 20.0 s, at the riser before ascent 3
+    # measured the tread ahead on it; judged in ascent 4, limping home
+    # finished the step by that tread and stopped on a tilt of +15 deg in
+    # ascent 7.  The standing rule ends the program there instead.
+    r, events = run(flight(38458, 20.0, "SFR", 0.05))
+    assert (r.outcome, r.steps_climbed) == ("error", 0), r.to_dict()
+    assert r.error is not None and "still disagree" in r.error, r.error
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 10.0, r.to_dict()
+    assert not [e for e in events if "degraded" in e.data]
