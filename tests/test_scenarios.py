@@ -175,6 +175,22 @@ def test_max_step_rise_m_is_where_the_simulated_robot_stops_climbing(seed: int) 
     assert not under.fell and not over.fell
 
 
+@pytest.mark.parametrize("seed", [1, 4])
+def test_a_rise_just_under_max_step_rise_m_is_seen_over_at_the_top_of_the_lift(
+        seed: int) -> None:
+    """0.5 mm under the limit the beams rise past the riser only as MTF
+    reaches the top of ascent 3's lift, and the pair reports it its latency
+    and its median's majority later.  Called too high on arrival there, the
+    robot refused the step (or climbed the first and refused the second,
+    the same rise); it stands at the top until its readings stand for it."""
+    rise = CONFIG.max_step_rise_m - 0.0005
+    r, events = run_sim(parse_scenario(EDGE.format(rise=rise, seed=seed), "just_under"))
+    assert (r.outcome, r.ascent_end, r.steps_climbed, r.steps_descended) == (
+        "completed", "top_reached", 2, 2), r.to_dict()
+    assert not r.fell
+    assert not any("too high" in e.message for e in events)
+
+
 TREAD_EDGE = """
 [stairs]
 count = 2

@@ -28,10 +28,11 @@ from textual.screen import Screen
 from textual.widget import Widget
 from textual.widgets import Footer
 
-from stairbot.console import choices, motion_gate, paint
+from stairbot.console import choices, limp_question, motion_gate, paint
 from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key
-from stairbot.console.help import HelpScreen
+from stairbot.console.help import COMMANDS, HelpScreen
+from stairbot.console.limp_gate import stranded
 from stairbot.console.robot_holder import SPEEDS
 from stairbot.console.state import LiveState, StateView
 from stairbot.console.widgets.banner import Banner
@@ -48,31 +49,10 @@ from stairbot.control.robot_config import load_config
 from stairbot.errors import InputError, StairbotError
 from stairbot.inputs.config import RobotConfig
 from stairbot.run.journaled import ResumePlan
+from stairbot.run.runner import RunResult
 from stairbot.views.top_view import RobotShape
 
 REFRESH_HZ = 10.0
-
-# (action, palette title, palette help) for every operator action.
-COMMANDS: tuple[tuple[str, str, str], ...] = (
-    ("estop", "EMERGENCY STOP", "Stop every motor now (key: space)"),
-    ("clear_estop", "Clear emergency stop", "Allow motion again; resume with p (key: c)"),
-    ("start('full')", "Start full run", "Calibrate, climb, descend (key: s)"),
-    ("start('calibrate')", "Calibrate only", "Run the calibration and stop (key: k)"),
-    ("pause", "Pause / resume", "Hold the run where it is, or go on (key: p)"),
-    ("stop_run", "Stop the run", "End the run, motors stopped (key: x)"),
-    ("reset", "Reset the simulated scenario", "Reopen the simulation at its start (key: r)"),
-    ("choose_robot", "Choose robot URL", "sim://, serial://PORT, can://IF/CH (key: u)"),
-    ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
-    ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
-    ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
-                                "the events as JSON lines (key: w)"),
-    ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
-    ("top_view", "Top view / side view", "The stairwell and the robot seen from above, or "
-                                         "the side view again (key: t)"),
-    ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
-    ("help", "Help", "Every key, and how to read the screen (key: ?)"),
-)
-
 
 class StairbotConsole(App[None]):
     """The stairbot operator console."""
@@ -92,6 +72,7 @@ class StairbotConsole(App[None]):
         Binding("q", "quit_console('q')", "quit"),
         Binding("question_mark", "help", "help", key_display="?"),
         Binding("k", "start('calibrate')", "calib", show=False),
+        Binding("l", "limp_home", "limp home", show=False),
         Binding("u", "choose_robot", "robot", show=False),
         Binding("o", "choose_scenario", "scenario", show=False),
         Binding("f", "speed", "speed", show=False),
@@ -238,9 +219,22 @@ class StairbotConsole(App[None]):
 
     @work(thread=True, group="run", exclusive=False, exit_on_error=False)
     def run_program(self, mode: str, resume: ResumePlan | None = None) -> None:
-        result = self.engine.run(mode, resume)
-        if result is not None:
-            self._tell(f"run {result.outcome}", "information")
+        self._ran(self.engine.run(mode, resume))
+
+    @work(thread=True, group="run", exclusive=False, exit_on_error=False)
+    def limp_home(self) -> None:
+        """The operator consented: the degraded stop's program carried on, limping home."""
+        self._ran(self.engine.limp_home())
+
+    def _ran(self, result: RunResult | None) -> None:
+        """A run ended (worker thread): say how; after a degraded stop, ask
+        whether to limp home, or say why the robot stays stopped."""
+        if result is None:
+            return
+        self._tell(f"run {result.outcome}", "information")
+        if self.engine.limp_offer is not None or self.engine.limp_refused \
+                or stranded(self.state.view().degraded):
+            self.call_from_thread(limp_question.after_stop, self)
 
     def _tell(self, message: str, severity: str) -> None:
         self.call_from_thread(self.say, message, severity)
@@ -270,6 +264,7 @@ class StairbotConsole(App[None]):
     def action_estop(self) -> None:
         """Stop every motor now, whatever the console is doing."""
         self.engine.estop()
+        limp_question.withdraw(self)
         self.refresh_view()
 
     def action_clear_estop(self) -> None:
@@ -282,6 +277,11 @@ class StairbotConsole(App[None]):
 
     def action_pause(self) -> None:
         motion_gate.pause(self)
+
+    def action_limp_home(self) -> None:
+        """Ask whether to limp home after a degraded stop
+        (:func:`~stairbot.console.limp_question.ask`)."""
+        limp_question.ask(self)
 
     def action_stop_run(self) -> None:
         if self.engine.running:

@@ -33,8 +33,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="The operator console: watch and command the robot in a terminal.\n"
                     "Keys: space EMERGENCY STOP (everywhere), c clear it, s start, k calibrate\n"
                     "only, p pause/resume, x stop, r reset the simulation, u robot URL,\n"
-                    "o scenario, f simulation speed, w record, g graphs, q quit; ctrl+p\n"
-                    "lists all.  --replay FILE plays a recording instead (stairbot replay).",
+                    "o scenario, f simulation speed, w record, g graphs, l limp home (after\n"
+                    "a degraded stop: it asks at the stop), q quit; ctrl+p lists all.\n"
+                    "--replay FILE plays a recording instead (stairbot replay).",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--robot", metavar="URL", default="sim://",

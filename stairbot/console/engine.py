@@ -17,7 +17,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypedDict
 
+from stairbot.console import limp_gate
 from stairbot.console.climb_gate import MidClimb, after_run
+from stairbot.console.limp_gate import LimpOffer
 from stairbot.console.robot_holder import LATCH_HINT, OpenFn, RobotHolder, default_open
 from stairbot.console.state import LiveState
 from stairbot.control.algorithm.controller import Controller
@@ -81,11 +83,15 @@ def _mode(mode: str) -> Mode:
     return {"calibrate": Mode.CALIBRATE_ONLY, "descend": Mode.DESCEND}.get(mode, Mode.FULL)
 
 
-def describe_result(result: RunResult) -> tuple[str, str]:
-    """One line saying how a run ended, and its severity (good/warning/error)."""
+def describe_result(result: RunResult, limped: tuple[str, ...] = ()) -> tuple[str, str]:
+    """One line saying how a run ended, and its severity (good/warning/error);
+    ``limped``: the sensors a limp home went without."""
     parts = [f"run {result.outcome}"]
     if result.error:  # first: on a narrow screen the end of the line is cut
         parts.append(result.error)
+    if result.outcome == "came_home_degraded":
+        lost = ", ".join(limped) or "a sensor"
+        parts.append(f"back where it began WITHOUT {lost}: repair before the next run")
     if result.ascent_end:
         parts.append(result.ascent_end.replace("_", " "))
     parts.append(f"climbed {result.steps_climbed}, descended {result.steps_descended}")
@@ -111,14 +117,20 @@ class ConsoleEngine(RobotHolder):
         self._controller: Controller | None = None  # the run's, as the last tick saw it
         self._last_ctx = -1.0
         self._last_flow, self._last_label = "", ""  # the run's last phase before its end
+        self._last_tick_s = 0.0  # the robot's clock at the run's last tick
+        self.limp_refused = ""
+        """Why the last run's degraded stop, which the robot could limp home
+        from, cannot be carried on by this console ("": it can, or none)."""
 
     # -- the run (worker thread) -----------------------------------------------
-    def run(self, mode: str = "full", resume: ResumePlan | None = None) -> RunResult | None:
+    def run(self, mode: str = "full", resume: ResumePlan | None = None,
+            limp: LimpOffer | None = None) -> RunResult | None:
         """Run the program until it ends; returns its result, or None when it
         could not run.  ``resume``: carry on the journal's run (checked by
-        :meth:`plan_resume` and confirmed by the operator).  Refused while
-        the robot may stand mid-climb (:attr:`mid_climb`) unless resuming.
-        Never raises: failures end up in the live state."""
+        :meth:`plan_resume` and confirmed by the operator); ``limp``: carry
+        on the program of a degraded stop, limping home (:meth:`limp_home`).
+        Refused while the robot may stand mid-climb (:attr:`mid_climb`)
+        unless resuming.  Never raises: failures end up in the live state."""
         if self.session is None or self.robot is None or self.clock is None:
             self.state.set_status(message="no robot open: choose a robot first (u)",
                                   severity="warning")
@@ -126,7 +138,7 @@ class ConsoleEngine(RobotHolder):
         if self.robot.estopped or self.latched:
             self.state.set_status(message=LATCH_HINT, severity="error")
             return None
-        if self.mid_climb is not None and resume is None:
+        if self.mid_climb is not None and resume is None and limp is None:
             self.state.set_status(message=MID_CLIMB_HINT, severity="error")
             return None
         if self._running.is_set():
@@ -139,15 +151,18 @@ class ConsoleEngine(RobotHolder):
                 return None
             mode = "descend"
         try:
-            plan = self._plan(mode, resume)
+            plan = self._plan(mode, resume, limp)
         except StairbotError as exc:
             self.state.set_status(message=f"not started: {exc}", severity="error")
             return None
+        self.limp_offer = None
         self._running.set()
         session = RobotSession(self.robot, self.clock, self.session.url,
                                self.session.simulated, self.session.sim)
         self.state.on_result(None)
-        what = "resumed from the journal" if resume is not None else (
+        began_s = self.clock.now()
+        what = "limping home (consented)" if limp is not None else \
+            "resumed from the journal" if resume is not None else (
             "calibrating only" if mode == "calibrate" else
             "descending from the top" if mode == "descend" else "full run")
         self.state.set_status(robot="running", paused=False, severity="info", message=what)
@@ -173,7 +188,19 @@ class ConsoleEngine(RobotHolder):
         self.mid_climb = after_run(result, self._last_flow, self._last_label)
         self.robot.refresh_scene()
         self.state.on_result(result)
-        line, severity = describe_result(result)
+        self.limp_refused = ""
+        try:
+            self.limp_offer = limp_gate.offer_after(
+                result, self._controller, self.state.view().degraded, mode, self._last_tick_s,
+                None if self.in_process else self.plan_resume)
+        except StairbotError as exc:  # the journal's run does not check: no question
+            self.limp_offer, self.limp_refused = None, str(exc)
+            self.state.note(f"limp home cannot be offered: {exc}", "error")
+        line, severity = describe_result(result, self.state.view().limping)
+        stop = self.state.view().degraded
+        if result.outcome == "error" and stop is not None and stop.time_s >= began_s:
+            line = limp_gate.banner_line(stop, self.limp_offer is not None,  # this run's stop
+                                         self.limp_refused)
         if self.robot.estopped:
             line += " · EMERGENCY STOP latched: c clears it"
             if not self.latched:  # the run latched it (an error): the console holds it too
@@ -187,10 +214,14 @@ class ConsoleEngine(RobotHolder):
                               message=line, severity=severity)
         return result
 
-    def _plan(self, mode: str, resume: ResumePlan | None) -> RunPlan:
+    def _plan(self, mode: str, resume: ResumePlan | None, limp: LimpOffer | None) -> RunPlan:
         """The journal (boards on a wire: a fresh one, or the resumed run's)
         and the controller.  StairbotError when the journal cannot be written."""
         session, scenario = self.session, self.scenario
+        if limp is not None and resume is None and self.clock is not None:
+            # the simulation: its program carried on here, from where it stopped
+            return RunPlan(controller=limp_gate.carried_on(
+                limp, self.clock.now(), self.config, self._sink, _mode(limp.mode)))
         if session is None or self.in_process or scenario is None:
             return RunPlan()
         if resume is not None:
@@ -216,8 +247,40 @@ class ConsoleEngine(RobotHolder):
         self.mid_climb = None
         self.state.note("the operator says the robot is back at the start", "warning")
 
+    def limp_home(self) -> RunResult | None:
+        """The operator consents: carry the program of the last run's degraded
+        stop (:attr:`limp_offer`) on, limping home on the sensors that remain.
+        The stop latched the robot's emergency stop; the consent clears it
+        (boards: after the journal's checks), never one the operator set.
+        Refused, with a message and nothing moved, when there is nothing to
+        carry on, a run goes on, the operator's emergency stop is set, or the
+        journal's run no longer checks.  Worker thread."""
+        offer = self.limp_offer
+        if offer is None or self.robot is None or self.running:
+            self.state.set_status(message="no degraded stop to limp home from",
+                                  severity="warning")
+            return None
+        if self.state.view().status.latch == "operator":
+            self.state.set_status(message="not moved: the operator's emergency stop is set; "
+                                  "c clears it (look at the robot), then l", severity="error")
+            return None
+        resume = None
+        try:
+            if not self.in_process:
+                resume = self.plan_resume()
+            if self.robot.estopped:
+                self.robot.clear()
+        except StairbotError as exc:
+            self.state.set_status(message=f"not moved: {exc}", severity="error")
+            return None
+        self.state.set_status(estopped=False, latch="")
+        self._say(Event(self._now(), EventKind.INFO, "limp home: the operator consents; the "
+                        "degraded stop's emergency stop cleared"))
+        return self.run(offer.mode, resume, limp=offer)
+
     def _on_tick(self, ctl: Controller, snap: Snapshot) -> None:
         self._controller = ctl
+        self._last_tick_s = snap.time_s
         self._watch_phase(ctl)
         recorder = self.recorder
         if isinstance(recorder, RecordsTicks) and self.robot is not None:

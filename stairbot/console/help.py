@@ -1,4 +1,5 @@
-"""The help screen (``?``): every key, and how to read the screen.
+"""The help screen (``?``): every key, and how to read the screen; and
+every action by name, for the command palette (:data:`COMMANDS`).
 
 Its lines fit :data:`WIDTH` columns: the dialog's width (``.help`` in
 console.tcss, 72) less its border, padding and scroll bar; a longer one
@@ -14,6 +15,29 @@ from textual.widgets import Static
 
 WIDTH = 64
 
+# (action, palette title, palette help) for every operator action.
+COMMANDS: tuple[tuple[str, str, str], ...] = (
+    ("estop", "EMERGENCY STOP", "Stop every motor now (key: space)"),
+    ("clear_estop", "Clear emergency stop", "Allow motion again; resume with p (key: c)"),
+    ("start('full')", "Start full run", "Calibrate, climb, descend (key: s)"),
+    ("start('calibrate')", "Calibrate only", "Run the calibration and stop (key: k)"),
+    ("pause", "Pause / resume", "Hold the run where it is, or go on (key: p)"),
+    ("stop_run", "Stop the run", "End the run, motors stopped (key: x)"),
+    ("limp_home", "Limp home", "After a degraded stop: come home on the remaining "
+                               "sensors, once you consent (key: l)"),
+    ("reset", "Reset the simulated scenario", "Reopen the simulation at its start (key: r)"),
+    ("choose_robot", "Choose robot URL", "sim://, serial://PORT, can://IF/CH (key: u)"),
+    ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
+    ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
+    ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
+                                "the events as JSON lines (key: w)"),
+    ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
+    ("top_view", "Top view / side view", "The stairwell and the robot seen from above, or "
+                                         "the side view again (key: t)"),
+    ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
+    ("help", "Help", "Every key, and how to read the screen (key: ?)"),
+)
+
 HELP = """\
 KEYS
   space   EMERGENCY STOP: every motor stops at once, from any
@@ -22,6 +46,9 @@ KEYS
           robot)
   s       start the full run      k  calibrate only
   p       pause / resume          x  stop the run
+  l       limp home: after a degraded stop (a sensor lost on the
+          stairs), asks whether the robot may come down on the
+          sensors that remain; the console asks at the stop
   q       quit (mid-run: the robot stops first, then it asks);
           Ctrl+Q and Ctrl-C do the same
   u       robot URL               o  scenario
@@ -37,15 +64,18 @@ KEYS
 
 READING THE SCREEN
   Banner: the state (READY, RUNNING, PAUSED, ENDED, FAULT),
-  E-STOP and who latched it (operator, or automatic: why), then
-  what to know now, whole.
+  E-STOP and who latched it (operator, or automatic: why),
+  DEGRADED while a run limps home on the sensors that remain
+  (which is out, the survivor its pair runs on, the speed) and
+  after it, then what to know now, whole.
   Every panel says how old its values are; values not read for
   1.5 s are dimmed and marked STALE: they are not live.
   Sensors: front R/L look ahead (SFR, SFL), back R/L look down
   (SBR, SBL); side R/L look right and left (SSR, SSL), on a
   robot with the side pair only; ok, out (of range: the value
   is the sensor's limit), old (the sensor's own reading is
-  stale), ERROR, none (no reading of it).
+  stale), ERROR, none (no reading of it); LOST: a limp home goes
+  without it, its pair runs on the other ("runs on SFL").
   Motors: ▶ forward ◀ back; a lift shows the segment that moves:
   1▲ segment 1 rises, 2▼ segment 2 sinks (segments 1 front, 2
   middle, 3 back, coloured as in the picture).  With no run

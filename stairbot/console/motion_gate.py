@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from stairbot.console import limp_question
 from stairbot.console.climb_gate import MidClimb
 from stairbot.console.engine import MID_CLIMB_HINT
 from stairbot.console.modals import ChoiceScreen, ConfirmScreen
@@ -94,9 +95,15 @@ def _mid_climb(app: StairbotConsole, mode: str, gate: MidClimb) -> None:
                                 if wired else "Reset puts the simulated robot at the start")
                 + "; or say the robot is back at the start.")
     first = ("r", "Resume (r)") if wired else ("r", "Reset (r)")
+    offered = [first, ("b", "Back at start (b)")]
+    if app.engine.limp_offer is not None:  # the last run stopped degraded: it can come home
+        question += "  Limp home asks whether it may come down on the sensors that remain."
+        offered.insert(0, ("l", "Limp home (l)"))
 
     def chosen(key: str | None) -> None:
-        if key == "r":
+        if key == "l":
+            limp_question.ask(app)
+        elif key == "r":
             if wired:
                 _resume(app, mode)
             else:
@@ -117,7 +124,7 @@ def _mid_climb(app: StairbotConsole, mode: str, gate: MidClimb) -> None:
             app.say("nothing moved")
 
     app.state.set_status(message=MID_CLIMB_HINT, severity="error")
-    app.push_screen(ChoiceScreen(question, [first, ("b", "Back at start (b)")]), chosen)
+    app.push_screen(ChoiceScreen(question, offered), chosen)
 
 
 def _resume(app: StairbotConsole, mode: str) -> None:

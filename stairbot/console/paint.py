@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 from rich.text import Text
 
 from stairbot.console.freshness import age_words, is_stale
+from stairbot.console.limp_gate import limping_words
 from stairbot.console.state import StateView
 from stairbot.console.words import carried_by
 from stairbot.hardware import MotorId
@@ -48,7 +49,8 @@ def lay_out(app: StairbotConsole, rows: int | None = None) -> None:
 
 def show(app: StairbotConsole, v: StateView) -> None:
     """Every panel, from ``v`` (a copy of the live state)."""
-    app.banner.show(v.url, v.scenario, v.status, v.recording)
+    app.banner.show(v.url, v.scenario, v.status, v.recording,
+                    limping_words(v.limping) if v.limping else "")
     picture = app.picture
     age = v.read_age_s
     # never markup: the URL may hold brackets; with a landing, the frame it is in
@@ -74,9 +76,9 @@ def show(app: StairbotConsole, v: StateView) -> None:
     picture.show(scene, v.stairs, lifts, note)
     show_top(app, v)
     running = v.status.robot in ("running", "replay")  # a replay: the recorded phase
-    app.sensors.show(snap, age)
+    app.sensors.show(snap, age, v.limping)
     app.motors.show(snap, v.commands, age, carried_by(v.phase_id) if running else ())
-    app.phase.show(v.phase, v.flow, v.context, v.phase_id)
+    app.phase.show(v.phase, v.flow, v.context, v.phase_id, degraded=degraded_title(v))
     app.link.show(not v.wired, snap.time_s if snap else None, v.speed, v.health, age,
                   replay=app.replaying)
     if app.trends.display:
@@ -85,6 +87,16 @@ def show(app: StairbotConsole, v: StateView) -> None:
         log = app.log_panel
         log.add(v.events)
         app.shown_event = log.last_seq
+
+
+def degraded_title(v: StateView) -> str:
+    """The phase panel's word for a run that limps home: while it does, and
+    how it ended ("": it does not)."""
+    if not v.limping:
+        return ""
+    if not v.limp_end:
+        return "LIMPING HOME"
+    return "CAME HOME DEGRADED" if v.limp_end == "came_home_degraded" else "DEGRADED"
 
 
 def show_top(app: StairbotConsole, v: StateView) -> None:

@@ -40,6 +40,7 @@ KEY_WORDS = {
     "s": "s starts a run", "k": "k calibrates", "c": "c clears an emergency stop",
     "u": "u opens a robot", "r": "r resets the simulation", "o": "o picks a scenario",
     "x": "x stops a run", "w": "w records a run", "f": "f sets the simulation's speed",
+    "l": "l limps home after a degraded stop",
 }
 """The live console's keys that would reach a robot, and what each does there."""
 

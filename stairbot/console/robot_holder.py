@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from stairbot.console.climb_gate import MidClimb, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
+from stairbot.console.limp_gate import LimpOffer
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, WatchedRobot, watch
 from stairbot.errors import InputError, LatchedError, OutputError, StairbotError
@@ -81,6 +82,9 @@ class RobotHolder:
         fresh start until the operator resumes or says it is back at the start."""
         self.latched_boards: tuple[str, str | None, str] | None = None
         """(url, scenario, why) of boards refused for the latch they hold."""
+        self.limp_offer: LimpOffer | None = None
+        """The last run's degraded stop, which the robot can limp home from once
+        the operator consents (stairbot.console.limp_gate); None: none."""
 
     # -- robot -----------------------------------------------------------------
     @property
@@ -129,6 +133,7 @@ class RobotHolder:
               clear_latches: bool) -> None:
         self.close()
         self._poll_fault = None
+        self.limp_offer = None  # the program it belongs to ran on the robot closed
         self.state.set_status(robot="connecting", message=f"opening {url}", severity="info")
         try:
             session = self._open_fn(url, self.config, scenario,

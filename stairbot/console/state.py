@@ -72,6 +72,15 @@ class StateView:
     """The robot seen from above, as last taken (None: none yet)."""
     top_age_s: float | None = None
     """Wall seconds since ``top`` was taken (None: never)."""
+    degraded: Event | None = None
+    """The run's degraded stop, as its event told it (its ``data["degraded"]``:
+    what failed, where, the lifts, what follows); None: none this run."""
+    limping: tuple[str, ...] = ()
+    """The sensors lost while the robot limps home, each pair's survivor
+    standing in for its partner (empty: not limping)."""
+    limp_end: str = ""
+    """How the program that limped home ended (its END's outcome,
+    "came_home_degraded" or another); "": it has not."""
 
 
 class LiveState:
@@ -109,6 +118,9 @@ class LiveState:
         self._events: deque[tuple[int, Event]] = deque(maxlen=LOG_LENGTH)
         self._event_seq = 0
         self._history = History()
+        self._degraded: Event | None = None
+        self._limping: tuple[str, ...] = ()
+        self._limp_end = ""
 
     # -- writers -----------------------------------------------------------------
     def _bump(self) -> None:
@@ -129,6 +141,7 @@ class LiveState:
             self._phase_id = ""
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
             self._history.clear()
+            self._degraded, self._limping, self._limp_end = None, (), ""
             self._bump()
 
     def rename(self, url: str, scenario: str, stairs: tuple[tuple[float, float], ...]) -> None:
@@ -199,12 +212,36 @@ class LiveState:
                 self._health.update(
                     {k: float(v) for k, v in event.data.items() if isinstance(v, int | float)}
                 )
+            self._limp_told(event)
             self._bump()
 
+    def _limp_told(self, event: Event) -> None:
+        """Follow a degraded stop and the limp home by the run's own events (a
+        replay's too): the stop's WARNING, the RESUME that limps on (its
+        ``limp``: the sensors lost, or the limp's record when a consent
+        reopened the program), its END, and a fresh program's start, which
+        ends them all."""
+        data = event.data
+        if not data:
+            return
+        if event.kind is EventKind.PHASE and data.get("why") == "program start":
+            self._degraded, self._limping, self._limp_end = None, (), ""
+        elif event.kind is EventKind.END and self._limping:
+            self._limp_end = str(data.get("outcome", ""))
+        elif event.kind is EventKind.WARNING and isinstance(data.get("degraded"), dict):
+            self._degraded = event
+        elif event.kind is EventKind.RESUME and "limp" in data:
+            limp = data["limp"]
+            lost = limp.get("lost") if isinstance(limp, dict) else limp
+            if isinstance(lost, list) and lost:
+                self._limping, self._limp_end = tuple(str(s) for s in lost), ""
+
     def clear_events(self) -> None:
-        """Forget the event list (a replay sought back plays it again)."""
+        """Forget the event list (a replay sought back plays it again), and
+        what it told of a degraded stop."""
         with self._lock:
             self._events.clear()
+            self._degraded, self._limping, self._limp_end = None, (), ""
             self._bump()
 
     def note(self, message: str, severity: str = "information") -> None:
@@ -265,4 +302,7 @@ class LiveState:
                 plan=self._plan,
                 top=self._top,
                 top_age_s=None if self._top_at is None else self._wall() - self._top_at,
+                degraded=self._degraded,
+                limping=self._limping,
+                limp_end=self._limp_end,
             )

@@ -141,9 +141,11 @@ def run_on(world: BoardWorld, boards: dict[int, Board], seconds: float) -> None:
 class Resumption:
     """What a new host made of a killed one's journal: ``verdict`` "resumed"
     (the run completed, never fell), "refused" (one line, ``reason``, before
-    any Clear: the boards still hold their latches) or "UNSAFE" (refused
-    after the latches were cleared, or a resumed run that did not
-    complete); ``cleared``: whether the host sent the boards a Clear."""
+    any Clear: the boards still hold their latches), "stopped" (the new
+    host's link failed as it took over; the boards left standing, latched)
+    or "UNSAFE" (refused after the latches were cleared, a resumed run that
+    did not complete, or a failed link that left a board unlatched or
+    moving); ``cleared``: whether the host sent the boards a Clear."""
 
     verdict: str
     reason: str
@@ -154,6 +156,19 @@ class Resumption:
 def latched(boards: BoardsOnWire) -> bool:
     """Whether a fake board holds a latch (its e-stop or its tripped watchdog)."""
     return any(b.estop or b.watchdog_tripped for b in boards.boards.values())
+
+
+def _link_failed(boards: BoardsOnWire, cleared: bool, exc: HardwareError) -> Resumption:
+    """The new host's link failed as it took over (a reply later than its
+    timeout: a machine too loaded for the wire's timeout).  That is a stop,
+    not a resume: "stopped" when, the world run on with no host, every motor
+    stands and a latch holds the boards, else "UNSAFE"."""
+    run_on(boards.world, boards.boards, HOST_DEAD_S)
+    held = latched(boards)
+    if held and not any(boards.world.speeds().values()):
+        return Resumption("stopped", f"the resume's link failed: {exc}", cleared, held)
+    return Resumption("UNSAFE", f"the resume's link failed and the boards were left "
+                                f"unlatched or moving: {exc}", cleared, held)
 
 
 def resume_watched(boards: BoardsOnWire, config: RobotConfig, journal: Path,
@@ -180,6 +195,8 @@ def resume_watched(boards: BoardsOnWire, config: RobotConfig, journal: Path,
             return Resumption("refused" if safe else "UNSAFE",
                               str(exc) if safe else f"refused after a Clear, or not in one "
                               f"line, or the latches gone: {exc}", cleared, held)
+        except HardwareError as exc:
+            return _link_failed(boards, cleared, exc)
         try:
             result = run(session, config, controller=resumed.controller,
                          journal=resumed.journal)

@@ -205,6 +205,8 @@ class SerialBoardServer:
             wire = last[1]
         else:
             replies: list[Message] = board.handle(frame.messages, frame.session)
+            if not replies:  # a board that answers nothing (killed or hung) sends nothing
+                return
             wire = self._reply_frame(frame, replies)
             self._last[frame.board] = (frame, wire)
         if not self._silent(frame.board):

@@ -143,6 +143,20 @@ def describe(state: JournalState) -> list[str]:
 _TIMES = ("phase_started_s", "pause_started_s")
 
 
+def moved_on(context: dict[str, Any], shift: float) -> dict[str, Any]:
+    """A copy of a saved context (:meth:`Context.to_dict`) with its timers
+    moved on by ``shift`` seconds: the time the program stood still, which
+    must not count against a phase's timeout."""
+    data: dict[str, Any] = copy.deepcopy(context)
+    for key in _TIMES:
+        if isinstance(data.get(key), int | float):
+            data[key] = float(data[key]) + shift
+    work = data.get("work")
+    if isinstance(work, dict) and isinstance(work.get("still_since"), int | float):
+        work["still_since"] = float(work["still_since"]) + shift
+    return data
+
+
 def restored_context(state: JournalState, now_s: float, max_steps: int | None = None
                      ) -> Context:
     """The journal's last context, its timers moved on by the time between the
@@ -152,14 +166,7 @@ def restored_context(state: JournalState, now_s: float, max_steps: int | None = 
     config's)."""
     if state.context is None:
         raise ResumeRefused(f"{state.path}: no context to resume from")
-    data: dict[str, Any] = copy.deepcopy(state.context)
-    shift = now_s - float(state.last.get("time_s", now_s))
-    for key in _TIMES:
-        if isinstance(data.get(key), int | float):
-            data[key] = float(data[key]) + shift
-    work = data.get("work")
-    if isinstance(work, dict) and isinstance(work.get("still_since"), int | float):
-        work["still_since"] = float(work["still_since"]) + shift
+    data = moved_on(state.context, now_s - float(state.last.get("time_s", now_s)))
     try:
         ctx = Context.from_dict(data, "the context")
     except InputError as exc:

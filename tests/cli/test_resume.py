@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 from lockstep_boards import kill_mid_lift, last_tick, lockstep_boards
+from lost_sensor import LOST_MID_CLIMB
 
 from stairbot.run.journal import JournalWriter, read_journal
 from stairbot.run.resume import ResumeRefused, check, describe
@@ -266,16 +267,6 @@ def test_a_resume_drops_a_line_cut_short_and_carries_the_chain_on(tmp_path: Path
     assert again.resumes == 1 and again.last["time_s"] == 5.0
     assert b'"pr{' not in path.read_bytes()
     assert json.loads(mark_path(path).read_bytes())["seq"] == 3
-
-
-LOST_MID_CLIMB = """
-[stairs]
-count = 2
-[[faults]]
-at = 42.0
-sensor = "SFR"
-kind = "error"
-"""
 
 
 def test_a_sensor_lost_mid_climb_without_consent_stops_and_resume_yes_limps_home(

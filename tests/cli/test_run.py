@@ -14,6 +14,7 @@ import time
 from importlib import resources
 from pathlib import Path
 
+import lost_sensor
 import pytest
 
 from stairbot.cli import main
@@ -202,13 +203,7 @@ def test_config_overrides_the_scenario_robot_with_a_note(
     assert json.loads(out)["config"] == "<robot ideal>" and "note" not in err
 
 
-LOST_MID_CLIMB = """
-[stairs]
-count = 2
-[[faults]]
-at = 42.0
-sensor = "SFR"
-kind = "error"
+LOST_MID_CLIMB = lost_sensor.LOST_MID_CLIMB + """
 [expect]
 outcome = "came_home_degraded"
 steps_climbed = 1

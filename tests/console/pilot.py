@@ -18,9 +18,12 @@ from stairbot.hardware import MotorId, Speeds
 from stairbot.run.robots import RobotSession, open_robot
 
 
-async def until(pilot: Any, cond: Callable[[], bool], what: str) -> None:
-    """Let the app run until ``cond`` holds (the bound only stops a broken test)."""
-    for _ in range(1200):
+async def until(pilot: Any, cond: Callable[[], bool], what: str, *,
+                bound_s: float = 60.0) -> None:
+    """Let the app run until ``cond`` holds (the bound only stops a broken test:
+    a run on fake boards in lockstep, at the speed of a loaded machine, may
+    be given more)."""
+    for _ in range(int(bound_s / 0.05)):
         if cond():
             await pilot.pause(0.01)
             return

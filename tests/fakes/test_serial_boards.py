@@ -154,3 +154,24 @@ def test_a_request_whose_replies_cannot_fit_one_frame_gets_those_that_fit(
     assert reply.from_board and reply.seq == 9 and isinstance(reply.messages[0], m.Status)
     assert srv.stats.cut == 1
     assert sum(2 + len(p) for p in (m.encode(x)[1] for x in reply.messages)) <= 255
+
+
+class _Silent:
+    """A board that answers nothing (the fault matrix's killed or hung board)."""
+
+    def handle(self, msgs: object, session: int) -> list[m.Message]:
+        return []
+
+
+def test_a_board_that_answers_nothing_leaves_the_server_serving_the_other(
+        server: tuple) -> None:
+    """The motor board killed: its frames get no reply, and the server goes on
+    answering the sensor board (it raised on the empty reply before, and the
+    thread that serves both boards died)."""
+    srv, r = server
+    srv.boards[m.Board.MOTOR] = _Silent()
+    srv.receive(b"\x00" + encode_frame(Frame(m.Board.MOTOR, 5, (m.GetStatus(),))))
+    assert drain(r) == b""
+    srv.receive(encode_frame(Frame(m.Board.SENSOR, 6, (m.GetStatus(),))))
+    (reply,) = FrameReader().feed(drain(r))
+    assert reply.board == m.Board.SENSOR and reply.seq == 6

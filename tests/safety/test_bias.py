@@ -103,9 +103,10 @@ def test_a_back_sensor_biased_out_of_range_is_named_by_its_mount_height() -> Non
 
 
 def test_a_front_sensor_biased_out_of_sight_is_named_by_the_odometer_on_the_tread() -> None:
-    # case 419: SFR 3 cm short from 109.3 s, while it read too near to
-    # measure (descent 6); the pair disagreed backing off the next step
-    r, events = run(flight(111609, 109.3, "SFR", -0.03))
+    # case 419: SFR 3 cm short while it read too near to measure (descent 6
+    # of step 2: 109.3 s in the sweep, 98.4 to 107.0 s since f34d063's
+    # braking); the pair disagreed backing off the next step
+    r, events = run(flight(111609, 105.0, "SFR", -0.03))
     assert home(r), r.to_dict()
     stop = degraded(events)
     assert (stop["lost"], stop["phase"]) == (["SFR"], "descent_back_off")

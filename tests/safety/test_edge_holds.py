@@ -79,3 +79,20 @@ def test_holds_in_every_crossing_still_bring_the_robot_down_each_edge_once_refou
     # found the floor again at most once an edge: after it the robot backs
     # slowly, and a crossing read after a hold is placed
     assert sum(NOT_SEEN in m for m in said) <= r.steps_descended
+
+
+@pytest.mark.parametrize(("stale_s", "every_s"), [(0.15, 0.25), (0.16, 0.27)])
+def test_a_drop_read_as_the_backing_brakes_is_placed_by_what_the_wheels_backed(
+        stale_s: float, every_s: float) -> None:
+    """The sonar robot, its back pair's replies lost part of the time: the
+    pair read the drop as a backing braked (into a hold, or at its end),
+    and the wheels' speed then, times the pair's lag, placed the crossing
+    millimetres too far back -- the robot had backed faster while the
+    measurements came through.  Backing the clearance from there, it
+    pitched 17-18 deg nose up on the way down.  What the odometer recorded
+    over the lag places it."""
+    r, said = held_up_run("sonar", stale_s, every_s)
+    assert any(m.startswith("sensor hold") for m in said)
+    assert (r.outcome, r.steps_descended) == ("completed", r.steps_climbed), r.to_dict()
+    assert r.steps_climbed == 5 and not r.fell, r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 8.0, r.to_dict()

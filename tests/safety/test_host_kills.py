@@ -64,3 +64,20 @@ def test_a_run_that_ends_before_the_kill_says_how_it_ended(tmp_path: Path) -> No
     with pytest.raises(EndedBeforeKill, match=ended), \
             killed_host("can", tmp_path / "journal.jsonl", 10**7):
         pass
+
+
+def test_a_resume_whose_link_fails_is_a_stop_with_the_boards_latched(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The new host's first reply later than the serial rig's 5 ms timeout (a
+    loaded machine): the resume raised LinkLostError and the whole fault
+    matrix died with it.  It is a stop: the boards left standing, latched."""
+    from stairbot.errors import LinkLostError
+    from stairbot.fakes import fault_rig
+
+    def lost(*_args: object, **_kw: object) -> None:
+        raise LinkLostError("serial://test: link lost: no reply from the motor board")
+
+    monkeypatch.setattr(fault_rig, "resume", lost)
+    cell = run_kill("serial", "cal_check", "middle")
+    assert cell.verdict == "stopped", cell.reason
+    assert cell.reason.startswith("the resume's link failed: ")

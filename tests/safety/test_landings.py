@@ -155,21 +155,21 @@ FAULTS = "[[faults]]\nat = {at}\nsensor = 'SSR'\nkind = '{kind}'\n{more}"
 @pytest.mark.parametrize(("width", "turn", "fault", "end", "steps"), [
     # SSR 0.3 m long from the scan on, a flight 0.6 m wide between walls: the way
     # down backed to where the side pair said the turn was, turned back into a wall
-    (0.6, "right", FAULTS.format(at=143.2, kind="offset", more="offset = 0.3\n"),
+    (0.6, "right", FAULTS.format(at=138.04, kind="offset", more="offset = 0.3\n"),
      "top_reached", 6),
     # SSR (the wall's side) 1 m long from 10 mm up: read past its range at the
     # top, it was taken for the flight; the robot turned to the wall
-    (1.0, "left", FAULTS.format(at=143.8, kind="offset", more="offset = 1.0\n"),
+    (1.0, "left", FAULTS.format(at=138.64, kind="offset", more="offset = 1.0\n"),
      "top_reached", 6),
     # SSR failing for 3 s during the scan ended the program on the landing
-    (1.0, "left", FAULTS.format(at=147.2, kind="error", more="duration = 3.0\n"),
+    (1.0, "left", FAULTS.format(at=142.04, kind="error", more="duration = 3.0\n"),
      "top_reached", 6),
     # the open side's sensor failing for good during the scan: no flight seen, home
-    (1.0, "right", FAULTS.format(at=147.2, kind="error", more=""), "landing_closed", 3),
+    (1.0, "right", FAULTS.format(at=142.04, kind="error", more=""), "landing_closed", 3),
 ])
 def test_a_side_sensor_that_fails_or_reads_wrong_during_the_scan_is_no_reason_to_stop(
         width: float, turn: str, fault: str, end: str, steps: int) -> None:
-    """The red team's faults on SSR around the scan (130-160 s robot time):
+    """The red team's faults on SSR around the scan (125-155 s robot time):
     the robot climbs on to the flight the other sensor saw, or refuses the
     landing, and comes home; it never turns to a wall, nor stops on the
     landing."""

@@ -122,7 +122,7 @@ def test_a_back_sensor_reading_the_drop_far_before_the_other_stops_the_robot_on_
     two, the crossing left the robot short of the edge and it tipped nose
     down lowering segment 3.  More than MAX_EDGE_YAW_RAD's worth apart, the
     robot stops where it stands."""
-    text = RED_FLIGHT + ("[[faults]]\nat = 204.3\nsensor = 'SBL'\nkind = 'offset'\n"
+    text = RED_FLIGHT + ("[[faults]]\nat = 193.1\nsensor = 'SBL'\nkind = 'offset'\n"
                          "offset = 0.1\nduration = 6\n")
     result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"))
     assert result.outcome == "error" and not result.fell, result.to_dict()

@@ -12,9 +12,10 @@ SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
 
 
 def banner_text(url: str, scenario: str, status: RunStatus,
-                recording: str | None = None) -> Text:
+                recording: str | None = None, degraded: str = "") -> Text:
     """`` FAULT  E-STOP (automatic)  why...``: the robot's state, the latch and
-    who set it, then the one thing to know now (whole: the banner wraps)."""
+    who set it, ``DEGRADED`` and how (``degraded``: the run limps home, or
+    came home so), then the one thing to know now (whole: the banner wraps)."""
     state = "PAUSED" if status.paused and status.robot == "running" else status.robot.upper()
     out = Text(f" {state} ", "bold reverse")
     if status.estopped:
@@ -25,6 +26,10 @@ def banner_text(url: str, scenario: str, status: RunStatus,
             out.append(f" ({who})", "bold")
     if recording:
         out.append(" ● REC", "bold")
+    if degraded:
+        out.append(" ")
+        out.append(" DEGRADED ", "bold reverse")
+        out.append(f" {degraded} ·", "bold")
     out.append(f" {status.message}" if status.message else f" {url or '—'} · {scenario}")
     return out
 
@@ -40,12 +45,12 @@ class Banner(Static):
         self.plain = ""  # the text shown, for tests and logs
 
     def show(self, url: str, scenario: str, status: RunStatus,
-             recording: str | None = None) -> None:
-        key = (url, scenario, status, recording)
+             recording: str | None = None, degraded: str = "") -> None:
+        key = (url, scenario, status, recording, degraded)
         if key == self._last:
             return
         self._last = key
-        text = banner_text(url, scenario, status, recording)
+        text = banner_text(url, scenario, status, recording, degraded)
         self.plain = text.plain
         self.update(text)
         self.remove_class(*SEVERITY_CLASSES)

@@ -59,14 +59,17 @@ class PhasePanel(Static):
         self.border_title = "phase"
 
     def show(self, label: str, flow: str, context: Mapping[str, Any],
-             phase_id: str = "") -> None:
+             phase_id: str = "", *, degraded: str = "") -> None:
         """``label``: the seed's; ``phase_id``: the phase's value, for the
-        operator's words (stairbot.console.words)."""
-        key = (label, flow, phase_id, repr(context.get("number_of_steps")),
+        operator's words (stairbot.console.words); ``degraded``: the title's
+        word for a run that limps home ("LIMPING HOME"), or came home so."""
+        key = (label, flow, phase_id, degraded, repr(context.get("number_of_steps")),
                repr(context.get("steps_descended")), repr(context.get("tab_length_to_edge")))
         if key == self._last:
             return
         self._last = key
+        self.border_title = Text.assemble("phase · ", (degraded, "bold reverse")) \
+            if degraded else "phase"
         words = phase_words(phase_id)
         steps = Text("steps climbed ", "bold", no_wrap=True, overflow="ellipsis")
         steps.append(str(context.get("number_of_steps", "—")))

@@ -50,10 +50,16 @@ def _value(line: Text, r: SensorReading | None, unit: str = " m") -> None:
             line.append("ok", "green")
 
 
-def _reading(sensor: SensorId, r: SensorReading | None) -> Text:
+def _reading(sensor: SensorId, r: SensorReading | None, lost: bool = False) -> Text:
+    """``lost``: the run limps home without it (its partner stands in): its
+    value means nothing to the program, so none is shown."""
     line = Text(f"{NAMES[sensor]:<7} ", style="bold")
     line.append(f"{sensor.value} ", "dim")
-    _value(line, r)
+    if lost:
+        line.append("  —     ", "dim")
+        line.append("LOST", "bold red")
+    else:
+        _value(line, r)
     line.pad_right(READING_WIDTH - line.cell_len)
     return line
 
@@ -105,10 +111,13 @@ class SensorPanel(Static):
         self._last: object = ()
         self.border_title = titled("sensors", None)
 
-    def show(self, snap: Snapshot | None, age_s: float | None = None) -> None:
-        """``age_s``: wall seconds since ``snap`` was read (None: never)."""
+    def show(self, snap: Snapshot | None, age_s: float | None = None,
+             lost: tuple[str, ...] = ()) -> None:
+        """``age_s``: wall seconds since ``snap`` was read (None: never);
+        ``lost``: the sensors a limp home goes without (their pair runs on
+        the other: its verdict says which)."""
         sensors = dict(snap.sensors) if snap is not None else {}
-        key = (sensors, age_key(age_s))
+        key = (sensors, age_key(age_s), lost)
         if key == self._last:
             return
         self._last = key
@@ -117,8 +126,12 @@ class SensorPanel(Static):
         lines = []
         for a, b in PAIRS:
             top, bottom = pair_verdict(sensors.get(a), sensors.get(b), self.tolerance)
+            gone = [s for s in (a, b) if s.value in lost]
+            if len(gone) == 1:  # the pair runs on its survivor
+                survivor = b if gone[0] is a else a
+                top, bottom = Text("runs on", "bold yellow"), Text(survivor.value, "bold yellow")
             for sensor, bracket, verdict in ((a, " ┐ ", top), (b, " ┘ ", bottom)):
-                line = _reading(sensor, sensors.get(sensor))
+                line = _reading(sensor, sensors.get(sensor), sensor.value in lost)
                 line.append(bracket, "dim")
                 line.append_text(verdict)
                 lines.append(line)

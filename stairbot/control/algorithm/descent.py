@@ -180,7 +180,7 @@ def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
     backs = [t.snap.sensors[s] for s in BACK_SENSORS]
     if all(r.ok for r in backs):
         speed = motion.approach(cfg.motors.lift_speed, cfg.lift_turns(to_go),
-                                motion.LIFT_SLOW_ZONE, cfg.algorithm.tick)
+                                motion.LIFT_BRAKE_ZONE, cfg.algorithm.tick)
         return stay({MotorId.MTB: -min(speed, abs(limit))})
     return stay({MotorId.MTB: limit})  # out of range far: nothing below yet, keep lowering
 

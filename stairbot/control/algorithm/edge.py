@@ -29,7 +29,7 @@ from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import EdgeWork
 from stairbot.control.timeline import keep_since, value_at
 from stairbot.control.tolerances import max_age, measurement_period, window
-from stairbot.hardware import BACK_SENSORS, WHEEL_MOTORS, SensorId, SensorStatus
+from stairbot.hardware import BACK_SENSORS, SensorId, SensorStatus
 from stairbot.inputs.config import RobotConfig
 
 EDGE_GAP_TICKS = 2.5
@@ -158,7 +158,7 @@ def edge_bound(t: Tick, w: EdgeWork, refind: bool) -> float | None:
                 return None
             return motion.wheel_position(t.snap)  # the back-off ends here
         else:
-            step.edge_wheel, sight = _crossed(t, w.edge_first_wheel)
+            step.edge_wheel, sight = _crossed(t, w, w.edge_first_wheel)
             if w.edge_floor_held:
                 step.edge_wheel = held_crossing(t, w, step.edge_wheel)
                 sight = (step.edge_wheel - here) * cfg.wheel_circumference
@@ -249,11 +249,18 @@ def held_crossing(t: Tick, w: EdgeWork, crossed: float) -> float:
     return max(crossed, w.edge_floor_at + face)
 
 
-def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
+def _crossed(t: Tick, w: EdgeWork, first_wheel: float | None = None) -> tuple[float, float]:
     """Where the back pair crossed the edge whose drop it reads now for the
-    first time, on the odometer, and how far past it the pair is
-    (:func:`edge_sight_m` at the wheels' speed): behind the robot's back
-    (backing, the odometer runs down), so at a larger count.  If one sensor
+    first time, on the odometer, and how far past it the pair is: what the
+    wheels backed over the pair's lag (:func:`edge_lag_s`), by the
+    odometer's record of the watched ticks (``w.edge_recent``), plus for a
+    first-echo sensor the riser's face it keeps seeing (:func:`edge_sight_m`
+    standing).  By the record, not the speed now times the lag: a drop read
+    as the backing brakes (at its end, or into a hold) was measured while
+    the robot backed faster, the speed now would place the crossing too far
+    back, and backing the clearance from there tips the robot back.  Behind
+    the robot's back (backing, the odometer runs down), so at a larger
+    count.  If one sensor
     read the drop first (at ``first_wheel``), the crossing is placed
     half-way between the two: where the robot's centre line crossed, the
     pair being mounted either side of it; placed where the second sensor
@@ -265,9 +272,9 @@ def _crossed(t: Tick, first_wheel: float | None = None) -> tuple[float, float]:
     segment 3's front wheels on the corner, and lowering it there tips the
     robot nose down."""
     cfg = t.cfg
-    speed = sum(t.snap.motors[m].speed_tps for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
-    sight = edge_sight_m(cfg, speed * cfg.wheel_circumference, t.ctx.from_top)
     here = motion.wheel_position(t.snap)
+    backed = value_at(w.edge_recent, t.snap.time_s - edge_lag_s(cfg)) - here
+    sight = backed * cfg.wheel_circumference + edge_sight_m(cfg, 0.0, t.ctx.from_top)
     if first_wheel is not None:
         # what one measurement period's backing explains is the sensors'
         # timing, not where they crossed (edge_doubt_m covers it)
@@ -293,10 +300,11 @@ def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     off the edge."""
     cfg, step = t.cfg, t.ctx.descent
     if step.narrow_edge_wheel is None:
+        _remember(t, w, motion.wheel_position(t.snap))
         if not sees_drop(t):
             w.edge_floor_s = t.snap.time_s
         elif w.edge_floor_s is not None:
-            step.narrow_edge_wheel = _crossed(t)[0]
+            step.narrow_edge_wheel = _crossed(t, w)[0]
     if step.narrow_edge_wheel is None:
         return None
     g = cfg.geometry

@@ -13,11 +13,22 @@ import statistics
 from stairbot.control.algorithm import landing, limits, long_tread, lost, motion
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.modes import AscentEnd
-from stairbot.control.algorithm.moves import lift
-from stairbot.control.algorithm.phase import FAILED, FAULT, Exit, PhaseDef, Step, Tick, go, stay
+from stairbot.control.algorithm.moves import lift, stood
+from stairbot.control.algorithm.phase import (
+    FAILED,
+    FAULT,
+    NO_MOTION,
+    Exit,
+    PhaseDef,
+    Step,
+    Tick,
+    go,
+    stay,
+)
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.texts import ascent as say
-from stairbot.control.algorithm.work import LiftWork, SightWork
+from stairbot.control.algorithm.work import LiftFirstWork, LiftWork, SightWork
+from stairbot.control.tolerances import settle_s
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 
@@ -38,7 +49,7 @@ def _lf(t: Tick) -> LiftFirst:
     return t.ctx.family_of(LiftFirst)
 
 
-def _lift_first_enter(t: Tick, w: LiftWork) -> None:
+def _lift_first_enter(t: Tick, w: LiftFirstWork) -> None:
     ctx, cfg = t.ctx, t.cfg
     _lf(t).return_mtf = w.entry_mtf
     w.target_mtf = w.entry_mtf + cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
@@ -62,7 +73,7 @@ def tread_seen(t: Tick) -> float | None:
     return min(near) - gap if near else float("inf")
 
 
-def _lift_first(t: Tick, w: LiftWork) -> Step:
+def _lift_first(t: Tick, w: LiftFirstWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     if lost.limping(t):
         return go("limp_home")
@@ -80,6 +91,12 @@ def _lift_first(t: Tick, w: LiftWork) -> Step:
     assert w.target_mtf is not None
     speed = motion.lift_to(cfg, t.snap, MotorId.MTF, w.target_mtf)
     if speed is None:
+        # At the top of its travel: the pair reports what it sees there its
+        # latency and its median's majority late.  A riser the beams rose
+        # past just before is seen over only then: stand, the lift holding,
+        # until the filtered readings stand for the top (settle_s).
+        if not stood(t, w, settle_s(cfg)):
+            return stay(NO_MOTION)
         ctx.ascent_end = AscentEnd.OBSTACLE
         _lf(t).wall_ahead = True
         allowed = cfg.MAX_OF_VERTICAL_TURNS - ctx.number_of_vertical_turns
@@ -89,7 +106,7 @@ def _lift_first(t: Tick, w: LiftWork) -> Step:
 
 
 LIFT_FIRST = PhaseDef(
-    P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, LiftWork,
+    P.ASCENT_LIFT_FIRST, "ascent 3 — lift segment 1", FLOW, _lift_first, LiftFirstWork,
     enter=_lift_first_enter, carried_by=(2, 3), family=LiftFirst,
     on={"sees_over": Exit(P.ASCENT_LIFT_FIRST_MORE, "sees over the riser (reads ≥ gap + "
                                                     "SIGHT_JUMP_M)"),
@@ -200,8 +217,16 @@ def _tread_measured(t: Tick, w: SightWork) -> float | None:
     return min(m for m in _sight_medians(t, w) if m is not None) - _gap(t)
 
 
-_more_enter, _lift_more = lift(lambda t, _w: {MotorId.MTF: t.ctx.number_of_vertical_turns},
-                               _lifted_first)
+def _more_deltas(t: Tick, w: LiftWork) -> dict[MotorId, float]:
+    """number_of_vertical_turns more, within MTF's stroke: a riser seen over
+    only as segment 1 stood at the top of its lift (MAX_OF_VERTICAL_TURNS
+    less them, within LIFT_DONE) leaves no more than the rest of the stroke,
+    and a target past its end is never reached."""
+    return {MotorId.MTF: min(t.ctx.number_of_vertical_turns,
+                             t.cfg.MAX_OF_VERTICAL_TURNS - w.entry_mtf)}
+
+
+_more_enter, _lift_more = lift(_more_deltas, _lifted_first)
 
 
 def _more_step(t: Tick, w: SightWork) -> Step:

@@ -119,13 +119,15 @@ class DegradedStop:
     biased: tuple[str, ...] = ()
     """Those of ``lost`` judged biased: they read, but wrong (``failed`` says
     on what evidence); the others report errors or went stale."""
+    plan: str = ""
+    """What limping home would do from here, in words ("": it cannot)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"lost": list(self.lost), "failed": self.failed, "phase": self.phase,
                 "where": self.where, "steps_climbed": self.steps_climbed,
                 "steps_descended": self.steps_descended, "lifts": dict(self.lifts),
                 "then": self.then, "why": self.why, "survivors": list(self.survivors),
-                "biased": list(self.biased)}
+                "biased": list(self.biased), "plan": self.plan}
 
 
 def lifts(snap: Snapshot) -> dict[str, float]:

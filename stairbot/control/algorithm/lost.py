@@ -34,18 +34,18 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
     lost = sorted(set(known) | set(errors), key=lambda s: s.value)
     why = limp.cannot_limp(lost, phase, purpose, tilt_watched,
                            turned_at_landing=ctx.landing.step is not None)
+    plan = "" if why is not None else _plan(ctx, phase, purpose)
     if why is not None:
         then, told = "stranded", say.stranded(why)
     elif not consent:
         then, told = "no_consent", say.NO_CONSENT
     else:
-        then, told = "limp_home", say.limping(_plan(ctx, phase, purpose),
-                                              limp.survivors(lost), limp.LIMP_SPEED)
+        then, told = "limp_home", say.limping(plan, limp.survivors(lost), limp.LIMP_SPEED)
     return limp.DegradedStop(
         lost=tuple(s.value for s in lost), failed=failed, phase=phase.value,
         where=where(ctx, phase), steps_climbed=ctx.number_of_steps,
         steps_descended=ctx.steps_descended, lifts=limp.lifts(snap), then=then, why=told,
-        survivors=limp.survivors(lost),
+        survivors=limp.survivors(lost), plan=plan,
         biased=tuple(sorted(s.value for s in lost if s in biased)))
 
 

@@ -1,12 +1,15 @@
 """Readings and motions shared by the phases.
 
 What the sensors say (measurable, nothing ahead, the pair's mean) and how a
-motion approaches its target: full speed far away, slowing in proportion to
-what remains, never below a floor, so it stops within a fraction of a
-millimetre (wheels) or a few hundredths of a turn (lifts) of its target.
+motion approaches its target: full speed until it must brake, then braking
+at a constant rate to a stop on the target, never below a floor, so it stops
+within a fraction of a millimetre (wheels) or a few hundredths of a turn
+(lifts) of it.
 """
 
 from __future__ import annotations
+
+import math
 
 from stairbot.hardware import (
     BACK_SENSORS,
@@ -23,10 +26,12 @@ from stairbot.inputs.config import RobotConfig
 
 SLOW_FLOOR = 0.15
 """Slowest approach speed, as a fraction of the motor's maximum."""
-WHEEL_SLOW_ZONE = 0.15
-"""Wheel turns before a target where the drive starts slowing down."""
-LIFT_SLOW_ZONE = 2.0
-"""Lift turns before a target where the lift starts slowing down."""
+WHEEL_BRAKE_ZONE = 0.075
+"""Wheel turns a drive at the motor's top speed brakes over to a stop (7.5 mm
+on the reference robot: 0.67 m/s², 0.15 s from 0.1 m/s)."""
+LIFT_BRAKE_ZONE = 1.0
+"""Lift turns a lift at the motor's top speed brakes over to a stop (2 mm on
+the reference robot: 0.1 m/s², 0.2 s from 20 mm/s)."""
 WHEEL_DONE = 0.002
 """A drive is done within this many wheel turns of its target (0.2 mm)."""
 LIFT_DONE = 0.01
@@ -89,18 +94,21 @@ def sensor_errors(snap: Snapshot, sensors: tuple[SensorId, ...]) -> list[SensorI
     return [s for s in sensors if snap.sensors[s].status is SensorStatus.ERROR]
 
 
-def approach(vmax: float, remaining: float, slow_zone: float, tick: float) -> float:
-    """Speed magnitude (per second) for ``remaining`` turns to go: proportional
-    to what remains within ``slow_zone``, at least SLOW_FLOOR of ``vmax``, and
-    never more than covers the remainder in one ``tick`` (no overshoot)."""
-    v = vmax * min(1.0, max(SLOW_FLOOR, remaining / slow_zone))
+def approach(vmax: float, remaining: float, brake_zone: float, tick: float) -> float:
+    """Speed magnitude (per second) for ``remaining`` turns to go: ``vmax``
+    until braking at a constant rate (``vmax`` to a stop over ``brake_zone``
+    turns) must begin to stop on the target, then that braking curve; at
+    least SLOW_FLOOR of ``vmax``, and never more than covers the remainder in
+    one ``tick`` (no overshoot)."""
+    braking = vmax * math.sqrt(max(0.0, remaining) / brake_zone)
+    v = max(SLOW_FLOOR * vmax, min(vmax, braking))
     return max(0.0, min(v, remaining / tick))
 
 
 def drive(cfg: RobotConfig, direction: int, remaining_turns: float) -> Speeds:
     """All four wheel motors at the same speed, ``direction`` +1 forward or -1
-    back, slowing as ``remaining_turns`` shrinks."""
-    v = direction * approach(cfg.motors.wheel_speed, remaining_turns, WHEEL_SLOW_ZONE,
+    back, braking to stop when ``remaining_turns`` are made."""
+    v = direction * approach(cfg.motors.wheel_speed, remaining_turns, WHEEL_BRAKE_ZONE,
                              cfg.algorithm.tick)
     return {m: v for m in WHEEL_MOTORS}
 
@@ -136,7 +144,7 @@ def lift_to(cfg: RobotConfig, snap: Snapshot, motor: MotorId, target: float) -> 
     delta = target - snap.turns(motor)
     if abs(delta) <= LIFT_DONE:
         return None
-    v = approach(cfg.motors.lift_speed, abs(delta), LIFT_SLOW_ZONE, cfg.algorithm.tick)
+    v = approach(cfg.motors.lift_speed, abs(delta), LIFT_BRAKE_ZONE, cfg.algorithm.tick)
     return v if delta > 0 else -v
 
 

@@ -281,8 +281,10 @@ def _turn_to(t: Tick, w: Work) -> Step:
     too_far = _turned_too_far(t, P.CAL_TURN_TO)
     if too_far is not None:
         return too_far
-    slow = min(1.0, max(TURN_SLOW_FLOOR, abs(remaining) / motion.WHEEL_SLOW_ZONE))
-    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, slow))
+    # braking as a drive does, from the turning speed
+    top = min(motion.TURN_SPEED, t.cfg.motors.wheel_speed)
+    speed = motion.approach(top, abs(remaining), motion.WHEEL_BRAKE_ZONE, t.cfg.algorithm.tick)
+    return stay(motion.turn(1 if remaining > 0 else -1, t.cfg, speed / top))
 
 
 TURN_TO = PhaseDef(

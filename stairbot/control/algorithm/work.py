@@ -160,6 +160,14 @@ class ApproachTurnsWork(Work):
 
 
 @dataclass
+class LiftFirstWork(LiftWork):
+    """Ascent 3's lift of segment 1 until its sensors see over the riser."""
+
+    still_since: float | None = None
+    """When the lift stood at the top of its travel, not seeing over yet."""
+
+
+@dataclass
 class SightWork(LiftWork):
     """Ascent 3's lift past the sight-over."""
 
