@@ -5,13 +5,15 @@ motion did not, what the back pair reads standing on a surface, where the
 odometer puts a riser it measured -- treats it as lost, and with the
 operator's consent comes home on its partner; it says what it judged, and
 on what evidence.  The scenarios are cases of sweeps/sensor_faults.toml on
-the reference robot (their index in the names)."""
+the reference robot (their index in the names), and healthy robots the
+evidence must not take for biased."""
 
 from __future__ import annotations
 
 from typing import Any
 
 from simrun import run_sim
+from test_vl53l1x_front import LOW_RISER_ASKEW, VL53L1X_FRONT
 
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
@@ -142,3 +144,18 @@ def test_a_front_sensor_gone_wrong_before_the_tread_was_measured_is_not_climbed_
     assert r.error is not None and "still disagree" in r.error, r.error
     assert r.max_pitch_deg is not None and r.max_pitch_deg < 10.0, r.to_dict()
     assert not [e for e in events if "degraded" in e.data]
+
+
+def test_a_cone_that_sees_over_a_riser_as_segment_1_is_lowered_is_no_bias() -> None:
+    # the VL53L1X pair 20 deg askew before a 0.10 m riser, no fault: segment 1
+    # lifted a centimetre for the squaring turn, SFR's cone saw over the
+    # riser; lowered, it met the riser again, 2.2 cm shorter, while SFL held
+    # and the wheels stood still.  That step was taken for SFR's onset and
+    # judged at once in calibration: a healthy robot stopped, "SFR judged
+    # biased".  Segment 1 rising or falling in the air moves where a cone
+    # meets the world: no front onset then.
+    events: list[Event] = []
+    r = run_sim(VL53L1X_FRONT, parse_scenario(LOW_RISER_ASKEW, "<vl53l1x_front>"), events)
+    assert not [e.message for e in events if "biased" in e.message]
+    assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), \
+        r.to_dict()

@@ -87,6 +87,10 @@ rise a flight has is about 0.08 m): a biased one reading 5 cm long does not."""
 HANGING = frozenset({Phase.ASCENT_LIFT_THIRD, Phase.DESCENT_LOWER_THIRD})
 """The phases in which MTB lifts or lowers segment 3 in the air: what its
 sensors read moves with MTB's counter."""
+FIRST_STANDS = frozenset({Phase.ASCENT_LIFT_SECOND, Phase.DESCENT_LOWER_SECOND})
+"""The phases in which MTF moves segment 2 while segment 1 stands on its
+tread; in any other it moves segment 1, and the front cones with it, in the
+air (lifted for the turns, over a riser, lowered off a tread)."""
 ON_THE_TREAD = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE,
                           Phase.DESCENT_LOWER_THIRD, Phase.DESCENT_DRIVE_SECOND,
                           Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST})
@@ -115,6 +119,10 @@ class BiasWatch:
         self._pairs = (self._watches[0].track, self._watches[1].track)
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
         self._lift_m = cfg.motors.lift_travel_per_turn
+        self._mtf: float | None = None
+        self._cones_m = 0.0
+        """How far MTF has moved segment 1 in the air (not FIRST_STANDS), summed
+        over the run: a front step while it changed is no onset."""
         self._mtb: float | None = None
         self._hung_m = 0.0
         """How far MTB has moved segment 3 in the air (HANGING), summed over the
@@ -152,10 +160,14 @@ class BiasWatch:
         yaw = (motors[MotorId.MWR].turns - motors[MotorId.MWL].turns) * self._yaw_per_turn
         front, back = self._pairs
         judged = self._judged
-        self._watches[0].tick(snap, odometer, yaw, 0.0, True, judged)
         # the standing rule's wait stands where the phase it stopped in stood
         where = BY_VALUE[ctx.pause.resume_phase] if phase is Phase.PAUSED \
             and ctx.pause is not None else phase
+        mtf = motors[MotorId.MTF].turns
+        if where not in FIRST_STANDS and self._mtf is not None:
+            self._cones_m += (mtf - self._mtf) * self._lift_m
+        self._mtf = mtf
+        self._watches[0].tick(snap, odometer, yaw, self._cones_m, True, judged)
         surface = where in ON_A_SURFACE and not ctx.from_top
         mtb = motors[MotorId.MTB].turns
         if where in HANGING and self._mtb is not None:

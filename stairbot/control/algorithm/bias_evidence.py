@@ -17,12 +17,14 @@ from dataclasses import dataclass
 
 from stairbot.hardware import SensorId
 
-Sample = tuple[float, float, float, float, float, bool, bool, bool, bool]
+Sample = tuple[float, float, float, float, float, bool, bool, bool, bool, float]
 """(time, right, left, odometer m, yaw rad, right too near, left too near,
-right level, left level): one tick of a pair, its readings compensated for
-the motion, whether each read too near to measure (its clamp stands for it:
-a step it makes is at least what it says), and (the back pair) whether each
-read its mount height on a surface (no drop in sight)."""
+right level, left level, lifted m): one tick of a pair, its readings
+compensated for the motion, whether each read too near to measure (its
+clamp stands for it: a step it makes is at least what it says), (the back
+pair) whether each read its mount height on a surface (no drop in sight),
+and how far its lift has moved the pair's segment in the air, summed over
+the run."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -4,7 +4,12 @@ whose difference steps because one of them moved and its partner held
 
 A front sensor looks along the drive: its reading plus the odometer stays
 put while the robot drives at a riser, and turning left lengthens SFL and
-shortens SFR by front_lateral per radian of the odometer's yaw.  A back
+shortens SFR by front_lateral per radian of the odometer's yaw.  Where a
+beam meets the world depends on more than that, near an edge: turning, each
+beam may meet another wall, and while MTF lifts or lowers segment 1 in the
+air a cone may see over a riser's top or stop doing so (the VL53L1X pair
+before a 0.10 m riser).  Neither can be compensated, so a front step taken
+while the heading or segment 1's height changed is no onset.  A back
 sensor looks down: driving on a floor does not move what it reads, and
 while MTB lifts segment 3 in the air its reading less MTB's travel stays
 put.  The compensated readings' means over two windows a settle time apart
@@ -72,7 +77,8 @@ class PairWatch:
     def tick(self, snap: Snapshot, odometer: float, yaw: float, lifted_m: float,
              surface: bool, judged: Collection[SensorId]) -> None:
         """One tick (``surface``: for the back pair, segment 3 stands on a
-        surface; ``lifted_m``: what MTB moved it in the air; the pair is not
+        surface; ``lifted_m``: what the pair's lift moved its segment in the
+        air, summed: MTB segment 3's, MTF segment 1's; the pair is not
         watched once one of it is ``judged``).  A back onset while the drive
         moved counts only if the sensor read its mount height before it, and
         its partner throughout."""
@@ -101,7 +107,7 @@ class PairWatch:
         else:
             level_r = level_l = True
         moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, level_r,
-                           level_l))
+                           level_l, lifted_m))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
             level = sum(x[2] - x[1] for x in track.buf) / track.window
@@ -131,12 +137,8 @@ class PairWatch:
             return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
-        yaws = [x[4] for x in before + after]
-        if not track.back and max(yaws) - min(yaws) > STILL_RAD:
-            # turning, a beam's reading follows the shape of what it sees, not
-            # only the odometer's yaw: at a corner each beam sees another wall,
-            # and one switching walls between the windows looks like a jump
-            return
+        if not track.back and _cones_moved(before + after):
+            return  # the beams met the world elsewhere: the module docstring
         what = _motion(before, after)
         if abs(step.moved_right) <= share:
             near = any(s[6] for s in before) or any(s[6] for s in after)
@@ -165,6 +167,17 @@ class PairWatch:
         assert waiting is not None
         if held:
             track.record(waiting.onset, waiting.threshold)
+
+
+def _cones_moved(samples: list[Sample]) -> bool:
+    """Whether the front cones turned or rose or fell over ``samples``: at a
+    corner a beam switching walls looks like a jump (case 3B), and so does a
+    cone that sees over a riser once segment 1 is lifted a centimetre for the
+    squaring turn and on the riser again once it is lowered
+    (tests/test_vl53l1x_front.py)."""
+    yaws = [x[4] for x in samples]
+    lifts = [x[9] for x in samples]
+    return max(yaws) - min(yaws) > STILL_RAD or max(lifts) - min(lifts) > STILL_M
 
 
 def _driving(samples: list[Sample]) -> list[Sample]:
