@@ -159,3 +159,28 @@ def test_a_cone_that_sees_over_a_riser_as_segment_1_is_lowered_is_no_bias() -> N
     assert not [e.message for e in events if "biased" in e.message]
     assert (r.outcome, r.ascent_end, r.steps_climbed) == ("completed", "obstacle", 0), \
         r.to_dict()
+
+
+def test_a_back_cone_meeting_the_edge_it_backs_towards_is_no_bias() -> None:
+    # case 31 of sweeps/quick.toml, no fault: backing off on the second
+    # tread 3.8 deg askew, SBR's cone met the edge first and read 2.3 cm
+    # longer while SBL held; taken for SBR's onset, it was judged at once a
+    # step lower, where the pair backing to the edge read as far apart.
+    # Backing or turning, a back cone passes over ground the robot has not
+    # stood on: reading longer then is no onset.
+    text = """
+[stairs]
+count = 3
+rise = 0.2
+tread = 0.3
+top = "landing"
+[start]
+distance = 0.5
+yaw_deg = -3.832525
+[sensors]
+noise = 0.001
+seed = 733148
+"""
+    r, events = run(text)
+    assert not [e.message for e in events if "biased" in e.message]
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 3, 3), r.to_dict()

@@ -148,6 +148,11 @@ class PairWatch:
             onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
         else:
             return  # both moved: the world changed, or nobody can tell
+        if track.back and onset.step_m > 0 and _over_new_ground(before + after):
+            # backing or turning, a cone passes over ground the robot has not
+            # stood on: one meeting an edge first reads longer (case 31 of
+            # the quick sweep, the top edge askew), a bias or not
+            return
         mine, partner = (8, 7) if onset.sensor is track.left else (7, 8)
         if track.back and not (all(x[mine] for x in _driving(before))
                                and all(x[partner] for x in _driving(before) + _driving(after))):
@@ -178,6 +183,16 @@ def _cones_moved(samples: list[Sample]) -> bool:
     yaws = [x[4] for x in samples]
     lifts = [x[9] for x in samples]
     return max(yaws) - min(yaws) > STILL_RAD or max(lifts) - min(lifts) > STILL_M
+
+
+def _over_new_ground(samples: list[Sample]) -> bool:
+    """Whether segment 3's cones passed over ground the robot has not stood on
+    over ``samples``: it backed (by more than STILL_M) or turned.  Driving
+    forward, they pass where segment 3's own wheels, and the rest of the
+    robot, have been."""
+    backed = sum(min(x[3] - y[3], 0.0) for x, y in zip(samples[1:], samples[:-1], strict=False))
+    yaws = [x[4] for x in samples]
+    return backed < -STILL_M or max(yaws) - min(yaws) > STILL_RAD
 
 
 def _driving(samples: list[Sample]) -> list[Sample]:
