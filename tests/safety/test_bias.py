@@ -184,3 +184,15 @@ seed = 733148
     r, events = run(text)
     assert not [e.message for e in events if "biased" in e.message]
     assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 3, 3), r.to_dict()
+
+
+def test_a_back_cone_turned_over_the_edge_is_not_judged_for_a_front_bias() -> None:
+    # case 418: SFR 3 cm short from 104.0 s; descent 1 of the next step
+    # turned back to its heading (-4.2 deg) at the edge, SBL's cone swept
+    # off the drop and read 7.0 cm shorter while SBR held: SBL, healthy, was
+    # judged at once and the robot limped home on SBR and the biased SFR.
+    # Turning, the back cones sweep sideways over the ground: no onset.
+    r, events = run(flight(187214, 104.0, "SFR", -0.03))
+    assert not [e.message for e in events if "SBL judged" in e.message or "SBR judged" in e.message]
+    assert [e.data["degraded"]["lost"] for e in events if "degraded" in e.data] in ([], [["SFR"]])
+    assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 10.0, r.to_dict()

@@ -9,7 +9,11 @@ beam meets the world depends on more than that, near an edge: turning, each
 beam may meet another wall, and while MTF lifts or lowers segment 1 in the
 air a cone may see over a riser's top or stop doing so (the VL53L1X pair
 before a 0.10 m riser).  Neither can be compensated, so a front step taken
-while the heading or segment 1's height changed is no onset.  A back
+while the heading or segment 1's height changed is no onset.  A back cone
+looks down at the ground it passes over: turning sweeps it sideways, and
+backing takes it over ground the robot has not stood on, where an edge
+may be; a back step taken while the heading changed is no onset, nor is
+one that lengthens a reading while segment 3 backed.  A back
 sensor looks down: driving on a floor does not move what it reads, and
 while MTB lifts segment 3 in the air its reading less MTB's travel stays
 put.  The compensated readings' means over two windows a settle time apart
@@ -137,8 +141,8 @@ class PairWatch:
             return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
-        if not track.back and _cones_moved(before + after):
-            return  # the beams met the world elsewhere: the module docstring
+        if _turned(before + after) or not track.back and _lifted(before + after):
+            return  # the cones met the world elsewhere: the module docstring
         what = _motion(before, after)
         if abs(step.moved_right) <= share:
             near = any(s[6] for s in before) or any(s[6] for s in after)
@@ -148,10 +152,10 @@ class PairWatch:
             onset = Onset(track.right, step.moved_right, step.moved_left, step.at_s, what, near)
         else:
             return  # both moved: the world changed, or nobody can tell
-        if track.back and onset.step_m > 0 and _over_new_ground(before + after):
-            # backing or turning, a cone passes over ground the robot has not
-            # stood on: one meeting an edge first reads longer (case 31 of
-            # the quick sweep, the top edge askew), a bias or not
+        if track.back and onset.step_m > 0 and _backed(before + after):
+            # backing, the cones pass over ground the robot has not stood on:
+            # the one meeting an edge first reads longer (case 31 of the
+            # quick sweep), a bias or not
             return
         mine, partner = (8, 7) if onset.sensor is track.left else (7, 8)
         if track.back and not (all(x[mine] for x in _driving(before))
@@ -174,25 +178,31 @@ class PairWatch:
             track.record(waiting.onset, waiting.threshold)
 
 
-def _cones_moved(samples: list[Sample]) -> bool:
-    """Whether the front cones turned or rose or fell over ``samples``: at a
-    corner a beam switching walls looks like a jump (case 3B), and so does a
-    cone that sees over a riser once segment 1 is lifted a centimetre for the
-    squaring turn and on the riser again once it is lowered
+def _turned(samples: list[Sample]) -> bool:
+    """Whether the heading changed over ``samples``: a front beam switching
+    walls at a corner looks like a jump (case 3B); the back cones sweep
+    sideways over the ground, and near an edge one of them crosses it (the
+    top edge 20 deg askew, case 418 of sweeps/sensor_faults.toml)."""
+    yaws = [x[4] for x in samples]
+    return max(yaws) - min(yaws) > STILL_RAD
+
+
+def _lifted(samples: list[Sample]) -> bool:
+    """Whether MTF moved segment 1, and the front cones, up or down in the air
+    over ``samples``: lifted a centimetre for the squaring turn a cone sees
+    over a low riser, and lowered it meets it again
     (tests/test_vl53l1x_front.py)."""
-    yaws = [x[4] for x in samples]
     lifts = [x[9] for x in samples]
-    return max(yaws) - min(yaws) > STILL_RAD or max(lifts) - min(lifts) > STILL_M
+    return max(lifts) - min(lifts) > STILL_M
 
 
-def _over_new_ground(samples: list[Sample]) -> bool:
-    """Whether segment 3's cones passed over ground the robot has not stood on
-    over ``samples``: it backed (by more than STILL_M) or turned.  Driving
-    forward, they pass where segment 3's own wheels, and the rest of the
-    robot, have been."""
+def _backed(samples: list[Sample]) -> bool:
+    """Whether the drive backed segment 3 (by more than STILL_M) over
+    ``samples``: its cones passed over ground the robot has not stood on.
+    Driving forward, they pass where segment 3's own wheels, and the rest of
+    the robot, have been."""
     backed = sum(min(x[3] - y[3], 0.0) for x, y in zip(samples[1:], samples[:-1], strict=False))
-    yaws = [x[4] for x in samples]
-    return backed < -STILL_M or max(yaws) - min(yaws) > STILL_RAD
+    return backed < -STILL_M
 
 
 def _driving(samples: list[Sample]) -> list[Sample]:
