@@ -196,3 +196,16 @@ def test_a_back_cone_turned_over_the_edge_is_not_judged_for_a_front_bias() -> No
     assert not [e.message for e in events if "SBL judged" in e.message or "SBR judged" in e.message]
     assert [e.data["degraded"]["lost"] for e in events if "degraded" in e.data] in ([], [["SFR"]])
     assert not r.fell and r.max_pitch_deg is not None and r.max_pitch_deg < 10.0, r.to_dict()
+
+
+def test_a_front_bias_just_after_segment_1_was_lowered_is_still_an_onset() -> None:
+    # case 562: SFL 5 cm long from 14.5 s, 0.2 s after calibration lowered
+    # segments 1 and 3; the first window before the step held the end of
+    # the lowering, and counting any lift in the windows as the cones moving
+    # lost the onset: squared up to SFL, the robot climbed askew and the
+    # tilt watch stopped it on the stairs at -155 deg/s.  Only a lift where
+    # the step formed (and a settle time before, the filter's lag) counts.
+    r, events = run(flight(940152, 14.5, "SFL", 0.05))
+    assert home(r), r.to_dict()
+    stop = degraded(events)
+    assert (stop["lost"], stop["biased"], stop["phase"]) == (["SFL"], ["SFL"], "cal_check")

@@ -116,6 +116,14 @@ class Onsets:
             sums[3] = sum(s[2] for s in items[-w:])
         return (sums[2] - sums[0]) / w, (sums[3] - sums[1]) / w
 
+    def across(self) -> list[Sample]:
+        """The ticks across which the step formed: the gap between the
+        windows, the last settle time (``gap`` ticks) of the first window
+        before it (the filtered readings lag the world by up to that), and
+        one tick either side."""
+        w, g = self.window, self.gap
+        return list(self.buf)[max(0, w - g - 1):w + g + 1]
+
     def windows(self) -> tuple[list[Sample], list[Sample]]:
         items = list(self.buf)
         return items[:self.window], items[-self.window:]

@@ -141,7 +141,7 @@ class PairWatch:
             return  # one sensor crossed an edge before its partner: not a bias
         share = max(ATTRIBUTE_SHARE * step.size, step.threshold / 2)
         before, after = track.windows()
-        if _turned(before + after) or not track.back and _lifted(before + after):
+        if _turned(before + after) or not track.back and _lifted(track.across()):
             return  # the cones met the world elsewhere: the module docstring
         what = _motion(before, after)
         if abs(step.moved_right) <= share:
@@ -189,9 +189,11 @@ def _turned(samples: list[Sample]) -> bool:
 
 def _lifted(samples: list[Sample]) -> bool:
     """Whether MTF moved segment 1, and the front cones, up or down in the air
-    over ``samples``: lifted a centimetre for the squaring turn a cone sees
-    over a low riser, and lowered it meets it again
-    (tests/test_vl53l1x_front.py)."""
+    over ``samples`` (:meth:`Onsets.across`: where the step formed, and a
+    settle time before it, the filter's lag): lifted a centimetre for the
+    squaring turn a cone sees over a low riser, and lowered it meets it
+    again (tests/test_vl53l1x_front.py).  A lift that ended a settle time
+    before the step, or began after it, moved nothing the step saw."""
     lifts = [x[9] for x in samples]
     return max(lifts) - min(lifts) > STILL_M
 
