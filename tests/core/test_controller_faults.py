@@ -173,14 +173,32 @@ def test_a_passing_disagreement_pauses_for_the_wait_and_resumes_where_it_stopped
     assert robot.front_x == pytest.approx(robot.start_front_x, abs=0.003)
 
 
-def test_a_lasting_disagreement_ends_with_an_error_after_the_wait() -> None:
-    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 5.0, offset=0.05)])
+def test_a_lasting_disagreement_no_evidence_explains_ends_with_an_error_after_the_wait() -> None:
+    # both sensors jump at once, by as much each way: nothing tells which is wrong
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 7.0, offset=0.03),
+                                        Fault(SensorId.SFR, 7.0, offset=-0.03)])
     run(ctrl, robot)
     r = ctrl.result
     assert (r.outcome, r.pauses) == ("error", 1)
     assert "still disagree" in str(r.error)
     pause = of(events, EventKind.PAUSE)[0]
     assert of(events, EventKind.ERROR)[0].time_s - pause.time_s == pytest.approx(WAIT, abs=0.1)
+
+
+def test_a_lasting_disagreement_one_sensor_jumped_into_judges_it_after_the_wait() -> None:
+    ctrl, robot, events = start(faults=[Fault(SensorId.SFL, 7.0, offset=0.05)])  # approaching
+    run(ctrl, robot)
+    r = ctrl.result
+    # one pause (the standing rule's); then, without consent, a degraded stop
+    assert (r.outcome, r.pauses) == ("error", 1)
+    error = str(r.error)
+    assert error.startswith("sensor error: SFL judged biased: SFL read 5.0 cm longer"), error
+    assert "still disagree" not in error and "for 1 s" not in error
+    pause = of(events, EventKind.PAUSE)[0]
+    assert of(events, EventKind.ERROR)[0].time_s - pause.time_s == pytest.approx(WAIT, abs=0.1)
+    stop = [e.data["degraded"] for e in events if "degraded" in e.data]
+    assert [(d["lost"], d["survivors"], d["then"]) for d in stop] == [
+        (["SFL"], ["SFR"], "no_consent")]
 
 
 def test_a_disagreement_shorter_than_the_debounce_does_not_stop() -> None:

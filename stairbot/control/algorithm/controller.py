@@ -7,13 +7,11 @@ supervisor's tilt and stall), then a sensor the phase needs that reads as
 ERROR (the robot stands and waits for it, up to SENSOR_WAIT_S), then the
 standing rule, then -- once, before a lift phase's first step -- the
 static-stability check (:mod:`~stairbot.control.algorithm.stability`), then the
-phase's step.
-Whichever decides returns a :class:`~stairbot.control.algorithm.phase.Step`; if it
+phase's step.  Whichever decides returns a :class:`~stairbot.control.algorithm.phase.Step`; if it
 says what happened, :meth:`Controller._apply` looks the outcome up in
 :data:`~stairbot.control.algorithm.transitions.EXITS` and enters the phase it
 leads to — the one place a phase is entered, at most once a tick — and tells
-it as an event.
-The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
+it as an event.  The clock is ``Snapshot.time_s`` alone; nothing here sleeps.
 """
 
 from __future__ import annotations
@@ -21,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from stairbot.control.algorithm import guards, limp, lost, motion, stability, standing
+from stairbot.control.algorithm import bias, guards, limp, lost, motion, stability, standing
 from stairbot.control.algorithm.context import Context, Pause, Watch
 from stairbot.control.algorithm.families import Calibration, Family
 from stairbot.control.algorithm.guards import (
@@ -40,12 +38,7 @@ from stairbot.control.algorithm.transitions import exit_of
 from stairbot.control.perception import Perception
 from stairbot.control.supervisor import Supervisor
 from stairbot.events import Event, EventKind, EventSink, discard
-from stairbot.hardware import (
-    LIFT_MOTORS,
-    MotorId,
-    SensorId,
-    Snapshot,
-)
+from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, Snapshot
 from stairbot.inputs.config import RobotConfig
 
 
@@ -77,12 +70,11 @@ class Controller:
                 context.from_top = True
                 context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
-        reopened = False
+        # a program reopened to limp home is said so at its first tick, on its time
+        self._reopened = context.phase_started_s is not None and limp_home \
+            and lost.reopen(context)
         if context.phase_started_s is not None:
-            reopened = limp_home and lost.reopen(context)
             check_restored(context)
-        self._reopened = reopened
-        """A program reopened to limp home: said at the first tick, on its time."""
         self._ctx = context
         self._started = context.phase_started_s is not None
         self._held: str | None = None
@@ -94,6 +86,7 @@ class Controller:
         self._stroke = config.MAX_OF_VERTICAL_TURNS
         self._timeout = phase_timeout_s(config)
         self._perception = Perception(config)
+        self._bias = bias.BiasWatch(config)
         self._supervisor = Supervisor(config)
         self._tilt = self._supervisor.tilt
         self._sensor_since: float | None = None
@@ -176,6 +169,7 @@ class Controller:
         if self.finished:
             return _zeros()
         snap = self._perception.see(snap)
+        snap = self._bias.see(snap, self._ctx)  # a sensor judged biased reads as ERROR: lost
         if self._reopened:
             self._reopened = False
             self._emit(EventKind.RESUME, say_limp.REOPENED, snap.time_s,
@@ -256,37 +250,38 @@ class Controller:
                 self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
                            f"{phase.label}", snap.time_s, {"phase": phase.value})
             return False
-        why = "; ".join([f"{s} {self._perception.why(s) or 'reports an error'}"
+        why = "; ".join([f"{s} {self._bias.why(s, self._perception.why(s))}"
                          for s in errors] + ([imu] if imu is not None else []))
+        # a sensor judged biased does not come back: no use waiting for it
+        wait = 0.0 if imu is None and self._bias.all_judged(errors) else SENSOR_WAIT_S
         if self._sensor_since is None:
-            self._sensor_since = snap.time_s
-            self._sensor_link = dict(snap.health)
-            ctx.pauses += 1
-            self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
-                       f"stopped, lifts holding, waiting up to {SENSOR_WAIT_S:g} s",
-                       snap.time_s, {"resume_phase": phase.value, "sensors": list(errors),
-                                         "imu_stale": imu is not None})
-            return True
-        if snap.time_s - self._sensor_since < SENSOR_WAIT_S:
+            self._sensor_since, self._sensor_link = snap.time_s, dict(snap.health)
+            if wait > 0.0:
+                ctx.pauses += 1
+                self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
+                           f"stopped, lifts holding, waiting up to {wait:g} s", snap.time_s,
+                           {"resume_phase": phase.value, "sensors": list(errors),
+                            "imu_stale": imu is not None})
+                return True
+        if snap.time_s - self._sensor_since < wait:
             return True
         since, self._sensor_since = self._sensor_since, None
         stale = link_meanwhile(self._sensor_link, snap.health,
                                "the readings were stale on the wire")
         stop = None if imu is not None else lost.degraded_stop(
             ctx, snap, phase, errors, why, mode=self.mode, consent=self.limp_home,
-            tilt_watched=self._tilt.watched)
+            tilt_watched=self._tilt.watched, biased=tuple(self._bias.judged))
         if stop is None:
-            self._apply(fail(f"sensor error: {why} for {SENSOR_WAIT_S:g} s in {phase.label}"
-                             f"{stale}"), snap)
+            self._apply(fail(say_limp.lost_sensor_end(why, wait, phase.label) + stale), snap)
             return True
-        self._emit(EventKind.WARNING, say_limp.stopped_at(
-            why, phase.label, stop.where, stop.lifts, stop.steps_climbed,
+        self._emit(EventKind.WARNING, say_limp.stopped_at(  # (the phase a pause stopped in)
+            why, BY_VALUE[stop.phase].label, stop.where, stop.lifts, stop.steps_climbed,
             stop.steps_descended) + ": " + stop.why, snap.time_s, {"degraded": stop.to_dict()})
         if stop.then == "no_consent":
             lost.start_limping(ctx, stop, snap.time_s, phase.label)
         if stop.then != "limp_home":
-            self._apply(fail(say_limp.lost_sensor_end(why, SENSOR_WAIT_S, phase.label, stop.why)
-                             + stale), snap)
+            self._apply(fail(say_limp.lost_sensor_end(why, wait, BY_VALUE[stop.phase].label,
+                                                      stop.why) + stale), snap)
             return True
         lost.start_limping(ctx, stop, snap.time_s, phase.label)
         self._shift_timers(snap.time_s - since)

@@ -2,7 +2,8 @@
 (not in the seed, which has no sensor faults).
 
 A sensor the phase needs that reads as ERROR (errors, or stale) for
-SENSOR_WAIT_S is *lost*.  On the floor where the program began that ends
+SENSOR_WAIT_S, or that is judged biased (it reads, but wrong:
+:mod:`~stairbot.control.algorithm.bias`), is *lost*.  On the floor where the program began that ends
 the run as it always has: the robot is home.  Anywhere else it is a
 *degraded stop* (:class:`DegradedStop`): every motor stopped, the lifts
 holding, and the robot says what failed, where it stands, and whether it
@@ -115,6 +116,9 @@ class DegradedStop:
     then: str
     why: str
     survivors: tuple[str, ...] = ()
+    biased: tuple[str, ...] = ()
+    """Those of ``lost`` judged biased: they read, but wrong (``failed`` says
+    on what evidence); the others report errors or went stale."""
     plan: str = ""
     """What limping home would do from here, in words ("": it cannot)."""
 
@@ -123,7 +127,7 @@ class DegradedStop:
                 "where": self.where, "steps_climbed": self.steps_climbed,
                 "steps_descended": self.steps_descended, "lifts": dict(self.lifts),
                 "then": self.then, "why": self.why, "survivors": list(self.survivors),
-                "plan": self.plan}
+                "biased": list(self.biased), "plan": self.plan}
 
 
 def lifts(snap: Snapshot) -> dict[str, float]:

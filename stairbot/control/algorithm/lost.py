@@ -17,12 +17,13 @@ from stairbot.hardware import SensorId, Snapshot
 
 
 def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[SensorId],
-                  failed: str, *, mode: Mode, consent: bool,
-                  tilt_watched: bool) -> limp.DegradedStop | None:
+                  failed: str, *, mode: Mode, consent: bool, tilt_watched: bool,
+                  biased: Sequence[SensorId] = ()) -> limp.DegradedStop | None:
     """What follows the loss of the sensors ``errors`` in ``phase`` (``failed``
-    says what they report): None on the floor where the program began (the
-    run ends on the sensor error, as it always has), else a degraded stop
-    whose ``then`` says whether the robot limps home."""
+    says what they report; ``biased``: those judged biased,
+    :mod:`~stairbot.control.algorithm.bias`): None on the floor where the
+    program began (the run ends on the sensor error, as it always has), else
+    a degraded stop whose ``then`` says whether the robot limps home."""
     if phase is Phase.PAUSED and ctx.pause is not None:  # lost while the standing rule waits
         phase = BY_VALUE[ctx.pause.resume_phase]
     purpose = ctx.family.purpose if isinstance(ctx.family, Calibration) else None
@@ -44,7 +45,8 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
         lost=tuple(s.value for s in lost), failed=failed, phase=phase.value,
         where=where(ctx, phase), steps_climbed=ctx.number_of_steps,
         steps_descended=ctx.steps_descended, lifts=limp.lifts(snap), then=then, why=told,
-        survivors=limp.survivors(lost), plan=plan)
+        survivors=limp.survivors(lost), plan=plan,
+        biased=tuple(sorted(s.value for s in lost if s in biased)))
 
 
 _UNDO = (Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_LOWER_OBSTACLE)
@@ -71,6 +73,8 @@ def start_limping(ctx: Context, stop: limp.DegradedStop, time_s: float,
     sensors ``stop`` lost: it does, or (``stop.then`` "no_consent") will
     once the operator consents (:func:`reopen`)."""
     consented = stop.then == "limp_home"
+    if ctx.pause is not None:  # the standing rule's wait decides on the stand-in's figures
+        ctx.pause.diffs.clear()
     if ctx.limp is None:
         at = f"{label} ({stop.where})" if stop.where else label
         ctx.limp = limp.Limp(list(stop.lost), time_s, at, consented,

@@ -60,10 +60,12 @@ def stand_ins(lost: Sequence[str]) -> str:
     return " [limping: " + ", ".join(f"{s} reads {pairs[s]}'s value" for s in lost) + "]"
 
 
-def lost_sensor_end(failed: str, wait_s: float, label: str, then: str) -> str:
-    """The reason the program ends with on a degraded stop it does not limp
-    home from: the sensor error as it always read, then what followed."""
-    return f"sensor error: {failed} for {wait_s:g} s in {label}; {then}"
+def lost_sensor_end(failed: str, wait_s: float, label: str, then: str = "") -> str:
+    """The reason the program ends with on a sensor error (lost for
+    ``wait_s``; 0: judged biased, not waited for), or on a degraded stop it
+    does not limp home from (``then``: what followed)."""
+    held = f" for {wait_s:g} s" if wait_s > 0.0 else ""
+    return f"sensor error: {failed}{held} in {label}" + (f"; {then}" if then else "")
 
 
 def limp_down(steps: int) -> str:

@@ -1,0 +1,343 @@
+"""Bias: a distance sensor that keeps measuring but reads wrong by a constant
+offset (not in the seed, which has no sensor faults).
+
+Two sensors of a pair that disagree cannot say which of them is wrong; the
+host knows more than the pair.  :class:`BiasWatch` keeps, every tick, the
+evidence (:mod:`~stairbot.control.algorithm.bias_evidence`):
+
+* *onsets* (:mod:`~stairbot.control.algorithm.bias_onsets`): one sensor's
+  reading jumped by more than the motion since explains (the odometer, the
+  turn, MTB's travel) while its partner's followed the motion;
+* *mount heights*: what each back sensor read, less BACK_CLEARANCE, the last
+  second segment 3 stood on a surface away from an edge;
+* *risers*: where the start position and each tab_length_to_edge put the
+  riser ahead, by the odometer.
+
+An onset is evidence, not yet a verdict.  A sensor is *judged* biased, and
+reads as ERROR from then on in the snapshot :meth:`BiasWatch.see` returns,
+only where the evidence decides something:
+
+* at the end of the standing rule's wait, the pair still disagreeing: by the
+  onsets that say what the disagreement says; else, for the back pair, by
+  the mount heights; else, for the front pair on a tread or the floor on
+  the way down, by the riser the odometer places;
+* at once, where the robot steers by the pair (calibration squaring up to a
+  riser: the front pair; descent 1 finding the edge and descent 2 finding
+  the floor: the back pair), by the onsets, while the pair reads as far
+  apart as they say: squared up to one sensor's offset the robot would
+  stand atan(offset / (2 front_lateral)) askew (17 deg for 3 cm).
+
+A judged sensor is lost (:mod:`~stairbot.control.algorithm.limp`): on the
+floor where the program began the run ends on it; elsewhere a degraded
+stop, and with the operator's consent its partner stands in for it on the
+way home.  Where nothing names one of two sensors that disagree, the
+standing rule ends the program, as it always has.
+
+Pure Python, on the controller's clock (the snapshots' times); it keeps no
+state in the context (a resumed run starts with no evidence).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+from stairbot.control.algorithm import motion
+from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
+from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import Purpose
+from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.texts import bias as say
+from stairbot.control.tolerances import pair_tolerance, standing_tolerance
+from stairbot.hardware import (
+    WHEEL_MOTORS,
+    MotorId,
+    SensorId,
+    SensorReading,
+    SensorStatus,
+    Snapshot,
+)
+from stairbot.inputs.config import RobotConfig
+
+MATCH_SHARE = 0.35
+"""Evidence matches the standing rule's disagreement within the standing
+tolerance, or this share of the disagreement if more."""
+STEERS_BY_THE_FRONT = frozenset({Phase.CAL_CHECK, Phase.CAL_CLOSE_IN, Phase.CAL_PROBE,
+                                 Phase.CAL_TURN})
+"""The calibration phases in which the robot squares up to a riser by the
+front pair's difference: its onsets are judged at once there."""
+_RISER_PURPOSES = (Purpose.START, Purpose.ASCENT, Purpose.DESCENT)
+STEERS_BY_THE_BACK = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE})
+"""Descent 1's phases, in which the back pair finds the edge (where both read
+the drop): its onsets are judged at once there."""
+ON_A_SURFACE = frozenset({
+    Phase.CAL_CLOSE_IN, Phase.DESCENT_BACK_OFF, Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS,
+    Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_DRIVE_FIRST,
+    Phase.ASCENT_LIFT_SECOND, Phase.ASCENT_DRIVE_SECOND, Phase.DESCENT_DRIVE_SECOND,
+    Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST, Phase.DESCENT_LOWER_FIRST,
+    Phase.DESCENT_FINISH})
+"""The phases in which segment 3 stands on a surface and moves on it: its
+sensors read their mount height (BACK_CLEARANCE), until one reads a drop
+(DROP_M more: descent 1 backs off towards the edge)."""
+DROP_M = 0.07
+"""A back sensor reading this much over BACK_CLEARANCE sees a drop (the lowest
+rise a flight has is about 0.08 m): a biased one reading 5 cm long does not."""
+HANGING = frozenset({Phase.ASCENT_LIFT_THIRD, Phase.DESCENT_LOWER_THIRD})
+"""The phases in which MTB lifts or lowers segment 3 in the air: what its
+sensors read moves with MTB's counter."""
+FIRST_STANDS = frozenset({Phase.ASCENT_LIFT_SECOND, Phase.DESCENT_LOWER_SECOND})
+"""The phases in which MTF moves segment 2 while segment 1 stands on its
+tread; in any other it moves segment 1, and the front cones with it, in the
+air (lifted for the turns, over a riser, lowered off a tread)."""
+ON_THE_TREAD = frozenset({Phase.DESCENT_BACK_OFF, Phase.DESCENT_BACK_TO_EDGE,
+                          Phase.DESCENT_LOWER_THIRD, Phase.DESCENT_DRIVE_SECOND,
+                          Phase.DESCENT_LOWER_SECOND, Phase.DESCENT_DRIVE_FIRST})
+"""Descent 1 to 5 of a step: segment 1 stands on its tread and the front pair
+faces the riser above it, whose place the tab measured on the way up and
+the odometer since say (descent 6 lowers the pair past the tread)."""
+ON_THE_FLOOR = frozenset({Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
+ONTO_THE_TREAD = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
+                            Phase.ASCENT_DRIVE_SECOND, Phase.ASCENT_LIFT_THIRD})
+"""Ascent 4 to 7: the robot goes onto the tread length_of_next_step measured
+(ascent 3); limping home it finishes the step by it."""
+
+
+class BiasWatch:
+    """Gathers the evidence and judges biased sensors (see the module
+    docstring).  One per controller, told every tick's filtered snapshot."""
+
+    def __init__(self, cfg: RobotConfig) -> None:
+        self._cfg = cfg
+        self._lateral = cfg.sensors.front_lateral
+        self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
+        self._wheel_m = cfg.wheel_circumference
+        self._near = cfg.sensors.range(True)[0]
+        self._watches = (PairWatch(cfg, SensorId.SFR, SensorId.SFL, False),
+                         PairWatch(cfg, SensorId.SBR, SensorId.SBL, True))
+        self._pairs = (self._watches[0].track, self._watches[1].track)
+        self._mount = MountHeights(cfg.BACK_CLEARANCE)
+        self._lift_m = cfg.motors.lift_travel_per_turn
+        self._mtf: float | None = None
+        self._cones_m = 0.0
+        """How far MTF has moved segment 1 in the air (not FIRST_STANDS), summed
+        over the run: a front step while it changed is no onset."""
+        self._mtb: float | None = None
+        self._hung_m = 0.0
+        """How far MTB has moved segment 3 in the air (HANGING), summed over the
+        run: the back pair's readings less it stay put while it hangs, and
+        do not jump when it sets down or lifts off."""
+        self._yaw_per_turn = motion.turn_yaw_rad(cfg, 0.5)  # twist is half MWR less MWL
+        self._risers: dict[int, Reference] = {}
+        """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
+        self._judged: dict[SensorId, str] = {}
+        self._tread: tuple[float | None, float] = (None, -1.0)
+        """length_of_next_step as last seen, and when it was measured."""
+
+    @property
+    def judged(self) -> dict[SensorId, str]:
+        """The sensors judged biased, each with the evidence in words."""
+        return self._judged
+
+    def why(self, sensor: SensorId, otherwise: str | None = None) -> str:
+        """Why ``sensor`` reads as ERROR: judged biased, else ``otherwise``
+        (perception's reason), else it reports an error."""
+        return self._judged.get(sensor) or otherwise or "reports an error"
+
+    def all_judged(self, sensors: Sequence[SensorId]) -> bool:
+        """Whether every one of ``sensors`` is judged biased: no use waiting
+        for them to come back."""
+        return all(s in self._judged for s in sensors)
+
+    def see(self, snap: Snapshot, ctx: Context) -> Snapshot:
+        """Take this tick's filtered snapshot (before any stand-in), judge
+        where the evidence decides (module docstring); the snapshot with
+        every sensor judged biased reading as ERROR."""
+        phase = BY_VALUE[ctx.phase]
+        motors = snap.motors
+        odometer = sum(motors[m].turns for m in WHEEL_MOTORS) * self._metres_per_turn
+        yaw = (motors[MotorId.MWR].turns - motors[MotorId.MWL].turns) * self._yaw_per_turn
+        front, back = self._pairs
+        judged = self._judged
+        # the standing rule's wait stands where the phase it stopped in stood
+        where = BY_VALUE[ctx.pause.resume_phase] if phase is Phase.PAUSED \
+            and ctx.pause is not None else phase
+        mtf = motors[MotorId.MTF].turns
+        if where not in FIRST_STANDS and self._mtf is not None:
+            self._cones_m += (mtf - self._mtf) * self._lift_m
+        self._mtf = mtf
+        self._watches[0].tick(snap, odometer, yaw, self._cones_m, True, judged)
+        surface = where in ON_A_SURFACE and not ctx.from_top
+        mtb = motors[MotorId.MTB].turns
+        if where in HANGING and self._mtb is not None:
+            self._hung_m += (mtb - self._mtb) * self._lift_m
+        self._mtb = mtb
+        self._watches[1].tick(snap, odometer, yaw, self._hung_m, surface, judged)
+        self._on_a_surface(snap, surface)
+        if ctx.length_of_next_step != self._tread[0]:
+            self._tread = (ctx.length_of_next_step, snap.time_s)
+        if ctx.number_of_steps not in self._risers:
+            self._references(snap, ctx, odometer, yaw)
+        if phase is Phase.PAUSED and ctx.pause is not None:
+            self._judge_pause(snap, ctx, odometer, yaw)
+        elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
+            family = ctx.family
+            if isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES:
+                self._judge_at_once(front, snap)
+        elif phase in STEERS_BY_THE_BACK:
+            self._judge_at_once(back, snap)
+        if not self._judged:
+            return snap
+        sensors = dict(snap.sensors)
+        for sid in self._judged:
+            r = sensors[sid]
+            sensors[sid] = SensorReading(r.distance_m, SensorStatus.ERROR, r.age_s)
+        return replace(snap, sensors=sensors)
+
+    # -- gathering ------------------------------------------------------------------------
+    def _references(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:
+        """Note the start position (tread 0), and each tab_length_to_edge the
+        ascent stores (the tread it climbed onto), as the odometer places them,
+        when the pair read them alike."""
+        risers = self._risers
+        if ctx.number_of_steps == 0 and ctx.start.reading is not None \
+                and ctx.start.wheel is not None and ctx.climb_twist[0] is not None:
+            risers[0] = Reference(ctx.start.reading + ctx.start.wheel * self._wheel_m,
+                                  motion.turn_yaw_rad(self._cfg, ctx.climb_twist[0]), 0)
+        k = ctx.number_of_steps
+        if 0 < k <= len(ctx.tab_length_to_edge) and k not in risers and ctx.landing.step is None:
+            tab = ctx.tab_length_to_edge[k - 1]
+            diff = motion.pair_difference(snap, self._cfg)
+            if tab is not None and diff is not None \
+                    and abs(diff) <= standing_tolerance(self._cfg, tab):
+                risers[k] = Reference(tab + odometer, yaw, k)
+
+    def _on_a_surface(self, snap: Snapshot, surface: bool) -> None:
+        if not surface:
+            self._mount.end()
+            return
+        r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
+        dr, dl = distance(r, self._near), distance(left, self._near)
+        drop = self._cfg.BACK_CLEARANCE + DROP_M
+        if dr is None or dl is None or max(dr, dl) > drop:
+            self._mount.end()
+        else:
+            self._mount.add(dr, dl, not r.ok, not left.ok)
+
+    def _judge_at_once(self, track: Onsets, snap: Snapshot) -> None:
+        """Where the robot steers by the pair: a sensor its onsets name, by
+        more than the standing rule tolerates, is judged now (steering on it
+        would leave the robot askew, or take the floor for the drop)."""
+        diff = motion.pair_difference(snap, self._cfg, track.back)
+        if not track.found or diff is None:
+            return
+        offsets = track.offsets
+        for sensor, partner in ((track.left, track.right), (track.right, track.left)):
+            off = offsets[sensor]
+            reading = snap.sensors[sensor].distance_m
+            limit = standing_tolerance(self._cfg, reading, back=track.back)
+            # the pair reads as far apart now as the onsets say (an offset that
+            # ended unseen, while the pair read nothing, no longer does)
+            said = _signed(diff, sensor)
+            still = abs(said) > limit and abs(said - off + offsets[partner]) <= max(
+                pair_tolerance(self._cfg, reading, back=track.back), MATCH_SHARE * abs(off))
+            if abs(off) > limit and still and abs(offsets[partner]) <= abs(off) / 2:
+                onsets = [o for o in track.found if o.sensor is sensor]
+                self._judged[sensor] = say.judged_at_once(onsets, track.back)
+                return
+
+    # -- the standing rule's wait ends -----------------------------------------------------
+    def _judge_pause(self, snap: Snapshot, ctx: Context, odometer: float, yaw: float) -> None:
+        pause = ctx.pause
+        assert pause is not None
+        cfg = self._cfg
+        if snap.time_s - pause.started_s < cfg.algorithm.standing_wait - cfg.algorithm.tick / 2 \
+                or not pause.diffs:
+            return
+        resume = BY_VALUE[pause.resume_phase]
+        back = resume.record.watches == "back"
+        if motion.pair_difference(snap, cfg, back) is None:
+            return  # a pair that gives no figure now does not disagree (the standing rule)
+        diffs = sorted(pause.diffs)
+        disagree = diffs[len(diffs) // 2]  # left − right
+        r, left = motion.pair(snap, back)
+        near = min(r.distance_m, left.distance_m)
+        tolerance = standing_tolerance(cfg, near, back=back)
+        if abs(disagree) <= tolerance:
+            return
+        match = max(tolerance, MATCH_SHARE * abs(disagree))
+        threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
+        track = self._pairs[1 if back else 0]
+        found = self._by_onsets(track, disagree, match)
+        if found is not None and not back and resume in ONTO_THE_TREAD \
+                and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
+            # it went wrong before the tread ahead was measured on it: finishing
+            # the step by that figure is not safe, and the standing rule ends
+            # the program, as it always has (case 531 climbed on and tipped)
+            return
+        if found is None and back:
+            found = self._by_mount(disagree, match, threshold)
+        tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
+            0 if resume in ON_THE_FLOOR else None
+        if found is None and not back and tread is not None and tread in self._risers \
+                and ctx.landing.step is None and not ctx.from_top:
+            found = self._by_riser(snap, self._risers[tread], odometer, yaw, disagree,
+                                   min(tolerance, match))
+        if found is not None:
+            sensor, evidence = found
+            self._judged[sensor] = evidence
+
+    def _by_onsets(self, track: Onsets, disagree: float,
+                   match: float) -> tuple[SensorId, str] | None:
+        offsets = track.offsets
+        if not track.found:
+            return None
+        for sensor, partner in ((track.left, track.right), (track.right, track.left)):
+            off, said = offsets[sensor], _signed(disagree, sensor)
+            # an onset read too near to measure moved at least what it says
+            agrees = off * said > 0 and abs(said) >= abs(off) - match if track.at_least[sensor] \
+                else abs(off - said) <= match
+            # (each onset counted when it was a step beyond the threshold there)
+            if agrees and off != 0.0 and abs(offsets[partner]) <= abs(off) / 2:
+                onsets = [o for o in track.found if o.sensor is sensor]
+                return sensor, say.judged_by_onsets(onsets, partner, _signed(disagree, sensor))
+        return None
+
+    def _by_mount(self, disagree: float, match: float,
+                  threshold: float) -> tuple[SensorId, str] | None:
+        last = self._mount.last
+        if last is None:
+            return None
+        for sensor, partner, (off, near), (p_off, p_near) in (
+                (SensorId.SBL, SensorId.SBR, last[1], last[0]),
+                (SensorId.SBR, SensorId.SBL, last[0], last[1])):
+            said = _signed(disagree, sensor)
+            if p_near or abs(p_off) > threshold / 2:
+                continue
+            # read too near to measure, it reads at least that much short
+            if (near and said <= off) or (not near and abs(off) >= threshold
+                                          and abs(off - p_off - said) <= match):
+                return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said,
+                                                   self._cfg.BACK_CLEARANCE)
+        return None
+
+    def _by_riser(self, snap: Snapshot, riser: Reference, odometer: float, yaw: float,
+                  disagree: float, within: float) -> tuple[SensorId, str] | None:
+        """The sensor the drive does not bear out: its partner reads where the
+        riser stands by the odometer, within ``within``."""
+        turn = self._lateral * (yaw - riser.yaw_rad)
+        r, left = motion.pair(snap)
+        off_r = r.distance_m - (riser.position_m - odometer - turn)
+        off_l = left.distance_m - (riser.position_m - odometer + turn)
+        for sensor, partner, off, p_off in ((SensorId.SFL, SensorId.SFR, off_l, off_r),
+                                            (SensorId.SFR, SensorId.SFL, off_r, off_l)):
+            if abs(p_off) <= within < abs(off) and abs(off) >= 2 * abs(p_off):
+                return sensor, say.judged_by_riser(sensor, partner, off, p_off, riser.tread,
+                                                   _signed(disagree, sensor))
+        return None
+
+
+def _signed(disagree: float, sensor: SensorId) -> float:
+    """The disagreement (left − right) as how far ``sensor`` reads past its partner."""
+    return disagree if sensor in (SensorId.SFL, SensorId.SBL) else -disagree
