@@ -11,8 +11,11 @@ back down:
 1. *scans* (landing 1): lifts segment 3 its whole stroke with the side pair
    looking out.  A side that, standing at the top, reads on past what it
    saw below by SIDE_JUMP_M, having first done so no lower than the lowest
-   riser the robot climbs, is the next flight's first riser; any other is a
-   wall.  The readings before the lift say how far the sides are.
+   riser the robot climbs, is the next flight's first riser, if its reading
+   moved past while the beam rose and, segment 3 lowered again, reads what it
+   read there before the lift (a sensor whose reading moved, not the beam's
+   view, would send the robot into a wall); any other is a wall.  The
+   readings before the lift say how far the sides are.
 2. *decides*: no side open, the ascent ends as at a wall (``landing_closed``);
    a landing too small for the robot to turn in (its turning circle,
    TURN_ROOM_MARGIN clear of the walls, the riser and the edge behind), it
