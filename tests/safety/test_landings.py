@@ -166,6 +166,11 @@ FAULTS = "[[faults]]\nat = {at}\nsensor = 'SSR'\nkind = '{kind}'\n{more}"
      "top_reached", 6),
     # the open side's sensor failing for good during the scan: no flight seen, home
     (1.0, "right", FAULTS.format(at=142.04, kind="error", more=""), "landing_closed", 3),
+    # the open side's sensor 0.3 m long from mid-lift: lowered again it does not
+    # read what it read there before the lift -- a sensor wrong, not the flight
+    # proven -- so no flight is taken on its word, and the landing is refused
+    (0.6, "right", FAULTS.format(at=143.0, kind="offset", more="offset = 0.3\n"),
+     "landing_closed", 3),
 ])
 def test_a_side_sensor_that_fails_or_reads_wrong_during_the_scan_is_no_reason_to_stop(
         width: float, turn: str, fault: str, end: str, steps: int) -> None:
