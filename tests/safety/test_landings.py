@@ -166,6 +166,11 @@ FAULTS = "[[faults]]\nat = {at}\nsensor = 'SSR'\nkind = '{kind}'\n{more}"
      "top_reached", 6),
     # the open side's sensor failing for good during the scan: no flight seen, home
     (1.0, "right", FAULTS.format(at=142.04, kind="error", more=""), "landing_closed", 3),
+    # the open side's sensor 0.3 m long from mid-lift: lowered again it does not
+    # read what it read there before the lift -- a sensor wrong, not the flight
+    # proven -- so no flight is taken on its word, and the landing is refused
+    (0.6, "right", FAULTS.format(at=143.0, kind="offset", more="offset = 0.3\n"),
+     "landing_closed", 3),
 ])
 def test_a_side_sensor_that_fails_or_reads_wrong_during_the_scan_is_no_reason_to_stop(
         width: float, turn: str, fault: str, end: str, steps: int) -> None:
@@ -199,3 +204,49 @@ def test_a_fault_on_a_side_sensor_the_robot_does_not_have_is_refused() -> None:
     with pytest.raises(ScenarioError) as info:
         simrun.run_sim(load_config(), scenario)
     assert info.value.field == "faults[0].sensor" and "no side pair" in str(info.value)
+
+
+@pytest.mark.parametrize("offset", [0.1, 0.3, 1.0])
+@pytest.mark.parametrize("at", [140.6, 143.0, 145.2])
+def test_a_side_reading_that_jumps_mid_scan_is_no_flight_when_lowered_it_still_reads_past(
+        at: float, offset: float) -> None:
+    """SSR (on the landing's wall side) reading ``offset`` long from ``at``,
+    while segment 3 rises above the lowest riser the robot climbs and before
+    SSL sees over the flight on the left: the jump read as a flight whose
+    first riser is lower than the left one's, and the robot turned right, into
+    the wall (every start from 140.2 to 145.4 s, for 0.1, 0.3 and 1.0 m).
+    Lowered again, SSR still reads past what it saw there before the lift:
+    not the stairs.  The robot climbs the flight SSL saw."""
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, parse_scenario(landing(extra=FAULTS.format(
+        at=at, kind="offset", more=f"offset = {offset}\n")), "jump.toml"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "top_reached", 6, 6), result.to_dict()
+    assert result.wall_contact is None and not result.fell
+    told = infos(events)
+    # the fault struck mid-scan: SSR saw over, and lowered did not read it again
+    assert any(m.startswith("landing: SSR does not read again what it saw") for m in told)
+    assert any(m.startswith("landing: the next flight is to the left") for m in told)
+
+
+@pytest.mark.parametrize(("at", "more"), [
+    # from mid-lift on
+    (142.0, "offset = 0.3\n"),
+    # for 1 s from standing at the top: never past it while rising, and what
+    # it saw again once lowered
+    (149.3, "offset = 0.3\nduration = 1.0\n"),
+])
+def test_a_side_reading_that_jumps_mid_scan_opens_no_wall(at: float, more: str) -> None:
+    """No second flight (walls on both sides and ahead): SSR 0.3 m long from
+    ``at`` -- while segment 3 rises, or only standing at the top -- read as a
+    flight, and the robot turned right, into the wall.  A side is seen over
+    only if its reading moved past what it saw while the beam rose, and still
+    reads what it saw once lowered again: it refuses the landing and comes
+    home."""
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, parse_scenario(landing(count=0, extra=FAULTS.format(
+        at=at, kind="offset", more=more)), "wall.toml"), events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "landing_closed", 3, 3), result.to_dict()
+    assert result.wall_contact is None and not result.fell
+    assert Phase.LANDING_SCAN in phases(events)

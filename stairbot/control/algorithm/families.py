@@ -97,5 +97,8 @@ class LandingTurn(Family):
     riser on the right (left), m; None: not seen over (a wall)."""
     open: list[int] = field(default_factory=list)
     """The sides that open onto a flight: +1 left, -1 right."""
+    base_m: list[float | None] = field(default_factory=lambda: [None, None])
+    """What SSR (SSL) read before the scan's lift (the median of its first
+    SCAN_BASE_M), m; None: nothing."""
     depth_m: float | None = None
     """The landing's depth, from the edge behind to the wall ahead, m."""

@@ -11,8 +11,11 @@ back down:
 1. *scans* (landing 1): lifts segment 3 its whole stroke with the side pair
    looking out.  A side that, standing at the top, reads on past what it
    saw below by SIDE_JUMP_M, having first done so no lower than the lowest
-   riser the robot climbs, is the next flight's first riser; any other is a
-   wall.  The readings before the lift say how far the sides are.
+   riser the robot climbs, is the next flight's first riser, if its reading
+   moved past while the beam rose and, segment 3 lowered again, reads what it
+   read there before the lift (a sensor whose reading moved, not the beam's
+   view, would send the robot into a wall); any other is a wall.  The
+   readings before the lift say how far the sides are.
 2. *decides*: no side open, the ascent ends as at a wall (``landing_closed``);
    a landing too small for the robot to turn in (its turning circle,
    TURN_ROOM_MARGIN clear of the walls, the riser and the edge behind), it
@@ -37,7 +40,7 @@ from typing import Any
 
 from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.families import LandingTurn
-from stairbot.control.algorithm.landing_scan import LEFT, RIGHT, SCAN
+from stairbot.control.algorithm.landing_scan import LEFT, RIGHT, SCAN, recheck
 from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.moves import lift, reading_drive
 from stairbot.control.algorithm.phase import (
@@ -52,7 +55,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.texts import landing as say
-from stairbot.control.algorithm.work import DriveWork, LiftWork
+from stairbot.control.algorithm.work import DriveWork, LiftWork, RecheckWork
 from stairbot.hardware import MotorId
 from stairbot.inputs.config import RobotConfig
 
@@ -166,14 +169,16 @@ def _refuse(t: Tick, why: AscentEnd, message: str) -> Step:
     return go("refused")
 
 
-_scan_lower = lift(_lower_deltas, _decide)
+_scan_lower = lift(_lower_deltas, recheck(_decide))
 SCAN_LOWER = PhaseDef(
     P.LANDING_SCAN_LOWER, "landing 1 — lower segment 3; which way is open?", FLOW,
-    _scan_lower[1], LiftWork, enter=_scan_lower[0], carried_by=(1, 2), family=LandingTurn,
-    on={"room_to_turn": Exit(P.LANDING_CENTRE, "lowered; a side seen over, and room to turn"),
-        "refused": Exit(P.DESCENT_BACK_OFF, "lowered; no side seen over (landing_closed), or "
-                                            "too little room to turn (landing_too_small): the "
-                                            "descent begins"),
+    _scan_lower[1], RecheckWork, enter=_scan_lower[0], carried_by=(1, 2), family=LandingTurn,
+    on={"room_to_turn": Exit(P.LANDING_CENTRE, "lowered, a side seen over reads again what it "
+                                               "read there before the lift; room to turn"),
+        "refused": Exit(P.DESCENT_BACK_OFF, "lowered; no side seen over that reads again what "
+                                            "it read there before the lift (landing_closed), "
+                                            "or too little room to turn (landing_too_small): "
+                                            "the descent begins"),
         FAILED: Exit(P.ERROR, FAULT)})
 
 

@@ -5,6 +5,7 @@ decides what it found)."""
 from __future__ import annotations
 
 import statistics
+from collections.abc import Callable
 
 from stairbot.control.algorithm import limits, motion
 from stairbot.control.algorithm.families import LandingTurn
@@ -22,7 +23,7 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.texts import landing as say
-from stairbot.control.algorithm.work import ScanWork
+from stairbot.control.algorithm.work import RecheckWork, ScanWork
 from stairbot.control.tolerances import side_settle_s
 from stairbot.hardware import SIDE_SENSORS, MotorId, SensorReading, SensorStatus
 
@@ -131,21 +132,60 @@ def _record(t: Tick, w: ScanWork) -> Step:
     # met something it then lost: a fault, not a flight -- a side sensor
     # reading long from just above the landing would otherwise send the robot
     # turning to a wall)
-    lifted = _lifted_m(t, w)
-    seen_at = [lifted if o is None else o for o in w.side_open]
+    # The beam must have begun to read past it while rising: standing, nothing
+    # moves that could let it see over anything (a reading that changes there
+    # is the sensor's doing).
+    seen_at = w.side_open
     low = limits.min_step_rise_m(cfg) - cfg.sensors.side_height - SCAN_BASE_M
     opened = [bases[i] is not None and 2 * w.side_top[i] > SCAN_TOP_TICKS
-              and seen_at[i] >= low for i in (0, 1)]
-    turn.rise_m = [seen_at[i] + cfg.sensors.side_height if opened[i] else None
-                   for i in (0, 1)]
+              and (o := seen_at[i]) is not None and o >= low for i in (0, 1)]
+    turn.base_m = bases
+    turn.rise_m = [o + cfg.sensors.side_height if opened[i] and (o := seen_at[i]) is not None
+                   else None for i in (0, 1)]
     turn.open = [s for i, s in ((0, RIGHT), (1, LEFT)) if opened[i]]
     for i, sid in enumerate(SIDE_SENSORS):
-        if opened[i]:
-            base = bases[i]
-            assert base is not None  # opened only on a side seen
-            t.say(say.side_sees_over(sid.value, i == 0, base, seen_at[i]),
+        base, at = bases[i], seen_at[i]
+        if opened[i] and base is not None and at is not None:
+            t.say(say.side_sees_over(sid.value, i == 0, base, at),
                   sensor=sid.value, base=base)
     return go("scanned")
+
+
+# -- landing 1: lowered, the sides seen over read again ----------------------------------
+def recheck(done: Callable[[Tick, RecheckWork], Step]) -> Callable[[Tick, RecheckWork], Step]:
+    """Segment 3 lowered again, before ``done`` (the decision): standing once
+    the side pair's filter has settled, each side seen over is read
+    SCAN_TOP_TICKS ticks.  The beam is back where it read before the lift,
+    below the riser it saw over, and nothing else moved: it must read what it
+    read there (within SIDE_JUMP_M) on most of them.  One that does not was
+    not seeing over the stairs -- its reading moved, not the beam's view (an
+    offset that began mid-scan read as a flight: the robot turned into a
+    wall) -- and is no flight."""
+
+    def step(t: Tick, w: RecheckWork) -> Step:
+        turn = t.ctx.family_of(LandingTurn)
+        if not turn.open:
+            return done(t, w)
+        if not stood(t, w, side_settle_s(t.cfg)):
+            return stay(NO_MOTION)
+        for i, sid in enumerate(SIDE_SENSORS):
+            base = turn.base_m[i]
+            d = _side(t.snap.sensors[sid])
+            if base is not None and d is not None and abs(d - base) < SIDE_JUMP_M:
+                w.side_back[i] += 1
+        w.side_ticks += 1
+        if w.side_ticks < SCAN_TOP_TICKS:
+            return stay(NO_MOTION)
+        for i, (sid, side) in enumerate(zip(SIDE_SENSORS, (RIGHT, LEFT), strict=True)):
+            base = turn.base_m[i]
+            if side in turn.open and base is not None and 2 * w.side_back[i] <= SCAN_TOP_TICKS:
+                turn.open.remove(side)
+                turn.rise_m[i] = None
+                t.say(say.side_not_back(sid.value, i == 0, base, w.side_back[i],
+                                        SCAN_TOP_TICKS), sensor=sid.value, base=base)
+        return done(t, w)
+
+    return step
 
 
 SCAN = PhaseDef(

@@ -288,3 +288,16 @@ class ScanWork(LiftWork):
     """Ticks standing at the top on which SSR (SSL) read past it."""
     side_ticks: int = 0
     """Ticks read standing at the top."""
+
+
+@dataclass
+class RecheckWork(LiftWork):
+    """Landing 1's lowering: segment 3 back down, the sides it saw over read
+    again where they read before the lift."""
+
+    still_since: float | None = None
+    side_back: list[int] = field(default_factory=lambda: [0, 0])
+    """Ticks standing lowered on which SSR (SSL) read what it read before the
+    lift."""
+    side_ticks: int = 0
+    """Ticks read standing lowered."""

@@ -18,6 +18,14 @@ def side_sees_over(sensor: str, on_right: bool, base: float, seen_at: float) -> 
             f"standing at the top: the next flight")
 
 
+def side_not_back(sensor: str, on_right: bool, base: float, back: int, ticks: int) -> str:
+    return (f"landing: {sensor} does not read again what it saw on the "
+            f"{'right' if on_right else 'left'} ({base:.3f} m) with segment 3 lowered "
+            f"where it read it ({back} of {ticks} readings): what it saw over was its "
+            "reading moving, not the stairs (a sensor fault?); no flight on the "
+            f"{'right' if on_right else 'left'}")
+
+
 def no_next_flight(right: float | None, left: float | None) -> str:
     return ("landing: no next flight to either side (SSR "
             f"{_said(right)}, SSL {_said(left)}: walls, or nothing, that segment "
