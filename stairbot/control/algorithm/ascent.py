@@ -248,11 +248,21 @@ LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
     lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)}, P.ASCENT_DRIVE_SECOND, (1, 3))
 
+def _driven_second(t: Tick, w: DriveWork) -> Step:
+    # by turns, segment 2 ends 10-15 mm further on than by a reading (ascent 5
+    # slid the robot forward, which the wheels do not count), and so does the
+    # tab ascent 7 reads there: descent 3 and 5 go by turns off this step
+    i = t.ctx.number_of_steps
+    if i < len(t.ctx.second_by_turns):
+        t.ctx.second_by_turns[i] = w.target_reading is None
+    return go("reached")
+
+
 DRIVE_SECOND = drive_phase(
     P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, 1, _second_target,
     lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE, P.ASCENT_LIFT_THIRD,
     "reads length_of_next_step − LENGTH_OF_FIRST_MODULE − LENGTH_OF_SECOND_MODULE "
-    "(or turns made)", work=DriveWork)
+    "(or turns made)", _driven_second, work=DriveWork)
 
 
 def _lifted_third(t: Tick, _w: LiftWork) -> Step:
