@@ -13,7 +13,6 @@ sensor's rows of zones, and tilt a mount: :func:`model_for`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 from typing import Any
 
@@ -50,13 +49,14 @@ VL53L0X = _from(specs.VL53L0X, rays=5, rays_across=3, aggregate="weighted",
                 outlier_rate=0.005, dropout_rate=0.01, weak_range=1.2)
 
 # HC-SR04: the first echo wins ("nearest"): 7 rays up the cone, 3 across.
-# Incidence-angle loss (assumed, not in the datasheet; its "Attention" notes
-# ask for a target of at least 0.5 m^2, as smooth as possible): a ray meeting
-# its surface more than 10 degrees off the normal returns no echo, so the
-# 15-degree cone hears a surface turned up to about 17 degrees from its axis.
-# Assumed: 1 % outliers (cross-talk, multipath), 1 % dropouts (no echo).
+# Incidence-angle loss as the spec states it (echo_incidence_deg, assumed): a
+# ray meeting its surface more than 10 degrees off the normal returns no
+# echo, so the 15-degree cone hears a surface turned up to about 17 degrees
+# from its axis.  Assumed: 1 % outliers (cross-talk, multipath), 1 % dropouts
+# (no echo).
 HCSR04 = _from(specs.HCSR04, rays=7, rays_across=3, aggregate="nearest",
-               outlier_rate=0.01, dropout_rate=0.01, max_incidence_deg=10.0)
+               outlier_rate=0.01, dropout_rate=0.01,
+               max_incidence_deg=specs.HCSR04.echo_incidence_deg)
 
 # GP2Y0A21: a narrow spot, 3 rays in the side view.  Assumed: 0.2 % outliers;
 # no dropouts (an analog output has no status).
@@ -113,28 +113,11 @@ def model_for(sensors: Sensors, back: bool) -> SensorModel:
     return model
 
 
-ROW_SWITCH_PITCH_DEG = 2.0
-"""Pitched nose down by more than this (segment 2, as the sensor board's IMU
-reads it), the board publishes a multizone pair's block of zones moved up
-by whole rows (:func:`rows_up`): a level row pitched down looks at the
-tread or floor ahead (5 degrees down from 3 cm: 0.34 m), as happens from
-ascent 5 to 7.  Within it, the lowest rays meet the floor beyond 0.86 m at
-a grazing angle: too weak a return to read."""
-
-
-def rows_up(pitch_deg: float, zone_deg: float) -> int:
-    """Rows the board moves a block of zones up at ``pitch_deg`` (+ nose
-    up): none within :data:`ROW_SWITCH_PITCH_DEG` of level, else one per
-    ``zone_deg`` of nose-down pitch beyond it, rounded up."""
-    if pitch_deg >= -ROW_SWITCH_PITCH_DEG:
-        return 0
-    return math.ceil((-pitch_deg - ROW_SWITCH_PITCH_DEG) / zone_deg)
-
-
 def front_blocks(sensors: Sensors) -> tuple[SensorModel, ...]:
     """The front pair's model as mounted (:func:`model_for`), then, for a
     multizone sensor, the same block moved up 1, 2, ... rows while it stays
-    within the sensor's field: what :func:`rows_up` chooses from."""
+    within the sensor's field: what
+    :func:`~stairbot.inputs.sensor_specs.rows_up` chooses from."""
     model = model_for(sensors, back=False)
     spec = specs.SPECS[sensors.front_model]
     if not spec.zones:

@@ -8,8 +8,8 @@ through the sensor models (:mod:`stairbot.fakes.sensor_model`, one preset per
 pair from the config's ``[sensors] front_model`` / ``back_model``; the cones'
 rays are cast by :mod:`stairbot.fakes.beams`; a multizone front pair's board
 publishes its block of zones moved up a row or more while segment 2 pitches
-nose down, :func:`~stairbot.fakes.sensor_presets.rows_up`).  A robot with the side pair
-(``[sensors] side_model``) also reads SSR/SSL: one level ray each from
+nose down, :func:`~stairbot.inputs.sensor_specs.rows_up`).  A robot with the
+side pair (``[sensors] side_model``) also reads SSR/SSL: one level ray each from
 segment 3 (``side_from_rear`` from its rear, ``side_height`` above its wheels'
 contact line: lifting segment 3 raises them), square to the heading, to the
 right and to the left, cast against the stairwell's faces in flight 1's frame
@@ -36,11 +36,12 @@ from stairbot.fakes.beams import down_fans, front_hits, total_weight
 from stairbot.fakes.landing import Stairwell
 from stairbot.fakes.plan import Plan
 from stairbot.fakes.sensor_model import Hit, ModelSensor, SensorModel, combine
-from stairbot.fakes.sensor_presets import front_blocks, model_for, preset, rows_up
+from stairbot.fakes.sensor_presets import front_blocks, model_for, preset
 from stairbot.fakes.world import World
 from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario
+from stairbot.inputs.sensor_specs import rows_up
 
 _SFR, _SFL, _SBR, _SBL = SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL  # bound once
 _SSR, _SSL = SensorId.SSR, SensorId.SSL

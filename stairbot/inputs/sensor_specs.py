@@ -14,6 +14,7 @@ match :data:`stairbot.inputs.config.SensorModelName` (a test checks).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 
@@ -42,6 +43,10 @@ class SensorSpec:
     zones: int = 0
     """A multizone sensor's zones along each side of its square field (8: an
     8x8 grid, each zone ``fov_deg / zones`` square); 0: one zone, the cone."""
+    echo_incidence_deg: float | None = None
+    """A ranger that hears a surface only where its ray meets it within this
+    many degrees of the surface's normal (an ultrasonic ranger: a smooth
+    floor at a graze returns no echo); None: any surface in the cone counts."""
 
     @property
     def zone_deg(self) -> float:
@@ -86,9 +91,12 @@ VL53L0X = SensorSpec(name="vl53l0x", period_s=0.030, latency_s=0.030, noise_a=0.
 # - Latency: the echo pulse lasts up to ~23 ms at 4 m: assumed 25 ms.
 # - Assumed sigma = 2 mm + 0.3 % of the distance.
 # - The first echo back ends the measurement: the nearest surface in the cone.
+# - Incidence (assumed, not in the datasheet; its "Attention" notes ask for a
+#   target of at least 0.5 m^2, as smooth as possible): a ray meeting its
+#   surface more than 10 degrees off the normal returns no echo.
 HCSR04 = SensorSpec(name="hcsr04", period_s=0.060, latency_s=0.025, noise_a=0.002,
                     noise_b=0.003, resolution=0.003, min_range=0.02, max_range=4.0,
-                    fov_deg=15.0, first_echo=True)
+                    fov_deg=15.0, first_echo=True, echo_incidence_deg=10.0)
 
 # Sharp GP2Y0A21YK0F infrared triangulation ranger (analog output).
 # - Datasheet "Electro-optical Characteristics": 10 to 80 cm; "Timing chart":
@@ -118,3 +126,23 @@ VL53L5CX = SensorSpec(name="vl53l5cx", period_s=1.0 / 15.0, latency_s=1.0 / 15.0
 
 SPECS: dict[str, SensorSpec] = {s.name: s for s in (IDEAL, VL53L1X, VL53L0X, HCSR04, GP2Y0A21,
                                                    VL53L5CX)}
+
+
+ROW_SWITCH_PITCH_DEG = 2.0
+"""Pitched nose down by more than this (segment 2, as the sensor board's IMU
+reads it), the board publishes a multizone pair's block of zones moved up
+by whole rows (:func:`rows_up`): a level row pitched down looks at the
+tread or floor ahead (5 degrees down from 3 cm: 0.34 m), as happens from
+ascent 5 to 7.  Within it, the lowest rays meet the floor beyond 0.86 m at
+a grazing angle: too weak a return to read.  The simulation's board does
+this (:mod:`stairbot.fakes.sensor_presets`), and the controller reckons
+with it (:mod:`stairbot.control.algorithm.sight`)."""
+
+
+def rows_up(pitch_deg: float, zone_deg: float) -> int:
+    """Rows the board moves a block of zones up at ``pitch_deg`` (+ nose
+    up): none within :data:`ROW_SWITCH_PITCH_DEG` of level, else one per
+    ``zone_deg`` of nose-down pitch beyond it, rounded up."""
+    if pitch_deg >= -ROW_SWITCH_PITCH_DEG:
+        return 0
+    return math.ceil((-pitch_deg - ROW_SWITCH_PITCH_DEG) / zone_deg)

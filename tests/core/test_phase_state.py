@@ -22,7 +22,8 @@ from stairbot.inputs.scenario import load_scenario
 SEED = ("length_of_next_step", "number_of_vertical_turns", "number_of_turns_for_step_height",
         "number_of_steps", "tab_length_to_edge")
 PROGRESS = ("phase", "phase_started_s", "from_top", "steps_descended", "pauses", "ascent_end",
-            "outcome", "error", "end_reason", "tread_length", "climb_twist", "third_in_air",
+            "outcome", "error", "end_reason", "tread_length", "climb_twist", "second_by_turns",
+            "third_in_air",
             "riser_wheel", "start", "descent", "landing", "limp", "watch", "pause")
 PRESENT = ("family", "work")
 

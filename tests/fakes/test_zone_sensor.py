@@ -12,14 +12,8 @@ import pytest
 from stairbot.control.robot_config import parse_config
 from stairbot.errors import ConfigError
 from stairbot.fakes.sensor_model import Cause, SensorModel, combine
-from stairbot.fakes.sensor_presets import (
-    ROW_SWITCH_PITCH_DEG,
-    VL53L5CX,
-    front_blocks,
-    model_for,
-    rows_up,
-)
-from stairbot.inputs.sensor_specs import SPECS
+from stairbot.fakes.sensor_presets import VL53L5CX, front_blocks, model_for
+from stairbot.inputs.sensor_specs import ROW_SWITCH_PITCH_DEG, SPECS, rows_up
 
 ROW_ABOVE_AXIS = """extends = "reference"
 [sensors]

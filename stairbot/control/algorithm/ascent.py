@@ -13,7 +13,7 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import long_tread, lost, motion
+from stairbot.control.algorithm import long_tread, lost, motion, sight
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.lift_first import (
     LIFT_FIRST,
@@ -180,16 +180,38 @@ APPROACH_TURNS = PhaseDef(
 
 
 # -- ascent 4-7: segment by segment onto the step -------------------------------------------
-def _first_target(t: Tick) -> float | None:
+def _reading_length(t: Tick, ahead_m: float, segment_2_lifted: bool = False) -> float | None:
+    """length_of_next_step for a drive onto the step that starts with the
+    next riser length - ``ahead_m`` away to end at a reading
+    (long_tread.near_length), or None (by turns): also when the front pair,
+    at the pitch the robot stands at, meets the tread before that riser
+    (:mod:`~stairbot.control.algorithm.sight`): it would read the tread,
+    which rides along with the robot, and end the drive short."""
     length = long_tread.near_length(t)
+    if length is None:
+        return None
+    cfg = t.cfg
+    pitch = sight.pitch_now(cfg, t.snap, segment_2_lifted)
+    riser = length - ahead_m
+    if sight.riser_in_sight(cfg, riser, pitch):
+        return length
+    t.say(say.riser_out_of_sight(t.ctx.number_of_steps, riser, pitch,
+                                 sight.floor_sight_m(cfg, pitch)),
+          riser_m=riser, pitch_deg=pitch, by_turns=True)
+    return None
+
+
+def _first_target(t: Tick) -> float | None:
+    length = _reading_length(t, 0.0)
     return None if length is None else length - t.cfg.LENGTH_OF_FIRST_MODULE
 
 
 def _second_target(t: Tick) -> float | None:
-    length = long_tread.near_length(t)
+    cfg = t.cfg
+    length = _reading_length(t, cfg.LENGTH_OF_FIRST_MODULE, segment_2_lifted=True)
     if length is None:
         return None
-    return length - t.cfg.LENGTH_OF_FIRST_MODULE - t.cfg.LENGTH_OF_SECOND_MODULE
+    return length - cfg.LENGTH_OF_FIRST_MODULE - cfg.LENGTH_OF_SECOND_MODULE
 
 
 def _third_target(t: Tick) -> float | None:
@@ -197,11 +219,11 @@ def _third_target(t: Tick) -> float | None:
     the robot does not fit on), no nearer the next riser than a tread of
     min_tread_m would leave it (SAFE_LENGTH and the approach's gap): segment
     3 stays in the air over the step below.  None (by turns) past
-    FAR_TREAD_M, as for ascent 4 and 6."""
-    length = long_tread.near_length(t)
+    FAR_TREAD_M, or out of the front pair's sight, as for ascent 4 and 6."""
+    cfg = t.cfg
+    length = _reading_length(t, cfg.LENGTH_OF_FIRST_MODULE + cfg.LENGTH_OF_SECOND_MODULE)
     if length is None:
         return None
-    cfg = t.cfg
     return max(length - cfg.LENGTH_OF_A_ROBOT, cfg.SAFE_LENGTH + cfg.algorithm.approach_gap)
 
 
@@ -226,11 +248,21 @@ LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,
     lambda t, _w: {MotorId.MTF: -_h(t), MotorId.MTB: -_h(t)}, P.ASCENT_DRIVE_SECOND, (1, 3))
 
+def _driven_second(t: Tick, w: DriveWork) -> Step:
+    # by turns, segment 2 ends 10-15 mm further on than by a reading (ascent 5
+    # slid the robot forward, which the wheels do not count), and so does the
+    # tab ascent 7 reads there: descent 3 and 5 go by turns off this step
+    i = t.ctx.number_of_steps
+    if i < len(t.ctx.second_by_turns):
+        t.ctx.second_by_turns[i] = w.target_reading is None
+    return go("reached")
+
+
 DRIVE_SECOND = drive_phase(
     P.ASCENT_DRIVE_SECOND, "ascent 6 — drive segment 2 onto the step", FLOW, 1, _second_target,
     lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_SECOND_MODULE, P.ASCENT_LIFT_THIRD,
     "reads length_of_next_step − LENGTH_OF_FIRST_MODULE − LENGTH_OF_SECOND_MODULE "
-    "(or turns made)", work=DriveWork)
+    "(or turns made)", _driven_second, work=DriveWork)
 
 
 def _lifted_third(t: Tick, _w: LiftWork) -> Step:
@@ -247,13 +279,35 @@ def _lifted_third(t: Tick, _w: LiftWork) -> Step:
     return go("turns_made")
 
 
+LIFT_THIRD_MAX_PITCH_DEG = 3.0
+"""Ascent 7: segment 2's most nose-up pitch while segment 3 rises.  Lifting
+segment 3 only levels a robot that ascent 5 left nose down (-4.5 degrees on
+the shipped robots, to about 0 at the lift's end); one whose segment 2 did
+not reach the step (its rear axle behind the nosing) pitches on past level
+as segment 3 rises, the nosing a fulcrum, until it tips back off the edge
+(the ir robot on a 0.48 m tread: -4.5 to +10.5 degrees, then the fall
+faster than the tilt stop at 15 degrees could hold it; stopped at +3 degrees
+it stood, segment 3 still on the tread below: docs/envelope.md, "Reach").
+Healthy climbs end ascent 7 at +0.1 to +0.3 degrees."""
+
+
+def _lift_third(t: Tick, w: LiftWork) -> Step:
+    imu, cfg = t.snap.imu, t.cfg
+    if cfg.safety.imu and imu is not None and imu.pitch_deg > LIFT_THIRD_MAX_PITCH_DEG:
+        # the supervisor's tilt watch has ended the run on a pitch that is
+        # not a number, and on a stale IMU the controller holds
+        return fail(say.tipping_back(t.ctx.number_of_steps, imu.pitch_deg,
+                                     LIFT_THIRD_MAX_PITCH_DEG))
+    return _lift3[1](t, w)
+
+
 _lift3 = lift(lambda t, _w: {MotorId.MTB: _h(t)}, _lifted_third)
 LIFT_THIRD = PhaseDef(
-    P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift3[1], LiftWork, enter=_lift3[0],
-    watches="front", carried_by=(1, 2),
+    P.ASCENT_LIFT_THIRD, "ascent 7 — lift segment 3", FLOW, _lift_third, LiftWork,
+    enter=_lift3[0], watches="front", carried_by=(1, 2),
     on={"turns_made": Exit(P.ASCENT_CHECK, "turns made; tab_length_to_edge[i] stored, "
                                            "number_of_steps + 1"),
-        FAILED: Exit(P.ERROR, FAULT)})
+        FAILED: Exit(P.ERROR, f"{say.TIPPING_BACK_EDGE}; {FAULT}")})
 
 
 # -- ascent 8-9: the top, or the next step ------------------------------------------------------

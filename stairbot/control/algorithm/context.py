@@ -38,6 +38,10 @@ def _empty_tab() -> list[float | None]:
     return [None] * TAB_SIZE
 
 
+def _empty_flags() -> list[bool | None]:
+    return [None] * TAB_SIZE
+
+
 CONTEXT_VERSION = 2
 """The shape of :meth:`Context.to_dict`; a journal names the version of the
 contexts it holds, and one of another version is refused, not misread.
@@ -181,6 +185,10 @@ class Context:
     """Per step (0-based, as tab_length_to_edge): the heading by the odometer
     the robot climbed it with (where ascent 1's calibration left it).
     Descent 1 turns back to it, so that the way down retraces the way up."""
+    second_by_turns: list[bool | None] = field(default_factory=_empty_flags)
+    """Per step (0-based): ascent 6 drove segment 2 onto it by turns (a
+    tread past FAR_TREAD_M, the top, or a riser out of the front pair's
+    sight).  Descent 3 and 5 go by turns off it too."""
     third_in_air: bool = False
     """Narrow steps: segment 3 hangs in the air over the step below (it did
     not fit on the tread): it carries nothing, and the static-stability
@@ -269,7 +277,7 @@ class Context:
         return ctx
 
 
-_PER_STEP = ("tab_length_to_edge", "climb_twist", "tread_length")
+_PER_STEP = ("tab_length_to_edge", "climb_twist", "tread_length", "second_by_turns")
 """The context's lists with one entry per step (TAB_SIZE long)."""
 
 MAX_ABS = 1e9

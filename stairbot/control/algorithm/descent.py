@@ -257,13 +257,20 @@ edge, to pitch the robot to the tilt stop (the Sharp pair at 0.34 m,
 
 
 def _tab_to_drive(t: Tick) -> float | None:
-    """The tab descent 3 and 5 drive to, or None: by turns (FAR_TAB_M; or a
-    tread past FAR_TREAD_M, which the ascent drove onto by turns: its tab,
+    """The tab descent 3 and 5 drive to, or None: by turns (FAR_TAB_M; a
+    step whose ascent 6 went by turns, ``second_by_turns``: its tab was read
+    with segment 2 10-15 mm further on than a reading drive leaves it, and
+    descent 5, placing segment 1 there, left its front wheel on the nosing
+    (a nose-down pitch-rate stop lowering it, ir robot, treads 0.36-0.42 m);
+    or a tread past FAR_TREAD_M, which the ascent drove onto by turns: its tab,
     0.35 to 0.45 m on treads of 0.5 to 0.6 m, read with the cone over a
     riser lower than min_rise_for, jumps 22-27 mm as the robot backs, and
     descent 3 or 5 would end short enough to pitch segment 2 to the tilt
     stop)."""
     tab = step_tab(t)
+    i = t.descent_index
+    if 0 <= i < len(t.ctx.second_by_turns) and t.ctx.second_by_turns[i]:
+        return None
     if tab is None or tab > FAR_TAB_M or long_tread.far(step_tread(t)) \
             or t.cfg.sensors.sigma(False, tab) > TAB_SIGMA_MAX_M:
         return None

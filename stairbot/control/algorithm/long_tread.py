@@ -33,7 +33,9 @@ from stairbot.control.algorithm.work import SightWork
 
 FAR_TREAD_M = 0.5
 """A length_of_next_step longer than this: ascent 4, 6 and 9 drive by turns,
-and ascent 3 judges a rise below min_rise_for by :func:`steady`."""
+and ascent 3 judges a rise below min_rise_for by :func:`steady`.  (Nearer,
+they drive by turns too where the front pair, pitched as the robot stands,
+meets the tread before the riser: :mod:`~stairbot.control.algorithm.sight`.)"""
 
 STEADY_MIN_M = 0.010
 STEADY_SIGMAS = 2.0

@@ -97,12 +97,32 @@ def length_of_next_step(length: float, far: bool, far_tread_m: float) -> str:
                "go by turns)" if far else ""))
 
 
+def riser_out_of_sight(steps: int, riser: float, pitch_deg: float, sight_m: float) -> str:
+    return (f"step {steps + 1}: the next riser, {riser:.3f} m ahead, is beyond where the "
+            f"front pair meets the tread at pitch {pitch_deg:+.1f}° ({sight_m:.3f} m): the "
+            "pair would read the tread; the drive goes by turns")
+
+
 LENGTH_NOT_MEASURABLE = ("length_of_next_step not measurable (nothing ahead within "
                          "LENGTH_OF_INFINITY): driving "
                          "NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE turns")
 
 
 # -- ascent 7-8: the tab, the top -------------------------------------------------------
+TIPPING_BACK = "tipping back off the step"
+"""How the reason of ascent 7's pitch stop begins (as "unstable lift", "tilt")."""
+TIPPING_BACK_EDGE = "segment 2 pitches nose up past LIFT_THIRD_MAX_PITCH_DEG"
+"""Its condition on ascent 7's edge to the error, in the flowcharts."""
+
+
+def tipping_back(steps: int, pitch_deg: float, limit_deg: float) -> str:
+    return (f"{TIPPING_BACK}: segment 2 pitches {pitch_deg:+.1f}° nose up while segment 3 "
+            f"rises (ascent 7, step {steps + 1}), more than the {limit_deg:+g}° a robot on "
+            "the step levels to: segment 2 is not on the step, its rear over the nosing, and "
+            "lifting segment 3 on would tip the robot back over the edge; every motor "
+            "stopped, lifts holding")
+
+
 def tab_length(i: int, tab: float) -> str:
     return f"tab_length_to_edge[{i}] = {tab:.3f} m"
 
