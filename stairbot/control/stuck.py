@@ -41,7 +41,9 @@ sensor reads as ERROR (:meth:`StuckWatch.judge`), with why, until its value
 changes: a
 sensor the phase needs then stands the robot and, if it stays so, is lost
 (the limp home of :mod:`~stairbot.control.algorithm.limp`).  The side pair
-is not judged (nothing limps home on it).
+is not judged (nothing limps home on it).  The algorithm may judge one
+stuck too (:meth:`StuckWatch.distrust`), on what only it knows: the
+calibration's turn, descent 1's square heading.
 """
 
 from __future__ import annotations
@@ -204,6 +206,15 @@ class StuckWatch:
                 age = raw.age_s if held is None else held.age_s
                 seen[sid] = SensorReading(run.value[0], SensorStatus.ERROR, age)
                 why[sid] = run.why
+
+    def distrust(self, sid: SensorId, why: str) -> None:
+        """Judge ``sid`` stuck for ``why``, a reason the algorithm found (a
+        value held through a turn its partner saw, a crossing it missed): as
+        the rules' own judgment, it holds while the value does.  A sensor
+        with no value now reads as ERROR already."""
+        run = self._runs.get(sid)
+        if run is not None and run.why is None:
+            run.why = why
 
     def _moved(self, snap: Snapshot, now: float) -> None:
         """Add what every wheel drove alike this tick to the odometer, and
