@@ -101,10 +101,11 @@ def _follow(t: Tick, w: TurnWork) -> None:
     (a distance, or "nothing within range" or "too near" at the clamp), and
     how far each has moved from it."""
     now = [(r.distance_m, r.status is not SensorStatus.ERROR) for r in motion.pair(t.snap)]
-    w.turn_held = tuple(h and ok and d == f for h, (d, ok), f  # type: ignore[assignment]
-                        in zip(w.turn_held, now, w.turn_first, strict=True))
-    w.turn_moved = tuple(max(m, abs(d - f)) if ok else m  # type: ignore[assignment]
-                         for m, (d, ok), f in zip(w.turn_moved, now, w.turn_first, strict=True))
+    held = [h and ok and d == f for h, (d, ok), f in zip(w.turn_held, now, w.turn_first,
+                                                          strict=True)]
+    moved = [max(m, abs(d - f)) if ok else m
+             for m, (d, ok), f in zip(w.turn_moved, now, w.turn_first, strict=True)]
+    w.turn_held, w.turn_moved = (held[0], held[1]), (moved[0], moved[1])
 
 
 def _held_through(t: Tick, w: TurnWork, made: float) -> Step | None:
