@@ -88,6 +88,11 @@ nearer than FLOOR_SHARE of the distance at which the lowest ray would meet
 the floor the robot stands on (:meth:`StuckWatch._floor_m`).  Without an
 IMU the pitch is not known: the rule does not hold."""
 FLOOR_SHARE = 0.8
+HELD_SIGMAS = 2.0
+"""The algorithm's judgment (:meth:`StuckWatch.distrust`) of a sensor holding
+a distance needs a stated sigma of this many steps of its rounding: a sensor
+that is not stuck then repeats a value by chance about one measurement in 7,
+REPEATS in a row about once in 10^5."""
 PARTNER_JUMP_M = 0.02
 """A partner's filtered reading that moves more than this from one tick to
 the next jumped (onto another surface, or its own fault began): its moves
@@ -207,14 +212,25 @@ class StuckWatch:
                 seen[sid] = SensorReading(run.value[0], SensorStatus.ERROR, age)
                 why[sid] = run.why
 
-    def distrust(self, sid: SensorId, why: str) -> None:
+    def distrust(self, sid: SensorId, why: str) -> bool:
         """Judge ``sid`` stuck for ``why``, a reason the algorithm found (a
-        value held through a turn its partner saw, a crossing it missed): as
-        the rules' own judgment, it holds while the value does.  A sensor
-        with no value now reads as ERROR already."""
+        value held through a turn its partner saw, a crossing it missed), if
+        its measurements say so too: its value held REPEATS measurements in
+        a row, and, a distance, at a stated sigma of HELD_SIGMAS steps of
+        its rounding or more (a noiseless sensor holds a value by right).
+        As the rules' own judgment, it holds while the value does.  Whether
+        it was judged: the algorithm's reason alone may as well be its
+        partner's fault (a partner reading long reads a drop early)."""
         run = self._runs.get(sid)
-        if run is not None and run.why is None:
-            run.why = why
+        if run is None or run.why is not None or run.count < REPEATS:
+            return False
+        value, kind = run.value
+        spec = self._cfg.sensors.spec(sid in BACK_SENSORS)
+        resolution = spec.resolution or self._cfg.sensors.resolution
+        if kind == OK and spec.sigma(value, self._cfg.sensors.noise) < HELD_SIGMAS * resolution:
+            return False
+        run.why = why
+        return True
 
     def _moved(self, snap: Snapshot, now: float) -> None:
         """Add what every wheel drove alike this tick to the odometer, and

@@ -105,9 +105,12 @@ def fail(reason: str) -> Step:
 
 def distrust(sensor: SensorId, why: str) -> Step:
     """Stop (this tick) in this phase: ``sensor`` reads wrong, for ``why``.
-    Perception reads it as ERROR from the next tick on while its value holds
+    If its measurements held one value, perception reads it as ERROR from
+    the next tick on while that value holds
     (:meth:`~stairbot.control.perception.Perception.distrust`), as it does a
-    stuck one: the sensor hold stands the robot, and it is then lost."""
+    stuck one: the sensor hold stands the robot, and it is then lost.  If
+    not, the phase goes on, and must not ask again (it ends the run as it
+    would have)."""
     return Step(NO_MOTION, wrong=(sensor, why))
 
 
