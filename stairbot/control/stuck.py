@@ -118,7 +118,7 @@ Value = tuple[float, int]
 """A reading as this watch takes it: the distance and its kind."""
 
 
-def held_repeats(cfg: RobotConfig, back: bool, distance_m: float) -> float:
+def held_repeats(cfg: RobotConfig, back: bool, distance_m: float) -> int:
     """Measurements of one distance in a row that a sensor that is not
     stuck gives with a chance of HELD_CHANCE, the surface not moving: two
     readings of a stated sigma s rounded to steps r are equal about

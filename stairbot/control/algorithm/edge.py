@@ -62,9 +62,10 @@ def _off_climb_heading(t: Tick) -> float | None:
 
 def edge_stopped(w: EdgeWork) -> Step:
     """The step's answer to the watch's stop (``w.edge_stop``): a back
-    sensor judged wrong is distrusted, and the step goes on (it is lost and
-    the robot limps home on its partner, whose crossing the watch placed);
-    else the program ends with the error."""
+    sensor judged wrong is distrusted, and the step goes on (if perception
+    judges it so, it is lost and the robot limps home on its partner: the
+    watch finds the floor again and the edge with the survivor); else the
+    program ends with the error."""
     stop, wrong = w.edge_stop, w.edge_wrong
     assert stop is not None
     if wrong is None:
