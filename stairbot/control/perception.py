@@ -155,6 +155,13 @@ class Perception:
         self._stuck.judge(snap, sensors, self._why)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
+    def distrust(self, sensor: SensorId, why: str) -> bool:
+        """The algorithm found ``sensor`` reading wrong (``why``): if its
+        measurements held one value, from the next tick on it reads as ERROR
+        while that value holds, as a stuck one
+        (:meth:`~stairbot.control.stuck.StuckWatch.distrust`)."""
+        return self._stuck.distrust(sensor, why)
+
     def why(self, sensor: SensorId) -> str | None:
         """Why the sensor reads as ERROR now (stale, errors), or None."""
         return self._why.get(sensor)

@@ -41,7 +41,9 @@ sensor reads as ERROR (:meth:`StuckWatch.judge`), with why, until its value
 changes: a
 sensor the phase needs then stands the robot and, if it stays so, is lost
 (the limp home of :mod:`~stairbot.control.algorithm.limp`).  The side pair
-is not judged (nothing limps home on it).
+is not judged (nothing limps home on it).  The algorithm may judge one
+stuck too (:meth:`StuckWatch.distrust`), on what only it knows: the
+calibration's turn, descent 1's square heading.
 """
 
 from __future__ import annotations
@@ -86,6 +88,11 @@ nearer than FLOOR_SHARE of the distance at which the lowest ray would meet
 the floor the robot stands on (:meth:`StuckWatch._floor_m`).  Without an
 IMU the pitch is not known: the rule does not hold."""
 FLOOR_SHARE = 0.8
+HELD_CHANCE = 1e-5
+"""The algorithm's judgment (:meth:`StuckWatch.distrust`) of a sensor holding
+a distance takes as many measurements in a row (REPEATS at least) as make
+this the chance that one that is not stuck repeats its value so often
+standing on one surface (:func:`held_repeats`)."""
 PARTNER_JUMP_M = 0.02
 """A partner's filtered reading that moves more than this from one tick to
 the next jumped (onto another surface, or its own fault began): its moves
@@ -109,6 +116,21 @@ range" clamp."""
 
 Value = tuple[float, int]
 """A reading as this watch takes it: the distance and its kind."""
+
+
+def held_repeats(cfg: RobotConfig, back: bool, distance_m: float) -> int:
+    """Measurements of one distance in a row that a sensor that is not
+    stuck gives with a chance of HELD_CHANCE, the surface not moving: two
+    readings of a stated sigma s rounded to steps r are equal about
+    r / (2 sqrt(pi) s) of the time (for s well over r; at most 0.99 here, so
+    a noiseless sensor is never judged so).  A VL53L0X 0.04 m above a tread
+    (s 3.8 mm in 1 mm steps): REPEATS; an HC-SR04 (s 2.1 mm in 3 mm steps):
+    14."""
+    spec = cfg.sensors.spec(back)
+    resolution = spec.resolution or cfg.sensors.resolution
+    sigma = spec.sigma(distance_m, cfg.sensors.noise)
+    same = 0.99 if sigma <= 0.0 else min(0.99, resolution / (2.0 * math.sqrt(math.pi) * sigma))
+    return max(REPEATS, 1 + math.ceil(math.log(HELD_CHANCE) / math.log(same)))
 
 
 def drive_limit(cfg: RobotConfig) -> float:
@@ -204,6 +226,24 @@ class StuckWatch:
                 age = raw.age_s if held is None else held.age_s
                 seen[sid] = SensorReading(run.value[0], SensorStatus.ERROR, age)
                 why[sid] = run.why
+
+    def distrust(self, sid: SensorId, why: str) -> bool:
+        """Judge ``sid`` stuck for ``why``, a reason the algorithm found (a
+        value held through a turn its partner saw, a crossing it missed), if
+        its measurements say so too: its value held REPEATS measurements in
+        a row, a distance :func:`held_repeats` (a noiseless sensor holds a
+        value by right).
+        As the rules' own judgment, it holds while the value does.  Whether
+        it was judged: the algorithm's reason alone may as well be its
+        partner's fault (a partner reading long reads a drop early)."""
+        run = self._runs.get(sid)
+        if run is None or run.why is not None or run.count < REPEATS:
+            return False
+        value, kind = run.value
+        if kind == OK and run.count < held_repeats(self._cfg, sid in BACK_SENSORS, value):
+            return False
+        run.why = why
+        return True
 
     def _moved(self, snap: Snapshot, now: float) -> None:
         """Add what every wheel drove alike this tick to the odometer, and

@@ -66,3 +66,45 @@ def test_a_back_sensor_stuck_lowering_segment_3_is_lost_and_the_robot_comes_home
         ["SBR"], ["SBL"], "descent_lower_third")
     assert stop["failed"].startswith("SBR stuck at 0."), stop
     assert "SBL's reading went from" in stop["failed"] and "as MTB moved" in stop["failed"]
+
+
+def test_a_front_sensor_stuck_reading_nothing_from_the_top_is_lost_in_descent_1s_turn() -> None:
+    # stuck in step 2's climb, it holds "nothing within range" from the top:
+    # descent 1's squaring turn on step 1 turned 42 degrees with SFR at
+    # 1.300 m throughout while SFL moved, and the run ended on the stairs
+    r, stop = stuck(65.0, "SFR")
+    assert (r.outcome, r.steps_climbed) == ("came_home_degraded", 2), r.to_dict()
+    assert home(r), r.to_dict()
+    assert (stop["lost"], stop["survivors"], stop["phase"], stop["then"]) == (
+        ["SFR"], ["SFL"], "cal_turn", "limp_home")
+    assert stop["failed"].startswith("SFR stuck: read 1.300 m through a turn of"), stop
+    assert "while SFL went from" in stop["failed"]
+
+
+def test_a_back_sensor_stuck_on_the_floor_is_lost_when_its_partner_crosses_the_edge() -> None:
+    # stuck descending step 2, it holds the floor: descent 1 on step 1 saw
+    # SBL read the drop and SBR the floor 48 mm later, the robot square to
+    # the edge by the odometer, and the run ended on the stairs
+    r, stop = stuck(93.5, "SBR")
+    assert (r.outcome, r.steps_climbed) == ("came_home_degraded", 2), r.to_dict()
+    assert home(r), r.to_dict()
+    assert (stop["lost"], stop["survivors"], stop["then"]) == (["SBR"], ["SBL"], "limp_home")
+    assert stop["phase"].startswith("descent_"), stop
+    assert stop["failed"].startswith("SBR stuck: still reads the floor"), stop
+    assert "after SBL read the drop" in stop["failed"]
+
+
+def test_a_back_sensor_reading_long_reads_the_drop_early_and_its_partner_is_not_judged() -> None:
+    # SBL 5 cm long from descending step 2 reads the drop at step 1's edge
+    # early, SBR (right, and noisy) the floor: the edge watch's lag alone
+    # does not say which is wrong, SBR's values do not hold, and the run
+    # ends there as it did, with no sensor hold (judged on the lag alone,
+    # SBR read as ERROR for a tick, and had it held its value the robot
+    # would have limped home on the biased SBL)
+    text = TWO_STEPS + '[[faults]]\nat = 93.5\nsensor = "SBL"\nkind = "offset"\noffset = 0.05\n'
+    events: list[Event] = []
+    r = run_sim(CONFIG, parse_scenario(text, "<long>"), events, limp_home=True)
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("error", 2, 1), r.to_dict()
+    assert "SBL reads the drop, SBR still the floor" in str(r.error), r.to_dict()
+    assert not r.fell and r.pauses == 0, r.to_dict()
+    assert not [e for e in events if e.kind is EventKind.WARNING and "degraded" in e.data]

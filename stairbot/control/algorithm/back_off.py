@@ -11,6 +11,7 @@ import math
 from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.edge import (
     edge_bound,
+    edge_stopped,
     narrow_bound,
     refind,
 )
@@ -54,7 +55,7 @@ square to the edge), in both backings' records."""
 # -- descent 1: back off, calibrate, back up to the edge ---------------------------------------
 def _backed_off(t: Tick, w: EdgeWork) -> Step:
     if w.edge_stop is not None:
-        return fail(w.edge_stop)
+        return edge_stopped(w)
     if w.square_yaw is not None:
         return _turn_square(t, w)
     if t.ctx.from_top:
@@ -204,7 +205,7 @@ def _to_edge_step(t: Tick, w: EdgeWork) -> Step:
     if w.refind_from is None:
         step = _to_edge[1](t, w)
         if w.edge_stop is not None:
-            return fail(w.edge_stop)
+            return edge_stopped(w)
         if w.square_yaw is not None:
             return _turn_square(t, w)
         if w.refind_from is None:

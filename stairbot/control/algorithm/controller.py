@@ -208,6 +208,8 @@ class Controller:
         if step is None:
             assert record.step is not None  # only DONE and ERROR have none
             step = record.step(t, ctx.work)
+        if step.wrong is not None:
+            self._perception.distrust(*step.wrong)
         if step.happened is not None:
             self._apply(step, snap)
             speeds = _zeros()

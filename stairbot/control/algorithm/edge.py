@@ -24,7 +24,7 @@ from stairbot.control.algorithm.edge_measure import (
     edge_sight_m,
 )
 from stairbot.control.algorithm.modes import Outcome
-from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, end, fail, stay
+from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, distrust, end, fail, stay
 from stairbot.control.algorithm.texts import descent as say
 from stairbot.control.algorithm.work import EdgeWork
 from stairbot.control.timeline import keep_since, value_at
@@ -46,6 +46,32 @@ def drops(t: Tick) -> list[bool]:
     return [r.status is SensorStatus.OUT_OF_RANGE and r.distance_m > cfg.BACK_CLEARANCE
             or r.ok and r.distance_m > drop
             for r in (t.snap.sensors[s] for s in BACK_SENSORS)]
+
+
+def _off_climb_heading(t: Tick) -> float | None:
+    """On a climbed step, how far (radians, + = left) the odometer says the
+    robot is turned from the heading it climbed the step with, which
+    calibration squared to the riser and descent 1 turns back to (None: not
+    known, as in a continuous descent)."""
+    ctx = t.ctx
+    climbed = None if ctx.from_top else ctx.climb_twist[t.descent_index]
+    if climbed is None:
+        return None
+    return motion.turn_yaw_rad(t.cfg, motion.twist(t.snap) - climbed)
+
+
+def edge_stopped(w: EdgeWork) -> Step:
+    """The step's answer to the watch's stop (``w.edge_stop``): a back
+    sensor judged wrong is distrusted, and the step goes on (if perception
+    judges it so, it is lost and the robot limps home on its partner: the
+    watch finds the floor again and the edge with the survivor); else the
+    program ends with the error."""
+    stop, wrong = w.edge_stop, w.edge_wrong
+    assert stop is not None
+    if wrong is None:
+        return fail(stop)
+    w.edge_stop = w.edge_wrong = None
+    return distrust(wrong, stop)
 
 
 def sees_drop(t: Tick) -> bool:
@@ -95,6 +121,12 @@ def square_to_edge(t: Tick, w: EdgeWork) -> str | None:
         most = 2 * cfg.sensors.back_lateral * math.tan(MAX_EDGE_YAW_RAD)
         if lag > most:
             other = SensorId.SBL if right else SensorId.SBR
+            off = _off_climb_heading(t)
+            if off is not None and abs(off) <= EDGE_SQUARE_RAD and not w.edge_distrusted:
+                # square by the odometer: no yaw explains the lag, the
+                # sensor still reading the floor is wrong
+                w.edge_wrong, w.edge_distrusted = other, True
+                return say.missed_crossing(first, lag, most, MAX_EDGE_YAW_RAD, off)
             return say.edge_askew(first, other, lag, most, MAX_EDGE_YAW_RAD)
         return None
     if not ctx.from_top:

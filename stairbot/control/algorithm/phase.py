@@ -29,7 +29,7 @@ from stairbot.control.algorithm.families import Calibration, Family
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, Outcome, Purpose
 from stairbot.control.algorithm.phases import Mode, Phase
 from stairbot.control.algorithm.work import Work
-from stairbot.hardware import Snapshot, Speeds
+from stairbot.hardware import SensorId, Snapshot, Speeds
 from stairbot.inputs.config import RobotConfig
 
 FAULT = "sensor error, motor fault or phase timeout"
@@ -68,13 +68,15 @@ class Step:
     ``outcome`` (COMPLETED or STOPPED) what DONE means.  For any other
     phase ``reason`` overrides the exit's condition in the event that tells
     the transition.  ``begin``: the state the next phase's family begins
-    with (see :mod:`~stairbot.control.algorithm.families`)."""
+    with (see :mod:`~stairbot.control.algorithm.families`).  ``wrong``: a
+    sensor the phase found reading wrong, and why (:func:`distrust`)."""
 
     speeds: Speeds = field(default_factory=lambda: NO_MOTION)
     happened: str | None = None
     reason: str | None = None
     outcome: Outcome | None = None
     begin: Family | None = None
+    wrong: tuple[SensorId, str] | None = None
 
 
 def stay(speeds: Speeds) -> Step:
@@ -99,6 +101,17 @@ def calibrate(happened: str, purpose: Purpose, turn_to: float | None = None,
 def fail(reason: str) -> Step:
     """End the program with an error (the outcome :data:`FAILED`)."""
     return Step(NO_MOTION, FAILED, reason)
+
+
+def distrust(sensor: SensorId, why: str) -> Step:
+    """Stop (this tick) in this phase: ``sensor`` reads wrong, for ``why``.
+    If its measurements held one value, perception reads it as ERROR from
+    the next tick on while that value holds
+    (:meth:`~stairbot.control.perception.Perception.distrust`), as it does a
+    stuck one: the sensor hold stands the robot, and it is then lost.  If
+    not, the phase goes on, and must not ask again (it ends the run as it
+    would have)."""
+    return Step(NO_MOTION, wrong=(sensor, why))
 
 
 def end(outcome: Outcome, reason: str) -> Step:

@@ -11,7 +11,7 @@ from typing import Any
 from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.calibration import FLOW
 from stairbot.control.algorithm.families import Calibration
-from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase
+from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Purpose
 from stairbot.control.algorithm.phase import (
     FAILED,
     FAULT,
@@ -20,6 +20,7 @@ from stairbot.control.algorithm.phase import (
     PhaseDef,
     Step,
     Tick,
+    distrust,
     fail,
     go,
     stay,
@@ -38,6 +39,7 @@ from stairbot.control.algorithm.squaring import (
     TURN_MARGIN_RAD,
     TURN_SLOW_FLOOR,
     askew_rad,
+    heading_off_rad,
     mean_diff,
     measured_standing,
     one_riser,
@@ -48,7 +50,7 @@ from stairbot.control.algorithm.squaring import (
 from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
 from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
-from stairbot.hardware import MotorId
+from stairbot.hardware import FRONT_SENSORS, MotorId, SensorStatus
 
 P = Phase
 
@@ -73,6 +75,7 @@ def _turn_enter(t: Tick, w: TurnWork) -> None:
     # Both beams on one riser, the difference says how far the robot is turned
     # from square to it: the turn may make that and a margin, no more.
     w.turn_from = t.snap.turns(MotorId.MWR)
+    w.turn_first = (sfr, sfl)
     if motion.far(r, t.cfg) or motion.far(l_, t.cfg):
         # one beam off the flight's side: no figure, at most as askew as a
         # calibration may stand
@@ -89,11 +92,72 @@ def _turned_past_limit(t: Tick, w: TurnWork) -> Step | None:
     made = motion.turn_yaw_rad(t.cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
     if made <= w.turn_limit_rad:
         return None
-    return fail(say.turned_past_first_readings(where(t.ctx, P.CAL_TURN), made, w.turn_limit_rad))
+    return _held_through(t, w, made) or fail(
+        say.turned_past_first_readings(where(t.ctx, P.CAL_TURN), made, w.turn_limit_rad))
+
+
+def _follow(t: Tick, w: TurnWork) -> None:
+    """Whether SFR and SFL still read what they read at the turn's start
+    (a distance, or "nothing within range" or "too near" at the clamp), and
+    how far each has moved from it."""
+    now = [(r.distance_m, r.status is not SensorStatus.ERROR) for r in motion.pair(t.snap)]
+    held = [h and ok and d == f for h, (d, ok), f in zip(w.turn_held, now, w.turn_first,
+                                                          strict=True)]
+    moved = [max(m, abs(d - f)) if ok else m
+             for m, (d, ok), f in zip(w.turn_moved, now, w.turn_first, strict=True)]
+    w.turn_held, w.turn_moved = (held[0], held[1]), (moved[0], moved[1])
+
+
+def _held_through(t: Tick, w: TurnWork, made: float) -> Step | None:
+    """Descent 1 on a climbed step, turned past what the first readings
+    allow: a front sensor that read one value on every tick of the turn
+    while its partner reads the riser and moved by more than the pair's
+    noise is stuck (a turn on the spot moves what both look at; a value
+    held through it, "nothing within range" included, beside a partner that
+    sees the riser the robot climbed, is not a reading).  Judged once; the
+    robot then limps home on the partner, back on the heading it climbed
+    the step with (:func:`_turn`)."""
+    ctx, cfg = t.ctx, t.cfg
+    if w.distrusted or t.cal.purpose is not Purpose.DESCENT or ctx.from_top \
+            or ctx.climb_twist[t.descent_index] is None:
+        return None
+    pair = motion.pair(t.snap)
+    for i, sid in enumerate(FRONT_SENSORS):
+        partner = pair[1 - i]
+        if not w.turn_held[i] or w.turn_held[1 - i] or not partner.ok \
+                or motion.far(partner, cfg) \
+                or w.turn_moved[1 - i] <= pair_tolerance(cfg, partner.distance_m):
+            continue
+        w.distrusted = True
+        return distrust(sid, say.held_through_turn(
+            sid.value, w.turn_first[i], FRONT_SENSORS[1 - i].value, w.turn_first[1 - i],
+            partner.distance_m, made))
+    return None
+
+
+def _limp_turn_back(t: Tick) -> Step | None:
+    """A front sensor lost in descent 1's turn (:func:`_held_through`): the
+    survivor reads for both, so SFR = SFL says nothing of the heading; turn
+    back by the odometer to the one the step was climbed with instead."""
+    ctx = t.ctx
+    if ctx.limp is None or not set(ctx.limp.lost) & {s.value for s in FRONT_SENSORS} \
+            or t.cal.purpose is not Purpose.DESCENT or ctx.from_top:
+        return None
+    climbed = ctx.climb_twist[t.descent_index]
+    if climbed is None:
+        return None
+    t.cal.turn_to = climbed
+    ctx.descent.turned_back = True
+    t.say(say.limp_turn_back(heading_off_rad(t, climbed)))
+    return go("limp_turn_back")
 
 
 def _turn(t: Tick, w: TurnWork) -> Step:
     cfg = t.cfg
+    back = _limp_turn_back(t)
+    if back is not None:
+        return back
+    _follow(t, w)
     sfr, sfl = readings(t)
     if w.measuring:  # stopped at SFR = SFL: measuring standing still, once settled
         if not settled(t, w):
@@ -136,6 +200,9 @@ TURN = PhaseDef(
     P.CAL_TURN, "calibration case 2 — turn until SFR = SFL", FLOW, _turn, TurnWork,
     enter=_turn_enter, family=Calibration,
     on={"square": Exit(P.CAL_LOWER, "SFR = SFL"),
+        "limp_turn_back": Exit(P.CAL_TURN_TO, "limping home, a front sensor lost in the "
+                                              "turn: back to the heading the step was "
+                                              "climbed with"),
         FAILED: Exit(P.ERROR, "turned too far, or more than its first readings allow; "
                               + FAULT)})
 

@@ -133,7 +133,12 @@ class EdgeWork(DriveWork):
     the other still read the floor."""
     edge_stop: str | None = None
     """The watch found a reason to end the program (the step ends it with
-    this error)."""
+    this error) ..."""
+    edge_wrong: SensorId | None = None
+    """... or, with this, a back sensor reading wrong (the step distrusts it
+    for that reason: :func:`~stairbot.control.algorithm.edge.edge_stopped`)."""
+    edge_distrusted: bool = False
+    """The watch has judged one back sensor wrong in this phase (once)."""
     square_yaw: float | None = None
     """Continuous descent: the yaw (radians, + = turn left) that squares the
     robot up to the edge, from how far it backed between its two back
@@ -217,6 +222,14 @@ class TurnWork(StandingWork):
     turn_limit_rad: float = 0.0
     """MWR's counter at its start, and the most it may turn (what the
     readings at its start say, and a margin)."""
+    turn_first: tuple[float, float] = (0.0, 0.0)
+    """SFR's and SFL's readings at its start ..."""
+    turn_held: tuple[bool, bool] = (True, True)
+    """... whether each has read just that on every tick since ..."""
+    turn_moved: tuple[float, float] = (0.0, 0.0)
+    """... and the most each has moved from it."""
+    distrusted: bool = False
+    """A sensor that held its value through the turn was judged stuck."""
 
 
 @dataclass

@@ -96,6 +96,17 @@ def turned_past_first_readings(where: str, made_rad: float, limit_rad: float) ->
             "not squaring up to something other than the riser")
 
 
+def held_through_turn(sensor: str, value: float, partner: str, first: float, now: float,
+                      made_rad: float) -> str:
+    return (f"stuck: read {value:.3f} m through a turn of {math.degrees(made_rad):.0f}° "
+            f"on the spot while {partner} went from {first:.3f} m to {now:.3f} m")
+
+
+def limp_turn_back(off_rad: float) -> str:
+    return (f"limping home on one front sensor: turning {math.degrees(-off_rad):+.1f}° back "
+            "to the heading the step was climbed with (by the odometer)")
+
+
 def squared_up(diff: float, n: int, sfr: float, sfl: float) -> str:
     return (f"squared up: SFL − SFR = {diff * 1000:+.1f} mm over {n} readings "
             f"standing still (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")

@@ -50,6 +50,14 @@ def edge_askew(first: str, other: str, lag: float, most: float, max_yaw_rad: flo
             "sensor reading wrong")
 
 
+def missed_crossing(first: str, lag: float, most: float, max_yaw_rad: float,
+                    off_rad: float) -> str:
+    return (f"stuck: still reads the floor {lag * 1000:.0f} mm after {first} read the "
+            f"drop (more than {most * 1000:.0f} mm: {math.degrees(max_yaw_rad):.0f}° from "
+            f"square), the robot square to the edge ({math.degrees(off_rad):+.1f}° from "
+            "the heading the step was climbed with, by the odometer)")
+
+
 def drop_read_first(first: str | None, lag: float, yaw_rad: float, square_yaw: float) -> str:
     return (f"{first} read the drop {lag * 1000:.0f} mm before the other: "
             f"{math.degrees(yaw_rad):.1f}° from square to the edge; turning "
