@@ -71,8 +71,7 @@ class Controller:
                 context.family = None
                 context.phase = Phase.DESCENT_BACK_TO_EDGE.value
         # a program reopened to limp home is said so at its first tick, on its time
-        self._reopened = context.phase_started_s is not None and limp_home \
-            and lost.reopen(context)
+        self._reopened = limp_home and context.phase_started_s is not None and lost.reopen(context)
         if context.phase_started_s is not None:
             check_restored(context)
         self._ctx = context
