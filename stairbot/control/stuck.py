@@ -18,7 +18,10 @@ robot moved what it looks at:
   jammed, the robot against something unseen) move the robot by less than
   their mean, or not at all, and the stall watch is theirs.  A value "too
   near" says only that the surface is nearer than the minimum: backing away
-  more than the minimum (and the limit) must end it.
+  more than the minimum (and the limit) must end it.  One that does not
+  says the sensor reads too near -- stuck, or biased short (a front sensor
+  2 cm short reads under the minimum at a riser 4 cm away, and stays there
+  as the robot backs 4 cm): the host cannot tell which, and says only that.
 * **the lift, by the partner** (SBR, SBL): the back pair looks down from
   segment 3, so a drive along a tread does not change what it reads, and
   MTB moves segment 3 (and the pair) when segment 3 hangs, or segment 2
@@ -321,17 +324,25 @@ class StuckWatch:
         if run.count < REPEATS:
             return None
         v, kind = run.value
-        held = (f"stuck at {v:.3f} m" if kind == OK else f"stuck reading too near (under "
-                f"{v:.3f} m)" if kind == NEAR else f"stuck reading nothing within {v:.3f} m"
-                ) + f" for {run.taken_s - run.first_s:.1f} s"
         if front and run.odometer is not None and kind != FAR:
             drove = run.last_odometer - run.odometer
             # too near says only that the surface is nearer than the minimum:
-            # backing away more than the minimum (and the limit) must end it
-            if (drove < -(v + self._limit)) if kind == NEAR else abs(drove) > self._limit:
+            # backing away more than the minimum (and the limit) must end it.
+            # Still too near, the sensor reads wrong: stuck, or reading short
+            # (a bias), which the host cannot tell apart -- so it says which
+            if kind == NEAR and drove < -(v + self._limit):
+                return (f"reads too near (under {v:.3f} m) after the drive moved "
+                        f"{-drove * 1000:.0f} mm away from the riser")
+            if kind == OK and abs(drove) > self._limit:
                 way = "toward" if drove > 0 else "away from"
-                return f"{held} while the drive moved {abs(drove) * 1000:.0f} mm {way} the riser"
-        return None if lifted is None else f"{held} while {lifted}"
+                return (f"{self._held(run)} while the drive moved {abs(drove) * 1000:.0f} mm "
+                        f"{way} the riser")
+        return None if lifted is None else f"{self._held(run)} while {lifted}"
+
+    @staticmethod
+    def _held(run: _Run) -> str:
+        """A run of one distance, judged stuck: its value and how long it held."""
+        return f"stuck at {run.value[0]:.3f} m for {run.taken_s - run.first_s:.1f} s"
 
     def _partner(self, sid: SensorId, run: _Run, seen: dict[SensorId, SensorReading]
                  ) -> str | None:

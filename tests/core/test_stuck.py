@@ -138,3 +138,27 @@ def test_a_partner_that_steps_by_itself_does_not_make_this_one_stuck() -> None:
                                    SBR: 0.04 + h, SBL: 0.04 + h},
                   lift_speed=0.02, ticks=200)
     assert errors(seen, SFR) == [] and errors(seen, SFL) == []
+
+
+def test_a_front_sensor_still_too_near_after_backing_away_reads_too_near_not_stuck() -> None:
+    """A front sensor reading under its minimum range at a riser, still so
+    after the robot backed further than that minimum: it reads wrong, but
+    stuck or biased short (2 cm short at a riser 4 cm away reads under 3 cm)
+    the host cannot tell, and says only what it knows."""
+    near = CFG.sensors.range(False)[0]
+    p = Perception(CFG)
+    seen = []
+    for i in range(200):
+        backed = 0.1 * i * TICK
+        motors = {m: MotorState(0.0) for m in MotorId}
+        for m in WHEEL_MOTORS:
+            motors[m] = MotorState(-backed / METRES_PER_WHEEL_TURN)
+        clamp = SensorReading(near, SensorStatus.OUT_OF_RANGE)
+        sensors = {SFR: clamp, SFL: SensorReading(round(near + 0.01 + backed, 3)),
+                   SBR: SensorReading(0.04), SBL: SensorReading(0.04)}
+        seen.append(p.see(Snapshot(i * TICK, sensors, motors, imu=Imu(0.0, 0.0))))
+    assert errors(seen, SFR) and errors(seen, SFL) == []
+    why = p.why(SFR)
+    assert why is not None and why.startswith(f"reads too near (under {near:.3f} m) after "
+                                               f"the drive moved "), why
+    assert why.endswith("mm away from the riser") and "stuck" not in why, why

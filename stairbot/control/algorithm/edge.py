@@ -320,16 +320,34 @@ NARROW_AXLE_MARGIN_M = 0.004
 edge than this (the tab puts it 8.5 mm past it, as ascent 6 left it)."""
 
 
+def narrow_early_m(cfg: RobotConfig) -> float:
+    """How much earlier than :func:`_crossed` places it the back pair may
+    have crossed a narrow tread's edge: a sensor that mixes its cone's
+    returns by their signal (a time-of-flight cone, not a first echo, whose
+    riser face :func:`edge_sight_m` counts already) is dominated by the
+    tread BACK_CLEARANCE below until nearly its whole footprint has passed
+    the edge, BACK_CLEARANCE x tan(half the cone) past it; and the crossing
+    falls anywhere in a measurement period (:func:`edge_doubt_m`).  A bound
+    that keeps the robot on the tread counts from the earliest."""
+    spec = cfg.sensors.spec(True)
+    doubt = edge_doubt_m(cfg)
+    if spec.first_echo:
+        return doubt
+    fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
+    return cfg.BACK_CLEARANCE * math.tan(math.radians(fov) / 2) + doubt
+
+
 def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     """Narrow steps: watch the back pair cross the edge of the narrow tread
     the robot stands on, or steps down onto (floor, then the drop, as
     :func:`edge_bound` does) and
     keep where (``DescentStep.narrow_edge_wheel``); once known, the odometer
     count the backing never passes: segment 2's rear axle
-    NARROW_AXLE_MARGIN_M past that edge.  The front pair's tab alone leaves
-    8.5 mm to spare there: both of its sensors reading 20 mm short (a common
-    fault the standing rule cannot see) would back segment 2's rear wheels
-    off the edge."""
+    NARROW_AXLE_MARGIN_M past that edge, counted from where the pair may
+    have crossed it at the earliest (:func:`narrow_early_m`).  The front
+    pair's tab alone leaves 8.5 mm to spare there: both of its sensors
+    reading 20 mm short (a common fault the standing rule cannot see) would
+    back segment 2's rear wheels off the edge."""
     cfg, step = t.cfg, t.ctx.descent
     if step.narrow_edge_wheel is None:
         _remember(t, w, motion.wheel_position(t.snap))
@@ -341,7 +359,8 @@ def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
         return None
     g = cfg.geometry
     reach = g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear + g.wheel_inset
-    return step.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M)
+    return step.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M
+                                                    - narrow_early_m(cfg))
 
 
 def refind_max_m(cfg: RobotConfig) -> float:
