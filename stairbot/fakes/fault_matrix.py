@@ -68,7 +68,7 @@ from stairbot.run.journal import read_journal
 from stairbot.run.journaled import start_journal
 from stairbot.run.runner import RunResult, run
 
-LATE_S = {"can": 0.005, "serial": 0.03}  # a late frame: ten and six timeouts late
+LATE_S = {"can": 0.005, "serial": 0.12}  # a late frame: ten and six timeouts late
 AFTER_S = 2.0  # world seconds run on after a stopped run, no host
 LIFT_HELD_TURNS = 1e-3  # a held lift's give under load is 1e-5 turns
 MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)

@@ -68,7 +68,7 @@ def test_a_run_that_ends_before_the_kill_says_how_it_ended(tmp_path: Path) -> No
 
 def test_a_resume_whose_link_fails_is_a_stop_with_the_boards_latched(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    """The new host's first reply later than the serial rig's 5 ms timeout (a
+    """The new host's first reply later than the serial rig's timeout (a
     loaded machine): the resume raised LinkLostError and the whole fault
     matrix died with it.  It is a stop: the boards left standing, latched."""
     from stairbot.errors import LinkLostError
