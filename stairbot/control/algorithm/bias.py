@@ -274,7 +274,7 @@ class BiasWatch:
                 and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
             # it went wrong before the tread ahead was measured on it: finishing
             # the step by that figure is not safe, and the standing rule ends
-            # the program, as it always has (case 531 climbed on and tipped)
+            # the program, as it always has (climbing on, it would tip)
             return
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)

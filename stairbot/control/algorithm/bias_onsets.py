@@ -154,8 +154,7 @@ class PairWatch:
             return  # both moved: the world changed, or nobody can tell
         if track.back and onset.step_m > 0 and _backed(before + after):
             # backing, the cones pass over ground the robot has not stood on:
-            # the one meeting an edge first reads longer (case 31 of the
-            # quick sweep), a bias or not
+            # the one meeting an edge first reads longer, a bias or not
             return
         mine, partner = (8, 7) if onset.sensor is track.left else (7, 8)
         if track.back and not (all(x[mine] for x in _driving(before))
@@ -180,9 +179,8 @@ class PairWatch:
 
 def _turned(samples: list[Sample]) -> bool:
     """Whether the heading changed over ``samples``: a front beam switching
-    walls at a corner looks like a jump (case 3B); the back cones sweep
-    sideways over the ground, and near an edge one of them crosses it (the
-    top edge 20 deg askew, case 418 of sweeps/sensor_faults.toml)."""
+    walls at a corner looks like a jump; the back cones sweep sideways over
+    the ground, and near an edge one of them crosses it first."""
     yaws = [x[4] for x in samples]
     return max(yaws) - min(yaws) > STILL_RAD
 
