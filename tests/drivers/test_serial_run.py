@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from lockstep_boards import lockstep_boards
+from lost_sensor import TWO_STEPS
 
 from stairbot.control.robot_config import load_config
 from stairbot.inputs.scenario import load_scenario
@@ -43,15 +44,7 @@ def test_full_ascent_and_descent_over_a_pty_ends_as_sim_does(fake_boards_url: st
     assert isinstance(health, dict) and health["lost"] == 0 and health["crc_errors"] == 0
 
 
-STUCK = """
-[stairs]
-count = 2
-rise = 0.17
-tread = 0.28
-[sensors]
-noise = 0.001
-seed = 5
-[[faults]]
+STUCK = TWO_STEPS + """[[faults]]
 at = 42.0
 sensor = "SFR"
 kind = "stuck"

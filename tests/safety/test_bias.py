@@ -10,13 +10,12 @@ evidence must not take for biased."""
 
 from __future__ import annotations
 
-from typing import Any
-
+from lost_sensor import degraded
 from simrun import run_sim
 from test_vl53l1x_front import LOW_RISER_ASKEW, VL53L1X_FRONT
 
 from stairbot.control.robot_config import load_config
-from stairbot.events import Event, EventKind
+from stairbot.events import Event
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.runner import RunResult
 
@@ -50,13 +49,6 @@ def run(text: str, consent: bool = True) -> tuple[RunResult, list[Event]]:
     r = run_sim(CONFIG, parse_scenario(text, "<bias>"), events, limp_home=consent)
     return r, events
 
-
-def degraded(events: list[Event]) -> dict[str, Any]:
-    stops = [e.data["degraded"] for e in events
-             if e.kind is EventKind.WARNING and "degraded" in e.data]
-    assert len(stops) == 1, stops
-    stop: dict[str, Any] = stops[0]
-    return stop
 
 
 def home(r: RunResult) -> bool:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
+from lost_sensor import TWO_STEPS, degraded, home
 from simrun import run_sim
 
 from stairbot.control.algorithm.controller import Controller
@@ -25,15 +26,6 @@ from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
-TWO_STEPS = """
-[stairs]
-count = 2
-rise = 0.17
-tread = 0.28
-[sensors]
-noise = 0.001
-seed = 5
-"""
 
 
 def faulted(*faults: tuple[float, str, str]) -> str:
@@ -49,22 +41,11 @@ def run(text: str, *, consent: bool = True,
     return r, events
 
 
-def degraded(events: list[Event]) -> dict[str, Any]:
-    stops = [e.data["degraded"] for e in events
-             if e.kind is EventKind.WARNING and "degraded" in e.data]
-    assert len(stops) == 1, stops
-    stop: dict[str, Any] = stops[0]
-    return stop
-
 
 def phases_after(events: list[Event], time_s: float) -> list[str]:
     return [str(e.data["phase"]) for e in events
             if e.kind is EventKind.PHASE and e.time_s >= time_s]
 
-
-def home(r: RunResult) -> bool:
-    return (not r.fell and r.steps_climbed == r.steps_descended
-            and r.final_offset_m is not None and r.final_offset_m <= 0.05)
 
 
 def test_a_front_sensor_lost_lifting_segment_3_finishes_the_step_and_comes_home() -> None:

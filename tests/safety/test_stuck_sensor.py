@@ -12,23 +12,15 @@ from __future__ import annotations
 
 from typing import Any
 
+from lost_sensor import TWO_STEPS, degraded_stops, home
 from simrun import run_sim
 
 from stairbot.control.robot_config import load_config
-from stairbot.events import Event, EventKind
+from stairbot.events import Event
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
-TWO_STEPS = """
-[stairs]
-count = 2
-rise = 0.17
-tread = 0.28
-[sensors]
-noise = 0.001
-seed = 5
-"""
 
 
 def stuck(at: float, sensor: str) -> tuple[RunResult, dict[str, Any]]:
@@ -37,15 +29,10 @@ def stuck(at: float, sensor: str) -> tuple[RunResult, dict[str, Any]]:
     text = TWO_STEPS + f'[[faults]]\nat = {at}\nsensor = "{sensor}"\nkind = "stuck"\n'
     events: list[Event] = []
     r = run_sim(CONFIG, parse_scenario(text, "<stuck>"), events, limp_home=True)
-    stops = [e.data["degraded"] for e in events
-             if e.kind is EventKind.WARNING and "degraded" in e.data]
+    stops = degraded_stops(events)
     assert len(stops) == 1, (r.to_dict(), stops)
     return r, stops[0]
 
-
-def home(r: RunResult) -> bool:
-    return (not r.fell and r.steps_climbed == r.steps_descended
-            and r.final_offset_m is not None and r.final_offset_m <= 0.05)
 
 
 def test_a_front_sensor_stuck_mid_climb_is_lost_and_the_robot_comes_home() -> None:
@@ -108,7 +95,6 @@ def test_a_back_sensor_reading_long_reads_the_drop_early_and_its_partner_is_not_
     assert (r.outcome, r.steps_climbed, r.steps_descended) == (
         "came_home_degraded", 2, 2), r.to_dict()
     assert home(r), r.to_dict()
-    stops = [e.data["degraded"] for e in events
-             if e.kind is EventKind.WARNING and "degraded" in e.data]
+    stops = degraded_stops(events)
     assert [(s["lost"], s["survivors"]) for s in stops] == [(["SBL"], ["SBR"])], stops
     assert not [e for e in events if "SBR" in e.message and "stuck" in e.message]
