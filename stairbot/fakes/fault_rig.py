@@ -165,12 +165,19 @@ def _link_failed(boards: BoardsOnWire, cleared: bool, exc: HardwareError) -> Res
     timeout: a machine too loaded for the wire's timeout).  That is a stop,
     not a resume: "stopped" when, the world run on with no host, every motor
     stands and a latch holds the boards, else "UNSAFE"."""
+    return _held(boards, cleared, f"the resume's link failed: {exc}")
+
+
+def _held(boards: BoardsOnWire, cleared: bool, why: str) -> Resumption:
+    """A host that stopped on a failed link: the world run on with no host,
+    "stopped" when every motor stands and a latch holds the boards, else
+    "UNSAFE"."""
     run_on(boards.world, boards.boards, HOST_DEAD_S)
     held = latched(boards)
     if held and not any(boards.world.speeds().values()):
-        return Resumption("stopped", f"the resume's link failed: {exc}", cleared, held)
-    return Resumption("UNSAFE", f"the resume's link failed and the boards were left "
-                                f"unlatched or moving: {exc}", cleared, held)
+        return Resumption("stopped", why, cleared, held)
+    return Resumption("UNSAFE", f"{why}, and the boards were left unlatched or moving",
+                      cleared, held)
 
 
 def resume_watched(boards: BoardsOnWire, config: RobotConfig, journal: Path,
@@ -209,5 +216,7 @@ def resume_watched(boards: BoardsOnWire, config: RobotConfig, journal: Path,
             session.close()
     if result.outcome == "completed" and not result.fell:
         return Resumption("resumed", "", cleared, latched(boards))
+    if result.fault == "link" and not result.fell:
+        return _held(boards, cleared, f"the resumed run lost its link: {result.error}")
     return Resumption("UNSAFE", f"the resumed run ended {result.outcome}: {result.error}",
                       cleared, latched(boards))

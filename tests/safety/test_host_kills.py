@@ -81,3 +81,28 @@ def test_a_resume_whose_link_fails_is_a_stop_with_the_boards_latched(
     cell = run_kill("serial", "cal_check", "middle")
     assert cell.verdict == "stopped", cell.reason
     assert cell.reason.startswith("the resume's link failed: ")
+
+
+def test_a_resumed_run_that_loses_its_link_is_a_stop_with_the_boards_latched(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The resume took over, then the boards went deaf: the resumed run ends
+    on a lost link, the boards' watchdogs latch them standing.  That is the
+    same stop as a resume whose link fails, not an unsafe end."""
+    from stairbot.fakes import fault_rig
+
+    opened: list[fault_rig.BoardsOnWire] = []
+    real_open, real_run = fault_rig.BoardsOnWire.open, fault_rig.run
+
+    def opening(self: fault_rig.BoardsOnWire, allow_latched: bool = False) -> object:
+        opened.append(self)
+        return real_open(self, allow_latched)
+
+    def deafened(*args: object, **kw: object) -> object:
+        opened[-1].deaf(True)
+        return real_run(*args, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(fault_rig.BoardsOnWire, "open", opening)
+    monkeypatch.setattr(fault_rig, "run", deafened)
+    cell = run_kill("can", "cal_check", "middle")
+    assert cell.verdict == "stopped", cell.reason
+    assert cell.reason.startswith("the resumed run lost its link: ")
