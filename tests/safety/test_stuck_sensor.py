@@ -23,12 +23,13 @@ from stairbot.run.runner import RunResult
 CONFIG = load_config()
 
 
-def stuck(at: float, sensor: str) -> tuple[RunResult, dict[str, Any]]:
+def stuck(at: float, sensor: str, robot: str = "reference") -> tuple[RunResult, dict[str, Any]]:
     """TWO_STEPS with ``sensor`` stuck from ``at`` on, consented: the result
     and the one degraded stop."""
     text = TWO_STEPS + f'[[faults]]\nat = {at}\nsensor = "{sensor}"\nkind = "stuck"\n'
     events: list[Event] = []
-    r = run_sim(CONFIG, parse_scenario(text, "<stuck>"), events, limp_home=True)
+    cfg = CONFIG if robot == "reference" else load_config(robot)
+    r = run_sim(cfg, parse_scenario(text, "<stuck>"), events, limp_home=True)
     stops = degraded_stops(events)
     assert len(stops) == 1, (r.to_dict(), stops)
     return r, stops[0]
@@ -66,6 +67,20 @@ def test_a_front_sensor_stuck_reading_nothing_from_the_top_is_lost_in_descent_1s
         ["SFR"], ["SFL"], "cal_turn", "limp_home")
     assert stop["failed"].startswith("SFR stuck: read 1.300 m through a turn of"), stop
     assert "while SFL went from" in stop["failed"]
+
+
+def test_a_front_sonar_stuck_at_nothing_is_lost_when_its_partners_echo_turns_off_the_riser(
+        ) -> None:
+    # the sonar robot: descent 1's squaring turn toward SFR's side lost SFR's
+    # echo off the riser's face before the turn's limit, both then read
+    # 1.300 m, "squared up" on no readings, and the run ended on the stairs
+    r, stop = stuck(54.1, "SFL", "sonar")
+    assert (r.outcome, r.steps_climbed) == ("came_home_degraded", 2), r.to_dict()
+    assert home(r), r.to_dict()
+    assert (stop["lost"], stop["survivors"], stop["phase"], stop["then"]) == (
+        ["SFL"], ["SFR"], "cal_turn", "limp_home")
+    assert stop["failed"].startswith("SFL stuck: read 1.300 m through a turn of"), stop
+    assert "and then to nothing ahead" in stop["failed"]
 
 
 def test_a_back_sensor_stuck_on_the_floor_is_lost_when_its_partner_crosses_the_edge() -> None:

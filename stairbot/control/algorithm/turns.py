@@ -75,7 +75,7 @@ def _turn_enter(t: Tick, w: TurnWork) -> None:
     # Both beams on one riser, the difference says how far the robot is turned
     # from square to it: the turn may make that and a margin, no more.
     w.turn_from = t.snap.turns(MotorId.MWR)
-    w.turn_first = (sfr, sfl)
+    w.turn_first = w.turn_seen = (sfr, sfl)
     if motion.far(r, t.cfg) or motion.far(l_, t.cfg):
         # one beam off the flight's side: no figure, at most as askew as a
         # calibration may stand
@@ -98,40 +98,49 @@ def _turned_past_limit(t: Tick, w: TurnWork) -> Step | None:
 
 def _follow(t: Tick, w: TurnWork) -> None:
     """Whether SFR and SFL still read what they read at the turn's start
-    (a distance, or "nothing within range" or "too near" at the clamp), and
-    how far each has moved from it."""
-    now = [(r.distance_m, r.status is not SensorStatus.ERROR) for r in motion.pair(t.snap)]
-    held = [h and ok and d == f for h, (d, ok), f in zip(w.turn_held, now, w.turn_first,
-                                                          strict=True)]
-    moved = [max(m, abs(d - f)) if ok else m
-             for m, (d, ok), f in zip(w.turn_moved, now, w.turn_first, strict=True)]
+    (a distance, or "nothing within range" or "too near" at the clamp), how
+    far each has moved from it reading a distance, and the last distance
+    each read."""
+    now = [(r.distance_m, r.status is not SensorStatus.ERROR, not motion.far(r, t.cfg))
+           for r in motion.pair(t.snap)]
+    held = [h and ok and d == f for h, (d, ok, _), f in zip(w.turn_held, now, w.turn_first,
+                                                             strict=True)]
+    moved = [max(m, abs(d - f)) if ok and near else m
+             for m, (d, ok, near), f in zip(w.turn_moved, now, w.turn_first, strict=True)]
+    seen = [d if ok and near else s for s, (d, ok, near) in zip(w.turn_seen, now, strict=True)]
     w.turn_held, w.turn_moved = (held[0], held[1]), (moved[0], moved[1])
+    w.turn_seen = (seen[0], seen[1])
 
 
-def _held_through(t: Tick, w: TurnWork, made: float) -> Step | None:
+def _held_through(t: Tick, w: TurnWork, made: float, gone: bool = False) -> Step | None:
     """Descent 1 on a climbed step, turned past what the first readings
-    allow: a front sensor that read one value on every tick of the turn
-    while its partner reads the riser and moved by more than the pair's
-    noise is stuck (a turn on the spot moves what both look at; a value
-    held through it, "nothing within range" included, beside a partner that
-    sees the riser the robot climbed, is not a reading).  Judged once; the
-    robot then limps home on the partner, back on the heading it climbed
-    the step with (:func:`_turn`)."""
+    allow -- or, ``gone``, turned until both beams read nothing ahead, which
+    no heading square to the riser the robot climbed gives: a front sensor
+    that read one value on every tick of the turn while its partner read
+    the riser and moved by more than the pair's noise is stuck (a turn on
+    the spot moves what both look at; a value held through it, "nothing
+    within range" included, beside a partner that sees the riser the robot
+    climbed, is not a reading).  A partner gone to nothing ahead has turned
+    its beam off the riser's face: an HC-SR04 hears no echo from a surface
+    turned more than its `echo_incidence_deg` away.  Judged once; the robot
+    then limps home on the partner, back on the heading it climbed the step
+    with (:func:`_turn`)."""
     ctx, cfg = t.ctx, t.cfg
     if w.distrusted or t.cal.purpose is not Purpose.DESCENT or ctx.from_top \
             or ctx.climb_twist[t.descent_index] is None:
         return None
     pair = motion.pair(t.snap)
     for i, sid in enumerate(FRONT_SENSORS):
-        partner = pair[1 - i]
-        if not w.turn_held[i] or w.turn_held[1 - i] or not partner.ok \
-                or motion.far(partner, cfg) \
-                or w.turn_moved[1 - i] <= pair_tolerance(cfg, partner.distance_m):
+        partner, first = pair[1 - i], w.turn_first[1 - i]
+        seen = partner.ok and not motion.far(partner, cfg)
+        if not w.turn_held[i] or w.turn_held[1 - i] or not (seen or gone) \
+                or first >= cfg.LENGTH_OF_INFINITY \
+                or w.turn_moved[1 - i] <= pair_tolerance(cfg, first):
             continue
         w.distrusted = True
         return distrust(sid, say.held_through_turn(
-            sid.value, w.turn_first[i], FRONT_SENSORS[1 - i].value, w.turn_first[1 - i],
-            partner.distance_m, made))
+            sid.value, w.turn_first[i], FRONT_SENSORS[1 - i].value, first,
+            w.turn_seen[1 - i], made, gone=not seen))
     return None
 
 
@@ -187,6 +196,11 @@ def _turn(t: Tick, w: TurnWork) -> Step:
     # check it standing still.
     remaining = -w.turn_direction * w.turn_diff
     if remaining <= cfg.sensors.resolution / 20:
+        if all(motion.far(r, cfg) for r in motion.pair(t.snap)):
+            made = motion.turn_yaw_rad(cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
+            lost = _held_through(t, w, made, gone=True)
+            if lost is not None:
+                return lost
         w.measuring = True
         return stay(NO_MOTION)
     too_far = _turned_too_far(t, P.CAL_TURN) or _turned_past_limit(t, w)

@@ -227,7 +227,9 @@ class TurnWork(StandingWork):
     turn_held: tuple[bool, bool] = (True, True)
     """... whether each has read just that on every tick since ..."""
     turn_moved: tuple[float, float] = (0.0, 0.0)
-    """... and the most each has moved from it."""
+    """... the most each has moved from it reading a distance ..."""
+    turn_seen: tuple[float, float] = (0.0, 0.0)
+    """... and the last distance each read."""
     distrusted: bool = False
     """A sensor that held its value through the turn was judged stuck."""
 

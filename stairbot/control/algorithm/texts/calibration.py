@@ -97,9 +97,12 @@ def turned_past_first_readings(where: str, made_rad: float, limit_rad: float) ->
 
 
 def held_through_turn(sensor: str, value: float, partner: str, first: float, now: float,
-                      made_rad: float) -> str:
+                      made_rad: float, gone: bool = False) -> str:
+    went = f"went from {first:.3f} m to {now:.3f} m"
+    if gone:
+        went += " and then to nothing ahead (its beam turned off the riser)"
     return (f"stuck: read {value:.3f} m through a turn of {math.degrees(made_rad):.0f}° "
-            f"on the spot while {partner} went from {first:.3f} m to {now:.3f} m")
+            f"on the spot while {partner} {went}")
 
 
 def limp_turn_back(off_rad: float) -> str:
