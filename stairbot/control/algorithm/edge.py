@@ -274,8 +274,9 @@ def held_crossing(t: Tick, w: EdgeWork, crossed: float) -> float:
     """The crossing of a drop read after a stretch the robot stood through:
     ``crossed`` (where a watched crossing would be placed), or the far end of
     the span the floor reading before the stretch leaves, if further
-    forward: that reading's position plus, for a first-echo sensor, the
-    riser's face it keeps seeing (:func:`edge_sight_m` standing)."""
+    forward: that reading's position plus how far past the edge the pair
+    may still read the floor (:func:`edge_sight_m` standing: a first-echo
+    sensor's riser face, a signal-mixing cone's footprint)."""
     assert w.edge_floor_at is not None
     face = t.cfg.wheel_turns(edge_sight_m(t.cfg, 0.0, t.ctx.from_top))
     return max(crossed, w.edge_floor_at + face)
@@ -285,9 +286,10 @@ def _crossed(t: Tick, w: EdgeWork, first_wheel: float | None = None) -> tuple[fl
     """Where the back pair crossed the edge whose drop it reads now for the
     first time, on the odometer, and how far past it the pair is: what the
     wheels backed over the pair's lag (:func:`edge_lag_s`), by the
-    odometer's record of the watched ticks (``w.edge_recent``), plus for a
-    first-echo sensor the riser's face it keeps seeing (:func:`edge_sight_m`
-    standing).  By the record, not the speed now times the lag: a drop read
+    odometer's record of the watched ticks (``w.edge_recent``), plus what
+    the cone lets the pair see (:func:`edge_sight_m` standing: a first-echo
+    sensor's riser face, a signal-mixing cone's footprint still on the
+    tread).  By the record, not the speed now times the lag: a drop read
     as the backing brakes (at its end, or into a hold) was measured while
     the robot backed faster, the speed now would place the crossing too far
     back, and backing the clearance from there tips the robot back.  Behind
@@ -320,23 +322,6 @@ NARROW_AXLE_MARGIN_M = 0.004
 edge than this (the tab puts it 8.5 mm past it, as ascent 6 left it)."""
 
 
-def narrow_early_m(cfg: RobotConfig) -> float:
-    """How much earlier than :func:`_crossed` places it the back pair may
-    have crossed a narrow tread's edge: a sensor that mixes its cone's
-    returns by their signal (a time-of-flight cone, not a first echo, whose
-    riser face :func:`edge_sight_m` counts already) is dominated by the
-    tread BACK_CLEARANCE below until nearly its whole footprint has passed
-    the edge, BACK_CLEARANCE x tan(half the cone) past it; and the crossing
-    falls anywhere in a measurement period (:func:`edge_doubt_m`).  A bound
-    that keeps the robot on the tread counts from the earliest."""
-    spec = cfg.sensors.spec(True)
-    doubt = edge_doubt_m(cfg)
-    if spec.first_echo:
-        return doubt
-    fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
-    return cfg.BACK_CLEARANCE * math.tan(math.radians(fov) / 2) + doubt
-
-
 def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     """Narrow steps: watch the back pair cross the edge of the narrow tread
     the robot stands on, or steps down onto (floor, then the drop, as
@@ -344,10 +329,12 @@ def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     keep where (``DescentStep.narrow_edge_wheel``); once known, the odometer
     count the backing never passes: segment 2's rear axle
     NARROW_AXLE_MARGIN_M past that edge, counted from where the pair may
-    have crossed it at the earliest (:func:`narrow_early_m`).  The front
-    pair's tab alone leaves 8.5 mm to spare there: both of its sensors
-    reading 20 mm short (a common fault the standing rule cannot see) would
-    back segment 2's rear wheels off the edge."""
+    have crossed it at the earliest: :func:`_crossed` places it (a
+    signal-mixing cone's footprint counted, :func:`edge_sight_m`), and the
+    crossing falls anywhere in a measurement period (:func:`edge_doubt_m`).
+    The front pair's tab alone leaves 8.5 mm to spare there: both of its
+    sensors reading 20 mm short (a common fault the standing rule cannot
+    see) would back segment 2's rear wheels off the edge."""
     cfg, step = t.cfg, t.ctx.descent
     if step.narrow_edge_wheel is None:
         _remember(t, w, motion.wheel_position(t.snap))
@@ -360,7 +347,7 @@ def narrow_bound(t: Tick, w: EdgeWork) -> float | None:
     g = cfg.geometry
     reach = g.LENGTH_OF_THIRD_MODULE - cfg.sensors.back_from_rear + g.wheel_inset
     return step.narrow_edge_wheel - cfg.wheel_turns(reach - NARROW_AXLE_MARGIN_M
-                                                    - narrow_early_m(cfg))
+                                                    - edge_doubt_m(cfg))
 
 
 def refind_max_m(cfg: RobotConfig) -> float:

@@ -86,25 +86,46 @@ def edge_lag_s(cfg: RobotConfig) -> float:
         + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
 
 
+def _back_half_cone_rad(cfg: RobotConfig) -> float:
+    """Half the back pair's cone (the config's back_fov_deg, else its model's)."""
+    fov = cfg.sensors.back_fov_deg
+    return math.radians(cfg.sensors.spec(True).fov_deg if fov is None else fov) / 2
+
+
+def mixed_footprint_m(cfg: RobotConfig) -> float:
+    """How far past an edge a back sensor that mixes its cone's returns by
+    their signal (a time-of-flight cone; not a first echo, whose riser face
+    :func:`edge_sight_m` counts instead) may still read the tread: the tread
+    BACK_CLEARANCE below returns (BACK_CLEARANCE + rise)^2 / BACK_CLEARANCE^2
+    times the drop's signal per ray, so the mix reads past the edge only
+    once nearly the whole footprint has left it, BACK_CLEARANCE x tan(half
+    the cone) past the edge (a VL53L0X pair: 8.9 mm).  From the top, the
+    drop read LOW_DROP_M past the floor, sooner: counted in full there, it
+    stops segment 3's front wheels up to half the footprint short of where
+    edge_clearance_m puts them, within its EDGE_MARGIN_M.  0 for one ray."""
+    if cfg.sensors.spec(True).first_echo:
+        return 0.0
+    return cfg.BACK_CLEARANCE * math.tan(_back_half_cone_rad(cfg))
+
+
 def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> float:
     """How far past an edge the back pair's sensors are when perception first
     reports the drop, backing at ``speed_mps``: the distance backed while
     the measurements came through (the sensor's latency, then the median's
     majority of the window, one period each, the first of them half a
-    period after the crossing on average), and for a sensor that reports
-    the first echo in its cone, the riser's face below the edge that the
-    cone's back half keeps seeing, nearer than the drop, until the sensor
-    is ``edge_drop_m`` x sin(half the cone) past it.  For a wide cone this
-    is centimetres (an HC-SR04 pair sees the drop about 2.4 cm past the
-    edge), and the backing that follows subtracts it from
-    edge_clearance_m: counted from the sighting instead, it would tip the
-    robot back."""
-    spec = cfg.sensors.spec(True)
+    period after the crossing on average), and where the cone lets the
+    sensor see the drop at all: for a sensor that reports the first echo in
+    its cone, the riser's face below the edge that the cone's back half
+    keeps seeing, nearer than the drop, until the sensor is ``edge_drop_m``
+    x sin(half the cone) past it (an HC-SR04 pair: about 2.4 cm); for one
+    that mixes its cone by signal, the footprint still on the tread
+    (:func:`mixed_footprint_m`).  The backing that follows subtracts it
+    from edge_clearance_m: counted from the sighting instead, it backs that
+    much too far, and segment 2's rear wheels go over the edge."""
     sight = abs(speed_mps) * edge_lag_s(cfg)
-    if spec.first_echo:
-        fov = spec.fov_deg if cfg.sensors.back_fov_deg is None else cfg.sensors.back_fov_deg
-        sight += edge_drop_m(cfg, from_top) * math.sin(math.radians(fov) / 2)
-    return sight
+    if cfg.sensors.spec(True).first_echo:
+        return sight + edge_drop_m(cfg, from_top) * math.sin(_back_half_cone_rad(cfg))
+    return sight + mixed_footprint_m(cfg)
 
 
 
