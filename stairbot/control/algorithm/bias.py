@@ -42,7 +42,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.context import Context
@@ -132,6 +132,9 @@ class BiasWatch:
         self._risers: dict[int, Reference] = {}
         """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
         self._judged: dict[SensorId, str] = {}
+        self._distrusted: dict[SensorId, str] = {}
+        """Both front sensors, where they still disagree and nothing names one
+        (:mod:`~stairbot.control.algorithm.blind`), each with why in words."""
         self._tread: tuple[float | None, float] = (None, -1.0)
         """length_of_next_step as last seen, and when it was measured."""
 
@@ -143,12 +146,13 @@ class BiasWatch:
     def why(self, sensor: SensorId, otherwise: str | None = None) -> str:
         """Why ``sensor`` reads as ERROR: judged biased, else ``otherwise``
         (perception's reason), else it reports an error."""
-        return self._judged.get(sensor) or otherwise or "reports an error"
+        return self._judged.get(sensor) or self._distrusted.get(sensor) or otherwise \
+            or "reports an error"
 
     def all_judged(self, sensors: Sequence[SensorId]) -> bool:
-        """Whether every one of ``sensors`` is judged biased: no use waiting
-        for them to come back."""
-        return all(s in self._judged for s in sensors)
+        """Whether every one of ``sensors`` is judged biased, or distrusted with
+        its pair: no use waiting for them to come back."""
+        return all(s in self._judged or s in self._distrusted for s in sensors)
 
     def see(self, snap: Snapshot, ctx: Context) -> Snapshot:
         """Take this tick's filtered snapshot (before any stand-in), judge
@@ -187,10 +191,10 @@ class BiasWatch:
                 self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
-        if not self._judged:
+        if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)
-        for sid in self._judged:
+        for sid in (*self._judged, *self._distrusted):
             r = sensors[sid]
             sensors[sid] = SensorReading(r.distance_m, SensorStatus.ERROR, r.age_s)
         return replace(snap, sensors=sensors)
@@ -287,6 +291,11 @@ class BiasWatch:
         if found is not None:
             sensor, evidence = found
             self._judged[sensor] = evidence
+        elif not back and blind.needs_no_front(resume, ctx):
+            # nothing names one of the two: neither is trusted, and the robot
+            # goes on only where the way home needs no front reading
+            self._distrusted = dict(zip((SensorId.SFR, SensorId.SFL),
+                                        say.distrusted(disagree), strict=True))
 
     def _by_onsets(self, track: Onsets, disagree: float,
                    match: float) -> tuple[SensorId, str] | None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from stairbot.control.algorithm import limp
+from stairbot.control.algorithm import blind, limp
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import AscentEnd, Purpose
@@ -33,8 +33,10 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
     known = [SensorId(s) for s in ctx.limp.lost] if ctx.limp is not None else []
     lost = sorted(set(known) | set(errors), key=lambda s: s.value)
     why = limp.cannot_limp(lost, phase, purpose, tilt_watched,
-                           turned_at_landing=ctx.landing.step is not None)
-    plan = "" if why is not None else _plan(ctx, phase, purpose)
+                           turned_at_landing=ctx.landing.step is not None,
+                           needs_no_front=blind.needs_no_front(phase, ctx))
+    plan = "" if why is not None else say.BY_THE_ODOMETER if blind.unusable(set(lost)) \
+        else _plan(ctx, phase, purpose)
     if why is not None:
         then, told = "stranded", say.stranded(why)
     elif not consent:
