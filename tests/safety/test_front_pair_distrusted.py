@@ -2,11 +2,12 @@
 disagree after the standing rule's wait, and neither an onset, nor the
 riser the odometer places, says which reads wrong.  Neither is trusted then
 and no guess is made: where the way home needs no front reading (descent 7,
-on the floor after the last step) the robot, with the operator's consent,
-backs to where the program began by the odometer alone and comes home
-degraded; anywhere else the standing rule ends the program, as it always
-has.  The scenarios are cases of sweeps/sensor_faults.toml on the reference
-robot (their index in the names)."""
+on the floor after the last step; ascent 4 of the first step, undone by the
+odometer) the robot, with the operator's consent, goes back to where the
+program began by the odometer alone and comes home degraded; anywhere else
+the standing rule ends the program, as it always has.  The scenarios are
+cases of sweeps/sensor_faults.toml on the reference robot (their index in
+the names)."""
 
 from __future__ import annotations
 
@@ -31,11 +32,30 @@ def test_a_front_bias_nothing_names_in_descent_7_comes_home_by_the_odometer() ->
         ["SFL", "SFR"], [], [], "limp_home", "descent_finish"), stop
     assert "no evidence names which of the two reads wrong" in stop["failed"], stop
     assert "by the odometer alone" in stop["plan"], stop
-    after = [e.message for e in events
-             if e.kind is EventKind.INFO and e.time_s >= r.sim_time_s - 30]
+    stopped = next(e.time_s for e in events if "degraded" in e.data)
+    after = [e.message for e in events if e.kind is EventKind.INFO and e.time_s >= stopped]
     # neither sensor stands in for the other: no reading of the pair steers
     assert not [m for m in after if "'s value" in m], after
     assert [m for m in after if m.startswith("descent 7: the front pair distrusted")], after
+
+
+def test_a_front_bias_nothing_names_on_the_first_step_undoes_it_by_the_odometer() -> None:
+    # case 564: SFL 5 cm long from 22.5 s, as ascent 3 lifted segment 1 and
+    # both beams read too near at the riser; the pair disagreed as ascent 4
+    # drove segment 1 onto the tread ascent 3 measured on the bias
+    r, events = run(flight(499892, 22.5, "SFL", 0.05))
+    assert home(r) and r.steps_climbed == 0, r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 5.0, r.to_dict()
+    stop = degraded(events)
+    assert (stop["lost"], stop["biased"], stop["then"], stop["phase"]) == (
+        ["SFL", "SFR"], [], "limp_home", "ascent_drive_first"), stop
+    assert stop["plan"].startswith("undoing step 1 by the odometer"), stop
+    stopped = next(e.time_s for e in events if "degraded" in e.data)
+    after = [str(e.data["phase"]) for e in events
+             if e.kind is EventKind.PHASE and e.time_s >= stopped]
+    # backed off the step and segment 1 lowered again: nothing more of the climb
+    assert after.index("ascent_lower_obstacle") < after.index("descent_finish"), after
+    assert "ascent_lift_second" not in after, after
 
 
 def test_a_front_pair_distrusted_without_consent_stays_stopped_and_awaits_it() -> None:

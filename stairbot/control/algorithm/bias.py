@@ -277,9 +277,12 @@ class BiasWatch:
         if found is not None and not back and resume in ONTO_THE_TREAD \
                 and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
             # it went wrong before the tread ahead was measured on it: finishing
-            # the step by that figure is not safe, and the standing rule ends
-            # the program, as it always has (climbing on, it would tip)
-            return
+            # the step by that figure is not safe (climbing on, it would tip).
+            # On the first step the robot undoes it by the odometer, neither
+            # sensor trusted; elsewhere the standing rule ends the program
+            if not blind.needs_no_front(resume, ctx):
+                return
+            found = None
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
         tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \

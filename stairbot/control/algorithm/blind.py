@@ -10,7 +10,11 @@ go on only where the rest of the way home needs no front reading:
   where the program began by the odometer (as when no step was climbed),
   turning by it to the floor's and the start's headings (calibration's
   lift, turn and lowering with a heading to turn to, ``Purpose.FLOOR`` or
-  ``Purpose.HOME``).
+  ``Purpose.HOME``);
+* ascent 4 of the first step, the whole robot on the floor and segment 1
+  lifted over the tread: the step undone by the odometer
+  (:mod:`~stairbot.control.algorithm.undo_first`), segment 1 lowered again
+  (ascent 3's obstacle phase), then descent 7 as above.
 
 Anywhere else (a riser to square up to, a tread or a tab to read) the robot
 stays stopped, lifts holding, and says why: stranded, as before.
@@ -29,6 +33,8 @@ _HOMING = frozenset({Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
 _TURNING_HOME = frozenset({Phase.CAL_LIFT, Phase.CAL_TURN_TO, Phase.CAL_LOWER})
 """Calibration's turn back to a heading by the odometer (in descent 7)."""
 _HOME_PURPOSES = (Purpose.FLOOR, Purpose.HOME)
+_UNDOING = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LOWER_OBSTACLE})
+"""Ascent 4 and ascent 3's lowering of segment 1: of the first step, undone."""
 
 
 def needs_no_front(phase: Phase, ctx: Context) -> bool:
@@ -41,6 +47,8 @@ def needs_no_front(phase: Phase, ctx: Context) -> bool:
         return False
     if phase in _HOMING:
         return True
+    if phase in _UNDOING:
+        return ctx.number_of_steps == 0
     family = ctx.family
     return phase in _TURNING_HOME and isinstance(family, Calibration) \
         and family.purpose in _HOME_PURPOSES and family.turn_to is not None

@@ -45,6 +45,11 @@ def plan(kind: str, step: int, down: int) -> str:
 BY_THE_ODOMETER = ("back to the start by the odometer alone, turning by it to the floor's "
                    "and the start's headings, the front pair distrusted")
 """The plan where the front pair is distrusted (:mod:`~stairbot.control.algorithm.blind`)."""
+UNDO_FIRST = ("undoing step 1 by the odometer (segment 1 backed off the step to where ascent "
+              "4 began and lowered again), then " + BY_THE_ODOMETER)
+"""The same plan from ascent 4 of the first step."""
+UNDO_BY_THE_ODOMETER = ("ascent 4, step 1: the front pair distrusted, backing segment 1 off "
+                        "the step by the odometer to where ascent 4 began")
 
 NO_CONSENT = ("it can come down on the sensors that remain, but only with the operator's "
               "consent; until then it stays stopped, lifts holding, or a person brings it "
