@@ -31,7 +31,9 @@ A judged sensor is lost (:mod:`~stairbot.control.algorithm.limp`): on the
 floor where the program began the run ends on it; elsewhere a degraded
 stop, and with the operator's consent its partner stands in for it on the
 way home.  Where nothing names one of two sensors that disagree, the
-standing rule ends the program, as it always has.
+standing rule ends the program, as it always has -- but for the front pair
+where the way home needs no front reading
+(:mod:`~stairbot.control.algorithm.blind`): both are distrusted there.
 
 Pure Python, on the controller's clock (the snapshots' times); it keeps no
 state in the context (a resumed run starts with no evidence).

@@ -8,8 +8,10 @@ the run as it always has: the robot is home.  Anywhere else it is a
 *degraded stop* (:class:`DegradedStop`): every motor stopped, the lifts
 holding, and the robot says what failed, where it stands, and whether it
 can come down on what remains.  It can while each pair keeps one sensor
-(the survivor then stands for both: :func:`mirrored`), the IMU watches the
-tilt, and it is not on a landing; with the operator's consent
+(the survivor then stands for both: :func:`mirrored`; or the front pair is
+lost where the way home reads nothing of it:
+:mod:`~stairbot.control.algorithm.blind`), the IMU watches the tilt, and it
+is not on a landing; with the operator's consent
 (``stairbot run --yes``) it then finishes or undoes the step in progress and
 goes down by the geometry it measured on the way up, at LIMP_SPEED of
 every motor's speed, and the program ends ``came_home_degraded``.  Without
