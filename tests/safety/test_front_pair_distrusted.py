@@ -39,6 +39,18 @@ def test_a_front_bias_nothing_names_in_descent_7_comes_home_by_the_odometer() ->
     assert [m for m in after if m.startswith("descent 7: the front pair distrusted")], after
 
 
+def test_a_bias_within_the_evidence_tolerance_is_distrusted_where_the_standing_rule_ends() -> None:
+    # case 311: SFL 1 cm long from 60.1 s; the pair still disagrees in descent
+    # 7 by the standing rule's own test (the median of the wait's last second
+    # past the smoothed tolerance), under the tolerance the evidence is
+    # weighed against: distrusted on the tick the rule would end the run
+    r, events = run(flight(584376, 60.1, "SFL", 0.01))
+    assert home(r), r.to_dict()
+    stop = degraded(events)
+    assert (stop["lost"], stop["phase"]) == (["SFL", "SFR"], "descent_finish"), stop
+    assert "still disagree by 1." in stop["failed"], stop
+
+
 def test_a_front_bias_nothing_names_on_the_first_step_undoes_it_by_the_odometer() -> None:
     # case 564: SFL 5 cm long from 22.5 s, as ascent 3 lifted segment 1 and
     # both beams read too near at the riser; the pair disagreed as ascent 4

@@ -271,6 +271,7 @@ class BiasWatch:
         near = min(r.distance_m, left.distance_m)
         tolerance = standing_tolerance(cfg, near, back=back)
         if abs(disagree) <= tolerance:
+            self._distrust(snap, ctx, resume)
             return
         match = max(tolerance, MATCH_SHARE * abs(disagree))
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
@@ -296,11 +297,19 @@ class BiasWatch:
         if found is not None:
             sensor, evidence = found
             self._judged[sensor] = evidence
-        elif not back and blind.needs_no_front(resume, ctx):
-            # nothing names one of the two: neither is trusted, and the robot
-            # goes on only where the way home needs no front reading
+        else:
+            self._distrust(snap, ctx, resume)
+
+    def _distrust(self, snap: Snapshot, ctx: Context, resume: Phase) -> None:
+        """Nothing names one of the front pair: where the way home needs no
+        front reading, neither is trusted from the tick on which the standing
+        rule would end the program (:func:`blind.ends_now`)."""
+        if resume.record.watches == "back" or not blind.needs_no_front(resume, ctx):
+            return
+        median = blind.ends_now(snap, ctx, self._cfg)
+        if median is not None:
             self._distrusted = dict(zip((SensorId.SFR, SensorId.SFL),
-                                        say.distrusted(disagree), strict=True))
+                                        say.distrusted(median), strict=True))
 
     def _by_onsets(self, track: Onsets, disagree: float,
                    match: float) -> tuple[SensorId, str] | None:

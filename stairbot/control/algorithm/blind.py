@@ -22,11 +22,16 @@ stays stopped, lifts holding, and says why: stranded, as before.
 
 from __future__ import annotations
 
+import statistics
+
+from stairbot.control.algorithm import motion, standing
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
-from stairbot.hardware import FRONT_SENSORS, SensorId
+from stairbot.control.tolerances import standing_tolerance
+from stairbot.hardware import FRONT_SENSORS, SensorId, Snapshot
+from stairbot.inputs.config import RobotConfig
 
 _HOMING = frozenset({Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
 """Descent 7: on the floor, back to the start position."""
@@ -64,3 +69,19 @@ def front_unusable(ctx: Context) -> bool:
 def unusable(lost: set[SensorId]) -> bool:
     """Whether ``lost`` holds both front sensors."""
     return all(s in lost for s in FRONT_SENSORS)
+
+
+def ends_now(snap: Snapshot, ctx: Context, cfg: RobotConfig) -> float | None:
+    """While the standing rule waits on the front pair: the median of the
+    pair's difference (SFL less SFR) over the wait's last MEDIAN_S, if the
+    rule ends the program on this tick (its own test, before its step runs:
+    past the smoothed tolerance DEBOUNCE_TICKS ticks in a row, this the
+    last); else None."""
+    pause, diff = ctx.pause, motion.pair_difference(snap, cfg)
+    if pause is None or diff is None or ctx.watch.ticks < standing.DEBOUNCE_TICKS - 1:
+        return None
+    recent = [*pause.diffs, diff][-max(1, round(standing.MEDIAN_S / cfg.algorithm.tick)):]
+    median = statistics.median(recent)
+    right, left = motion.pair(snap)
+    near = min(right.distance_m, left.distance_m)
+    return median if abs(median) > standing_tolerance(cfg, near, motion.DIFF_SMOOTHING) else None
