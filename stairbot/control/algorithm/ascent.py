@@ -13,7 +13,7 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import long_tread, lost, motion, sight
+from stairbot.control.algorithm import long_tread, lost, motion, sight, undo_first
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.lift_first import (
     LIFT_FIRST,
@@ -238,11 +238,11 @@ def _driven_first(t: Tick, _w: DriveWork) -> Step:
     return go("reached")
 
 
-DRIVE_FIRST = drive_phase(
+DRIVE_FIRST = undo_first.with_undo(drive_phase(
     P.ASCENT_DRIVE_FIRST, "ascent 4 — drive segment 1 onto the step", FLOW, 1, _first_target,
     lambda t: t.cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_FIRST_MODULE, P.ASCENT_LIFT_SECOND,
     "reads length_of_next_step − LENGTH_OF_FIRST_MODULE (or turns made); from a narrow "
-    "step, segment 3 on its tread again", _driven_first, work=DriveWork)
+    "step, segment 3 on its tread again", _driven_first, work=DriveWork))
 
 LIFT_SECOND = lift_phase(
     P.ASCENT_LIFT_SECOND, "ascent 5 — lift segment 2", FLOW,

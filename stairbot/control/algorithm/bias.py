@@ -31,7 +31,9 @@ A judged sensor is lost (:mod:`~stairbot.control.algorithm.limp`): on the
 floor where the program began the run ends on it; elsewhere a degraded
 stop, and with the operator's consent its partner stands in for it on the
 way home.  Where nothing names one of two sensors that disagree, the
-standing rule ends the program, as it always has.
+standing rule ends the program, as it always has -- but for the front pair
+where the way home needs no front reading
+(:mod:`~stairbot.control.algorithm.blind`): both are distrusted there.
 
 Pure Python, on the controller's clock (the snapshots' times); it keeps no
 state in the context (a resumed run starts with no evidence).
@@ -42,7 +44,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.context import Context
@@ -132,6 +134,9 @@ class BiasWatch:
         self._risers: dict[int, Reference] = {}
         """Where the riser ahead of each tread stood by the odometer (0: the floor's)."""
         self._judged: dict[SensorId, str] = {}
+        self._distrusted: dict[SensorId, str] = {}
+        """Both front sensors, where they still disagree and nothing names one
+        (:mod:`~stairbot.control.algorithm.blind`), each with why in words."""
         self._tread: tuple[float | None, float] = (None, -1.0)
         """length_of_next_step as last seen, and when it was measured."""
 
@@ -143,12 +148,13 @@ class BiasWatch:
     def why(self, sensor: SensorId, otherwise: str | None = None) -> str:
         """Why ``sensor`` reads as ERROR: judged biased, else ``otherwise``
         (perception's reason), else it reports an error."""
-        return self._judged.get(sensor) or otherwise or "reports an error"
+        return self._judged.get(sensor) or self._distrusted.get(sensor) or otherwise \
+            or "reports an error"
 
     def all_judged(self, sensors: Sequence[SensorId]) -> bool:
-        """Whether every one of ``sensors`` is judged biased: no use waiting
-        for them to come back."""
-        return all(s in self._judged for s in sensors)
+        """Whether every one of ``sensors`` is judged biased, or distrusted with
+        its pair: no use waiting for them to come back."""
+        return all(s in self._judged or s in self._distrusted for s in sensors)
 
     def see(self, snap: Snapshot, ctx: Context) -> Snapshot:
         """Take this tick's filtered snapshot (before any stand-in), judge
@@ -187,10 +193,10 @@ class BiasWatch:
                 self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
-        if not self._judged:
+        if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)
-        for sid in self._judged:
+        for sid in (*self._judged, *self._distrusted):
             r = sensors[sid]
             sensors[sid] = SensorReading(r.distance_m, SensorStatus.ERROR, r.age_s)
         return replace(snap, sensors=sensors)
@@ -265,6 +271,7 @@ class BiasWatch:
         near = min(r.distance_m, left.distance_m)
         tolerance = standing_tolerance(cfg, near, back=back)
         if abs(disagree) <= tolerance:
+            self._distrust(snap, ctx, resume)
             return
         match = max(tolerance, MATCH_SHARE * abs(disagree))
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
@@ -273,9 +280,12 @@ class BiasWatch:
         if found is not None and not back and resume in ONTO_THE_TREAD \
                 and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
             # it went wrong before the tread ahead was measured on it: finishing
-            # the step by that figure is not safe, and the standing rule ends
-            # the program, as it always has (climbing on, it would tip)
-            return
+            # the step by that figure is not safe (climbing on, it would tip).
+            # On the first step the robot undoes it by the odometer, neither
+            # sensor trusted; elsewhere the standing rule ends the program
+            if not blind.needs_no_front(resume, ctx):
+                return
+            found = None
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
         tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
@@ -287,6 +297,19 @@ class BiasWatch:
         if found is not None:
             sensor, evidence = found
             self._judged[sensor] = evidence
+        else:
+            self._distrust(snap, ctx, resume)
+
+    def _distrust(self, snap: Snapshot, ctx: Context, resume: Phase) -> None:
+        """Nothing names one of the front pair: where the way home needs no
+        front reading, neither is trusted from the tick on which the standing
+        rule would end the program (:func:`blind.ends_now`)."""
+        if resume.record.watches == "back" or not blind.needs_no_front(resume, ctx):
+            return
+        median = blind.ends_now(snap, ctx, self._cfg)
+        if median is not None:
+            self._distrusted = dict(zip((SensorId.SFR, SensorId.SFL),
+                                        say.distrusted(median), strict=True))
 
     def _by_onsets(self, track: Onsets, disagree: float,
                    match: float) -> tuple[SensorId, str] | None:

@@ -91,7 +91,7 @@ class Controller:
         self._sensor_since: float | None = None
         self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
         self._phase_link: Mapping[str, float] = {}  # ... when the present phase began
-        self._now_key: tuple[str, str | None] | None = None  # see _present
+        self._now_key: tuple[str, str | None, int] | None = None  # see _present
         self._now: tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]] | None = None
 
     # -- what the outside sees --------------------------------------------------------
@@ -224,9 +224,9 @@ class Controller:
 
     def _present(self) -> tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]]:
         """The present phase, its record and :func:`_needed_sensors`, looked up
-        again only when the context's phase or the one a pause resumes changes."""
+        again only when the phase, the one a pause resumes or the lost change."""
         ctx = self._ctx
-        key = (ctx.phase, ctx.resume_phase)
+        key = (ctx.phase, ctx.resume_phase, 0 if ctx.limp is None else len(ctx.limp.lost))
         now = self._now
         if now is None or key != self._now_key:
             phase = BY_VALUE[ctx.phase]

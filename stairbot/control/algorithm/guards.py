@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
-from stairbot.control.algorithm import motion, squaring
+from stairbot.control.algorithm import blind, motion, squaring
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
 from stairbot.control.algorithm.transitions import BACK_PAIR_PHASES
@@ -117,6 +117,8 @@ def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
         phase = Phase(ctx.pause.resume_phase)
     if phase.terminal:
         return ()
+    if blind.front_unusable(ctx) and blind.needs_no_front(phase, ctx):
+        return ()  # nothing else read there: the way home goes by the odometer
     if ctx.from_top and phase.flow != "ascent":
         return BACK_SENSORS  # a continuous descent steers by the back pair alone
     if phase in _EDGE_WATCH:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.modes import Outcome, Purpose
 from stairbot.control.algorithm.moves import (
     checked_first,
@@ -44,15 +44,26 @@ def _on_the_floor_all_along(t: Tick) -> bool:
     return t.ctx.number_of_steps == 0 and t.ctx.start.wheel is not None
 
 
+def _by_the_odometer(t: Tick) -> bool:
+    """Descent 7 goes by the odometer alone: no step was climbed
+    (:func:`_on_the_floor_all_along`), or the front pair is distrusted
+    (:mod:`~stairbot.control.algorithm.blind`: its two sensors disagree and
+    nothing names which reads wrong; on the floor, all wheels down, the
+    odometer's drift of a centimetre or so a step climbed and descended is
+    all it costs)."""
+    return _on_the_floor_all_along(t) or (blind.front_unusable(t.ctx)
+                                          and t.ctx.start.wheel is not None)
+
+
 def _finish_turns(t: Tick) -> float:
     """How far descent 7 backs while the front pair cannot measure: by the
-    odometer if no step was climbed; else from the riser (approach_gap
-    away) to the start reading -- not the seed's
+    odometer if no step was climbed, or the front pair is distrusted; else
+    from the riser (approach_gap away) to the start reading -- not the seed's
     NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH, within which a pair that reads
     only from 10 cm (a Sharp) may not yet measure, which would stop the
     robot 0.4 m short."""
     start, cfg = t.ctx.start, t.cfg
-    if _on_the_floor_all_along(t):
+    if _by_the_odometer(t):
         assert start.wheel is not None
         return max(0.0, motion.wheel_position(t.snap) - start.wheel)
     if start.reading is None:
@@ -101,12 +112,24 @@ def _floor_heading(t: Tick, _w: DriveWork) -> Step | None:
     return calibrate("off_floor_heading", Purpose.FLOOR, floor)
 
 
-_finish = reading_drive(-1, lambda t: None if _on_the_floor_all_along(t) else t.ctx.start.reading,
+_finish = reading_drive(-1, lambda t: None if _by_the_odometer(t) else t.ctx.start.reading,
                         _finish_turns, _at_start_position)
+
+
+def _finishing(t: Tick, w: DriveWork) -> Step:
+    """Descent 7's drive; from the tick the front pair is distrusted on, to
+    the start position by the odometer (the target its readings gave is
+    dropped)."""
+    if w.target_reading is not None and _by_the_odometer(t):
+        assert t.ctx.start.wheel is not None
+        w.target_reading, w.target_wheel = None, t.ctx.start.wheel
+        t.say(say.BY_THE_ODOMETER)
+    return _finish[1](t, w)
 FINISH = PhaseDef(
     P.DESCENT_FINISH, "descent 7 — finish: back off to the start position", FLOW,
-    checked_first(_floor_heading, _finish[1]), DriveWork, enter=_finish[0], watches="front",
-    on={ENDED: Exit(P.DONE, "reads the start reading (or turns made; with no step climbed: "
+    checked_first(_floor_heading, _finishing), DriveWork, enter=_finish[0], watches="front",
+    on={ENDED: Exit(P.DONE, "reads the start reading (or turns made; with no step climbed, or "
+                            "the front pair distrusted: "
                             "back by the odometer to the start position)"),
         "off_floor_heading": Exit(P.CAL_LIFT, "turned from the heading it crossed the floor "
                                               "with: lift to turn back to it"),

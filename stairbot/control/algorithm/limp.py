@@ -8,8 +8,10 @@ the run as it always has: the robot is home.  Anywhere else it is a
 *degraded stop* (:class:`DegradedStop`): every motor stopped, the lifts
 holding, and the robot says what failed, where it stands, and whether it
 can come down on what remains.  It can while each pair keeps one sensor
-(the survivor then stands for both: :func:`mirrored`), the IMU watches the
-tilt, and it is not on a landing; with the operator's consent
+(the survivor then stands for both: :func:`mirrored`; or the front pair is
+lost where the way home reads nothing of it:
+:mod:`~stairbot.control.algorithm.blind`), the IMU watches the tilt, and it
+is not on a landing; with the operator's consent
 (``stairbot run --yes``) it then finishes or undoes the step in progress and
 goes down by the geometry it measured on the way up, at LIMP_SPEED of
 every motor's speed, and the program ends ``came_home_degraded``.  Without
@@ -24,7 +26,7 @@ from typing import Any
 
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, Purpose
 from stairbot.control.algorithm.phases import Mode, Phase
-from stairbot.hardware import MotorId, SensorId, Snapshot
+from stairbot.hardware import MotorId, SensorId, SensorReading, SensorStatus, Snapshot
 
 LIMP_SPEED = 0.5
 """While limping home every motor runs at most this share of its maximum
@@ -60,11 +62,17 @@ def mirrored(snap: Snapshot, lost: Sequence[str]) -> Snapshot:
     """``snap`` with each lost sensor reading what its partner reads: a pair
     of which one survives steers as one sensor (its mean is the survivor's,
     it never disagrees with itself, and it crosses an edge where the
-    survivor does)."""
+    survivor does).  A pair both of whose sensors are lost reads as ERROR
+    (:mod:`~stairbot.control.algorithm.blind`: only what needs no reading of
+    it goes on)."""
     sensors = dict(snap.sensors)
     for name in lost:
         sid = SensorId(name)
-        sensors[sid] = snap.sensors[PARTNER[sid]]
+        if PARTNER[sid].value in lost:
+            r = snap.sensors[sid]
+            sensors[sid] = SensorReading(r.distance_m, SensorStatus.ERROR, r.age_s)
+        else:
+            sensors[sid] = snap.sensors[PARTNER[sid]]
     return replace(snap, sensors=sensors)
 
 
@@ -83,15 +91,18 @@ def on_the_floor(phase: Phase, purpose: Purpose | None, steps_climbed: int,
 
 
 def cannot_limp(lost: Iterable[SensorId], phase: Phase, purpose: Purpose | None,
-                tilt_watched: bool, turned_at_landing: bool = False) -> str | None:
-    """Why the robot cannot come down on what remains (None: it can)."""
+                tilt_watched: bool, turned_at_landing: bool = False,
+                needs_no_front: bool = False) -> str | None:
+    """Why the robot cannot come down on what remains (None: it can).
+    ``needs_no_front``: the way home from ``phase`` reads no front sensor
+    (:func:`~stairbot.control.algorithm.blind.needs_no_front`)."""
     gone = set(lost)
     for right, left, pair, what in (
             (SensorId.SFR, SensorId.SFL, "front", "nothing reads the risers and treads the "
                                                   "way down is measured against"),
             (SensorId.SBR, SensorId.SBL, "back", "nothing finds the edges and the floor "
                                                  "below a step")):
-        if right in gone and left in gone:
+        if right in gone and left in gone and not (needs_no_front and pair == "front"):
             return f"both {pair} sensors lost: {what}"
     if not tilt_watched:
         return "no IMU watches the tilt: the robot does not move blind on its remaining sensors"

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from stairbot.control.algorithm import limp
+from stairbot.control.algorithm import blind, limp
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import AscentEnd, Purpose
@@ -33,8 +33,9 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
     known = [SensorId(s) for s in ctx.limp.lost] if ctx.limp is not None else []
     lost = sorted(set(known) | set(errors), key=lambda s: s.value)
     why = limp.cannot_limp(lost, phase, purpose, tilt_watched,
-                           turned_at_landing=ctx.landing.step is not None)
-    plan = "" if why is not None else _plan(ctx, phase, purpose)
+                           turned_at_landing=ctx.landing.step is not None,
+                           needs_no_front=blind.needs_no_front(phase, ctx))
+    plan = "" if why is not None else _plan(ctx, phase, purpose, blind.unusable(set(lost)))
     if why is not None:
         then, told = "stranded", say.stranded(why)
     elif not consent:
@@ -53,8 +54,11 @@ _UNDO = (Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_LOW
 _TURN_BACK = (Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS)
 
 
-def _plan(ctx: Context, phase: Phase, purpose: Purpose | None) -> str:
-    """What the limp home does from ``phase``, in words."""
+def _plan(ctx: Context, phase: Phase, purpose: Purpose | None, distrusted: bool) -> str:
+    """What the limp home does from ``phase``, in words (``distrusted``: the
+    front pair)."""
+    if distrusted:
+        return say.UNDO_FIRST if phase is Phase.ASCENT_DRIVE_FIRST else say.BY_THE_ODOMETER
     n = ctx.number_of_steps
     if ctx.ascent_end is not None or ctx.from_top or phase.flow == "descent" \
             or purpose not in (None, Purpose.START, Purpose.ASCENT):

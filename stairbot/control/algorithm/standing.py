@@ -39,6 +39,7 @@ from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import Work
 from stairbot.control.tolerances import standing_tolerance
+from stairbot.hardware import SensorStatus
 
 BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
                            Phase.ASCENT_DRIVE_SECOND})
@@ -152,7 +153,9 @@ def _paused(t: Tick, _w: Work) -> Step:
             t.cfg, near, motion.DIFF_SMOOTHING, back)
     if not disagree:
         ctx.watch.ticks = 0
-        return go(resumed(resume.phase), say.agree_again(back, _readings(t, back), resume.label))
+        lost = SensorStatus.ERROR in (r.status for r in motion.pair(t.snap, back))
+        return go(resumed(resume.phase), say.no_figure(back, resume.label) if lost
+                  else say.agree_again(back, _readings(t, back), resume.label))
     ctx.watch.ticks += 1
     if ctx.watch.ticks >= DEBOUNCE_TICKS:
         return fail(say.still_disagree(back, t.cfg.algorithm.standing_wait, _readings(t, back),

@@ -76,3 +76,14 @@ def judged_by_riser(sensor: SensorId, partner: SensorId, off_m: float, partner_o
     return (f"judged biased: {sensor} reads {_cm(off_m)} {'more' if off_m > 0 else 'less'} "
             f"than the drive says ({where} and the odometer since), {partner} within "
             f"{abs(partner_off_m) * 1000:.1f} mm of it; {_past(sensor, partner, said_m)}")
+
+
+def distrusted(disagree_m: float) -> tuple[str, str]:
+    """At the standing rule's wait's end, nothing naming either sensor of the
+    front pair (``disagree_m``: SFL less SFR): why SFR and why SFL are
+    distrusted."""
+    more = "SFL" if disagree_m > 0 else "SFR"
+    return (f"distrusted: standing still, SFR and SFL still disagree by {_cm(disagree_m)} "
+            f"({more} reads more) after the standing rule's wait, and no evidence names "
+            "which of the two reads wrong",
+            "distrusted with SFR: the front pair")

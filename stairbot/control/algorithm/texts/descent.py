@@ -154,3 +154,6 @@ def off_floor_heading(off_rad: float) -> str:
 
 
 BACK_WHERE_BEGAN = "back where the program began"
+
+BY_THE_ODOMETER = ("descent 7: the front pair distrusted, back to the start position by the "
+                   "odometer alone")

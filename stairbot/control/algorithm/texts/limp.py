@@ -42,6 +42,15 @@ def plan(kind: str, step: int, down: int) -> str:
     return f"{head}{steps}back to the start"
 
 
+BY_THE_ODOMETER = ("back to the start by the odometer alone, turning by it to the floor's "
+                   "and the start's headings, the front pair distrusted")
+"""The plan where the front pair is distrusted (:mod:`~stairbot.control.algorithm.blind`)."""
+UNDO_FIRST = ("undoing step 1 by the odometer (segment 1 backed off the step to where ascent "
+              "4 began and lowered again), then " + BY_THE_ODOMETER)
+"""The same plan from ascent 4 of the first step."""
+UNDO_BY_THE_ODOMETER = ("ascent 4, step 1: the front pair distrusted, backing segment 1 off "
+                        "the step by the odometer to where ascent 4 began")
+
 NO_CONSENT = ("it can come down on the sensors that remain, but only with the operator's "
               "consent; until then it stays stopped, lifts holding, or a person brings it "
               "down")
@@ -57,7 +66,10 @@ def stranded(why: str) -> str:
 def stand_ins(lost: Sequence[str]) -> str:
     """What a message says of the pair's readings while limping home."""
     pairs = {"SFR": "SFL", "SFL": "SFR", "SBR": "SBL", "SBL": "SBR"}
-    return " [limping: " + ", ".join(f"{s} reads {pairs[s]}'s value" for s in lost) + "]"
+    said = [f"{s} reads {pairs[s]}'s value" for s in lost if pairs[s] not in lost]
+    said += [f"{s} and {pairs[s]} distrusted" for s in ("SFR", "SBR") if s in lost
+             and pairs[s] in lost]
+    return " [limping: " + ", ".join(said) + "]"
 
 
 def lost_sensor_end(failed: str, wait_s: float, label: str, then: str = "") -> str:

@@ -35,6 +35,12 @@ def agree_again(back: bool, readings: tuple[float, float], label: str) -> str:
             f"({_readings(readings)}): resuming {label}")
 
 
+def no_figure(back: bool, label: str) -> str:
+    """The wait's end, the pair giving no figure (lost: it reads as ERROR)."""
+    return (f"standing rule: {_pair(back)} give no figure to compare (lost): resuming "
+            f"{label}")
+
+
 def still_disagree(back: bool, wait_s: float, readings: tuple[float, float], label: str) -> str:
     return (f"standing rule: {_pair(back)} still disagree after "
             f"{wait_s:g} s ({_readings(readings)}) in "
