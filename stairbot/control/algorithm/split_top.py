@@ -37,13 +37,13 @@ measurable while the pair does not read "nothing ahead" either."""
 def tab_again(t: Tick, w: WaitWork) -> Step | None:
     """Ascent 7 found no tab and the pair does not read "nothing ahead" now:
     stand up to TAB_WAIT_S for the pair to read it (kept), or both nothing
-    (the top, :func:`~stairbot.control.algorithm.ascent` decides).  Still
-    split after it: the top where the nearer beam reads no riser
-    (:func:`beside_the_top`); otherwise go on, and descent 1 finds this
-    step's edge by the back pair alone.  The split reading is not otherwise
-    taken for the top: one sensor reading a little long, the robot askew at
-    the flight's side, would then end the ascent, and coming down the step
-    it stands on from there tips the robot back.  None: go on."""
+    (the top: ascent 8 itself decides it).  Still split after it: the top
+    where the nearer beam reads no riser (:func:`beside_the_top`); otherwise
+    go on, and descent 1 finds this step's edge by the back pair alone.  The
+    split reading is not otherwise taken for the top: one sensor reading a
+    little long, the robot askew at the flight's side, would then end the
+    ascent, and coming down the step it stands on from there tips the robot
+    back.  None: go on."""
     ctx, cfg = t.ctx, t.cfg
     i = ctx.number_of_steps - 1
     if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:
