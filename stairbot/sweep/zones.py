@@ -143,10 +143,28 @@ def _cone_clearances(scenario: Scenario, steps: tuple[Step, ...] | list[Step],
     return near, far
 
 
-LATERAL_DRIFT_M = 0.05
-"""How far across the flight a climb may carry the robot from where it
-started: calibration squares up within its tolerance (a degree or so), and
-1.3 degrees over three steps and the landing's approach moved it 45 mm."""
+def landing_drift_m(scenario: Scenario, config: RobotConfig) -> float:
+    """How far across the flight the climb may carry the robot from where it
+    was set down, by the time it looks sideways from the landing's wall: the
+    start's close-in drive at the yaw it was set down with, then the yaw the
+    start's squaring may leave (the pair's difference within
+    :func:`~stairbot.control.tolerances.square_tolerance` over its baseline,
+    2 x front_lateral: 2.9 degrees on the reference robot's 5 mm over 0.1 m),
+    which later steps keep (their calibration turns only past the tolerance),
+    over the way from where it squared up to the wall ahead: 0.1 m over the
+    2 m to a 1.02 m landing's wall behind two 0.28 m treads."""
+    from stairbot.control.tolerances import square_tolerance  # the sweep runs the controller
+
+    landing = scenario.landing
+    assert landing is not None
+    start = scenario.start
+    squared = min(start.distance, limits.square_range_m(config))
+    close_in = (start.distance - squared) * abs(math.sin(math.radians(start.yaw_deg)))
+    yaw = math.atan(square_tolerance(config, squared)
+                    / (2.0 * max(config.sensors.front_lateral, 1e-6)))
+    way = (squared + sum(s.tread for s in scenario.steps[:-1]) + landing.depth
+           - config.algorithm.approach_gap)
+    return close_in + way * math.tan(yaw)
 
 
 def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
@@ -159,8 +177,10 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     pair's LENGTH_OF_INFINITY past the robot standing at the edge), and the
     robot's turning room (:func:`~stairbot.control.algorithm.landing.turn_room_m`)
     fits in half the landing's measured depth and on either side of where it
-    climbed (half the width, less start.lateral), give or take the tread
-    margin.  Where the landing refuses, the first flight's zone stands: the
+    climbed (half the width, less start.lateral and the drift the squaring's
+    tolerance allows: :func:`landing_drift_m`), give or take the tread
+    margin; where it fits centred but not so drifted, either is right (the
+    band).  Where the landing refuses, the first flight's zone stands: the
     robot climbs it, refuses the landing, comes home, and that is right
     ("refused"); where it does not, both flights must be climbed."""
     from stairbot.control.algorithm.landing import DEPTH_MARGIN, turn_room_m
@@ -176,10 +196,10 @@ def landing_zone(scenario: Scenario, config: RobotConfig, rules: Rules
     tm = rules.tread_margin_m
     room = turn_room_m(config)
     depth = landing.depth - DEPTH_MARGIN
-    # where the robot stands across the landing: start.lateral, and what
-    # calibration's residual yaw adds over the flight (LATERAL_DRIFT_M)
+    # where the robot stands across the landing: start.lateral, and what the
+    # yaw the squaring leaves adds over the flight (either way: the nearer side)
     centred = scenario.width / 2.0 - room
-    drifted = centred - abs(scenario.start.lateral) - LATERAL_DRIFT_M
+    drifted = centred - abs(scenario.start.lateral) - landing_drift_m(scenario, config)
     # how far inside LENGTH_OF_INFINITY ascent 8 reads the wall ahead
     top = config.LENGTH_OF_INFINITY - _riser_seen_m(landing.depth, config)
     sight = sight_margin(config)

@@ -250,3 +250,50 @@ def test_a_side_reading_that_jumps_mid_scan_opens_no_wall(at: float, more: str) 
             result.steps_descended) == ("completed", "landing_closed", 3, 3), result.to_dict()
     assert result.wall_contact is None and not result.fell
     assert Phase.LANDING_SCAN in phases(events)
+
+
+SKEWED_ONTO_A_NARROW_FLIGHT = """
+[stairs]
+count = 3
+rise = 0.17
+tread = 0.28
+width = 0.6
+[start]
+distance = 0.5
+yaw_deg = -3.945422
+lateral = 0.014349
+[sensors]
+noise = 0.001
+seed = 814971
+outliers = 0.01
+[landing]
+turn = "left"
+depth = 0.4
+count = 3
+[[faults]]
+at = 0.0
+sensor = "SFL"
+kind = "offset"
+offset = 0.002
+duration = 14.5
+"""
+
+
+def test_a_side_wall_grazed_beside_an_open_top_is_the_top_not_a_riser_to_turn_to() -> None:
+    """SFL 2 mm long while the start squares up leaves the robot 4° askew
+    (inside equal_tolerance); the landing's turn carries it onto a second
+    flight 0.4 m wide, climbed towards the landing's far wall, which runs on
+    past the top.  At ascent 8 of the top step SFR's cone grazes that wall
+    (0.44 m) and SFL reads nothing ahead: taken for a riser out of SFL's
+    reach, the ascent went on and the next calibration turned towards the
+    wall until segment 1 met it.  A reading that far short of
+    LENGTH_OF_INFINITY is no riser the other beam misses, ascent 3 measured
+    none: the top, and home."""
+    events: list[Event] = []
+    result = simrun.run_sim(LANDINGS, parse_scenario(SKEWED_ONTO_A_NARROW_FLIGHT, "skewed"),
+                            events)
+    assert (result.outcome, result.ascent_end, result.steps_climbed,
+            result.steps_descended) == ("completed", "top_reached", 6, 6), result.to_dict()
+    assert result.wall_contact is None and not result.fell
+    assert any(m.startswith("top reached after 6 steps") and "SFR sees no riser" in m
+               for m in infos(events))

@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import sys
 import types
+from dataclasses import replace
 from pathlib import Path
 
+import msgspec
 import pytest
 
 from stairbot.cli import main
@@ -58,6 +60,41 @@ def test_last_tread_under_a_landing_does_not_count_but_under_a_wall_it_does() ->
     assert zone(parse_scenario(text.format(n=2, top="landing"), "x"), cfg, rules)[0] == "outside"
     band = parse_scenario("[stairs]\ncount = 2\nrise = 0.20\ntread = 0.3\n", "x")
     assert zone(band, cfg, rules)[0] == "band"
+
+
+QUARTER_TURN = """
+[stairs]
+count = 3
+rise = 0.17
+tread = 0.28
+width = {width}
+[start]
+distance = 0.5
+yaw_deg = -5.686636
+lateral = -0.036316
+[landing]
+turn = "right"
+depth = 1.02
+count = 3
+"""
+
+
+def test_a_landing_allows_for_the_drift_the_squarings_tolerance_leaves() -> None:
+    """Squared up within equal_tolerance the robot may stand 2.9° askew
+    (5 mm over the pair's 0.1 m), and keeps it up the flight: over the 2 m to
+    a 1.02 m landing's wall that is 0.1 m across, so a 0.6 m wide flight
+    climbed 36 mm to the side may leave less room to turn than the robot
+    needs (0.167 m of 0.174 m, squared 2.5° askew: the landings sweep, case
+    311).  It allowed 5 cm and judged the refusal wrong; now it is the band,
+    and a 0.8 m wide flight inside -- the band too where the squaring is
+    twice as loose (the drift follows from equal_tolerance)."""
+    cfg, rules = load_config("landings"), Rules()
+    assert zone(parse_scenario(QUARTER_TURN.format(width=0.6), "x"), cfg, rules)[0] == "band"
+    wide = parse_scenario(QUARTER_TURN.format(width=0.8), "x")
+    assert zone(wide, cfg, rules)[0] == "inside"
+    loose = replace(cfg, algorithm=msgspec.structs.replace(
+        cfg.algorithm, equal_tolerance=2.0 * cfg.algorithm.equal_tolerance))
+    assert zone(wide, loose, rules)[0] == "band"
 
 
 @pytest.mark.parametrize(("distance", "yaw", "expected"), [

@@ -13,7 +13,7 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import long_tread, lost, motion, sight, undo_first
+from stairbot.control.algorithm import long_tread, lost, motion, sight, split_top, undo_first
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.lift_first import (
     LIFT_FIRST,
@@ -311,11 +311,6 @@ LIFT_THIRD = PhaseDef(
 
 
 # -- ascent 8-9: the top, or the next step ------------------------------------------------------
-TAB_WAIT_S = 1.0
-"""Ascent 8: how long the robot stands for a tab ascent 7 found not
-measurable while the pair does not read "nothing ahead" either."""
-
-
 def _check(t: Tick, w: WaitWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
     if lost.limping(t):
@@ -325,7 +320,7 @@ def _check(t: Tick, w: WaitWork) -> Step:
         ctx.ascent_end = AscentEnd.TOP_REACHED
         t.say(say.top_reached(ctx.number_of_steps), ascent_end="top_reached")
         return go("top_reached")
-    tab = _tab_again(t, w)
+    tab = split_top.tab_again(t, w)
     if tab is not None:
         return tab
     if ctx.number_of_steps >= cfg.algorithm.max_steps:
@@ -335,38 +330,12 @@ def _check(t: Tick, w: WaitWork) -> Step:
     return go("next_step")
 
 
-def _tab_again(t: Tick, w: WaitWork) -> Step | None:
-    """Ascent 7 found no tab (one sensor at least read nothing ahead) and
-    the pair does not read "nothing ahead" now: a riser about
-    LENGTH_OF_INFINITY away, which one beam reaches and the other not.  The
-    descent of this step reads it: stand up to TAB_WAIT_S for the pair to
-    read it (kept), or both nothing (the top); still neither, go on, and
-    descent 1 finds this step's edge by the back pair alone.  The wait gives
-    descent 1 a tab to back to where one can be read.  The split reading is
-    not taken for the top: one sensor reading a little long, the robot askew
-    at the flight's side, would then end the ascent, and coming down the
-    step it stands on from there tips the robot back.  None: go on."""
-    ctx, cfg = t.ctx, t.cfg
-    i = ctx.number_of_steps - 1
-    if not 0 <= i < len(ctx.tab_length_to_edge) or ctx.tab_length_to_edge[i] is not None:
-        return None
-    if motion.measurable(t.snap, cfg):
-        tab = ctx.tab_length_to_edge[i] = motion.mean_distance(t.snap)
-        t.say(say.tab_read_standing(i, tab), index=i, tab_length_to_edge=tab)
-        return None
-    if w.still_since is None:
-        w.still_since = t.snap.time_s
-    if t.snap.time_s - w.still_since < TAB_WAIT_S:
-        return stay(NO_MOTION)
-    sfr, sfl = motion.pair(t.snap)
-    t.say(say.tab_not_measured(i, sfr.distance_m, sfl.distance_m, TAB_WAIT_S))
-    return None  # the phase goes on this tick
-
-
 CHECK = PhaseDef(
     P.ASCENT_CHECK, "ascent 8 — check the distance (top?)", FLOW, _check, WaitWork,
     watches="front",
-    on={"top_reached": Exit(P.DESCENT_LOWER_THIRD, "reads ≥ LENGTH_OF_INFINITY (top reached)"),
+    on={"top_reached": Exit(P.DESCENT_LOWER_THIRD, "reads ≥ LENGTH_OF_INFINITY (top reached); "
+                                                   "or, no tab, one beam nothing ahead and the "
+                                                   "other no riser (split_top)"),
         "step_limit": Exit(P.DESCENT_LOWER_THIRD, "number_of_steps = max_steps"),
         "limp_home": Exit(P.DESCENT_LOWER_THIRD, lost.LIMP + ": the step finished, down it"),
         "next_step": Exit(P.ASCENT_DRIVE_THIRD, "otherwise"),

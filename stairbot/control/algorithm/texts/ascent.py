@@ -141,6 +141,16 @@ def top_reached(steps: int) -> str:
             "LENGTH_OF_INFINITY; the descent begins")
 
 
+def top_beside(steps: int, near: str, sfr: float, sfl: float, one_riser: float,
+               wait_s: float) -> str:
+    far = "SFL" if near == "SFR" else "SFR"
+    return (f"top reached after {steps} steps: SFR/SFL read {sfr:.3f}/{sfl:.3f} m for "
+            f"{wait_s:g} s, {far} nothing ahead; {near} reads more than both beams on one "
+            f"riser can differ ({one_riser * 1000:.0f} mm) short of LENGTH_OF_INFINITY, and "
+            f"ascent 3 measured no riser ahead: {near} sees no riser (a side wall at a graze); "
+            "the descent begins")
+
+
 def step_limit(max_steps: int) -> str:
     return f"number_of_steps reached {max_steps}: the ascent ends; the descent begins"
 
