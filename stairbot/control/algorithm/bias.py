@@ -264,7 +264,11 @@ class BiasWatch:
         r, left = motion.pair(snap, back)
         near = min(r.distance_m, left.distance_m)
         tolerance = standing_tolerance(cfg, near, back=back)
-        if abs(disagree) <= tolerance:
+        # the back pair: judged as far apart as the standing rule ends the
+        # program on (the median beyond its smoothed tolerance), not only
+        # beyond the wider tolerance of one tick
+        ends = standing_tolerance(cfg, near, motion.DIFF_SMOOTHING, back) if back else tolerance
+        if abs(disagree) <= ends:
             return
         match = max(tolerance, MATCH_SHARE * abs(disagree))
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)

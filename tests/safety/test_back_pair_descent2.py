@@ -1,0 +1,75 @@
+"""A back sensor reading wrong as descent 2 lowers segment 3 over an edge
+(issue 33, limp home): the robot must not be stranded on the stairs where
+its partner can still bring it down.
+
+* The standing rule stops descent 2 with the pair apart, and no onset and no
+  mount height names one: each sensor's reading, less MTB's travel, is
+  compared with what it read of the same rise at the end of that step's
+  ascent 7 (the pair agreeing there); the one that no longer reads it is
+  judged, and the robot limps home on its partner.
+* The standing rule ends its wait on the same figure the bias watch judges
+  on: the watch asked for a wider one, and a 2.5 cm disagreement that the
+  rule ended the run on was, to the watch, no disagreement.
+* One sensor 1 cm long, within the standing tolerance, keeps the pair's mean
+  above BACK_CLEARANCE on the step below: segment 3 is found standing by
+  its sensors no longer falling with MTB's travel, not pushed down to
+  MAX_OF_VERTICAL_TURNS (13 deg nose down, "floor not found").
+
+The scenarios are cases of sweeps/sensor_faults.toml on the reference robot
+(their index in the names); each ended stranded on the stairs before."""
+
+from __future__ import annotations
+
+from lost_sensor import degraded
+from simrun import run_sim
+
+from stairbot.control.robot_config import load_config
+from stairbot.events import Event
+from stairbot.inputs.scenario import parse_scenario
+from stairbot.run.runner import RunResult
+
+CONFIG = load_config()
+
+
+
+def flight(seed: int, at: float, sensor: str, fault: str) -> str:
+    """The sweep's two-step flight, its sensor noise seeded, with ``fault``
+    (the TOML of its kind) on ``sensor`` from ``at`` on."""
+    return f"""
+[stairs]
+count = 2
+rise = 0.17
+tread = 0.28
+top = "landing"
+[start]
+distance = 0.5
+[sensors]
+noise = 0.001
+seed = {seed}
+[[faults]]
+at = {at}
+sensor = "{sensor}"
+{fault}
+"""
+
+
+def run(text: str) -> tuple[RunResult, list[Event]]:
+    events: list[Event] = []
+    r = run_sim(CONFIG, parse_scenario(text, "<back pair>"), events, limp_home=True)
+    return r, events
+
+
+def home(r: RunResult, outcome: str = "came_home_degraded") -> bool:
+    return (r.outcome == outcome and not r.fell and r.steps_climbed == r.steps_descended == 2
+            and r.final_offset_m is not None and r.final_offset_m <= 0.05)
+
+
+def test_the_mount_height_names_a_back_bias_the_standing_rule_ends_the_wait_on() -> None:
+    # case 465: SBR 3 cm short from 22.5 s read too near to measure on every
+    # surface since; at the end of descent 2's wait the pair's median was
+    # 2.5 cm apart, beyond the rule's 1.6 cm, within the watch's own 2.6 cm
+    r, events = run(flight(709768, 22.5, "SBR", 'kind = "offset"\noffset = -0.03'))
+    assert home(r), r.to_dict()
+    stop = degraded(events)
+    assert (stop["lost"], stop["phase"]) == (["SBR"], "descent_lower_third"), stop
+    assert "SBR read too near to measure" in stop["failed"], stop["failed"]
