@@ -64,6 +64,41 @@ def home(r: RunResult, outcome: str = "came_home_degraded") -> bool:
             and r.final_offset_m is not None and r.final_offset_m <= 0.05)
 
 
+def _judged_by_rise(events: list[Event], sensor: str, step: int) -> str:
+    stop = degraded(events)
+    assert (stop["lost"], stop["biased"], stop["phase"], stop["then"]) == (
+        [sensor], [sensor], "descent_lower_third", "limp_home"), stop
+    failed = stop["failed"]
+    assert f"lowering segment 3 over step {step}'s edge, {sensor} reads " in failed, failed
+    assert "than at the end of that step's ascent 7 less MTB's travel since" in failed, failed
+    return str(failed)
+
+
+def test_a_back_sensor_biased_backing_to_the_edge_is_named_by_the_rise_it_read_up() -> None:
+    # case 486: SBR 3 cm short from 108.7 s (descent 1 of step 1, backing to
+    # the edge); descent 2 stopped at once, "still disagree after 5 s"
+    r, events = run(flight(854147, 108.7, "SBR", 'kind = "offset"\noffset = -0.03'))
+    assert home(r), r.to_dict()
+    failed = _judged_by_rise(events, "SBR", 1)
+    assert "SBR reads 2." in failed and "cm less" in failed, failed
+
+
+def test_a_back_sensor_biased_long_over_the_edge_is_named_by_the_rise_it_read_up() -> None:
+    # case 652: SBL 5 cm long from 109.4 s, as descent 2 of step 1 began
+    r, events = run(flight(531515, 109.4, "SBL", 'kind = "offset"\noffset = 0.05'))
+    assert home(r), r.to_dict()
+    assert "cm more" in _judged_by_rise(events, "SBL", 1)
+
+
+def test_a_back_sensor_stuck_as_segment_3_is_lowered_is_named_by_the_rise_it_read_up() -> None:
+    # case 744: SBR stuck at 0.135 m from 84.1 s, half-way down descent 2 of
+    # the top step; SBL went on falling with MTB until the standing rule
+    # stopped the robot, and nothing said which was wrong
+    r, events = run(flight(382018, 84.1, "SBR", 'kind = "stuck"'))
+    assert home(r), r.to_dict()
+    assert "(or stuck" in _judged_by_rise(events, "SBR", 2)
+
+
 def test_the_mount_height_names_a_back_bias_the_standing_rule_ends_the_wait_on() -> None:
     # case 465: SBR 3 cm short from 22.5 s read too near to measure on every
     # surface since; at the end of descent 2's wait the pair's median was

@@ -19,8 +19,10 @@ only where the evidence decides something:
 
 * at the end of the standing rule's wait, the pair still disagreeing: by the
   onsets that say what the disagreement says; else, for the back pair, by
-  the mount heights; else, for the front pair on a tread or the floor on
-  the way down, by the riser the odometer places;
+  the mount heights, or in descent 2 by the rise each back sensor read at
+  the end of that step's ascent 7 (:mod:`~stairbot.control.algorithm.bias_rise`);
+  else, for the front pair on a tread or the floor on the way down, by the
+  riser the odometer places;
 * at once, where the robot steers by the pair (calibration squaring up to a
   riser: the front pair; descent 1 finding the edge and descent 2 finding
   the floor: the back pair), by the onsets, while the pair reads as far
@@ -45,10 +47,12 @@ from dataclasses import replace
 from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
+from stairbot.control.algorithm.bias_rise import Rises, by_rise
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.texts import back_pair as say_rise
 from stairbot.control.algorithm.texts import bias as say
 from stairbot.control.tolerances import pair_tolerance, standing_tolerance
 from stairbot.hardware import (
@@ -118,6 +122,7 @@ class BiasWatch:
                          PairWatch(cfg, SensorId.SBR, SensorId.SBL, True))
         self._pairs = (self._watches[0].track, self._watches[1].track)
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
+        self._rises = Rises(cfg)
         self._lift_m = cfg.motors.lift_travel_per_turn
         self._mtf: float | None = None
         self._cones_m = 0.0
@@ -175,6 +180,7 @@ class BiasWatch:
         self._mtb = mtb
         self._watches[1].tick(snap, odometer, yaw, self._hung_m, surface, judged)
         self._on_a_surface(snap, surface)
+        self._rises.tick(snap, where, phase is Phase.PAUSED, ctx.number_of_steps)
         if ctx.length_of_next_step != self._tread[0]:
             self._tread = (ctx.length_of_next_step, snap.time_s)
         if ctx.number_of_steps not in self._risers:
@@ -282,6 +288,9 @@ class BiasWatch:
             return
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
+        if found is None and back and resume is Phase.DESCENT_LOWER_THIRD and not ctx.from_top:
+            found = self._by_rise(ctx.number_of_steps - ctx.steps_descended - 1, disagree,
+                                  match, ends)
         tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
             0 if resume in ON_THE_FLOOR else None
         if found is None and not back and tread is not None and tread in self._risers \
@@ -325,6 +334,19 @@ class BiasWatch:
                 return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said,
                                                    self._cfg.BACK_CLEARANCE)
         return None
+
+    def _by_rise(self, step: int, disagree: float, match: float,
+                 off_by: float) -> tuple[SensorId, str] | None:
+        """Descent 2: the sensor that no longer reads the rise it read at the
+        end of the step's ascent 7 (:mod:`~stairbot.control.algorithm.bias_rise`)."""
+        rise, standing = self._rises.rises.get(step), self._rises.standing()
+        found = None if rise is None or standing is None else \
+            by_rise(self._cfg, rise, standing, disagree, match, off_by)
+        if found is None:
+            return None
+        sensor, off, p_off = found
+        return sensor, say_rise.judged_by_rise(sensor, off, p_off, step,
+                                               _signed(disagree, sensor))
 
     def _by_riser(self, snap: Snapshot, riser: Reference, odometer: float, yaw: float,
                   disagree: float, within: float) -> tuple[SensorId, str] | None:
