@@ -12,15 +12,17 @@ its partner can still bring it down.
   rule ended the run on was, to the watch, no disagreement.
 * One sensor 1 cm long, within the standing tolerance, keeps the pair's mean
   above BACK_CLEARANCE on the step below: segment 3 is found standing by
-  its sensors no longer falling with MTB's travel, not pushed down to
-  MAX_OF_VERTICAL_TURNS (13 deg nose down, "floor not found").
+  its sensors no longer falling with MTB's travel and segment 2 pitching
+  nose down, not pushed on to MAX_OF_VERTICAL_TURNS (13 deg nose down,
+  "floor not found"); a healthy pair's medians holding still a centimetre
+  up, segment 2 level, is not taken for it.
 
 The scenarios are cases of sweeps/sensor_faults.toml on the reference robot
 (their index in the names); each ended stranded on the stairs before."""
 
 from __future__ import annotations
 
-from lost_sensor import degraded
+from lost_sensor import degraded, degraded_stops
 from simrun import run_sim
 
 from stairbot.control.robot_config import load_config
@@ -29,7 +31,6 @@ from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
-
 
 
 def flight(seed: int, at: float, sensor: str, fault: str) -> str:
@@ -108,3 +109,27 @@ def test_the_mount_height_names_a_back_bias_the_standing_rule_ends_the_wait_on()
     stop = degraded(events)
     assert (stop["lost"], stop["phase"]) == (["SBR"], "descent_lower_third"), stop
     assert "SBR read too near to measure" in stop["failed"], stop["failed"]
+
+
+def test_segment_3_on_the_step_below_with_a_back_sensor_reading_long_is_not_pushed_on() -> None:
+    # case 333: SBR 1 cm long from 22.5 s, within the standing tolerance
+    # (nothing judges it); the pair's mean read 5 mm over BACK_CLEARANCE on
+    # the floor, and MTB pushed to -MAX_OF_VERTICAL_TURNS, segment 2 13 deg
+    # nose down: "floor not found"
+    r, events = run(flight(174779, 22.5, "SBR", 'kind = "offset"\noffset = 0.01'))
+    assert home(r, "completed"), r.to_dict()
+    assert r.max_pitch_deg is not None and r.max_pitch_deg < 6.0, r.to_dict()
+    assert not degraded_stops(events)
+    stood = [e.message for e in events if e.message.startswith("segment 3 stands on the step")]
+    assert stood, [e.message for e in events]  # (the top step's pair read within the tolerance)
+
+
+def test_a_healthy_pair_whose_medians_hold_above_the_step_below_is_not_set_down_there() -> None:
+    # case 7: SFR lost from 38.4 s, the robot limping home at half speed; in
+    # descent 2 of step 1 the back pair's medians held 0.047-0.049 m for half
+    # a second while segment 3 still hung a centimetre up.  On the sums alone
+    # it was taken as standing, raised back 6 mm, and descended on a height
+    # 1.5 cm short; segment 2's pitch had not moved
+    r, events = run(flight(806318, 38.4, "SFR", 'kind = "error"'))
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("came_home_degraded", 1, 1)
+    assert not [e.message for e in events if e.message.startswith("segment 3 stands on")]

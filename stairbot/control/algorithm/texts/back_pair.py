@@ -1,5 +1,7 @@
 """Descent 2's back-pair evidence in words: a back sensor judged by the rise
-it read on the way up (:mod:`~stairbot.control.algorithm.bias_rise`)."""
+it read on the way up (:mod:`~stairbot.control.algorithm.bias_rise`), and
+segment 3 found standing on the step below by touch
+(:mod:`~stairbot.control.algorithm.touchdown`)."""
 
 from __future__ import annotations
 
@@ -17,3 +19,9 @@ def judged_by_rise(sensor: SensorId, off_m: float, partner_off_m: float, step: i
             f"ascent 7 less MTB's travel since, {partner} within "
             f"{abs(partner_off_m) * 1000:.1f} mm of it; {_past(sensor, partner, said_m)}")
 
+
+def stood_by_touch(right_m: float, left_m: float, clearance: float, pushed_m: float) -> str:
+    """Descent 2: segment 3 met the step below before the pair read BACK_CLEARANCE."""
+    return (f"segment 3 stands on the step below: SBR/SBL stopped falling with MTB's travel "
+            f"(they read {right_m:.3f}/{left_m:.3f} m, BACK_CLEARANCE {clearance:.3f} m: one "
+            f"or both read long); MTB back up {pushed_m * 1000:.1f} mm, what it lowered since")
