@@ -270,16 +270,18 @@ class BiasWatch:
         r, left = motion.pair(snap, back)
         near = min(r.distance_m, left.distance_m)
         tolerance = standing_tolerance(cfg, near, back=back)
-        # the back pair: judged as far apart as the standing rule ends the
-        # program on (the median beyond its smoothed tolerance), not only
-        # beyond the wider tolerance of one tick
+        # the back pair: its mount heights and rises judged as far apart as
+        # the standing rule ends the program on (the median beyond its
+        # smoothed tolerance); its onsets, as before, only beyond the wider
+        # tolerance of one tick (within it, on the sonar robot, a 1 cm bias's
+        # onset was taken for its healthy partner's)
         ends = standing_tolerance(cfg, near, motion.DIFF_SMOOTHING, back) if back else tolerance
         if abs(disagree) <= ends:
             return
         match = max(tolerance, MATCH_SHARE * abs(disagree))
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
         track = self._pairs[1 if back else 0]
-        found = self._by_onsets(track, disagree, match)
+        found = self._by_onsets(track, disagree, match) if abs(disagree) > tolerance else None
         if found is not None and not back and resume in ONTO_THE_TREAD \
                 and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
             # it went wrong before the tread ahead was measured on it: finishing

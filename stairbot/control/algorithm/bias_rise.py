@@ -35,8 +35,9 @@ from stairbot.inputs.config import RobotConfig
 
 RECORD_TICKS = 25
 """The rise is each sensor's mean over the last this many ticks of ascent 7
-(0.5 s at the 20 ms tick): the lift slows to a stop there, and the mean of
-a VL53L0X pair's filtered readings at 0.2 m is known to about 1.5 mm."""
+(0.5 s at the 20 ms tick): the lift slows to a stop there, and over half a
+second the sensors' noise averages down (a reading at 0.2 m is the noisiest
+the back pair gives on the way up)."""
 STAND_TICKS = 50
 """While the standing rule waits in descent 2, each sensor's reading is the
 mean of its last this many ticks (the wait's last second, as the rule's
