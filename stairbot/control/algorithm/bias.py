@@ -19,8 +19,10 @@ only where the evidence decides something:
 
 * at the end of the standing rule's wait, the pair still disagreeing: by the
   onsets that say what the disagreement says; else, for the back pair, by
-  the mount heights; else, for the front pair on a tread or the floor on
-  the way down, by the riser the odometer places;
+  the mount heights, or in descent 2 by the rise each back sensor read at
+  the end of that step's ascent 7 (:mod:`~stairbot.control.algorithm.bias_rise`);
+  else, for the front pair on a tread or the floor on the way down, by the
+  riser the odometer places;
 * at once, where the robot steers by the pair (calibration squaring up to a
   riser: the front pair; descent 1 finding the edge and descent 2 finding
   the floor: the back pair), by the onsets, while the pair reads as far
@@ -47,10 +49,12 @@ from dataclasses import replace
 from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
+from stairbot.control.algorithm.bias_rise import Rises, by_rise
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.texts import back_pair as say_rise
 from stairbot.control.algorithm.texts import bias as say
 from stairbot.control.tolerances import pair_tolerance, standing_tolerance
 from stairbot.hardware import (
@@ -120,6 +124,7 @@ class BiasWatch:
                          PairWatch(cfg, SensorId.SBR, SensorId.SBL, True))
         self._pairs = (self._watches[0].track, self._watches[1].track)
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
+        self._rises = Rises(cfg)
         self._lift_m = cfg.motors.lift_travel_per_turn
         self._mtf: float | None = None
         self._cones_m = 0.0
@@ -181,6 +186,7 @@ class BiasWatch:
         self._mtb = mtb
         self._watches[1].tick(snap, odometer, yaw, self._hung_m, surface, judged)
         self._on_a_surface(snap, surface)
+        self._rises.tick(snap, where, phase is Phase.PAUSED, ctx.number_of_steps)
         if ctx.length_of_next_step != self._tread[0]:
             self._tread = (ctx.length_of_next_step, snap.time_s)
         if ctx.number_of_steps not in self._risers:
@@ -270,13 +276,20 @@ class BiasWatch:
         r, left = motion.pair(snap, back)
         near = min(r.distance_m, left.distance_m)
         tolerance = standing_tolerance(cfg, near, back=back)
-        if abs(disagree) <= tolerance:
-            self._distrust(snap, ctx, resume)
+        # the back pair: its mount heights and rises judged as far apart as
+        # the standing rule ends the program on (the median beyond its
+        # smoothed tolerance); its onsets, as before, only beyond the wider
+        # tolerance of one tick (within it, on the sonar robot, a 1 cm bias's
+        # onset was taken for its healthy partner's)
+        ends = standing_tolerance(cfg, near, motion.DIFF_SMOOTHING, back) if back else tolerance
+        if abs(disagree) <= ends:
+            if not back:
+                self._distrust(snap, ctx, resume)
             return
         match = max(tolerance, MATCH_SHARE * abs(disagree))
         threshold = STEP_SIGMAS * pair_tolerance(cfg, near, back=back)
         track = self._pairs[1 if back else 0]
-        found = self._by_onsets(track, disagree, match)
+        found = self._by_onsets(track, disagree, match) if abs(disagree) > tolerance else None
         if found is not None and not back and resume in ONTO_THE_TREAD \
                 and min(o.at_s for o in track.found if o.sensor is found[0]) <= self._tread[1]:
             # it went wrong before the tread ahead was measured on it: finishing
@@ -288,6 +301,9 @@ class BiasWatch:
             found = None
         if found is None and back:
             found = self._by_mount(disagree, match, threshold)
+        if found is None and back and resume is Phase.DESCENT_LOWER_THIRD and not ctx.from_top:
+            found = self._by_rise(ctx.number_of_steps - ctx.steps_descended - 1, disagree,
+                                  match, ends)
         tread = ctx.number_of_steps - ctx.steps_descended if resume in ON_THE_TREAD else \
             0 if resume in ON_THE_FLOOR else None
         if found is None and not back and tread is not None and tread in self._risers \
@@ -344,6 +360,19 @@ class BiasWatch:
                 return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said,
                                                    self._cfg.BACK_CLEARANCE)
         return None
+
+    def _by_rise(self, step: int, disagree: float, match: float,
+                 off_by: float) -> tuple[SensorId, str] | None:
+        """Descent 2: the sensor that no longer reads the rise it read at the
+        end of the step's ascent 7 (:mod:`~stairbot.control.algorithm.bias_rise`)."""
+        rise, standing = self._rises.rises.get(step), self._rises.standing()
+        found = None if rise is None or standing is None else \
+            by_rise(self._cfg, rise, standing, disagree, match, off_by)
+        if found is None:
+            return None
+        sensor, off, p_off = found
+        return sensor, say_rise.judged_by_rise(sensor, off, p_off, step,
+                                               _signed(disagree, sensor))
 
     def _by_riser(self, snap: Snapshot, riser: Reference, odometer: float, yaw: float,
                   disagree: float, within: float) -> tuple[SensorId, str] | None:

@@ -4,7 +4,9 @@
 
 i is the step being descended (0-based, into tab_length_to_edge); h is
 number_of_turns_for_step_height as descent 2 measures it.  Descent 2 lowers
-segment 3 (MTB down) until SBR/SBL read BACK_CLEARANCE; descent 4 moves MTF and
+segment 3 (MTB down) until SBR/SBL read BACK_CLEARANCE (or, reading it a
+little long, segment 3 is found standing: :mod:`~stairbot.control.algorithm.touchdown`);
+descent 4 moves MTF and
 MTB by +h (segment 2 goes down); descent 6 moves MTF by −h.  The drives end at
 a reading measured against tab_length_to_edge[i]; where that is not
 measurable (the top step reads "nothing ahead") they go by the seed's turn
@@ -48,7 +50,9 @@ from stairbot.control.algorithm.phase import (
 )
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.step_down import height, narrow_here, step_tab, step_tread
+from stairbot.control.algorithm.texts import back_pair as say_touch
 from stairbot.control.algorithm.texts import descent as say
+from stairbot.control.algorithm.touchdown import stood as stood_on_step
 from stairbot.control.algorithm.work import (
     DriveWork,
     EdgeWork,
@@ -161,6 +165,13 @@ def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
             # get there: a drop 5 mm deeper than the stroke waited out the
             # phase's timeout)
             return _floor_not_found(t, reading)
+    if not w.finishing:
+        stood = stood_on_step(cfg, t.snap, w)
+        if stood is not None:  # the pair reads the step below long: segment 3 stands on it
+            w.finishing, w.target_mtb = True, stood[0]
+            r, left = motion.pair(t.snap, back=True)
+            t.say(say_touch.stood_by_touch(r.distance_m, left.distance_m, cfg.BACK_CLEARANCE,
+                                           stood[1]))
     if w.finishing:
         assert w.target_mtb is not None
         finish = motion.lift_to(cfg, t.snap, MotorId.MTB, w.target_mtb)

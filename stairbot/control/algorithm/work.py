@@ -276,6 +276,14 @@ class LowerThirdWork(LiftWork):
     mtb_recent: list[tuple[float, float]] = field(default_factory=list)
     """(time, MTB's counter) on the phase's ticks, back to the back pair's lag:
     how far segment 3 was lowered since what its filtered reading stands for."""
+    touch_sums: list[tuple[float, float]] = field(default_factory=list)
+    touch_lowest: tuple[float, float] | None = None
+    touch_pitch: float | None = None
+    """SBR's and SBL's readings plus MTB's travel over the last ticks, their
+    lowest smoothed, and segment 2's pitch when the pair came near
+    BACK_CLEARANCE: whether segment 3 stands on the step below though
+    the pair reads it above BACK_CLEARANCE
+    (:mod:`~stairbot.control.algorithm.touchdown`)."""
 
 
 @dataclass
