@@ -48,3 +48,25 @@ def home(r: RunResult) -> bool:
     """Back on the floor where it began, every step climbed come down."""
     return (not r.fell and r.steps_climbed == r.steps_descended
             and r.final_offset_m is not None and r.final_offset_m <= 0.05)
+
+
+def sweep_flight(seed: int, at: float, sensor: str, fault: str) -> str:
+    """The two-step flight of sweeps/sensor_faults.toml, its sensor noise
+    seeded, with ``fault`` (the TOML of its kind) on ``sensor`` from ``at``
+    on."""
+    return f"""
+[stairs]
+count = 2
+rise = 0.17
+tread = 0.28
+top = "landing"
+[start]
+distance = 0.5
+[sensors]
+noise = 0.001
+seed = {seed}
+[[faults]]
+at = {at}
+sensor = "{sensor}"
+{fault}
+"""

@@ -23,6 +23,7 @@ The scenarios are cases of sweeps/sensor_faults.toml on the reference robot
 from __future__ import annotations
 
 from lost_sensor import degraded, degraded_stops
+from lost_sensor import sweep_flight as flight
 from simrun import run_sim
 
 from stairbot.control.robot_config import load_config
@@ -31,27 +32,6 @@ from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
-
-
-def flight(seed: int, at: float, sensor: str, fault: str) -> str:
-    """The sweep's two-step flight, its sensor noise seeded, with ``fault``
-    (the TOML of its kind) on ``sensor`` from ``at`` on."""
-    return f"""
-[stairs]
-count = 2
-rise = 0.17
-tread = 0.28
-top = "landing"
-[start]
-distance = 0.5
-[sensors]
-noise = 0.001
-seed = {seed}
-[[faults]]
-at = {at}
-sensor = "{sensor}"
-{fault}
-"""
 
 
 def run(text: str) -> tuple[RunResult, list[Event]]:

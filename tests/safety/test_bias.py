@@ -10,7 +10,7 @@ evidence must not take for biased."""
 
 from __future__ import annotations
 
-from lost_sensor import degraded
+from lost_sensor import degraded, sweep_flight
 from simrun import run_sim
 from test_vl53l1x_front import LOW_RISER_ASKEW, VL53L1X_FRONT
 
@@ -25,23 +25,7 @@ CONFIG = load_config()
 def flight(seed: int, at: float, sensor: str, offset: float) -> str:
     """The sweep's two-step flight, its sensor noise seeded, with a bias of
     ``offset`` on ``sensor`` from ``at`` on."""
-    return f"""
-[stairs]
-count = 2
-rise = 0.17
-tread = 0.28
-top = "landing"
-[start]
-distance = 0.5
-[sensors]
-noise = 0.001
-seed = {seed}
-[[faults]]
-at = {at}
-sensor = "{sensor}"
-kind = "offset"
-offset = {offset}
-"""
+    return sweep_flight(seed, at, sensor, f'kind = "offset"\noffset = {offset}')
 
 
 def run(text: str, consent: bool = True) -> tuple[RunResult, list[Event]]:
