@@ -76,6 +76,7 @@ Examples::
 from __future__ import annotations
 
 import ipaddress
+import os
 from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import unquote
@@ -235,12 +236,15 @@ def open_bus(spec: CanUrl) -> can.BusABC:
 
 def lock_bus(spec: CanUrl) -> PortLock:
     """This machine's lock on the bus ``spec`` names (``port_lock.py``): one
-    stairbot host on a bus at a time.  PortBusyError names the holder;
-    RobotUrlError when the lock file cannot be made."""
+    stairbot host on a bus at a time.  A python-can ``virtual`` bus does not
+    leave its process (two processes on one channel name are two buses), so
+    its lock is this process's own, as ``loop://``'s would be.  PortBusyError
+    names the holder; RobotUrlError when the lock file cannot be made."""
     cfg = resolve_bus_config(spec)
     where = f"{cfg.get('interface')}/{cfg.get('channel') if cfg.get('channel') is not None else ''}"
+    key = f"can:{where}" + (f"@pid{os.getpid()}" if cfg.get("interface") == "virtual" else "")
     try:
-        return take_port_lock(f"can:{where}", f"CAN bus {where}")
+        return take_port_lock(key, f"CAN bus {where}")
     except OSError as exc:
         raise RobotUrlError(spec.url, None, f"cannot lock CAN bus {where}: "
                             f"{exc.strerror or exc}") from None

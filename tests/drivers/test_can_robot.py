@@ -11,6 +11,7 @@ import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import can
 import pytest
@@ -454,3 +455,34 @@ def test_a_reply_frame_lost_between_others_is_a_gap_matched_by_channel() -> None
     for t in tel[3:]:
         assert req.offer(t, 0) is taken
     assert req.owed == 0 and req.gap  # every reply that will come came; incomplete
+
+
+def test_a_virtual_bus_is_locked_per_process_as_it_does_not_leave_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two processes on one ``virtual`` channel name are two buses: the
+    other's lock does not refuse this one (two pytest-xdist workers opened
+    ``virtual/conformance-4`` at once and one was told the bus was in use);
+    a second host on it in this process is still refused."""
+    import subprocess
+    import sys
+
+    from stairbot.drivers.can_robot import lock_bus
+    from stairbot.errors import PortBusyError
+
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    env = dict(os.environ)
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import sys\nfrom stairbot.drivers.can_robot import lock_bus, "
+         "parse_can_url\nlock = lock_bus(parse_can_url('can://virtual/owned'))\n"
+         "print('held', flush=True)\nsys.stdin.read()\n"],
+        env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        mine = lock_bus(parse_can_url("can://virtual/owned"))
+        try:
+            with pytest.raises(PortBusyError, match="in use by another stairbot"):
+                lock_bus(parse_can_url("can://virtual/owned"))
+        finally:
+            mine.release()
+    finally:
+        holder.communicate("", timeout=30)
