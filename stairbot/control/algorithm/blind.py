@@ -22,14 +22,11 @@ stays stopped, lifts holding, and says why: stranded, as before.
 
 from __future__ import annotations
 
-import statistics
-
 from stairbot.control.algorithm import motion, standing
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
-from stairbot.control.tolerances import standing_tolerance
 from stairbot.hardware import FRONT_SENSORS, SensorId, Snapshot
 from stairbot.inputs.config import RobotConfig
 
@@ -81,7 +78,4 @@ def ends_now(snap: Snapshot, ctx: Context, cfg: RobotConfig) -> float | None:
     if pause is None or diff is None or ctx.watch.ticks < standing.DEBOUNCE_TICKS - 1:
         return None
     recent = [*pause.diffs, diff][-max(1, round(standing.MEDIAN_S / cfg.algorithm.tick)):]
-    median = statistics.median(recent)
-    right, left = motion.pair(snap)
-    near = min(right.distance_m, left.distance_m)
-    return median if abs(median) > standing_tolerance(cfg, near, motion.DIFF_SMOOTHING) else None
+    return standing.ended_median(recent, snap, cfg, False)

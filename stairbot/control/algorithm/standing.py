@@ -39,7 +39,8 @@ from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import Work
 from stairbot.control.tolerances import standing_tolerance
-from stairbot.hardware import SensorStatus
+from stairbot.hardware import SensorStatus, Snapshot
+from stairbot.inputs.config import RobotConfig
 
 BY_TURNS_ONTO = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
                            Phase.ASCENT_DRIVE_SECOND})
@@ -126,6 +127,18 @@ MEDIAN_S = 1.0
 over its last this many seconds decides."""
 
 
+def ended_median(diffs: list[float], snap: Snapshot, cfg: RobotConfig,
+                 back: bool) -> float | None:
+    """The median of ``diffs`` (the wait's last MEDIAN_S of ticks that gave a
+    figure) if it lies beyond the smoothed standing tolerance at the pair's
+    nearer reading now -- the pair still disagrees -- else None."""
+    right, left = motion.pair(snap, back)
+    near = min(right.distance_m, left.distance_m)
+    median = statistics.median(diffs)
+    return median if abs(median) > standing_tolerance(cfg, near, motion.DIFF_SMOOTHING,
+                                                      back) else None
+
+
 def _paused(t: Tick, _w: Work) -> Step:
     ctx, pause = t.ctx, t.ctx.pause
     assert pause is not None
@@ -146,11 +159,7 @@ def _paused(t: Tick, _w: Work) -> Step:
     if t.snap.time_s - pause.started_s < t.cfg.algorithm.standing_wait:
         return stay(NO_MOTION)
     if diff is not None and pause.diffs:
-        recent = pause.diffs  # the last MEDIAN_S of ticks that gave a figure
-        right, left = motion.pair(t.snap, back)
-        near = min(right.distance_m, left.distance_m)
-        disagree = abs(statistics.median(recent)) > standing_tolerance(
-            t.cfg, near, motion.DIFF_SMOOTHING, back)
+        disagree = ended_median(pause.diffs, t.snap, t.cfg, back) is not None
     if not disagree:
         ctx.watch.ticks = 0
         lost = SensorStatus.ERROR in (r.status for r in motion.pair(t.snap, back))
