@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.edge import (
     edge_bound,
     edge_stopped,
@@ -150,9 +150,11 @@ def _edge_by_watch(t: Tick) -> bool:
     continuous descent, and on a climbed step whose tab_length_to_edge was
     not measured (the riser ahead about LENGTH_OF_INFINITY away, which one
     beam reached and the other not: ascent 7 read nothing, ascent 8 read a
-    riser, and the robot went on).  Not on a narrow step, whose tab places
-    the robot."""
-    return t.ctx.from_top or (step_tab(t) is None and not narrow_here(t))
+    riser, and the robot went on); and with the front pair distrusted
+    (:mod:`~stairbot.control.algorithm.blind`), which reads no tab.  Not on a
+    narrow step, whose tab places the robot."""
+    return t.ctx.from_top or ((step_tab(t) is None or blind.front_unusable(t.ctx))
+                              and not narrow_here(t))
 
 
 def unmeasured_search_m(t: Tick) -> float:

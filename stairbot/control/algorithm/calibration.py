@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stairbot.control.algorithm import landing, limits, lost, motion
+from stairbot.control.algorithm import blind_descent, landing, limits, lost, motion
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
 from stairbot.control.algorithm.moves import lift
@@ -74,6 +74,9 @@ def _check(t: Tick, w: StandingWork) -> Step:
         if ctx.start.wheel is None:
             ctx.start.wheel = motion.wheel_position(t.snap)
         return lost.limp_down(t)
+    blind = blind_descent.check(t)  # the front pair distrusted: by the odometer
+    if blind is not None:
+        return blind
     sfr, sfl = motion.pair(t.snap)
     if cal.purpose is Purpose.DESCENT and cal.squaring_turns == 0 \
             and not ctx.descent.turned_back:

@@ -118,7 +118,9 @@ def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     if phase.terminal:
         return ()
     if blind.front_unusable(ctx) and blind.needs_no_front(phase, ctx):
-        return ()  # nothing else read there: the way home goes by the odometer
+        # the front pair distrusted: the back pair still finds the edge and the
+        # floor below; elsewhere the way home goes by the odometer
+        return BACK_SENSORS if phase in _EDGE_WATCH or phase in BACK_PAIR_PHASES else ()
     if ctx.from_top and phase.flow != "ascent":
         return BACK_SENSORS  # a continuous descent steers by the back pair alone
     if phase in _EDGE_WATCH:

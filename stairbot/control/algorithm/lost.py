@@ -52,13 +52,19 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
 
 _UNDO = (Phase.ASCENT_LIFT_FIRST, Phase.ASCENT_LIFT_FIRST_MORE, Phase.ASCENT_LOWER_OBSTACLE)
 _TURN_BACK = (Phase.ASCENT_APPROACH, Phase.ASCENT_APPROACH_TURNS)
+_HOME = (Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR)
+_HOME_PURPOSES = (Purpose.FLOOR, Purpose.HOME)
 
 
 def _plan(ctx: Context, phase: Phase, purpose: Purpose | None, distrusted: bool) -> str:
     """What the limp home does from ``phase``, in words (``distrusted``: the
     front pair)."""
     if distrusted:
-        return say.UNDO_FIRST if phase is Phase.ASCENT_DRIVE_FIRST else say.BY_THE_ODOMETER
+        if phase is Phase.ASCENT_DRIVE_FIRST:
+            return say.UNDO_FIRST
+        if phase is Phase.ASCENT_LOWER_OBSTACLE or phase in _HOME or purpose in _HOME_PURPOSES:
+            return say.BY_THE_ODOMETER
+        return say.FINISH_BLIND if phase.flow == "ascent" else say.DOWN_BLIND
     n = ctx.number_of_steps
     if ctx.ascent_end is not None or ctx.from_top or phase.flow == "descent" \
             or purpose not in (None, Purpose.START, Purpose.ASCENT):

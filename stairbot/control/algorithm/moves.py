@@ -15,7 +15,7 @@ import statistics
 from collections.abc import Callable
 from typing import Protocol, TypeVar
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.phase import (
     FAILED,
     FAULT,
@@ -75,18 +75,27 @@ def reading_drive(
     while they are not, the drive carries on to the last such target — or,
     if they never were, to ``fallback_turns(t)`` turns from the phase's start
     (the seed's "not measurable" fallback).  A ``target`` of
-    None means a drive by turns only.  ``bound(t, w)``, when it gives one, is
+    None means a drive by turns only, and so does a front pair distrusted
+    (:func:`~stairbot.control.algorithm.blind.front_unusable`): then the
+    drive goes ``fallback_turns(t)`` from the phase's start, whatever its
+    readings gave before.  ``bound(t, w)``, when it gives one, is
     a wheel-counter position the drive never passes, whatever the readings say;
     with ``exact``, the position it ends at.
     """
 
     def enter(t: Tick, w: D) -> None:
-        w.target_reading = target(t)
+        w.target_reading = None if blind.front_unusable(t.ctx) else target(t)
         w.target_wheel = w.entry_wheel + direction * fallback_turns(t)
 
     def step(t: Tick, w: D) -> Step:
         cfg = t.cfg
         here = motion.wheel_position(t.snap)
+        if w.target_reading is not None and blind.front_unusable(t.ctx):
+            # the front pair distrusted (:mod:`~stairbot.control.algorithm.blind`):
+            # no target its readings gave stands, the drive goes by its turns
+            # from where it began
+            w.target_reading = None
+            w.target_wheel = w.entry_wheel + direction * fallback_turns(t)
         if w.target_reading is not None and not w.reading_lost \
                 and motion.measurable(t.snap, cfg):
             reading = motion.mean_distance(t.snap)

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 
@@ -45,6 +46,28 @@ def plan(kind: str, step: int, down: int) -> str:
 BY_THE_ODOMETER = ("back to the start by the odometer alone, turning by it to the floor's "
                    "and the start's headings, the front pair distrusted")
 """The plan where the front pair is distrusted (:mod:`~stairbot.control.algorithm.blind`)."""
+DOWN_BLIND = ("down the steps climbed, the front pair distrusted: the back-off, descent 3 "
+              "and 5 by the seed's turns, the heading the odometer's (each step's as it "
+              "was climbed), the edges found by the back pair; then " + BY_THE_ODOMETER)
+"""The plan where the front pair is distrusted on the stairs, going down."""
+FINISH_BLIND = ("finishing the step by counts (the lifts by the step's height, ascent 6 by "
+                "the seed's turns), then " + DOWN_BLIND)
+"""The same plan from ascent 5 to 8."""
+
+
+def squared_by_odometer(index: int, off_rad: float) -> str:
+    return (f"descent 1, step {index + 1}: the front pair distrusted, squared by the "
+            f"odometer to the heading it climbed this step with ({math.degrees(off_rad):+.2f}° "
+            "off): backing up to the edge by the back pair alone")
+
+
+def front_needed(why: str) -> str:
+    """The standing rule's end where the front pair cannot be done without."""
+    return (f"; neither front sensor can be named the wrong one, and the way home from "
+            f"here needs the front pair ({why}): the remaining sensors cannot support a "
+            "descent")
+
+
 UNDO_FIRST = ("undoing step 1 by the odometer (segment 1 backed off the step to where ascent "
               "4 began and lowered again), then " + BY_THE_ODOMETER)
 """The same plan from ascent 4 of the first step."""
