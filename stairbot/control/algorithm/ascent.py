@@ -13,7 +13,7 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import long_tread, lost, motion, sight, split_top, undo_first
+from stairbot.control.algorithm import blind, long_tread, lost, motion, sight, split_top, undo_first
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.lift_first import (
     LIFT_FIRST,
@@ -273,7 +273,8 @@ def _lifted_third(t: Tick, _w: LiftWork) -> Step:
         t.say(say.tab_length(i, tab), index=i, tab_length_to_edge=tab)
     else:
         ctx.tab_length_to_edge[i] = None
-        t.say(say.tab_not_measurable(i), index=i, tab_length_to_edge=None)
+        t.say(say.tab_not_measurable(i, blind.front_unusable(ctx)), index=i,
+              tab_length_to_edge=None)
     ctx.number_of_steps += 1
     t.say(say.number_of_steps(ctx.number_of_steps), number_of_steps=ctx.number_of_steps)
     return go("turns_made")

@@ -46,7 +46,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from stairbot.control.algorithm import blind, motion
+from stairbot.control.algorithm import blind, motion, standing
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.bias_rise import Rises, by_rise
@@ -319,10 +319,10 @@ class BiasWatch:
     def _distrust(self, snap: Snapshot, ctx: Context, resume: Phase) -> None:
         """Nothing names one of the front pair: where the way home needs no
         front reading, neither is trusted from the tick on which the standing
-        rule would end the program (:func:`blind.ends_now`)."""
+        rule would end the program (:func:`standing.ends_now`)."""
         if resume.record.watches == "back" or not blind.needs_no_front(resume, ctx):
             return
-        median = blind.ends_now(snap, ctx, self._cfg)
+        median = standing.ends_now(snap, ctx, self._cfg)
         if median is not None:
             self._distrusted = dict(zip((SensorId.SFR, SensorId.SFL),
                                         say.distrusted(median), strict=True))

@@ -34,13 +34,11 @@ lifts holding, and says why: stranded (:func:`why_not`).
 
 from __future__ import annotations
 
-from stairbot.control.algorithm import blind_descent, motion, standing
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
-from stairbot.hardware import FRONT_SENSORS, SensorId, Snapshot
-from stairbot.inputs.config import RobotConfig
+from stairbot.hardware import FRONT_SENSORS, SensorId
 
 _HOMING = frozenset({Phase.DESCENT_FINISH, Phase.DESCENT_FINISH_FLOOR})
 """Descent 7: on the floor, back to the start position."""
@@ -83,7 +81,7 @@ def why_not(phase: Phase, ctx: Context) -> str | None:
     if phase in _UNDOING:
         return None if ctx.number_of_steps == 0 else \
             "ascent 4 of a later step: the tread ahead is measured by the front pair"
-    family = ctx.family
+    family = ctx.family if phase.flow == "calibration" else None
     if isinstance(family, Calibration) and family.purpose in _HOME_PURPOSES:
         return None if phase in _TURNING_HOME and family.turn_to is not None else \
             "squaring up to the riser"
@@ -125,16 +123,3 @@ def front_unusable(ctx: Context) -> bool:
 def unusable(lost: set[SensorId]) -> bool:
     """Whether ``lost`` holds both front sensors."""
     return all(s in lost for s in FRONT_SENSORS)
-
-
-def ends_now(snap: Snapshot, ctx: Context, cfg: RobotConfig) -> float | None:
-    """While the standing rule waits on the front pair: the median of the
-    pair's difference (SFL less SFR) over the wait's last MEDIAN_S, if the
-    rule ends the program on this tick (its own test, before its step runs:
-    past the smoothed tolerance DEBOUNCE_TICKS ticks in a row, this the
-    last); else None."""
-    pause, diff = ctx.pause, motion.pair_difference(snap, cfg)
-    if pause is None or diff is None or ctx.watch.ticks < standing.DEBOUNCE_TICKS - 1:
-        return None
-    recent = [*pause.diffs, diff][-max(1, round(standing.MEDIAN_S / cfg.algorithm.tick)):]
-    return standing.ended_median(recent, snap, cfg, False)

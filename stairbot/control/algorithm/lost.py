@@ -32,9 +32,12 @@ def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[S
         return None
     known = [SensorId(s) for s in ctx.limp.lost] if ctx.limp is not None else []
     lost = sorted(set(known) | set(errors), key=lambda s: s.value)
+    front_why = blind.why_not(phase, ctx)
     why = limp.cannot_limp(lost, phase, purpose, tilt_watched,
                            turned_at_landing=ctx.landing.step is not None,
-                           needs_no_front=blind.needs_no_front(phase, ctx))
+                           needs_no_front=front_why is None)
+    if why is not None and front_why is not None and blind.unusable(set(lost)):
+        why += f" ({front_why})"  # where the way home needs the front pair, why
     plan = "" if why is not None else _plan(ctx, phase, purpose, blind.unusable(set(lost)))
     if why is not None:
         then, told = "stranded", say.stranded(why)

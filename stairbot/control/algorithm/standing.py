@@ -22,7 +22,8 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import long_tread, motion
+from stairbot.control.algorithm import blind, long_tread, motion
+from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phase import (
     FAILED,
     FAULT,
@@ -36,6 +37,7 @@ from stairbot.control.algorithm.phase import (
     stay,
 )
 from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.texts import limp as say_limp
 from stairbot.control.algorithm.texts import shared as say
 from stairbot.control.algorithm.work import Work
 from stairbot.control.tolerances import standing_tolerance
@@ -139,6 +141,19 @@ def ended_median(diffs: list[float], snap: Snapshot, cfg: RobotConfig,
                                                       back) else None
 
 
+def ends_now(snap: Snapshot, ctx: Context, cfg: RobotConfig) -> float | None:
+    """While the standing rule waits on the front pair: the median of the
+    pair's difference (SFL less SFR) over the wait's last MEDIAN_S, if the
+    rule ends the program on this tick (its own test, before its step runs:
+    past the smoothed tolerance DEBOUNCE_TICKS ticks in a row, this the
+    last); else None."""
+    pause, diff = ctx.pause, motion.pair_difference(snap, cfg)
+    if pause is None or diff is None or ctx.watch.ticks < DEBOUNCE_TICKS - 1:
+        return None
+    recent = [*pause.diffs, diff][-max(1, round(MEDIAN_S / cfg.algorithm.tick)):]
+    return ended_median(recent, snap, cfg, False)
+
+
 def _paused(t: Tick, _w: Work) -> Step:
     ctx, pause = t.ctx, t.ctx.pause
     assert pause is not None
@@ -167,8 +182,11 @@ def _paused(t: Tick, _w: Work) -> Step:
                   else say.agree_again(back, _readings(t, back), resume.label))
     ctx.watch.ticks += 1
     if ctx.watch.ticks >= DEBOUNCE_TICKS:
+        # the front pair, where the way home cannot do without it: why
+        why = None if back else blind.why_not(resume.phase, ctx)
         return fail(say.still_disagree(back, t.cfg.algorithm.standing_wait, _readings(t, back),
-                                       resume.label))
+                                       resume.label)
+                    + ("" if why is None else say_limp.front_needed(why)))
     return stay(NO_MOTION)
 
 

@@ -127,8 +127,10 @@ def tab_length(i: int, tab: float) -> str:
     return f"tab_length_to_edge[{i}] = {tab:.3f} m"
 
 
-def tab_not_measurable(i: int) -> str:
-    return (f"tab_length_to_edge[{i}] not measurable (nothing ahead): the descent of this "
+def tab_not_measurable(i: int, distrusted: bool = False) -> str:
+    """``distrusted``: the front pair (:mod:`~stairbot.control.algorithm.blind`)."""
+    why = "the front pair distrusted" if distrusted else "nothing ahead"
+    return (f"tab_length_to_edge[{i}] not measurable ({why}): the descent of this "
             "step drives by turns")
 
 
