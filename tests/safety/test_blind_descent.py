@@ -87,10 +87,13 @@ def test_a_front_bias_nothing_names_in_ascent_5_finishes_the_step_by_counts() ->
 
 def test_where_the_way_home_needs_the_front_pair_the_stop_says_why() -> None:
     ctx = Context()
-    ctx.start.wheel = 0.0
-    assert blind.why_not(Phase.DESCENT_LOWER_SECOND, ctx) is not None  # no heading kept
-    ctx.number_of_steps, ctx.climb_twist[0] = 1, 0.0
+    ctx.start.wheel, ctx.number_of_steps = 0.0, 1
+    assert "heading step 1 was climbed with" in str(blind.why_not(Phase.DESCENT_LOWER_SECOND,
+                                                                  ctx))
+    ctx.climb_twist[0] = 0.0
     assert blind.why_not(Phase.DESCENT_LOWER_SECOND, ctx) is None
+    assert blind.why_not(Phase.ASCENT_CHECK, ctx) is None  # step 1 counted, its heading kept
+    assert "heading step 2" in str(blind.why_not(Phase.ASCENT_LIFT_SECOND, ctx))
     ctx.family = Calibration(purpose=Purpose.DESCENT)
     assert blind.why_not(Phase.CAL_CHECK, ctx) is None
     assert "squaring turn" in str(blind.why_not(Phase.CAL_TURN, ctx))

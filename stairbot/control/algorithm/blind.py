@@ -76,8 +76,11 @@ def why_not(phase: Phase, ctx: Context) -> str | None:
         return "across a landing's turn the front pair places the robot"
     if ctx.start.wheel is None:
         return "where the program began was not measured"
-    if phase in _HOMING or phase in _FINISHING:
+    if phase in _HOMING:
         return None
+    if phase in _FINISHING:  # (ascent 7 counted the step before ascent 8)
+        return _headings_unknown(ctx, ctx.number_of_steps
+                                 - (1 if phase is Phase.ASCENT_CHECK else 0))
     if phase in _UNDOING:
         return None if ctx.number_of_steps == 0 else \
             "ascent 4 of a later step: the tread ahead is measured by the front pair"
@@ -101,9 +104,9 @@ def _descent_why_not(phase: Phase, ctx: Context) -> str | None:
     """Descent 1 to 6 of a climbed step, and descent 1's calibration: blind,
     the heading is the one the step was climbed with by the odometer, which
     must be known; calibration's own squaring turns read the front pair."""
-    i = ctx.number_of_steps - ctx.steps_descended - 1
-    if not 0 <= i < len(ctx.climb_twist) or ctx.climb_twist[i] is None:
-        return f"the heading step {i + 1} was climbed with is not known"
+    unknown = _headings_unknown(ctx, ctx.number_of_steps - ctx.steps_descended - 1)
+    if unknown is not None:
+        return unknown
     family = ctx.family
     if phase in _DESCENDING or phase in _NO_TURN:
         return None
@@ -123,3 +126,14 @@ def front_unusable(ctx: Context) -> bool:
 def unusable(lost: set[SensorId]) -> bool:
     """Whether ``lost`` holds both front sensors."""
     return all(s in lost for s in FRONT_SENSORS)
+
+
+def _headings_unknown(ctx: Context, top: int) -> str | None:
+    """Whether the heading each step from the first to ``top`` (0-based) was
+    climbed with is known: blind, descent 1 of each turns back to it."""
+    if top >= len(ctx.climb_twist):
+        return f"the heading step {top + 1} was climbed with is not known"
+    for i in range(top + 1):
+        if ctx.climb_twist[i] is None:
+            return f"the heading step {i + 1} was climbed with is not known"
+    return None
