@@ -17,12 +17,16 @@ from __future__ import annotations
 from lost_sensor import degraded
 from test_bias import flight, home, run
 
-from stairbot.control.algorithm import blind
-from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm import blind, standing
+from stairbot.control.algorithm.context import Context, Pause
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
-from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.phase import FAILED, Tick
+from stairbot.control.algorithm.phases import Mode, Phase
+from stairbot.control.algorithm.work import Work
+from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
+from stairbot.hardware import MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 
 def _after_stop(events: list[Event]) -> tuple[list[str], list[str]]:
@@ -101,3 +105,31 @@ def test_where_the_way_home_needs_the_front_pair_the_stop_says_why() -> None:
     assert "ascent 4 of a later step" in str(blind.why_not(Phase.ASCENT_DRIVE_FIRST, ctx))
     ctx.from_top = True
     assert "continuous descent" in str(blind.why_not(Phase.DESCENT_LOWER_SECOND, ctx))
+
+
+def _end_of_wait(resume: Phase, ctx: Context) -> str:
+    """The standing rule's end, SFL reading 2 cm more than SFR all through
+    its wait in ``resume``: the error it ends the program with."""
+    cfg = load_config("reference")
+    ctx.phase = Phase.PAUSED.value
+    ctx.pause = Pause(resume.value, 0.0, [0.02] * 50)
+    ctx.watch.ticks = standing.DEBOUNCE_TICKS - 1
+    motors = {m: MotorState(0.0) for m in MotorId}
+    snap = Snapshot(cfg.algorithm.standing_wait + 0.1,
+                    {SensorId.SFR: SensorReading(0.20), SensorId.SFL: SensorReading(0.22),
+                     SensorId.SBR: SensorReading(0.2), SensorId.SBL: SensorReading(0.2)},
+                    motors)
+    step = standing.PAUSED.step
+    assert step is not None
+    ended = step(Tick(snap, cfg, ctx, Mode.FULL, lambda *a, **k: None), Work.at_entry(snap))
+    assert ended.happened == FAILED, ended
+    return str(ended.reason)
+
+
+def test_the_standing_rules_end_says_why_the_way_home_needs_the_front_pair() -> None:
+    ctx = Context()
+    ctx.start.wheel, ctx.number_of_steps, ctx.climb_twist[0] = 0.0, 1, 0.0
+    said = _end_of_wait(Phase.ASCENT_APPROACH, ctx)
+    assert said.startswith("standing rule: SFR/SFL still disagree"), said
+    assert "the way home from here needs the front pair (ascent 2" in said, said
+    assert said.endswith("the remaining sensors cannot support a descent"), said
