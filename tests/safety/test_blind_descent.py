@@ -47,7 +47,7 @@ def test_a_front_bias_nothing_names_in_descent_1_goes_down_by_the_back_pair() ->
     stop = degraded(events)
     assert (stop["lost"], stop["biased"], stop["then"], stop["phase"]) == (
         ["SFL", "SFR"], [], "limp_home", "descent_back_off"), stop
-    assert stop["plan"].startswith("down the steps climbed, the front pair distrusted"), stop
+    assert stop["plan"].startswith("down the steps climbed without the front pair"), stop
     phases, infos = _after_stop(events)
     # no squaring turn on the pair: the odometer's heading, then the back pair's edge
     assert "cal_turn" not in phases, phases

@@ -46,9 +46,9 @@ def plan(kind: str, step: int, down: int) -> str:
 BY_THE_ODOMETER = ("back to the start by the odometer alone, turning by it to the floor's "
                    "and the start's headings, the front pair distrusted")
 """The plan where the front pair is distrusted (:mod:`~stairbot.control.algorithm.blind`)."""
-DOWN_BLIND = ("down the steps climbed, the front pair distrusted: the back-off, descent 3 "
-              "and 5 by the seed's turns, the heading the odometer's (each step's as it "
-              "was climbed), the edges found by the back pair; then " + BY_THE_ODOMETER)
+DOWN_BLIND = ("down the steps climbed without the front pair (the back-off and descent 3 "
+              "and 5 by the seed's turns, each step's heading as it was climbed by the "
+              "odometer, the edges found by the back pair), then " + BY_THE_ODOMETER)
 """The plan where the front pair is distrusted on the stairs, going down."""
 FINISH_BLIND = ("finishing the step by counts (the lifts by the step's height, ascent 6 by "
                 "the seed's turns), then " + DOWN_BLIND)
