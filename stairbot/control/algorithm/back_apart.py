@@ -30,7 +30,9 @@ sensor reading short), or until segment 3 is found standing by touch
 (:mod:`~stairbot.control.algorithm.touchdown`: the sums stop falling and
 the IMU reads segment 2 pitched, which sets it down on the step whatever
 a sensor reading long says).  Touch needs the IMU: without it, the standing
-rule ends the program as before.  The standing rule stays armed in this
+rule ends the program as before.  So it does in a continuous descent: from
+the top, the edge watch takes LOW_DROP_M (1.5 cm) past the floor for a drop
+(any rise may come), less than the allowance.  The standing rule stays armed in this
 descent 2 for a disagreement beyond the allowance.  The allowance is kept
 in descent 2's work (``apart``): a resumed run carries it.
 """
@@ -69,9 +71,10 @@ def goes_on(t: Tick, resume: Phase, diffs: list[float], resumed: str) -> Step | 
     the back pair in descent 2 (``resume``): the resume (outcome
     ``resumed``), lowering on by the longer reading and by touch, if the
     median of the wait's last second (``diffs``, left − right) is within
-    :func:`allowance_m` and the IMU is watched; else None."""
+    :func:`allowance_m` and the IMU is watched, on a flight the robot climbed;
+    else None."""
     cfg, w = t.cfg, _work(t)
-    if resume is not Phase.DESCENT_LOWER_THIRD or w is None or not diffs \
+    if resume is not Phase.DESCENT_LOWER_THIRD or w is None or not diffs or t.ctx.from_top \
             or not cfg.safety.imu or t.snap.imu is None:
         return None
     median = statistics.median(diffs)
