@@ -178,12 +178,6 @@ class MountHeights:
         if n >= MOUNT_TICKS:
             self.last = ((sums[0] / n, 2 * sums[2] > n), (sums[1] / n, 2 * sums[3] > n))
 
-    @property
-    def current(self) -> bool:
-        """Whether ``last`` stands for the last MOUNT_TICKS ticks, segment 3 on
-        a surface on every one of them up to now."""
-        return len(self.ticks) >= MOUNT_TICKS
-
     def end(self) -> None:
         if self.ticks:
             self.ticks.clear()

@@ -22,7 +22,7 @@ surface).  Not in the seed, which has no sensor faults.
 
 from __future__ import annotations
 
-from stairbot.control.algorithm.bias_evidence import MountHeights
+from stairbot.control.algorithm.bias_evidence import MOUNT_TICKS, MountHeights
 from stairbot.control.algorithm.edge_measure import edge_drop_m
 from stairbot.control.algorithm.texts import bias as say
 from stairbot.control.tolerances import pair_tolerance, standing_tolerance
@@ -83,8 +83,8 @@ def at_once(cfg: RobotConfig, mount: MountHeights, snap: Snapshot) -> tuple[Sens
     more than the standing tolerance and a pair tolerance, the pair as far
     apart now), while its partner reads the floor and read its mount
     height.  Returns the sensor and the evidence in words, or None."""
-    if not mount.current:
-        return None
+    if len(mount.ticks) < MOUNT_TICKS:
+        return None  # the stretch on the tread ended (an edge read) or is younger than that
     r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
     if not (r.ok and left.ok):
         return None
