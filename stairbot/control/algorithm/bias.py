@@ -46,8 +46,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from stairbot.control.algorithm import blind, motion, standing
+from stairbot.control.algorithm import bias_mount, blind, motion, standing
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
+from stairbot.control.algorithm.bias_mount import MATCH_SHARE, by_mount
+from stairbot.control.algorithm.bias_mount import signed as _signed
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.bias_rise import Rises, by_rise
 from stairbot.control.algorithm.context import Context
@@ -67,9 +69,6 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import RobotConfig
 
-MATCH_SHARE = 0.35
-"""Evidence matches the standing rule's disagreement within the standing
-tolerance, or this share of the disagreement if more."""
 STEERS_BY_THE_FRONT = frozenset({Phase.CAL_CHECK, Phase.CAL_CLOSE_IN, Phase.CAL_PROBE,
                                  Phase.CAL_TURN})
 """The calibration phases in which the robot squares up to a riser by the
@@ -199,6 +198,10 @@ class BiasWatch:
                 self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
+            found = None if judged or ctx.from_top else bias_mount.at_once(self._cfg, self._mount,
+                                                                           snap)
+            if found is not None:
+                judged[found[0]] = found[1]
         if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)
@@ -300,7 +303,7 @@ class BiasWatch:
                 return
             found = None
         if found is None and back:
-            found = self._by_mount(disagree, match, threshold)
+            found = by_mount(self._mount, cfg.BACK_CLEARANCE, disagree, match, threshold)
         if found is None and back and resume is Phase.DESCENT_LOWER_THIRD and not ctx.from_top:
             found = self._by_rise(ctx.number_of_steps - ctx.steps_descended - 1, disagree,
                                   match, ends)
@@ -343,24 +346,6 @@ class BiasWatch:
                 return sensor, say.judged_by_onsets(onsets, partner, _signed(disagree, sensor))
         return None
 
-    def _by_mount(self, disagree: float, match: float,
-                  threshold: float) -> tuple[SensorId, str] | None:
-        last = self._mount.last
-        if last is None:
-            return None
-        for sensor, partner, (off, near), (p_off, p_near) in (
-                (SensorId.SBL, SensorId.SBR, last[1], last[0]),
-                (SensorId.SBR, SensorId.SBL, last[0], last[1])):
-            said = _signed(disagree, sensor)
-            if p_near or abs(p_off) > threshold / 2:
-                continue
-            # read too near to measure, it reads at least that much short
-            if (near and said <= off) or (not near and abs(off) >= threshold
-                                          and abs(off - p_off - said) <= match):
-                return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said,
-                                                   self._cfg.BACK_CLEARANCE)
-        return None
-
     def _by_rise(self, step: int, disagree: float, match: float,
                  off_by: float) -> tuple[SensorId, str] | None:
         """Descent 2: the sensor that no longer reads the rise it read at the
@@ -389,7 +374,3 @@ class BiasWatch:
                                                    _signed(disagree, sensor))
         return None
 
-
-def _signed(disagree: float, sensor: SensorId) -> float:
-    """The disagreement (left − right) as how far ``sensor`` reads past its partner."""
-    return disagree if sensor in (SensorId.SFL, SensorId.SBL) else -disagree

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from stairbot.control.algorithm import landing, long_tread, motion
+from stairbot.control.algorithm import back_apart, landing, long_tread, motion
 from stairbot.control.algorithm.back_off import BACK_OFF, BACK_TO_EDGE
 from stairbot.control.algorithm.edge import narrow_bound
 from stairbot.control.algorithm.edge_measure import (
@@ -153,7 +153,7 @@ def lowered_unseen_m(t: Tick, w: LowerThirdWork) -> float:
 
 def _lower_third(t: Tick, w: LowerThirdWork) -> Step:
     ctx, cfg = t.ctx, t.cfg
-    reading = motion.mean_distance(t.snap, back=True)
+    reading = back_apart.reading(t.snap, w)  # the mean; the longer one, the pair apart
     to_go = reading - cfg.BACK_CLEARANCE - (0.0 if w.finishing else lowered_unseen_m(t, w))
     if not w.finishing and to_go <= floor_tolerance(cfg):
         # Within the noise of BACK_CLEARANCE: the rest the reading says, by

@@ -22,7 +22,7 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import blind, long_tread, motion
+from stairbot.control.algorithm import back_apart, blind, long_tread, motion
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.phase import (
     FAILED,
@@ -85,6 +85,8 @@ def _disagree(t: Tick, back: bool, raw_too: bool = True) -> bool:
     right, left = motion.pair(t.snap, back)
     near = min(right.distance_m, left.distance_m)
     smoothed_tol = standing_tolerance(t.cfg, near, motion.DIFF_SMOOTHING, back)
+    if back and back_apart.within(t, watch.diff, diff if raw_too else None):
+        return False  # descent 2 goes on with the pair this far apart
     return abs(watch.diff) > smoothed_tol and \
         (not raw_too or abs(diff) > standing_tolerance(t.cfg, near, back=back))
 
@@ -182,6 +184,11 @@ def _paused(t: Tick, _w: Work) -> Step:
                   else say.agree_again(back, _readings(t, back), resume.label))
     ctx.watch.ticks += 1
     if ctx.watch.ticks >= DEBOUNCE_TICKS:
+        on = back_apart.goes_on(t, resume.phase, pause.diffs, resumed(resume.phase)) \
+            if back else None
+        if on is not None:
+            ctx.watch.ticks = 0
+            return on
         # the front pair, where the way home cannot do without it: why
         why = None if back else blind.why_not(resume.phase, ctx)
         return fail(say.still_disagree(back, t.cfg.algorithm.standing_wait, _readings(t, back),

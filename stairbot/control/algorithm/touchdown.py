@@ -101,6 +101,8 @@ def stood(cfg: RobotConfig, snap: Snapshot, w: LowerThirdWork) -> tuple[float, f
     n = smoothing_ticks(cfg)
     del w.touch_sums[:-n]
     mean = (readings[0].distance_m + readings[1].distance_m) / 2
+    if w.apart is not None:  # the pair apart (back_apart): the nearer one reads the surface
+        mean = min(readings[0].distance_m, readings[1].distance_m)
     near = cfg.BACK_CLEARANCE + standing_tolerance(cfg, cfg.BACK_CLEARANCE, back=True)
     if mean > near:  # still over a drop: no surface to stand on yet
         w.touch_lowest = w.touch_pitch = None

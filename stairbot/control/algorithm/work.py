@@ -284,6 +284,10 @@ class LowerThirdWork(LiftWork):
     BACK_CLEARANCE: whether segment 3 stands on the step below though
     the pair reads it above BACK_CLEARANCE
     (:mod:`~stairbot.control.algorithm.touchdown`)."""
+    apart: float | None = None
+    """The back pair's disagreement the standing rule's wait ended on, within
+    what descent 2 allows: it lowers on by the longer reading and by touch
+    (:mod:`~stairbot.control.algorithm.back_apart`); None: by the mean."""
 
 
 @dataclass

@@ -25,3 +25,15 @@ def stood_by_touch(right_m: float, left_m: float, clearance: float, pushed_m: fl
     return (f"segment 3 stands on the step below: SBR/SBL stopped falling with MTB's travel "
             f"(they read {right_m:.3f}/{left_m:.3f} m, BACK_CLEARANCE {clearance:.3f} m: one "
             f"or both read long); MTB back up {pushed_m * 1000:.1f} mm, what it lowered since")
+
+
+def apart_goes_on(right_m: float, left_m: float, median_m: float, allowance_m: float,
+                  label: str) -> str:
+    """Descent 2: the standing rule's wait ends with the back pair apart,
+    within what descent 2 allows (:mod:`~stairbot.control.algorithm.back_apart`)."""
+    return (f"standing rule: SBR/SBL still disagree after the wait ({right_m:.3f} m / "
+            f"{left_m:.3f} m, {abs(median_m) * 1000:.0f} mm apart) in {label}, and nothing "
+            f"names either; within what descent 2 allows ({allowance_m * 1000:.0f} mm, a "
+            f"quarter of the lowest rise: both read the step below, and either still tells "
+            f"the next edge's drop from its tread): lowering on until the longer reading "
+            f"reads BACK_CLEARANCE or segment 3 is found standing by touch")

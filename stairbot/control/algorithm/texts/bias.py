@@ -68,6 +68,19 @@ def judged_by_mount(sensor: SensorId, partner: SensorId, off_m: float, partner_o
             f"{_past(sensor, partner, said_m)}, as that says")
 
 
+def judged_mount_backing(sensor: SensorId, partner: SensorId, off_m: float,
+                         partner_off_m: float, said_m: float, clearance: float,
+                         drop: float) -> str:
+    """Descent 1 backing off: a back sensor reading past where the edge watch
+    reads the drop, as it read over the tread for the last second."""
+    return (f"judged biased: over the last second segment 3 stood on the tread, {sensor} "
+            f"read {_cm(off_m)} more than its mount height {clearance:.3f} m while {partner} "
+            f"read it within {abs(partner_off_m) * 1000:.1f} mm; backing off, {sensor} reads "
+            f"{_cm(said_m)} more than {partner}, past {drop:.3f} m, where the edge watch "
+            f"reads a drop: backing to the edge by it would take the tread for the drop "
+            f"(the step's drop, climbed, is a whole rise)")
+
+
 def judged_by_riser(sensor: SensorId, partner: SensorId, off_m: float, partner_off_m: float,
                     tread: int, said_m: float) -> str:
     """At the standing rule's wait's end: where the odometer puts the riser."""
