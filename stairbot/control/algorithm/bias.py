@@ -46,7 +46,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from stairbot.control.algorithm import blind, motion
+from stairbot.control.algorithm import blind, chased, motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.bias_rise import Rises, by_rise
@@ -199,6 +199,8 @@ class BiasWatch:
                 self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
+        if not self._distrusted:  # a squaring turn chased an offset (chased.py)
+            self._distrusted = chased.distrusted(ctx, where)
         if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stairbot.control.algorithm import landing, limits, lost, motion
+from stairbot.control.algorithm import chased, landing, limits, lost, motion
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
 from stairbot.control.algorithm.moves import lift
@@ -69,6 +69,9 @@ def _after_calibration(t: Tick) -> Step:
 # -- check the readings --------------------------------------------------------------
 def _check(t: Tick, w: StandingWork) -> Step:
     cfg, ctx, cal = t.cfg, t.ctx, t.cal
+    back = chased.at_check(t)  # turned back from chasing an offset: the pair distrusted
+    if back is not None:
+        return back
     if cal.purpose is Purpose.START and lost.limping(t):
         # squaring up cannot go on one sensor: back to where the program began
         if ctx.start.wheel is None:
@@ -166,7 +169,11 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     # SFL farther than SFR: turned left of square, turn right (and the other way).
     yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
-    cal.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
+    target = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
+    beyond = chased.beyond(t, target)
+    if beyond is not None:
+        return beyond
+    cal.turn_to = target
     cal.squaring_turns += 1
     t.say(say.not_square_on_all_wheels(diff, len(w.diffs), sfr, sfl, yaw),
           SFR=sfr, SFL=sfl, diff=diff)
@@ -213,10 +220,14 @@ CHECK = PhaseDef(
         "off_climb_heading": Exit(P.CAL_LIFT, "descent 1: turned from the heading the step "
                                               "was climbed with"),
         "not_square": Exit(P.CAL_LIFT, "a squaring turn checked and not square: correct it"),
+        "chased": Exit(P.CAL_LIFT, "descent 1: the correction would turn further from the "
+                                   "climbed heading than square allows: back to it"),
         "square_to_climb": Exit(P.ASCENT_APPROACH, "ascent 1 on a later step: SFR = SFL; or "
                                                    "squared up (checked)"),
         "square_to_descend": Exit(P.DESCENT_BACK_TO_EDGE, "descent 1: SFR = SFL; or squared up "
-                                                          "(checked)"),
+                                                          "(checked); or turned back to the "
+                                                          "climbed heading, the front pair "
+                                                          "lost"),
         "limp_home_floor": Exit(P.DESCENT_FINISH, lost.LIMP + ": start, back to where the "
                                                   "program began"),
         FAILED: Exit(P.ERROR, "case 1: sensor error; later: nothing ahead where a riser should "

@@ -57,6 +57,10 @@ class Calibration(Family):
     return_mtf: float = 0.0
     return_mtb: float = 0.0
     """Lift counters before the clearance lift: where the lowering returns to."""
+    chased: str | None = None
+    """Descent 1: why the squaring turn was found chasing a front sensor's
+    offset and turned back to the climbed heading
+    (:mod:`~stairbot.control.algorithm.chased`); None: it was not."""
 
 
 @dataclass

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from stairbot.control.algorithm import motion
+from stairbot.control.algorithm import chased, motion
 from stairbot.control.algorithm.calibration import FLOW
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Purpose
@@ -168,12 +168,18 @@ def _turn(t: Tick, w: TurnWork) -> Step:
         return back
     _follow(t, w)
     sfr, sfl = readings(t)
+    beyond = None if w.measuring else chased.beyond(t)
+    if beyond is not None:
+        return beyond
     if w.measuring:  # stopped at SFR = SFL: measuring standing still, once settled
         if not settled(t, w):
             return stay(NO_MOTION)
         # as long as it takes to know the difference to within equal_tolerance
         if not measured_standing(t, w, max(STILL_TICKS, still_samples(cfg, min(sfr, sfl)))):
             return stay(NO_MOTION)
+        if not w.diffs:  # not one tick read both: nothing was squared to
+            return chased.lost_both(t, motion.turn_yaw_rad(
+                cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from)))
         diff = mean_diff(t, w)
         if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
             t.say(say.squared_up(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)
@@ -217,8 +223,10 @@ TURN = PhaseDef(
         "limp_turn_back": Exit(P.CAL_TURN_TO, "limping home, a front sensor lost in the "
                                               "turn: back to the heading the step was "
                                               "climbed with"),
+        "chased": Exit(P.CAL_TURN_TO, "descent 1: turned further from the climbed heading "
+                                      "than square allows, or lost both beams: back to it"),
         FAILED: Exit(P.ERROR, "turned too far, or more than its first readings allow; "
-                              + FAULT)})
+                              "lost both beams; " + FAULT)})
 
 
 def _probe(t: Tick, w: ProbeWork) -> Step:

@@ -1,0 +1,137 @@
+"""A squaring turn that chases a front sensor's offset (not in the seed).
+
+A front sensor that reads a constant offset moves as a healthy one does
+when the robot turns on the spot: the turn's geometry does not show it,
+and calibration turns until SFR = SFL, askew of the riser by
+``askew_rad(offset)`` (17° for 3 cm on a 0.1 m pair), or, an HC-SR04
+pair, until both beams meet the riser too obliquely to hear an echo and
+"square up" to nothing.
+
+On a climbed step the odometer knows better: descent 1 turned back to the
+heading the step was climbed with (:mod:`~stairbot.control.algorithm.calibration`),
+which calibration squared to the riser while both sensors read it alike,
+and a flight's risers are parallel.  Square to this riser lies within
+:func:`allowed_rad` of that heading: what each of the two squarings may
+leave (:func:`~stairbot.control.tolerances.square_tolerance` as a yaw) and
+what the odometer's heading may have drifted over the step
+(:data:`STEP_DRIFT_M` of one wheel's slip over the track).  A squaring turn
+in descent 1 that takes the robot further than that from the climbed
+heading, or loses both beams within it, is not squaring to the riser: the
+pair disagrees by an offset, and nothing the turn shows names the sensor
+that carries it (a sensor held through the turn, or stepping in it, is
+named by :func:`~stairbot.control.algorithm.turns._held_through` and
+:mod:`~stairbot.control.algorithm.bias`'s onsets before this).  The robot
+turns back to the climbed heading by the odometer, lowers, and then
+distrusts both front sensors (:func:`distrusted`, as
+:mod:`~stairbot.control.algorithm.blind` does at the end of the standing
+rule's wait): they read as ERROR, and the limp home sees both lost.
+
+Anywhere else (the start's calibration, ascent 1: no heading known to be
+square) a turn that loses both beams stops the program and says that one
+front sensor may read an offset, instead of squaring up over no reading.
+"""
+
+from __future__ import annotations
+
+import math
+
+from stairbot.control.algorithm import blind, limits, motion
+from stairbot.control.algorithm.context import Context
+from stairbot.control.algorithm.families import Calibration
+from stairbot.control.algorithm.modes import Purpose
+from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, fail, go, stay, where
+from stairbot.control.algorithm.phases import Phase
+from stairbot.control.algorithm.squaring import askew_rad, heading_off_rad
+from stairbot.control.algorithm.texts import chased as say
+from stairbot.control.tolerances import square_tolerance
+from stairbot.hardware import FRONT_SENSORS, SensorId
+from stairbot.inputs.config import RobotConfig
+
+STEP_DRIFT_M = 0.0135
+"""How far the odometer drifts over a step climbed and descended (2.7 cm
+from the start after two steps, case 425 of sensor_faults: docs/algorithm.md,
+descent 7 by the odometer).  Taken whole as one wheel's slip against the
+other, it turns the heading the odometer does not see by this over the
+track width (4.8° on a 0.16 m track)."""
+
+
+def allowed_rad(cfg: RobotConfig, distance_m: float) -> float:
+    """How far square to the riser ``distance_m`` ahead may lie from the
+    heading the step was climbed with: the climb's squaring (at most as
+    far as the start's, square_range_m), this one's, and the odometer's
+    drift over the step."""
+    climbed = square_tolerance(cfg, max(distance_m, limits.square_range_m(cfg)))
+    here = square_tolerance(cfg, distance_m)
+    drift = STEP_DRIFT_M / cfg.geometry.track_width
+    return askew_rad(cfg, climbed) + askew_rad(cfg, here) + drift
+
+
+def _climbed(t: Tick) -> float | None:
+    """The heading (odometer twist) descent 1's step was climbed with; None
+    elsewhere, or not known (a continuous descent)."""
+    ctx = t.ctx
+    if t.cal.purpose is not Purpose.DESCENT or ctx.from_top:
+        return None
+    return ctx.climb_twist[t.descent_index]
+
+
+def _near(t: Tick) -> float:
+    seen = [r.distance_m for r in motion.pair(t.snap) if r.ok and not motion.far(r, t.cfg)]
+    return min(seen, default=limits.square_range_m(t.cfg))
+
+
+def beyond(t: Tick, twist: float | None = None, lost: bool = False) -> Step | None:
+    """Descent 1 on a climbed step: the heading ``twist`` (the odometer's
+    now, if None) lies further from the climbed one than :func:`allowed_rad`,
+    or (``lost``) both beams read nothing ahead: turn back to the climbed
+    heading, the pair to be distrusted once lowered (module docstring).
+    None: go on as before."""
+    climbed, cal = _climbed(t), t.cal
+    if climbed is None or cal.chased is not None:
+        return None
+    now = motion.twist(t.snap) if twist is None else twist
+    off = heading_off_rad(t, climbed) if twist is None else motion.turn_yaw_rad(
+        t.cfg, now - climbed)
+    allowed = allowed_rad(t.cfg, _near(t))
+    if abs(off) <= allowed and not lost:
+        return None
+    sfr, sfl = motion.pair(t.snap)
+    cal.chased = say.chased(t.descent_index, off, allowed, sfr.distance_m, sfl.distance_m, lost)
+    cal.turn_to = climbed
+    t.ctx.descent.turned_back = True
+    t.say(cal.chased, off_deg=math.degrees(off), allowed_deg=math.degrees(allowed))
+    return go("chased")
+
+
+def lost_both(t: Tick, made_rad: float) -> Step:
+    """A squaring turn lost both beams: on a climbed step, :func:`beyond`;
+    elsewhere the program stops, saying why."""
+    step = beyond(t, lost=True)
+    if step is not None:
+        return step
+    sfr, sfl = motion.pair(t.snap)
+    return fail(say.lost_both(where(t.ctx, Phase.CAL_TURN), made_rad, sfr.distance_m,
+                              sfl.distance_m))
+
+
+def at_check(t: Tick) -> Step | None:
+    """Calibration's check after the turn back (:func:`beyond`): with both
+    front sensors lost, on to backing up to the edge on the climbed heading
+    (the way down goes without them, where it can); before that, standing
+    still while the pair turns to ERROR (:func:`distrusted`).  None: no
+    turn back was made."""
+    if t.cal.chased is None:
+        return None
+    if blind.front_unusable(t.ctx):
+        return go("square_to_descend")
+    return stay(NO_MOTION)
+
+
+def distrusted(ctx: Context, phase: Phase) -> dict[SensorId, str]:
+    """Both front sensors with why, once the robot stands lowered on the
+    climbed heading after :func:`beyond` (calibration's check); else none."""
+    family = ctx.family
+    if phase is not Phase.CAL_CHECK or not isinstance(family, Calibration) \
+            or family.chased is None:
+        return {}
+    return dict(zip(FRONT_SENSORS, say.distrusted(family.chased), strict=True))
