@@ -156,6 +156,9 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     ctx, cfg, cal = t.ctx, t.cfg, t.cal
     r, l_ = motion.pair(t.snap)
     sfr, sfl = r.distance_m, l_.distance_m
+    if cal.beams_lost_rad is not None and motion.far(r, cfg) and motion.far(l_, cfg):
+        # lowered, still neither beam meets the riser the turn lost
+        return chased.lost_both(t, cal.beams_lost_rad)
     if motion.far(r, cfg) or motion.far(l_, cfg):
         # no figure to square to, nor a riser where it squared up: stop
         return fail(say.nothing_ahead_squared(where(ctx, P.CAL_CHECK), sfr, sfl))

@@ -16,7 +16,8 @@ leave (:func:`~stairbot.control.tolerances.square_tolerance` as a yaw) and
 what the odometer's heading may have drifted over the step
 (:data:`STEP_DRIFT_M` of one wheel's slip over the track).  A squaring turn
 in descent 1 that takes the robot further than that from the climbed
-heading, or loses both beams within it, is not squaring to the riser: the
+heading, or stops with both beams reading nothing ahead where, lowered on
+all wheels, neither meets the riser either, is not squaring to it: the
 pair disagrees by an offset, and nothing the turn shows names the sensor
 that carries it (a sensor held through the turn, or stepping in it, is
 named by :func:`~stairbot.control.algorithm.turns._held_through` and
@@ -27,8 +28,12 @@ distrusts both front sensors (:func:`distrusted`, as
 rule's wait): they read as ERROR, and the limp home sees both lost.
 
 Anywhere else (the start's calibration, ascent 1: no heading known to be
-square) a turn that loses both beams stops the program and says that one
-front sensor may read an offset, instead of squaring up over no reading.
+square) such a turn stops the program, as it did, and says that one front
+sensor may read an offset (before: "squared up" over no reading, then
+"nothing ahead where the riser should be").  A turn that lost both beams
+with segments 1 and 3 lifted, whose beams meet the riser again lowered
+(a cone tilted up sees over a low riser, a clearance higher), goes on as
+before.
 """
 
 from __future__ import annotations
@@ -104,13 +109,14 @@ def beyond(t: Tick, twist: float | None = None, lost: bool = False) -> Step | No
 
 
 def lost_both(t: Tick, made_rad: float) -> Step:
-    """A squaring turn lost both beams: on a climbed step, :func:`beyond`;
-    elsewhere the program stops, saying why."""
+    """A squaring turn stopped with both beams reading nothing ahead, and
+    lowered on all wheels neither meets the riser: on a climbed step,
+    :func:`beyond`; elsewhere the program stops, saying why."""
     step = beyond(t, lost=True)
     if step is not None:
         return step
     sfr, sfl = motion.pair(t.snap)
-    return fail(say.lost_both(where(t.ctx, Phase.CAL_TURN), made_rad, sfr.distance_m,
+    return fail(say.lost_both(where(t.ctx, Phase.CAL_CHECK), made_rad, sfr.distance_m,
                               sfl.distance_m))
 
 

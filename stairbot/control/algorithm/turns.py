@@ -177,9 +177,9 @@ def _turn(t: Tick, w: TurnWork) -> Step:
         # as long as it takes to know the difference to within equal_tolerance
         if not measured_standing(t, w, max(STILL_TICKS, still_samples(cfg, min(sfr, sfl)))):
             return stay(NO_MOTION)
-        if not w.diffs:  # not one tick read both: nothing was squared to
-            return chased.lost_both(t, motion.turn_yaw_rad(
-                cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from)))
+        if not w.diffs:  # not one tick read both: the check on all wheels says what follows
+            t.cal.beams_lost_rad = motion.turn_yaw_rad(
+                cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
         diff = mean_diff(t, w)
         if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
             t.say(say.squared_up(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)

@@ -23,6 +23,7 @@ def distrusted(why: str) -> tuple[str, str]:
 
 def lost_both(where: str, made_rad: float, sfr: float, sfl: float) -> str:
     return (f"calibration ({where}): the squaring turn lost both beams after "
-            f"{math.degrees(made_rad):.0f}° (SFR {sfr:.3f} m, SFL {sfl:.3f} m): no heading "
-            "square to a riser loses both; one front sensor may read an offset, which the "
-            "turn chased until neither beam met the riser; stopping")
+            f"{math.degrees(made_rad):.0f}°, and standing on all wheels neither meets the "
+            f"riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m): no heading square to a riser loses "
+            "both; one front sensor may read an offset, which the turn chased until "
+            "neither beam met the riser; stopping")
