@@ -46,10 +46,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import replace
 
-from stairbot.control.algorithm import blind, chased, motion
+from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.bias_rise import Rises, by_rise
+from stairbot.control.algorithm.chased import distrusted as chased_distrusted
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
@@ -200,7 +201,7 @@ class BiasWatch:
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
         if not self._distrusted:  # a squaring turn chased an offset (chased.py)
-            self._distrusted = chased.distrusted(ctx, where)
+            self._distrusted = chased_distrusted(ctx, where)
         if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)

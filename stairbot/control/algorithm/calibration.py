@@ -14,7 +14,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from stairbot.control.algorithm import chased, landing, limits, lost, motion
+from stairbot.control.algorithm import landing, limits, lost, motion
+from stairbot.control.algorithm.chased import at_check, beyond, lost_both
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
 from stairbot.control.algorithm.moves import lift
@@ -69,15 +70,15 @@ def _after_calibration(t: Tick) -> Step:
 # -- check the readings --------------------------------------------------------------
 def _check(t: Tick, w: StandingWork) -> Step:
     cfg, ctx, cal = t.cfg, t.ctx, t.cal
-    back = chased.at_check(t)  # turned back from chasing an offset: the pair distrusted
-    if back is not None:
-        return back
     if cal.purpose is Purpose.START and lost.limping(t):
         # squaring up cannot go on one sensor: back to where the program began
         if ctx.start.wheel is None:
             ctx.start.wheel = motion.wheel_position(t.snap)
         return lost.limp_down(t)
     sfr, sfl = motion.pair(t.snap)
+    chased = at_check(t)  # turned back from chasing an offset: the pair distrusted
+    if chased is not None:
+        return chased
     if cal.purpose is Purpose.DESCENT and cal.squaring_turns == 0 \
             and not ctx.descent.turned_back:
         # Descent 1 first turns back to the heading it climbed this step with
@@ -158,7 +159,7 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     sfr, sfl = r.distance_m, l_.distance_m
     if cal.beams_lost_rad is not None and motion.far(r, cfg) and motion.far(l_, cfg):
         # lowered, still neither beam meets the riser the turn lost
-        return chased.lost_both(t, cal.beams_lost_rad)
+        return lost_both(t, cal.beams_lost_rad)
     if motion.far(r, cfg) or motion.far(l_, cfg):
         # no figure to square to, nor a riser where it squared up: stop
         return fail(say.nothing_ahead_squared(where(ctx, P.CAL_CHECK), sfr, sfl))
@@ -173,9 +174,9 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
     target = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
-    beyond = chased.beyond(t, target)
-    if beyond is not None:
-        return beyond
+    chased = beyond(t, target)
+    if chased is not None:
+        return chased
     cal.turn_to = target
     cal.squaring_turns += 1
     t.say(say.not_square_on_all_wheels(diff, len(w.diffs), sfr, sfl, yaw),
