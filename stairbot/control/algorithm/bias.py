@@ -50,11 +50,11 @@ from stairbot.control.algorithm import blind, motion
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
 from stairbot.control.algorithm.bias_rise import Rises, by_rise
-from stairbot.control.algorithm.chased import distrusted as chased_distrusted
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.squaring_bias import distrusted as distrusted_chasing
 from stairbot.control.algorithm.texts import back_pair as say_rise
 from stairbot.control.algorithm.texts import bias as say
 from stairbot.control.tolerances import pair_tolerance, standing_tolerance
@@ -200,8 +200,8 @@ class BiasWatch:
                 self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
-        if not self._distrusted:  # a squaring turn chased an offset (chased.py)
-            self._distrusted = chased_distrusted(ctx, where)
+        if not self._distrusted:  # a squaring turn chased an offset (squaring_bias.py)
+            self._distrusted = distrusted_chasing(ctx, where)
         if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)

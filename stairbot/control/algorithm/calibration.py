@@ -15,7 +15,6 @@ import math
 from typing import Any
 
 from stairbot.control.algorithm import landing, limits, lost, motion
-from stairbot.control.algorithm.chased import at_check, beyond, lost_both
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Outcome, Purpose
 from stairbot.control.algorithm.moves import lift
@@ -48,6 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.squaring_bias import at_check, beyond, lost_both
 from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork, StandingWork
 from stairbot.control.tolerances import still_samples, still_tolerance

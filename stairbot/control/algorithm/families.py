@@ -60,7 +60,7 @@ class Calibration(Family):
     chased: str | None = None
     """Descent 1: why the squaring turn was found chasing a front sensor's
     offset and turned back to the climbed heading
-    (:mod:`~stairbot.control.algorithm.chased`); None: it was not."""
+    (:mod:`~stairbot.control.algorithm.squaring_bias`); None: it was not."""
     beams_lost_rad: float | None = None
     """How far the last squaring turn had turned when it stopped with both
     beams reading nothing ahead (not one tick of its check standing still

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from stairbot.control.algorithm import chased, motion
+from stairbot.control.algorithm import motion
 from stairbot.control.algorithm.calibration import FLOW
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import LANDING_PURPOSES, CalibrationCase, Purpose
@@ -47,6 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.squaring_bias import beyond
 from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
 from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
@@ -168,9 +169,9 @@ def _turn(t: Tick, w: TurnWork) -> Step:
         return back
     _follow(t, w)
     sfr, sfl = readings(t)
-    beyond = None if w.measuring else chased.beyond(t)
-    if beyond is not None:
-        return beyond
+    chased = None if w.measuring else beyond(t)
+    if chased is not None:
+        return chased
     if w.measuring:  # stopped at SFR = SFL: measuring standing still, once settled
         if not settled(t, w):
             return stay(NO_MOTION)

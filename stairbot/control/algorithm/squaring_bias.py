@@ -47,7 +47,7 @@ from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, fail, go, stay, where
 from stairbot.control.algorithm.phases import Phase
 from stairbot.control.algorithm.squaring import askew_rad, heading_off_rad
-from stairbot.control.algorithm.texts import chased as say
+from stairbot.control.algorithm.texts import squaring_bias as say
 from stairbot.control.tolerances import square_tolerance
 from stairbot.hardware import FRONT_SENSORS, SensorId
 from stairbot.inputs.config import RobotConfig

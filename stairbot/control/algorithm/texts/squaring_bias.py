@@ -1,4 +1,4 @@
-"""What :mod:`~stairbot.control.algorithm.chased` says."""
+"""What :mod:`~stairbot.control.algorithm.squaring_bias` says."""
 
 from __future__ import annotations
 
