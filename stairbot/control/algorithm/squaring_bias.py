@@ -19,9 +19,10 @@ in descent 1 that takes the robot further than that from the climbed
 heading, or stops with both beams reading nothing ahead where, lowered on
 all wheels, neither meets the riser either, is not squaring to it: the
 pair disagrees by an offset, and nothing the turn shows names the sensor
-that carries it (a sensor held through the turn, or stepping in it, is
-named by :func:`~stairbot.control.algorithm.turns._held_through` and
-:mod:`~stairbot.control.algorithm.bias`'s onsets before this).  The robot
+that carries it (one that held a single value through the turn is left
+to the stuck rule, :func:`~stairbot.control.algorithm.turns._held_through`;
+one whose reading stepped while the robot stood is named by
+:mod:`~stairbot.control.algorithm.bias`'s onsets).  The robot
 turns back to the climbed heading by the odometer, lowers, and then
 distrusts both front sensors (:func:`distrusted`, as
 :mod:`~stairbot.control.algorithm.blind` does at the end of the standing
@@ -46,7 +47,7 @@ from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, fail, go, stay, where
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.squaring import askew_rad, heading_off_rad
+from stairbot.control.algorithm.squaring import askew_rad
 from stairbot.control.algorithm.texts import squaring_bias as say
 from stairbot.control.tolerances import square_tolerance
 from stairbot.hardware import FRONT_SENSORS, SensorId
@@ -85,21 +86,28 @@ def _near(t: Tick) -> float:
     return min(seen, default=limits.square_range_m(t.cfg))
 
 
+def past(t: Tick, twist: float | None = None) -> bool:
+    """Descent 1 on a climbed step: whether the heading ``twist`` (the
+    odometer's now, if None) lies further from the one the step was climbed
+    with than :func:`allowed_rad` (once a calibration)."""
+    climbed = _climbed(t)
+    if climbed is None or t.cal.chased is not None:
+        return False
+    now = motion.twist(t.snap) if twist is None else twist
+    return abs(motion.turn_yaw_rad(t.cfg, now - climbed)) > allowed_rad(t.cfg, _near(t))
+
+
 def beyond(t: Tick, twist: float | None = None, lost: bool = False) -> Step | None:
-    """Descent 1 on a climbed step: the heading ``twist`` (the odometer's
-    now, if None) lies further from the climbed one than :func:`allowed_rad`,
-    or (``lost``) both beams read nothing ahead: turn back to the climbed
-    heading, the pair to be distrusted once lowered (module docstring).
-    None: go on as before."""
+    """Descent 1 on a climbed step, :func:`past` for ``twist``, or (``lost``)
+    both beams read nothing ahead: turn back to the climbed heading, the
+    pair to be distrusted once lowered (module docstring).  None: go on as
+    before."""
     climbed, cal = _climbed(t), t.cal
-    if climbed is None or cal.chased is not None:
+    if climbed is None or cal.chased is not None or not (lost or past(t, twist)):
         return None
     now = motion.twist(t.snap) if twist is None else twist
-    off = heading_off_rad(t, climbed) if twist is None else motion.turn_yaw_rad(
-        t.cfg, now - climbed)
+    off = motion.turn_yaw_rad(t.cfg, now - climbed)
     allowed = allowed_rad(t.cfg, _near(t))
-    if abs(off) <= allowed and not lost:
-        return None
     sfr, sfl = motion.pair(t.snap)
     cal.chased = say.chased(t.descent_index, off, allowed, sfr.distance_m, sfl.distance_m, lost)
     cal.turn_to = climbed

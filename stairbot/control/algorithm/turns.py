@@ -47,7 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
-from stairbot.control.algorithm.squaring_bias import beyond
+from stairbot.control.algorithm.squaring_bias import beyond, past
 from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
 from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
@@ -169,9 +169,13 @@ def _turn(t: Tick, w: TurnWork) -> Step:
         return back
     _follow(t, w)
     sfr, sfl = readings(t)
-    chased = None if w.measuring else beyond(t)
-    if chased is not None:
-        return chased
+    if not w.measuring and w.turn_held[0] == w.turn_held[1] and past(t):
+        # not squaring to the riser, and neither sensor held one value through
+        # the turn (the stuck rule's case, :func:`_held_through`): one of the
+        # pair reads an offset, and nothing names which
+        chased = beyond(t)
+        if chased is not None:
+            return chased
     if w.measuring:  # stopped at SFR = SFL: measuring standing still, once settled
         if not settled(t, w):
             return stay(NO_MOTION)
