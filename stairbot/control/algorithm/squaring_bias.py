@@ -64,9 +64,10 @@ track width (4.8° on a 0.16 m track)."""
 def allowed_rad(cfg: RobotConfig, distance_m: float) -> float:
     """How far square to the riser ``distance_m`` ahead may lie from the
     heading the step was climbed with: the climb's squaring (at most as
-    far as the start's, square_range_m), this one's, and the odometer's
-    drift over the step."""
-    climbed = square_tolerance(cfg, max(distance_m, limits.square_range_m(cfg)))
+    far as the start's, square_range_m, and nearer than nothing ahead),
+    this one's, and the odometer's drift over the step."""
+    start = min(limits.square_range_m(cfg), cfg.LENGTH_OF_INFINITY)
+    climbed = square_tolerance(cfg, max(distance_m, start))
     here = square_tolerance(cfg, distance_m)
     drift = STEP_DRIFT_M / cfg.geometry.track_width
     return askew_rad(cfg, climbed) + askew_rad(cfg, here) + drift
@@ -82,8 +83,11 @@ def _climbed(t: Tick) -> float | None:
 
 
 def _near(t: Tick) -> float:
-    seen = [r.distance_m for r in motion.pair(t.snap) if r.ok and not motion.far(r, t.cfg)]
-    return min(seen, default=limits.square_range_m(t.cfg))
+    """The nearer of the pair's distances (as far as the start's squaring,
+    if neither reads one)."""
+    seen = [r.distance_m for r in motion.pair(t.snap)
+            if r.ok and not motion.far(r, t.cfg) and math.isfinite(r.distance_m)]
+    return min(seen, default=min(limits.square_range_m(t.cfg), t.cfg.LENGTH_OF_INFINITY))
 
 
 def past(t: Tick, twist: float | None = None) -> bool:
