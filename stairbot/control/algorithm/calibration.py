@@ -235,7 +235,8 @@ CHECK = PhaseDef(
         "limp_home_floor": Exit(P.DESCENT_FINISH, lost.LIMP + ": start, back to where the "
                                                   "program began"),
         FAILED: Exit(P.ERROR, "case 1: sensor error; later: nothing ahead where a riser should "
-                              "be; checking a squaring turn: nothing ahead, or still not square "
+                              "be; checking a squaring turn: nothing ahead (both beams lost in "
+                              "the turn: a sensor may read an offset), or still not square "
                               "after MAX_SQUARING_TURNS turns"),
     })
 

@@ -231,7 +231,7 @@ TURN = PhaseDef(
         "chased": Exit(P.CAL_TURN_TO, "descent 1: turned further from the climbed heading "
                                       "than square allows, or lost both beams: back to it"),
         FAILED: Exit(P.ERROR, "turned too far, or more than its first readings allow; "
-                              "lost both beams; " + FAULT)})
+                              + FAULT)})
 
 
 def _probe(t: Tick, w: ProbeWork) -> Step:
