@@ -201,7 +201,8 @@ class BiasWatch:
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
         if not self._distrusted:  # a squaring turn chased an offset (squaring_bias.py)
-            self._distrusted = distrusted_chasing(ctx, where)
+            found = distrusted_chasing(ctx, where)
+            (self._judged if len(found) == 1 else self._distrusted).update(found)
         if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)

@@ -76,7 +76,7 @@ def _check(t: Tick, w: StandingWork) -> Step:
             ctx.start.wheel = motion.wheel_position(t.snap)
         return lost.limp_down(t)
     sfr, sfl = motion.pair(t.snap)
-    chased = at_check(t)  # turned back from chasing an offset: the pair distrusted
+    chased = at_check(t, w)  # back from chasing an offset: which sensor changed?
     if chased is not None:
         return chased
     if cal.purpose is Purpose.DESCENT and cal.squaring_turns == 0 \
@@ -140,6 +140,9 @@ def _check(t: Tick, w: StandingWork) -> Step:
     cal.case = CalibrationCase.THREE if equal else (
         CalibrationCase.TWO_W if wall else CalibrationCase.TWO)
     cal.case_diff = diff
+    if w.standing:  # where the squaring turn began: a chase comes back to it
+        cal.checked = (trimmed_mean([r for r, _l in w.standing]),
+                       trimmed_mean([l_ for _r, l_ in w.standing]), motion.twist(t.snap))
     t.say(say.case_chosen(where(ctx, P.CAL_CHECK), sfr.distance_m, sfl.distance_m, equal, wall,
                           MAX_SQUARE_YAW_RAD),
           case=cal.case.value, SFR=sfr.distance_m, SFL=sfl.distance_m)

@@ -47,9 +47,16 @@ from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phase import NO_MOTION, Step, Tick, fail, go, stay, where
 from stairbot.control.algorithm.phases import Phase
-from stairbot.control.algorithm.squaring import askew_rad
+from stairbot.control.algorithm.squaring import (
+    STILL_TICKS,
+    askew_rad,
+    measured_standing,
+    settled,
+    trimmed_mean,
+)
 from stairbot.control.algorithm.texts import squaring_bias as say
-from stairbot.control.tolerances import square_tolerance
+from stairbot.control.algorithm.work import StandingWork
+from stairbot.control.tolerances import square_tolerance, still_tolerance
 from stairbot.hardware import FRONT_SENSORS, SensorId
 from stairbot.inputs.config import RobotConfig
 
@@ -123,33 +130,84 @@ def beyond(t: Tick, twist: float | None = None, lost: bool = False) -> Step | No
 def lost_both(t: Tick, made_rad: float) -> Step:
     """A squaring turn stopped with both beams reading nothing ahead, and
     lowered on all wheels neither meets the riser: on a climbed step,
-    :func:`beyond`; elsewhere the program stops, saying why."""
+    :func:`beyond`; elsewhere back to the heading the turn began from, if
+    its check measured the pair there, to see which reading changed
+    (:func:`at_check`); else the program stops, saying why."""
     step = beyond(t, lost=True)
     if step is not None:
         return step
-    sfr, sfl = motion.pair(t.snap)
-    return fail(say.lost_both(where(t.ctx, Phase.CAL_CHECK), made_rad, sfr.distance_m,
-                              sfl.distance_m))
+    cal, (sfr, sfl) = t.cal, motion.pair(t.snap)
+    lost = say.lost_both(where(t.ctx, Phase.CAL_CHECK), made_rad, sfr.distance_m,
+                         sfl.distance_m)
+    if cal.checked is None or cal.chased is not None:
+        return fail(lost)
+    cal.chased, cal.turn_to = lost, cal.checked[2]
+    t.say(say.turning_back(lost))
+    return go("chased")
 
 
-def at_check(t: Tick) -> Step | None:
-    """Calibration's check after the turn back (:func:`beyond`): with both
-    front sensors lost, on to backing up to the edge on the climbed heading
-    (the way down goes without them, where it can); before that, standing
-    still while the pair turns to ERROR (:func:`distrusted`).  None: no
-    turn back was made."""
-    if t.cal.chased is None:
+def at_check(t: Tick, w: StandingWork) -> Step | None:
+    """Calibration's check on the heading a chase turned back to
+    (:func:`beyond`, :func:`lost_both`): measured standing still as the
+    check that began the turn was, a sensor whose reading there changed by
+    more than the pair's noise while its partner's did not carries an
+    offset that began meanwhile, and is judged biased; if neither can be
+    named, descent 1 distrusts both and the start or ascent 1 stops.  The
+    sensors so judged read as ERROR from the next tick on
+    (:func:`distrusted`): lost, the limp home follows.  With both front
+    sensors lost, descent 1 goes on to back up to the edge on the climbed
+    heading.  None: no chase, or limping on the named sensor's partner."""
+    cal, ctx = t.cal, t.ctx
+    if cal.chased is None:
         return None
-    if blind.front_unusable(t.ctx):
-        return go("square_to_descend")
+    if cal.verdict is not None:
+        if blind.front_unusable(ctx):
+            return go("square_to_descend")
+        return None if ctx.limp is not None else stay(NO_MOTION)
+    if not settled(t, w) or not measured_standing(t, w, STILL_TICKS):
+        return stay(NO_MOTION)
+    cal.verdict = _judged(t, w)
+    if cal.verdict[0] == BOTH and cal.purpose is not Purpose.DESCENT:
+        return fail(cal.verdict[1])
+    t.say(cal.verdict[1])
     return stay(NO_MOTION)
 
 
+BOTH = "both"
+"""A verdict that names neither sensor."""
+
+
+def _judged(t: Tick, w: StandingWork) -> tuple[str, str]:
+    """The sensor whose trimmed mean standing now differs from the check's
+    before the turn by more than twice the tolerance of such a mean
+    (:func:`~stairbot.control.tolerances.still_tolerance`), its partner's
+    by no more than once: the same pose, by the odometer, gives the same
+    readings."""
+    cal, chased = t.cal, t.cal.chased
+    assert chased is not None
+    if cal.checked is None or not w.standing:
+        return BOTH, say.unnamed(chased, None)
+    now = (trimmed_mean([r for r, _l in w.standing]),
+           trimmed_mean([l_ for _r, l_ in w.standing]))
+    moved = (now[0] - cal.checked[0], now[1] - cal.checked[1])
+    tol = still_tolerance(t.cfg, len(w.standing), min(now))
+    for i, sensor in enumerate(FRONT_SENSORS):
+        if abs(moved[1 - i]) <= tol < abs(moved[i]) / 2:
+            return sensor.value, say.named(sensor.value, moved[i], FRONT_SENSORS[1 - i].value,
+                                           moved[1 - i], chased)
+    return BOTH, say.unnamed(chased, moved)
+
+
 def distrusted(ctx: Context, phase: Phase) -> dict[SensorId, str]:
-    """Both front sensors with why, once the robot stands lowered on the
-    climbed heading after :func:`beyond` (calibration's check); else none."""
+    """The front sensors :func:`at_check` judged, with why, while the robot
+    stands in calibration's check (both: in descent 1 only); else none."""
     family = ctx.family
     if phase is not Phase.CAL_CHECK or not isinstance(family, Calibration) \
-            or family.chased is None:
+            or family.verdict is None:
         return {}
-    return dict(zip(FRONT_SENSORS, say.distrusted(family.chased), strict=True))
+    who, why = family.verdict
+    if who != BOTH:
+        return {SensorId(who): why}
+    if family.purpose is not Purpose.DESCENT:
+        return {}
+    return dict(zip(FRONT_SENSORS, say.distrusted(why), strict=True))
