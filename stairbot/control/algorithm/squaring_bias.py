@@ -18,23 +18,27 @@ what the odometer's heading may have drifted over the step
 in descent 1 that takes the robot further than that from the climbed
 heading, or stops with both beams reading nothing ahead where, lowered on
 all wheels, neither meets the riser either, is not squaring to it: the
-pair disagrees by an offset, and nothing the turn shows names the sensor
-that carries it (one that held a single value through the turn is left
-to the stuck rule, :func:`~stairbot.control.algorithm.turns._held_through`;
-one whose reading stepped while the robot stood is named by
-:mod:`~stairbot.control.algorithm.bias`'s onsets).  The robot
-turns back to the climbed heading by the odometer, lowers, and then
-distrusts both front sensors (:func:`distrusted`, as
+pair disagrees by an offset.  The robot turns back to the climbed heading
+by the odometer, lowers, and measures the pair standing still as the
+check that began the turn did (``cal.checked``): the same pose gives the
+same readings, so a sensor whose reading there changed while its
+partner's did not carries an offset that began in the turn, and is
+judged biased (:func:`at_check`); if neither changed, nothing names which
+carries it, and both front sensors are distrusted (:func:`distrusted`, as
 :mod:`~stairbot.control.algorithm.blind` does at the end of the standing
-rule's wait): they read as ERROR, and the limp home sees both lost.
+rule's wait).  Either way they read as ERROR, and the limp home sees them
+lost.  A sensor that held one value through the turn is left to the stuck
+rule (:func:`~stairbot.control.algorithm.turns._held_through`).
 
 Anywhere else (the start's calibration, ascent 1: no heading known to be
-square) such a turn stops the program, as it did, and says that one front
-sensor may read an offset (before: "squared up" over no reading, then
-"nothing ahead where the riser should be").  A turn that lost both beams
-with segments 1 and 3 lifted, whose beams meet the riser again lowered
-(a cone tilted up sees over a low riser, a clearance higher), goes on as
-before.
+square) only a turn that stopped over no reading and, lowered on all
+wheels, still meets no riser is taken for a chase (before: "squared up"
+over no reading, then "nothing ahead where the riser should be"): it
+turns back to the heading its check measured the pair at and judges as
+above, and where neither sensor is named the program stops, saying that
+one front sensor may read an offset.  A turn that lost both beams with
+segments 1 and 3 lifted, whose beams meet the riser again lowered (a cone
+tilted up sees over a low riser, a clearance higher), goes on as before.
 """
 
 from __future__ import annotations
