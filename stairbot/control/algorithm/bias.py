@@ -192,6 +192,9 @@ class BiasWatch:
             self._tread = (ctx.length_of_next_step, snap.time_s)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
+        if not self._distrusted:  # a squaring turn chased an offset (squaring_bias.py)
+            chased = distrusted_chasing(ctx, where)
+            (self._judged if len(chased) == 1 else self._distrusted).update(chased)
         if phase is Phase.PAUSED and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
         elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
@@ -200,9 +203,6 @@ class BiasWatch:
                 self._judge_at_once(front, snap)
         elif phase in STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
-        if not self._distrusted:  # a squaring turn chased an offset (squaring_bias.py)
-            found = distrusted_chasing(ctx, where)
-            (self._judged if len(found) == 1 else self._distrusted).update(found)
         if not self._judged and not self._distrusted:
             return snap
         sensors = dict(snap.sensors)
