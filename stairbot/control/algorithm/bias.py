@@ -56,6 +56,7 @@ from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration
 from stairbot.control.algorithm.modes import Purpose
 from stairbot.control.algorithm.phases import BY_VALUE, Phase
+from stairbot.control.algorithm.squaring_bias import distrusted as distrusted_chasing
 from stairbot.control.algorithm.texts import back_pair as say_rise
 from stairbot.control.algorithm.texts import bias as say
 from stairbot.control.tolerances import pair_tolerance, standing_tolerance
@@ -190,6 +191,9 @@ class BiasWatch:
             self._tread = (ctx.length_of_next_step, snap.time_s)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
+        if not self._distrusted:  # a squaring turn chased an offset (squaring_bias.py)
+            chased = distrusted_chasing(ctx, where)
+            (self._judged if len(chased) == 1 else self._distrusted).update(chased)
         if phase is Phase.PAUSED and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
         elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:

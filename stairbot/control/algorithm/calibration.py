@@ -47,6 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.squaring_bias import at_check, beyond, lost_both
 from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import DriveWork, LiftWork, StandingWork
 from stairbot.control.tolerances import still_samples, still_tolerance
@@ -78,6 +79,9 @@ def _check(t: Tick, w: StandingWork) -> Step:
     if blind is not None:
         return blind
     sfr, sfl = motion.pair(t.snap)
+    chased = at_check(t, w)  # back from chasing an offset: which sensor changed?
+    if chased is not None:
+        return chased
     if cal.purpose is Purpose.DESCENT and cal.squaring_turns == 0 \
             and not ctx.descent.turned_back:
         # Descent 1 first turns back to the heading it climbed this step with
@@ -139,6 +143,9 @@ def _check(t: Tick, w: StandingWork) -> Step:
     cal.case = CalibrationCase.THREE if equal else (
         CalibrationCase.TWO_W if wall else CalibrationCase.TWO)
     cal.case_diff = diff
+    if w.standing:  # where the squaring turn began: a chase comes back to it
+        cal.checked = (trimmed_mean([r for r, _l in w.standing]),
+                       trimmed_mean([l_ for _r, l_ in w.standing]), motion.twist(t.snap))
     t.say(say.case_chosen(where(ctx, P.CAL_CHECK), sfr.distance_m, sfl.distance_m, equal, wall,
                           MAX_SQUARE_YAW_RAD),
           case=cal.case.value, SFR=sfr.distance_m, SFL=sfl.distance_m)
@@ -156,6 +163,9 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     ctx, cfg, cal = t.ctx, t.cfg, t.cal
     r, l_ = motion.pair(t.snap)
     sfr, sfl = r.distance_m, l_.distance_m
+    if cal.beams_lost_rad is not None and motion.far(r, cfg) and motion.far(l_, cfg):
+        # lowered, still neither beam meets the riser the turn lost
+        return lost_both(t, cal.beams_lost_rad)
     if motion.far(r, cfg) or motion.far(l_, cfg):
         # no figure to square to, nor a riser where it squared up: stop
         return fail(say.nothing_ahead_squared(where(ctx, P.CAL_CHECK), sfr, sfl))
@@ -169,7 +179,11 @@ def _verify(t: Tick, w: StandingWork) -> Step:
     # SFL farther than SFR: turned left of square, turn right (and the other way).
     yaw = -askew_rad(cfg, diff)
     yaw = max(-MAX_SQUARE_YAW_RAD, min(MAX_SQUARE_YAW_RAD, yaw))
-    cal.turn_to = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
+    target = motion.twist(t.snap) + motion.yaw_turns(cfg, yaw)
+    chased = beyond(t, target)
+    if chased is not None:
+        return chased
+    cal.turn_to = target
     cal.squaring_turns += 1
     t.say(say.not_square_on_all_wheels(diff, len(w.diffs), sfr, sfl, yaw),
           SFR=sfr, SFL=sfl, diff=diff)
@@ -216,14 +230,19 @@ CHECK = PhaseDef(
         "off_climb_heading": Exit(P.CAL_LIFT, "descent 1: turned from the heading the step "
                                               "was climbed with"),
         "not_square": Exit(P.CAL_LIFT, "a squaring turn checked and not square: correct it"),
+        "chased": Exit(P.CAL_LIFT, "descent 1: the correction would turn further from the "
+                                   "climbed heading than square allows: back to it"),
         "square_to_climb": Exit(P.ASCENT_APPROACH, "ascent 1 on a later step: SFR = SFL; or "
                                                    "squared up (checked)"),
         "square_to_descend": Exit(P.DESCENT_BACK_TO_EDGE, "descent 1: SFR = SFL; or squared up "
-                                                          "(checked)"),
+                                                          "(checked); or turned back to the "
+                                                          "climbed heading, the front pair "
+                                                          "lost"),
         "limp_home_floor": Exit(P.DESCENT_FINISH, lost.LIMP + ": start, back to where the "
                                                   "program began"),
         FAILED: Exit(P.ERROR, "case 1: sensor error; later: nothing ahead where a riser should "
-                              "be; checking a squaring turn: nothing ahead, or still not square "
+                              "be; checking a squaring turn: nothing ahead (both beams lost in "
+                              "the turn: a sensor may read an offset), or still not square "
                               "after MAX_SQUARING_TURNS turns"),
     })
 

@@ -57,6 +57,21 @@ class Calibration(Family):
     return_mtf: float = 0.0
     return_mtb: float = 0.0
     """Lift counters before the clearance lift: where the lowering returns to."""
+    chased: str | None = None
+    """Descent 1: why the squaring turn was found chasing a front sensor's
+    offset and turned back to the climbed heading
+    (:mod:`~stairbot.control.algorithm.squaring_bias`); None: it was not."""
+    checked: tuple[float, float, float] | None = None
+    """SFR's and SFL's trimmed means standing, and the heading (odometer
+    twist), at the check that chose the squaring turn's case."""
+    verdict: tuple[str, str] | None = None
+    """After :attr:`chased`, back on that heading: the front sensor whose
+    reading there changed ("SFR", "SFL"), or "both" (neither can be named),
+    with why in words; None: not judged yet."""
+    beams_lost_rad: float | None = None
+    """How far the last squaring turn had turned when it stopped with both
+    beams reading nothing ahead (not one tick of its check standing still
+    read both); None: it did not."""
 
 
 @dataclass

@@ -47,6 +47,7 @@ from stairbot.control.algorithm.squaring import (
     settled,
     trimmed_mean,
 )
+from stairbot.control.algorithm.squaring_bias import beyond, past
 from stairbot.control.algorithm.texts import calibration as say
 from stairbot.control.algorithm.work import AwayWork, CornerWork, ProbeWork, TurnWork, Work
 from stairbot.control.tolerances import pair_tolerance, still_samples, still_tolerance
@@ -168,12 +169,22 @@ def _turn(t: Tick, w: TurnWork) -> Step:
         return back
     _follow(t, w)
     sfr, sfl = readings(t)
+    if not w.measuring and w.turn_held[0] == w.turn_held[1] and past(t):
+        # not squaring to the riser, and neither sensor held one value through
+        # the turn (the stuck rule's case, :func:`_held_through`): one of the
+        # pair reads an offset, and nothing names which
+        chased = beyond(t)
+        if chased is not None:
+            return chased
     if w.measuring:  # stopped at SFR = SFL: measuring standing still, once settled
         if not settled(t, w):
             return stay(NO_MOTION)
         # as long as it takes to know the difference to within equal_tolerance
         if not measured_standing(t, w, max(STILL_TICKS, still_samples(cfg, min(sfr, sfl)))):
             return stay(NO_MOTION)
+        if not w.diffs:  # not one tick read both: the check on all wheels says what follows
+            t.cal.beams_lost_rad = motion.turn_yaw_rad(
+                cfg, abs(t.snap.turns(MotorId.MWR) - w.turn_from))
         diff = mean_diff(t, w)
         if abs(diff) <= still_tolerance(cfg, max(1, len(w.diffs)), min(sfr, sfl)):
             t.say(say.squared_up(diff, len(w.diffs), sfr, sfl), SFR=sfr, SFL=sfl, diff=diff)
@@ -217,6 +228,8 @@ TURN = PhaseDef(
         "limp_turn_back": Exit(P.CAL_TURN_TO, "limping home, a front sensor lost in the "
                                               "turn: back to the heading the step was "
                                               "climbed with"),
+        "chased": Exit(P.CAL_TURN_TO, "descent 1: turned further from the climbed heading "
+                                      "than square allows, or lost both beams: back to it"),
         FAILED: Exit(P.ERROR, "turned too far, or more than its first readings allow; "
                               + FAULT)})
 
