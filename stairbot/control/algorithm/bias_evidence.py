@@ -118,10 +118,11 @@ class Onsets:
 
     def moved_medians(self) -> tuple[float, float]:
         """How far the right and the left sensor moved between the medians of
-        the two windows: what :meth:`add`'s means say, less any spike that got
-        through perception's median (three outliers among its five
-        measurements stand for one measurement; in a window's mean, a 0.5 m
-        one moves it by 8 cm, in its median, not at all)."""
+        the two windows: what :meth:`add`'s means say of a step that holds,
+        but not of a spike that got through perception's median (three
+        outliers among its five measurements stand for one measurement: in a
+        window's mean a 0.5 m one moves it by 8 cm, in its median not at
+        all).  Sorted on the ticks a step shows, not every tick."""
         before, after = self.windows()
         return (_median([s[1] for s in after]) - _median([s[1] for s in before]),
                 _median([s[2] for s in after]) - _median([s[2] for s in before]))

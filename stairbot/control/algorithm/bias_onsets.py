@@ -16,12 +16,12 @@ may be; a back step taken while the heading changed is no onset, nor is
 one that lengthens a reading while segment 3 backed.  A back
 sensor looks down: driving on a floor does not move what it reads, and
 while MTB lifts segment 3 in the air its reading less MTB's travel stays
-put.  The compensated readings' medians over two windows a settle time
-apart are compared (their means screen for a step, tick by tick: a spike
-perception's median let through moves a mean, not a median): the pair's
-difference *steps* when they differ by more than STEP_SIGMAS pair
-tolerances; the step is an onset of the sensor that moved if its partner
-held, and counts once the next window bears it out."""
+put.  The compensated readings' means over two windows a settle time apart
+are compared: the pair's difference *steps* when they differ by more than
+STEP_SIGMAS pair tolerances, and the windows' medians do as well (a spike
+perception's median let through moves a mean, not a median); the step is
+an onset of the sensor that moved if its partner held, and counts once the
+next window bears it out (its median level held)."""
 
 from __future__ import annotations
 
@@ -35,19 +35,18 @@ from stairbot.hardware import SensorId, SensorReading, SensorStatus, Snapshot
 from stairbot.inputs.config import RobotConfig
 
 MIN_WINDOW_TICKS = 5
-"""The gap between the two windows whose medians are compared spans the pair's
+"""The gap between the two windows whose means are compared spans the pair's
 settle time (:func:`~stairbot.control.tolerances.settle_s`: the filter's
 median comes round to a new level within it), and at least this many
 ticks."""
 WINDOW_SETTLES = 2.0
 """Each of the two windows spans this many settle times: long enough that
-its median is quieter than a tick by about the square root of the
-measurements it holds (a mean would be a little quieter still, but one
-spike moves it)."""
+its mean is quieter than a tick by about the square root of the
+measurements it holds."""
 STEP_SIGMAS = 1.0
 """A step counts when the pair's difference moves by more than this many of
 its pair tolerance (itself four sigmas of one tick's difference, so more
-sigmas of two windows' medians): a fault-free run must not take its noise for
+sigmas of two windows' means): a fault-free run must not take its noise for
 an onset, and the next window must bear an onset out before it counts."""
 MAX_ONSET_M = 0.08
 """A one-sided step larger than this is one sensor crossing an edge before its
@@ -126,15 +125,15 @@ class PairWatch:
         pending = track.pending
         if pending is None and abs(step) <= self._least_step:
             return  # the common case, kept short
-        # the windows' means screen, their medians measure: a spike perception's
-        # median let through moves a mean, not a median
-        moved_r, moved_l = track.moved_medians()
-        step = moved_l - moved_r
         near = min(r.distance_m, left.distance_m)
         threshold = STEP_SIGMAS * pair_tolerance(self._cfg, near, back=back)
         if abs(step) > threshold and (pending is None or abs(step) >= pending.size):
-            at = track.buf[track.window + track.gap // 2][0]
-            track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
+            # a step the windows' medians bear out: a spike perception's median
+            # let through moves a window's mean, not its median
+            right_m, left_m = track.moved_medians()
+            if abs(left_m - right_m) > threshold:
+                at = track.buf[track.window + track.gap // 2][0]
+                track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
             return
         if pending is not None:
             self._decide(pending)
