@@ -10,16 +10,19 @@ evidence must not take for biased."""
 
 from __future__ import annotations
 
+import pytest
 from lost_sensor import degraded, sweep_flight
 from simrun import run_sim
 from test_vl53l1x_front import LOW_RISER_ASKEW, VL53L1X_FRONT
 
+from stairbot.control.algorithm.bias_evidence import Onsets, Sample
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event
 from stairbot.inputs.scenario import parse_scenario
 from stairbot.run.runner import RunResult
 
 CONFIG = load_config()
+LANDINGS = load_config("landings")
 
 
 def flight(seed: int, at: float, sensor: str, offset: float) -> str:
@@ -203,3 +206,69 @@ def test_a_front_bias_just_after_segment_1_was_lowered_is_still_an_onset() -> No
     assert home(r), r.to_dict()
     stop = degraded(events)
     assert (stop["lost"], stop["biased"], stop["phase"]) == (["SFL"], ["SFL"], "cal_check")
+
+
+LANDINGS_141 = """
+[stairs]
+count = 3
+rise = 0.17
+tread = 0.28
+top = "landing"
+width = 1.0
+side_wall = "none"
+[start]
+distance = 0.5
+yaw_deg = -4.432602
+lateral = -0.044517
+[sensors]
+noise = 0.001
+seed = 485317
+outliers = 0.01
+[landing]
+turn = "left"
+depth = 1.02
+count = 3
+"""
+"""Case 141 of sweeps/landings.toml on the landings robot: no fault."""
+
+
+def test_an_outlier_burst_through_the_filter_is_no_back_onset() -> None:
+    # case 141 of sweeps/landings.toml on --config landings, no fault: standing
+    # still on step 5 after ascent 9, SBL measured 0.62, 0.74 and 0.52 m among
+    # five measurements (1 % outliers), so perception's median read 0.517 m
+    # for one measurement; in the mean of a window of 18 ticks that was a step
+    # of 8.3 cm, taken for SBL's onset, borne out by the next window (SBL read
+    # its tread again), and judged at once 88 s later in descent 1 of step 4,
+    # where SBR saw the edge first and the pair read as far apart: a healthy
+    # robot stopped on a landing's flight, "SBL judged biased".  A window's
+    # median is not moved by one measurement.
+    events: list[Event] = []
+    r = run_sim(LANDINGS, parse_scenario(LANDINGS_141, "<landings 141>"), events,
+                limp_home=True)
+    assert not [e.message for e in events if "biased" in e.message]
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 6, 6), r.to_dict()
+
+
+def test_an_edge_split_in_descent_1_judges_no_onset(monkeypatch: pytest.MonkeyPatch) -> None:
+    # the same run, the windows' medians made their means (the spike taken for
+    # SBL's onset of 8.3 cm, and borne out, as before they were): descent 1 of
+    # step 4 backing askew, SBR read the drop (0.124 m) while SBL read the
+    # tread (0.049 m), and the pair's difference matched the onset.  One back
+    # sensor over an edge before the other, the difference is the rise's.
+    def means(track: Onsets) -> tuple[float, float]:
+        before, after = track.windows()
+
+        def moved(k: int) -> float:
+            return sum(s[k] for s in after) / len(after) - sum(s[k] for s in before) / len(before)
+        return moved(1), moved(2)
+
+    def level(_track: Onsets, samples: list[Sample]) -> float:
+        return sum(s[2] - s[1] for s in samples) / len(samples)
+
+    monkeypatch.setattr(Onsets, "moved_medians", means)
+    monkeypatch.setattr(Onsets, "level", level)
+    events: list[Event] = []
+    r = run_sim(LANDINGS, parse_scenario(LANDINGS_141, "<landings 141>"), events,
+                limp_home=True)
+    assert not [e.message for e in events if "biased" in e.message]
+    assert (r.outcome, r.steps_climbed, r.steps_descended) == ("completed", 6, 6), r.to_dict()

@@ -247,10 +247,15 @@ class BiasWatch:
     def _judge_at_once(self, track: Onsets, snap: Snapshot) -> None:
         """Where the robot steers by the pair: a sensor its onsets name, by
         more than the standing rule tolerates, is judged now (steering on it
-        would leave the robot askew, or take the floor for the drop)."""
+        would leave the robot askew, or take the floor for the drop); not
+        while one back sensor reads a drop and its partner a surface."""
         diff = motion.pair_difference(snap, self._cfg, track.back)
         if not track.found or diff is None:
             return
+        drop = self._cfg.BACK_CLEARANCE + DROP_M
+        if track.back and (snap.sensors[track.right].distance_m > drop) \
+                != (snap.sensors[track.left].distance_m > drop):
+            return  # one back cone over an edge before the other: the rise splits them
         offsets = track.offsets
         for sensor, partner in ((track.left, track.right), (track.right, track.left)):
             off = offsets[sensor]

@@ -116,6 +116,21 @@ class Onsets:
             sums[3] = sum(s[2] for s in items[-w:])
         return (sums[2] - sums[0]) / w, (sums[3] - sums[1]) / w
 
+    def moved_medians(self) -> tuple[float, float]:
+        """How far the right and the left sensor moved between the medians of
+        the two windows: what :meth:`add`'s means say of a step that holds,
+        but not of a spike that got through perception's median (three
+        outliers among its five measurements stand for one measurement: in a
+        window's mean a 0.5 m one moves it by 8 cm, in its median not at
+        all).  Sorted on the ticks a step shows, not every tick."""
+        before, after = self.windows()
+        return (_median([s[1] for s in after]) - _median([s[1] for s in before]),
+                _median([s[2] for s in after]) - _median([s[2] for s in before]))
+
+    def level(self, samples: list[Sample]) -> float:
+        """The pair's difference (left - right) over ``samples``: its median."""
+        return _median([s[2] - s[1] for s in samples])
+
     def across(self) -> list[Sample]:
         """The ticks across which the step formed: the gap between the
         windows, the last settle time (``gap`` ticks) of the first window
@@ -140,6 +155,12 @@ class Onsets:
             self.found.clear()
             return False
         return True
+
+
+def _median(values: list[float]) -> float:
+    s = sorted(values)
+    n = len(s)
+    return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2
 
 
 MOUNT_TICKS = 50

@@ -18,8 +18,10 @@ sensor looks down: driving on a floor does not move what it reads, and
 while MTB lifts segment 3 in the air its reading less MTB's travel stays
 put.  The compensated readings' means over two windows a settle time apart
 are compared: the pair's difference *steps* when they differ by more than
-STEP_SIGMAS pair tolerances; the step is an onset of the sensor that moved
-if its partner held, and counts once the next window bears it out."""
+STEP_SIGMAS pair tolerances, and the windows' medians do as well (a spike
+perception's median let through moves a mean, not a median); the step is
+an onset of the sensor that moved if its partner held, and counts once the
+next window bears it out (its median level held)."""
 
 from __future__ import annotations
 
@@ -114,7 +116,7 @@ class PairWatch:
                            level_l, lifted_m))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
-            level = sum(x[2] - x[1] for x in track.buf) / track.window
+            level = track.level(list(track.buf))
             self._confirm(abs(level - waiting.level) <= waiting.share)
         if moved is None:
             return
@@ -126,8 +128,12 @@ class PairWatch:
         near = min(r.distance_m, left.distance_m)
         threshold = STEP_SIGMAS * pair_tolerance(self._cfg, near, back=back)
         if abs(step) > threshold and (pending is None or abs(step) >= pending.size):
-            at = track.buf[track.window + track.gap // 2][0]
-            track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
+            # a step the windows' medians bear out: a spike perception's median
+            # let through moves a window's mean, not its median
+            right_m, left_m = track.moved_medians()
+            if abs(left_m - right_m) > threshold:
+                at = track.buf[track.window + track.gap // 2][0]
+                track.pending = Step(abs(step), moved_r, moved_l, threshold, at)
             return
         if pending is not None:
             self._decide(pending)
@@ -162,8 +168,7 @@ class PairWatch:
             # segment 3 driven where a cone sees part of a drop: it crosses an
             # edge a little at a time, and the sensor nearer it moves first
             return
-        level = sum(s[2] - s[1] for s in before) / len(before) \
-            + step.moved_left - step.moved_right
+        level = track.level(before) + step.moved_left - step.moved_right
         track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
 
     def _confirm(self, held: bool) -> None:
