@@ -32,13 +32,12 @@ rule (:func:`~stairbot.control.algorithm.turns._held_through`).
 
 Anywhere else (the start's calibration, ascent 1: no heading known to be
 square) only a turn that stopped over no reading and, lowered on all
-wheels, still meets no riser is taken for a chase (before: "squared up"
-over no reading, then "nothing ahead where the riser should be"): it
-turns back to the heading its check measured the pair at and judges as
-above, and where neither sensor is named the program stops, saying that
-one front sensor may read an offset.  A turn that lost both beams with
-segments 1 and 3 lifted, whose beams meet the riser again lowered (a cone
-tilted up sees over a low riser, a clearance higher), goes on as before.
+wheels, still meets no riser is taken for a chase: it turns back to the
+heading its check measured the pair at and judges as above, and where
+neither sensor is named the program stops, saying that one front sensor
+may read an offset.  A turn that lost both beams with segments 1 and 3
+lifted, whose beams meet the riser again lowered (a cone tilted up sees
+over a low riser, a clearance higher), goes on squaring up.
 """
 
 from __future__ import annotations
