@@ -24,22 +24,30 @@ SIGHT_MARGIN_M = 0.02
 front sensor may or may not read the first riser as nearer (the noise of one
 reading, or three of the sensor's stated sigma there if that is more)."""
 
+REST_S = 1.0
+"""How long the simulated robot stands, every motor stopped, before
+:func:`first_sight` reads its front pair: it is set down with its wheels
+1 mm into the stairs' surface and rises 0.5 mm in its first second, to
+within 10 um of rest by REST_S, and its calibration reads the pair standing
+there (0.9 s after the start on the reference robot): a ray that grazes the
+first riser's nosing from the pose it was set down in may pass over it by
+then and meet the riser beyond."""
+
 
 def first_sight(scenario: Scenario, config: RobotConfig) -> float:
-    """The nearer front sensor's reading at the start pose, before noise (inf:
-    nothing in range): what the simulated beams meet -- one level ray each,
+    """The nearer front sensor's reading at the start, before noise (inf:
+    nothing in range), as the robot stands when its calibration reads the
+    pair: the simulated robot left standing :data:`REST_S` (see there), then
+    what its beams meet (``SimSensors.front_seen``) -- one level ray each,
     or a cone as the sensor model combines it, so a cone tilted up that takes
     in the risers beyond the first reads long.  The calibration's case 1 stops
     the robot, rightly, when both read LENGTH_OF_INFINITY or more: stairs that
     far are not in sight, whatever their steps."""
-    from stairbot.fakes.plan import Plan
-    from stairbot.fakes.sim_sensors import SimSensors  # the sweep runs the sim anyway
-    from stairbot.fakes.world import World
+    from stairbot.fakes.sim import SimRobot  # the sweep runs the sim anyway
 
-    world = World(config, scenario)
-    plan = Plan(scenario.width, scenario.side_wall, y=scenario.start.lateral,
-                yaw=math.radians(scenario.start.yaw_deg))
-    right, left = SimSensors(config, scenario, world, plan).front_seen()
+    robot = SimRobot(config, scenario)
+    robot.advance(REST_S)
+    right, left = robot.board.front_seen()
     hi = config.sensors.range(back=False)[1]
     seen = [d for d in (right, left) if d is not None and d <= hi]
     return min(seen, default=math.inf)

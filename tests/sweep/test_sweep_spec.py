@@ -14,10 +14,11 @@ import pytest
 from stairbot.cli import main
 from stairbot.control.robot_config import load_config, parse_config
 from stairbot.inputs.scenario import parse_scenario
-from stairbot.sweep.cases import build_case, check_spec
+from stairbot.sweep.cases import Case, build_case, check_spec
 from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec
-from stairbot.sweep.zones import first_sight, zone
+from stairbot.sweep.worker import run_case
+from stairbot.sweep.zones import first_sight, sight_margin, zone
 
 VL53L1X_FRONT = load_config(str(Path(__file__).parents[1] / "robots" / "vl53l1x_front.toml"))
 
@@ -239,6 +240,41 @@ def test_a_cone_that_looks_up_sees_the_first_riser_nearer_than_a_level_ray() -> 
     assert first_sight(scen, load_config("reference")) == pytest.approx(0.95, abs=0.005)
     assert zone(scen, load_config("ideal"), rules)[0] == "inside"
     assert zone(scen, VL53L1X_FRONT, rules)[0] == "outside"
+
+
+# envelope case 485 on 52f0446: 0.945 m from a 0.122 m riser, 15 deg askew
+GRAZED_NOSING = """
+[stairs]
+top = "landing"
+steps = [{rise = 0.122146, tread = 0.345486}, {rise = 0.116755, tread = 0.354382},
+         {rise = 0.118321, tread = 0.345729}, {rise = 0.117499, tread = 0.34501},
+         {rise = 0.122326, tread = 0.347496}]
+[start]
+distance = 0.94534
+yaw_deg = 15.101871
+lateral = -0.001424
+[sensors]
+noise = 0.001
+seed = 485316
+"""
+
+
+def test_sight_is_read_as_the_robot_stands_when_its_calibration_reads_the_pair() -> None:
+    """Set down, the simulated robot has its wheels 1 mm into the floor's
+    surface and rises 0.5 mm to rest before its calibration reads the pair.
+    Here the top rays of the reference robot's row of zones meet riser 1's
+    nosing from the pose it was set down in (0.972 m: in sight) and pass
+    over it at rest to the riser beyond (1.047 m): the robot stops at case
+    1 ("nothing ahead"), and the stairs are out of sight, not inside."""
+    ref = load_config("reference")
+    scen = parse_scenario(GRAZED_NOSING, "x")
+    assert first_sight(scen, ref) > ref.LENGTH_OF_INFINITY + sight_margin(ref)
+    z = zone(scen, ref, Rules())[0]
+    assert z == "outside"
+    rec = run_case(Case(485, {}, GRAZED_NOSING, None, {
+        "zone": z, "expected_steps": 5, "faults": 0, "home_m": 0.05}))
+    assert rec["result"]["reason"].startswith("nothing ahead"), rec["why"]
+    assert rec["verdict"] == "refused", rec["why"]
 
 
 def test_a_measured_tread_asks_its_own_riser_to_reach_min_rise_for_it() -> None:
