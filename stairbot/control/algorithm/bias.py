@@ -27,7 +27,9 @@ only where the evidence decides something:
   riser: the front pair; descent 1 finding the edge and descent 2 finding
   the floor: the back pair), by the onsets, while the pair reads as far
   apart as they say: squared up to one sensor's offset the robot would
-  stand atan(offset / (2 front_lateral)) askew (17 deg for 3 cm).
+  stand atan(offset / (2 front_lateral)) askew (17 deg for 3 cm); in
+  descent 1 also by the mount heights (:mod:`~stairbot.control.algorithm.bias_mount`)
+  and by the step's rise (:mod:`~stairbot.control.algorithm.bias_flat`).
 
 A judged sensor is lost (:mod:`~stairbot.control.algorithm.limp`): on the
 floor where the program began the run ends on it; elsewhere a degraded
