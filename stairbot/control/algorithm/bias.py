@@ -27,7 +27,9 @@ only where the evidence decides something:
   riser: the front pair; descent 1 finding the edge and descent 2 finding
   the floor: the back pair), by the onsets, while the pair reads as far
   apart as they say: squared up to one sensor's offset the robot would
-  stand atan(offset / (2 front_lateral)) askew (17 deg for 3 cm).
+  stand atan(offset / (2 front_lateral)) askew (17 deg for 3 cm); in
+  descent 1 also by the mount heights (:mod:`~stairbot.control.algorithm.bias_mount`)
+  and by the step's rise (:mod:`~stairbot.control.algorithm.bias_flat`).
 
 A judged sensor is lost (:mod:`~stairbot.control.algorithm.limp`): on the
 floor where the program began the run ends on it; elsewhere a degraded
@@ -48,6 +50,7 @@ from dataclasses import replace
 
 from stairbot.control.algorithm import bias_mount, blind, motion, standing
 from stairbot.control.algorithm.bias_evidence import MountHeights, Onsets, Reference
+from stairbot.control.algorithm.bias_flat import FlatDrop
 from stairbot.control.algorithm.bias_mount import MATCH_SHARE, by_mount
 from stairbot.control.algorithm.bias_mount import signed as _signed
 from stairbot.control.algorithm.bias_onsets import STEP_SIGMAS, PairWatch, distance
@@ -125,6 +128,7 @@ class BiasWatch:
         self._pairs = (self._watches[0].track, self._watches[1].track)
         self._mount = MountHeights(cfg.BACK_CLEARANCE)
         self._rises = Rises(cfg)
+        self._flat = FlatDrop(cfg)
         self._lift_m = cfg.motors.lift_travel_per_turn
         self._mtf: float | None = None
         self._cones_m = 0.0
@@ -204,6 +208,9 @@ class BiasWatch:
             self._judge_at_once(back, snap)
             found = None if judged or ctx.from_top else bias_mount.at_once(self._cfg, self._mount,
                                                                            snap)
+            if found is None and not judged and not ctx.from_top:
+                step = ctx.number_of_steps - ctx.steps_descended - 1
+                found = self._flat.see(snap, odometer, self._rises.rises.get(step))
             if found is not None:
                 judged[found[0]] = found[1]
         if not self._judged and not self._distrusted:

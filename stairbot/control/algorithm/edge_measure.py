@@ -86,7 +86,7 @@ def edge_lag_s(cfg: RobotConfig) -> float:
         + (window(cfg, True) // 2 + 0.5) * measurement_period(cfg, True)
 
 
-def _back_half_cone_rad(cfg: RobotConfig) -> float:
+def back_half_cone_rad(cfg: RobotConfig) -> float:
     """Half the back pair's cone (the config's back_fov_deg, else its model's)."""
     fov = cfg.sensors.back_fov_deg
     return math.radians(cfg.sensors.spec(True).fov_deg if fov is None else fov) / 2
@@ -105,7 +105,7 @@ def mixed_footprint_m(cfg: RobotConfig) -> float:
     edge_clearance_m puts them, within its EDGE_MARGIN_M.  0 for one ray."""
     if cfg.sensors.spec(True).first_echo:
         return 0.0
-    return cfg.BACK_CLEARANCE * math.tan(_back_half_cone_rad(cfg))
+    return cfg.BACK_CLEARANCE * math.tan(back_half_cone_rad(cfg))
 
 
 def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> float:
@@ -124,7 +124,7 @@ def edge_sight_m(cfg: RobotConfig, speed_mps: float, from_top: bool = False) -> 
     much too far, and segment 2's rear wheels go over the edge."""
     sight = abs(speed_mps) * edge_lag_s(cfg)
     if cfg.sensors.spec(True).first_echo:
-        return sight + edge_drop_m(cfg, from_top) * math.sin(_back_half_cone_rad(cfg))
+        return sight + edge_drop_m(cfg, from_top) * math.sin(back_half_cone_rad(cfg))
     return sight + mixed_footprint_m(cfg)
 
 

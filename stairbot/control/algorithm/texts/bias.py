@@ -81,6 +81,17 @@ def judged_mount_backing(sensor: SensorId, partner: SensorId, off_m: float,
             f"(the step's drop, climbed, is a whole rise)")
 
 
+def judged_flat_drop(sensor: SensorId, partner: SensorId, high_m: float, backed_m: float,
+                     short_m: float, rise_m: float, step: int, drop: float) -> str:
+    """Descent 1 backing off: a back sensor past the drop line, short of the
+    step's climbed rise, over backing an edge's crossing would have ended."""
+    return (f"judged biased: backing off, {sensor} read past {drop:.3f} m, where the edge "
+            f"watch reads a drop, while {partner} read the floor, and held at most "
+            f"{high_m:.3f} m over {backed_m * 1000:.0f} mm of backing; crossing an edge it "
+            f"would read this step's rise, {rise_m:.3f} m as the pair read it climbing step "
+            f"{step + 1} (above {short_m:.3f} m), within that backing: no edge explains it")
+
+
 def judged_by_riser(sensor: SensorId, partner: SensorId, off_m: float, partner_off_m: float,
                     tread: int, said_m: float) -> str:
     """At the standing rule's wait's end: where the odometer puts the riser."""
