@@ -127,10 +127,6 @@ class Onsets:
         return (_median([s[1] for s in after]) - _median([s[1] for s in before]),
                 _median([s[2] for s in after]) - _median([s[2] for s in before]))
 
-    def level(self, samples: list[Sample]) -> float:
-        """The pair's difference (left - right) over ``samples``: its median."""
-        return _median([s[2] - s[1] for s in samples])
-
     def across(self) -> list[Sample]:
         """The ticks across which the step formed: the gap between the
         windows, the last settle time (``gap`` ticks) of the first window

@@ -21,7 +21,7 @@ are compared: the pair's difference *steps* when they differ by more than
 STEP_SIGMAS pair tolerances, and the windows' medians do as well (a spike
 perception's median let through moves a mean, not a median); the step is
 an onset of the sensor that moved if its partner held, and counts once the
-next window bears it out (its median level held)."""
+next window bears it out (its mean level held)."""
 
 from __future__ import annotations
 
@@ -116,7 +116,7 @@ class PairWatch:
                            level_l, lifted_m))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
-            level = track.level(list(track.buf))
+            level = sum(x[2] - x[1] for x in track.buf) / track.window
             self._confirm(abs(level - waiting.level) <= waiting.share)
         if moved is None:
             return
@@ -168,7 +168,8 @@ class PairWatch:
             # segment 3 driven where a cone sees part of a drop: it crosses an
             # edge a little at a time, and the sensor nearer it moves first
             return
-        level = track.level(before) + step.moved_left - step.moved_right
+        level = sum(s[2] - s[1] for s in before) / len(before) \
+            + step.moved_left - step.moved_right
         track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
 
     def _confirm(self, held: bool) -> None:
