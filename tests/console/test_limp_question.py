@@ -32,10 +32,14 @@ from stairbot.run.resume import ResumeRefused
 
 LOST_MID_CLIMB = 'name = "sfr-lost-ascent7"\n' + lost_sensor.LOST_MID_CLIMB
 
-BOTH_FRONT_LOST = LOST_MID_CLIMB + """
+BOTH_BACK_LOST = 'name = "both-back-lost"\n' + lost_sensor.TWO_STEPS + """
 [[faults]]
-at = 42.0
-sensor = "SFL"
+at = 111.1
+sensor = "SBR"
+kind = "error"
+[[faults]]
+at = 111.1
+sensor = "SBL"
 kind = "error"
 """
 
@@ -185,14 +189,14 @@ def test_the_emergency_stop_withdraws_the_question(tmp_path: Path) -> None:
 
 def test_too_little_left_to_come_down_on_is_said_not_asked(tmp_path: Path) -> None:
     async def go() -> None:
-        app = build_app(scenario=scenario(tmp_path, BOTH_FRONT_LOST), speed="max")
+        app = build_app(scenario=scenario(tmp_path, BOTH_BACK_LOST), speed="max")
         async with app.run_test(size=(80, 24)) as pilot:
             await ready(pilot)
             await press(pilot, "s")
             await until(pilot, lambda: isinstance(app.screen, StopNotice), "the notice")
             text = dialog(app)
             assert "DEGRADED STOP" in text and "No question to ask" in text, text
-            assert "both front sensors lost" in text, text
+            assert "both back sensors lost" in text, text
             assert app.engine.limp_offer is None
             await press(pilot, "enter")
             await until(pilot, lambda: len(app.screen_stack) == 1, "read")

@@ -15,7 +15,7 @@ from lost_sensor import degraded, sweep_flight
 from simrun import run_sim
 from test_vl53l1x_front import LOW_RISER_ASKEW, VL53L1X_FRONT
 
-from stairbot.control.algorithm.bias_evidence import Onsets, Sample
+from stairbot.control.algorithm.bias_evidence import Onsets
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event
 from stairbot.inputs.scenario import parse_scenario
@@ -250,7 +250,7 @@ def test_an_outlier_burst_through_the_filter_is_no_back_onset() -> None:
 
 
 def test_an_edge_split_in_descent_1_judges_no_onset(monkeypatch: pytest.MonkeyPatch) -> None:
-    # the same run, the windows' medians made their means (the spike taken for
+    # the same run, the medians' veto made the means' (the spike taken for
     # SBL's onset of 8.3 cm, and borne out, as before they were): descent 1 of
     # step 4 backing askew, SBR read the drop (0.124 m) while SBL read the
     # tread (0.049 m), and the pair's difference matched the onset.  One back
@@ -262,11 +262,7 @@ def test_an_edge_split_in_descent_1_judges_no_onset(monkeypatch: pytest.MonkeyPa
             return sum(s[k] for s in after) / len(after) - sum(s[k] for s in before) / len(before)
         return moved(1), moved(2)
 
-    def level(_track: Onsets, samples: list[Sample]) -> float:
-        return sum(s[2] - s[1] for s in samples) / len(samples)
-
     monkeypatch.setattr(Onsets, "moved_medians", means)
-    monkeypatch.setattr(Onsets, "level", level)
     events: list[Event] = []
     r = run_sim(LANDINGS, parse_scenario(LANDINGS_141, "<landings 141>"), events,
                 limp_home=True)

@@ -115,16 +115,23 @@ def test_a_front_sensor_reading_short_while_the_tab_of_a_long_tread_is_read_stop
     assert result.steps_climbed == 1
 
 
+@pytest.mark.parametrize(("offset", "said"), [
+    (0.1, "SBL judged biased"),  # reads a "drop" far short of the rise, flat
+    (0.17, "SBL reads the drop, SBR still the floor"),  # reads the rise's drop
+])
 def test_a_back_sensor_reading_the_drop_far_before_the_other_stops_the_robot_on_the_tread(
-        ) -> None:
-    """The red team: SBL 0.1 m long as the robot backs up to the 0.7 m
+        offset: float, said: str) -> None:
+    """The red team: SBL reading long as the robot backs up to the 0.7 m
     step's edge reads a drop 0.2 m before SBR; placed half-way between the
     two, the crossing left the robot short of the edge and it tipped nose
-    down lowering segment 3.  More than MAX_EDGE_YAW_RAD's worth apart, the
-    robot stops where it stands."""
+    down lowering segment 3.  A reading far short of the step's rise that
+    holds flat while the robot backs is no edge: SBL is judged biased
+    (bias_flat.py).  One that reads the rise, as a real drop does, more
+    than MAX_EDGE_YAW_RAD's worth before its partner: the robot stops
+    where it stands.  Either way it stops, without consent, on the tread."""
     text = RED_FLIGHT + ("[[faults]]\nat = 193.1\nsensor = 'SBL'\nkind = 'offset'\n"
-                         "offset = 0.1\nduration = 6\n")
+                         f"offset = {offset}\nduration = 6\n")
     result = simrun.run_sim(REFERENCE, parse_scenario(text, "<t>"))
     assert result.outcome == "error" and not result.fell, result.to_dict()
-    assert "SBL reads the drop, SBR still the floor" in str(result.error)
+    assert said in str(result.error), result.error
     assert result.max_pitch_deg is not None and result.max_pitch_deg < 8.0

@@ -61,10 +61,10 @@ def test_quick_spec_end_to_end(tmp_path: Path) -> None:
     assert "stairs.rise" in rep.stdout and (tmp_path / "map.png").stat().st_size > 10_000
 
 
-# SFR and SFL fail for good half way up the step, so every case ends
-# "stranded" (by design: with no front sensor left the robot cannot limp
-# home; it stops there, lifts holding) -- with a robot config override, to
-# write both files.
+# SBR and SBL fail for good half way up the step, so every case ends
+# "stranded" (by design: with no back sensor left nothing finds the edge
+# below, and the robot cannot limp home; it stops there, lifts holding) --
+# with a robot config override, to write both files.
 STRANDED = """
 [sweep]
 name = "stranded"
@@ -74,8 +74,8 @@ seed = 5
 "stairs.count" = 1
 "config.masses.second_module" = { uniform = [1.2, 1.4] }
 "sensors.seed" = { randint = [1, 1000] }
-"faults" = [[{ at = 30.0, sensor = "SFR", kind = "error" },
-             { at = 30.0, sensor = "SFL", kind = "error" }]]
+"faults" = [[{ at = 30.0, sensor = "SBR", kind = "error" },
+             { at = 30.0, sensor = "SBL", kind = "error" }]]
 """
 
 
