@@ -9,10 +9,9 @@ two agree to their noise.  The standing tolerance is what the pair's noise
 says two readings of one surface may differ by; it is no bound on what the
 descent can bear, and it differs by a factor of two between the shipped
 robots: the reference robot's VL53L0X pair lowers on with 2.6 cm between
-its sensors at 0.18 m, the quieter HC-SR04 pair stops at 1.3 cm (a sensor
-reading 1 cm long, sweeps/sensor_faults.toml on the sonar robot: 17 cases
-stranded on the stairs, the pair's resolution 3 mm and noise too coarse
-for its rise on the way up to name the sensor).  A disagreement of a
+its sensors at 0.18 m, the quieter HC-SR04 pair stops at 1.3 cm, where
+its 3 mm resolution and noise are too coarse for the rise read on the way
+up to name a sensor reading 1 cm long.  A disagreement of a
 quarter of the lowest rise the robot climbs:
 
 * cannot be the two sensors over two surfaces of the flight: the nearest

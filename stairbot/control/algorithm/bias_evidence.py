@@ -12,6 +12,7 @@ biased sensor on, each kind kept as it comes, tick by tick:
 
 from __future__ import annotations
 
+import statistics
 from collections import deque
 from dataclasses import dataclass
 
@@ -124,8 +125,9 @@ class Onsets:
         window's mean a 0.5 m one moves it by 8 cm, in its median not at
         all).  Sorted on the ticks a step shows, not every tick."""
         before, after = self.windows()
-        return (_median([s[1] for s in after]) - _median([s[1] for s in before]),
-                _median([s[2] for s in after]) - _median([s[2] for s in before]))
+        med = statistics.median
+        return (med([s[1] for s in after]) - med([s[1] for s in before]),
+                med([s[2] for s in after]) - med([s[2] for s in before]))
 
     def across(self) -> list[Sample]:
         """The ticks across which the step formed: the gap between the
@@ -151,12 +153,6 @@ class Onsets:
             self.found.clear()
             return False
         return True
-
-
-def _median(values: list[float]) -> float:
-    s = sorted(values)
-    n = len(s)
-    return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2
 
 
 MOUNT_TICKS = 50

@@ -65,8 +65,8 @@ from stairbot.inputs.config import RobotConfig
 
 STEP_DRIFT_M = 0.0135
 """How far the odometer drifts over a step climbed and descended (2.7 cm
-from the start after two steps, case 425 of sensor_faults: docs/algorithm.md,
-descent 7 by the odometer).  Taken whole as one wheel's slip against the
+from the start after two steps as the simulation measured it:
+docs/algorithm.md, descent 7 by the odometer).  Taken whole as one wheel's slip against the
 other, it turns the heading the odometer does not see by this over the
 track width (4.8° on a 0.16 m track)."""
 
