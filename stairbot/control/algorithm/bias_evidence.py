@@ -217,9 +217,9 @@ class MountHeights:
         n = len(ticks)
         if n >= MOUNT_TICKS:
             self.last = ((sums[0] / n, 2 * sums[2] > n), (sums[1] / n, 2 * sums[3] > n))
-            r, left = self.runs
-            self.tails = ((r[1] / r[0], r[2]) if r[0] >= TAIL_TICKS else None,
-                          (left[1] / left[0], left[2]) if left[0] >= TAIL_TICKS else None)
+            right_tail, left_tail = ((run[1] / run[0], run[2]) if run[0] >= TAIL_TICKS else None
+                                     for run in self.runs)
+            self.tails = (right_tail, left_tail)
 
     def end(self) -> None:
         if self.ticks:
