@@ -159,22 +159,42 @@ MOUNT_TICKS = 50
 """What the back pair reads on a surface is the mean of its last this many
 ticks there (1 s at the 20 ms tick), once it has as many."""
 
+TAIL_TICKS = 10
+"""A back sensor that read too near to measure for at least this many ticks
+(0.2 s: six VL53L1X measurements, three HC-SR04 ones) at the end of its
+stretch on a surface, its partner measuring throughout, went short there
+though the second's mean says little of it (:attr:`MountHeights.tails`)."""
+
+Tail = tuple[float, float]
+"""(offset m, the partner's largest offset m): a sensor's trailing run of too
+near readings on a surface, and how far its partner's readings strayed from
+the mount height meanwhile."""
+
 
 class MountHeights:
     """What SBR and SBL read, less BACK_CLEARANCE, over the last MOUNT_TICKS
     ticks segment 3 stood on a surface: their means, and whether the sensor
     read too near to measure on most of them (its mean is then at most what
-    it says).  A tick off a surface ends the stretch; what the last stretch
-    long enough said is kept."""
+    it says); and each sensor's trailing run of too near readings there.  A
+    tick off a surface ends the stretch; what the last stretch long enough
+    said is kept."""
 
-    __slots__ = ("clearance", "ticks", "sums", "nears", "last")
+    __slots__ = ("clearance", "ticks", "sums", "runs", "last", "tails")
 
     def __init__(self, clearance: float) -> None:
         self.clearance = clearance
         self.ticks: deque[tuple[float, float, bool, bool]] = deque()
         self.sums: list[float] = [0.0, 0.0, 0.0, 0.0]
+        self.runs: list[list[float]] = [[0, 0.0, 0.0], [0, 0.0, 0.0]]
+        """SBR's and SBL's current run of too near ticks, while the partner
+        measured: (ticks, summed offset m, the partner's largest |offset| m)."""
         self.last: tuple[tuple[float, bool], tuple[float, bool]] | None = None
         """(offset m, read too near) of SBR and SBL."""
+        self.tails: tuple[Tail | None, Tail | None] = (None, None)
+        """SBR's and SBL's run of too near readings that ended the stretch
+        :attr:`last` describes, if TAIL_TICKS long or more: its mean offset
+        (what the clamp says: at least that short), and its partner's largest
+        offset meanwhile."""
 
     def add(self, right: float, left: float, right_near: bool, left_near: bool) -> None:
         """One tick on a surface."""
@@ -187,14 +207,25 @@ class MountHeights:
             old = ticks.popleft()
             for k in range(4):
                 sums[k] -= old[k]
+        for k, run in enumerate(self.runs):
+            if sample[2 + k] and not sample[3 - k]:
+                run[0] += 1
+                run[1] += sample[k]
+                run[2] = max(run[2], abs(sample[1 - k]))
+            else:
+                run[:] = [0, 0.0, 0.0]
         n = len(ticks)
         if n >= MOUNT_TICKS:
             self.last = ((sums[0] / n, 2 * sums[2] > n), (sums[1] / n, 2 * sums[3] > n))
+            right_tail, left_tail = ((run[1] / run[0], run[2]) if run[0] >= TAIL_TICKS else None
+                                     for run in self.runs)
+            self.tails = (right_tail, left_tail)
 
     def end(self) -> None:
         if self.ticks:
             self.ticks.clear()
             self.sums = [0.0, 0.0, 0.0, 0.0]
+        self.runs = [[0, 0.0, 0.0], [0, 0.0, 0.0]]
 
 
 @dataclass(frozen=True, slots=True)

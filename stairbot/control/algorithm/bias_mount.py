@@ -5,7 +5,10 @@ surface).  Not in the seed, which has no sensor faults.
 
 * :func:`by_mount`: at the end of the standing rule's wait, one sensor off
   its mount height (or too near to measure) as the disagreement says, its
-  partner on it;
+  partner on it.  Too near to measure counts over most of the last second
+  on a surface, or over the last TAIL_TICKS of it while its partner held
+  its mount height: a bias that set in just before segment 3 left the
+  surface shows only there (the second's mean averages it away);
 * :func:`at_once`: descent 1 backing off, a sensor reading past
   :func:`~stairbot.control.algorithm.edge_measure.edge_drop_m` -- what the
   edge watch takes for the drop -- while its partner reads the floor, and
@@ -41,25 +44,34 @@ def signed(disagree: float, sensor: SensorId) -> float:
 
 
 def _named(mount: MountHeights, disagree: float, match: float,
-           threshold: float) -> tuple[SensorId, SensorId, float, float, bool, float] | None:
+           threshold: float) -> tuple[SensorId, SensorId, float, float, bool, float, bool] | None:
     """The back sensor whose mount height says what the disagreement (left −
-    right) says, within ``match``: off by ``threshold`` or more (or read
-    too near to measure, at least as short), its partner within half of
-    it.  (sensor, partner, its offset, the partner's, read too near, how
-    far it reads past its partner now), or None."""
+    right) says, within ``match``: off by ``threshold`` or more, or read too
+    near to measure (at least as short) over most of the last second or
+    over its last TAIL_TICKS ticks or more, its partner measuring
+    throughout; its partner within half of ``threshold`` (a sensor read too
+    near: within ``threshold`` and a quarter of that sensor's shortfall).
+    (sensor, partner, its offset, the partner's, read too near, how far it
+    reads past its partner now, judged by its tail), or None."""
     last = mount.last
     if last is None:
         return None
-    for sensor, partner, (off, near), (p_off, p_near) in (
-            (SensorId.SBL, SensorId.SBR, last[1], last[0]),
-            (SensorId.SBR, SensorId.SBL, last[0], last[1])):
+    for sensor, partner, (off, near), (p_off, p_near), tail in (
+            (SensorId.SBL, SensorId.SBR, last[1], last[0], mount.tails[1]),
+            (SensorId.SBR, SensorId.SBL, last[0], last[1], mount.tails[0])):
         said = signed(disagree, sensor)
-        if p_near or abs(p_off) > threshold / 2:
+        by_tail = not near and tail is not None and tail[1] <= threshold / 2
+        if by_tail:
+            assert tail is not None
+            off, near = tail[0], True
+        # a clamp says the sensor read at least that short: a partner a few
+        # millimetres off its mount height (a sonar's 3 mm steps) still held
+        held = abs(p_off) <= threshold / 2 or (near and abs(p_off) <= min(threshold, -off / 4))
+        if p_near or not held:
             continue
-        # read too near to measure, it reads at least that much short
         if (near and said <= off) or (not near and abs(off) >= threshold
                                       and abs(off - p_off - said) <= match):
-            return sensor, partner, off, p_off, near, said
+            return sensor, partner, off, p_off, near, said, by_tail
     return None
 
 
@@ -72,8 +84,9 @@ def by_mount(mount: MountHeights, clearance: float, disagree: float, match: floa
     found = _named(mount, disagree, match, threshold)
     if found is None:
         return None
-    sensor, partner, off, p_off, near, said = found
-    return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said, clearance)
+    sensor, partner, off, p_off, near, said, by_tail = found
+    return sensor, say.judged_by_mount(sensor, partner, off, p_off, near, said, clearance,
+                                       by_tail)
 
 
 def at_once(cfg: RobotConfig, mount: MountHeights, snap: Snapshot) -> tuple[SensorId, str] | None:
@@ -98,7 +111,7 @@ def at_once(cfg: RobotConfig, mount: MountHeights, snap: Snapshot) -> tuple[Sens
     found = _named(mount, disagree, max(pair, MATCH_SHARE * abs(disagree)), threshold)
     if found is None or found[4]:
         return None
-    sensor, partner, off, p_off, _near, said = found
+    sensor, partner, off, p_off, _near, said, _tail = found
     if snap.sensors[sensor].distance_m <= drop:
         return None  # the floor-reading one: not what the edge watch is misled by
     return sensor, say.judged_mount_backing(sensor, partner, off, p_off, said, clearance, drop)

@@ -57,10 +57,11 @@ def judged_by_onsets(onsets: Sequence[Onset], partner: SensorId, said_m: float) 
 
 
 def judged_by_mount(sensor: SensorId, partner: SensorId, off_m: float, partner_off_m: float,
-                    near: bool, said_m: float, clearance: float) -> str:
-    """At the standing rule's wait's end: what the back pair read on a surface."""
+                    near: bool, said_m: float, clearance: float, tail: bool = False) -> str:
+    """At the standing rule's wait's end: what the back pair read on a surface
+    (``tail``: too near over the last ticks there, not most of its second)."""
     read = (f"read too near to measure ({_cm(off_m)} or more short of its mount height "
-            f"{clearance:.3f} m)" if near else
+            f"{clearance:.3f} m){' as it left the surface' if tail else ''}" if near else
             f"read {_cm(off_m)} {'more' if off_m > 0 else 'less'} than its mount height "
             f"{clearance:.3f} m")
     return (f"judged biased: where segment 3 last stood on a surface, {sensor} {read} while "
