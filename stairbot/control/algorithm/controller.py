@@ -235,11 +235,10 @@ class Controller:
         return now
 
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:
-        """While a sensor the phase needs (``needed``) reads as ERROR (it reports
-        errors, or it is stale), or the IMU's reading is too old to watch tilt
-        by (:meth:`~stairbot.control.tilt.TiltWatch.stale`): every motor stops, the
-        lifts hold, the timers stand, for up to SENSOR_WAIT_S; then the program
-        ends with the error.  True while holding."""
+        """While a sensor the phase needs (``needed``) reads as ERROR (errors, stale) or
+        the IMU's reading is too old to watch tilt by (``TiltWatch.stale``): every motor
+        stops, the lifts hold, the timers stand, up to SENSOR_WAIT_S; then every sensor
+        in error, needed or not (``lost.every_error``), is lost.  True while holding."""
         ctx = self._ctx
         errors = motion.sensor_errors(snap, needed)
         imu = self._tilt.stale(snap)
@@ -251,6 +250,7 @@ class Controller:
                 self._emit(EventKind.RESUME, f"sensors back after {held:.2f} s: resuming "
                            f"{phase.label}", snap.time_s, {"phase": phase.value})
             return False
+        errors = lost.every_error(ctx, snap, errors)  # the phase's, then any other in error
         why = "; ".join([f"{s} {self._bias.why(s, self._perception.why(s))}"
                          for s in errors] + ([imu] if imu is not None else []))
         # a sensor judged biased does not come back: no use waiting for it

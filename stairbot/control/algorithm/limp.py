@@ -3,7 +3,10 @@
 
 A sensor the phase needs that reads as ERROR (errors, or stale) for
 SENSOR_WAIT_S, or that is judged biased (it reads, but wrong:
-:mod:`~stairbot.control.algorithm.bias`), is *lost*.  On the floor where the program began that ends
+:mod:`~stairbot.control.algorithm.bias`), is *lost*, and with it every other
+distance sensor that reads as ERROR then, needed by the phase or not
+(:func:`~stairbot.control.algorithm.lost.every_error`): what remains is judged
+by all of them.  On the floor where the program began that ends
 the run as it always has: the robot is home.  Anywhere else it is a
 *degraded stop* (:class:`DegradedStop`): every motor stopped, the lifts
 holding, and the robot says what failed, where it stands, and whether it

@@ -1,6 +1,7 @@
 """A sensor lost for good: the controller's decision when a sensor the phase
 needs has read as ERROR for SENSOR_WAIT_S (:mod:`~stairbot.control.algorithm.limp`
-says what limping home is)."""
+says what limping home is).  The decision counts every distance sensor that
+reads as ERROR then, needed by the phase or not (:func:`every_error`)."""
 
 from __future__ import annotations
 
@@ -13,14 +14,32 @@ from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.phase import Step, Tick, go, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.control.algorithm.texts import limp as say
-from stairbot.hardware import SensorId, Snapshot
+from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, SensorId, SensorStatus, Snapshot
+
+_DISTANCE = FRONT_SENSORS + BACK_SENSORS
+
+
+def every_error(ctx: Context, snap: Snapshot, errors: Sequence[SensorId]) -> list[SensorId]:
+    """``errors`` (the sensors the phase needs that read as ERROR), then every
+    other distance sensor that reads as ERROR in ``snap`` (errors, stale,
+    stuck, judged biased or distrusted) and is not lost already.  A sensor
+    hold names them all, and waits for them all unless every one is judged;
+    a degraded stop counts them all: the way home may need a sensor the
+    present phase does not (the back pair, from ascent 7 of a step, finds
+    the edges of the way down), and one that does not come back in the
+    hold's wait is as lost as a sensor the phase needs."""
+    known = ctx.limp.lost if ctx.limp is not None else ()
+    sensors = snap.sensors
+    return [*errors, *(s for s in _DISTANCE if s not in errors and s.value not in known
+                       and sensors[s].status is SensorStatus.ERROR)]
 
 
 def degraded_stop(ctx: Context, snap: Snapshot, phase: Phase, errors: Sequence[SensorId],
                   failed: str, *, mode: Mode, consent: bool, tilt_watched: bool,
                   biased: Sequence[SensorId] = ()) -> limp.DegradedStop | None:
-    """What follows the loss of the sensors ``errors`` in ``phase`` (``failed``
-    says what they report; ``biased``: those judged biased,
+    """What follows the loss of the sensors ``errors`` in ``phase`` (every
+    distance sensor that reads as ERROR: :func:`every_error`; ``failed`` says
+    what they report; ``biased``: those judged biased,
     :mod:`~stairbot.control.algorithm.bias`): None on the floor where the
     program began (the run ends on the sensor error, as it always has), else
     a degraded stop whose ``then`` says whether the robot limps home."""
