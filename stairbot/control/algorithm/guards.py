@@ -130,11 +130,12 @@ def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
         # reads no distance there is no flight (the landing is refused, the
         # robot goes home), not a reason to end the program on the landing.
         return ()
-    if phase.flow != "calibration" or ctx.number_of_steps > 0:
-        # Past the start's calibration the way home needs both pairs (the
-        # front reads the risers and treads, the back finds each edge): a
-        # sensor lost where the phase reads only the other pair stands the
-        # robot there, not a step or a flight later where it is read.
+    if phase.flow == "ascent" or ctx.number_of_steps > ctx.steps_descended:
+        # From the approach until the last step is come down, the way home
+        # needs both pairs (the front reads the risers and treads, the back
+        # finds each edge): a sensor lost where the phase reads only the
+        # other pair stands the robot there, not a step or a flight later
+        # where it is read.  On the floor at either end the phase's own.
         return FRONT_SENSORS + BACK_SENSORS
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
