@@ -223,7 +223,7 @@ class Controller:
         return self._timeout if self._ctx.limp is None else self._timeout / limp.LIMP_SPEED
 
     def _present(self) -> tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]]:
-        """The present phase, its record and :func:`_needed_sensors`, looked up
+        """The present phase, its record and :func:`guards.needed_sensors`, looked up
         again only when the phase, the one a pause resumes or the lost change."""
         ctx = self._ctx
         key = (ctx.phase, ctx.resume_phase, 0 if ctx.limp is None else len(ctx.limp.lost))

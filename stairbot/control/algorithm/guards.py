@@ -112,7 +112,9 @@ def check_restored(ctx: Context) -> None:
 
 def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     """The sensors whose ERROR status (errors, or stale) stands the robot in
-    ``phase``, and ends the program if it lasts."""
+    ``phase``, and ends the program if it lasts.  What it reads of ``ctx``
+    (the steps climbed and come down, the lost, a pause) changes only with
+    the phase or the lost, when the controller asks again."""
     if phase is Phase.PAUSED and ctx.pause is not None:
         phase = Phase(ctx.pause.resume_phase)
     if phase.terminal:
