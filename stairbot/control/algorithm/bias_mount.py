@@ -60,10 +60,9 @@ def _named(mount: MountHeights, disagree: float, match: float,
             (SensorId.SBL, SensorId.SBR, last[1], last[0], mount.tails[1]),
             (SensorId.SBR, SensorId.SBL, last[0], last[1], mount.tails[0])):
         said = signed(disagree, sensor)
-        by_tail = not near and tail is not None and tail[1] <= threshold / 2
-        if by_tail:
-            assert tail is not None
-            off, near = tail[0], True
+        by_tail = False
+        if not near and tail is not None and tail[1] <= threshold / 2:
+            off, near, by_tail = tail[0], True, True
         # a clamp says the sensor read at least that short: a partner a few
         # millimetres off its mount height (a sonar's 3 mm steps) still held
         held = abs(p_off) <= threshold / 2 or (near and abs(p_off) <= min(threshold, -off / 4))

@@ -16,6 +16,7 @@ from stairbot.control.algorithm.transitions import BACK_PAIR_PHASES
 from stairbot.errors import InputError
 from stairbot.hardware import (
     BACK_SENSORS,
+    BASE_SENSORS,
     FRONT_SENSORS,
     LIFT_MOTORS,
     MotorId,
@@ -126,7 +127,7 @@ def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
     if ctx.from_top and phase.flow != "ascent":
         return BACK_SENSORS  # a continuous descent steers by the back pair alone
     if phase in _EDGE_WATCH:
-        return FRONT_SENSORS + BACK_SENSORS
+        return BASE_SENSORS
     if phase is Phase.LANDING_SCAN:
         # The scan moves segment 3 alone, and steers nothing: a side pair that
         # reads no distance there is no flight (the landing is refused, the
@@ -138,7 +139,7 @@ def needed_sensors(phase: Phase, ctx: Context) -> tuple[SensorId, ...]:
         # finds each edge): a sensor lost where the phase reads only the
         # other pair stands the robot there, not a step or a flight later
         # where it is read.  On the floor at either end the phase's own.
-        return FRONT_SENSORS + BACK_SENSORS
+        return BASE_SENSORS
     return BACK_SENSORS if phase in BACK_PAIR_PHASES else FRONT_SENSORS
 
 

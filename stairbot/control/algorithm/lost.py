@@ -14,9 +14,7 @@ from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.phase import Step, Tick, go, where
 from stairbot.control.algorithm.phases import BY_VALUE, Mode, Phase
 from stairbot.control.algorithm.texts import limp as say
-from stairbot.hardware import BACK_SENSORS, FRONT_SENSORS, SensorId, SensorStatus, Snapshot
-
-_DISTANCE = FRONT_SENSORS + BACK_SENSORS
+from stairbot.hardware import BASE_SENSORS, SensorId, SensorStatus, Snapshot
 
 
 def every_error(ctx: Context, snap: Snapshot, errors: Sequence[SensorId]) -> list[SensorId]:
@@ -30,7 +28,7 @@ def every_error(ctx: Context, snap: Snapshot, errors: Sequence[SensorId]) -> lis
     hold's wait is as lost as a sensor the phase needs."""
     known = ctx.limp.lost if ctx.limp is not None else ()
     sensors = snap.sensors
-    return [*errors, *(s for s in _DISTANCE if s not in errors and s.value not in known
+    return [*errors, *(s for s in BASE_SENSORS if s not in errors and s.value not in known
                        and sensors[s].status is SensorStatus.ERROR)]
 
 
