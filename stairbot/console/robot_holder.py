@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
+from urllib.parse import urlsplit
 
 from stairbot.console.climb_gate import MidClimb, from_journal
 from stairbot.console.freshness import POLL_PERIOD_S
@@ -37,9 +38,14 @@ if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
     from stairbot.recording.mcap_sink import McapRecord
 
 LATCH_HINT = "EMERGENCY STOP latched — c clears it (after you look at the robot)"
+NO_ROBOT_STOPPED = ("no robot connected: nothing was stopped — the console's stop is latched "
+                    "for any robot opened until c clears it")
 
 SPEEDS: dict[str, float | None] = {"1x": 1.0, "10x": 10.0, "max": None}
 """Simulation speeds the operator can pick: sim seconds per wall second."""
+IDLE_CATCH_UP_S = 2.0
+"""The most robot time one idle read of a simulation passes (a console
+that was busy or asleep does not simulate all it missed)."""
 
 OpenFn = Callable[[str, RobotConfig, Scenario, RobotOptions], RobotSession]
 
@@ -76,6 +82,7 @@ class RobotHolder:
         self._poller: threading.Thread | None = None
         self._closing = threading.Event()
         self._poll_fault: str | None = None  # why the last idle read failed
+        self._idle_at: float | None = None  # wall time of the last idle read of a simulation
         self._opening = False
         self.mid_climb: MidClimb | None = None
         """The robot may stand part way up (stairbot.console.climb_gate): no
@@ -134,6 +141,10 @@ class RobotHolder:
         self.close()
         self._poll_fault = None
         self.limp_offer = None  # the program it belongs to ran on the robot closed
+        # the robot being opened, before it answers: a refused one is not taken
+        # for a simulation, nor shown with the closed one's readings
+        simulated = urlsplit(url).scheme == "sim"
+        self.state.set_robot(url, scenario.name, simulated, wired=not simulated)
         self.state.set_status(robot="connecting", message=f"opening {url}", severity="info")
         try:
             session = self._open_fn(url, self.config, scenario,
@@ -216,8 +227,10 @@ class RobotHolder:
         reason, once; one that works again after that makes it READY."""
         robot = self.robot
         if robot is None or self.running or self._opening:
+            self._idle_at = None
             return
         try:
+            self._pass_idle_time()
             robot.read()
         except Exception as exc:  # noqa: BLE001 - a failing read is news, not a crash
             if self.running or robot is not self.robot:
@@ -233,6 +246,24 @@ class RobotHolder:
             self.state.set_status(robot="ready", severity="warning",
                                   message="the robot answers again")
             self.state.note("the robot answers again", "warning")
+
+    def _pass_idle_time(self) -> None:
+        """A simulation's time goes on while no run does, as a robot's would:
+        its physics runs, every motor stopped and the lifts holding, for the
+        wall time since the last idle read at the chosen speed (1x at max),
+        at most IDLE_CATCH_UP_S.  So an idle read says what the robot does
+        now -- its motors still, not their speeds when the last run stopped."""
+        clock = self.clock
+        if clock is None or not self.in_process:
+            return
+        now = self._wall()
+        last, self._idle_at = self._idle_at, now
+        if last is None:
+            return
+        tick = self.config.algorithm.tick
+        due = min((now - last) * (SPEEDS[self._speed] or 1.0), IDLE_CATCH_UP_S)
+        for _ in range(int(due / tick + 1e-9)):
+            clock.idle(tick)
 
     def close(self) -> None:
         """Stop and release the robot (never raises)."""

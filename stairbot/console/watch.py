@@ -219,6 +219,13 @@ class PacedClock:
         with self._lock:
             return self.inner.now()
 
+    def idle(self, dt: float) -> None:
+        """Advance ``dt`` under the lock, unpaced: a simulation's time while no
+        run goes on (:meth:`~stairbot.console.robot_holder.RobotHolder.poll`)."""
+        with self._lock:
+            self.inner.advance(dt)
+        self._anchor = None
+
     def advance(self, dt: float) -> None:
         with self._lock:
             self.inner.advance(dt)

@@ -14,10 +14,12 @@ from __future__ import annotations
 from rich.text import Text
 from textual.widgets import Static
 
-from stairbot.console.freshness import age_key, is_stale, titled
+from stairbot.console.freshness import age_key, is_stale, titled, without_status
 from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, Snapshot, Speeds
 
-STILL = 1e-3  # turns/s below which a motor counts as stopped
+STILL = 0.05
+"""Turns/s below which a motor shows as stopped: what its speed shows at one
+decimal (``+0.0``), so the arrow and the figure never disagree."""
 NAMES = {MotorId.MWF: "front wheels", MotorId.MWB: "back wheels",
          MotorId.MWR: "mid wheels R", MotorId.MWL: "mid wheels L",
          MotorId.MTF: "front lift", MotorId.MTB: "back lift"}
@@ -49,17 +51,23 @@ def direction(motor: MotorId, speed: float,
 
 
 def motor_line(motor: MotorId, state: MotorState | None, commanded: float | None,
-               carried_by: tuple[int, ...] = ()) -> Text:
+               carried_by: tuple[int, ...] = (), stale: bool = False) -> Text:
     """``front lift   MTF 1▲ +10.0    95.0``: name, seed name, direction,
-    speed (turns/s), turn counter; then a fault or the commanded speed."""
+    speed (turns/s), turn counter; then a fault or the commanded speed.
+    ``stale``: the values are old (:mod:`~stairbot.console.freshness`): no
+    arrow (``?``: how it moves now is not known), no colour, no command."""
     line = Text(f"{NAMES[motor]:<12} ", style="bold")
     line.append(f"{motor.value} ", "dim")
     if state is None:
         line.append("—", "dim")
         return line
+    if stale:
+        speed = state.speed_tps if abs(state.speed_tps) >= STILL else 0.0
+        line.append(f"? {speed:+5.1f} {state.turns:7.1f}")
+        return without_status(line)
     glyph, style = direction(motor, state.speed_tps, carried_by)
     line.append(f"{glyph:<2}", style)
-    speed = state.speed_tps if abs(state.speed_tps) >= 0.05 else 0.0  # no "-0.0"
+    speed = state.speed_tps if abs(state.speed_tps) >= STILL else 0.0  # no "-0.0"
     line.append(f" {speed:+5.1f} {state.turns:7.1f}")
     if state.fault:
         line.append(f" {state.fault}", "bold red")
@@ -88,8 +96,10 @@ class MotorPanel(Static):
             return
         self._last = key
         self.border_title = titled("motors  turn/s  turns", age_s)
-        self.set_class(is_stale(age_s), "-stale")
+        stale = is_stale(age_s)
+        self.set_class(stale, "-stale")
         self.update(Text("\n").join(
-            motor_line(m, motors.get(m), commands.get(m) if commands else None, carried_by)
+            motor_line(m, motors.get(m), commands.get(m) if commands else None, carried_by,
+                       stale)
             for m in MotorId
         ))
