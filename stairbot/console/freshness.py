@@ -41,3 +41,9 @@ def titled(name: str, age_s: float | None) -> Text:
     out = Text(f"{name} · ")
     out.append(age_words(age_s), "bold red" if is_stale(age_s) else "dim")
     return out
+
+
+def without_status(text: Text) -> Text:
+    """``text`` all dim, its colours gone: a stale panel's values say nothing
+    about now, so no green "ok", red "DIFFER" or bold figure may look live."""
+    return Text(text.plain, style="dim", no_wrap=text.no_wrap, overflow=text.overflow)

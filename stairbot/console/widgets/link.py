@@ -10,7 +10,7 @@ from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
-from stairbot.console.freshness import age_key, is_stale, titled
+from stairbot.console.freshness import age_key, is_stale, titled, without_status
 
 SPEED_NAMES = {"1x": "1×", "10x": "10×", "max": "max"}
 ERROR_KEYS = ("crc_errors", "malformed", "stray", "error_frames")
@@ -80,7 +80,8 @@ class LinkPanel(Static):
         if key == self._last:
             return
         self._last = key
-        self.set_class(is_stale(age_s), "-stale")
+        stale = is_stale(age_s)
+        self.set_class(stale, "-stale")
         if in_process:
             self.border_title = titled("recorded simulation" if replay else "simulation",
                                        age_s)
@@ -88,8 +89,9 @@ class LinkPanel(Static):
             out.append("—" if time_s is None else f"{time_s:7.1f} s")
             out.append("  replay " if replay else "  speed ", "dim")
             out.append(SPEED_NAMES.get(speed, speed), "bold")
-            self.update(out)
+            self.update(without_status(out) if stale else out)
         else:
             self.border_title = titled("recorded link health" if replay else "link health",
                                        age_s)
-            self.update(Group(*health_text(health)))
+            lines = health_text(health)
+            self.update(Group(*(without_status(line) for line in lines) if stale else lines))

@@ -21,7 +21,7 @@ from __future__ import annotations
 from rich.text import Text
 from textual.widgets import Static
 
-from stairbot.console.freshness import STALE_S, age_key, is_stale, titled
+from stairbot.console.freshness import STALE_S, age_key, is_stale, titled, without_status
 from stairbot.hardware import SIDE_SENSORS, SensorId, SensorReading, SensorStatus, Snapshot
 
 PAIRS = ((SensorId.SFR, SensorId.SFL), (SensorId.SBR, SensorId.SBL))
@@ -122,10 +122,13 @@ class SensorPanel(Static):
             return
         self._last = key
         self.border_title = titled(f"sensors ±{self.tolerance * 1000:.0f} mm", age_s)
-        self.set_class(is_stale(age_s), "-stale")
+        stale = is_stale(age_s)
+        self.set_class(stale, "-stale")
         lines = []
         for a, b in PAIRS:
             top, bottom = pair_verdict(sensors.get(a), sensors.get(b), self.tolerance)
+            if stale:  # whether the pair agrees now is not known
+                top, bottom = Text("—"), Text()
             gone = [s for s in (a, b) if s.value in lost]
             if len(gone) == 1:  # the pair runs on its survivor
                 survivor = b if gone[0] is a else a
@@ -137,4 +140,6 @@ class SensorPanel(Static):
                 lines.append(line)
         if self.side_pair or any(s in sensors for s in SIDE_SENSORS):
             lines.append(_side_line(sensors))
+        if stale:
+            lines = [without_status(line) for line in lines]
         self.update(Text("\n").join(lines))
