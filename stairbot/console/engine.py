@@ -20,7 +20,13 @@ from typing import TypedDict
 from stairbot.console import limp_gate
 from stairbot.console.climb_gate import MidClimb, after_run
 from stairbot.console.limp_gate import LimpOffer
-from stairbot.console.robot_holder import LATCH_HINT, OpenFn, RobotHolder, default_open
+from stairbot.console.robot_holder import (
+    LATCH_HINT,
+    NO_ROBOT_STOPPED,
+    OpenFn,
+    RobotHolder,
+    default_open,
+)
 from stairbot.console.state import LiveState
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.algorithm.lost import awaits_consent
@@ -309,13 +315,21 @@ class ConsoleEngine(RobotHolder):
         too, holds the program and does not repeat it).  ``why``: what the
         operator did (the key, "quit pressed mid-run"), for the event list.
         Safe from any thread."""
+        robot = self.robot
+        if robot is None:
+            # nothing to stop: the console's latch alone, for any robot opened next
+            self.state.set_status(estopped=True, paused=False, severity="error",
+                                  message=NO_ROBOT_STOPPED, latch="operator")
+            self._say(Event(self._now(), EventKind.WARNING, "emergency stop pressed with "
+                            "no robot connected: nothing was stopped"
+                            + (f" ({why})" if why else "")))
+            return
         self.state.set_status(estopped=True, paused=self.running, severity="error",
                               message=LATCH_HINT, latch="operator")
-        if self.robot is not None:
-            # The boards' estop() puts the stop on the wire at once, then waits
-            # for their confirmation (a few ms; at most half a second, after
-            # which a LINK event names the board that did not confirm).
-            self.robot.estop()
+        # The boards' estop() puts the stop on the wire at once, then waits for
+        # their confirmation (a few ms; at most half a second, after which a
+        # LINK event names the board that did not confirm).
+        robot.estop()
         if self.control is not None and self.running:
             self.control.estop()
         self._say(Event(self._now(), EventKind.WARNING, "emergency stop by the operator"
