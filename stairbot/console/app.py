@@ -26,7 +26,7 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widget import Widget
-from textual.widgets import Footer
+from textual.widgets import Footer, Static
 
 from stairbot.console import choices, limp_question, motion_gate, paint
 from stairbot.console.engine import ConsoleEngine, EngineHooks
@@ -116,6 +116,9 @@ class StairbotConsole(App[None]):
         self.log_panel = EventLog(id="log")
         self.trends = TrendsPanel(engine.config.motors.lift_travel_per_turn,
                                   side_pair=side_pair, id="trends")
+        self.main_area = Horizontal(id="main")
+        self.small_notice = Static(id="too-small", markup=False)
+        """Says the terminal is too small, in the panels' place (paint.lay_out)."""
         self.screen_rows: int | None = None  # the screen's height, as the last resize said
         self.graphs: bool | None = None
         """The operator's choice of graphs (g); None: by the screen's size."""
@@ -125,7 +128,8 @@ class StairbotConsole(App[None]):
         with Horizontal(id="top"):
             yield self.banner
             yield self.top_right()
-        with Horizontal(id="main"):
+        yield self.small_notice
+        with self.main_area:
             with Vertical(id="left"):
                 yield self.picture
                 yield self.top_view
@@ -147,7 +151,8 @@ class StairbotConsole(App[None]):
         return EStopButton(id="estop")
 
     def on_resize(self, event: events.Resize) -> None:
-        paint.lay_out(self, event.size.height)  # before the app's own size follows
+        # before the app's own size follows
+        paint.lay_out(self, event.size.height, event.size.width)
 
     def on_mount(self) -> None:
         # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):

@@ -12,6 +12,9 @@ POLL_PERIOD_S = 0.5
 """Seconds between reads of an idle robot (no run going): sensors and link."""
 STALE_S = 3 * POLL_PERIOD_S
 """Values read longer ago than this are stale."""
+STILL_TPS = 0.05
+"""Turns/s below which a motor reads as stopped: what its speed shows at one
+decimal (``+0.0``)."""
 
 
 def is_stale(age_s: float | None) -> bool:

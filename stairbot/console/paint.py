@@ -14,6 +14,7 @@ from rich.text import Text
 from stairbot.console.freshness import age_words, is_stale
 from stairbot.console.limp_gate import limping_words
 from stairbot.console.state import StateView
+from stairbot.console.widgets.banner import liveness
 from stairbot.console.words import carried_by
 from stairbot.hardware import MotorId
 from stairbot.views.reckon import dead_reckon
@@ -32,10 +33,32 @@ def tall(app: StairbotConsole, rows: int | None = None) -> bool:
     return (app.size.height if rows is None else rows) >= GRAPHS_ROWS
 
 
-def lay_out(app: StairbotConsole, rows: int | None = None) -> None:
+MIN_COLUMNS, MIN_ROWS = 80, 24
+"""The smallest screen the panels fit: on a smaller one they give way to a
+notice that says so (a cut panel would hide a status, a speed, a key)."""
+
+
+def too_small(columns: int, rows: int) -> str:
+    """What the notice says on a ``columns`` x ``rows`` screen ("": it fits)."""
+    if columns >= MIN_COLUMNS and rows >= MIN_ROWS:
+        return ""
+    return (f"The terminal is too small: {columns}x{rows}; the console needs "
+            f"{MIN_COLUMNS}x{MIN_ROWS}.  Make it larger to see the robot.\n"
+            "space: EMERGENCY STOP (every motor, now)   q: quit   x: stop the run")
+
+
+def lay_out(app: StairbotConsole, rows: int | None = None,
+            columns: int | None = None) -> None:
     """Show the graphs under the picture on a tall screen (``rows``: its
     height, None: the app's); on a smaller one in the picture's place,
-    and only while the operator wants them."""
+    and only while the operator wants them.  Below MIN_COLUMNS x MIN_ROWS
+    (``columns``: its width, None: the app's) the panels give way to the
+    too-small notice."""
+    small = too_small(app.size.width if columns is None else columns,
+                      app.size.height if rows is None else rows)
+    app.main_area.display = not small
+    app.small_notice.display = bool(small)
+    app.small_notice.update(small)
     is_tall = tall(app, rows)
     app.screen_rows = rows if rows is not None else app.size.height
     wanted = is_tall if app.graphs is None else app.graphs
@@ -49,10 +72,12 @@ def lay_out(app: StairbotConsole, rows: int | None = None) -> None:
 
 def show(app: StairbotConsole, v: StateView) -> None:
     """Every panel, from ``v`` (a copy of the live state)."""
-    app.banner.show(v.url, v.scenario, v.status, v.recording,
-                    limping_words(v.limping) if v.limping else "")
-    picture = app.picture
     age = v.read_age_s
+    app.banner.show(v.url, v.scenario, v.status, v.recording,
+                    limping_words(v.limping) if v.limping else "",
+                    "" if app.replaying else liveness(age, v.status), v.boards,
+                    replay=app.replaying)
+    picture = app.picture
     # never markup: the URL may hold brackets; with a landing, the frame it is in
     framed = v.top.flight if v.top is not None and v.plan and v.plan.landing else None
     title = Text("side view · " if framed is None else f"side view, flight {framed} · ")

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from stairbot.console.climb_gate import MidClimb, from_journal
-from stairbot.console.freshness import POLL_PERIOD_S
+from stairbot.console.freshness import POLL_PERIOD_S, STILL_TPS
 from stairbot.console.limp_gate import LimpOffer
 from stairbot.console.state import LiveState
 from stairbot.console.watch import PacedClock, WatchedRobot, watch
@@ -56,6 +56,15 @@ def default_open(url: str, config: RobotConfig, scenario: Scenario,
     from stairbot.run.robots import open_robot
 
     return open_robot(url, config, replace(options, world=scenario))
+
+
+def boards_words(identity: dict[str, dict[str, int]] | None) -> str:
+    """``motor #4660 · sensor #22136``: each board and its serial number
+    ("": no boards, a simulation)."""
+    if not identity:
+        return ""
+    return " · ".join(f"{name} #{ident.get('serial', '?')}"
+                      for name, ident in sorted(identity.items()))
 
 
 class RobotHolder:
@@ -198,8 +207,9 @@ class RobotHolder:
             return
         self.robot.refresh_scene()
         # boards: their journal says whether an earlier host left them mid-climb
-        self.mid_climb = None if sim is not None else from_journal(
-            default_path(url), self.robot.identity())
+        identity = self.robot.identity()
+        self.mid_climb = None if sim is not None else from_journal(default_path(url), identity)
+        self.state.set_boards(boards_words(identity))
         latched = self.latched
         self.state.set_status(robot="ready", paused=False,
                               message=LATCH_HINT if latched else "",
@@ -235,7 +245,8 @@ class RobotHolder:
         except Exception as exc:  # noqa: BLE001 - a failing read is news, not a crash
             if self.running or robot is not self.robot:
                 return  # a run or another robot took over meanwhile
-            why = f"no reading from {self.state.view().url}: {exc}"
+            # the driver's message names the port; the banner's strip, the URL
+            why = f"no reading from the robot: {exc}"
             if why != self._poll_fault:
                 self._poll_fault = why
                 self.state.set_status(robot="fault", severity="error", message=why)
@@ -248,13 +259,18 @@ class RobotHolder:
             self.state.note("the robot answers again", "warning")
 
     def _pass_idle_time(self) -> None:
-        """A simulation's time goes on while no run does, as a robot's would:
-        its physics runs, every motor stopped and the lifts holding, for the
-        wall time since the last idle read at the chosen speed (1x at max),
-        at most IDLE_CATCH_UP_S.  So an idle read says what the robot does
-        now -- its motors still, not their speeds when the last run stopped."""
+        """While a simulation's motors still read as moving (a run stopped
+        mid-motion), its time goes on with no run, as a robot's would: its
+        physics runs, every motor stopped and the lifts holding, for the wall
+        time since the last idle read at the chosen speed (1x at max), at most
+        IDLE_CATCH_UP_S.  So an idle read says what the robot does now -- its
+        motors still, not their speeds when the run stopped.  A simulation at
+        rest stays as it is (a run started from it is the headless run's)."""
         clock = self.clock
-        if clock is None or not self.in_process:
+        snap = self.state.view().snapshot
+        if clock is None or not self.in_process or snap is None or all(
+                abs(m.speed_tps) < STILL_TPS for m in snap.motors.values()):
+            self._idle_at = None
             return
         now = self._wall()
         last, self._idle_at = self._idle_at, now

@@ -81,6 +81,9 @@ class StateView:
     limp_end: str = ""
     """How the program that limped home ended (its END's outcome,
     "came_home_degraded" or another); "": it has not."""
+    boards: str = ""
+    """The boards' identity (``motor #12 · sensor #34``; "": not a robot on a
+    wire, or not known yet)."""
 
 
 class LiveState:
@@ -115,6 +118,7 @@ class LiveState:
         self._result: RunResult | None = None
         self._speed = "max"
         self._recording: str | None = None
+        self._boards = ""
         self._events: deque[tuple[int, Event]] = deque(maxlen=LOG_LENGTH)
         self._event_seq = 0
         self._history = History()
@@ -142,6 +146,13 @@ class LiveState:
             self._scene, self._stairs, self._health, self._result = None, stairs, {}, None
             self._history.clear()
             self._degraded, self._limping, self._limp_end = None, (), ""
+            self._boards = ""
+            self._bump()
+
+    def set_boards(self, boards: str) -> None:
+        """The opened boards' identity, as the banner shows it."""
+        with self._lock:
+            self._boards = boards
             self._bump()
 
     def rename(self, url: str, scenario: str, stairs: tuple[tuple[float, float], ...]) -> None:
@@ -305,4 +316,5 @@ class LiveState:
                 degraded=self._degraded,
                 limping=self._limping,
                 limp_end=self._limp_end,
+                boards=self._boards,
             )

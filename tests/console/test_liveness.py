@@ -21,11 +21,12 @@ from typing import Any
 
 import pytest
 from lockstep_boards import stairbot
-from pilot import banner, press, ready, said, shown, until
+from pilot import banner, press, ready, said, say_yes, shown, until
 from still_robot import StillClock, StillRobot, make_still_app
 
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.modals import ConfirmScreen
+from stairbot.console.widgets.banner import message_text
 from stairbot.hardware import Imu, Snapshot
 from stairbot.run.robots import RobotSession
 
@@ -84,7 +85,7 @@ def test_boards_killed_mid_run_are_a_fault_with_the_drivers_reason(
             await ready(pilot)
             await press(pilot, "s")
             await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
-            await press(pilot, "y")
+            await say_yes(pilot)
 
             def ticks() -> int:
                 return app.state.view().ticks
@@ -122,7 +123,7 @@ def test_an_automatic_stop_says_why_and_is_not_an_operator_stop() -> None:
             await ready(pilot)
             await press(pilot, "s")  # a robot without an in-process world: it asks
             await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
-            await press(pilot, "y")
+            await say_yes(pilot)
             await until(pilot, lambda: "E-STOP" in banner(app), "the stop")
             await until(pilot, lambda: not app.engine.running, "the run ends")
             text = banner(app)
@@ -160,10 +161,13 @@ def test_a_bad_port_at_start_shows_its_whole_reason_and_keeps_it() -> None:
             assert message.startswith(f"cannot open {url}: ")
             assert message.endswith("No such file or directory: "
                                     "'/dev/stairbot-test-no-such-port'")
+            # whole, wrapped under the strip, which holds the URL
+            reason = " ".join(message_text(url, message).plain.split())
+            assert reason.startswith("cannot open the robot: cannot open port")
             on_screen = " ".join(shown(app.banner).split())
-            assert " ".join(message.split()) in on_screen  # whole, wrapped
-            assert message in said(app)  # and kept in the event list
+            assert reason in on_screen
+            assert message in said(app)  # and kept in the event list, URL and all
             app.clear_notifications()  # the toast gone, the reason stays
             await pilot.pause(0.2)
-            assert " ".join(message.split()) in " ".join(shown(app.banner).split())
+            assert reason in " ".join(shown(app.banner).split())
     asyncio.run(go())

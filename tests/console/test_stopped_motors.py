@@ -52,11 +52,26 @@ def test_an_idle_simulation_reads_its_motors_stopped_after_a_stop() -> None:
     engine.close()
 
 
+def stopped_mid_motion(wall: Wall) -> ConsoleEngine:
+    """A console whose simulation's wheels were driving when they stopped."""
+    config = load_config()
+    engine = ConsoleEngine(LiveState(), config, wall=wall, sleep=lambda _s: None)
+    engine.open("sim://", None)
+    robot, clock = engine.robot, engine.clock
+    assert robot is not None and clock is not None
+    robot.command({m: 1.0 for m in (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL)})
+    for _ in range(10):
+        robot.read()
+        clock.advance(config.algorithm.tick)
+    robot.read()
+    robot.stop_all()
+    return engine
+
+
 def test_an_idle_read_passes_at_most_a_bounded_time() -> None:
     """A console that was asleep for a minute does not simulate the minute."""
     wall = Wall()
-    engine = ConsoleEngine(LiveState(), load_config(), wall=wall, sleep=lambda _s: None)
-    engine.open("sim://", None)
+    engine = stopped_mid_motion(wall)
     engine.poll()
     before = engine.state.view().snapshot
     wall.t += 60.0
@@ -65,6 +80,34 @@ def test_an_idle_read_passes_at_most_a_bounded_time() -> None:
     assert before is not None and after is not None
     assert 0.0 < after.time_s - before.time_s <= 2.0 + 1e-9
     engine.close()
+
+
+def test_a_simulation_at_rest_stays_as_it_is() -> None:
+    """Once its motors read still, idle reads pass no more time: a run
+    started then is the run a headless `stairbot run` makes from there."""
+    wall = Wall()
+    engine = stopped_mid_motion(wall)
+    for _ in range(4):
+        engine.poll()
+        wall.t += 0.5
+    rest = engine.state.view().snapshot
+    assert rest is not None
+    assert all(abs(m.speed_tps) < 0.05 for m in rest.motors.values())
+    for _ in range(4):
+        engine.poll()
+        wall.t += 0.5
+    later = engine.state.view().snapshot
+    assert later is not None and later.time_s == rest.time_s
+    engine.close()
+
+    fresh = ConsoleEngine(LiveState(), load_config(), wall=wall, sleep=lambda _s: None)
+    fresh.open("sim://", None)
+    for _ in range(3):
+        fresh.poll()
+        wall.t += 0.5
+    snap = fresh.state.view().snapshot
+    assert snap is not None and snap.time_s == 0.0
+    fresh.close()
 
 
 @pytest.mark.parametrize("speed", [-0.02, 0.0, 0.049, -0.049])

@@ -1,23 +1,40 @@
-"""The banner: which robot, the run's state, and the one thing the operator must
-know now (an emergency stop, a lost link, how the run ended)."""
+"""The banner: its first line a strip that says which robot and whether it is
+live, always (the run's state and latch, then LIVE/DOWN and the age of the
+last reading, the boards, the URL: cut at the screen's edge, never wrapped);
+under it, while there is one, the one thing the operator must know now (an
+emergency stop, a lost link, how the run ended), whole up to four lines."""
 
 from __future__ import annotations
 
+from rich.console import Group
 from rich.text import Text
 from textual.widgets import Static
 
+from stairbot.console.freshness import is_stale
 from stairbot.console.state import RunStatus
 
 SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
 
 
-def banner_text(url: str, scenario: str, status: RunStatus,
-                recording: str | None = None, degraded: str = "") -> Text:
-    """`` FAULT  E-STOP (automatic)  why...``: the robot's state, the latch and
-    who set it, ``DEGRADED`` and how (``degraded``: the run limps home, or
-    came home so), then the one thing to know now (whole: the banner wraps)."""
+def liveness(age_s: float | None, status: RunStatus) -> str:
+    """``LIVE 0.2 s``, ``DOWN 12 s`` (nothing read for longer than a stale
+    value's age, or the robot at fault), ``NOT READ`` (nothing read yet)."""
+    if age_s is None:
+        return "NOT READ"
+    shown = f"{age_s:.1f} s" if age_s < 10 else f"{age_s:.0f} s"
+    if is_stale(age_s) or status.robot == "fault":
+        return f"DOWN {shown}"
+    return f"LIVE {shown}"
+
+
+def strip_text(url: str, scenario: str, status: RunStatus, recording: str | None = None,
+               degraded: str = "", link: str = "", boards: str = "") -> Text:
+    """`` FAULT  E-STOP (automatic) · DOWN 12 s · motor #12 · serial://...``:
+    the robot's state, the latch and who set it, ``DEGRADED`` and how
+    (``degraded``: the run limps home, or came home so), the link's word
+    (:func:`liveness`), the boards, the URL and scenario -- one line."""
     state = "PAUSED" if status.paused and status.robot == "running" else status.robot.upper()
-    out = Text(f" {state} ", "bold reverse")
+    out = Text(f" {state} ", "bold reverse", no_wrap=True, overflow="ellipsis")
     if status.estopped:
         who = status.latch.split(":", 1)[0] if status.latch else ""
         out.append(" ")
@@ -29,29 +46,70 @@ def banner_text(url: str, scenario: str, status: RunStatus,
     if degraded:
         out.append(" ")
         out.append(" DEGRADED ", "bold reverse")
-        out.append(f" {degraded} ·", "bold")
-    out.append(f" {status.message}" if status.message else f" {url or '—'} · {scenario}")
+        out.append(f" {degraded}", "bold")
+    if link:
+        out.append(" · ")
+        out.append(link, "bold")
+    if boards:
+        out.append(f" · {boards}")
+    out.append(f" · {url or '—'}" + (f" · {scenario}" if scenario else ""))
     return out
 
 
-class Banner(Static):
-    """One line, coloured by severity; red while the emergency stop is set."""
+def message_text(url: str, message: str) -> Text:
+    """The message with the URL (which the strip shows) said as "the robot",
+    once: a long URL must not hide the reason (``no reading from the robot:
+    URL: link lost`` reads ``no reading from the robot: link lost``)."""
+    if url:
+        message = message.replace(f": {url}: ", ": ").replace(url, "the robot")
+    return Text(f" {message}")
 
-    DEFAULT_CSS = "Banner { height: auto; max-height: 6; width: 1fr; }"
+
+class Banner(Static):
+    """The strip, and the message under it; coloured by severity, red while
+    the emergency stop is set."""
+
+    DEFAULT_CSS = "Banner { height: auto; max-height: 5; width: 1fr; }"
 
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id)
         self._last: object = None
         self.plain = ""  # the text shown, for tests and logs
+        self.strip = ""  # its first line
 
-    def show(self, url: str, scenario: str, status: RunStatus,
-             recording: str | None = None, degraded: str = "") -> None:
-        key = (url, scenario, status, recording, degraded)
+    def show(self, url: str, scenario: str, status: RunStatus, recording: str | None = None,
+             degraded: str = "", link: str = "", boards: str = "", replay: bool = False) -> None:
+        """``replay``: a recording played back -- no robot, so no strip: the
+        state, then the message (the recording's place and source) as it is."""
+        width = self.content_region.width
+        key = (url, scenario, status, recording, degraded, link, boards, replay, width)
         if key == self._last:
             return
         self._last = key
-        text = banner_text(url, scenario, status, recording, degraded)
-        self.plain = text.plain
-        self.update(text)
+        if replay and status.message:
+            strip = strip_text("", "", status, recording, degraded)
+            strip.remove_suffix(" · —")
+            whole = strip.copy()
+            whole.no_wrap = False
+            whole.append(f" {status.message}")
+            self.strip, self.plain = strip.plain, whole.plain
+            self.update(whole)
+        else:
+            strip = strip_text(url, scenario, status, recording, degraded, link, boards)
+            self.strip = strip.plain
+            if not status.message:
+                self.plain = strip.plain
+                self.update(strip)
+            else:
+                message = message_text(url, status.message)
+                if 0 < strip.cell_len + 2 + message.cell_len <= width:  # one line holds both
+                    line = strip.copy()
+                    line.append(" │")
+                    line.append_text(message)
+                    self.plain = line.plain
+                    self.update(line)
+                else:
+                    self.plain = f"{strip.plain}\n{message.plain}"
+                    self.update(Group(strip, message))
         self.remove_class(*SEVERITY_CLASSES)
         self.add_class("-estop" if status.estopped else f"-{status.severity}")

@@ -14,10 +14,10 @@ from __future__ import annotations
 from rich.text import Text
 from textual.widgets import Static
 
-from stairbot.console.freshness import age_key, is_stale, titled, without_status
+from stairbot.console.freshness import STILL_TPS, age_key, is_stale, titled, without_status
 from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, Snapshot, Speeds
 
-STILL = 0.05
+STILL = STILL_TPS
 """Turns/s below which a motor shows as stopped: what its speed shows at one
 decimal (``+0.0``), so the arrow and the figure never disagree."""
 NAMES = {MotorId.MWF: "front wheels", MotorId.MWB: "back wheels",
