@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from stairbot.console.modals import AskScreen
+from stairbot.console.modals import AskScreen, Notice
 from stairbot.console.paint import lay_out, tall
 from stairbot.console.robot_holder import SPEEDS
 from stairbot.errors import InputError
@@ -20,9 +20,13 @@ if TYPE_CHECKING:
 SPEED_ORDER = tuple(SPEEDS)
 
 
+RUN_GOING_ON = ("A run is going on: {what} can be chosen once it has ended "
+                "(x stops it).")
+
+
 def choose_robot(app: StairbotConsole) -> None:
     if app.engine.running:
-        app.say("stop the run first (x)", severity="warning")
+        app.push_screen(Notice(RUN_GOING_ON.format(what="another robot")))
         return
 
     def chosen(url: str | None) -> None:
@@ -35,7 +39,7 @@ def choose_robot(app: StairbotConsole) -> None:
 
 def choose_scenario(app: StairbotConsole) -> None:
     if app.engine.running:
-        app.say("stop the run first (x)", severity="warning")
+        app.push_screen(Notice(RUN_GOING_ON.format(what="another scenario")))
         return
 
     def chosen(name: str | None) -> None:

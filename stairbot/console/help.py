@@ -63,13 +63,17 @@ KEYS
   Ctrl+P  every action by name
 
 READING THE SCREEN
-  Banner: the state (READY, RUNNING, PAUSED, ENDED, FAULT),
-  E-STOP and who latched it (operator, or automatic: why),
-  DEGRADED while a run limps home on the sensors that remain
-  (which is out, the survivor its pair runs on, the speed) and
-  after it, then what to know now, whole.
+  Banner, first line: the state (READY, RUNNING, PAUSED, ENDED,
+  FAULT), E-STOP and who latched it (operator, or automatic:
+  why), DEGRADED while a run limps home on the sensors that
+  remain (which is out, the survivor its pair runs on, the
+  speed) and after it, LIVE or DOWN and how long ago the robot
+  was read, the boards, the URL.  Under it: what to know now.
   Every panel says how old its values are; values not read for
-  1.5 s are dimmed and marked STALE: they are not live.
+  1.5 s are dimmed and marked STALE: they are not live (no
+  colour, no arrow: ? for a motor).
+  Questions that let the robot move take yes typed and Enter;
+  Escape answers no.
   Sensors: front R/L look ahead (SFR, SFL), back R/L look down
   (SBR, SBL); side R/L look right and left (SSR, SSL), on a
   robot with the side pair only; ok, out (of range: the value

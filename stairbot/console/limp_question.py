@@ -3,8 +3,9 @@ degraded stop (:mod:`stairbot.console.limp_gate` says when it can be).
 
 The question shows the stop plainly -- what failed, where the robot stands,
 the lifts holding, what limping home will do and at what speed -- and
-takes one of two answers: come home on the remaining sensors (y), which
-carries the same program on in this session, or stay stopped (n, Escape),
+takes one of two answers: come home on the remaining sensors (``yes``
+typed, then Enter: no stray key gives it), which carries the same program
+on in this session, or stay stopped (Escape),
 which leaves the robot stopped, lifts holding, the stop's emergency stop
 latched, and says how to bring it home later.  Space (the emergency stop)
 withdraws the question: the robot stays stopped.  Quitting leaves it
@@ -17,24 +18,22 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from textual.app import ComposeResult
-from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Label
 
 from stairbot.console import limp_gate
-from stairbot.console.modals import ConfirmScreen
+from stairbot.console.modals import MotionConfirm
 from stairbot.text import printable
 
 if TYPE_CHECKING:
     from stairbot.console.app import StairbotConsole
 
 
-class LimpQuestion(ConfirmScreen):
-    """Come home on the remaining sensors (True) or stay stopped (False); q
-    quits the console from here, the robot stopped (the run has ended)."""
-
-    BINDINGS = [Binding("q", "app.quit_console('q')", "quit")]
+class LimpQuestion(MotionConfirm):
+    """Come home on the remaining sensors (True: ``yes`` typed, then Enter) or
+    stay stopped (False: Escape); quitting from here (Escape, then q) leaves
+    the robot stopped (the run has ended)."""
 
     def on_mount(self) -> None:
         super().on_mount()
@@ -134,8 +133,8 @@ def ask(app: StairbotConsole) -> None:
             app.state.set_status(message=f"DEGRADED STOP, stays stopped, lifts holding; to "
                                  f"bring it home later: {later(app)}", severity="warning")
 
-    app.push_screen(LimpQuestion(question, yes="Come home on what remains (y)",
-                                 no="Stay stopped (n)"), answered)
+    app.push_screen(LimpQuestion(question, yes="Come home on what remains",
+                                 no="Stay stopped (Esc)"), answered)
 
 
 def withdraw(app: StairbotConsole) -> None:

@@ -1,4 +1,5 @@
-"""Small modal screens: a yes/no question and a one-line text prompt.  The
+"""Small modal screens: a yes/no question, one whose yes moves the robot
+(typed, not a key), and a one-line text prompt.  The
 emergency stop key (space) stays live over them: the app takes it before any
 screen or widget sees it, so a prompt cannot take a space (and says so)."""
 
@@ -28,8 +29,12 @@ class ConfirmScreen(ModalScreen[bool]):
                 yield Button(self.yes, variant="warning", id="yes", compact=True)
                 yield Button(self.no, variant="primary", id="no", compact=True)
 
+    FOCUS = "#no"
+    """What has the focus when the question opens (Textual calls each class's
+    on_mount: a subclass names its own here)."""
+
     def on_mount(self) -> None:
-        self.query_one("#no", Button).focus()
+        self.query_one(self.FOCUS).focus()
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         event.stop()
@@ -37,6 +42,39 @@ class ConfirmScreen(ModalScreen[bool]):
 
     def action_answer(self, yes: bool) -> None:
         self.dismiss(yes)
+
+
+class MotionConfirm(ConfirmScreen, inherit_bindings=False):
+    """A question whose yes lets the robot move: answered yes only by typing
+    ``yes`` and Enter, which no stray letter gives -- typed text (a URL typed
+    while a refusal showed) goes into the answer field, not to the console's
+    keys or the buttons.  Anything else entered says so and asks again;
+    Escape (or the No button) answers no."""
+
+    BINDINGS = [Binding("escape", "answer(False)", "no")]
+    FOCUS = "#answer"
+    WORD = "yes"
+
+    def __init__(self, question: str, yes: str = "Start", no: str = "No (Esc)") -> None:
+        super().__init__(question, yes, no)
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog"):
+            yield Label(self.question, classes="question", markup=False)
+            yield Input(placeholder=f"type {self.WORD} and Enter: {self.yes}", id="answer")
+            yield Label("Esc: no, nothing moves.", classes="hint", id="motion-hint",
+                        markup=False)
+            with Horizontal(classes="buttons"):
+                yield Button(self.no, variant="primary", id="no", compact=True)
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        if event.value.strip().lower() == self.WORD:
+            self.dismiss(True)
+            return
+        event.input.value = ""
+        self.query_one("#motion-hint", Label).update(
+            f"Not {self.WORD}: nothing moved.  Type {self.WORD} and Enter, or Esc.")
 
 
 class AskScreen(ModalScreen[str | None]):
@@ -101,3 +139,24 @@ class ChoiceScreen(ModalScreen[str | None]):
 
     def action_choose(self, key: str | None) -> None:
         self.dismiss(key)
+
+
+class Notice(ModalScreen[None]):
+    """Something the console will not do now, and why: Enter or Escape
+    closes it; every other key is taken and does nothing (text typed on
+    while it shows -- the URL the operator meant to enter -- runs no
+    command)."""
+
+    BINDINGS = [Binding("enter,escape", "close", "close")]
+
+    def __init__(self, text: str) -> None:
+        super().__init__()
+        self.text = text
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog"):
+            yield Label(self.text, classes="question", markup=False)
+            yield Label("Enter or Esc closes this", classes="hint")
+
+    def action_close(self) -> None:
+        self.dismiss(None)

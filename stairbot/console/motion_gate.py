@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from stairbot.console import limp_question
 from stairbot.console.climb_gate import MidClimb
 from stairbot.console.engine import MID_CLIMB_HINT
-from stairbot.console.modals import ChoiceScreen, ConfirmScreen
+from stairbot.console.modals import ChoiceScreen, ConfirmScreen, MotionConfirm
 from stairbot.console.robot_holder import LATCH_HINT
 from stairbot.errors import StairbotError
 
@@ -145,10 +145,10 @@ def _resume(app: StairbotConsole, mode: str) -> None:
             app.say("not resumed: nothing moved")
 
     lines = "\n".join(plan.lines)
-    app.push_screen(ConfirmScreen(
+    app.push_screen(MotionConfirm(
         f"Resume on {plan.state.start.get('url')}:\n{lines}\n\nLook at the robot: does "
         "it stand where these lines say?  Resume and let it move?  Space stops every "
-        "motor.", yes="Yes, resume (y)"), answered)
+        "motor.", yes="Resume"), answered)
 
 
 def pause(app: StairbotConsole) -> None:
@@ -181,9 +181,9 @@ def after_consent(app: StairbotConsole, what: str, go: Callable[[], object]) -> 
         else:
             app.say("nothing moved")
 
-    app.push_screen(ConfirmScreen(
+    app.push_screen(MotionConfirm(
         f"{what} on {session.url}?\n{boards}\n"
-        "The motors will move. Space stops every motor."), answered)
+        "The motors will move. Space stops every motor.", yes=what), answered)
 
 
 def quit_console(app: StairbotConsole, key: str = "q") -> None:

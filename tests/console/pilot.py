@@ -45,6 +45,12 @@ def banner(app: StairbotConsole) -> str:
     return app.banner.plain
 
 
+async def say_yes(pilot: Any) -> None:
+    """Answer a question that lets the robot move (MotionConfirm): type
+    ``yes`` into it, then Enter."""
+    await press(pilot, "y", "e", "s", "enter")
+
+
 async def ready(pilot: Any) -> None:
     await pilot.app.workers.wait_for_complete()
     await until(pilot, lambda: "READY" in banner(pilot.app), "the robot is ready")

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from pilot import SpyRobot, banner, press, ready, spied_open, until
+from pilot import SpyRobot, banner, press, ready, say_yes, spied_open, until
 from still_robot import still_open
 from textual.widgets import Input
 
@@ -198,13 +198,13 @@ def test_starting_a_wired_robot_asks_first(still_app: Callable[..., StairbotCons
             robot = app.engine.session.robot  # type: ignore[union-attr]
             await press(pilot, "s")
             await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
-            await press(pilot, "n")
+            await press(pilot, "escape")
             await until(pilot, lambda: len(app.screen_stack) == 1, "the answer")
             await pilot.pause(0.1)
             assert not app.engine.running and robot.commands == []
             await press(pilot, "s")
             await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "the question")
-            await press(pilot, "y")
+            await say_yes(pilot)
             await until(pilot, lambda: len(robot.commands) > 0, "the run starts")
             await press(pilot, "x")
             await until(pilot, lambda: not app.engine.running, "the run stops")

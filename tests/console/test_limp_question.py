@@ -14,7 +14,7 @@ from pathlib import Path
 import lost_sensor
 import pytest
 from lockstep_boards import lockstep_boards
-from pilot import SpyRobot, banner, press, ready, said, shown, spied_open, until
+from pilot import SpyRobot, banner, press, ready, said, say_yes, shown, spied_open, until
 from simrun import run_sim
 from textual.widgets import Label
 
@@ -86,7 +86,7 @@ def test_the_degraded_stop_is_shown_and_consent_carries_the_run_home(tmp_path: P
             assert "run error" not in banner(app)
             spy = spies[-1]
             assert spy.inner.estopped  # stopped, latched, while it asks
-            await press(pilot, "y")
+            await say_yes(pilot)
             await until(pilot, lambda: app.engine.running and bool(app.state.view().limping),
                         "limping home")
             await press(pilot, "p")  # held, to look at the screen while it limps
@@ -123,7 +123,7 @@ def test_refusing_leaves_the_robot_stopped_and_says_how_to_bring_it_home(
             await the_question(pilot, app)
             spy = spies[-1]
             n = len(spy.calls)
-            await press(pilot, "n")
+            await press(pilot, "escape")
             await until(pilot, lambda: not isinstance(app.screen, LimpQuestion), "answered")
             await pilot.pause(0.5)
             assert spy.motion(n) == [] and spy.inner.estopped and not app.engine.running
@@ -133,7 +133,7 @@ def test_refusing_leaves_the_robot_stopped_and_says_how_to_bring_it_home(
             # later: l asks again; or, the stop's latch cleared (c), s offers it
             await press(pilot, "l")
             await until(pilot, lambda: isinstance(app.screen, LimpQuestion), "asked again")
-            await press(pilot, "n")
+            await press(pilot, "escape")
             await until(pilot, lambda: len(app.screen_stack) == 1, "refused again")
             await press(pilot, "c")
             await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "clear?")
@@ -145,13 +145,13 @@ def test_refusing_leaves_the_robot_stopped_and_says_how_to_bring_it_home(
             assert "Limp home asks whether it may come down" in dialog(app)
             await press(pilot, "l")
             await until(pilot, lambda: isinstance(app.screen, LimpQuestion), "asked from s")
-            await press(pilot, "y")
+            await say_yes(pilot)
             await until(pilot, lambda: outcome(app) == "came_home_degraded",
                         "came home degraded")
     asyncio.run(go())
 
 
-@pytest.mark.parametrize("key", ["ctrl+c", "q"])
+@pytest.mark.parametrize("key", ["ctrl+c", "ctrl+q"])
 def test_quitting_at_the_question_leaves_the_robot_stopped(tmp_path: Path, key: str) -> None:
     spies: list[SpyRobot] = []
 
@@ -245,7 +245,7 @@ def test_boards_come_home_from_the_question_through_their_journal(
                 await ready(pilot)
                 await press(pilot, "s")
                 await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "start?")
-                await press(pilot, "y")
+                await say_yes(pilot)
                 await until(pilot, lambda: isinstance(app.screen, LimpQuestion)
                             or outcome(app) is not None, "the question", bound_s=600)
                 await app.workers.wait_for_complete()  # the run's worker asks at its end
@@ -253,7 +253,7 @@ def test_boards_come_home_from_the_question_through_their_journal(
                 assert "(boards on a wire)" in dialog(app)
                 end = read_journal(journal).end
                 assert end is not None and end["resumable"] is True
-                await press(pilot, "y")
+                await say_yes(pilot)
                 await until(pilot, lambda: outcome(app) == "came_home_degraded", "home",
                             bound_s=600)
         asyncio.run(go())

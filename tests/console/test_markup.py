@@ -70,5 +70,5 @@ def test_a_scenario_name_with_brackets_in_the_title_and_the_dialogs(
             from textual.widgets import Label
             text = " ".join(str(label.render()) for label in app.screen.query(Label))
             assert BRACKETS in text
-            await press(pilot, "n")
+            await press(pilot, "escape")
     asyncio.run(go())

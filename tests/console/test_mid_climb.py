@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from lockstep_boards import fake_boards, kill_mid_lift, last_tick
-from pilot import SpyRobot, banner, press, ready, spied_open, until
+from pilot import SpyRobot, banner, press, ready, say_yes, spied_open, until
 from textual.widgets import Label
 
 from stairbot.console.app import StairbotConsole, build_app
@@ -101,7 +101,7 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
                 text = dialog_text(app)
                 assert "last command: MTF +10.00 turn/s" in text
                 assert "does it stand where these lines say?" in text
-                await press(pilot, "n")  # not yet: nothing moves
+                await press(pilot, "escape")  # not yet: nothing moves
                 await until(pilot, lambda: len(app.screen_stack) == 1, "answered")
                 await pilot.pause(0.3)
                 assert not app.engine.running
@@ -110,7 +110,7 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
                 await until(pilot, lambda: isinstance(app.screen, ChoiceScreen), "again")
                 await press(pilot, "r")
                 await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "resume?")
-                await press(pilot, "y")
+                await say_yes(pilot)
                 await until(pilot, lambda: app.engine.running, "resumed")
                 await until(pilot, lambda: not app.engine.running, "the run ends")
                 result = app.state.view().result
