@@ -89,3 +89,17 @@ def test_a_5000_character_url_leaves_the_reason_in_view() -> None:
             shown = app.banner.render_lines(app.banner.region.reset_offset)
             assert "no such port" in " ".join(" ".join(s.text for s in shown).split())
     asyncio.run(go())
+
+
+def test_a_run_held_by_the_latch_is_in_the_e_stop_state_not_paused() -> None:
+    """Issue 35, defect 8: an e-stop mid-run read ``PAUSED E-STOP``."""
+    from stairbot.console.state import RunStatus
+    from stairbot.console.widgets.banner import strip_text
+
+    held = RunStatus(robot="running", estopped=True, paused=True, latch="operator")
+    strip = strip_text("sim://", "default", held, link="LIVE 0.1 s").plain
+    assert strip.startswith(" E-STOP  (operator)") and "PAUSED" not in strip
+    paused = RunStatus(robot="running", paused=True)
+    assert strip_text("sim://", "default", paused).plain.startswith(" PAUSED ")
+    refused = RunStatus(robot="fault", estopped=True, latch="operator")
+    assert strip_text("sim://", "", refused).plain.startswith(" FAULT   E-STOP  (operator)")

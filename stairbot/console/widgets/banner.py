@@ -33,11 +33,16 @@ def strip_text(url: str, scenario: str, status: RunStatus, recording: str | None
     the robot's state, the latch and who set it, ``DEGRADED`` and how
     (``degraded``: the run limps home, or came home so), the link's word
     (:func:`liveness`), the boards, the URL and scenario -- one line."""
-    state = "PAUSED" if status.paused and status.robot == "running" else status.robot.upper()
-    out = Text(f" {state} ", "bold reverse", no_wrap=True, overflow="ellipsis")
+    out = Text(no_wrap=True, overflow="ellipsis")
+    # a run held by the latch is in the e-stop state, not merely paused
+    if not (status.estopped and status.robot == "running"):
+        state = "PAUSED" if status.paused and status.robot == "running" \
+            else status.robot.upper()
+        out.append(f" {state} ", "bold reverse")
+        if status.estopped:
+            out.append(" ")
     if status.estopped:
         who = status.latch.split(":", 1)[0] if status.latch else ""
-        out.append(" ")
         out.append(" E-STOP ", "bold reverse")
         if who:
             out.append(f" ({who})", "bold")

@@ -20,6 +20,13 @@ FOLLOW_DOTS = 14  # the robot's length in dots when following it
 ZOOMS = ("auto", "flight", "robot")
 
 
+
+def lift_mm(offset_m: float) -> str:
+    """A lift's offset in whole millimetres, signed, ``+0`` for what rounds to
+    nothing (never ``-0``)."""
+    mm = round(offset_m * 1000)
+    return f"{mm + 0:+4d}"
+
 class StairsPicture(Widget):
     """Draws the latest :class:`SceneView` scaled to the widget, with a caption
     line: the step each segment stands over and the two lift offsets."""
@@ -144,9 +151,9 @@ class StairsPicture(Widget):
         if self._lifts is not None:
             mtf, mtb = self._lifts
             out.append("MTF ", SEGMENT_STYLES[0])
-            out.append(f"{mtf * 1000:+4.0f} mm  ")
+            out.append(f"{lift_mm(mtf)} mm  ")
             out.append("MTB ", SEGMENT_STYLES[2])
-            out.append(f"{mtb * 1000:+4.0f} mm")
+            out.append(f"{lift_mm(mtb)} mm")
         if self.following and out.cell_len + 8 <= width:
             out.append("  zoomed", "dim")
         out.truncate(width)
