@@ -108,7 +108,7 @@ class StairbotConsole(App[None]):
         self.robot_shape = RobotShape.of(engine.config)
         self.contact_said: str | None = None  # the wall contact told the operator
         side_pair = engine.config.sensors.has_side_pair
-        self.sensors = SensorPanel(engine.config.algorithm.equal_tolerance, side_pair=side_pair,
+        self.sensors = SensorPanel(engine.config, side_pair=side_pair,
                                    id="sensors")
         self.motors = MotorPanel(id="motors")
         self.phase = PhasePanel(id="phase")

@@ -72,9 +72,9 @@ def test_sensor_pairs_agree_differ_or_cannot_compare() -> None:
     ok, near = SensorReading(0.500), SensorReading(0.503)
     far = SensorReading(0.520)
     out = SensorReading(1.3, SensorStatus.OUT_OF_RANGE)
-    assert verdict(ok, near) == "agree Δ 3 mm"
-    assert verdict(ok, far) == "DIFFER Δ 20 mm"
-    assert verdict(ok, SensorReading(0.9)) == "DIFFER Δ>99 mm"
+    assert verdict(ok, near) == "agree Δ 3/5 mm"
+    assert verdict(ok, far) == "DIFFER Δ 20/5 mm"
+    assert verdict(ok, SensorReading(0.9)) == "DIFFER Δ>99/5 mm"
     assert verdict(out, out) == "both out of range"
     assert verdict(ok, SensorReading(0, SensorStatus.ERROR)) == "cannot compare"
 

@@ -148,7 +148,8 @@ def test_a_robot_without_a_top_view_shows_nothing_and_says_why() -> None:
             async with app.run_test(size=(80, 24)) as pilot:
                 await ready(pilot)
                 await press(pilot, "t")
-                await until(pilot, lambda: why in " ".join(drawn(app).split()), "why")
+                await until(pilot, lambda app=app, why=why: why in " ".join(drawn(app).split()),
+                            "why")
                 text = drawn(app)
                 assert not has_dots(text)
                 assert "top view · none" in title(app.top_view)

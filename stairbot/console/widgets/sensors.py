@@ -1,5 +1,7 @@
 """The distance sensors: value and status, and whether each pair that must
-agree (front right/left, back right/left) agrees within ``equal_tolerance``.
+agree (front right/left, back right/left) agrees within the standing rule's
+tolerance at its distance (what the robot itself accepts), debounced as
+perception debounces its kinds.
 Operator words first (``front R``), the seed's names (SFR...) beside them,
 dimmer.  On a robot with the side pair (its config's ``[sensors]
 side_model``, or a reading that carries SSR/SSL) one line more, ``side``:
@@ -22,7 +24,10 @@ from rich.text import Text
 from textual.widgets import Static
 
 from stairbot.console.freshness import STALE_S, age_key, is_stale, titled, without_status
+from stairbot.control.perception import CONFIRM
+from stairbot.control.tolerances import standing_tolerance
 from stairbot.hardware import SIDE_SENSORS, SensorId, SensorReading, SensorStatus, Snapshot
+from stairbot.inputs.config import RobotConfig
 
 PAIRS = ((SensorId.SFR, SensorId.SFL), (SensorId.SBR, SensorId.SBL))
 NAMES = {SensorId.SFR: "front R", SensorId.SFL: "front L", SensorId.SBR: "back R",
@@ -81,34 +86,52 @@ def _side_line(sensors: dict[SensorId, SensorReading]) -> Text:
 
 def pair_verdict(a: SensorReading | None, b: SensorReading | None,
                  tolerance: float) -> tuple[Text, Text]:
-    """Two short texts, beside each sensor of a pair: ``agree`` / ``Δ 1 mm``,
-    ``DIFFER`` / ``Δ 12 mm``, ``both out`` / ``of range``, ``cannot`` / ``compare``."""
+    """Two short texts, beside each sensor of a pair: ``agree`` / ``Δ 1/17 mm``,
+    ``DIFFER`` / ``Δ 24/17 mm`` (the difference, and the tolerance it is
+    judged by), ``both out`` / ``of range``, ``cannot`` / ``compare``."""
     if a is None or b is None or not a.ok or not b.ok:
         if (a is not None and b is not None and a.status is SensorStatus.OUT_OF_RANGE
                 and b.status is SensorStatus.OUT_OF_RANGE):
             return Text("both out", "yellow"), Text("of range", "yellow")
         return Text("cannot", "yellow"), Text("compare", "yellow")
     delta_mm = abs(a.distance_m - b.distance_m) * 1000
-    delta = Text(f"Δ {delta_mm:.0f} mm" if delta_mm < 99.5 else "Δ>99 mm", "dim")
+    shown = f"{delta_mm:.0f}" if delta_mm < 99.5 else ">99"
+    delta = Text(f"Δ {shown}/{tolerance * 1000:.0f} mm".replace("Δ >", "Δ>"), "dim")
     if delta_mm <= tolerance * 1000:
         return Text("agree", "bold green"), delta
     return Text("DIFFER", "bold white on red"), delta
 
 
+def pair_tolerance_m(config: RobotConfig, a: SensorReading | None, b: SensorReading | None,
+                     back: bool) -> float:
+    """How far the pair may differ and still agree: the standing rule's own
+    tolerance (:func:`~stairbot.control.tolerances.standing_tolerance`) at
+    the nearer reading -- what the robot itself accepts of its sensors'
+    noise; ``equal_tolerance`` when there is no reading to size it by."""
+    near = [r.distance_m for r in (a, b) if r is not None and r.ok]
+    if not near:
+        return config.algorithm.equal_tolerance
+    return standing_tolerance(config, min(near), back=back)
+
+
 class SensorPanel(Static):
     """Four sensor lines, each pair bracketed with its verdict; the side
-    pair's line after them on a robot that has it."""
+    pair's line after them on a robot that has it.  A pair's verdict
+    (agree, DIFFER, ...) changes only once CONFIRM readings in a row say
+    the new one, as perception's kinds do: noise the robot accepts does not
+    make it flicker."""
 
     DEFAULT_CSS = "SensorPanel { height: auto; }"
 
-    def __init__(self, tolerance: float, *, side_pair: bool = False,
+    def __init__(self, config: RobotConfig, *, side_pair: bool = False,
                  id: str | None = None) -> None:  # noqa: A002
         """``side_pair``: the robot has SSR/SSL (its config says so); their
         line shows then, and whenever a reading carries them."""
         super().__init__(id=id)
-        self.tolerance = tolerance
+        self.config = config
         self.side_pair = side_pair
         self._last: object = ()
+        self._verdicts: dict[SensorId, _Debounced] = {a: _Debounced() for a, _b in PAIRS}
         self.border_title = titled("sensors", None)
 
     def show(self, snap: Snapshot | None, age_s: float | None = None,
@@ -121,12 +144,16 @@ class SensorPanel(Static):
         if key == self._last:
             return
         self._last = key
-        self.border_title = titled(f"sensors ±{self.tolerance * 1000:.0f} mm", age_s)
+        self.border_title = titled("sensors", age_s)
         stale = is_stale(age_s)
         self.set_class(stale, "-stale")
         lines = []
-        for a, b in PAIRS:
-            top, bottom = pair_verdict(sensors.get(a), sensors.get(b), self.tolerance)
+        reading_time = None if snap is None else snap.time_s
+        for back, (a, b) in enumerate(PAIRS):
+            ra, rb = sensors.get(a), sensors.get(b)
+            top, bottom = self._verdicts[a].see(
+                pair_verdict(ra, rb, pair_tolerance_m(self.config, ra, rb, bool(back))),
+                reading_time)
             if stale:  # whether the pair agrees now is not known
                 top, bottom = Text("—"), Text()
             gone = [s for s in (a, b) if s.value in lost]
@@ -143,3 +170,35 @@ class SensorPanel(Static):
         if stale:
             lines = [without_status(line) for line in lines]
         self.update(Text("\n").join(lines))
+
+
+_JUDGED = {"agree", "DIFFER"}
+
+
+class _Debounced:
+    """A pair's verdict as shown: agree and DIFFER give way to each other only
+    once CONFIRM readings in a row (new robot times) say so; any other
+    verdict (cannot compare, both out of range) shows at once."""
+
+    def __init__(self) -> None:
+        self.shown: tuple[Text, Text] | None = None
+        self.candidate = ""  # a verdict other than the one shown, and its readings in a row
+        self.run = 0
+        self.at: float | None = None  # the robot time of the last reading counted
+
+    def see(self, verdict: tuple[Text, Text], reading_time: float | None) -> tuple[Text, Text]:
+        word = verdict[0].plain
+        new_reading = reading_time != self.at
+        self.at = reading_time
+        if self.shown is None or word == self.shown[0].plain \
+                or not {word, self.shown[0].plain} <= _JUDGED:
+            # the verdict shown (its figures as they stand now), or a pair that
+            # can or cannot be compared now: shown at once, no change pending
+            self.shown, self.candidate, self.run = verdict, "", 0
+            return verdict
+        if new_reading:
+            self.run = self.run + 1 if word == self.candidate else 1
+            self.candidate = word
+        if word == self.candidate and self.run >= CONFIRM:
+            self.shown, self.candidate, self.run = verdict, "", 0
+        return self.shown
