@@ -267,7 +267,7 @@ class RobotHolder:
         motors still, not their speeds when the run stopped.  A simulation at
         rest stays as it is (a run started from it is the headless run's)."""
         clock = self.clock
-        snap = self.state.view().snapshot
+        snap = self.state.snapshot
         if clock is None or not self.in_process or snap is None or all(
                 abs(m.speed_tps) < STILL_TPS for m in snap.motors.values()):
             self._idle_at = None
@@ -365,5 +365,5 @@ class RobotHolder:
         self.state.set_recording(None)
 
     def _now(self) -> float:
-        snap = self.state.view().snapshot
+        snap = self.state.snapshot
         return snap.time_s if snap is not None else 0.0

@@ -280,6 +280,13 @@ class LiveState:
 
     # -- readers -----------------------------------------------------------------
     @property
+    def snapshot(self) -> Snapshot | None:
+        """The last snapshot read (None: none since the robot was opened),
+        without copying the rest as :meth:`view` does."""
+        with self._lock:
+            return self._snapshot
+
+    @property
     def version(self) -> int:
         with self._lock:
             return self._version

@@ -28,11 +28,13 @@ def liveness(age_s: float | None, status: RunStatus) -> str:
 
 
 def strip_text(url: str, scenario: str, status: RunStatus, recording: str | None = None,
-               degraded: str = "", link: str = "", boards: str = "") -> Text:
+               degraded: str = "", link: str = "", boards: str = "",
+               place: bool = True) -> Text:
     """`` FAULT  E-STOP (automatic) · DOWN 12 s · motor #12 · serial://...``:
     the robot's state, the latch and who set it, ``DEGRADED`` and how
     (``degraded``: the run limps home, or came home so), the link's word
-    (:func:`liveness`), the boards, the URL and scenario -- one line."""
+    (:func:`liveness`), the boards, the URL and scenario (``place``; a
+    replay's message says its own) -- one line."""
     out = Text(no_wrap=True, overflow="ellipsis")
     # a run held by the latch is in the e-stop state, not merely paused
     if not (status.estopped and status.robot == "running"):
@@ -57,7 +59,8 @@ def strip_text(url: str, scenario: str, status: RunStatus, recording: str | None
         out.append(link, "bold")
     if boards:
         out.append(f" · {boards}")
-    out.append(f" · {url or '—'}" + (f" · {scenario}" if scenario else ""))
+    if place:
+        out.append(f" · {url or '—'}" + (f" · {scenario}" if scenario else ""))
     return out
 
 
@@ -92,8 +95,7 @@ class Banner(Static):
             return
         self._last = key
         if replay and status.message:
-            strip = strip_text("", "", status, recording, degraded)
-            strip.remove_suffix(" · —")
+            strip = strip_text(url, scenario, status, recording, degraded, place=False)
             whole = strip.copy()
             whole.no_wrap = False
             whole.append(f" {status.message}")

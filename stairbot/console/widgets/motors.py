@@ -17,9 +17,6 @@ from textual.widgets import Static
 from stairbot.console.freshness import STILL_TPS, age_key, is_stale, titled, without_status
 from stairbot.hardware import LIFT_MOTORS, MotorId, MotorState, Snapshot, Speeds
 
-STILL = STILL_TPS
-"""Turns/s below which a motor shows as stopped: what its speed shows at one
-decimal (``+0.0``), so the arrow and the figure never disagree."""
 NAMES = {MotorId.MWF: "front wheels", MotorId.MWB: "back wheels",
          MotorId.MWR: "mid wheels R", MotorId.MWL: "mid wheels L",
          MotorId.MTF: "front lift", MotorId.MTB: "back lift"}
@@ -42,7 +39,7 @@ def direction(motor: MotorId, speed: float,
               carried_by: tuple[int, ...] = ()) -> tuple[str, str]:
     """A glyph and a style: wheels ▶ forward ◀ back; lifts the segment and
     ▲ up ▼ down (``1▲``); ■ stopped."""
-    if abs(speed) < STILL:
+    if abs(speed) < STILL_TPS:
         return "■", "dim"
     if motor in LIFT_MOTORS:
         segment, arrow = lift_motion(motor, speed, carried_by)
@@ -61,14 +58,15 @@ def motor_line(motor: MotorId, state: MotorState | None, commanded: float | None
     if state is None:
         line.append("—", "dim")
         return line
+    # the arrow and the figure share STILL_TPS: no "-0.0", no arrow beside "+0.0"
+    speed = state.speed_tps if abs(state.speed_tps) >= STILL_TPS else 0.0
+    figures = f" {speed:+5.1f} {state.turns:7.1f}"
     if stale:
-        speed = state.speed_tps if abs(state.speed_tps) >= STILL else 0.0
-        line.append(f"? {speed:+5.1f} {state.turns:7.1f}")
+        line.append(f"?{figures}")
         return without_status(line)
     glyph, style = direction(motor, state.speed_tps, carried_by)
     line.append(f"{glyph:<2}", style)
-    speed = state.speed_tps if abs(state.speed_tps) >= STILL else 0.0  # no "-0.0"
-    line.append(f" {speed:+5.1f} {state.turns:7.1f}")
+    line.append(figures)
     if state.fault:
         line.append(f" {state.fault}", "bold red")
     elif commanded is not None and abs(commanded - state.speed_tps) > 0.05:

@@ -20,12 +20,12 @@ FOLLOW_DOTS = 14  # the robot's length in dots when following it
 ZOOMS = ("auto", "flight", "robot")
 
 
-
 def lift_mm(offset_m: float) -> str:
     """A lift's offset in whole millimetres, signed, ``+0`` for what rounds to
     nothing (never ``-0``)."""
     mm = round(offset_m * 1000)
     return f"{mm + 0:+4d}"
+
 
 class StairsPicture(Widget):
     """Draws the latest :class:`SceneView` scaled to the widget, with a caption

@@ -95,8 +95,8 @@ def pair_verdict(a: SensorReading | None, b: SensorReading | None,
             return Text("both out", "yellow"), Text("of range", "yellow")
         return Text("cannot", "yellow"), Text("compare", "yellow")
     delta_mm = abs(a.distance_m - b.distance_m) * 1000
-    shown = f"{delta_mm:.0f}" if delta_mm < 99.5 else ">99"
-    delta = Text(f"Δ {shown}/{tolerance * 1000:.0f} mm".replace("Δ >", "Δ>"), "dim")
+    shown = f"Δ {delta_mm:.0f}" if delta_mm < 99.5 else "Δ>99"
+    delta = Text(f"{shown}/{tolerance * 1000:.0f} mm", "dim")
     if delta_mm <= tolerance * 1000:
         return Text("agree", "bold green"), delta
     return Text("DIFFER", "bold white on red"), delta
@@ -177,8 +177,9 @@ _JUDGED = {"agree", "DIFFER"}
 
 class _Debounced:
     """A pair's verdict as shown: agree and DIFFER give way to each other only
-    once CONFIRM readings in a row (new robot times) say so; any other
-    verdict (cannot compare, both out of range) shows at once."""
+    once CONFIRM readings in a row say so (readings the panel is shown, each
+    counted once by its robot time); any other verdict (cannot compare, both
+    out of range) shows at once."""
 
     def __init__(self) -> None:
         self.shown: tuple[Text, Text] | None = None
