@@ -3,6 +3,8 @@ readings made up tick by tick: what a window's statistic lets through."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from stairbot.control.algorithm.bias_onsets import WARM_SETTLES, PairWatch
 from stairbot.control.robot_config import load_config
 from stairbot.control.tolerances import settle_s
@@ -43,3 +45,35 @@ def test_a_step_that_holds_is_still_an_onset() -> None:
         watch.tick(back_pair(t, 0.076 - 0.001 * (k % 2), left), 0.0, 0.0, 0.0, False, ())
     [onset] = watch.track.found
     assert onset.sensor is SensorId.SBL and abs(onset.step_m + 0.03) < 0.003, onset
+
+
+def _hang(watch: PairWatch, right_at: Callable[[int], float], left_at: Callable[[int], float],
+          ticks: int = 400, first: int = 0) -> None:
+    """Segment 3 hanging still, the pair reading ``right_at(k)`` and
+    ``left_at(k)`` on ticks ``first`` to ``first + ticks``, with some noise."""
+    start = WARM_SETTLES * settle_s(CONFIG, True)
+    for k in range(first, first + ticks):
+        t = start + k * TICK
+        watch.tick(back_pair(t, right_at(k) - 0.001 * (k % 2), left_at(k) + 0.001 * (k % 3 - 1)),
+                   0.0, 0.0, 0.0, False, ())
+
+
+def test_a_disagreement_that_ends_is_no_onset_heavy_middle_envelope_1501() -> None:
+    # segment 3 in the air after a climb, SBR's cone on the nosing reading
+    # 2 cm long, then (the robot drove on) on the tread, agreeing with SBL:
+    # SBR's step ended a disagreement, it began no offset (taken for one,
+    # descent 1 matched a new split at the edge to it and judged SBR biased)
+    watch = PairWatch(CONFIG, SensorId.SBR, SensorId.SBL, back=True)
+    _hang(watch, lambda k: 0.066 if k < 150 else 0.046, lambda k: 0.046)
+    assert watch.track.found == [] and watch.track.unconfirmed is None
+
+
+def test_a_bias_that_ends_cancels_its_onset() -> None:
+    # SBR reading 2 cm long from one tick on, then right again: its onset,
+    # then the step back to agreement the onset explains, which cancels it
+    watch = PairWatch(CONFIG, SensorId.SBR, SensorId.SBL, back=True)
+    _hang(watch, lambda k: 0.066 if 100 <= k < 250 else 0.046, lambda k: 0.046, 250)
+    [onset] = watch.track.found
+    assert onset.sensor is SensorId.SBR and abs(onset.step_m - 0.02) < 0.003, onset
+    _hang(watch, lambda k: 0.046, lambda k: 0.046, 200, first=250)
+    assert watch.track.found == [] and watch.track.offsets[SensorId.SBR] == 0.0

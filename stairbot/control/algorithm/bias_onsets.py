@@ -21,7 +21,10 @@ are compared: the pair's difference *steps* when they differ by more than
 STEP_SIGMAS pair tolerances, and the windows' medians do as well (a spike
 perception's median let through moves a mean, not a median); the step is
 an onset of the sensor that moved if its partner held, and counts once the
-next window bears it out (its mean level held)."""
+next window bears it out (its mean level held).  Healthy, the back pair
+reads alike: a back step that takes its difference back towards what the
+onsets say, from further than a step from it, ends a disagreement (a cone
+on a nosing, then off it) and begins no offset."""
 
 from __future__ import annotations
 
@@ -162,15 +165,19 @@ class PairWatch:
             # backing, the cones pass over ground the robot has not stood on:
             # the one meeting an edge first reads longer, a bias or not
             return
+        level = sum(s[2] - s[1] for s in before) / len(before)
+        if track.back and _ended(level, level + step.moved_left - step.moved_right,
+                                 track.offsets[track.left] - track.offsets[track.right],
+                                 step.threshold):
+            return
         mine, partner = (8, 7) if onset.sensor is track.left else (7, 8)
         if track.back and not (all(x[mine] for x in _driving(before))
                                and all(x[partner] for x in _driving(before) + _driving(after))):
             # segment 3 driven where a cone sees part of a drop: it crosses an
             # edge a little at a time, and the sensor nearer it moves first
             return
-        level = sum(s[2] - s[1] for s in before) / len(before) \
-            + step.moved_left - step.moved_right
-        track.unconfirmed = Unconfirmed(onset, level, share, step.threshold)
+        track.unconfirmed = Unconfirmed(onset, level + step.moved_left - step.moved_right, share,
+                                        step.threshold)
 
     def _confirm(self, held: bool) -> None:
         """Count the onset waiting for the next window if the pair's
@@ -181,6 +188,16 @@ class PairWatch:
         assert waiting is not None
         if held:
             track.record(waiting.onset, waiting.threshold)
+
+
+def _ended(before: float, after: float, said: float, threshold: float) -> bool:
+    """Whether the back pair's difference (left − right) stepped from
+    ``before``, more than ``threshold`` from what its onsets say (``said``),
+    back towards it (``after``): a disagreement the onsets do not explain
+    ended -- one cone on a nosing or over part of an edge, then off it -- and
+    no offset began.  Both look down at the surface segment 3 is over, so
+    healthy they read alike."""
+    return abs(before - said) > threshold and abs(after - said) < abs(before - said)
 
 
 def _turned(samples: list[Sample]) -> bool:
