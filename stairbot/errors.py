@@ -78,7 +78,14 @@ class LatchedError(HardwareError):
     """A board holds a latch -- its emergency stop, or its watchdog that
     tripped -- from before this host opened it.  Opening never clears a latch:
     the operator checks the robot and clears it (``stairbot clear``).  The
-    message is one line naming the URL, the board, the latch and that command."""
+    message is one line naming the URL, the board, the latch and that command;
+    ``boards`` holds the serial number of each board identified (as the
+    boards' identity does: ``{"motor": {"serial": 7}}``), the latched one's
+    among them, so the robot's journal can be found."""
+
+    def __init__(self, message: str, boards: dict[str, dict[str, int]] | None = None) -> None:
+        super().__init__(message)
+        self.boards = boards or {}
 
 
 class PortBusyError(HardwareError):

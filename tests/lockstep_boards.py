@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -35,32 +36,51 @@ class Boards:
     proc: subprocess.Popen[str]
     stderr: str = ""
     returncode: int | None = None
+    motor_serial: int = 0
+    """The motor board's serial number, as their banner says (drawn each launch)."""
+
+    @property
+    def identity(self) -> dict[str, dict[str, int]]:
+        """What a journal is kept by (:func:`~stairbot.run.journaled.default_path`)."""
+        return {"motor": {"serial": self.motor_serial}}
 
 
 @contextmanager
 def lockstep_boards(cwd: Path, env: dict[str, str] | None = None,
                     stop: signal.Signals = signal.SIGINT, *,
                     scenario: str | None = None,
-                    config: str | None = None) -> Iterator[Boards]:
+                    config: str | None = None, can: str | None = None) -> Iterator[Boards]:
     """Serve fake boards in lockstep (on ``scenario``, default the default
-    stairs; for ``config``, default the reference robot) until the block
+    stairs; for ``config``, default the reference robot) on a pty, or on the
+    CAN bus ``can`` names (``udp_multicast/GROUP?port=N``), until the block
     ends, then stop them with ``stop`` (unless the block did), killing them
     after 10 s.  ``cwd`` elsewhere than the source tree: the installed
     package runs."""
     more = (*(() if scenario is None else ("--scenario", scenario)),
             *(() if config is None else ("--config", config)))
-    proc = stairbot("fake-boards", "--serial", "--lockstep", *more, env=env, cwd=cwd)
+    wire = ("--serial",) if can is None else ("--can", can)
+    proc = stairbot("fake-boards", *wire, "--lockstep", *more, env=env, cwd=cwd)
     assert proc.stdout is not None
     boards = Boards(proc.stdout.readline().strip(), proc)
+    banner = ""
     try:
-        assert boards.url.startswith("serial:///dev/") and boards.url.endswith(
-            "?lockstep=1"), boards.url
+        assert boards.url.startswith("serial:///dev/" if can is None else "can://") \
+            and boards.url.endswith("lockstep=1"), boards.url
+        assert proc.stderr is not None
+        while "serving on" not in banner:  # after a config note, if any
+            line = proc.stderr.readline()
+            assert line, banner
+            banner += line
+        found = re.search(r"motor board serial (\d+)", banner)
+        assert found is not None, banner
+        boards.motor_serial = int(found.group(1))
         yield boards
     finally:
         if proc.poll() is None:
             proc.send_signal(stop)
         try:
-            _, boards.stderr = proc.communicate(timeout=10)
+            _, rest = proc.communicate(timeout=10)
+            boards.stderr = banner + rest
             boards.returncode = proc.returncode
         except subprocess.TimeoutExpired:
             proc.kill()

@@ -27,7 +27,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.handshake import latch_names
 from stairbot.errors import HardwareError
-from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.robots import RobotOptions, RobotSession, open_robot
 
 EXIT_FAILED = 1
 
@@ -44,11 +44,11 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _say_unfinished(url: str) -> None:
+def _say_unfinished(url: str, session: RobotSession) -> None:
     """Say so when the robot's journal holds a run that did not finish."""
-    from stairbot.run.journaled import default_path, unfinished
+    from stairbot.run.journaled import session_journal, unfinished
 
-    path = default_path(url)
+    path = session_journal(session)
     left = None if path is None else unfinished(path)
     if left is not None:
         print(f"{url}: the journal {path} holds {left}; clearing keeps it: "
@@ -75,7 +75,7 @@ def main(argv: list[str], confirm: Callable[[str], bool] = ask) -> int:
         for board, flags in sorted(robot.latched.items()):
             print(f"{args.robot}: the {m.Board(board).name.lower()} board has "
                   f"{latch_names(flags)}")
-        _say_unfinished(args.robot)
+        _say_unfinished(args.robot, session)
         question = ("Look at the robot first: it may stand part way up a step, and the next "
                     "run starts from where it stands.  Clear these latches? [y/N] ")
         if not args.yes and not confirm(question):

@@ -13,6 +13,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import replace
+from pathlib import Path
 from types import FrameType
 from typing import Any, TextIO
 
@@ -115,12 +116,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     from stairbot.run.journaled import resume as resume_run
     from stairbot.run.resume import ResumeRefused
     from stairbot.run.robots import RobotOptions, open_robot
-    from stairbot.run.runner import RunControl, run
+    from stairbot.run.runner import RunControl, board_identity, run
 
     progress: TextIO = sys.stderr if args.json else sys.stdout
     options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale,
                            allow_latched=args.resume)
-    path = journal_path(args.robot, args.journal)
     from_top = args.from_top or scenario.start.on == "top"
     if args.calibrate_only and from_top:
         print(f"{PROG}: error: --calibrate-only squares up to a riser ahead; a robot on the "
@@ -139,11 +139,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"{PROG}: error: --resume carries the journal's run on, --discard-journal sets "
               "it aside: leave one out", file=sys.stderr)
         return EXIT_INPUT
-    left = None if args.resume or path is None else unfinished(path)
 
-    def keep_unfinished() -> int | None:
-        """A new run would write over the journal's unfinished run: refused
-        (EXIT_INPUT) unless --discard-journal, which sets it aside."""
+    def keep_unfinished(path: Path | None) -> int | None:
+        """A new run would write over the journal's unfinished run at
+        ``path``: refused (EXIT_INPUT) unless --discard-journal, which sets it
+        aside."""
+        left = None if args.resume or path is None else unfinished(path)
         if left is None or path is None:
             return None
         if not args.discard_journal:
@@ -173,7 +174,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"{PROG}: error: {exc}", file=sys.stderr)
             return EXIT_MISMATCH
         except LatchedError as exc:  # after a host that stopped mid-run: --resume first
-            kept = keep_unfinished()
+            kept = keep_unfinished(journal_path(args.robot, args.journal, exc.boards))
             if kept is not None:
                 return kept
             print(f"{PROG}: error: cannot open {printable(args.robot)}: {exc}",
@@ -183,7 +184,9 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"{PROG}: error: cannot open {printable(args.robot)}: {exc}",
                   file=sys.stderr)
             return EXIT_MISMATCH
-        kept = keep_unfinished()
+        # the robot's journal: by its motor board's serial number, once it answered
+        path = journal_path(args.robot, args.journal, board_identity(session.robot))
+        kept = keep_unfinished(path)
         if kept is not None:
             session.close()
             return kept

@@ -37,7 +37,13 @@ from stairbot.hardware import Snapshot
 from stairbot.inputs.config import RobotConfig
 from stairbot.recording.record import RecordsTicks
 from stairbot.run.journal import JournalWriter
-from stairbot.run.journaled import ResumePlan, carry_on, default_path, plan_resume, start_journal
+from stairbot.run.journaled import (
+    ResumePlan,
+    carry_on,
+    plan_resume,
+    session_journal,
+    start_journal,
+)
 from stairbot.run.resume import ResumeRefused
 from stairbot.run.robots import RobotSession
 from stairbot.run.runner import RunControl, RunResult
@@ -236,7 +242,7 @@ class ConsoleEngine(RobotHolder):
             resumed = carry_on(resume, session, self.config, self._sink,
                                limp_home=awaits_consent(resume.context))
             return RunPlan(resumed.journal, resumed.controller)
-        return RunPlan(start_journal(default_path(session.url), session.url, session,
+        return RunPlan(start_journal(session_journal(session), session.url, session,
                                      self.config, scenario.name, _mode(mode)))
 
     def plan_resume(self) -> ResumePlan:
@@ -245,7 +251,7 @@ class ConsoleEngine(RobotHolder):
         is.  Moves nothing.  ResumeRefused (or JournalError) says why not."""
         if self.session is None:
             raise ResumeRefused("no robot open")
-        return plan_resume(default_path(self.session.url), self.session.url, self.session,
+        return plan_resume(session_journal(self.session), self.session.url, self.session,
                            self.config)
 
     def back_at_start(self) -> None:

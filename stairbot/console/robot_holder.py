@@ -208,7 +208,8 @@ class RobotHolder:
         self.robot.refresh_scene()
         # boards: their journal says whether an earlier host left them mid-climb
         identity = self.robot.identity()
-        self.mid_climb = None if sim is not None else from_journal(default_path(url), identity)
+        self.mid_climb = None if sim is not None else from_journal(default_path(url, identity),
+                                                                   identity)
         self.state.set_boards(boards_words(identity))
         latched = self.latched
         self.state.set_status(robot="ready", paused=False,

@@ -196,7 +196,8 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
     if status.flags & LATCHES and not allow_latched:
         raise LatchedError(
             f"{url}: the {name} board has {latch_names(status.flags)}; opening never "
-            f"clears a latch: check the robot, then `stairbot clear --robot {url}`")
+            f"clears a latch: check the robot, then `stairbot clear --robot {url}`",
+            {name: {"serial": ident.serial}})
     # Setting up is the one place where a command frame is sent again after a
     # timeout (SetWatchdog sets a value: the same effect however often it runs).
     reply = _set_up(link, url, board, m.SetWatchdog(watchdog_ms, hold_ms))
@@ -236,9 +237,12 @@ def open_boards(link: BoardLink, url: str, *, lockstep: bool, watchdog_ms: int, 
             if status is not None:
                 out.status[board] = status
             opened(board)
-    except BaseException:
+    except BaseException as exc:
         for taken in out.boots:  # the leases taken so far
             release_board(link, m.Board(taken), nonce)
+        if isinstance(exc, LatchedError):  # the boards identified before the latched one
+            exc.boards.update({m.Board(b).name.lower(): {"serial": ident.serial}
+                               for b, ident in out.idents.items()})
         raise
     return out
 

@@ -367,8 +367,23 @@ class SensorBoard(Board):
         return super().answer(msg)
 
 
-def make_boards(world: BoardWorld) -> dict[int, Board]:
-    """Both boards on one world, keyed by board address."""
-    motor, sensor = MotorBoard(world), SensorBoard(world)
+def make_boards(world: BoardWorld, serials: tuple[int, int] = (1, 2)) -> dict[int, Board]:
+    """Both boards on one world, keyed by board address; ``serials``: the
+    motor board's and the sensor board's serial numbers."""
+    motor, sensor = MotorBoard(world, serials[0]), SensorBoard(world, serials[1])
     motor.peer = sensor
     return {int(m.Board.MOTOR): motor, int(m.Board.SENSOR): sensor}
+
+
+def launch_serials() -> tuple[int, int]:
+    """Serial numbers for the boards of one ``stairbot fake-boards`` process,
+    drawn anew each launch: its world begins and ends with it, so it is a
+    robot of its own, as two real robots' boards differ (a journal kept on
+    one is never taken for another's, on a port or bus they both used)."""
+    return 1 + secrets.randbelow(0xFFFF), 1 + secrets.randbelow(0xFFFF)
+
+
+def serials_words(boards: dict[int, Board]) -> str:
+    """The boards' serial numbers in words, for the fake boards' banner."""
+    return ", ".join(f"{type(b).__name__.removesuffix('Board').lower()} board serial {b.serial}"
+                     for _, b in sorted(boards.items()))

@@ -30,7 +30,7 @@ from importlib import import_module
 from stairbot.args import bounded
 from stairbot.control.robot_config import config_for
 from stairbot.fakes.board_world import BoardWorld
-from stairbot.fakes.boards import make_boards
+from stairbot.fakes.boards import launch_serials, make_boards, serials_words
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.inputs.config import RobotConfig
@@ -119,13 +119,15 @@ def main(argv: list[str]) -> int:
         print(f"stairbot fake-boards: {note}", file=sys.stderr, flush=True)
     world = make_world(config, scenario, args.lockstep)
     pty = PtyPair()
-    server = SerialBoardServer(pty.master, world, make_boards(world), faults_from(args),
+    boards = make_boards(world, launch_serials())
+    server = SerialBoardServer(pty.master, world, boards, faults_from(args),
                                time_scale=args.time_scale)
     stop_on_signals(server.stop)
     suffix = "?lockstep=1" if args.lockstep else (
         f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"serial://{pty.path}{suffix}", flush=True)
-    print(f"fake boards serving on {pty.path} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+    print(f"fake boards ({serials_words(boards)}) serving on {pty.path} (Ctrl-C to stop)",
+          file=sys.stderr, flush=True)
     try:
         server.serve()
     except KeyboardInterrupt:

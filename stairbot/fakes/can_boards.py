@@ -50,7 +50,7 @@ from stairbot.drivers.can_wire import BROADCAST, CanFrame, CanWire, wire
 from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.errors import RobotUrlError
 from stairbot.fakes.board_world import BoardWorld, Pacer
-from stairbot.fakes.boards import Board, make_boards
+from stairbot.fakes.boards import Board, launch_serials, make_boards, serials_words
 from stairbot.fakes.serial_boards import FaultDice, WireFaults
 from stairbot.inputs.scenario import load_scenario
 
@@ -243,16 +243,16 @@ def main(argv: list[str]) -> int:
         print(f"stairbot fake-boards: {note}", file=sys.stderr, flush=True)
     world = make_world(config, scenario, args.lockstep)
     bus = open_bus(spec)
-    server = CanBoardServer(bus, world, make_boards(world), faults_from(args),
-                            time_scale=args.time_scale)
+    boards = make_boards(world, launch_serials())
+    server = CanBoardServer(bus, world, boards, faults_from(args), time_scale=args.time_scale)
     stop_on_signals(server.stop)  # before the URL is printed
 
     sep = "&" if "?" in url else "?"
     suffix = f"{sep}lockstep=1" if args.lockstep else (
         f"{sep}time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     print(f"{url}{suffix}", flush=True)
-    print(f"fake boards serving on CAN {spec.label}{reach(bus)} (Ctrl-C to stop)",
-          file=sys.stderr, flush=True)
+    print(f"fake boards ({serials_words(boards)}) serving on CAN {spec.label}{reach(bus)} "
+          "(Ctrl-C to stop)", file=sys.stderr, flush=True)
 
     try:
         server.serve()

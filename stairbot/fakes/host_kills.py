@@ -48,7 +48,7 @@ from stairbot.hardware import Snapshot
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, parse_scenario
 from stairbot.run.journal import mark_path
-from stairbot.run.journaled import default_path, start_journal
+from stairbot.run.journaled import session_journal, start_journal
 from stairbot.run.runner import RunResult, run
 
 POINTS = ("first", "middle", "last")
@@ -102,9 +102,9 @@ def killed_host(wire: str, journal: Path | None, tick: int) -> Iterator[Killed]:
     real = make_boards(world)
     boards = BoardsOnWire(wire, world, real, config)
     try:
-        journal = journal or default_path(boards.url)
-        assert journal is not None
         session = boards.open()
+        journal = journal or session_journal(session)
+        assert journal is not None
         writer = start_journal(journal, boards.url, session, config, scenario.name, Mode.FULL)
         assert writer is not None
         ticks = 0

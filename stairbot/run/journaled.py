@@ -3,9 +3,9 @@ fake-board harnesses keep them (the journal's format:
 :mod:`stairbot.run.journal`; what a resume checks: :mod:`stairbot.run.resume`).
 
 A run on boards (``serial://``, ``can://``) keeps a journal by default, at
-``$XDG_STATE_HOME/stairbot/journal-<robot>.jsonl`` (``~/.local/state`` when
-unset; ``<robot>`` names the port or bus, not the URL's options), or where
-``--journal FILE`` says.  A simulated run keeps one only when asked: it
+``$XDG_STATE_HOME/stairbot/journal-motor-<serial>.jsonl`` (``~/.local/state``
+when unset; the motor board's serial number: the robot, whatever port or
+bus it is on), or where ``--journal FILE`` says.  A simulated run keeps one only when asked: it
 cannot be resumed (its world ends with the process).
 
 A journal whose run on boards did not finish is never overwritten: a new
@@ -59,18 +59,32 @@ def config_digest(config: RobotConfig) -> str:
     return digest(values)
 
 
-def default_path(url: str) -> Path | None:
-    """The default journal of a robot on a wire (None: the simulation)."""
+def default_path(url: str, boards: Mapping[str, Mapping[str, int]] | None = None) -> Path | None:
+    """The default journal of a robot on a wire (None: the simulation), kept
+    by its motor board's serial number when ``boards`` (their identity, as
+    :func:`~stairbot.run.runner.board_identity` gives it) names it: the
+    robot's journal follows it to another port, and another robot on a port
+    this one used never finds it.  By the port or bus when the motor board's
+    serial is not known."""
     if not url.startswith(("serial://", "can://")):
         return None
+    state = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
+    serial = (boards or {}).get("motor", {}).get("serial")
+    if isinstance(serial, int):
+        return Path(state) / "stairbot" / f"journal-motor-{serial}.jsonl"
     where = url.split("?", 1)[0]
     slug = hashlib.sha256(where.encode()).hexdigest()[:12]
-    state = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
     return Path(state) / "stairbot" / f"journal-{slug}.jsonl"
 
 
-def journal_path(url: str, given: str | None) -> Path | None:
-    return Path(given) if given else default_path(url)
+def journal_path(url: str, given: str | None,
+                 boards: Mapping[str, Mapping[str, int]] | None = None) -> Path | None:
+    return Path(given) if given else default_path(url, boards)
+
+
+def session_journal(session: RobotSession) -> Path | None:
+    """The default journal of the robot ``session`` opened."""
+    return default_path(session.url, board_identity(session.robot))
 
 
 def start_journal(path: Path | None, url: str, session: RobotSession, config: RobotConfig,

@@ -305,3 +305,22 @@ def test_a_robot_that_tipped_while_no_host_watched_is_not_resumed(
     monkeypatch.setattr(BoardRobot, "attitude", lambda self: imu)
     code, err = resume(capsys, killed)
     refused(code, err, killed, 1, *words)
+
+
+def test_the_journal_is_kept_by_the_motor_boards_serial_not_the_port(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Console defect 6: the journal follows the robot to another port, and
+    another robot on this one's port never finds it."""
+    from stairbot.run.journaled import default_path
+
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path))
+    robot = {"motor": {"serial": 4711, "uptime_ms": 1, "boot": 3}, "sensor": {"serial": 12}}
+    other = {"motor": {"serial": 4712}, "sensor": {"serial": 12}}
+    here, there = "serial:///dev/ttyUSB0?timeout=0.1", "serial:///dev/ttyACM1"
+    assert default_path(here, robot) == default_path(there, robot) \
+        == tmp_path / "stairbot" / "journal-motor-4711.jsonl"
+    assert default_path(here, other) != default_path(here, robot)
+    assert default_path("can://socketcan/can0", robot) == default_path(here, robot)
+    assert default_path(here) == default_path(here.split("?")[0])  # not known: by the port
+    assert default_path(here) != default_path(there)
+    assert default_path("sim://", robot) is None

@@ -236,7 +236,7 @@ def test_boards_come_home_from_the_question_through_their_journal(
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
     path = scenario(tmp_path)
     with lockstep_boards(tmp_path, scenario=path) as served:
-        journal = default_path(served.url)
+        journal = default_path(served.url, served.identity)
         assert journal is not None
 
         async def go() -> None:

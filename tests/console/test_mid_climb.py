@@ -10,10 +10,11 @@ from __future__ import annotations
 import asyncio
 import json
 import os
+import random
 from pathlib import Path
 
 import pytest
-from lockstep_boards import fake_boards, kill_mid_lift, last_tick
+from lockstep_boards import kill_mid_lift, last_tick, lockstep_boards
 from pilot import SpyRobot, banner, press, ready, say_yes, spied_open, until
 from textual.widgets import Label
 
@@ -76,8 +77,9 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
     until the operator confirms."""
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
-    with fake_boards(tmp_path) as url:
-        journal = default_path(url)
+    with lockstep_boards(tmp_path) as boards:
+        url = boards.url
+        journal = default_path(url, boards.identity)
         assert journal is not None
         killed = kill_mid_lift(url, journal, dict(os.environ), tmp_path)
 
@@ -123,3 +125,37 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
         assert [r["kind"] for r in records].count("resume") == 1  # the same run, carried on
         assert records[-1]["kind"] == "end" and records[-1]["outcome"] == "completed"
         assert read_journal(journal).end is not None
+
+
+def test_a_journal_of_other_boards_on_the_same_url_is_not_offered_console_defect_6(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Finding: on a reused port, the console offered Resume for another
+    process's run (the journal was kept by the port alone).  It is kept by
+    the motor board's serial number; each launch of the fake boards is a
+    robot of its own: boards served again on the same bus are not the
+    journal's."""
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
+    bus = f"udp_multicast/239.74.{random.randrange(1, 255)}.{random.randrange(1, 255)}" \
+          f"?port={random.randrange(40000, 60000)}"
+    with lockstep_boards(tmp_path, can=bus) as first:
+        url = first.url + "&timeout=2"
+        journal = default_path(url, first.identity)
+        assert journal is not None
+        kill_mid_lift(url, journal, dict(os.environ), tmp_path, phase="ascent_approach",
+                      lift=("MWR", 1))  # driving at the first riser
+    with lockstep_boards(tmp_path, can=bus) as second:
+        assert second.url == first.url and second.motor_serial != first.motor_serial
+
+        async def go() -> None:
+            app = build_app(url=url)
+            async with app.run_test(size=(100, 30)) as pilot:
+                await app.workers.wait_for_complete()
+                await until(pilot, lambda: "READY" in banner(app), "opened")
+                assert app.engine.mid_climb is None  # nothing says these boards climbed
+                await press(pilot, "s")
+                await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "start?")
+                assert "part way up" not in dialog_text(app)
+                await press(pilot, "escape")
+        asyncio.run(go())
+    assert read_journal(journal).end is None  # the first boards' run, kept as it was
