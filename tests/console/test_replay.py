@@ -521,3 +521,24 @@ def test_without_the_mcap_reader_one_line_names_the_extra(recorded: dict[str, Pa
     assert proc.returncode == 2
     assert proc.stderr == ("stairbot: error: stairbot replay: needs mcap to read MCAP, which "
                            "is not installed: pip install 'stairbot[replay]'\n")
+
+
+def test_a_json_lines_replay_shows_no_value_as_an_error_console_defect_8(
+        recorded: dict[str, Path]) -> None:
+    """Findings: graphs of a record with no sensor values read "ERROR" for
+    every sensor; the close-in's phase line said "(start) (start)"."""
+    clock = Clock()
+
+    async def go() -> None:
+        app = replay_app(recorded["jsonl"], clock)
+        async with app.run_test(size=(120, 40)) as pilot:
+            await until(pilot, lambda: "REPLAY" in app.banner.plain, "the banner")
+            clock.t += 5.0
+            app.advance()
+            await until(pilot, lambda: bool(app.trends.plain), "the graphs drawn")
+            for name in ("SFR", "SFL", "SBR", "SBL"):
+                assert app.trends.plain[name].endswith("—"), app.trends.plain[name]
+            assert not any("ERROR" in line for line in app.trends.plain.values())
+            assert not any("(start) (start)" in message for message in said(app))
+            assert any("close in to square_range_m (start)" in m for m in said(app))
+    run(go)

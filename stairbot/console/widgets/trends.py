@@ -94,7 +94,7 @@ class TrendsPanel(Vertical):
         for name in self.series:
             i = column(name)
             values = [r[i] for r in rows if math.isfinite(r[i])]
-            last = rows[-1][i] if rows else math.nan
+            last = rows[-1][i] if rows else NOT_CARRIED  # never read: no value, no error
             label, low, high = self._texts(name, last, values)
             self.labels[name].update(label)
             self.ranges[name].update(Text(f"{low}…{high}" if values else ""))
@@ -108,7 +108,7 @@ class TrendsPanel(Vertical):
         low = min(values) if values else math.nan
         high = max(values) if values else math.nan
         if name == "pitch":
-            value = "—" if math.isnan(last) else f"{_signed(last, 1)}°"
+            value = "—" if not math.isfinite(last) else f"{_signed(last, 1)}°"
             lo, hi = _signed(low, 1), f"{_signed(high, 1)}°"
         elif name in SensorId.__members__:
             value = ("—" if last == NOT_CARRIED  # no such reading (a side sensor not read)
@@ -116,7 +116,7 @@ class TrendsPanel(Vertical):
             lo, hi = f"{low:.3f}", f"{high:.3f}"
         else:  # a lift: turns as the extension, mm
             mm = 1000 * self.lift_m_per_turn
-            value = "—" if math.isnan(last) else f"{_signed(last * mm, 0)}mm"
+            value = "—" if not math.isfinite(last) else f"{_signed(last * mm, 0)}mm"
             lo, hi = _signed(low * mm, 0), _signed(high * mm, 0)
         out.append(value.rjust(LABEL_WIDTH - 8), "bold red" if value == "ERROR" else "")
         return out, lo, hi

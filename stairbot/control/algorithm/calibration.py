@@ -269,7 +269,7 @@ def _close_in(t: Tick, w: DriveWork) -> Step:
 
 
 CLOSE_IN = PhaseDef(
-    P.CAL_CLOSE_IN, "calibration — close in to square_range_m (start)", FLOW, _close_in,
+    P.CAL_CLOSE_IN, "calibration — close in to square_range_m", FLOW, _close_in,
     DriveWork, enter=_close_in_enter, family=Calibration,
     on={"closed_in": Exit(P.CAL_CHECK, "the nearer reads square_range_m, or the first "
                                        "reading's distance driven"),
