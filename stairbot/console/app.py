@@ -24,7 +24,7 @@ from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
-from textual.screen import Screen
+from textual.screen import ModalScreen, Screen
 from textual.widget import Widget
 from textual.widgets import Footer, Static
 
@@ -160,6 +160,7 @@ class StairbotConsole(App[None]):
         with contextlib.suppress(ValueError):  # not the main thread: left as it is
             self._sigint = signal.signal(signal.SIGINT, self._on_sigint)
         paint.lay_out(self)
+        self.screen_change_signal.subscribe(self, self._on_screen_change)
         self.begin()
 
     def begin(self) -> None:
@@ -249,10 +250,20 @@ class StairbotConsole(App[None]):
         """Tell the operator: a toast, and (``keep``) a line in the event list
         that stays after the toast has gone.  The text is shown as it is, never
         parsed as markup: URLs, paths and drivers' messages hold brackets."""
+        if isinstance(self.screen, ModalScreen):
+            # a toast would cover the dialog's text: the event list keeps it
+            self.state.note(message, severity)
+            return
         if keep:
             self.state.note(message, severity)
         self.notify(message, severity=severity, timeout=timeout,  # type: ignore[arg-type]
                     markup=False)
+
+    def _on_screen_change(self, screen: Screen[Any]) -> None:
+        """A dialog shown: the toasts go (each is in the event list), none
+        covers what it asks."""
+        if isinstance(screen, ModalScreen):
+            self.clear_notifications()
 
     # -- actions -------------------------------------------------------------------
     async def on_event(self, event: events.Event) -> None:
