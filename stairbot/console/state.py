@@ -120,6 +120,9 @@ class LiveState:
         self._recording: str | None = None
         self._boards = ""
         self._events: deque[tuple[int, Event]] = deque(maxlen=LOG_LENGTH)
+        self._heard_s = 0.0
+        """The robot's clock as last heard from: its latest reading or run event
+        (a console note is listed at it, after what came before)."""
         self._event_seq = 0
         self._history = History()
         self._degraded: Event | None = None
@@ -147,6 +150,7 @@ class LiveState:
             self._history.clear()
             self._degraded, self._limping, self._limp_end = None, (), ""
             self._boards = ""
+            self._heard_s = 0.0  # another robot, another clock
             self._bump()
 
     def set_boards(self, boards: str) -> None:
@@ -182,6 +186,7 @@ class LiveState:
         """``snap`` was read ``at`` on the ages' clock (None: now)."""
         with self._lock:
             self._snapshot = snap
+            self._heard_s = max(self._heard_s, snap.time_s)
             self._read_at = self._wall() if at is None else at
             self._ticks += 1
             self._history.add(snap)
@@ -219,6 +224,7 @@ class LiveState:
         with self._lock:
             self._event_seq += 1
             self._events.append((self._event_seq, event))
+            self._heard_s = max(self._heard_s, event.time_s)
             if event.kind.value == "link" and event.data:
                 self._health.update(
                     {k: float(v) for k, v in event.data.items() if isinstance(v, int | float)}
@@ -252,15 +258,16 @@ class LiveState:
         what it told of a degraded stop."""
         with self._lock:
             self._events.clear()
+            self._heard_s = 0.0
             self._degraded, self._limping, self._limp_end = None, (), ""
             self._bump()
 
     def note(self, message: str, severity: str = "information") -> None:
         """What the console told the operator, kept in the event list (on the
-        robot's clock as last read; not in the record: the run's events are
-        what `stairbot run --record` writes)."""
-        time_s = self._snapshot.time_s if self._snapshot is not None else 0.0
-        self.on_event(Event(time_s, NOTE_KINDS.get(severity, EventKind.INFO), message,
+        robot's clock as last heard from, so after every event listed before
+        it; not in the record: the run's events are what `stairbot run
+        --record` writes)."""
+        self.on_event(Event(self._heard_s, NOTE_KINDS.get(severity, EventKind.INFO), message,
                             CONSOLE))
 
     def on_result(self, result: RunResult | None) -> None:
