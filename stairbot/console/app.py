@@ -100,7 +100,9 @@ class StairbotConsole(App[None]):
         self._sigint: Any = None  # the SIGINT handler before ours
         # The panels, kept here: refresh_view must reach them while a modal
         # screen is on top (app.query_one looks only at the top screen).
-        self.banner = Banner(id="banner")  # the line that says how things stand
+        # the line that says how things stand; a message too long for it, whole
+        # in the event list
+        self.banner = Banner(id="banner", told=self._told_whole)
         self.picture = StairsPicture(id="picture")
         self.top_view = TopViewPicture(id="topview")
         self.top_shown = False
@@ -241,6 +243,13 @@ class StairbotConsole(App[None]):
         if self.engine.limp_offer is not None or self.engine.limp_refused \
                 or stranded(self.state.view().degraded):
             self.call_from_thread(limp_question.after_stop, self)
+
+    def _told_whole(self, message: str, severity: str) -> None:
+        """A message the banner cut: whole in the event list, unless said there
+        just now."""
+        if any(event.message == message for _, event in list(self.state.view().events)[-5:]):
+            return
+        self.state.note(message, severity)
 
     def _tell(self, message: str, severity: str) -> None:
         self.call_from_thread(self.say, message, severity)

@@ -2,9 +2,12 @@
 live, always (the run's state and latch, then LIVE/DOWN and the age of the
 last reading, the boards, the URL: cut at the screen's edge, never wrapped);
 under it, while there is one, the one thing the operator must know now (an
-emergency stop, a lost link, how the run ended), whole up to four lines."""
+emergency stop, a lost link, how the run ended), whole up to four lines; a
+longer one is cut there, and told whole to ``told`` (the event list) once."""
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from rich.console import Group
 from rich.text import Text
@@ -14,6 +17,9 @@ from stairbot.console.freshness import is_stale
 from stairbot.console.state import RunStatus
 
 SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
+MESSAGE_LINES = 4
+"""The banner's lines for its message, under the strip (its max-height: 5)."""
+CUT = " … (whole in the events)"
 
 
 def liveness(age_s: float | None, status: RunStatus) -> str:
@@ -79,8 +85,13 @@ class Banner(Static):
 
     DEFAULT_CSS = "Banner { height: auto; max-height: 5; width: 1fr; }"
 
-    def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
+    def __init__(self, *, id: str | None = None,  # noqa: A002
+                 told: Callable[[str, str], None] | None = None) -> None:
+        """``told(message, severity)``: a message too long to show whole goes
+        there whole, once (the console's event list)."""
         super().__init__(id=id)
+        self._told = told
+        self._cut: str = ""  # the last message cut, told already
         self._last: object = None
         self.plain = ""  # the text shown, for tests and logs
         self.strip = ""  # its first line
@@ -116,7 +127,25 @@ class Banner(Static):
                     self.plain = line.plain
                     self.update(line)
                 else:
+                    message = self._fit(message, width, status)
                     self.plain = f"{strip.plain}\n{message.plain}"
                     self.update(Group(strip, message))
         self.remove_class(*SEVERITY_CLASSES)
         self.add_class("-estop" if status.estopped else f"-{status.severity}")
+
+    def _fit(self, message: Text, width: int, status: RunStatus) -> Text:
+        """``message`` whole if it wraps to MESSAGE_LINES at ``width``; else its
+        first lines, the last ending in CUT, and the whole told once."""
+        if width <= len(CUT) + 1:
+            return message
+        lines = message.wrap(self.app.console, width)
+        if len(lines) <= MESSAGE_LINES:
+            return message
+        last = lines[MESSAGE_LINES - 1]
+        last.truncate(width - len(CUT))
+        last.rstrip()
+        last.append(CUT)
+        if self._told is not None and self._cut != status.message:
+            self._cut = status.message
+            self._told(status.message, status.severity)
+        return Text("\n").join([*lines[:MESSAGE_LINES - 1], last])
