@@ -65,16 +65,34 @@ def default_path(url: str, boards: Mapping[str, Mapping[str, int]] | None = None
     :func:`~stairbot.run.runner.board_identity` gives it) names it: the
     robot's journal follows it to another port, and another robot on a port
     this one used never finds it.  By the port or bus when the motor board's
-    serial is not known."""
+    serial is not known, or where the journal kept by the port (as stairbot
+    did before) is of the same motor board and none is kept by its serial."""
     if not url.startswith(("serial://", "can://")):
         return None
-    state = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
-    serial = (boards or {}).get("motor", {}).get("serial")
-    if isinstance(serial, int):
-        return Path(state) / "stairbot" / f"journal-motor-{serial}.jsonl"
+    state = Path(os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state"))
     where = url.split("?", 1)[0]
     slug = hashlib.sha256(where.encode()).hexdigest()[:12]
-    return Path(state) / "stairbot" / f"journal-{slug}.jsonl"
+    by_port = state / "stairbot" / f"journal-{slug}.jsonl"
+    serial = (boards or {}).get("motor", {}).get("serial")
+    if not isinstance(serial, int):
+        return by_port
+    path = state / "stairbot" / f"journal-motor-{serial}.jsonl"
+    if not path.exists() and _motor_serial(by_port) == serial:
+        return by_port  # kept by the port, as stairbot did before: still this robot's
+    return path
+
+
+def _motor_serial(path: Path) -> object:
+    """The motor board's serial number in the start record of the journal at
+    ``path`` (None: no journal there, or none it names)."""
+    try:
+        if not path.is_file():  # nothing there, or no journal (a FIFO would block)
+            return None
+        with open(path, "rb") as f:
+            first = json.loads(f.readline(MAX_LINE))
+        return first["boards"]["motor"]["serial"]
+    except (OSError, ValueError, RecursionError, KeyError, TypeError):
+        return None
 
 
 def journal_path(url: str, given: str | None,

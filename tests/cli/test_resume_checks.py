@@ -310,7 +310,8 @@ def test_a_robot_that_tipped_while_no_host_watched_is_not_resumed(
 def test_the_journal_is_kept_by_the_motor_boards_serial_not_the_port(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Console defect 6: the journal follows the robot to another port, and
-    another robot on this one's port never finds it."""
+    another robot on this one's port never finds it; a journal an earlier
+    stairbot kept by the port is still found by its own robot."""
     from stairbot.run.journaled import default_path
 
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path))
@@ -324,3 +325,12 @@ def test_the_journal_is_kept_by_the_motor_boards_serial_not_the_port(
     assert default_path(here) == default_path(here.split("?")[0])  # not known: by the port
     assert default_path(here) != default_path(there)
     assert default_path("sim://", robot) is None
+    # a journal kept by the port, as stairbot did before: this robot's stays in use
+    by_port = default_path(here)
+    assert by_port is not None
+    by_port.parent.mkdir(parents=True)
+    by_port.write_text(json.dumps({"kind": "start", "boards": robot}) + "\n")
+    assert default_path(here, robot) == by_port
+    assert default_path(here, other) == tmp_path / "stairbot" / "journal-motor-4712.jsonl"
+    (tmp_path / "stairbot" / "journal-motor-4711.jsonl").write_text("")
+    assert default_path(here, robot) == tmp_path / "stairbot" / "journal-motor-4711.jsonl"
