@@ -102,7 +102,7 @@ class StairbotConsole(App[None]):
         # screen is on top (app.query_one looks only at the top screen).
         # the line that says how things stand; a message too long for it, whole
         # in the event list
-        self.banner = Banner(id="banner", told=self._told_whole)
+        self.banner = Banner(id="banner", told=self.state.note_once)
         self.picture = StairsPicture(id="picture")
         self.top_view = TopViewPicture(id="topview")
         self.top_shown = False
@@ -244,13 +244,6 @@ class StairbotConsole(App[None]):
                 or stranded(self.state.view().degraded):
             self.call_from_thread(limp_question.after_stop, self)
 
-    def _told_whole(self, message: str, severity: str) -> None:
-        """A message the banner cut: whole in the event list, unless said there
-        just now."""
-        if any(event.message == message for _, event in list(self.state.view().events)[-5:]):
-            return
-        self.state.note(message, severity)
-
     def _tell(self, message: str, severity: str) -> None:
         self.call_from_thread(self.say, message, severity)
 
@@ -259,14 +252,12 @@ class StairbotConsole(App[None]):
         """Tell the operator: a toast, and (``keep``) a line in the event list
         that stays after the toast has gone.  The text is shown as it is, never
         parsed as markup: URLs, paths and drivers' messages hold brackets."""
-        if isinstance(self.screen, ModalScreen):
-            # a toast would cover the dialog's text: the event list keeps it
+        modal = isinstance(self.screen, ModalScreen)
+        if keep or modal:  # a toast would cover a dialog's text: the event list keeps it
             self.state.note(message, severity)
-            return
-        if keep:
-            self.state.note(message, severity)
-        self.notify(message, severity=severity, timeout=timeout,  # type: ignore[arg-type]
-                    markup=False)
+        if not modal:
+            self.notify(message, severity=severity, timeout=timeout,  # type: ignore[arg-type]
+                        markup=False)
 
     def _on_screen_change(self, screen: Screen[Any]) -> None:
         """A dialog shown: the toasts go (each is in the event list), none

@@ -37,13 +37,7 @@ from stairbot.hardware import Snapshot
 from stairbot.inputs.config import RobotConfig
 from stairbot.recording.record import RecordsTicks
 from stairbot.run.journal import JournalWriter
-from stairbot.run.journaled import (
-    ResumePlan,
-    carry_on,
-    plan_resume,
-    session_journal,
-    start_journal,
-)
+from stairbot.run.journaled import ResumePlan, carry_on, plan_resume, session_journal, start_journal
 from stairbot.run.resume import ResumeRefused
 from stairbot.run.robots import RobotSession
 from stairbot.run.runner import RunControl, RunResult

@@ -270,6 +270,13 @@ class LiveState:
         self.on_event(Event(self._heard_s, NOTE_KINDS.get(severity, EventKind.INFO), message,
                             CONSOLE))
 
+    def note_once(self, message: str, severity: str = "information") -> None:
+        """:meth:`note`, unless one of the last few events says it already."""
+        with self._lock:
+            recent = list(self._events)[-5:]
+        if all(event.message != message for _, event in recent):
+            self.note(message, severity)
+
     def on_result(self, result: RunResult | None) -> None:
         with self._lock:
             self._result = result
