@@ -28,13 +28,14 @@ from textual.screen import ModalScreen, Screen
 from textual.widget import Widget
 from textual.widgets import Footer, Static
 
-from stairbot.console import choices, limp_question, motion_gate, paint
+from stairbot.console import choices, limp_question, motion_gate, paint, watching
 from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key
 from stairbot.console.help import COMMANDS, HelpScreen
 from stairbot.console.limp_gate import stranded
 from stairbot.console.robot_holder import SPEEDS
-from stairbot.console.state import LiveState, StateView
+from stairbot.console.sharing import MirrorState
+from stairbot.console.state import StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton
 from stairbot.console.widgets.event_log import EventLog
@@ -46,7 +47,7 @@ from stairbot.console.widgets.sensors import SensorPanel
 from stairbot.console.widgets.top_view import TopViewPicture
 from stairbot.console.widgets.trends import TrendsPanel
 from stairbot.control.robot_config import load_config
-from stairbot.errors import InputError, StairbotError
+from stairbot.errors import InputError, PortBusyError, StairbotError
 from stairbot.inputs.config import RobotConfig
 from stairbot.run.journaled import ResumePlan
 from stairbot.run.runner import RunResult
@@ -81,6 +82,7 @@ class StairbotConsole(App[None]):
         Binding("z", "zoom", "zoom", show=False),
         Binding("t", "top_view", "top view", show=False),
         Binding("g", "graphs", "graphs", show=False),
+        Binding("h", "ask_control", "ask control", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
     ]
@@ -93,6 +95,8 @@ class StairbotConsole(App[None]):
         self.url = url
         self.scenario = scenario
         self._record = record
+        self.sharing = watching.Sharing()
+        """The hub that shares this console's robot, or the client watching another's."""
         self.shown_key: object = None  # what the panels show (None: redraw at the next refresh)
         self.shown_event = 0  # the last event the list shows
         self.asking_quit = False
@@ -202,11 +206,19 @@ class StairbotConsole(App[None]):
     def open_robot(self, url: str, scenario: str | None, clear_latches: bool = False) -> None:
         """Open a robot off the UI thread; on bad input say so and reopen the
         previous robot (if opening the new one closed it).  ``clear_latches``:
-        the operator confirmed clearing the latches the boards hold."""
+        the operator confirmed clearing the latches the boards hold.  A robot
+        another console holds and shares is watched (console/watching.py)."""
+        watching.stop_watching(self)
+        watching.unshare(self)
         previous = (self.url, self.scenario) if self.engine.session is not None else None
         try:
             self.engine.open(url, scenario, clear_latches=clear_latches)
         except Exception as exc:  # noqa: BLE001 - any failure is a message, not a traceback
+            if isinstance(exc, PortBusyError) and watching.watch(self, url):
+                self.url, self.scenario = url, scenario
+                self._tell(f"another console controls {url}: watching it (h asks for "
+                           "control)", "information")
+                return
             why = _why(exc)
             message = f"cannot open {why}" if why.startswith(f"{url}: ") else \
                 f"cannot open {url}: {why}"
@@ -216,6 +228,7 @@ class StairbotConsole(App[None]):
                 try:
                     self.engine.open(*previous)
                     message = f"kept {previous[0]}: {message}"
+                    watching.share(self)
                 except Exception as again:  # noqa: BLE001
                     message += f"; {previous[0]} did not reopen either: {_why(again)}"
             if self.engine.session is None:
@@ -224,6 +237,7 @@ class StairbotConsole(App[None]):
                 self.state.set_status(severity="error", message=message)
             return
         self.url, self.scenario = url, scenario
+        watching.share(self)
 
     @work(thread=True, group="run", exclusive=False, exit_on_error=False)
     def run_program(self, mode: str, resume: ResumePlan | None = None) -> None:
@@ -277,8 +291,21 @@ class StairbotConsole(App[None]):
             return
         await super().on_event(event)
 
+    async def run_action(self, action: Any, default_namespace: Any = None,
+                         namespaces: Any = None) -> bool:
+        """Every action, by key or by name: one that would reach the robot is
+        refused while another console controls it."""
+        if default_namespace in (None, self) and isinstance(action, str):
+            name = action.split("(", 1)[0].rsplit(".", 1)[-1]
+            if watching.blocked(self, name):
+                return True
+        return await super().run_action(action, default_namespace, namespaces)
+
     def action_estop(self) -> None:
-        """Stop every motor now, whatever the console is doing."""
+        """Stop every motor now, whatever the console is doing (watching:
+        the controlling console stops it)."""
+        if watching.estop(self):
+            return
         self.engine.estop()
         limp_question.withdraw(self)
         self.refresh_view()
@@ -333,6 +360,9 @@ class StairbotConsole(App[None]):
     def action_graphs(self) -> None:
         choices.graphs(self)
 
+    def action_ask_control(self) -> None:
+        watching.ask_control(self)
+
     def action_zoom(self) -> None:
         choices.zoom(self)
 
@@ -350,6 +380,7 @@ class StairbotConsole(App[None]):
         return go
 
     def on_unmount(self) -> None:
+        watching.close(self)
         self.engine.shutdown()
         if self._sigint is not None:
             with contextlib.suppress(ValueError):
@@ -390,7 +421,7 @@ def build_app(config: RobotConfig | str | Path | None = None, *, url: str = "sim
     cfg = config if isinstance(config, RobotConfig) else load_config(config)
     if speed not in SPEEDS:
         raise InputError("--speed", None, f"{speed!r}; allowed: {', '.join(SPEEDS)}")
-    state = LiveState(url=url, wall=ages_wall)
+    state = MirrorState(url=url, wall=ages_wall)
     engine = ConsoleEngine(state, cfg, **engine_hooks)
     engine.set_speed(speed)
     return StairbotConsole(engine, url, scenario, record)

@@ -35,6 +35,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("top_view", "Top view / side view", "The stairwell and the robot seen from above, or "
                                          "the side view again (key: t)"),
     ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
+    ("ask_control", "Ask for control", "Watching another console's robot: ask its "
+                                       "operator to hand control over (key: h)"),
     ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
 
@@ -60,6 +62,8 @@ KEYS
   g       graphs: pitch, distance sensors, lifts over the last
           30 s of robot time (36 rows or more: under the
           picture; fewer: in its place until g again)
+  h       watching a robot another console controls: ask that
+          console's operator to hand control over
   Ctrl+P  every action by name
 
 READING THE SCREEN
@@ -69,6 +73,10 @@ READING THE SCREEN
   remain (which is out, the survivor its pair runs on, the
   speed) and after it, LIVE or DOWN and how long ago the robot
   was read, the boards, the URL.  Under it: what to know now.
+  WATCHING first: another console (a browser tab, a terminal)
+  has the robot open and controls it; this one shows what that
+  one shows, its keys that would reach the robot say so, and
+  space sends that console the emergency stop.
   Every panel says how old its values are; values not read for
   1.5 s are dimmed and marked STALE: they are not live (no
   colour, no arrow: ? for a motor).

@@ -76,7 +76,7 @@ def show(app: StairbotConsole, v: StateView) -> None:
     app.banner.show(v.url, v.scenario, v.status, v.recording,
                     limping_words(v.limping) if v.limping else "",
                     "" if app.replaying else liveness(age, v.status), v.boards,
-                    replay=app.replaying)
+                    replay=app.replaying, watching=bool(v.watching))
     picture = app.picture
     # never markup: the URL may hold brackets; with a landing, the frame it is in
     framed = v.top.flight if v.top is not None and v.plan and v.plan.landing else None

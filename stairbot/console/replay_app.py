@@ -5,7 +5,7 @@ console --replay FILE``): the same panels as a live console, drawn from a
 
 Nothing here opens a robot or commands one.  The banner says REPLAY and
 the file; where the E-STOP button stands, a mark says there is no robot.
-The keys that would move a robot (s, k, c, u, r, o, x, w, f) say
+The keys that would move a robot (s, k, c, u, r, o, x, w, f, l, h) say
 "replay: no robot" and do nothing else.  Space, the emergency stop
 everywhere else, stops nothing here and says so, loudly -- and does not
 pause the replay either: an operator who pressed it thinking this was the
@@ -41,6 +41,7 @@ KEY_WORDS = {
     "u": "u opens a robot", "r": "r resets the simulation", "o": "o picks a scenario",
     "x": "x stops a run", "w": "w records a run", "f": "f sets the simulation's speed",
     "l": "l limps home after a degraded stop",
+    "h": "h asks another console for control of its robot",
 }
 """The live console's keys that would reach a robot, and what each does there."""
 
@@ -65,7 +66,7 @@ KEYS
   ?         this help          Ctrl+P  every action by name
   space     a live console's EMERGENCY STOP: here it says
             there is no robot to stop (the replay goes on)
-  s k c u r o x w f   say "replay: no robot"
+  s k c u r o x w f l h   say "replay: no robot"
 
 READING THE SCREEN
   The banner: REPLAY, ▶ playing ⏸ paused ■ at the end, the

@@ -84,6 +84,9 @@ class StateView:
     boards: str = ""
     """The boards' identity (``motor #12 · sensor #34``; "": not a robot on a
     wire, or not known yet)."""
+    watching: str = ""
+    """Who controls the robot shown, when it is not this console (console/
+    sharing.py: this one only watches); "": this console."""
 
 
 class LiveState:

@@ -234,15 +234,22 @@ def open_bus(spec: CanUrl) -> can.BusABC:
         raise RobotUrlError(spec.url, None, f"cannot open CAN bus {where}: {detail}") from exc
 
 
+def bus_lock_key(spec: CanUrl) -> tuple[str, str]:
+    """(the key of the lock on ``spec``'s bus, the bus as a message names it:
+    ``udp_multicast/239.74.163.2``).  RobotUrlError when no interface is named."""
+    cfg = resolve_bus_config(spec)
+    where = f"{cfg.get('interface')}/{cfg.get('channel') if cfg.get('channel') is not None else ''}"
+    return f"can:{where}" + (f"@pid{os.getpid()}" if cfg.get("interface") == "virtual"
+                             else ""), where
+
+
 def lock_bus(spec: CanUrl) -> PortLock:
     """This machine's lock on the bus ``spec`` names (``port_lock.py``): one
     stairbot host on a bus at a time.  A python-can ``virtual`` bus does not
     leave its process (two processes on one channel name are two buses), so
     its lock is this process's own, as ``loop://``'s would be.  PortBusyError
     names the holder; RobotUrlError when the lock file cannot be made."""
-    cfg = resolve_bus_config(spec)
-    where = f"{cfg.get('interface')}/{cfg.get('channel') if cfg.get('channel') is not None else ''}"
-    key = f"can:{where}" + (f"@pid{os.getpid()}" if cfg.get("interface") == "virtual" else "")
+    key, where = bus_lock_key(spec)
     try:
         return take_port_lock(key, f"CAN bus {where}")
     except OSError as exc:

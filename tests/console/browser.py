@@ -95,24 +95,36 @@ def served_console(*options: str, cwd: str | None = None) -> Iterator[tuple[str,
 
 
 @contextlib.contextmanager
-def chromium_page(url: str, width: int = 1100, height: int = 640) -> Iterator[Any]:
-    """A headless Chromium page on ``url``, every request elsewhere refused
-    (the page asks Google for a font: the fallback monospace is fine)."""
+def chromium_tabs(url: str, width: int = 1100, height: int = 640) -> Iterator[Callable[[], Any]]:
+    """A headless Chromium; yields a function that opens a tab (a page) on
+    ``url``, every request elsewhere refused (the page asks Google for a
+    font: the fallback monospace is fine)."""
     from playwright.sync_api import sync_playwright
 
     assert CHROMIUM is not None, "no chromium: apt-get install chromium (scripts/test does)"
     origin = url.rstrip("/")
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, headless=True)
-        try:
-            page = browser.new_page(viewport={"width": width, "height": height})
+        context = browser.new_context(viewport={"width": width, "height": height})
+
+        def open_tab() -> Any:
+            page = context.new_page()
             page.route("**/*", lambda route: route.continue_()
                        if route.request.url.startswith(origin) else route.abort())
             page.add_init_script(CATCH_TERMINAL)
             page.goto(url)
-            yield page
+            return page
+        try:
+            yield open_tab
         finally:
             browser.close()
+
+
+@contextlib.contextmanager
+def chromium_page(url: str, width: int = 1100, height: int = 640) -> Iterator[Any]:
+    """A headless Chromium page on ``url`` (:func:`chromium_tabs`, one tab)."""
+    with chromium_tabs(url, width, height) as open_tab:
+        yield open_tab()
 
 
 def screen_text(page: Any) -> str:

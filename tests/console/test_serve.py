@@ -16,7 +16,16 @@ import time
 from pathlib import Path
 
 import pytest
-from browser import CHROMIUM, chromium_page, press, served_console, wait_screen
+from browser import (
+    CHROMIUM,
+    chromium_page,
+    chromium_tabs,
+    press,
+    screen_text,
+    served_console,
+    wait_screen,
+)
+from lockstep_boards import fake_boards
 
 from stairbot.cli import main as stairbot_main
 from stairbot.console.cli import build_parser
@@ -134,6 +143,31 @@ def test_a_tab_closed_mid_run_stops_the_run_and_ends_its_console(tmp_path: Path)
         # no quit dialog could ask first: the e-stop latched, as quitting mid-run does
         assert any(e["message"] == "emergency stop by the operator (the console closed "
                    "mid-run)" for e in map(json.loads, record.read_text().splitlines()))
+
+
+@needs_chromium
+def test_a_second_tab_watches_the_first_tabs_robot_console_defect_9(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Before, each tab's console opened the robot for itself: the second was
+    refused (a serial port is locked) or commanded it too."""
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    with fake_boards(tmp_path) as robot, served_console(
+            "--robot", robot, cwd=str(tmp_path)) as (url, _), chromium_tabs(url) as open_tab:
+        first = open_tab()
+        wait_screen(first, lambda s: "READY" in first_row(s), "the first tab controls")
+        second = open_tab()
+        watched = wait_screen(second, lambda s: "WATCHING" in first_row(s)
+                              and "READY" in first_row(s), "the second tab watches")
+        assert "h asks for control" in banner_rows(watched)
+        press(second, "s")
+        wait_screen(second, lambda s: "watching: another console controls this robot" in s,
+                    "a start refused there")
+        assert "RUNNING" not in first_row(screen_text(first))
+        press(second, "Space")
+        wait_screen(first, lambda s: re.search(r"E-STOP\s+\(operator\)", first_row(s))
+                    is not None, "the first tab's console latched the stop")
+        wait_screen(second, lambda s: "E-STOP" in first_row(s), "the latch shown in both")
 
 
 def test_host_and_origin_are_checked_before_a_console_opens() -> None:

@@ -35,13 +35,17 @@ def liveness(age_s: float | None, status: RunStatus) -> str:
 
 def strip_text(url: str, scenario: str, status: RunStatus, recording: str | None = None,
                degraded: str = "", link: str = "", boards: str = "",
-               place: bool = True) -> Text:
+               place: bool = True, watching: bool = False) -> Text:
     """`` FAULT  E-STOP (automatic) · DOWN 12 s · motor #12 · serial://...``:
     the robot's state, the latch and who set it, ``DEGRADED`` and how
     (``degraded``: the run limps home, or came home so), the link's word
     (:func:`liveness`), the boards, the URL and scenario (``place``; a
-    replay's message says its own) -- one line."""
+    replay's message says its own) -- one line.  ``watching``: another
+    console controls the robot (console/sharing.py), said first."""
     out = Text(no_wrap=True, overflow="ellipsis")
+    if watching:
+        out.append(" WATCHING ", "bold reverse")
+        out.append(" ")
     # a run held by the latch is in the e-stop state, not merely paused
     if not (status.estopped and status.robot == "running"):
         state = "PAUSED" if status.paused and status.robot == "running" \
@@ -97,11 +101,14 @@ class Banner(Static):
         self.strip = ""  # its first line
 
     def show(self, url: str, scenario: str, status: RunStatus, recording: str | None = None,
-             degraded: str = "", link: str = "", boards: str = "", replay: bool = False) -> None:
+             degraded: str = "", link: str = "", boards: str = "", replay: bool = False,
+             watching: bool = False) -> None:
         """``replay``: a recording played back -- no robot, so no strip: the
-        state, then the message (the recording's place and source) as it is."""
+        state, then the message (the recording's place and source) as it is.
+        ``watching``: another console controls the robot shown."""
         width = self.content_region.width
-        key = (url, scenario, status, recording, degraded, link, boards, replay, width)
+        key = (url, scenario, status, recording, degraded, link, boards, replay, watching,
+               width)
         if key == self._last:
             return
         self._last = key
@@ -113,7 +120,8 @@ class Banner(Static):
             self.strip, self.plain = strip.plain, whole.plain
             self.update(whole)
         else:
-            strip = strip_text(url, scenario, status, recording, degraded, link, boards)
+            strip = strip_text(url, scenario, status, recording, degraded, link, boards,
+                               watching=watching)
             self.strip = strip.plain
             if not status.message:
                 self.plain = strip.plain
