@@ -48,6 +48,8 @@ class Sharing:
     def __init__(self) -> None:
         self.hub: ShareHub | None = None
         self.client: ShareClient | None = None
+        self.asked = False
+        """A request for control is being put to this console's operator."""
 
 
 def is_watching(app: StairbotConsole) -> bool:
@@ -174,8 +176,13 @@ def _asked(app: StairbotConsole, who: str, reply: Reply) -> None:
                      "let it end first")
         app.say(f"{who} asked for control: refused while the run goes on", "warning")
         return
+    if app.sharing.asked:
+        reply(False, "its operator is being asked already")
+        return
+    app.sharing.asked = True
 
     def answered(yes: bool | None) -> None:
+        app.sharing.asked = False
         if not yes:
             reply(False, "its operator kept control")
             app.say(f"control kept: {who} was told no")

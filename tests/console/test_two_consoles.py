@@ -12,11 +12,12 @@ opens the robot through the drivers, lock and all."""
 from __future__ import annotations
 
 import asyncio
+import random
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from lockstep_boards import fake_boards
+from lockstep_boards import fake_boards, lockstep_boards
 from pilot import banner, press, ready, said, say_yes, until
 
 from stairbot.console.app import build_app
@@ -32,8 +33,19 @@ def boards_url(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[str]
         yield url
 
 
+@pytest.mark.parametrize("wire", ["serial", "can"])
 def test_a_second_console_watches_the_first_and_cannot_command_it_console_defect_9(
-        boards_url: str) -> None:
+        wire: str, boards_url: str, tmp_path: Path) -> None:
+    if wire == "can":  # the same on a CAN bus, locked as a serial port is
+        bus = f"udp_multicast/239.74.{random.randrange(1, 255)}.{random.randrange(1, 255)}" \
+              f"?port={random.randrange(40000, 60000)}"
+        with lockstep_boards(tmp_path, can=bus) as boards:
+            watched(boards.url + "&timeout=2")
+    else:
+        watched(boards_url)
+
+
+def watched(boards_url: str) -> None:
     async def go() -> None:
         first, second = build_app(url=boards_url), build_app(url=boards_url)
         async with first.run_test(size=(120, 40)) as p1:
@@ -75,6 +87,8 @@ def test_control_passes_only_when_the_first_hands_it_over(boards_url: str) -> No
                 # asked, and kept: nothing changes hands
                 await press(p2, "h")
                 await until(p1, lambda: isinstance(first.screen, MotionConfirm), "the question")
+                await press(p2, "h")  # asked again meanwhile: one question at a time
+                await until(p2, lambda: "being asked already" in said(second), "told")
                 await press(p1, "escape")
                 await until(p2, lambda: "control not handed over: its operator kept control"
                             in said(second), "the refusal told")
