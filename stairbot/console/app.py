@@ -214,7 +214,8 @@ class StairbotConsole(App[None]):
         try:
             self.engine.open(url, scenario, clear_latches=clear_latches)
         except Exception as exc:  # noqa: BLE001 - any failure is a message, not a traceback
-            if isinstance(exc, PortBusyError) and watching.watch(self, url):
+            if isinstance(exc, PortBusyError) and watching.watch(self, url,
+                                                                 watching.SHARE_WAIT_S):
                 self.url, self.scenario = url, scenario
                 self._tell(f"another console controls {url}: watching it (h asks for "
                            "control)", "information")

@@ -23,22 +23,39 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
+import queue
 import socket
 import sys
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from multiprocessing.connection import Client, Connection, Listener
-from multiprocessing.context import AuthenticationError
+from multiprocessing.connection import (
+    Connection,
+    Listener,
+    answer_challenge,
+    deliver_challenge,
+)
 from pathlib import Path
 from typing import Any
 
-from stairbot.console.state import LiveState, StateView
+from stairbot.console.state import CONSOLE, LiveState, StateView
 from stairbot.drivers.robot_lock import robot_lock_path
 
 SEND_PERIOD_S = 0.1
 """Seconds between copies sent to a watching console (the screen's own rate)."""
+HISTORY_EVERY = 10
+"""The graphs' rows (30 s of readings, most of a copy's size) go with every
+tenth copy; the watching console keeps the last it got in between."""
+OUTBOX_POLL_S = 0.02
+"""How often a hub's thread looks for answers to send while it waits."""
+CONNECT_TIMEOUT_S = 3.0
+"""How long a console waits for a hub to answer and prove its key."""
+CLOSE_GRACE_S = 0.5
+"""How long a closing hub lets its watchers' threads send what is left."""
+SOCKET_PATH_MAX = 100
+"""A Unix socket's path longer than this (sun_path holds 108 bytes) is named
+in Linux's abstract namespace instead."""
 KEY_BYTES = 32
 
 
@@ -61,9 +78,10 @@ def share_address(url: str) -> ShareAddress | None:
         return None
     digest = hashlib.sha256(str(lock).encode()).hexdigest()[:24]
     name = f"share-{digest}"
-    socket = f"\0stairbot-{os.getuid()}-{name}" if sys.platform == "linux" \
-        else str(lock.parent / f"{name}.sock")
-    return ShareAddress(socket, lock.parent / f"{name}.key")
+    path = lock.parent / f"{name}.sock"  # in the user's own directory (0700)
+    socket_name = str(path) if len(str(path)) < SOCKET_PATH_MAX or sys.platform != "linux" \
+        else f"\0stairbot-{os.getuid()}-{name}"
+    return ShareAddress(socket_name, lock.parent / f"{name}.key")
 
 
 def whoami() -> str:
@@ -71,17 +89,37 @@ def whoami() -> str:
     return f"the console with pid {os.getpid()}"
 
 
-Reply = Callable[[bool, str], None]
-"""Answers a request for control: (granted, why)."""
+class Request:
+    """A watching console's request for control, answered once (from any
+    thread: the answer is sent on the hub's own thread)."""
+
+    def __init__(self, who: str, outbox: queue.SimpleQueue[tuple[Any, ...]],
+                 gone: threading.Event) -> None:
+        self.who = who
+        self._outbox = outbox
+        self._gone = gone
+        self._answered = threading.Event()
+
+    @property
+    def alive(self) -> bool:
+        """The console that asked is still connected."""
+        return not self._gone.is_set()
+
+    def answer(self, granted: bool, why: str) -> None:
+        if not self._answered.is_set():
+            self._answered.set()
+            self._outbox.put(("granted" if granted else "refused", why))
 
 
 class ShareHub:
-    """Sends ``state`` to every console that connects at ``address``; passes
-    their requests on: ``on_estop(who) -> what was done`` and
-    ``on_ask(who, reply)`` (``reply`` may be called from any thread, once)."""
+    """Sends ``state`` to every console that connects at ``address`` and
+    proves it read the key; passes their requests on: ``on_estop(who) ->
+    what was done`` and ``on_ask(request)``.  Each watching console has a
+    thread of its own, which alone sends to it: a console that stops reading
+    holds up nothing else."""
 
     def __init__(self, address: ShareAddress, state: LiveState, *,
-                 on_estop: Callable[[str], str], on_ask: Callable[[str, Reply], None],
+                 on_estop: Callable[[str], str], on_ask: Callable[[Request], None],
                  period_s: float = SEND_PERIOD_S) -> None:
         self.address = address
         self._state = state
@@ -90,18 +128,16 @@ class ShareHub:
         self._closed = threading.Event()
         self._conns: list[Connection] = []
         self._lock = threading.Lock()
-        key = os.urandom(KEY_BYTES)
+        self._key = os.urandom(KEY_BYTES)
         address.key.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
         # The caller holds the robot's lock: files left here are a dead console's.
         address.key.unlink(missing_ok=True)
         fd = os.open(address.key, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, "wb") as out:
-            out.write(key)
+            out.write(self._key)
         if not address.socket.startswith("\0"):
             Path(address.socket).unlink(missing_ok=True)
-        self._listener = Listener(address.socket, family="AF_UNIX", authkey=key)
-        if not address.socket.startswith("\0"):
-            os.chmod(address.socket, 0o600)
+        self._listener = Listener(address.socket, family="AF_UNIX")
         self._acceptor = threading.Thread(target=self._accept, name="share hub", daemon=True)
         self._acceptor.start()
 
@@ -109,10 +145,10 @@ class ShareHub:
         while not self._closed.is_set():
             try:
                 conn = self._listener.accept()
-            except (AuthenticationError, EOFError, ConnectionError):
-                continue  # a client that did not prove it read the key (or close()'s wake-up)
             except OSError:
-                return  # closed
+                if self._closed.is_set():
+                    return
+                continue
             with self._lock:
                 if self._closed.is_set():
                     conn.close()
@@ -122,71 +158,85 @@ class ShareHub:
                              daemon=True).start()
 
     def _serve(self, conn: Connection) -> None:
+        outbox: queue.SimpleQueue[tuple[Any, ...]] = queue.SimpleQueue()
+        gone = threading.Event()
         sent = 0  # the last event sent
-        send_lock = threading.Lock()
-
-        def send(message: tuple[Any, ...]) -> None:
-            with send_lock:
-                conn.send(message)
-
+        count = 0
         try:
+            # the key's proof, both ways, here: a client that stalls or lies
+            # holds up its own thread alone
+            deliver_challenge(conn, self._key)
+            answer_challenge(conn, self._key)
             while not self._closed.is_set():
                 view = self._state.view(events_after=sent)
                 if view.events:
                     sent = view.events[-1][0]
-                send(("view", view))
+                whole = count % HISTORY_EVERY == 0  # the graphs' rows: once a second
+                count += 1
+                conn.send(("view", view if whole else replace(view, history=()), whole))
                 deadline = time.monotonic() + self._period_s
-                while (left := deadline - time.monotonic()) > 0 and conn.poll(left):
-                    self._handle(conn.recv(), send)
-        except (OSError, EOFError):
-            pass  # the watching console went, or this hub closed
+                while (left := deadline - time.monotonic()) > 0:
+                    while not outbox.empty():
+                        conn.send(outbox.get())
+                    if conn.poll(min(left, OUTBOX_POLL_S)):
+                        self._handle(conn.recv(), outbox, gone)
+            while not outbox.empty():  # answers given as the hub closed (control handed over)
+                conn.send(outbox.get())
+        except Exception:  # noqa: BLE001 - any failure ends this watcher's connection alone
+            pass
         finally:
+            gone.set()
             with self._lock:
                 if conn in self._conns:
                     self._conns.remove(conn)
-            conn.close()
+            with contextlib.suppress(OSError):
+                conn.close()
 
-    def _handle(self, message: Any, send: Callable[[tuple[Any, ...]], None]) -> None:
+    def _handle(self, message: Any, outbox: queue.SimpleQueue[tuple[Any, ...]],
+                gone: threading.Event) -> None:
         if not isinstance(message, tuple) or not message:
             return
         kind, who = message[0], str(message[1]) if len(message) > 1 else "a watching console"
         if kind == "estop":
-            send(("said", self._on_estop(who), "warning"))
+            outbox.put(("said", self._on_estop(who), "warning"))
         elif kind == "ask":
-            answered = threading.Event()
-
-            def reply(granted: bool, why: str) -> None:
-                if answered.is_set():
-                    return
-                answered.set()
-                with contextlib.suppress(OSError):
-                    send(("granted" if granted else "refused", why))
-            self._on_ask(who, reply)
+            self._on_ask(Request(who, outbox, gone))
 
     def close(self) -> None:
         """Stop sharing: the watching consoles are told the connection ended."""
         if self._closed.is_set():
             return
         self._closed.set()
+        # the key file only if it is still this hub's (a console that took
+        # control over may have started its own by now)
+        with contextlib.suppress(OSError):
+            if self.address.key.read_bytes() == self._key:
+                self.address.key.unlink()
         # A socket closed while accept() waits on it stays bound until accept
         # returns: wake it with a connection first, so the address is free
         # for the next console at once.
         with contextlib.suppress(OSError), socket.socket(socket.AF_UNIX) as wake:
+            wake.settimeout(1.0)
             wake.connect(self.address.socket)
         self._acceptor.join(timeout=2.0)
         with contextlib.suppress(OSError):
             self._listener.close()
+        # each watcher's thread sends what is left for it and closes its end;
+        # one that cannot (a watcher that stopped reading) is cut off
+        deadline = time.monotonic() + CLOSE_GRACE_S
+        while time.monotonic() < deadline:
+            with self._lock:
+                if not self._conns:
+                    break
+            time.sleep(OUTBOX_POLL_S)
         with self._lock:
             conns, self._conns = self._conns, []
         for conn in conns:
             with contextlib.suppress(OSError):
                 conn.close()
-        paths = [self.address.key]
         if not self.address.socket.startswith("\0"):
-            paths.append(Path(self.address.socket))
-        for path in paths:
             with contextlib.suppress(OSError):
-                path.unlink()
+                Path(self.address.socket).unlink()
 
 
 class MirrorState(LiveState):
@@ -201,11 +251,16 @@ class MirrorState(LiveState):
         self._got_at = 0.0
         self._gone = False
 
-    def watch(self, controller: str) -> None:
-        """Show what the hub sends (the copies that came since the client
-        connected included), ``controller`` named as who controls the robot."""
+    def connected(self) -> None:
+        """A connection to a hub was made: what it sends is live."""
         with self._lock:
-            self._watching, self._gone = controller, False
+            self._gone, self._remote = False, None
+            self._bump()
+
+    def watch(self, controller: str) -> None:
+        """Show what the hub sends, ``controller`` named as who controls the robot."""
+        with self._lock:
+            self._watching = controller
             self._bump()
 
     def unwatch(self) -> None:
@@ -220,11 +275,16 @@ class MirrorState(LiveState):
         with self._lock:
             return bool(self._watching) and not self._gone
 
-    def mirror(self, view: StateView) -> None:
-        """A copy the controlling console sent (its events: those new since the last)."""
+    def mirror(self, view: StateView, whole: bool = True) -> None:
+        """A copy the controlling console sent: its events (those new since the
+        last; its console's own notes left out, they were said to its
+        operator), and its graphs' rows when ``whole`` (else the last kept)."""
         for _, event in view.events:
-            self.on_event(event)
+            if event.phase != CONSOLE:
+                self.on_event(event)
         with self._lock:
+            if not whole and self._remote is not None:
+                view = replace(view, history=self._remote.history)
             self._remote, self._got_at = view, self._wall()
             self._bump()
 
@@ -250,18 +310,51 @@ class MirrorState(LiveState):
         if remote is None:
             return replace(own, watching=watching)
         status = remote.status
-        if not status.message:
-            status = replace(status, severity="info", message=(
-                f"watching: {watching} controls this robot; h asks for control"))
         if gone:
             status = replace(status, severity="warning", message=(
                 f"{watching} no longer answers: what it showed last, aging; nothing "
                 "here controls the robot (u opens it here)"))
+        else:  # its message was for its own operator, whose keys these are not
+            status = replace(status, message=(
+                f"watching: {watching} controls this robot; h asks for control"
+                + (f" · there: {status.message}" if status.message else "")))
         return replace(
             remote, version=own.version, events=own.events, status=status,
             read_age_s=None if remote.read_age_s is None else remote.read_age_s + since,
             top_age_s=None if remote.top_age_s is None else remote.top_age_s + since,
             watching=watching + (" (gone)" if gone else ""))
+
+
+def _open_connection(address: ShareAddress, key: bytes) -> Connection:
+    """A connection to the hub at ``address`` that proved, both ways, it read
+    ``key``; OSError when none answers, or none proves it within
+    CONNECT_TIMEOUT_S (a hub that stalls is no hub)."""
+    sock = socket.socket(socket.AF_UNIX)
+    try:
+        sock.settimeout(CONNECT_TIMEOUT_S)
+        sock.connect(address.socket)
+        sock.setblocking(True)
+    except BaseException:
+        sock.close()
+        raise
+    conn = Connection(sock.detach())
+    done, failed = threading.Event(), threading.Event()
+
+    def prove() -> None:
+        try:
+            answer_challenge(conn, key)
+            deliver_challenge(conn, key)
+        except Exception:  # noqa: BLE001 - any failure: no hub here
+            failed.set()
+        finally:
+            done.set()
+
+    threading.Thread(target=prove, name="share proof", daemon=True).start()
+    if not done.wait(CONNECT_TIMEOUT_S) or failed.is_set():
+        with contextlib.suppress(OSError):
+            conn.close()
+        raise OSError(f"the console sharing at {address.socket!r} did not prove its key")
+    return conn
 
 
 class ShareClient:
@@ -273,11 +366,12 @@ class ShareClient:
     def __init__(self, address: ShareAddress, state: MirrorState,
                  on_reply: Callable[[str, str, str], None]) -> None:
         key = address.key.read_bytes()  # OSError: no console shares there
-        self._conn = Client(address.socket, family="AF_UNIX", authkey=key)
+        self._conn = _open_connection(address, key)
         self._state = state
         self._on_reply = on_reply
         self._send_lock = threading.Lock()
         self._closed = threading.Event()
+        state.connected()
         threading.Thread(target=self._receive, name="share client", daemon=True).start()
 
     def _receive(self) -> None:
@@ -286,16 +380,20 @@ class ShareClient:
                 message = self._conn.recv()
                 kind = message[0]
                 if kind == "view":
-                    self._state.mirror(message[1])
+                    self._state.mirror(message[1], bool(message[2]))
                 elif kind == "said":
-                    self._on_reply("said", str(message[1]), str(message[2]))
+                    self._reply("said", str(message[1]), str(message[2]))
                 elif kind in ("granted", "refused"):
-                    self._on_reply(kind, str(message[1]), "information")
-        except (OSError, EOFError, TypeError, ValueError):
-            pass  # the hub closed, or this end did (close() from another thread)
+                    self._reply(kind, str(message[1]), "information")
+        except Exception:  # noqa: BLE001 - closed, cut, or a copy that does not read
+            pass
         if not self._closed.is_set():
             self._state.lost()
-            self._on_reply("gone", "the controlling console closed", "warning")
+            self._reply("gone", "the controlling console closed", "warning")
+
+    def _reply(self, kind: str, text: str, severity: str) -> None:
+        with contextlib.suppress(Exception):  # a console quitting: nobody to tell
+            self._on_reply(kind, text, severity)
 
     def send(self, kind: str) -> bool:
         """Send a request ("estop", "ask"); False when the hub no longer answers."""
@@ -320,5 +418,5 @@ def connect(url: str, state: MirrorState,
         return None
     try:
         return ShareClient(address, state, on_reply)
-    except (OSError, EOFError, AuthenticationError):
+    except (OSError, EOFError):
         return None

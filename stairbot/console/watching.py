@@ -15,12 +15,15 @@ from __future__ import annotations
 import errno
 import threading
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING
+
+from textual.screen import ModalScreen
 
 from stairbot.console.modals import MotionConfirm
 from stairbot.console.sharing import (
     MirrorState,
-    Reply,
+    Request,
     ShareClient,
     ShareHub,
     connect,
@@ -40,6 +43,9 @@ TAKE_OVER_WAIT_S = 30.0
 """How long a console that handed control over waits to watch the new controller."""
 HUB_WAIT_S = 2.0
 """How long a console that took control over waits for the old hub's address."""
+SHARE_WAIT_S = 3.0
+"""How long a console that finds the robot held waits for its holder to share
+it (a console still opening it does once the boards answer)."""
 
 
 class Sharing:
@@ -69,7 +75,7 @@ def share(app: StairbotConsole) -> None:
             app.sharing.hub = ShareHub(
                 address, app.state,
                 on_estop=lambda who: _estop_from(app, who),
-                on_ask=lambda who, reply: app.call_from_thread(_asked, app, who, reply))
+                on_ask=lambda request: app.call_from_thread(_asked, app, request))
             return
         except OSError as exc:
             # a console that handed control over here closes its hub just after
@@ -85,17 +91,29 @@ def unshare(app: StairbotConsole) -> None:
         hub.close()
 
 
-def watch(app: StairbotConsole, url: str) -> bool:
-    """Watch the console that holds ``url`` (False: none shares it)."""
-    stop_watching(app)
+def watch(app: StairbotConsole, url: str, wait_s: float = 0.0) -> bool:
+    """Watch the console that holds ``url``, trying for up to ``wait_s`` (a
+    console still opening the robot shares it once it answers); False: none
+    shares it, or this console holds a robot itself.  What a hub that went
+    quiet showed stays on screen meanwhile."""
+    client, app.sharing.client = app.sharing.client, None
+    if client is not None:
+        client.close()
     state = app.state
     if not isinstance(state, MirrorState):
         return False
-    client = connect(url, state, lambda kind, text, severity: app.call_from_thread(
-        _replied, app, kind, text, severity))
-    if client is None:
-        return False
-    state.watch(f"the console that opened {url} first")
+    deadline = time.monotonic() + wait_s
+    while True:
+        if app.sharing.hub is not None or app.engine.session is not None:
+            return False
+        client = connect(url, state, lambda kind, text, severity: app.call_from_thread(
+            _replied, app, kind, text, severity))
+        if client is not None:
+            break
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(0.1)
+    state.watch("another console")
     app.sharing.client = client
     return True
 
@@ -169,27 +187,35 @@ def _withdraw_question(app: StairbotConsole) -> None:
     app.refresh_view()
 
 
-def _asked(app: StairbotConsole, who: str, reply: Reply) -> None:
+def _asked(app: StairbotConsole, request: Request) -> None:
     """Another console asks for control (the UI thread)."""
+    who = request.who
     if app.engine.running:
-        reply(False, "a run is going on: the console that controls it must stop it or "
-                     "let it end first")
+        request.answer(False, "a run is going on: the console that controls it must stop "
+                              "it or let it end first")
         app.say(f"{who} asked for control: refused while the run goes on", "warning")
         return
     if app.sharing.asked:
-        reply(False, "its operator is being asked already")
+        request.answer(False, "its operator is being asked already")
+        return
+    if isinstance(app.screen, ModalScreen):  # a yes typed for that question must not hand over
+        request.answer(False, "its operator is answering another question there; ask again")
+        app.say(f"{who} asked for control while a question was open: told to ask again",
+                "warning")
         return
     app.sharing.asked = True
 
     def answered(yes: bool | None) -> None:
         app.sharing.asked = False
-        if not yes:
-            reply(False, "its operator kept control")
+        if not request.alive:
+            app.say(f"{who} has gone: control kept")
+        elif not yes:
+            request.answer(False, "its operator kept control")
             app.say(f"control kept: {who} was told no")
         elif app.engine.running:
-            reply(False, "a run began meanwhile")
+            request.answer(False, "a run began meanwhile")
         else:
-            _hand_over(app, who, reply)
+            _hand_over(app, request)
 
     app.push_screen(MotionConfirm(
         f"{who.capitalize()} asks for control of {app.url}.\n\nHand it over? This console "
@@ -197,29 +223,37 @@ def _asked(app: StairbotConsole, who: str, reply: Reply) -> None:
         yes="Hand over", no="Keep it (Esc)"), answered)
 
 
-def _hand_over(app: StairbotConsole, who: str, reply: Reply) -> None:
+def _hand_over(app: StairbotConsole, request: Request) -> None:
     """Close the robot, tell the asker it may open it, then watch it (a
     worker thread waits for the asker to share it)."""
+    who = request.who
     app.engine.close()
     app.state.set_status(robot="no robot", severity="info",
                          message=f"control handed to {who}")
-    reply(True, f"control handed over by {whoami()}")
-    unshare(app)
+    request.answer(True, f"control handed over by {whoami()}")
+    unshare(app)  # the answer goes first: the hub's thread sends it before it closes
     url = app.url
 
     def watch_new_controller() -> None:
-        deadline = time.monotonic() + TAKE_OVER_WAIT_S
-        while time.monotonic() < deadline:
-            if app.sharing.client is not None or app.engine.session is not None:
-                return
-            if watch(app, url):
-                app._tell(f"watching {url}: {who} controls it now", "information")
-                return
-            time.sleep(0.1)
-        app._tell(f"{who} did not open {url}: u opens it here", "warning")
+        if watch(app, url, wait_s=TAKE_OVER_WAIT_S):
+            app._tell(f"watching {url}: {who} controls it now", "information")
+        elif app.engine.session is None and app.sharing.client is None:
+            app._tell(f"{who} did not open {url}: u opens it here", "warning")
 
-    threading.Thread(target=watch_new_controller, name="watch the new controller",
-                     daemon=True).start()
+    _background(app, "watch the new controller", watch_new_controller)
+
+
+def _background(app: StairbotConsole, name: str, work: Callable[[], None]) -> None:
+    """Run ``work`` on a thread of its own; what fails there once the console
+    has quit (no screen left to tell) is let go."""
+    def run() -> None:
+        try:
+            work()
+        except Exception:
+            if app.is_running:
+                raise
+
+    threading.Thread(target=run, name=name, daemon=True).start()
 
 
 # -- the watching console --------------------------------------------------------
@@ -239,3 +273,11 @@ def _replied(app: StairbotConsole, kind: str, text: str, severity: str) -> None:
             client.close()
         app.say(f"the console that controlled {app.url} no longer answers; u opens the "
                 "robot here", "warning")
+        url = app.url
+
+        def rewatch() -> None:  # it may have handed control to another
+            if watch(app, url, wait_s=TAKE_OVER_WAIT_S / 3):
+                app._tell(f"watching {url} again: another console controls it now",
+                          "information")
+
+        _background(app, "watch again", rewatch)

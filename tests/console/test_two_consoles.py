@@ -158,3 +158,60 @@ def test_a_watched_console_that_closes_leaves_its_values_stale_and_the_robot_fre
             await until(p2, lambda: "READY" in banner(second)
                         and "WATCHING" not in banner(second), "controls it")
     asyncio.run(go())
+
+
+def test_a_third_console_watches_whoever_controls_after_a_handover_red_team(
+        boards_url: str) -> None:
+    """Finding: a third console was left saying nothing controls the robot."""
+    async def go() -> None:
+        a, b, c = (build_app(url=boards_url) for _ in range(3))
+        async with a.run_test(size=(120, 40)) as pa:
+            await ready(pa)
+            async with b.run_test(size=(120, 40)) as pb, c.run_test(size=(120, 40)) as pc:
+                await b.workers.wait_for_complete()
+                await c.workers.wait_for_complete()
+                await until(pc, lambda: "WATCHING" in banner(b) and "WATCHING" in banner(c),
+                            "both watch")
+                await press(pb, "h")
+                await until(pa, lambda: isinstance(a.screen, MotionConfirm), "asked")
+                await say_yes(pa)
+                await until(pb, lambda: b.engine.session is not None
+                            and b.sharing.hub is not None, "b controls and shares")
+                await until(pc, lambda: c.sharing.client is not None and "watching "
+                            "serial" in said(c) and "again" in said(c), "c watches b")
+                await until(pc, lambda: "WATCHING" in banner(c) and "READY" in banner(c),
+                            "shown so")
+                await press(pc, "space")
+                await until(pb, lambda: b.state.view().status.estopped, "c's stop reaches b")
+    asyncio.run(go())
+
+
+def test_a_request_never_answers_another_question_nor_outlives_its_asker_red_team(
+        boards_url: str) -> None:
+    """Findings: a yes typed for "Start calibration" handed control over (the
+    request had covered that question); a yes to a request whose console had
+    quit closed the robot for no one."""
+    async def go() -> None:
+        first = build_app(url=boards_url)
+        async with first.run_test(size=(120, 40)) as p1:
+            await ready(p1)
+            second = build_app(url=boards_url)
+            async with second.run_test(size=(120, 40)) as p2:
+                await second.workers.wait_for_complete()
+                await until(p2, lambda: "WATCHING" in banner(second), "watching")
+                await press(p1, "k")  # a question of the first's own, open
+                await until(p1, lambda: isinstance(first.screen, MotionConfirm), "asked")
+                question = first.screen
+                await press(p2, "h")
+                await until(p2, lambda: "answering another question there" in said(second),
+                            "told to ask again")
+                assert first.screen is question
+                await press(p1, "escape")
+                await until(p1, lambda: not isinstance(first.screen, MotionConfirm), "closed")
+                await press(p2, "h")
+                await until(p1, lambda: isinstance(first.screen, MotionConfirm), "asked now")
+            # the asker quit before the answer: yes keeps control here
+            await say_yes(p1)
+            await until(p1, lambda: "has gone: control kept" in said(first), "told")
+            assert first.engine.session is not None and first.sharing.hub is not None
+    asyncio.run(go())
