@@ -33,8 +33,8 @@ from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key
 from stairbot.console.help import COMMANDS, HelpScreen
 from stairbot.console.limp_gate import stranded
+from stairbot.console.mirror import MirrorState
 from stairbot.console.robot_holder import SPEEDS
-from stairbot.console.sharing import MirrorState
 from stairbot.console.state import StateView
 from stairbot.console.widgets.banner import Banner
 from stairbot.console.widgets.estop import ESTOP_KEY, EStopButton

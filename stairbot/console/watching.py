@@ -20,9 +20,9 @@ from typing import TYPE_CHECKING
 
 from textual.screen import ModalScreen
 
+from stairbot.console.mirror import MirrorState
 from stairbot.console.modals import MotionConfirm
 from stairbot.console.sharing import (
-    MirrorState,
     Request,
     ShareClient,
     ShareHub,

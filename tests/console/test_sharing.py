@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from stairbot.console.mirror import MirrorState
 from stairbot.console.sharing import (
-    MirrorState,
     Request,
     ShareAddress,
     ShareClient,
