@@ -83,6 +83,8 @@ class StairbotConsole(App[None]):
         Binding("t", "top_view", "top view", show=False),
         Binding("g", "graphs", "graphs", show=False),
         Binding("h", "ask_control", "ask control", show=False),
+        Binding("e", "event_filter", "filter events", show=False),
+        Binding("slash", "event_search", "search events", show=False, key_display="/"),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
     ]
@@ -363,6 +365,12 @@ class StairbotConsole(App[None]):
 
     def action_ask_control(self) -> None:
         watching.ask_control(self)
+
+    def action_event_filter(self) -> None:
+        choices.event_filter(self)
+
+    def action_event_search(self) -> None:
+        choices.event_search(self)
 
     def action_zoom(self) -> None:
         choices.zoom(self)

@@ -122,3 +122,22 @@ def top_view(app: StairbotConsole) -> None:
             else "picture: side view (t: the top view)", keep=False)
     app.shown_key = None
     app.refresh_view()
+
+
+def event_filter(app: StairbotConsole) -> None:
+    """``e``: the event list's next filter (every event, errors, warnings,
+    phases, the link's)."""
+    kinds = app.log_panel.next_filter()
+    app.notify(f"events: {kinds}" if kinds == "all" else f"events: {kinds} only",
+               timeout=2, markup=False)
+
+
+def event_search(app: StairbotConsole) -> None:
+    """``/``: list only the events whose text holds what is typed (empty: all)."""
+    def chosen(text: str | None) -> None:
+        if text is not None:
+            app.log_panel.set_filter(search=text)
+
+    app.push_screen(AskScreen("Search the events", app.log_panel.search, "lift",
+                              "only the events whose text holds it (any case); "
+                              "empty: every event"), chosen)

@@ -37,6 +37,10 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
     ("ask_control", "Ask for control", "Watching another console's robot: ask its "
                                        "operator to hand control over (key: h)"),
+    ("event_filter", "Filter the events", "Every event, errors, warnings, phases, the "
+                                           "link's: the next (key: e)"),
+    ("event_search", "Search the events", "Only the events whose text holds a word "
+                                          "(key: /)"),
     ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
 
@@ -62,6 +66,10 @@ KEYS
   g       graphs: pitch, distance sensors, lifts over the last
           30 s of robot time (36 rows or more: under the
           picture; fewer: in its place until g again)
+  e       the event list: every event, errors, warnings (and
+          errors), phases, the link's; e again: the next
+  /       the event list: only events whose text holds a word
+          (empty: every event)
   h       watching a robot another console controls: ask that
           console's operator to hand control over
   Ctrl+P  every action by name

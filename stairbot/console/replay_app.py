@@ -59,6 +59,7 @@ KEYS
   shift+← → back / forward {SEEK_LONG_S:g} s (also [ and ])
   Home End  the start / the end
   g         graphs (pitch, distance sensors, lifts; last 30 s)
+  e /       the event list: filter by kind / search its text
   z         picture zoom
   t         top view: a recording holds no pose seen from
             above, so it says so (t again: the side view)
