@@ -96,9 +96,7 @@ def watch(app: StairbotConsole, url: str, wait_s: float = 0.0) -> bool:
     console still opening the robot shares it once it answers); False: none
     shares it, or this console holds a robot itself.  What a hub that went
     quiet showed stays on screen meanwhile."""
-    client, app.sharing.client = app.sharing.client, None
-    if client is not None:
-        client.close()
+    _drop_client(app)
     state = app.state
     if not isinstance(state, MirrorState):
         return False
@@ -118,10 +116,15 @@ def watch(app: StairbotConsole, url: str, wait_s: float = 0.0) -> bool:
     return True
 
 
-def stop_watching(app: StairbotConsole) -> None:
+def _drop_client(app: StairbotConsole) -> None:
+    """Close the connection to the hub watched, if any (the screen keeps what it showed)."""
     client, app.sharing.client = app.sharing.client, None
     if client is not None:
         client.close()
+
+
+def stop_watching(app: StairbotConsole) -> None:
+    _drop_client(app)
     if isinstance(app.state, MirrorState):
         app.state.unwatch()
 
@@ -129,9 +132,7 @@ def stop_watching(app: StairbotConsole) -> None:
 def close(app: StairbotConsole) -> None:
     """The console quits: stop sharing and watching."""
     unshare(app)
-    client, app.sharing.client = app.sharing.client, None
-    if client is not None:
-        client.close()
+    _drop_client(app)
 
 
 def blocked(app: StairbotConsole, action: str) -> bool:
@@ -268,9 +269,7 @@ def _replied(app: StairbotConsole, kind: str, text: str, severity: str) -> None:
         app.say(f"{text}: opening the robot here")
         app.open_robot(app.url, app.scenario)
     elif kind == "gone":
-        client, app.sharing.client = app.sharing.client, None
-        if client is not None:
-            client.close()
+        _drop_client(app)
         app.say(f"the console that controlled {app.url} no longer answers; u opens the "
                 "robot here", "warning")
         url = app.url
