@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from functools import cache
 
 import msgspec
 
 from stairbot.control.algorithm import limits
 from stairbot.inputs.config import RobotConfig
-from stairbot.inputs.scenario import Scenario, Step
+from stairbot.inputs.scenario import Scenario, Step, parse_scenario
 from stairbot.sweep.spec import Rules
 
 SIGHT_MARGIN_M = 0.02
@@ -42,15 +43,55 @@ def first_sight(scenario: Scenario, config: RobotConfig) -> float:
     or a cone as the sensor model combines it, so a cone tilted up that takes
     in the risers beyond the first reads long.  The calibration's case 1 stops
     the robot, rightly, when both read LENGTH_OF_INFINITY or more: stairs that
-    far are not in sight, whatever their steps."""
+    far are not in sight, whatever their steps.
+
+    A robot set down on the floor at least :data:`FLOOR_CLEAR_M` before the
+    first riser touches nothing but the floor while it stands, so it comes
+    to rest as it does on open floor: its pose there (:func:`_rest_on_floor`,
+    once per robot config) is moved to where this robot was set down instead
+    of stepping the physics again."""
     from stairbot.fakes.sim import SimRobot  # the sweep runs the sim anyway
 
     robot = SimRobot(config, scenario)
-    robot.advance(REST_S)
+    if scenario.start.on == "floor" and scenario.start.distance >= FLOOR_CLEAR_M:
+        world = robot.world
+        bodies = (*world.segments, *world.all_wheels)
+        for body, (dx, y, angle) in zip(bodies, _rest_on_floor(config), strict=True):
+            body.position = (body.position.x + dx, y)
+            body.angle = angle
+        world.shift(0.0)  # the poses are read afresh
+        robot.plan.move(_rest_on_floor(config)[1][0])  # segment 2's drift, as advance moves it
+    else:
+        robot.advance(REST_S)
     right, left = robot.board.front_seen()
     hi = config.sensors.range(back=False)[1]
     seen = [d for d in (right, left) if d is not None and d <= hi]
     return min(seen, default=math.inf)
+
+
+FLOOR_CLEAR_M = 0.05
+"""How far before the first riser a robot set down on the floor stands clear
+of it while it comes to rest (it moves well under a millimetre)."""
+
+_OPEN_FLOOR = "[stairs]\ncount = 1\n[start]\ndistance = 1.0\n"
+"""Where :func:`_rest_on_floor` lets a robot come to rest: a metre before a
+single step."""
+
+
+@cache
+def _rest_on_floor(config: RobotConfig) -> tuple[tuple[float, float, float], ...]:
+    """Each body of ``config``'s simulated robot (segments, then wheels, in the
+    world's order) after standing :data:`REST_S` on open floor: how far it
+    moved along x from where it was set down, its height and its angle."""
+    from stairbot.fakes.sim import SimRobot
+
+    robot = SimRobot(config, parse_scenario(_OPEN_FLOOR, "<open floor>"))
+    world = robot.world
+    bodies = (*world.segments, *world.all_wheels)
+    set_down = [body.position.x for body in bodies]
+    robot.advance(REST_S)
+    return tuple((body.position.x - x0, body.position.y, body.angle)
+                 for body, x0 in zip(bodies, set_down, strict=True))
 
 
 def sight_margin(config: RobotConfig) -> float:

@@ -3,6 +3,7 @@ before any case runs (exit 2, one line naming the field and what is allowed)."""
 
 from __future__ import annotations
 
+import math
 import sys
 import types
 from dataclasses import replace
@@ -18,7 +19,7 @@ from stairbot.sweep.cases import Case, build_case, check_spec
 from stairbot.sweep.execute import open_executor
 from stairbot.sweep.spec import Rules, parse_spec
 from stairbot.sweep.worker import run_case
-from stairbot.sweep.zones import first_sight, sight_margin, zone
+from stairbot.sweep.zones import REST_S, first_sight, sight_margin, zone
 
 VL53L1X_FRONT = load_config(str(Path(__file__).parents[1] / "robots" / "vl53l1x_front.toml"))
 
@@ -240,6 +241,34 @@ def test_a_cone_that_looks_up_sees_the_first_riser_nearer_than_a_level_ray() -> 
     assert first_sight(scen, load_config("reference")) == pytest.approx(0.95, abs=0.005)
     assert zone(scen, load_config("ideal"), rules)[0] == "inside"
     assert zone(scen, VL53L1X_FRONT, rules)[0] == "outside"
+
+
+OPEN_STAIRS = "[stairs]\ncount = 3\nrise = 0.17\ntread = 0.28\n[start]\ndistance = {}\n" \
+    "yaw_deg = {}\nlateral = {}\n"
+
+
+@pytest.mark.parametrize("robot", ["reference", "sonar", "ideal"])
+@pytest.mark.parametrize("stairs", [OPEN_STAIRS.format(0.3, 0.0, 0.0),
+                                    OPEN_STAIRS.format(0.62, -17.0, 0.12),
+                                    OPEN_STAIRS.format(0.95, 9.5, -0.15),
+                                    "grazed nosing"])
+def test_first_sight_from_the_pose_at_rest_on_open_floor_reads_as_standing_there(
+        robot: str, stairs: str) -> None:
+    """first_sight moves the robot's pose at rest on open floor to where the
+    case sets it down instead of stepping the physics: what the front pair
+    then reads is what it reads after standing REST_S there (on the grazed
+    nosing below, the half millimetre it rises to rest moves the reference
+    robot's reading from riser 1 to the riser beyond)."""
+    from stairbot.fakes.sim import SimRobot
+
+    config = load_config(robot)
+    scen = parse_scenario(GRAZED_NOSING if stairs == "grazed nosing" else stairs, "x")
+    stood = SimRobot(config, scen)
+    stood.advance(REST_S)
+    hi = config.sensors.range(back=False)[1]
+    seen = min([d for d in stood.board.front_seen() if d is not None and d <= hi],
+               default=math.inf)
+    assert first_sight(scen, config) == pytest.approx(seen, abs=1e-9)
 
 
 # envelope case 485 on 52f0446: 0.945 m from a 0.122 m riser, 15 deg askew
