@@ -65,15 +65,15 @@ class Kind(IntEnum):
 
 
 # bound once: an enum's member costs a slow attribute look-up, every sensor every tick
-_KIND_OK, _KIND_ERROR = Kind.OK, Kind.ERROR
-_STATUS_OK = SensorStatus.OK
+_KIND_OK, _KIND_NEAR, _KIND_FAR, _KIND_ERROR = Kind.OK, Kind.NEAR, Kind.FAR, Kind.ERROR
+_STATUS_OK, _STATUS_OUT = SensorStatus.OK, SensorStatus.OUT_OF_RANGE
 
 
 class _Track:
     """One sensor's recent measurements and the kind seen."""
 
-    __slots__ = ("front", "max_age", "midpoint", "ok_keys", "newest", "taken_s", "kind",
-                 "run_kind", "run", "last_of_kind", "seen_ok")
+    __slots__ = ("front", "max_age", "midpoint", "ok_keys", "median", "newest", "taken_s",
+                 "kind", "run_kind", "run", "last_of_kind", "seen_ok")
 
     def __init__(self, front: bool, window: int, max_age: float, midpoint: float) -> None:
         self.front = front
@@ -82,6 +82,9 @@ class _Track:
         self.ok_keys: deque[float] = deque(maxlen=window)
         """The last OK measurements' distances, plus (front) the odometer when
         each was taken; emptied when the kind seen leaves OK."""
+        self.median: float | None = None
+        """The median of ok_keys (None: there are none), taken when they
+        change: the ticks between two measurements read the same one."""
         self.newest: SensorReading | None = None
         self.taken_s = -math.inf
         self.kind: Kind | None = None
@@ -125,7 +128,7 @@ class Perception:
         now = snap.time_s
         self._odometer.append((now, odometer))
         sensors: dict[SensorId, SensorReading] = {}
-        tracks = self._tracks
+        tracks, why = self._tracks, self._why
         for sid, reading in snap.sensors.items():
             track = tracks[sid]
             age = reading.age_s
@@ -141,7 +144,8 @@ class Perception:
                         track.run += 1
                         keys = track.ok_keys
                         keys.append(d + odometer if track.front else d)
-                        m = _median(keys) - odometer if track.front else _median(keys)
+                        median = track.median = _median(keys)
+                        m = median - odometer if track.front else median
                         # immutable, and a new one costs: reuse an equal one (0.0 may be -0.0)
                         seen = track.seen_ok
                         if seen is None or seen.distance_m != m or m == 0.0:
@@ -150,8 +154,19 @@ class Perception:
                         continue
                 self._measured(track, reading, now, odometer)
             elif now - age > track.taken_s + 1e-9:
-                self._measured(track, reading, now - age, value_at(self._odometer, now - age))
-            sensors[sid] = self._verdict(sid, track, now, odometer)
+                taken = now - age  # the odometer then places a front measurement
+                self._measured(track, reading, taken,
+                               value_at(self._odometer, taken) if track.front else 0.0)
+            age = now - track.taken_s
+            kept = track.median
+            if track.kind is _KIND_OK and kept is not None and age <= track.max_age:
+                # the common case, kept short: the median of recent OK measurements
+                if why:  # most often empty: nothing to look up
+                    why.pop(sid, None)
+                sensors[sid] = SensorReading(kept - odometer if track.front else kept,
+                                             _STATUS_OK, age)
+            else:
+                sensors[sid] = self._verdict(sid, track, now, odometer)
         self._stuck.judge(snap, sensors, self._why)
         return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
@@ -169,19 +184,22 @@ class Perception:
     # -- per measurement ----------------------------------------------------------------
     def _measured(self, track: _Track, reading: SensorReading, taken: float,
                   odometer: float) -> None:
-        if reading.status is SensorStatus.OK:
+        """Take a new measurement, taken at ``taken`` (``odometer``: the drive's
+        odometer then, which only a front track uses)."""
+        status = reading.status
+        if status is _STATUS_OK:
             if not math.isfinite(reading.distance_m):
                 reading = SensorReading(reading.distance_m, SensorStatus.ERROR, reading.age_s)
-                kind = Kind.ERROR
+                kind = _KIND_ERROR
             else:
-                kind = Kind.OK
+                kind = _KIND_OK
                 d = reading.distance_m
                 track.ok_keys.append(d + odometer if track.front else d)
-        elif reading.status is SensorStatus.OUT_OF_RANGE:
-            kind = Kind.NEAR if reading.distance_m < track.midpoint else Kind.FAR
+        elif status is _STATUS_OUT:
+            kind = _KIND_NEAR if reading.distance_m < track.midpoint else _KIND_FAR
         else:
-            kind = Kind.ERROR
-        if kind is not Kind.OK and track.kind is not Kind.OK:
+            kind = _KIND_ERROR
+        if kind is not _KIND_OK and track.kind is not _KIND_OK:
             # OK measurements since the kind seen left OK that a bad one ends
             # came too few in a row to bring OK back: lone strays, not for
             # the median when it comes back
@@ -193,38 +211,43 @@ class Perception:
         else:
             track.run_kind, track.run = kind, 1
         if track.kind is None or (kind is not track.kind and track.run >= CONFIRM):
-            if track.kind is Kind.OK:
+            if track.kind is _KIND_OK:
                 # a fresh median when it comes back
                 track.ok_keys.clear()
             track.kind = kind
+        track.median = _median(track.ok_keys) if track.ok_keys else None
 
+    # -- per tick -------------------------------------------------------------------------
     def _verdict(self, sid: SensorId, track: _Track, now: float, odometer: float
                  ) -> SensorReading:
         newest = track.newest
         assert newest is not None and track.kind is not None
+        why = self._why
         age = now - track.taken_s
         if age > track.max_age:
-            self._why[sid] = (f"stale: its newest measurement is {age:.2f} s old "
-                              f"(at most {track.max_age:.2f} s)")
+            why[sid] = (f"stale: its newest measurement is {age:.2f} s old "
+                        f"(at most {track.max_age:.2f} s)")
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         kind = track.kind
         if kind is _KIND_OK:
-            if track.ok_keys:
-                m = _median(track.ok_keys)
-                self._why.pop(sid, None)
+            m = track.median
+            if m is not None:
+                if why:  # most often empty: nothing to look up
+                    why.pop(sid, None)
                 return SensorReading(m - odometer if track.front else m, _STATUS_OK, age)
-            self._why[sid] = "no valid measurement among its last ones"
+            why[sid] = "no valid measurement among its last ones"
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
         if kind is _KIND_ERROR:
-            self._why[sid] = f"{CONFIRM} measurements in a row report an error"
+            why[sid] = f"{CONFIRM} measurements in a row report an error"
             return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
-        self._why.pop(sid, None)
+        if why:
+            why.pop(sid, None)
         held = track.last_of_kind[kind]
         return SensorReading(held.distance_m, SensorStatus.OUT_OF_RANGE, age)
 
 
 def _median(values: Iterable[float]) -> float:
-    """statistics.median, without its generality (every sensor, every tick)."""
+    """statistics.median, without its generality (every sensor, every measurement)."""
     s = sorted(values)
     n = len(s)
     half = n // 2

@@ -60,6 +60,7 @@ from stairbot.hardware import (
     BACK_SENSORS,
     FRONT_SENSORS,
     WHEEL_MOTORS,
+    Imu,
     MotorId,
     SensorId,
     SensorReading,
@@ -113,6 +114,7 @@ publishes late (0.64 s at 20 ms, as perception's odometer)."""
 _PARTNER = {SensorId.SFR: SensorId.SFL, SensorId.SFL: SensorId.SFR,
             SensorId.SBR: SensorId.SBL, SensorId.SBL: SensorId.SBR}
 _OK, _OUT = SensorStatus.OK, SensorStatus.OUT_OF_RANGE
+_MTB = MotorId.MTB
 OK, NEAR, FAR = 0, 1, 2
 """What a value is: a distance, the "too near" clamp, the "nothing within
 range" clamp."""
@@ -146,7 +148,9 @@ def drive_limit(cfg: RobotConfig) -> float:
 
 class _Run:
     """One sensor's current run of measurements of one value, and what its
-    partner did meanwhile."""
+    partner did meanwhile.  A front sensor's run follows the drive's
+    odometer (its MTB figures stay 0), a back sensor's MTB's travel (its
+    odometer figures stay 0, and None)."""
 
     __slots__ = ("value", "count", "first_s", "taken_s", "odometer", "last_odometer",
                  "last_lift", "partner", "partner_last", "settled_s", "lift_from", "evidence",
@@ -162,6 +166,7 @@ class _Run:
         measurement that was a riser's or a wall's since the last that may
         not have been (None: may not be)."""
         self.last_odometer = odometer
+        """The odometer at the latest measurement."""
         self.last_lift = lift
         """MTB's travel (any direction) at the latest measurement."""
         self.partner: float | None = None
@@ -188,6 +193,7 @@ class StuckWatch:
         self._lift_m = cfg.motors.lift_travel_per_turn
         self._limit = drive_limit(cfg)
         self._runs: dict[SensorId, _Run | None] = dict.fromkeys(FRONT_SENSORS + BACK_SENSORS)
+        self._front = frozenset(FRONT_SENSORS)
         self._midpoint = {sid: sum(cfg.sensors.range(sid in BACK_SENSORS)) / 2.0
                           for sid in self._runs}
         self._settle = settle_s(cfg, back=True)
@@ -196,8 +202,8 @@ class StuckWatch:
         self._turns: tuple[float, ...] | None = None
         self._odometer = 0.0
         self._lift = 0.0
-        self._clear = -1.0
-        """A front value nearer than this is a riser's or a wall's (-1: none is)."""
+        self._imu: Imu | None = None
+        """This tick's IMU reading (its pitch says what the front pair looks at)."""
         s = cfg.sensors
         fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
         self._lowest_deg = s.front_tilt_deg - fov / 2.0
@@ -212,18 +218,23 @@ class StuckWatch:
         say why in ``why``."""
         now = self._now = snap.time_s
         self._moved(snap, now)
+        sensors, taken_at = snap.sensors, self._taken
         for sid, run in self._runs.items():
-            raw = snap.sensors.get(sid)
+            raw = sensors.get(sid)
             if raw is None:
                 continue
             taken = now - raw.age_s
-            if taken > self._taken.get(sid, -math.inf) + 1e-9:  # a new measurement
-                self._taken[sid] = taken
+            if taken > taken_at.get(sid, -math.inf) + 1e-9:  # a new measurement
+                taken_at[sid] = taken
                 run = self._measured(sid, run, raw, taken)
             if run is None:
                 continue
-            # judged once, it stays so while the value holds (the figures as they stand)
-            run.why = self._stuck(sid, run, seen) or run.why
+            # the partner is followed every tick; a run is judged from REPEATS
+            # measurements on, and once judged it stays so while the value
+            # holds (the figures as they stand)
+            lifted = None if sid in self._front else self._partner(sid, run, seen)
+            if run.count >= REPEATS:
+                run.why = self._stuck(sid, run, lifted) or run.why
             if run.why is not None:
                 held = seen.get(sid)
                 age = raw.age_s if held is None else held.age_s
@@ -251,21 +262,32 @@ class StuckWatch:
     def _moved(self, snap: Snapshot, now: float) -> None:
         """Add what every wheel drove alike this tick to the odometer, and
         MTB's turns, any direction, to its travel."""
-        turns = (*(snap.turns(m) for m in WHEEL_MOTORS), snap.turns(MotorId.MTB))
+        motors = snap.motors
+        w0, w1, w2, w3 = WHEEL_MOTORS
+        turns = (motors[w0].turns, motors[w1].turns, motors[w2].turns, motors[w3].turns,
+                 motors[_MTB].turns)
         last = self._turns
         if last is not None:
-            deltas = [a - b for a, b in zip(turns[:4], last[:4], strict=True)]
+            d0, d1, d2, d3 = (turns[0] - last[0], turns[1] - last[1], turns[2] - last[2],
+                              turns[3] - last[3])
             lift = abs(turns[4] - last[4]) * self._lift_m
-            if lift == lift and min(deltas) == min(deltas):  # not a number: no move here
+            least = min(d0, d1, d2, d3)
+            if lift == lift and least == least:  # not a number: no move here
                 self._lift += lift
-                if min(deltas) > 0.0 or max(deltas) < 0.0:
-                    alike = min(deltas) if deltas[0] > 0.0 else max(deltas)
+                most = max(d0, d1, d2, d3)
+                if least > 0.0 or most < 0.0:
+                    alike = least if d0 > 0.0 else most
                     self._odometer += alike * self._wheel_m
         self._turns = turns
-        imu = snap.imu
-        self._clear = -1.0 if imu is None else self._floor_m(imu.pitch_deg)
+        self._imu = snap.imu
         self._odometers.append((now, self._odometer))
         self._lifts.append((now, self._lift))
+
+    def _clear_m(self) -> float:
+        """A front value nearer than this is a riser's or a wall's, at this
+        tick's pitch (-1: none is, the pitch not known)."""
+        imu = self._imu
+        return -1.0 if imu is None else self._floor_m(imu.pitch_deg)
 
     def _floor_m(self, pitch_deg: float) -> float:
         """How near a front value must be to be a riser's or a wall's, at
@@ -300,8 +322,11 @@ class StuckWatch:
         if value is None:
             self._runs[sid] = None
             return None
-        odometer, lift = value_at(self._odometers, taken), value_at(self._lifts, taken)
-        clear = value[0] < self._clear  # a riser's or a wall's: the drive moves it
+        if sid in self._front:  # judged by the drive (the module docstring)
+            odometer, lift = value_at(self._odometers, taken), 0.0
+            clear = value[0] < self._clear_m()  # a riser's or a wall's: the drive moves it
+        else:  # judged by the partner, as MTB moves segment 3
+            odometer, lift, clear = 0.0, value_at(self._lifts, taken), False
         if run is not None and value == run.value:
             run.taken_s, run.last_odometer, run.last_lift = taken, odometer, lift
             if not clear:
@@ -316,15 +341,12 @@ class StuckWatch:
         self._runs[sid] = run
         return run
 
-    def _stuck(self, sid: SensorId, run: _Run, seen: dict[SensorId, SensorReading]
-               ) -> str | None:
-        """Why the run says the sensor is stuck, or None."""
-        front = sid in FRONT_SENSORS
-        lifted = None if front else self._partner(sid, run, seen)  # followed every tick
-        if run.count < REPEATS:
-            return None
+    def _stuck(self, sid: SensorId, run: _Run, lifted: str | None) -> str | None:
+        """Why the run (REPEATS measurements or more) says the sensor is
+        stuck, or None; ``lifted``: what the partner did, if it moved with
+        MTB as this one should have (:meth:`_partner`)."""
         v, kind = run.value
-        if front and run.odometer is not None and kind != FAR:
+        if sid in self._front and run.odometer is not None and kind != FAR:
             drove = run.last_odometer - run.odometer
             # too near says only that the surface is nearer than the minimum:
             # backing away more than the minimum (and the limit) must end it.

@@ -8,15 +8,21 @@ from collections.abc import Sequence
 def value_at(samples: Sequence[tuple[float, float]], t: float) -> float:
     """The value of ``(time, value)`` samples (oldest first) at time ``t``:
     linear between the samples either side, the oldest if ``t`` is older,
-    the newest if it is later."""
-    later: tuple[float, float] | None = None
-    for at, value in reversed(samples):
+    the newest if it is later.  Searched from the newest: the time asked
+    for is most often within the last tick."""
+    i = len(samples) - 1
+    at, value = samples[i]
+    if at <= t:
+        return value
+    while i > 0:
+        i -= 1
+        later_at, later_value = at, value
+        at, value = samples[i]
         if at <= t:
-            if later is None or later[0] == at:
+            if later_at == at:
                 return value
-            return value + (later[1] - value) * (t - at) / (later[0] - at)
-        later = (at, value)
-    return samples[0][1]
+            return value + (later_value - value) * (t - at) / (later_at - at)
+    return value
 
 
 def keep_since(samples: list[tuple[float, float]], t: float) -> None:

@@ -113,6 +113,25 @@ ONTO_THE_TREAD = frozenset({Phase.ASCENT_DRIVE_FIRST, Phase.ASCENT_LIFT_SECOND,
 (ascent 3); limping home it finishes the step by it."""
 
 
+def _values(phases: frozenset[Phase]) -> frozenset[str]:
+    """``phases`` by their values, as the context holds them: :meth:`BiasWatch.see`
+    asks every tick, and a str hashes faster than an Enum member."""
+    return frozenset(p.value for p in phases)
+
+
+_FIRST_STANDS, _ON_A_SURFACE, _HANGING = _values(FIRST_STANDS), _values(ON_A_SURFACE), \
+    _values(HANGING)
+_STEERS_BY_THE_FRONT, _STEERS_BY_THE_BACK = _values(STEERS_BY_THE_FRONT), \
+    _values(STEERS_BY_THE_BACK)
+
+# bound once: an enum member's look-up costs, every tick
+_PAUSED = Phase.PAUSED
+_MWF, _MWB, _MWR, _MWL = MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL
+_MTF, _MTB = MotorId.MTF, MotorId.MTB
+_SBR, _SBL = SensorId.SBR, SensorId.SBL
+_OK = SensorStatus.OK
+
+
 class BiasWatch:
     """Gathers the evidence and judges biased sensors (see the module
     docstring).  One per controller, told every tick's filtered snapshot."""
@@ -123,6 +142,7 @@ class BiasWatch:
         self._metres_per_turn = cfg.wheel_circumference / len(WHEEL_MOTORS)
         self._wheel_m = cfg.wheel_circumference
         self._near = cfg.sensors.range(True)[0]
+        self._drop = cfg.BACK_CLEARANCE + DROP_M
         self._watches = (PairWatch(cfg, SensorId.SFR, SensorId.SFL, False),
                          PairWatch(cfg, SensorId.SBR, SensorId.SBL, True))
         self._pairs = (self._watches[0].track, self._watches[1].track)
@@ -170,41 +190,45 @@ class BiasWatch:
         where the evidence decides (module docstring); the snapshot with
         every sensor judged biased reading as ERROR."""
         phase = BY_VALUE[ctx.phase]
+        paused = phase is _PAUSED
+        # the standing rule's wait stands where the phase it stopped in stood
+        at = ctx.pause.resume_phase if paused and ctx.pause is not None else ctx.phase
+        where = BY_VALUE[at]
         motors = snap.motors
-        odometer = sum(motors[m].turns for m in WHEEL_MOTORS) * self._metres_per_turn
-        yaw = (motors[MotorId.MWR].turns - motors[MotorId.MWL].turns) * self._yaw_per_turn
+        right, left = motors[_MWR].turns, motors[_MWL].turns
+        odometer = sum((motors[_MWF].turns, motors[_MWB].turns, right, left)) \
+            * self._metres_per_turn
+        yaw = (right - left) * self._yaw_per_turn
         front, back = self._pairs
         judged = self._judged
-        # the standing rule's wait stands where the phase it stopped in stood
-        where = BY_VALUE[ctx.pause.resume_phase] if phase is Phase.PAUSED \
-            and ctx.pause is not None else phase
-        mtf = motors[MotorId.MTF].turns
-        if where not in FIRST_STANDS and self._mtf is not None:
+        mtf = motors[_MTF].turns
+        if at not in _FIRST_STANDS and self._mtf is not None:
             self._cones_m += (mtf - self._mtf) * self._lift_m
         self._mtf = mtf
         self._watches[0].tick(snap, odometer, yaw, self._cones_m, True, judged)
-        surface = where in ON_A_SURFACE and not ctx.from_top
-        mtb = motors[MotorId.MTB].turns
-        if where in HANGING and self._mtb is not None:
+        surface = at in _ON_A_SURFACE and not ctx.from_top
+        mtb = motors[_MTB].turns
+        if at in _HANGING and self._mtb is not None:
             self._hung_m += (mtb - self._mtb) * self._lift_m
         self._mtb = mtb
         self._watches[1].tick(snap, odometer, yaw, self._hung_m, surface, judged)
         self._on_a_surface(snap, surface)
-        self._rises.tick(snap, where, phase is Phase.PAUSED, ctx.number_of_steps)
+        self._rises.tick(snap, where, paused, ctx.number_of_steps)
         if ctx.length_of_next_step != self._tread[0]:
             self._tread = (ctx.length_of_next_step, snap.time_s)
         if ctx.number_of_steps not in self._risers:
             self._references(snap, ctx, odometer, yaw)
         if not self._distrusted:  # a squaring turn chased an offset (squaring_bias.py)
             chased = distrusted_chasing(ctx, where)
-            (self._judged if len(chased) == 1 else self._distrusted).update(chased)
-        if phase is Phase.PAUSED and ctx.pause is not None:
+            if chased:
+                (self._judged if len(chased) == 1 else self._distrusted).update(chased)
+        if paused and ctx.pause is not None:
             self._judge_pause(snap, ctx, odometer, yaw)
-        elif phase in STEERS_BY_THE_FRONT and not ctx.from_top:
+        elif ctx.phase in _STEERS_BY_THE_FRONT and not ctx.from_top:
             family = ctx.family
             if isinstance(family, Calibration) and family.purpose in _RISER_PURPOSES:
                 self._judge_at_once(front, snap)
-        elif phase in STEERS_BY_THE_BACK:
+        elif ctx.phase in _STEERS_BY_THE_BACK:
             self._judge_at_once(back, snap)
             found = None if judged or ctx.from_top else bias_mount.at_once(self._cfg, self._mount,
                                                                            snap)
@@ -243,13 +267,12 @@ class BiasWatch:
         if not surface:
             self._mount.end()
             return
-        r, left = snap.sensors[SensorId.SBR], snap.sensors[SensorId.SBL]
+        r, left = snap.sensors[_SBR], snap.sensors[_SBL]
         dr, dl = distance(r, self._near), distance(left, self._near)
-        drop = self._cfg.BACK_CLEARANCE + DROP_M
-        if dr is None or dl is None or max(dr, dl) > drop:
+        if dr is None or dl is None or max(dr, dl) > self._drop:
             self._mount.end()
         else:
-            self._mount.add(dr, dl, not r.ok, not left.ok)
+            self._mount.add(dr, dl, r.status is not _OK, left.status is not _OK)
 
     def _judge_at_once(self, track: Onsets, snap: Snapshot) -> None:
         """Where the robot steers by the pair: a sensor its onsets name, by

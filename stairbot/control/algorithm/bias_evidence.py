@@ -201,18 +201,22 @@ class MountHeights:
         ticks, sums = self.ticks, self.sums
         sample = (right - self.clearance, left - self.clearance, right_near, left_near)
         ticks.append(sample)
-        for k in range(4):
-            sums[k] += sample[k]
+        sums[0] += sample[0]
+        sums[1] += sample[1]
+        sums[2] += right_near
+        sums[3] += left_near
         if len(ticks) > MOUNT_TICKS:
             old = ticks.popleft()
-            for k in range(4):
-                sums[k] -= old[k]
+            sums[0] -= old[0]
+            sums[1] -= old[1]
+            sums[2] -= old[2]
+            sums[3] -= old[3]
         for k, run in enumerate(self.runs):
             if sample[2 + k] and not sample[3 - k]:
                 run[0] += 1
                 run[1] += sample[k]
                 run[2] = max(run[2], abs(sample[1 - k]))
-            else:
+            elif run[0]:
                 run[:] = [0, 0.0, 0.0]
         n = len(ticks)
         if n >= MOUNT_TICKS:
@@ -222,10 +226,10 @@ class MountHeights:
             self.tails = (right_tail, left_tail)
 
     def end(self) -> None:
-        if self.ticks:
+        if self.ticks:  # none since the last end: nothing to reset
             self.ticks.clear()
             self.sums = [0.0, 0.0, 0.0, 0.0]
-        self.runs = [[0, 0.0, 0.0], [0, 0.0, 0.0]]
+            self.runs = [[0, 0.0, 0.0], [0, 0.0, 0.0]]
 
 
 @dataclass(frozen=True, slots=True)

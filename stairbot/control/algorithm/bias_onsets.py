@@ -67,6 +67,8 @@ STILL_M = 0.001
 DRIVING_M = 0.0001
 STILL_RAD = math.radians(0.2)
 
+_OK, _OUT = SensorStatus.OK, SensorStatus.OUT_OF_RANGE
+
 
 class PairWatch:
     """Finds one pair's onsets (:class:`Onsets` keeps them)."""
@@ -78,6 +80,7 @@ class PairWatch:
         self._warm = WARM_SETTLES * settle_s(cfg, back)
         """Robot time from which the pair is watched."""
         self._near = cfg.sensors.range(back)[0]
+        self._infinity = cfg.LENGTH_OF_INFINITY
         self._lateral = cfg.sensors.front_lateral
         self._level_m = cfg.BACK_CLEARANCE + LEVEL_M
         self._least_step = STEP_SIGMAS * cfg.algorithm.equal_tolerance
@@ -96,7 +99,7 @@ class PairWatch:
         r, left = sensors[track.right], sensors[track.left]
         dr, dl = distance(r, self._near), distance(left, self._near)
         if dr is None or dl is None or track.right in judged or track.left in judged \
-                or (not back and max(dr, dl) >= self._cfg.LENGTH_OF_INFINITY):
+                or (not back and max(dr, dl) >= self._infinity):
             if track.pending is not None:  # a step seen before one of them stopped reading
                 self._decide(track.pending)
             if track.unconfirmed is not None:
@@ -115,8 +118,8 @@ class PairWatch:
             level_l = surface and left.distance_m <= self._level_m
         else:
             level_r = level_l = True
-        moved = track.add((snap.time_s, dr, dl, odometer, yaw, not r.ok, not left.ok, level_r,
-                           level_l, lifted_m))
+        moved = track.add((snap.time_s, dr, dl, odometer, yaw, r.status is not _OK,
+                           left.status is not _OK, level_r, level_l, lifted_m))
         waiting = track.unconfirmed
         if waiting is not None and len(track.buf) == track.window:
             level = sum(x[2] - x[1] for x in track.buf) / track.window
@@ -238,9 +241,10 @@ def _driving(samples: list[Sample]) -> list[Sample]:
 def distance(r: SensorReading, near_m: float) -> float | None:
     """A reading's distance: OK, or too near to measure (its clamp, the
     nearest it can tell, ``near_m``); None for an error or nothing in range."""
-    if r.ok:
+    status = r.status
+    if status is _OK:
         return r.distance_m
-    if r.status is SensorStatus.OUT_OF_RANGE and r.distance_m <= near_m + 1e-9:
+    if status is _OUT and r.distance_m <= near_m + 1e-9:
         return r.distance_m
     return None
 

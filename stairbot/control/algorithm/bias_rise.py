@@ -44,6 +44,10 @@ mean of its last this many ticks (the wait's last second, as the rule's
 own median)."""
 
 
+_LIFT_THIRD, _LOWER_THIRD = Phase.ASCENT_LIFT_THIRD, Phase.DESCENT_LOWER_THIRD
+"""Bound once: an enum member's look-up costs, every tick."""
+
+
 @dataclass(frozen=True, slots=True)
 class Rise:
     """Step ``step`` (0-based)'s rise as the back pair read it at the end of
@@ -88,7 +92,7 @@ class Rises:
     def tick(self, snap: Snapshot, where: Phase, paused: bool, steps: int) -> None:
         """One tick in ``where`` (the phase, or the one the standing rule
         stopped in, ``paused``); ``steps``: the steps climbed so far."""
-        if where is Phase.ASCENT_LIFT_THIRD and not paused:
+        if where is _LIFT_THIRD and not paused:
             at = self._at_zero(snap)
             if at is not None:
                 self._ascent.append(at)
@@ -101,11 +105,11 @@ class Rises:
                 if abs(left - right) <= pair_tolerance(self._cfg, min(right, left), back=True):
                     self.rises[steps - 1] = Rise(steps - 1, right, left)
             self._ascent.clear()
-        if where is Phase.DESCENT_LOWER_THIRD and paused:
+        if where is _LOWER_THIRD and paused:
             at = self._at_zero(snap)
             if at is not None:
                 self._stand.append(at)
-        else:
+        elif self._stand or self._mtb:
             self._stand.clear()
             self._mtb.clear()
 
