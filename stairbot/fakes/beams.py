@@ -33,7 +33,7 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
     distance ahead of segment 2's centre.  (Each ray's top view is
     :meth:`Plan.front_hit_at`, written out: a cone has a dozen rays per mount.)"""
     mx, my = mount
-    tilt = math.radians(model.tilt_deg)
+    tilt = model.tilt
     ups, acrosses, rays = model.cone_index
     profile = world.profile
     cos, sin = math.cos, math.sin
@@ -57,10 +57,10 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
     # angle across too; a mount sits forward*cos - lateral*sin ahead of segment
     # 2's centre (the side view's ray from ``forward`` ahead meets a riser
     # ``ahead`` less far) and y_m to the side
-    yaw, half = plan.yaw, plan.width / 2
-    mount_c, mount_s = cos(yaw), sin(yaw)
+    half = plan.width / 2
+    mount_c, mount_s = plan.yaw_trig()
     y_fwd, ahead = plan.y + forward * mount_s, forward * (1.0 - mount_c)
-    turned = [(cos(psi), sin(psi)) for psi in [yaw + across for across in acrosses]]
+    turned = plan.turned(acrosses)
     out: list[list[Hit]] = [[] for _ in laterals]
     mounts = [(hits, y_fwd + lat * mount_c, lat * mount_s)
               for hits, lat in zip(out, laterals, strict=True)]
@@ -69,17 +69,20 @@ def front_hits(world: World, plan: Plan, model: SensorModel, mount: tuple[float,
         _front_walls(plan, side_view, turned, rays, mounts, ahead,
                      [x_fwd - lat * mount_s for lat in laterals])
         return out
-    for i_up, i_across, weight in rays:  # no side wall: a beam meets a riser or nothing
+    for i_up, row in model.cone_rows:  # no side wall: a beam meets a riser or nothing
         hit_dx, c, s, nx, ny, slant = side_view[i_up]
-        cos_psi, sin_psi = turned[i_across]
-        if hit_dx is None or cos_psi <= 1e-9:
+        if hit_dx is None:
             continue
         riser_dx = hit_dx + ahead
-        on_stairs = abs(c * cos_psi * nx + s * ny)  # the cosine of its incidence
-        for hits, y_m, side in mounts:
-            dx = riser_dx + side
-            if dx > 0.0 and abs(y_m + dx * sin_psi / cos_psi) <= half:
-                hits.append((dx / cos_psi * slant, on_stairs, weight))
+        for i_across, weight in row:
+            cos_psi, sin_psi = turned[i_across]
+            if cos_psi <= 1e-9:
+                continue
+            on_stairs = abs(c * cos_psi * nx + s * ny)  # the cosine of its incidence
+            for hits, y_m, side in mounts:
+                dx = riser_dx + side
+                if dx > 0.0 and abs(y_m + dx * sin_psi / cos_psi) <= half:
+                    hits.append((dx / cos_psi * slant, on_stairs, weight))
     return out
 
 
@@ -130,7 +133,7 @@ def down_fans(world: World, model: SensorModel, xs: tuple[float, ...], my: float
               pitch: float, reach: float) -> list[list[Hit]]:
     """:func:`down_hits` for mounts at each of ``xs``, all at height ``my`` on
     one segment (a pair turned by a yaw): the rays' angles are shared."""
-    tilt = math.radians(model.tilt_deg)
+    tilt = model.tilt
     sin, cos, hypot = math.sin, math.cos, math.hypot
     # per ray: its direction, its extent along x and where it ends in y
     rays: list[tuple[float, float, float, float, float]] = []

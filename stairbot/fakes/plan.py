@@ -45,6 +45,14 @@ class Plan:
     _right: tuple[Range, ...] = field(init=False, repr=False, default=())
     _left_all: bool = field(init=False, repr=False, default=False)
     _right_all: bool = field(init=False, repr=False, default=False)
+    # the trigonometry of the yaw, kept while the yaw stays the same (see yaw_trig)
+    _trig_of: float = field(init=False, repr=False, compare=False, default=math.nan)
+    _trig: tuple[float, float] = field(init=False, repr=False, compare=False,
+                                       default=(1.0, 0.0))
+    _turned_of: tuple[float, tuple[float, ...]] = field(init=False, repr=False, compare=False,
+                                                        default=(math.nan, ()))
+    _turned: list[tuple[float, float]] = field(init=False, repr=False, compare=False,
+                                               default_factory=list)
 
     def __post_init__(self) -> None:
         self.set_walls(self.walls)
@@ -78,6 +86,26 @@ class Plan:
         if self._left_all if left else self._right_all:
             return True
         return any(lo <= x <= hi for lo, hi in (self._left if left else self._right))
+
+    def yaw_trig(self) -> tuple[float, float]:
+        """The cosine and sine of the yaw.  Worked out again only when the yaw
+        has changed (the robot turns now and then; every sensor asks every
+        tick); a yaw of 0 is worked out each time, as its sign counts."""
+        yaw = self.yaw
+        if yaw != self._trig_of or yaw == 0.0:
+            self._trig_of, self._trig = yaw, (math.cos(yaw), math.sin(yaw))
+        return self._trig
+
+    def turned(self, angles: tuple[float, ...]) -> list[tuple[float, float]]:
+        """The cosine and sine of the yaw plus each of ``angles`` (a cone's
+        angles across it), worked out again only when the yaw or the angles
+        have changed (see :meth:`yaw_trig`).  Read, never change or keep."""
+        yaw = self.yaw
+        if (yaw, angles) != self._turned_of or yaw == 0.0:
+            self._turned_of = (yaw, angles)
+            self._turned = [(math.cos(psi), math.sin(psi))
+                            for psi in [yaw + across for across in angles]]
+        return self._turned
 
     def move(self, dx: float) -> None:
         """The robot advanced ``dx`` along x (towards the risers) on its heading."""

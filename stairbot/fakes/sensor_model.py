@@ -138,6 +138,22 @@ class SensorModel:
         return tuple(ups), tuple(acrosses), rays
 
     @cached_property
+    def cone_rows(self) -> tuple[tuple[int, tuple[tuple[int, float], ...]], ...]:
+        """The rays of :attr:`cone_index` in their order, in runs at one angle
+        up: (the angle's index, the rays' indexes across and weights), per run."""
+        rows: list[tuple[int, list[tuple[int, float]]]] = []
+        for i_up, i_across, weight in self.cone_index[2]:
+            if not rows or rows[-1][0] != i_up:
+                rows.append((i_up, []))
+            rows[-1][1].append((i_across, weight))
+        return tuple((i_up, tuple(row)) for i_up, row in rows)
+
+    @cached_property
+    def tilt(self) -> float:
+        """``tilt_deg`` in radians."""
+        return math.radians(self.tilt_deg)
+
+    @cached_property
     def fan(self) -> tuple[ConeRay, ...]:
         """The side-view rays only (a downward sensor's cone)."""
         return self._grid(1)
@@ -248,13 +264,10 @@ class ModelSensor:
     def sample(self, seen: tuple[float | None, Cause], t: float) -> None:
         """Take a measurement now of what the beam sees (a distance, or None and
         why not); it is published ``latency_s`` later."""
-        self._sample(seen[0], seen[1], t)
-
-    def _sample(self, distance: float | None, seen: Cause, t: float) -> None:
         period = self._period
         if period > 0.0:  # the next whole multiple of the period (0: every read)
             self._next = (math.floor(t / period + 1e-9) + 1) * period
-        reading, cause = self._measure(distance, seen, t)
+        reading, cause = self._measure(seen[0], seen[1], t)
         if self._stucks:
             if not stuck(self._stucks, t):
                 self._held = reading
@@ -281,9 +294,19 @@ class ModelSensor:
 
     def published(self, t: float) -> SensorReading:
         """:meth:`reading` with its :meth:`age` in it (the same object when 0 s
-        old): what the board publishes."""
-        reading = self.reading(t)
+        old): what the board publishes.  (:meth:`reading` written out: the
+        board publishes every sensor at every read.)"""
+        pending = self._pending
+        while pending and pending[0][0] <= t + 1e-12:
+            _, taken, reading, cause = pending.popleft()
+            self._current = (taken, reading, cause)
         current = self._current
+        if self.faults and active_faults(self.faults, t)[1]:
+            reading = self._error
+        elif current is not None:
+            reading = current[1]
+        else:
+            reading = self._far
         age = math.inf if current is None else t - current[0]
         return reading if age == 0.0 else SensorReading(reading.distance_m, reading.status, age)
 
@@ -300,14 +323,14 @@ class ModelSensor:
     def measure(self, true_distance: float | None, t: float) -> SensorReading:
         """One ray, square to its target: measure ``true_distance`` (None:
         nothing) if a measurement is due, and return the published reading."""
-        if self._instant:  # what _sample and reading come to for such a sensor
+        if self._instant:  # what sample and reading come to for such a sensor
             reading, cause = self._measure(true_distance,
                                            _OK if true_distance is not None else _NOTHING, t)
             self.measurements += 1
             self._current = (t, reading, cause)
             return reading
         if t >= self._next and not (self._freezes and frozen(self._freezes, t)):
-            self._sample(true_distance, _OK if true_distance is not None else _NOTHING, t)
+            self.sample((true_distance, _OK if true_distance is not None else _NOTHING), t)
         return self.reading(t)
 
     # -- one measurement --------------------------------------------------------------
@@ -319,12 +342,15 @@ class ModelSensor:
             sigma = a + self.noise_b * true_distance if true_distance is not None else a
             noise = self._gauss(0.0, sigma)
         outliers, dropouts = self._outlier_rate, self._dropout_rate
-        outlier = outliers > 0.0 and self._uniform() < outliers
-        outlier_at = self._uniform() if outliers > 0.0 else 0.0
-        dropout = dropouts > 0.0 and self._uniform() < dropouts
-        dropout_kind = self._uniform() if dropouts > 0.0 else 0.0
-        if dropout:
-            return (self._error if dropout_kind < 0.5 else self._far), Cause.DROPOUT
+        outlier = False
+        if outliers > 0.0:
+            outlier = self._uniform() < outliers
+            outlier_at = self._uniform()
+        if dropouts > 0.0:
+            dropout = self._uniform() < dropouts
+            dropout_kind = self._uniform()
+            if dropout:
+                return (self._error if dropout_kind < 0.5 else self._far), Cause.DROPOUT
         if outlier:
             d = self.min_range + outlier_at * (self.max_range - self.min_range)
             return self._quantized(d), Cause.OUTLIER

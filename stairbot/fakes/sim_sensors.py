@@ -192,7 +192,6 @@ class SimSensors:
         """What SFR and SFL publish at ``t``: one ray each for a single-ray model,
         else their cones, cast only when a measurement is due."""
         right, left = self._pairs[0]
-        model = self._front_block()
         if self._front_single:
             sfr, sfl = self._front_truth()
             now = right.measure(sfr, t), left.measure(sfl, t)
@@ -201,6 +200,7 @@ class SimSensors:
         else:
             due_r, due_l = right.due(t), left.due(t)
             if due_r or due_l:
+                model = self._front_block()
                 mx, my, a1, _c, _s, forward = self._front_origin()
                 hits = front_hits(self.world, self.plan, model, (mx, my), a1, forward,
                                   self._front_laterals, self._front_mount[2])
@@ -291,7 +291,7 @@ class SimSensors:
         lat = self.config.sensors.front_lateral
         # Plan.front_distance for both, turned by the one yaw
         plan = self.plan
-        cos_yaw, sin_yaw = math.cos(plan.yaw), math.sin(plan.yaw)
+        cos_yaw, sin_yaw = plan.yaw_trig()
         sfr = plan.front_hit_at(forward, -lat, hit_dx, slant, cos_yaw, sin_yaw)
         sfl = plan.front_hit_at(forward, lat, hit_dx, slant, cos_yaw, sin_yaw)
         return None if sfr is None else sfr[0], None if sfl is None else sfl[0]
@@ -312,13 +312,14 @@ class SimSensors:
         a3 = pa[2]
         c, s = math.cos(a3), math.sin(a3)
         mx, my = px[2] + c * lx - s * ly, py[2] + s * lx + c * ly
-        yaw = self.plan.yaw
-        if yaw == 0.0:
+        plan = self.plan
+        if plan.yaw == 0.0:
             return (mx, mx), my, a3, c, s, reach
         # top view: the mount sits `behind` along the robot and +-lateral across it
+        cos_yaw, sin_yaw = plan.yaw_trig()
         behind = mx - px[1]
-        shift = behind * (math.cos(yaw) - 1.0)
-        lat = self.config.sensors.back_lateral * math.sin(yaw)
+        shift = behind * (cos_yaw - 1.0)
+        lat = self.config.sensors.back_lateral * sin_yaw
         return (mx + shift + lat, mx + shift - lat), my, a3, c, s, reach
 
     def _down(self, mx: float, my: float, c: float, s: float, reach: float) -> float | None:

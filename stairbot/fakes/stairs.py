@@ -76,14 +76,22 @@ class StairsProfile:
         self.radius = radius
         self._xmin = [s[0] for s in self.segments]
         self._xmax = [s[2] for s in self.segments]
-        # per segment, what every cast needs (see _Geo); None: zero length
-        self._geo: list[_Geo | None] = []
+        # where first_from's walk stops: going forward, at a segment whose xmin is
+        # beyond the ray's x-range; going back, at one whose xmax is before it,
+        # which is one whose -xmax is beyond the ray's -x-range (the same test,
+        # negated exactly).  One more entry, NaN (within no range), stops either
+        # walk at its end: index n going forward, -1 going back.
+        self._stops = (self._xmin + [math.nan], [-x for x in self._xmax] + [math.nan])
+        # per segment, what every cast needs (see _Geo); a zero-length one meets nothing
+        self._geo: list[_Geo] = []
         self.normals: list[tuple[float, float]] = []  # per segment (0, 0: zero length)
         for ax, ay, bx, by in self.segments:
             ex, ey = bx - ax, by - ay
             length = math.hypot(ex, ey)
             if length == 0.0:
-                self._geo.append(None)
+                # no normal: inside the surface its parameter range is empty, and
+                # a ray has no crossing with it (zero denominator)
+                self._geo.append((ax, ay, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, ax, ay, ax, ay))
                 self.normals.append((0.0, 0.0))
                 continue
             nx, ny = -ey / length, ex / length
@@ -141,52 +149,43 @@ class StairsProfile:
         no call per segment: every sensor casts here every tick.)"""
         r = self.radius
         dx, dy = x1 - x0, y1 - y0
+        # the walk goes on while the next segment's bound is within lim (a NaN
+        # ray ends it at once)
         if x0 <= x1:
-            i, step, lim, bound = ahead, 1, x1 + r, self._xmin
-            if i >= len(bound) or bound[i] > lim:
-                return _MISS
+            i, step, lim, bound = ahead, 1, x1 + r, self._stops[0]
         else:
-            i, step, lim, bound = behind, -1, x1 - r, self._xmax
-            if i < 0 or bound[i] < lim:
-                return _MISS
+            i, step, lim, bound = behind, -1, r - x1, self._stops[1]
         inf = math.inf
         best, best_i = inf, -1
         geo = self._geo
-        while True:
-            g = geo[i]
+        while bound[i] <= lim:
+            ax, ay, ex, ey, len2, nx, ny, u_lo, u_hi, px, py, mx, my = geo[i]
             t = inf
-            if g is not None:
-                ax, ay, ex, ey, len2, nx, ny, u_lo, u_hi, px, py, mx, my = g
-                side = (x0 - ax) * nx + (y0 - ay) * ny
-                if side < 0.0:
-                    side, px, py = -side, mx, my
-                if side < r:
-                    # inside the surface: touching it; beside the segment's end: not this one
-                    along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
-                    if u_lo <= along <= u_hi:
-                        t = 0.0
-                else:
-                    denom = dx * ey - dy * ex
-                    if denom != 0.0:
-                        wx, wy = px - x0, py - y0
-                        tt = (wx * ey - wy * ex) / denom
-                        if 0.0 <= tt <= 1.0:
-                            u = (wx * dy - wy * dx) / denom
-                            if u_lo <= u <= u_hi:
-                                t = tt
+            side = (x0 - ax) * nx + (y0 - ay) * ny
+            if side < 0.0:
+                side, px, py = -side, mx, my
+            if side < r:
+                # inside the surface: touching it; beside the segment's end: not this one
+                along = ((x0 - ax) * ex + (y0 - ay) * ey) / len2
+                if u_lo <= along <= u_hi:
+                    t = 0.0
+            else:
+                denom = dx * ey - dy * ex
+                if denom != 0.0:
+                    wx, wy = px - x0, py - y0
+                    tt = (wx * ey - wy * ex) / denom
+                    if 0.0 <= tt <= 1.0:
+                        u = (wx * dy - wy * dx) / denom
+                        if u_lo <= u <= u_hi:
+                            t = tt
             if t < best:
                 best, best_i = t, i
             elif best < inf and dx != 0.0:
-                return best, best_i
+                break
             i += step
-            if step > 0:  # past the ray's x-range?
-                if i >= len(bound) or bound[i] > lim:
-                    return best, best_i
-            elif i < 0 or bound[i] < lim:
-                return best, best_i
+        return best, best_i
 
 
-_MISS = (math.inf, -1)
 _Geo = tuple[float, float, float, float, float, float, float, float,
              float, float, float, float, float]
 """A segment: start (ax, ay), direction (ex, ey), length squared, unit normal
