@@ -67,9 +67,12 @@ class Supervisor:
             return None
         dt = snap.time_s - prev.time_s
         sent, watch = self._sent, self._watch
+        if dt <= 0.0:  # no time to judge a motor by: every stretch starts afresh
+            watch.clear()
+            return None
         for motor, least in self._watched:
             v = sent.get(motor, 0.0)
-            if dt <= 0.0 or -least < v < least:
+            if -least < v < least:
                 if motor in watch:
                     del watch[motor]
                 continue

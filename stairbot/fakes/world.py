@@ -23,9 +23,10 @@ from typing import Any
 import pymunk
 
 try:  # the C functions behind pymunk's Body properties, without the Python wrapper
+    from pymunk._chipmunk import ffi as _ffi
     from pymunk._chipmunk import lib as _cp
 except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
-    _cp = None
+    _cp = _ffi = None
 from stairbot.fakes.fall_watch import FallWatch
 from stairbot.fakes.robot_bodies import CAT_STAIRS, PIN_REACH, build_robot
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
@@ -90,6 +91,10 @@ class World:
         self._bias = [-1.0, -1.0]
         self._moving = [False, False]
         self._pose_at = -1
+        # each segment and its (rear, front) wheels: (x, y, angle) of each, in one call
+        self._read_bodies = _batch_reader(space, [b for seg, (rear, front) in
+                                                  zip(self.segments, self.wheels, strict=True)
+                                                  for b in (seg, rear, front)])
         self._ptrs: list[tuple[object, object]] | None = None  # (segment, its front wheel)
         if _cp is not None and all(hasattr(b, "_body") for b in self.space.bodies):
             self._ptrs = [(b._body, w[1]._body)
@@ -172,7 +177,12 @@ class World:
         if self._pose_at == self._steps_done:
             return
         px, py, pa = self._px, self._py, self._pa
-        if self._ptrs is not None:
+        if self._read_bodies is not None:
+            (px[0], py[0], pa[0], _x, _y, _a, _x, _y, front0,
+             px[1], py[1], pa[1], _x, _y, _a, _x, _y, front1,
+             px[2], py[2], pa[2], _x, _y, _a, _x, _y, front2) = self._read_bodies()
+            wa = (front0, front1, front2)
+        elif self._ptrs is not None:
             get_pos, get_angle = _cp.cpBodyGetPosition, _cp.cpBodyGetAngle
             (b0, w0), (b1, w1), (b2, w2) = self._ptrs
             p0, p1, p2 = get_pos(b0), get_pos(b1), get_pos(b2)
@@ -271,15 +281,17 @@ class World:
     def advance(self, seconds: float) -> None:
         """Step the physics ``seconds`` (whole physics steps), moving the lifts at
         their set speeds within their stroke, then check stability."""
-        n = self._steps_for(seconds)
-        if n == 0:
-            return
         dt = self.params.dt
+        n = round((self.time + seconds) / dt) - self._steps_done  # as _steps_for
+        if n <= 0:
+            return
         self._set_lifts(n * dt)
         self._steps(n)
-        self._steps_done += n
-        self.time = self._steps_done * dt
-        self._check()
+        done = self._steps_done = self._steps_done + n
+        self.time = done * dt
+        if not self.falls.fell:  # the stability check, on the new state
+            self._fetch()
+            self.falls.check(self.time, self._py, self._pa)
 
     def _set_lifts(self, seconds: float) -> None:
         """Aim each moving lift's pin at where the screw will be in ``seconds``; the
@@ -290,22 +302,26 @@ class World:
                 and self._bias[0] == self._bias[1] == self.params.lift_hold_speed):
             return  # both held, as they were: nothing to set
         stroke, stall = self._stroke, self._stall
+        hold = self.params.lift_hold_speed
+        if self._pose_at != self._steps_done:
+            self._fetch()
+        offsets = self._lifts  # (lift_offset's)
         for i in (0, 1):
             v = speed[i]
             if v != 0.0:
                 # a stalled lead screw does not run ahead of its nut
-                actual = self.lift_offset(i)
+                actual = offsets[i]
                 t = min(max(self.lift_target[i], actual - stall), actual + stall) + v * seconds
                 t = stroke if t > stroke else (-stroke if t < -stroke else t)
                 self.lift_target[i] = t
                 self._set_distance[i](PIN_REACH + t)
             elif moving[i]:
                 # just stopped: the screw stands where the nut is now, no coasting on
-                t = self.lift_offset(i)
+                t = offsets[i]
                 self.lift_target[i] = t
                 self._set_distance[i](PIN_REACH + t)
             moving[i] = v != 0.0
-            bias = abs(v) if v != 0.0 else self.params.lift_hold_speed
+            bias = abs(v) if v != 0.0 else hold
             if bias != self._bias[i]:
                 self._bias[i] = bias
                 self.pins[i].max_bias = bias
@@ -324,11 +340,6 @@ class World:
     def max_pitch_deg(self) -> float:
         """The largest pitch of any segment so far, degrees."""
         return self.falls.max_pitch_deg
-
-    def _check(self) -> None:
-        if not self.falls.fell:
-            self._fetch()
-            self.falls.check(self.time, self._py, self._pa)
 
     # -- queries --------------------------------------------------------------------
     def ray(self, start: tuple[float, float], end: tuple[float, float]
@@ -364,6 +375,40 @@ class World:
         return [(float(v.x), float(v.y))
                 for v in (self.segments[segment].local_to_world(q)
                           for q in self.boxes[segment].get_vertices())]
+
+
+def _batch_reader(space: pymunk.Space, bodies: list[pymunk.Body]
+                  ) -> Callable[[], list[float]] | None:
+    """A function that reads (x, y, angle) of each of ``bodies``, flat, in their
+    order, in one C call through pymunk's batch API: what Body.position and
+    Body.angle tell, without a call for each.  None where the API is not at hand,
+    or the space does not go through its bodies in that order (it goes through
+    them in the order they were added, while none is removed or sleeps: this
+    world removes none and lets none sleep)."""
+    try:
+        from pymunk.batch import Buffer  # (pymunk 6.6 on)
+
+        buffer = Buffer()
+        data = _ffi.new("pmBatchedData *")
+        data.floatArray, data.intArray = buffer._float_arr, buffer._int_arr
+        each, visit = _cp.cpSpaceEachBody, _ffi.addressof(_cp, "pmSpaceBodyGetIteratorFuncBatched")
+        handle = space._space
+        data.fields = _cp.BODY_ID
+        each(handle, visit, data)
+        ids = buffer._int_arr
+        if _ffi.unpack(ids.arr, ids.num)[:len(bodies)] != [b.id for b in bodies]:
+            return None
+        data.fields = _cp.POSITION | _cp.ANGLE
+    except (AttributeError, ImportError, TypeError):  # pragma: no cover - another pymunk
+        return None
+    floats, unpack, count = buffer._float_arr, _ffi.unpack, 3 * len(bodies)
+
+    def read() -> list[float]:
+        floats.num = 0  # (the buffer, kept by this closure, is refilled from the start)
+        each(handle, visit, data)
+        return unpack(floats.arr, count)
+
+    return read
 
 
 def _setter(obj: pymunk.Constraint, name: str, c_function: str) -> Callable[[float], None]:

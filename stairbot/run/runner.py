@@ -87,25 +87,25 @@ class RunControl:
     def take_latches(self) -> list[Latch]:
         """The e-stops and clears pressed since the last call, oldest first
         (the run thread carries them out)."""
+        if not self._latches:  # none pressed (every tick of a run): no lock to take
+            return []
         with self._lock:
             out = list(self._latches)
             self._latches.clear()
             return out
 
+    # One attribute read is atomic: the run thread asks these every tick, without the lock.
     @property
     def estopped(self) -> bool:
-        with self._lock:
-            return self._estopped
+        return self._estopped
 
     @property
     def paused(self) -> bool:
-        with self._lock:
-            return self._paused
+        return self._paused
 
     @property
     def stop_reason(self) -> str | None:
-        with self._lock:
-            return self._stop_reason
+        return self._stop_reason
 
 
 @dataclass

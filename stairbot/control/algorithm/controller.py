@@ -91,8 +91,11 @@ class Controller:
         self._sensor_since: float | None = None
         self._sensor_link: dict[str, float] = {}  # the link's figures when the hold began
         self._phase_link: Mapping[str, float] = {}  # ... when the present phase began
-        self._now_key: tuple[str, str | None, int] | None = None  # see _present
+        # what _present looked its answer up for: the phase, the pause, the lost
+        self._now_phase, self._now_lost = "", 0
+        self._now_pause: Pause | None = None
         self._now: tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]] | None = None
+        self._say_fn = self._say  # bound once: every tick's Tick carries it
 
     # -- what the outside sees --------------------------------------------------------
     @property
@@ -165,7 +168,7 @@ class Controller:
         every motor.  After the end, and while held, every speed is 0.  The
         first tick enters the program's first phase and moves nothing."""
         self._time = snap.time_s
-        if self.finished:
+        if _TERMINAL[self._ctx.phase]:  # self.finished, without the property's call
             return _zeros()
         snap = self._perception.see(snap)
         snap = self._bias.see(snap, self._ctx)  # a sensor judged biased reads as ERROR: lost
@@ -191,7 +194,8 @@ class Controller:
             return _zeros()
         ctx = self._ctx
         phase, record, needed = self._present()
-        fault = guards.fault(snap, phase, needed, ctx.phase_started_s, self._timeout_now()) \
+        timeout = self._timeout if ctx.limp is None else self._timeout_now()
+        fault = guards.fault(snap, phase, needed, ctx.phase_started_s, timeout) \
             or self._supervisor.check(snap)
         if fault is not None:  # and what the link lost in the phase, if it lost frames
             self._apply(fail(fault + link_meanwhile(self._phase_link, snap.health)), snap)
@@ -199,7 +203,7 @@ class Controller:
         if self._sensor_hold(snap, phase, needed):
             self._supervisor.commanded({})
             return _zeros()
-        t = Tick(snap, self.config, ctx, self.mode, self._say)
+        t = Tick(snap, self.config, ctx, self.mode, self._say_fn)
         step = standing.watch(t, record)
         if step is None and record.carried_by and not ctx.work.balanced \
                 and self.check_stability:
@@ -224,14 +228,16 @@ class Controller:
 
     def _present(self) -> tuple[Phase, PhaseDef[Any], tuple[SensorId, ...]]:
         """The present phase, its record and :func:`guards.needed_sensors`, looked up
-        again only when the phase, the one a pause resumes or the lost change."""
+        again only when the phase, the pause (and so the phase it resumes) or the
+        lost change."""
         ctx = self._ctx
-        key = (ctx.phase, ctx.resume_phase, 0 if ctx.limp is None else len(ctx.limp.lost))
-        now = self._now
-        if now is None or key != self._now_key:
+        limp, now = ctx.limp, self._now
+        lost = 0 if limp is None else len(limp.lost)
+        if now is None or ctx.phase != self._now_phase or ctx.pause is not self._now_pause \
+                or lost != self._now_lost:
             phase = BY_VALUE[ctx.phase]
             now = self._now = (phase, phase.record, needed_sensors(phase, ctx))
-            self._now_key = key
+            self._now_phase, self._now_pause, self._now_lost = ctx.phase, ctx.pause, lost
         return now
 
     def _sensor_hold(self, snap: Snapshot, phase: Phase, needed: tuple[SensorId, ...]) -> bool:

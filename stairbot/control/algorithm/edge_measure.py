@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 from stairbot.control.algorithm import limits
+from stairbot.control.algorithm.per_config import per_config
 from stairbot.control.tolerances import max_age, measurement_period, median_sigma, window
 from stairbot.inputs.config import RobotConfig
 
@@ -21,6 +22,7 @@ FLOOR_SIGMAS = 2.0
 filtered mean (and half a resolution step)."""
 
 
+@per_config
 def floor_tolerance(cfg: RobotConfig) -> float:
     """How far above BACK_CLEARANCE the pair's mean may read and segment 3
     stand on the floor: half a resolution step, and FLOOR_SIGMAS sigmas of
@@ -77,6 +79,7 @@ def edge_drop_m(cfg: RobotConfig, from_top: bool = False) -> float:
     return cfg.BACK_CLEARANCE + floor_tolerance(cfg) + low
 
 
+@per_config
 def edge_lag_s(cfg: RobotConfig) -> float:
     """How long after the back pair's distance changes (it crosses an edge,
     or segment 3 is lowered) perception reports it: the sensor's latency,

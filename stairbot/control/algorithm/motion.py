@@ -76,8 +76,10 @@ def pair_difference(snap: Snapshot, cfg: RobotConfig, back: bool = False) -> flo
     """Left minus right reading of the pair (SFL − SFR, or SBL − SBR) when both
     give a usable distance (status OK, and for the front pair closer than
     LENGTH_OF_INFINITY); None otherwise."""
-    r, left = pair(snap, back)
-    if not (r.ok and left.ok):
+    sensors = snap.sensors  # (pair and SensorReading.ok, asked every tick: inline)
+    r_id, l_id = BACK_SENSORS if back else FRONT_SENSORS
+    r, left = sensors[r_id], sensors[l_id]
+    if r.status is not _OK or left.status is not _OK:
         return None
     if not back and max(r.distance_m, left.distance_m) >= cfg.LENGTH_OF_INFINITY:
         return None
@@ -91,7 +93,11 @@ def smooth(previous: float | None, newest: float) -> float:
 
 def sensor_errors(snap: Snapshot, sensors: tuple[SensorId, ...]) -> list[SensorId]:
     """The sensors among ``sensors`` whose status is ERROR."""
-    return [s for s in sensors if snap.sensors[s].status is SensorStatus.ERROR]
+    readings = snap.sensors
+    return [s for s in sensors if readings[s].status is _ERROR]
+
+
+_OK, _ERROR = SensorStatus.OK, SensorStatus.ERROR  # bound once: an enum's member is a slow look-up
 
 
 def approach(vmax: float, remaining: float, brake_zone: float, tick: float) -> float:
@@ -100,9 +106,15 @@ def approach(vmax: float, remaining: float, brake_zone: float, tick: float) -> f
     turns) must begin to stop on the target, then that braking curve; at
     least SLOW_FLOOR of ``vmax``, and never more than covers the remainder in
     one ``tick`` (no overshoot)."""
-    braking = vmax * math.sqrt(max(0.0, remaining) / brake_zone)
-    v = max(SLOW_FLOOR * vmax, min(vmax, braking))
-    return max(0.0, min(v, remaining / tick))
+    # max(a, b) and min(a, b) written out (b if b > a else a; b if b < a else a):
+    # the same answer, without the calls, asked for every moving motor every tick
+    braking = vmax * math.sqrt((remaining if remaining > 0.0 else 0.0) / brake_zone)
+    v = braking if braking < vmax else vmax
+    floor = SLOW_FLOOR * vmax
+    v = v if v > floor else floor
+    cap = remaining / tick
+    v = cap if cap < v else v
+    return v if v > 0.0 else 0.0
 
 
 def drive(cfg: RobotConfig, direction: int, remaining_turns: float) -> Speeds:
@@ -141,7 +153,7 @@ def yaw_turns(cfg: RobotConfig, yaw_rad: float) -> float:
 def lift_to(cfg: RobotConfig, snap: Snapshot, motor: MotorId, target: float) -> float | None:
     """Speed that moves lift ``motor`` towards the absolute counter ``target``,
     or None when it is there."""
-    delta = target - snap.turns(motor)
+    delta = target - snap.motors[motor].turns
     if abs(delta) <= LIFT_DONE:
         return None
     v = approach(cfg.motors.lift_speed, abs(delta), LIFT_BRAKE_ZONE, cfg.algorithm.tick)

@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic, NamedTuple, TypeVar
 
 from stairbot.control.algorithm.context import Context
 from stairbot.control.algorithm.families import Calibration, Family
@@ -58,9 +58,9 @@ class Exit:
     when: str
 
 
-@dataclass(frozen=True, slots=True)
-class Step:
-    """What one tick of a phase decides.
+class Step(NamedTuple):
+    """What one tick of a phase decides (a named tuple: immutable, and quick
+    to make, as one is every tick).
 
     ``happened`` is None while the phase goes on; else the outcome that ends
     it, which the phase's record maps to the next phase (:class:`Exit`).
@@ -71,7 +71,7 @@ class Step:
     with (see :mod:`~stairbot.control.algorithm.families`).  ``wrong``: a
     sensor the phase found reading wrong, and why (:func:`distrust`)."""
 
-    speeds: Speeds = field(default_factory=lambda: NO_MOTION)
+    speeds: Speeds = NO_MOTION
     happened: str | None = None
     reason: str | None = None
     outcome: Outcome | None = None
@@ -123,10 +123,10 @@ def end(outcome: Outcome, reason: str) -> Step:
 Say = Callable[..., None]
 
 
-@dataclass(frozen=True, slots=True)
-class Tick:
+class Tick(NamedTuple):
     """One tick as a phase sees it: the readings, the config, the context, the
-    mode, and ``say`` to tell a measurement or a decision (an INFO event)."""
+    mode, and ``say`` to tell a measurement or a decision (an INFO event).
+    A named tuple, as :class:`Step` is."""
 
     snap: Snapshot
     cfg: RobotConfig

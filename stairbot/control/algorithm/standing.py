@@ -51,6 +51,7 @@ None), the front pair's rule is not armed.  It is in ascent 7, where the pair
 reads the tab: unarmed there, one sensor reading short would go unseen, the
 tab would be stored short, and descent 1 would stop segment 3 short of the
 edge."""
+_BY_TURNS_ONTO = tuple(BY_TURNS_ONTO)  # asked every tick: a Phase's hash is Python's
 DISAGREE = "disagree"
 """The outcome of :func:`watch`: the pause, which the transition table adds to
 every armed phase."""
@@ -114,7 +115,7 @@ def watch(t: Tick, phase: PhaseDef[Any]) -> Step | None:
     back = phase.watches == "back"
     if ctx.from_top and not back:
         return None
-    if not back and phase.phase in BY_TURNS_ONTO and long_tread.near_length(t) is None:
+    if not back and phase.phase in _BY_TURNS_ONTO and long_tread.near_length(t) is None:
         return None
     if not _disagree(t, back):
         ctx.watch.ticks = 0

@@ -42,6 +42,7 @@ from __future__ import annotations
 import math
 
 from stairbot.control.algorithm.edge_measure import edge_lag_s
+from stairbot.control.algorithm.per_config import per_config
 from stairbot.control.algorithm.work import LowerThirdWork
 from stairbot.control.timeline import value_at
 from stairbot.control.tolerances import (
@@ -55,12 +56,14 @@ from stairbot.hardware import BACK_SENSORS, MotorId, Snapshot
 from stairbot.inputs.config import RobotConfig
 
 
+@per_config
 def smoothing_ticks(cfg: RobotConfig) -> int:
     """Each sum is smoothed over the back pair's settle time, in ticks: the
     filtered readings' own memory."""
     return max(1, round(settle_s(cfg, True) / cfg.algorithm.tick))
 
 
+@per_config
 def margin_m(cfg: RobotConfig) -> float:
     """How far a smoothed sum must rise above its lowest to say segment 3
     stands: SIGMAS sigmas of the difference of two such means at
@@ -73,6 +76,7 @@ def margin_m(cfg: RobotConfig) -> float:
     return SIGMAS * math.sqrt(2.0) * sigma + cfg.sensors.resolution / 2
 
 
+@per_config
 def pitch_deg(cfg: RobotConfig) -> float:
     """How far segment 2 must have pitched nose down, degrees: what pushing
     segment 3 half :func:`margin_m` onto a surface tilts it about segment

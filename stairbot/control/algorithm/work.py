@@ -18,6 +18,8 @@ from stairbot.hardware import MotorId, SensorId, Snapshot
 
 W = TypeVar("W", bound="Work")
 
+_MTF, _MTB = MotorId.MTF, MotorId.MTB  # bound once: an enum's member is a slow look-up
+
 KINDS: dict[str, type[Work]] = {}
 """Every class of work by its name (``kind`` in a saved context)."""
 
@@ -65,9 +67,9 @@ class LiftWork(Work):
         """The lift targets that are set."""
         out: dict[MotorId, float] = {}
         if self.target_mtf is not None:
-            out[MotorId.MTF] = self.target_mtf
+            out[_MTF] = self.target_mtf
         if self.target_mtb is not None:
-            out[MotorId.MTB] = self.target_mtb
+            out[_MTB] = self.target_mtb
         return out
 
 
