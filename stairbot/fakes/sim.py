@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from urllib.parse import urlsplit
 
 from stairbot.errors import RobotFellError, RobotUrlError
@@ -46,12 +46,9 @@ from stairbot.fakes.world import World, WorldParams
 from stairbot.hardware import (
     LIFT_MOTORS,
     ZERO_SPEEDS,
-    Imu,
     MotorId,
     MotorState,
     Scene,
-    SensorId,
-    SensorReading,
     Snapshot,
     Speeds,
     Truth,
@@ -66,37 +63,6 @@ TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to tu
 _MWF, _MWB, _MWR, _MWL, _MTF, _MTB = (MotorId.MWF, MotorId.MWB, MotorId.MWR, MotorId.MWL,
                                       MotorId.MTF, MotorId.MTB)
 _ZEROS: dict[MotorId, float] = dict(ZERO_SPEEDS)  # copied by every command (a dict copies fast)
-
-# MotorState and Snapshot are frozen dataclasses with slots: their __init__ sets
-# each field through object.__setattr__, slow for the seven a tick makes.
-# _motor_state and _snapshot fill the slots directly: the same objects, in about
-# half the time.
-_new = object.__new__
-_SET_TURNS, _SET_SPEED, _SET_FAULT = (vars(MotorState)[name].__set__
-                                      for name in ("turns", "speed_tps", "fault"))
-_SET_TIME, _SET_SENSORS, _SET_MOTORS, _SET_HEALTH, _SET_IMU = (
-    vars(Snapshot)[name].__set__ for name in ("time_s", "sensors", "motors", "health", "imu"))
-
-
-def _motor_state(turns: float, speed_tps: float) -> MotorState:
-    """MotorState(turns, speed_tps), no fault."""
-    state = _new(MotorState)
-    _SET_TURNS(state, turns)
-    _SET_SPEED(state, speed_tps)
-    _SET_FAULT(state, None)
-    return state
-
-
-def _snapshot(time_s: float, sensors: Mapping[SensorId, SensorReading],
-              motors: Mapping[MotorId, MotorState], imu: Imu) -> Snapshot:
-    """Snapshot(time_s, sensors, motors, {}, imu): no link health (no link)."""
-    snap = _new(Snapshot)
-    _SET_TIME(snap, time_s)
-    _SET_SENSORS(snap, sensors)
-    _SET_MOTORS(snap, motors)
-    _SET_HEALTH(snap, {})
-    _SET_IMU(snap, imu)
-    return snap
 
 
 class SimRobot:
@@ -149,7 +115,8 @@ class SimRobot:
             raise RobotFellError(w.fall_reason or "unstable")
         if self._snap is not None and self._snap_at == w.steps_done:
             return self._snap
-        snap = _snapshot(w.time, self.board.read(w.time), self._motor_states(), self._imu.read())
+        snap = Snapshot(w.time, self.board.read(w.time), self._motor_states(), {},
+                        self._imu.read())
         self._snap, self._snap_at = snap, w.steps_done
         return snap
 
@@ -341,12 +308,12 @@ class SimRobot:
         mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
         return {
-            _MWF: _motor_state(turns[0], tps[0]),
-            _MWB: _motor_state(turns[2], tps[2]),
-            _MWR: _motor_state(mean + d, mean_speed + ds),
-            _MWL: _motor_state(mean - d, mean_speed - ds),
-            _MTF: _motor_state(lifts[0] / per_turn, lift_tps[0]),
-            _MTB: _motor_state(lifts[1] / per_turn, lift_tps[1]),
+            _MWF: MotorState(turns[0], tps[0]),
+            _MWB: MotorState(turns[2], tps[2]),
+            _MWR: MotorState(mean + d, mean_speed + ds),
+            _MWL: MotorState(mean - d, mean_speed - ds),
+            _MTF: MotorState(lifts[0] / per_turn, lift_tps[0]),
+            _MTB: MotorState(lifts[1] / per_turn, lift_tps[1]),
         }
 
 
