@@ -159,6 +159,18 @@ def test_corner_each_sensor_sees_a_different_wall() -> None:
     assert sfr == pytest.approx(dx_sfr / math.cos(yaw))
 
 
+def test_the_yaws_trigonometry_follows_the_yaw() -> None:
+    plan = Plan(width=1.0, side_wall="none", yaw=0.1)
+    angles = (-0.05, 0.0, 0.05)
+    for yaw in (0.1, 0.1, -0.2, 0.0, -0.0, 0.3, 0.3):
+        plan.yaw = yaw
+        c, s = plan.yaw_trig()
+        assert (c, math.copysign(1.0, s), s) == (math.cos(yaw), math.copysign(1.0, math.sin(yaw)),
+                                                  math.sin(yaw))
+        assert plan.turned(angles) == [(math.cos(yaw + a), math.sin(yaw + a)) for a in angles]
+        assert plan.turned((0.1,)) == [(math.cos(yaw + 0.1), math.sin(yaw + 0.1))]
+
+
 def test_moving_on_a_heading_changes_the_lateral_position() -> None:
     plan = Plan(width=1.0, side_wall="none", yaw=math.radians(10.0))
     plan.move(0.2)
