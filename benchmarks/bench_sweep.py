@@ -35,10 +35,11 @@ import tempfile
 import time
 from concurrent.futures import wait
 from pathlib import Path
+from typing import Any
 
 from stairbot.sweep.cases import Case, check_spec
 from stairbot.sweep.execute import open_executor, run_cases
-from stairbot.sweep.spec import load_spec, parse_spec, with_config
+from stairbot.sweep.spec import Spec, load_spec, parse_spec, with_config
 from stairbot.sweep.store import ResultStore
 from stairbot.sweep.worker import run_case
 
@@ -53,10 +54,11 @@ cases = {n}
 """
 
 
-def rate(cases: list[Case], jobs: int, dask: str | None) -> tuple[float, float]:
-    """Cases per minute of ``cases`` on a fresh executor with ``jobs`` workers,
-    and the workers' mean CPU seconds per case."""
-    spec = parse_spec(SPEC.format(n=len(cases)), "bench.toml")
+def timed(spec: Spec, cases: list[Case], jobs: int, dask: str | None = None
+          ) -> tuple[list[dict[str, Any]], float]:
+    """Run ``cases`` of ``spec`` on a fresh executor with ``jobs`` workers, one
+    warm-up case per worker first (not counted): the records and the wall
+    time the counted cases took."""
     with tempfile.TemporaryDirectory() as tmp, open_executor(jobs, dask) as (ex, _label):
         wait([ex.submit(run_case, cases[k % len(cases)]) for k in range(jobs)])  # warm up
         store = ResultStore(Path(tmp), spec, resume=False)
@@ -64,8 +66,15 @@ def rate(cases: list[Case], jobs: int, dask: str | None) -> tuple[float, float]:
         out = run_cases(cases, store, ex, lambda _r: None, jobs)
         wall = time.perf_counter() - t0
         store.close()
-    cpu = statistics.fmean(r["cpu_s"] for r in out.records)
-    return out.ran / wall * 60.0, cpu
+    return out.records, wall
+
+
+def rate(cases: list[Case], jobs: int, dask: str | None) -> tuple[float, float]:
+    """Cases per minute of ``cases`` on a fresh executor with ``jobs`` workers,
+    and the workers' mean CPU seconds per case."""
+    records, wall = timed(parse_spec(SPEC.format(n=len(cases)), "bench.toml"), cases, jobs, dask)
+    cpu = statistics.fmean(r["cpu_s"] for r in records)
+    return len(records) / wall * 60.0, cpu
 
 
 def spec_rate(path: str, every: int, jobs: int, config: str | None) -> None:
@@ -75,18 +84,13 @@ def spec_rate(path: str, every: int, jobs: int, config: str | None) -> None:
         spec = with_config(spec, config)
     everything = check_spec(spec)
     cases = everything[::every]
-    with tempfile.TemporaryDirectory() as tmp, open_executor(jobs) as (ex, _label):
-        wait([ex.submit(run_case, cases[k % len(cases)]) for k in range(jobs)])  # warm up
-        store = ResultStore(Path(tmp), spec, resume=False)
-        t0 = time.perf_counter()
-        out = run_cases(cases, store, ex, lambda _r: None, jobs)
-        wall = time.perf_counter() - t0
-        store.close()
-    cpu = sum(r["cpu_s"] for r in out.records)
-    simulated = sum((r.get("result") or {}).get("sim_time_s") or 0.0 for r in out.records)
-    per_min = out.ran / wall * 60.0
-    print(f"{spec.name:<10} {out.ran:>5} of {len(everything):<5} {jobs:>4} "
-          f"{out.ran / cpu * 60.0:>16.1f} {per_min:>10.1f} {simulated / cpu:>12.0f} "
+    records, wall = timed(spec, cases, jobs)
+    ran = len(records)
+    cpu = sum(r["cpu_s"] for r in records)
+    simulated = sum((r.get("result") or {}).get("sim_time_s") or 0.0 for r in records)
+    per_min = ran / wall * 60.0
+    print(f"{spec.name:<10} {ran:>5} of {len(everything):<5} {jobs:>4} "
+          f"{ran / cpu * 60.0:>16.1f} {per_min:>10.1f} {simulated / cpu:>12.0f} "
           f"{len(everything) / per_min:>12.1f}", flush=True)
 
 
