@@ -90,7 +90,6 @@ class SimRobot:
         self._per_turn = m.lift_travel_per_turn
         self._speeds = dict(ZERO_SPEEDS)
         self._applied_along = math.nan  # cos(yaw) when the world's motors were last set
-        self._along_yaw, self._along_cos = math.nan, 1.0  # see _along
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)
         self._diff_speed = 0.0  # ... and its speed over the last advance, turns/s
         self._lift_turns = [0.0, 0.0]
@@ -295,11 +294,8 @@ class SimRobot:
 
     def _along(self) -> float:
         """cos(yaw): the share of the robot's travel along the flight's axis
-        (worked out again only when the heading changed: the robot turns seldom)."""
-        yaw = self.plan.yaw
-        if yaw != self._along_yaw:
-            self._along_yaw, self._along_cos = yaw, max(0.05, math.cos(yaw))
-        return self._along_cos
+        (the Plan's, worked out when the yaw changes)."""
+        return max(0.05, self.plan.yaw_trig()[0])
 
     def _motor_states(self) -> dict[MotorId, MotorState]:
         lifts = self.world.state()[4]
