@@ -259,10 +259,17 @@ class StairbotConsole(App[None]):
         self._tell(f"run {result.outcome}", "information")
         if self.engine.limp_offer is not None or self.engine.limp_refused \
                 or stranded(self.state.view().degraded):
-            self.call_from_thread(limp_question.after_stop, self)
+            self.from_thread(limp_question.after_stop, self)
 
     def _tell(self, message: str, severity: str) -> None:
-        self.call_from_thread(self.say, message, severity)
+        self.from_thread(self.say, message, severity)
+
+    def from_thread(self, callback: Callable[..., object], *args: object) -> None:
+        """Run ``callback(*args)`` on the UI thread (from another thread) and
+        wait for it; nothing once the console has begun to quit, when no loop
+        is left to run it on."""
+        if self.is_running:
+            self.call_from_thread(callback, *args)
 
     def say(self, message: str, severity: str = "information", *, keep: bool = True,
             timeout: float = 6) -> None:
@@ -405,7 +412,7 @@ class StairbotConsole(App[None]):
         def stop_then_ask() -> None:
             if self.engine.running and not self.engine.latched:
                 self.engine.estop("SIGINT")
-            self.call_from_thread(self.action_quit_console, "SIGINT")
+            self.from_thread(self.action_quit_console, "SIGINT")
         threading.Thread(target=stop_then_ask, name="SIGINT emergency stop",
                          daemon=True).start()
 

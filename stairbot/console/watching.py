@@ -75,7 +75,7 @@ def share(app: StairbotConsole) -> None:
             app.sharing.hub = ShareHub(
                 address, app.state,
                 on_estop=lambda who: _estop_from(app, who),
-                on_ask=lambda request: app.call_from_thread(_asked, app, request))
+                on_ask=lambda request: app.from_thread(_asked, app, request))
             return
         except OSError as exc:
             # a console that handed control over here closes its hub just after
@@ -104,7 +104,7 @@ def watch(app: StairbotConsole, url: str, wait_s: float = 0.0) -> bool:
     while True:
         if app.sharing.hub is not None or app.engine.session is not None:
             return False
-        client = connect(url, state, lambda kind, text, severity: app.call_from_thread(
+        client = connect(url, state, lambda kind, text, severity: app.from_thread(
             _replied, app, kind, text, severity))
         if client is not None:
             break
@@ -177,7 +177,7 @@ def ask_control(app: StairbotConsole) -> None:
 def _estop_from(app: StairbotConsole, who: str) -> str:
     """A watching console's emergency stop (the hub's thread): latched here at once."""
     app.engine.estop(f"pressed in {who}")
-    app.call_from_thread(_withdraw_question, app)
+    app.from_thread(_withdraw_question, app)
     return "emergency stop latched by the controlling console (c there clears it)"
 
 
