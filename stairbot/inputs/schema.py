@@ -169,6 +169,12 @@ def _bare(t: mi.Type) -> mi.Type:
     return t.type if isinstance(t, mi.Metadata) else t
 
 
+def describe_at(kind: Any, dotted: str) -> str:
+    """What the field ``dotted`` (``"motors.wheel_speed"``) of the struct
+    ``kind`` allows, in words (:func:`describe`)."""
+    return describe(_type_at(kind, _tokens("." + dotted)))
+
+
 def unit_at(kind: Any, dotted: str) -> str | None:
     """The unit a field of the struct ``kind`` is given in (``"m"``,
     ``"turns/s"``: its ``msgspec.Meta(extra={"unit": ...})``), None when the
