@@ -8,6 +8,7 @@ the new file's whole text, and used only once the operator presses the
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
+from weakref import WeakKeyDictionary
 
 from rich.text import Text
 from textual.app import ComposeResult
@@ -23,6 +24,7 @@ from stairbot.control.robot_config import load_config
 from stairbot.errors import StairbotError
 from stairbot.files import shown
 from stairbot.inputs.config import RobotConfig
+from stairbot.recording.record import RecordsTicks
 
 if TYPE_CHECKING:
     from stairbot.console.app import StairbotConsole
@@ -35,12 +37,14 @@ MID_RUN = ("a run is going on: parameters change between runs only (x stops the 
            "nothing changed")
 
 
+_PARAMETERS: WeakKeyDictionary[StairbotConsole, Parameters] = WeakKeyDictionary()
+
+
 def parameters(app: StairbotConsole) -> Parameters:
-    """The console's changes to the config it started with (made once)."""
-    found: Parameters | None = getattr(app, "_parameters", None)
+    """The console's changes to the config it started with (made once a console)."""
+    found = _PARAMETERS.get(app)
     if found is None:
-        found = Parameters(app.engine.world_config)
-        app._parameters = found  # type: ignore[attr-defined]
+        found = _PARAMETERS[app] = Parameters(app.engine.world_config)
     return found
 
 
@@ -250,6 +254,9 @@ class ParamsScreen(ModalScreen[None]):
         self.show_key(change.key)
         message = (f"parameters: {change.key} {shown_value(change.old)} → "
                    f"{shown_value(change.new)}; the next run uses {shown(path)}")
+        if isinstance(self.console.engine.recorder, RecordsTicks):
+            message += ("; the MCAP record holds the config it started with (w twice "
+                        "starts one with this)")
         self.tell(message, error=False)
         self.console.say(message, "information")
 
