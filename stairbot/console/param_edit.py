@@ -22,7 +22,9 @@ the console started with:
 * ``safety.max_pitch_deg``, ``safety.max_roll_deg``,
   ``safety.max_rate_dps``, ``safety.imu_max_age_s``: the supervisor's stop
   thresholds.  Tighter only (at most the started config's): a tighter one
-  can only stop the robot sooner.
+  can only stop the robot sooner.  (The narrow steps' stability check works
+  with the pitch the supervisor allows, so a tighter ``max_pitch_deg`` can
+  let it pass: the check's own verdict, with the bound kept every tick.)
 * ``safety.stability_margin``: how far inside its wheels the centre of mass
   must stay before a lift moves.  Larger only (at least the started
   config's), up to what the config checks allow.
@@ -200,8 +202,8 @@ class Parameters:
                     out.flush()
                     os.fsync(out.fileno())
                 break
-            except FileExistsError:  # taken since it was checked: the next name
-                path = Path(unused_path(str(path)))
+            except FileExistsError:  # taken since it was checked: the next free name
+                path = Path(unused_path(str(self.folder / self._name())))
         self.overrides, self.written = dict(edit.overrides), path
         return path
 

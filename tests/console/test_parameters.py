@@ -252,6 +252,10 @@ def test_a_change_to_a_users_file_is_written_beside_it(tmp_path: Path) -> None:
     assert again.path == tmp_path / "robot-params-1.toml"  # never over the first
     assert again.overrides == {"algorithm.max_steps": 2, "safety.max_pitch_deg": 12.0}
     assert f'extends = "{mine}"' in again.text  # one file deep, whatever the changes
+    again.path.write_text("# written meanwhile\n")  # the name taken after the check
+    assert params.write(again) == tmp_path / "robot-params-2.toml"
+    assert again.path.read_text() == "# written meanwhile\n"
+    assert load_config(tmp_path / "robot-params-2.toml").safety.max_pitch_deg == 12.0
 
 
 def test_a_parameter_that_is_not_runtime_safe_cannot_be_edited(config_home: Path) -> None:
