@@ -199,9 +199,10 @@ class ParamsScreen(ModalScreen[None]):
                         "nothing changed")
             return
         self.editing = key
+        self.tell(f"{key}: now {shown_value(value_of(self.config, key))}; allowed: "
+                  f"{allowed(key, self.params.started)}", error=False)
         self.query_one("#params-allowed", Label).update(
-            f"{key} = ? (now {shown_value(value_of(self.config, key))}; allowed: "
-            f"{allowed(key, self.params.started)}) · Enter checks it · Esc: no change")
+            f"{key} = ?   Enter checks it · Esc: no change")
         field = self.query_one("#params-edit", Input)
         field.value = shown_value(value_of(self.config, key))
         self.query_one("#params-edit-row").add_class("editing")
@@ -259,6 +260,8 @@ class ParamsScreen(ModalScreen[None]):
                         "starts one with this)")
         self.tell(message, error=False)
         self.console.say(message, "information")
+        if not self.console.engine.latched:  # the latch's line stays the one to know
+            self.console.state.set_status(message=message, severity="info")
 
     def action_close(self) -> None:
         if self.editing is not None:

@@ -220,6 +220,7 @@ def test_a_good_edit_shows_a_diff_then_writes_an_extends_file_the_next_run_uses(
             written = config_home / "reference-params-1.toml"
             assert f"the next run uses {written}" in said(app)
             assert str(written) in str(app.screen.query_one("#params-title").render())
+            assert f"the next run uses {written}" in app.state.view().status.message
             await press(pilot, "escape", "k")
             await until(pilot, lambda: "ENDED" in banner(app), "the calibration ends")
             await press(pilot, "r")  # the simulation reopened at the scenario's start
