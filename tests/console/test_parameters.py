@@ -18,7 +18,7 @@ from textual.widgets import Input, Tree
 
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.param_edit import Parameters
-from stairbot.console.params import Limit, Value, shown_value
+from stairbot.console.params import Limit, Value, shown_value, values
 from stairbot.console.params_screen import MID_RUN, DiffScreen, ParamsScreen
 from stairbot.control.algorithm import limits
 from stairbot.control.algorithm.phases import Mode
@@ -272,3 +272,19 @@ def test_a_parameter_that_is_not_runtime_safe_cannot_be_edited(config_home: Path
     with pytest.raises(InputError, match="not runtime-safe"):
         Parameters(load_config()).propose(load_config(), "sensors.front_height", "0.05")
     assert not config_home.exists()
+
+
+def test_a_file_changed_since_it_was_loaded_shows_no_sources(tmp_path: Path) -> None:
+    """Where each value came from is read again from the chain's files: once
+    they no longer resolve to the config the console holds, no source is
+    shown, and the screen says why, rather than name a file that now says
+    otherwise."""
+    mine = tmp_path / "robot.toml"
+    mine.write_text('extends = "reference"\n[motors]\nwheel_speed = 0.8\n')
+    cfg = load_config(str(mine))
+    assert values(cfg)[1] == ""
+    mine.write_text('extends = "reference"\n[motors]\nwheel_speed = 0.6\n')
+    rows, note = values(cfg)
+    assert all(v.source is None for v in rows)
+    assert f"{mine} changed since it was loaded" in note
+    assert next(v for v in rows if v.key == "motors.wheel_speed").value == 0.8
