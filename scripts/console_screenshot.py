@@ -2,18 +2,49 @@
 the picture docs/console-80x24.svg (README links it).
 
     python scripts/console_screenshot.py [OUT.svg] [--size 80x24]
+    python scripts/console_screenshot.py --parameters [docs/console-parameters.svg]
 
 The simulated robot at 10x, started with s, taken once a segment stands over
-the first tread.
+the first tread.  ``--parameters``: the parameters screen (``i``) between
+runs, the cursor on motors.wheel_speed (OUT); then that value changed to 0.5
+and its diff shown before it is used (OUT-diff.svg; nothing is written: the
+diff is answered no).
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
+import os
 from pathlib import Path
 
+from textual.widgets import Input
+
 from stairbot.console.app import build_app
+
+
+async def shoot_parameters(out: Path, width: int, height: int) -> None:
+    from stairbot.console.params_screen import DiffScreen, ParamsScreen
+
+    # the path the diff names, as an operator's would read (nothing is written)
+    os.environ["XDG_CONFIG_HOME"] = "/home/operator/.config"
+    app = build_app(speed="10x")
+    async with app.run_test(size=(width, height)) as pilot:
+        await app.workers.wait_for_complete()
+        await pilot.press("i")
+        screen = app.screen
+        assert isinstance(screen, ParamsScreen)
+        screen.show_key("motors.wheel_speed")
+        await pilot.pause(0.2)
+        app.save_screenshot(filename=out.name, path=str(out.parent))
+        await pilot.press("enter")
+        await pilot.pause(0.1)
+        screen.query_one("#params-edit", Input).value = "0.5"
+        await pilot.press("enter")
+        await pilot.pause(0.3)
+        assert isinstance(app.screen, DiffScreen)
+        app.save_screenshot(filename=f"{out.stem}-diff{out.suffix}", path=str(out.parent))
+        await pilot.press("escape")
 
 
 async def shoot(out: Path, width: int, height: int) -> None:
@@ -34,11 +65,18 @@ async def shoot(out: Path, width: int, height: int) -> None:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("out", nargs="?", default="docs/console-80x24.svg")
+    p.add_argument("out", nargs="?", default=None)
     p.add_argument("--size", default="80x24")
+    p.add_argument("--parameters", action="store_true",
+                   help="the parameters screen (i) with a change's diff")
     args = p.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
-    asyncio.run(shoot(Path(args.out), width, height))
+    if args.parameters:
+        args.out = args.out or "docs/console-parameters.svg"
+        asyncio.run(shoot_parameters(Path(args.out), width, height))
+    else:
+        args.out = args.out or "docs/console-80x24.svg"
+        asyncio.run(shoot(Path(args.out), width, height))
     print(args.out)
 
 

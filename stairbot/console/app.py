@@ -28,7 +28,7 @@ from textual.screen import ModalScreen, Screen
 from textual.widget import Widget
 from textual.widgets import Footer, Static
 
-from stairbot.console import choices, limp_question, motion_gate, paint, watching
+from stairbot.console import choices, limp_question, motion_gate, paint, params_screen, watching
 from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key
 from stairbot.console.help import COMMANDS, HelpScreen
@@ -85,6 +85,7 @@ class StairbotConsole(App[None]):
         Binding("h", "ask_control", "ask control", show=False),
         Binding("e", "event_filter", "filter events", show=False),
         Binding("slash", "event_search", "search events", show=False, key_display="/"),
+        Binding("i", "parameters", "parameters", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
         Binding("ctrl+c", "quit_console('Ctrl-C')", "stop, quit", show=False, priority=True),
     ]
@@ -378,6 +379,11 @@ class StairbotConsole(App[None]):
 
     def action_event_search(self) -> None:
         choices.event_search(self)
+
+    def action_parameters(self) -> None:
+        """The resolved config, its derived limits, and the edit of a
+        runtime-safe value between runs (console/params_screen.py)."""
+        params_screen.open_parameters(self)
 
     def action_zoom(self) -> None:
         choices.zoom(self)

@@ -41,6 +41,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
                                            "link's: the next (key: e)"),
     ("event_search", "Search the events", "Only the events whose text holds a word "
                                           "(key: /)"),
+    ("parameters", "Parameters", "The robot config, its derived limits; change a "
+                                 "runtime-safe value between runs (key: i)"),
     ("help", "Help", "Every key, and how to read the screen (key: ?)"),
 )
 
@@ -72,6 +74,9 @@ KEYS
           (empty: every event)
   h       watching a robot another console controls: ask that
           console's operator to hand control over
+  i       parameters: the robot config, what the controller
+          works from; between runs, change a value marked ✎
+          (a new file extends the config: a diff first)
   Ctrl+P  every action by name
 
 READING THE SCREEN

@@ -78,6 +78,12 @@ class RobotHolder:
                  sleep: Callable[[float], None] = time.sleep) -> None:
         self.state = state
         self.config = config
+        """The config the runs use (the parameters screen, ``i``, may change
+        its runtime-safe values between runs: console/param_edit.py)."""
+        self.world_config = config
+        """The config robots are opened with: the simulation's world (the
+        robot's bodies, sensors and motors) is built from it and stays the
+        same whatever the runs' config changes."""
         self._open_fn = open_fn
         self._wall, self._sleep = wall, sleep
         self._lock = threading.RLock()
@@ -156,7 +162,7 @@ class RobotHolder:
         self.state.set_robot(url, scenario.name, simulated, wired=not simulated)
         self.state.set_status(robot="connecting", message=f"opening {url}", severity="info")
         try:
-            session = self._open_fn(url, self.config, scenario,
+            session = self._open_fn(url, self.world_config, scenario,
                                     RobotOptions(allow_latched=clear_latches))
         except LatchedError as exc:
             message = f"{exc}; or press c here once you have looked at the robot"

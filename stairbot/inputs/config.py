@@ -202,10 +202,21 @@ def _extended(raw: dict[str, Any], source: str, chain: tuple[str, ...]) -> dict[
     else replaced.  ``chain`` holds the sources that extend this one, the
     first one loaded first.  Raises ConfigError on a loop (naming its files)
     or on a chain of more than :data:`MAX_EXTENDS`."""
+    out: dict[str, Any] = {}
+    for _, layer in _layers(raw, source, chain):
+        out = _merged(out, layer)
+    return out
+
+
+def _layers(raw: dict[str, Any], source: str,
+            chain: tuple[str, ...]) -> list[tuple[str, dict[str, Any]]]:
+    """The configs :func:`_extended` lays one over the other, each with its
+    source, the one at the bottom of the chain first and ``raw`` (without
+    its ``extends``) last.  Raises ConfigError as :func:`_extended` does."""
     chain = (*chain, source)
     base = raw.pop("extends", None)
     if base is None:
-        return raw
+        return [(source, raw)]
     if not isinstance(base, str) or not base:
         raise ConfigError(source, "extends", "must be a shipped robot's name ("
                           + ", ".join(shipped_configs()) + ") or a config file's path")
@@ -220,8 +231,22 @@ def _extended(raw: dict[str, Any], source: str, chain: tuple[str, ...]) -> dict[
         raise ConfigError(source, "extends", f"{base!r}: the chain of extends from "
                           f"{shown(chain[0])} goes deeper than {MAX_EXTENDS} configs; "
                           f"allowed: a config stands on at most {MAX_EXTENDS} others")
-    base_raw = _extended(load_toml(text, base_source, ConfigError), base_source, chain)
-    return _merged(base_raw, raw)
+    return [*_layers(load_toml(text, base_source, ConfigError), base_source, chain),
+            (source, raw)]
+
+
+def value_sources(text: str, source: str) -> dict[str, str]:
+    """Which config of the ``extends`` chain set each value of a config
+    document: ``"section.key"`` -> the source of the last one to set it (a
+    file's path, ``<robot NAME>``, ``<default ...>``).  A key no config of
+    the chain sets is left out: its value is the schema's default.  Raises
+    ConfigError as :func:`resolve_config` does."""
+    out: dict[str, str] = {}
+    for layer_source, layer in _layers(load_toml(text, source, ConfigError), source, ()):
+        for section, table in layer.items():
+            if isinstance(table, dict):
+                out.update({f"{section}.{key}": layer_source for key in table})
+    return out
 
 
 def _identity(source: str) -> str:
@@ -268,6 +293,17 @@ SHIPPED_DIR = "configs"
 def shipped_configs() -> list[str]:
     """Names of the robot configs shipped with stairbot (``--config NAME``)."""
     return sorted([REFERENCE, *shipped(SHIPPED_DIR)])
+
+
+def source_ref(source: str) -> str:
+    """What :func:`config_text` takes to read a config again from its source
+    name: a shipped robot's name (``"reference"``, ``"ir"``), else the
+    source itself (a file's path)."""
+    if source == f"<default {DEFAULT_CONFIG_NAME}>":
+        return REFERENCE
+    if source.startswith("<robot ") and source.endswith(">"):
+        return source[len("<robot "):-1]
+    return source
 
 
 def config_table(path: str | Path | None = None) -> dict[str, Any]:

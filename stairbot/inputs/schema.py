@@ -154,11 +154,38 @@ def _dotted(tokens: list[str | int]) -> str:
 
 
 def _strip_optional(t: mi.Type) -> mi.Type:
+    """``t`` without its ``| None`` and its metadata (a unit): the type that
+    bounds its values."""
+    t = _bare(t)
     if isinstance(t, mi.UnionType):
         rest = [u for u in t.types if not isinstance(u, mi.NoneType)]
         if len(rest) == 1:
-            return rest[0]
+            return _bare(rest[0])
     return t
+
+
+def _bare(t: mi.Type) -> mi.Type:
+    """``t`` without the metadata a ``msgspec.Meta(extra=...)`` wraps it in."""
+    return t.type if isinstance(t, mi.Metadata) else t
+
+
+def describe_at(kind: Any, dotted: str) -> str:
+    """What the field ``dotted`` (``"motors.wheel_speed"``) of the struct
+    ``kind`` allows, in words (:func:`describe`)."""
+    return describe(_type_at(kind, _tokens("." + dotted)))
+
+
+def unit_at(kind: Any, dotted: str) -> str | None:
+    """The unit a field of the struct ``kind`` is given in (``"m"``,
+    ``"turns/s"``: its ``msgspec.Meta(extra={"unit": ...})``), None when the
+    schema gives none."""
+    t = _type_at(kind, _tokens("." + dotted))
+    if isinstance(t, mi.UnionType):
+        t = next((u for u in t.types if not isinstance(u, mi.NoneType)), None)
+    if isinstance(t, mi.Metadata) and t.extra:
+        unit = t.extra.get("unit")
+        return unit if isinstance(unit, str) else None
+    return None
 
 
 def _type_at(kind: Any, tokens: list[str | int]) -> mi.Type | None:
@@ -186,6 +213,7 @@ def _value_at(raw: Any, tokens: list[str | int]) -> Any:
 def _literals(t: mi.Type) -> list[str]:
     values: list[str] = []
     for u in t.types if isinstance(t, mi.UnionType) else (t,):
+        u = _bare(u)
         if isinstance(u, mi.LiteralType):
             values += [str(v) for v in u.values]
     return values

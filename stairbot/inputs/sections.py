@@ -13,14 +13,21 @@ from stairbot.inputs.sensor_specs import SPECS, SensorSpec
 
 # Physical bounds: generous around any robot of this kind (the reference robot
 # is 0.225 m long and 2.4 kg), tight enough that the simulation's pymunk world
-# stays sane and a run ends (docs/config.md, "Bounds of the inputs").
-Length = Annotated[float, msgspec.Meta(ge=0.001, le=10.0)]
+# stays sane and a run ends (docs/config.md, "Bounds of the inputs").  Each
+# number carries its unit (``extra["unit"]``, read by
+# :func:`stairbot.inputs.schema.unit_at`: the console's parameters screen).
+Length = Annotated[float, msgspec.Meta(ge=0.001, le=10.0, extra={"unit": "m"})]
 """A length that must be there: 1 mm to 10 m."""
-Gap = Annotated[float, msgspec.Meta(ge=0.0, le=10.0)]
+Gap = Annotated[float, msgspec.Meta(ge=0.0, le=10.0, extra={"unit": "m"})]
 """A length that may be zero: 0 to 10 m."""
-Mass = Annotated[float, msgspec.Meta(ge=0.001, le=1000.0)]
+Mass = Annotated[float, msgspec.Meta(ge=0.001, le=1000.0, extra={"unit": "kg"})]
 """A mass: 1 g to 1 t."""
-TurnsPerSecond = Annotated[float, msgspec.Meta(ge=0.01, le=1000.0)]
+Degrees90 = Annotated[float, msgspec.Meta(ge=0, le=90, extra={"unit": "°"})]
+"""A sensor's full cone: 0 to 90 degrees."""
+Tilt = Annotated[float, msgspec.Meta(ge=-45, le=45, extra={"unit": "°"})]
+"""A sensor's mounting tilt: -45 to 45 degrees."""
+TurnsPerSecond = Annotated[float, msgspec.Meta(ge=0.01, le=1000.0,
+                                                 extra={"unit": "turns/s"})]
 
 # The kinds of distance sensor (stairbot.inputs.sensor_specs; the names must agree)
 SensorModelName = Literal["ideal", "vl53l1x", "vl53l0x", "hcsr04", "gp2y0a21", "vl53l5cx"]
@@ -34,7 +41,8 @@ class Geometry(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     track_width: Length
     wheel_radius: Length
     wheel_inset: Length
-    LENGTH_OF_A_ROBOT: Annotated[float, msgspec.Meta(gt=0, le=30.0)] | None = None
+    LENGTH_OF_A_ROBOT: Annotated[float, msgspec.Meta(gt=0, le=30.0,
+                                                     extra={"unit": "m"})] | None = None
     """Optional; must equal the sum of the segments."""
 
 
@@ -50,13 +58,13 @@ class Motors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     (config_checks: WHEEL_SPEED_M_S, LIFT_SPEED_M_S)."""
 
     wheel_speed: TurnsPerSecond
-    wheel_torque: Annotated[float, msgspec.Meta(ge=0.001, le=10000.0)]
+    wheel_torque: Annotated[float, msgspec.Meta(ge=0.001, le=10000.0, extra={"unit": "N·m"})]
     """N*m: 1 mN*m to 10 kN*m."""
-    lift_travel_per_turn: Annotated[float, msgspec.Meta(ge=0.00001, le=1.0)]
+    lift_travel_per_turn: Annotated[float, msgspec.Meta(ge=0.00001, le=1.0, extra={"unit": "m"})]
     """m: 10 um to 1 m."""
     lift_speed: TurnsPerSecond
     lift_travel: Length
-    lift_force: Annotated[float, msgspec.Meta(ge=0.01, le=100000.0)]
+    lift_force: Annotated[float, msgspec.Meta(ge=0.01, le=100000.0, extra={"unit": "N"})]
     """N: 10 mN to 100 kN."""
 
 
@@ -70,8 +78,8 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     back_lateral: Gap
     back_min_range: Gap
     back_max_range: Length
-    resolution: Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
-    noise: Annotated[float, msgspec.Meta(ge=0.0, le=1.0)] = 0.005
+    resolution: Annotated[float, msgspec.Meta(ge=0.0, le=1.0, extra={"unit": "m"})]
+    noise: Annotated[float, msgspec.Meta(ge=0.0, le=1.0, extra={"unit": "m"})] = 0.005
     """Stated sigma of a distance reading of the ``ideal`` model: perception
     derives its tolerances from it.  A named model states its own
     (stairbot.inputs.sensor_specs)."""
@@ -81,16 +89,16 @@ class Sensors(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     models it (stairbot.fakes.sensor_presets)."""
     back_model: SensorModelName = "ideal"
     """... and SBR/SBL."""
-    front_fov_deg: Annotated[float, msgspec.Meta(ge=0, le=90)] | None = None
+    front_fov_deg: Degrees90 | None = None
     """Full cone of SFR/SFL as mounted (a ToF's ROI narrows it), at most the
     model's; 0: one ray along the mount (what the ``ideal`` model has, and
     how a config that extends one with a cone takes the cone back); None
     (the key left out): the model's."""
-    front_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
+    front_tilt_deg: Tilt = 0.0
     """Mounting tilt of SFR/SFL, degrees up."""
-    back_fov_deg: Annotated[float, msgspec.Meta(ge=0, le=90)] | None = None
+    back_fov_deg: Degrees90 | None = None
     """... of SBR/SBL, the same way."""
-    back_tilt_deg: Annotated[float, msgspec.Meta(ge=-45, le=45)] = 0.0
+    back_tilt_deg: Tilt = 0.0
     """Mounting tilt of SBR/SBL, degrees towards the front."""
     side_model: SensorModelName | Literal["none"] = "none"
     """The side pair SSR/SSL (quarter-turn landings, the seed's extension 1):
@@ -146,13 +154,13 @@ class Algorithm(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     approach_gap: Gap
     clearance_lift: Length
     drive_clearance: Length
-    equal_tolerance: Annotated[float, msgspec.Meta(ge=0.0001, le=1.0)]
-    standing_wait: Annotated[float, msgspec.Meta(gt=0, le=3600.0)]
+    equal_tolerance: Annotated[float, msgspec.Meta(ge=0.0001, le=1.0, extra={"unit": "m"})]
+    standing_wait: Annotated[float, msgspec.Meta(gt=0, le=3600.0, extra={"unit": "s"})]
     """Controller seconds, at most an hour."""
-    max_steps: Annotated[int, msgspec.Meta(ge=1, le=20)]
+    max_steps: Annotated[int, msgspec.Meta(ge=1, le=20, extra={"unit": "steps"})]
     # at most 1 kHz: what a host drives over a serial link or a CAN bus (and the
     # simulation's physics step, 1/600 s, must fit in a tick for time to move)
-    tick: Annotated[float, msgspec.Meta(ge=0.001, le=0.5)]
+    tick: Annotated[float, msgspec.Meta(ge=0.001, le=0.5, extra={"unit": "s"})]
     narrow_steps: bool = False
     """The seed's extension 3: climb treads down to LENGTH_OF_FIRST_MODULE +
     LENGTH_OF_SECOND_MODULE (+ SAFE_LENGTH), segment 3 in the air over the
@@ -176,12 +184,12 @@ class Safety(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     """The sensor board has an IMU: without one in a snapshot the robot stops
     (with a stale one it stands until a fresh one comes, for at most the
     sensor wait).  False: tilt is not watched, and the run says so."""
-    max_pitch_deg: Annotated[float, msgspec.Meta(gt=0, le=30)]
-    max_roll_deg: Annotated[float, msgspec.Meta(gt=0, le=30)]
+    max_pitch_deg: Annotated[float, msgspec.Meta(gt=0, le=30, extra={"unit": "°"})]
+    max_roll_deg: Annotated[float, msgspec.Meta(gt=0, le=30, extra={"unit": "°"})]
     """Tilt beyond which every motor stops and the lifts hold (either sign)."""
-    max_rate_dps: Annotated[float, msgspec.Meta(gt=0, le=1000)]
+    max_rate_dps: Annotated[float, msgspec.Meta(gt=0, le=1000, extra={"unit": "°/s"})]
     """Pitch or roll rate beyond which every motor stops, degrees per second."""
-    imu_max_age_s: Annotated[float, msgspec.Meta(gt=0, le=1)]
+    imu_max_age_s: Annotated[float, msgspec.Meta(gt=0, le=1, extra={"unit": "s"})]
     """An IMU reading older than this cannot watch tilt: every motor stops
     until a fresher one comes (stairbot/control/tilt.py)."""
     stability_margin: Gap
