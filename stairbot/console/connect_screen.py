@@ -11,6 +11,7 @@ screen sees it.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 
 from rich.text import Text
@@ -25,6 +26,12 @@ from stairbot.console import connections
 from stairbot.console.connections import GROUPS, Listing
 
 EXAMPLES = "sim://  serial://PORT?baud=N  can://IF/CHANNEL"
+SHOWN_URL = 100
+"""A URL longer than this is shown cut (the row opens it whole)."""
+
+
+def _shown(url: str) -> str:
+    return url if len(url) <= SHOWN_URL else f"{url[:SHOWN_URL - 1]}… ({len(url)} characters)"
 
 
 class ConnectScreen(ModalScreen[str | None]):
@@ -63,7 +70,8 @@ class ConnectScreen(ModalScreen[str | None]):
 
     def compose(self) -> ComposeResult:
         with Vertical(id="connect"):
-            yield Label(f"Connect to a robot (now: {self.current})", markup=False)
+            yield Label(f"Connect to a robot (open now: {_shown(self.current)})",
+                        id="connect-title", markup=False)
             yield OptionList(id="robots")
             yield Static("", id="connect-notes", classes="empty", markup=False)
             yield Input(value=self.current, placeholder=EXAMPLES, id="url")
@@ -107,7 +115,7 @@ class ConnectScreen(ModalScreen[str | None]):
                 key = f"row-{len(self.urls)}"
                 self.urls[key] = entry.url
                 prompt = Text("  ")
-                prompt.append(entry.url, style="bold")
+                prompt.append(_shown(entry.url), style="bold")
                 prompt.append(f"  {entry.description}", style="dim")
                 options.append(Option(prompt, id=key))
         if listing.skipped:
@@ -117,6 +125,9 @@ class ConnectScreen(ModalScreen[str | None]):
         robots = self.query_one(OptionList)
         robots.set_options(options)
         robots.highlighted = self._first_row(options)
+        self.query_one("#connect-title", Label).update(
+            f"Connect to a robot (open now: {_shown(self.current)}) · as found at "
+            f"{time.strftime('%H:%M:%S')}")
         notes = self.query_one("#connect-notes", Static)
         notes.update("\n".join(listing.problems))
         notes.set_class(not listing.problems, "empty")

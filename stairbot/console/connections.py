@@ -27,11 +27,14 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
+from urllib.parse import quote
 
 import can
 from serial.tools import list_ports
 
 from stairbot.console import recent
+from stairbot.drivers.can_robot import parse_can_url
+from stairbot.errors import RobotUrlError
 from stairbot.fakes import registry
 
 GROUPS = ("Fake boards", "Serial ports", "CAN buses", "Simulation", "Recent")
@@ -157,10 +160,16 @@ def _can_entry(cfg: Any) -> tuple[Entry | None, str | None]:
         if group.version == 6:
             return None, (f"udp_multicast {channel}: an IPv6 group, and stairbot keeps "
                           "udp_multicast on loopback, IPv4 only (type ?lan=1: the network)")
-        return Entry("CAN buses", f"can://udp_multicast/{channel}",
-                     "python-can udp_multicast, on this machine's loopback only"), None
-    return Entry("CAN buses", f"can://{interface}/{channel}",
-                 f"python-can {interface} channel {channel}"), None
+        entry = Entry("CAN buses", f"can://udp_multicast/{channel}",
+                      "python-can udp_multicast, on this machine's loopback only")
+    else:
+        entry = Entry("CAN buses", f"can://{interface}/{quote(channel, safe='/:.')}",
+                      f"python-can {interface} channel {channel}")
+    try:
+        parse_can_url(entry.url)  # the driver's own reading of it
+    except RobotUrlError as exc:
+        return None, f"{interface} {channel}: {exc}"
+    return entry, None
 
 
 def _why(exc: BaseException) -> str:

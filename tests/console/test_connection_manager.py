@@ -209,3 +209,26 @@ def test_the_recent_list_keeps_the_newest_ten_once_each(tmp_path: Path) -> None:
     assert urls.count("serial:///dev/ttyUSB5") == 1
     assert "serial:///dev/ttyUSB1" not in urls  # the oldest went
     assert [p.name for p in tmp_path.iterdir()] == ["recent.json"]  # no temporary left
+
+
+def test_one_can_interface_failing_costs_only_its_own_entries(
+        own_dirs: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def detect(interfaces: list[str]) -> list[dict[str, Any]]:
+        (name,) = interfaces
+        if name == "pcan":
+            raise OSError("PCANBasic library not found")
+        if name == "socketcan":
+            return [{"interface": "socketcan", "channel": "vcan0"}]
+        if name == "udp_multicast":
+            return [{"interface": "udp_multicast", "channel": "ff15::1"},
+                    {"interface": "udp_multicast", "channel": "239.74.163.2"}]
+        return []
+
+    listing = connections.gather(sim="the simulation", detect=detect)
+    assert [e.url for e in listing.group("CAN buses")] == [
+        "can://socketcan/vcan0", "can://udp_multicast/239.74.163.2"]
+    (problem,) = [p for p in listing.problems if p.startswith("CAN")]
+    assert problem == "CAN: pcan: cannot look for buses: OSError: PCANBasic library not found"
+    skipped = "\n".join(listing.skipped)
+    assert "udp_multicast ff15::1: an IPv6 group" in skipped
+    assert "virtual: a bus inside one process" in skipped
