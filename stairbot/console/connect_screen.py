@@ -58,11 +58,12 @@ class ConnectScreen(ModalScreen[str | None]):
     """
 
     def __init__(self, current: str, sim: str,
-                 gather: Callable[..., Listing] = connections.gather) -> None:
+                 gather: Callable[..., Listing] | None = None) -> None:
         super().__init__()
         self.current = current
         self.sim = sim
         self.gather = gather
+        """What looks (None: :func:`connections.gather`, looked up at each look)."""
         self.urls: dict[str, str] = {}
         """Each openable row's option id -> its URL."""
         self.listing: Listing | None = None
@@ -96,7 +97,7 @@ class ConnectScreen(ModalScreen[str | None]):
 
     def _look(self) -> None:
         try:
-            listing = self.gather(sim=self.sim)
+            listing = (self.gather or connections.gather)(sim=self.sim)
         except Exception as exc:  # noqa: BLE001 - gather's sources cannot raise; a bug is a line
             listing = Listing(problems=[f"cannot look for robots: {type(exc).__name__}: {exc}"])
         self.app.call_from_thread(self._show, listing)

@@ -19,7 +19,7 @@ import pytest
 from lockstep_boards import lockstep_boards
 from pilot import banner, press, ready, type_into, until
 from serial.tools import list_ports
-from textual.widgets import OptionList
+from textual.widgets import Input, OptionList
 
 from stairbot.console import connections, recent
 from stairbot.console.app import build_app
@@ -232,3 +232,35 @@ def test_one_can_interface_failing_costs_only_its_own_entries(
     skipped = "\n".join(listing.skipped)
     assert "udp_multicast ff15::1: an IPv6 group" in skipped
     assert "virtual: a bus inside one process" in skipped
+
+
+def test_r_looks_again_from_the_list_and_is_a_letter_in_the_field(
+        own_dirs: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    looks: list[str] = []
+    real = connections.gather
+
+    def counted(**kwargs: Any) -> connections.Listing:
+        looks.append(kwargs["sim"])
+        return real(**kwargs)
+
+    monkeypatch.setattr(connections, "gather", counted)
+
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            screen = await open_manager(pilot)
+            assert len(looks) == 1
+            await press(pilot, "r")
+            await until(pilot, lambda: len(looks) == 2 and screen.listing is not None,
+                        "looked again")
+            field = screen.query_one("#url", Input)
+            field.focus()
+            await until(pilot, lambda: screen.focused is field, "the field focused")
+            await press(pilot, "end", "r")
+            await pilot.pause(0.1)
+            assert len(looks) == 2 and field.value == "sim://r"
+            await press(pilot, "escape")
+            await until(pilot, lambda: len(app.screen_stack) == 1, "closed")
+            assert app.url == "sim://"
+    asyncio.run(go())
