@@ -3,12 +3,15 @@ the picture docs/console-80x24.svg (README links it).
 
     python scripts/console_screenshot.py [OUT.svg] [--size 80x24]
     python scripts/console_screenshot.py --parameters [docs/console-parameters.svg]
+    python scripts/console_screenshot.py --connections [docs/console-connections.svg]
 
 The simulated robot at 10x, started with s, taken once a segment stands over
 the first tread.  ``--parameters``: the parameters screen (``i``) between
 runs, the cursor on motors.wheel_speed (OUT); then that value changed to 0.5
 and its diff shown before it is used (OUT-diff.svg; nothing is written: the
-diff is answered no).
+diff is answered no).  ``--connections``: the connection manager (u) instead,
+with fake boards served on a pty for it to list (their registry, and the
+recent URLs, in a temporary directory of their own).
 """
 
 from __future__ import annotations
@@ -16,6 +19,10 @@ from __future__ import annotations
 import argparse
 import asyncio
 import os
+import signal
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 from textual.widgets import Input
@@ -63,17 +70,56 @@ async def shoot(out: Path, width: int, height: int) -> None:
         await pilot.pause(0.2)
 
 
+async def shoot_connections(out: Path, width: int, height: int) -> None:
+    from stairbot.console.connect_screen import ConnectScreen
+
+    app = build_app(speed="1x")
+    async with app.run_test(size=(width, height)) as pilot:
+        await app.workers.wait_for_complete()
+        await pilot.press("u")
+        for _ in range(400):
+            if isinstance(app.screen, ConnectScreen) and app.screen.listing is not None:
+                break
+            await asyncio.sleep(0.05)
+        await pilot.pause(0.3)
+        app.save_screenshot(filename=out.name, path=str(out.parent))
+        await pilot.press("escape")
+
+
+def with_fake_boards(out: Path, width: int, height: int) -> None:
+    """Serve fake boards (lockstep: idle until a host steps them) while the
+    manager's picture is taken."""
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["XDG_RUNTIME_DIR"] = str(Path(tmp) / "run")
+        os.environ["XDG_STATE_HOME"] = str(Path(tmp) / "state")
+        boards = subprocess.Popen([sys.executable, "-m", "stairbot", "fake-boards", "--serial",
+                                   "--lockstep"], stdout=subprocess.PIPE,
+                                  stderr=subprocess.DEVNULL, text=True)
+        try:
+            assert boards.stdout is not None
+            boards.stdout.readline()  # the URL: registered by now
+            asyncio.run(shoot_connections(out, width, height))
+        finally:
+            boards.send_signal(signal.SIGINT)
+            boards.wait(10)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("out", nargs="?", default=None)
     p.add_argument("--size", default="80x24")
     p.add_argument("--parameters", action="store_true",
                    help="the parameters screen (i) with a change's diff")
+    p.add_argument("--connections", action="store_true",
+                   help="the connection manager (u), with fake boards to list")
     args = p.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     if args.parameters:
         args.out = args.out or "docs/console-parameters.svg"
         asyncio.run(shoot_parameters(Path(args.out), width, height))
+    elif args.connections:
+        args.out = args.out or "docs/console-connections.svg"
+        with_fake_boards(Path(args.out), width, height)
     else:
         args.out = args.out or "docs/console-80x24.svg"
         asyncio.run(shoot(Path(args.out), width, height))

@@ -28,7 +28,15 @@ from textual.screen import ModalScreen, Screen
 from textual.widget import Widget
 from textual.widgets import Footer, Static
 
-from stairbot.console import choices, limp_question, motion_gate, paint, params_screen, watching
+from stairbot.console import (
+    choices,
+    limp_question,
+    motion_gate,
+    paint,
+    params_screen,
+    recent,
+    watching,
+)
 from stairbot.console.engine import ConsoleEngine, EngineHooks
 from stairbot.console.freshness import age_key
 from stairbot.console.help import COMMANDS, HelpScreen
@@ -242,6 +250,8 @@ class StairbotConsole(App[None]):
             return
         self.url, self.scenario = url, scenario
         watching.share(self)
+        if (unsaved := recent.remember(url)) is not None:  # the connection manager's Recent
+            self._tell(unsaved, "warning")
 
     @work(thread=True, group="run", exclusive=False, exit_on_error=False)
     def run_program(self, mode: str, resume: ResumePlan | None = None) -> None:

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from stairbot.console.connect_screen import ConnectScreen
 from stairbot.console.modals import AskScreen, Notice
 from stairbot.console.paint import lay_out, tall
 from stairbot.console.robot_holder import SPEEDS
 from stairbot.errors import InputError
+from stairbot.inputs.schema import shipped
 
 if TYPE_CHECKING:
     from stairbot.console.app import StairbotConsole
@@ -33,8 +35,17 @@ def choose_robot(app: StairbotConsole) -> None:
         if url:
             app.open_robot(url, app.scenario)
 
-    app.push_screen(AskScreen("Robot URL", app.url, "sim://",
-                              "sim://  serial://PORT?baud=N  can://IF/CHANNEL"), chosen)
+    app.push_screen(ConnectScreen(app.url, sim_line(app)), chosen)
+
+
+def sim_line(app: StairbotConsole) -> str:
+    """What ``sim://`` opens in this console: its robot (set at start: the
+    panels are built for it) on the scenario ``o`` chooses."""
+    source = app.engine.config.source
+    robot = "reference" if source.startswith("<default") else \
+        source.removeprefix("<robot ").removesuffix(">")
+    return (f"{robot} robot, {app.scenario or 'default'} stairs (o: the stairs; "
+            f"another robot: stairbot console --config {'|'.join(shipped('configs'))})")
 
 
 def choose_scenario(app: StairbotConsole) -> None:

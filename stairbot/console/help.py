@@ -26,7 +26,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("limp_home", "Limp home", "After a degraded stop: come home on the remaining "
                                "sensors, once you consent (key: l)"),
     ("reset", "Reset the simulated scenario", "Reopen the simulation at its start (key: r)"),
-    ("choose_robot", "Choose robot URL", "sim://, serial://PORT, can://IF/CH (key: u)"),
+    ("choose_robot", "Connect to a robot", "pick one from the list (fake boards, serial "
+     "ports, CAN buses, sim://, recent) or type its URL (key: u)"),
     ("choose_scenario", "Choose scenario", "A scenario file or shipped name (key: o)"),
     ("speed", "Simulation speed", "Cycle 1×, 10×, as fast as possible (key: f)"),
     ("record", "Record events", "Start/stop recording: FILE.mcap every tick as MCAP, else "
@@ -59,7 +60,7 @@ KEYS
           sensors that remain; the console asks at the stop
   q       quit (mid-run: the robot stops first, then it asks);
           Ctrl+Q and Ctrl-C do the same
-  u       robot URL               o  scenario
+  u       connect: pick a robot   o  scenario
   f       simulation speed        r  reset the simulation
   w       record events to a file (never over an existing one)
   z       picture zoom            ?  this help

@@ -31,6 +31,7 @@ from stairbot.args import bounded
 from stairbot.control.robot_config import config_for
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import launch_serials, make_boards, serials_words
+from stairbot.fakes.registry import registered
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot
 from stairbot.inputs.config import RobotConfig
@@ -125,11 +126,15 @@ def main(argv: list[str]) -> int:
     stop_on_signals(server.stop)
     suffix = "?lockstep=1" if args.lockstep else (
         f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
-    print(f"serial://{pty.path}{suffix}", flush=True)
+    url = f"serial://{pty.path}{suffix}"
+    print(url, flush=True)
     print(f"fake boards ({serials_words(boards)}) serving on {pty.path} (Ctrl-C to stop)",
           file=sys.stderr, flush=True)
     try:
-        server.serve()
+        with registered(url, wire="serial", scenario=scenario.name,
+                        config=args.config or scenario.robot or "reference",
+                        serials=serials_words(boards)):
+            server.serve()
     except KeyboardInterrupt:
         pass
     finally:

@@ -51,6 +51,7 @@ from stairbot.drivers.udp_loopback import LoopbackUdpMulticastBus
 from stairbot.errors import RobotUrlError
 from stairbot.fakes.board_world import BoardWorld, Pacer
 from stairbot.fakes.boards import Board, launch_serials, make_boards, serials_words
+from stairbot.fakes.registry import registered
 from stairbot.fakes.serial_boards import FaultDice, WireFaults
 from stairbot.inputs.scenario import load_scenario
 
@@ -255,7 +256,10 @@ def main(argv: list[str]) -> int:
           "(Ctrl-C to stop)", file=sys.stderr, flush=True)
 
     try:
-        server.serve()
+        with registered(f"{url}{suffix}", wire="can", scenario=scenario.name,
+                        config=args.config or scenario.robot or "reference",
+                        serials=serials_words(boards)):
+            server.serve()
     except KeyboardInterrupt:
         pass
     finally:

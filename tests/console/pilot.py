@@ -57,10 +57,21 @@ async def ready(pilot: Any) -> None:
 
 
 async def answer_prompt(pilot: Any, key: str, value: str) -> None:
-    """Press ``key``, put ``value`` into the prompt it opens, press enter."""
+    """Press ``key``, put ``value`` into the prompt it opens (the URL field
+    of the connection manager), press enter."""
     await press(pilot, key)
     await until(pilot, lambda: bool(pilot.app.screen.query(Input)), "the prompt")
-    pilot.app.screen.query_one(Input).value = value
+    await type_into(pilot, value)
+
+
+async def type_into(pilot: Any, value: str) -> None:
+    """Put ``value`` into the open prompt's field, focused, and press enter."""
+    screen = pilot.app.screen
+    await until(pilot, lambda: screen.focused is not None, "the prompt's first focus")
+    field = screen.query_one(Input)
+    field.value = value
+    field.focus()
+    await until(pilot, lambda: screen.focused is field, "the field focused")
     await press(pilot, "enter")
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from pilot import SpyRobot, banner, press, ready, say_yes, spied_open, until
+from pilot import SpyRobot, banner, press, ready, say_yes, spied_open, type_into, until
 from still_robot import still_open
 from textual.widgets import Input
 
@@ -173,8 +173,7 @@ def test_invalid_robot_or_scenario_gives_a_message(key: str, value: str, expect:
             await ready(pilot)
             await press(pilot, key)
             await until(pilot, lambda: bool(app.screen.query(Input)), "the prompt")
-            app.screen.query_one(Input).value = value
-            await press(pilot, "enter")
+            await type_into(pilot, value)
             await until(pilot, lambda: expect in banner(app), "the message")
             await app.workers.wait_for_complete()
             await until(pilot, lambda: len(app.screen_stack) == 1, "the prompt closes")
@@ -282,8 +281,7 @@ def test_a_robot_that_fails_to_reopen_is_named_in_the_banner() -> None:
             await ready(pilot)
             await press(pilot, "u")
             await until(pilot, lambda: bool(app.screen.query(Input)), "the prompt")
-            app.screen.query_one(Input).value = "serial://second"
-            await press(pilot, "enter")
+            await type_into(pilot, "serial://second")
             await until(pilot, lambda: "did not reopen" in banner(app), "the message")
             text = banner(app)
             assert "FAULT" in text and "serial://second: no reply" in text
@@ -315,7 +313,7 @@ def test_speed_reset_palette_and_resize() -> None:
             titles = {c.title for c in app.get_system_commands(app.screen)}
             for title in ("EMERGENCY STOP", "Clear emergency stop", "Start full run",
                           "Calibrate only", "Pause / resume", "Reset the simulated scenario",
-                          "Choose robot URL", "Choose scenario", "Simulation speed",
+                          "Connect to a robot", "Choose scenario", "Simulation speed",
                           "Record events"):
                 assert title in titles
             for size in ((120, 40), (80, 24), (100, 30)):

@@ -11,7 +11,7 @@ from pilot import press, ready, said, until
 from textual.widgets._toast import Toast
 
 from stairbot.console.app import build_app
-from stairbot.console.modals import AskScreen
+from stairbot.console.connect_screen import ConnectScreen
 
 
 def test_a_dialog_is_never_covered_by_a_toast_nor_the_link_panel_console_defect_8() -> None:
@@ -24,7 +24,7 @@ def test_a_dialog_is_never_covered_by_a_toast_nor_the_link_panel_console_defect_
             toast = app.screen.query(Toast).first()
             assert not toast.region.overlaps(app.link.region), (toast.region, app.link.region)
             await press(pilot, "u")  # the robot's URL? (a dialog)
-            await until(pilot, lambda: isinstance(app.screen, AskScreen), "the dialog")
+            await until(pilot, lambda: isinstance(app.screen, ConnectScreen), "the dialog")
             await pilot.pause(0.2)
             assert not app.screen.query(Toast) and not app._notifications
             app.say("while it asks")
