@@ -2,9 +2,11 @@
 the picture docs/console-80x24.svg (README links it).
 
     python scripts/console_screenshot.py [OUT.svg] [--size 80x24]
+    python scripts/console_screenshot.py docs/console-plots.svg --plot SFR,SFL,MTF.lift
 
 The simulated robot at 10x, started with s, taken once a segment stands over
-the first tread.
+the first tread.  ``--plot KEYS``: those signals plotted (key v; the keys
+as console/signals.py names them), in the graphs' place.
 """
 
 from __future__ import annotations
@@ -13,13 +15,21 @@ import argparse
 import asyncio
 from pathlib import Path
 
+from stairbot.console import plotting
 from stairbot.console.app import build_app
 
 
-async def shoot(out: Path, width: int, height: int) -> None:
+async def shoot(out: Path, width: int, height: int, plot: list[str]) -> None:
     app = build_app(speed="10x")
     async with app.run_test(size=(width, height)) as pilot:
         await app.workers.wait_for_complete()
+        if plot:
+            plotting.plot(app, plot)
+            picked = [s.key for s in app.plotting.picked]
+            if picked != plot:
+                known = ", ".join(s.key for s in app.plotting.signals(app))
+                raise SystemExit(f"--plot: {', '.join(k for k in plot if k not in picked)}"
+                                 f" is no signal of this robot; allowed: {known}")
         await pilot.press("s")
         for _ in range(2400):
             scene = app.state.view().scene
@@ -36,9 +46,10 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("out", nargs="?", default="docs/console-80x24.svg")
     p.add_argument("--size", default="80x24")
+    p.add_argument("--plot", default="", help="signals to plot, comma-separated (SFR,MTF.lift)")
     args = p.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
-    asyncio.run(shoot(Path(args.out), width, height))
+    asyncio.run(shoot(Path(args.out), width, height, [k for k in args.plot.split(",") if k]))
     print(args.out)
 
 

@@ -21,8 +21,8 @@ from textual.widgets.selection_list import Selection
 
 from stairbot.console.signals import MAX_PICKED, MAX_UNITS, Signal, by_key, fits
 
-HINT = (f"Enter: pick / drop (at most {MAX_PICKED}, in at most {MAX_UNITS} units)   "
-        "v: plot them   Esc: as it was")
+HINT = (f"Enter: pick / drop (up to {MAX_PICKED}, in at most {MAX_UNITS} units) · "
+        "v: plot them · Esc: as it was")
 
 
 class PlotPicker(ModalScreen[tuple[str, ...] | None]):
@@ -34,6 +34,7 @@ class PlotPicker(ModalScreen[tuple[str, ...] | None]):
     PlotPicker { align: center middle; }
     PlotPicker .dialog { height: 90%; max-height: 30; }
     PlotPicker SelectionList { height: 1fr; }
+    PlotPicker .dialog Label { width: 100%; }
     PlotPicker #picker-why { color: $error; height: auto; }
     """
 

@@ -65,6 +65,13 @@ class Signal:
     age: Callable[[Snapshot], float] | None = None
     """How long before the reading the value was measured (a sensor's, the
     IMU's own count), when the reading says."""
+    short: str = ""
+    """The label in the plot's legend, where room is short ("": the label)."""
+
+    @property
+    def brief(self) -> str:
+        """The legend's label."""
+        return self.short or self.label
 
     @property
     def name(self) -> str:
@@ -83,7 +90,8 @@ def _sensor(sensor: str) -> Signal:
         r = s.sensors.get(sensor)  # type: ignore[call-overload]
         return 0.0 if r is None else r.age_s
 
-    return Signal(sensor, f"{sensor} distance", "m", "distance sensors", value, age)
+    return Signal(sensor, f"{sensor} distance", "m", "distance sensors", value, age,
+                  short=sensor)
 
 
 def _sensor_age(sensor: str) -> Signal:

@@ -145,7 +145,7 @@ def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values
             assert sfr.xs == (0.0, *(10 + i * 0.1 for i in range(1, 6)))
             assert sfr.ys == (0.3, *(0.2 + i / 100 for i in range(1, 6)))
             legend = panel.plain_legend
-            assert "SFR distance 0.250 m" in legend and "MWF speed 2.50 turn/s" in legend
+            assert "SFR 0.250 m" in legend and "MWF speed 2.50 turn/s" in legend
             assert "MWB speed 0.00 turn/s" in legend
             assert "STALE" not in legend and not panel.has_class("-stale")
             # none picked: the default graphs again
@@ -204,8 +204,9 @@ def test_a_stale_signal_says_stale_and_is_not_drawn_on() -> None:
             await until(pilot, lambda: panel.shown and panel.shown[0].xs[-1] == 20.4, "drawn")
             sfr, sfl = panel.shown
             assert sfr.stale and not sfl.stale
-            assert "SFR distance 0.300 m STALE" in panel.plain_legend
-            assert "SFL distance 0.310 m STALE" not in panel.plain_legend
+            assert "SFR 0.300 m STALE" in panel.plain_legend
+            assert "SFL 0.310 m" in panel.plain_legend
+            assert panel.plain_legend.count("STALE") == 1  # SFR's alone
             # no reading for longer than STALE_S: every signal STALE, the panel
             # dimmed, and nothing drawn past the last reading
             robot.silent = True

@@ -44,15 +44,18 @@ def value_words(value: float | None, unit: str) -> str:
         return "—"
     if math.isnan(value):
         return "ERROR"
-    return f"{value:.{DIGITS.get(unit, 2)}f} {unit}"
+    return f"{value:.{DIGITS.get(unit, 2)}f}{'' if unit == '°' else ' '}{unit}"
 
 
 class PlotPanel(Vertical):
     """The legend, the plot, and (replaying) the timeline with its markers."""
 
     DEFAULT_CSS = """
-    PlotPanel { height: 3fr; min-height: 8; }
-    PlotPanel .plot-legend { height: auto; max-height: 2; }
+    PlotPanel {
+        height: 3fr; min-height: 8;
+        border-top: solid $primary; border-title-color: $text-accent; padding: 0 0 0 1;
+    }
+    PlotPanel .plot-legend { height: auto; }
     PlotPanel PlotextPlot { height: 1fr; }
     PlotPanel .plot-timeline { height: 2; display: none; }
     """
@@ -96,18 +99,27 @@ class PlotPanel(Vertical):
         self._draw(readings)
 
     def _legend(self) -> None:
-        out = Text(overflow="fold")
+        """One entry a signal, as many a line as the width holds (an entry is
+        never broken)."""
+        width = self.legend.size.width or self.size.width - 1
+        lines: list[Text] = [Text(no_wrap=True, overflow="ellipsis")]
         for i, s in enumerate(self.shown):
             colour = "rgb({},{},{})".format(*(STALE_COLOUR if s.stale else COLOURS[i]))
-            if i:
-                out.append("  ")
-            out.append("━ ", colour)
-            out.append(f"{s.signal.label} ", "bold")
-            out.append(value_words(s.last, s.signal.unit),
-                       "dim" if s.stale else "bold red" if s.last is not None
-                       and math.isnan(s.last) else "")
+            entry = Text("━ ", colour)
+            entry.append(f"{s.signal.brief} ", "bold")
+            entry.append(value_words(s.last, s.signal.unit),
+                         "dim" if s.stale else "bold red" if s.last is not None
+                         and math.isnan(s.last) else "")
             if s.stale:
-                out.append(" STALE", "bold red")
+                entry.append(" STALE", "bold red")
+            line = lines[-1]
+            if line.plain and width > 0 and len(line) + 2 + len(entry) > width:
+                lines.append(Text(no_wrap=True, overflow="ellipsis"))
+                line = lines[-1]
+            if line.plain:
+                line.append("  ")
+            line.append_text(entry)
+        out = Text("\n").join(lines)
         self.legend.update(out)
         self.plain_legend = out.plain
 
@@ -119,7 +131,7 @@ class PlotPanel(Vertical):
             if not s.xs:
                 continue
             side = "left" if s.signal.unit == units[0] else "right"
-            plt.plot(list(s.xs), list(s.ys), yside=side,
+            plt.plot(list(s.xs), list(s.ys), yside=side, marker="braille",
                      color=STALE_COLOUR if s.stale else COLOURS[i])
         # the side positionally: textual-plotext's stub names it ``xside``
         plt.ylabel(units[0] if units else "", "left")
