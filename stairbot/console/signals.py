@@ -237,6 +237,38 @@ def series(signal: Signal, readings: Sequence[Reading], read_age_s: float | None
     return Series(signal, tuple(xs), tuple(ys), last, stale)
 
 
+def thin(xs: Sequence[float], ys: Sequence[float], buckets: int
+         ) -> tuple[list[float], list[float]]:
+    """At most two points a bucket of equal time, the lowest and the highest
+    in time order, and the first and last points kept: what a plot
+    ``buckets`` columns wide can show of ``xs``, ``ys`` (a spike stays, and
+    drawing costs what the width does, not the number of readings)."""
+    if len(xs) <= 2 * buckets + 2 or buckets < 1:
+        return list(xs), list(ys)
+    first, span = xs[0], (xs[-1] - xs[0]) or 1.0
+    out_x, out_y = [xs[0]], [ys[0]]
+    lo = hi = -1
+    bucket = 0
+    for i in range(1, len(xs) - 1):
+        b = min(buckets - 1, int((xs[i] - first) / span * buckets))
+        if b != bucket and lo >= 0:
+            for j in sorted({lo, hi}):
+                out_x.append(xs[j])
+                out_y.append(ys[j])
+            lo = hi = -1
+        bucket = b
+        if lo < 0 or ys[i] < ys[lo]:
+            lo = i
+        if hi < 0 or ys[i] > ys[hi]:
+            hi = i
+    for j in sorted({lo, hi} - {-1}):
+        out_x.append(xs[j])
+        out_y.append(ys[j])
+    out_x.append(xs[-1])
+    out_y.append(ys[-1])
+    return out_x, out_y
+
+
 class Samples:
     """The readings over the last ``window_s`` seconds of robot time, one a
     reading newer than the last kept; a clock that went back (another

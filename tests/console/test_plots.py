@@ -20,7 +20,7 @@ from stairbot.console.freshness import STALE_S
 from stairbot.console.markers import markers_of, step
 from stairbot.console.plot_picker import PlotPicker
 from stairbot.console.replay_app import build_replay_app
-from stairbot.console.signals import Samples, catalogue, fits
+from stairbot.console.signals import Samples, catalogue, fits, thin
 from stairbot.control.robot_config import load_config
 from stairbot.errors import LinkLostError
 from stairbot.events import Event, EventKind
@@ -118,6 +118,18 @@ def test_samples_keep_one_reading_a_robot_time_and_start_afresh_when_it_goes_bac
     assert [t for t, _ in s.readings()] == [0.5]
 
 
+def test_thinning_keeps_the_ends_and_each_buckets_lowest_and_highest() -> None:
+    xs = [i * 0.01 for i in range(1001)]
+    ys = [0.0] * 1001
+    ys[500] = 7.0  # one reading's spike
+    ys[501] = -3.0
+    tx, ty = thin(xs, ys, 20)
+    assert len(tx) <= 2 * 20 + 2 and tx == sorted(tx)
+    assert (tx[0], ty[0]) == (0.0, 0.0) and (tx[-1], ty[-1]) == (xs[-1], 0.0)
+    assert 7.0 in ty and -3.0 in ty and set(ty) == {0.0, 7.0, -3.0}
+    assert thin(xs[:30], ys[:30], 20) == (xs[:30], ys[:30])  # few: as they are
+
+
 def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values() -> None:
     robot, ages = ScriptedRobot(), [0.0]
 
@@ -141,6 +153,9 @@ def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values
             assert sfr.ys[-1] == state.sensors[SensorId.SFR].distance_m == 0.25
             assert mwf.ys[-1] == state.motors[MotorId.MWF].speed_tps == 2.5
             assert mwb.ys[-1] == state.motors[MotorId.MWB].speed_tps == 0.0
+            # what plotext was handed ends in the state's values too
+            assert [(xs[-1], ys[-1]) for xs, ys in panel.drawn] == [
+                (10.5, 0.25), (10.5, 2.5), (10.5, 0.0)]
             # every reading, not one a refresh
             assert sfr.xs == (0.0, *(10 + i * 0.1 for i in range(1, 6)))
             assert sfr.ys == (0.3, *(0.2 + i / 100 for i in range(1, 6)))

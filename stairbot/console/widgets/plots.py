@@ -28,7 +28,7 @@ from textual_plotext import PlotextPlot
 
 from stairbot.console.freshness import age_key, is_stale, titled
 from stairbot.console.markers import Marker, step, timeline
-from stairbot.console.signals import Reading, Series, Signal, series, units_of
+from stairbot.console.signals import Reading, Series, Signal, series, thin, units_of
 
 COLOURS: tuple[tuple[int, int, int], ...] = (
     (0, 200, 220), (255, 150, 0), (220, 80, 220), (90, 210, 90))
@@ -67,7 +67,10 @@ class PlotPanel(Vertical):
         self.plot = PlotextPlot(id="plot")
         self.timeline = Static("", classes="plot-timeline", markup=False)
         self.shown: tuple[Series, ...] = ()
-        """What the plot was last handed, for tests and the legend."""
+        """The signals' series as last shown, for the legend (and tests)."""
+        self.drawn: list[tuple[list[float], list[float]]] = []
+        """What plotext was last handed, each series thinned to what the
+        plot's width shows (:func:`~stairbot.console.signals.thin`)."""
         self.plain_legend = ""
         self.plain_timeline = ""
         self._last: object = None
@@ -127,11 +130,14 @@ class PlotPanel(Vertical):
         plt = self.plot.plt
         plt.clear_data()
         units = units_of(s.signal for s in self.shown)
+        self.drawn = [([], []) for _ in self.shown]
         for i, s in enumerate(self.shown):
             if not s.xs:
                 continue
             side = "left" if s.signal.unit == units[0] else "right"
-            plt.plot(list(s.xs), list(s.ys), yside=side, marker="braille",
+            xs, ys = thin(s.xs, s.ys, max(self.plot.size.width // 2, 10))  # a point a column
+            self.drawn[i] = (xs, ys)
+            plt.plot(xs, ys, yside=side, marker="braille",
                      color=STALE_COLOUR if s.stale else COLOURS[i])
         # the side positionally: textual-plotext's stub names it ``xside``
         plt.ylabel(units[0] if units else "", "left")
