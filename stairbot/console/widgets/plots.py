@@ -156,14 +156,14 @@ class PlotPanel(Vertical):
         width = max(self.timeline.size.width or self.size.width - 1, 10)
         line = timeline(markers, start_s, end_s, position, width)
         before, after = step(markers, position, -1), step(markers, position, +1)
-        words = Text(no_wrap=True, overflow="ellipsis")
-        words.append(f"{len(markers)} markers (, . previous/next)", "dim")
         here = [m for m in markers if abs(m.time_s - position) < 1e-6]
+        words = Text(f"{len(markers)} markers (keys , .)", "dim")
         if here:
             words.append(f" · here {here[-1].line()}")
-        if after is not None:
+        elif after is not None:
             words.append(f" · next {after.line()}")
-        elif before is not None and not here:
+        elif before is not None:
             words.append(f" · last {before.line()}")
-        self.timeline.update(Text("\n").join([line, words]))
+        shown = Text("\n", no_wrap=True, overflow="ellipsis").join([line, words])
+        self.timeline.update(shown)
         self.plain_timeline = f"{line.plain}\n{words.plain}"
