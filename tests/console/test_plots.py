@@ -76,11 +76,16 @@ async def pick(pilot: Any, app: StairbotConsole, *keys: str) -> None:
     """``v``, then Enter on each signal ``keys`` names, then ``v`` to plot them."""
     await press(pilot, "v")
     await until(pilot, lambda: isinstance(app.screen, PlotPicker), "the picker")
-    listed = app.screen.query_one(SelectionList)
+    picker = app.screen
+    assert isinstance(picker, PlotPicker)
+    listed = picker.query_one(SelectionList)
+    await until(pilot, lambda: listed.has_focus, "the list has the keys")
     for key in keys:
         listed.highlighted = [listed.get_option_at_index(i).value
                               for i in range(listed.option_count)].index(key)
+        was = key in picker.order
         await press(pilot, "enter")
+        await until(pilot, lambda k=key, w=was: (k in picker.order) != w, f"{key} toggled")
     await press(pilot, "v")
     await until(pilot, lambda: not isinstance(app.screen, PlotPicker), "the picker closed")
 
@@ -163,6 +168,12 @@ def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values
             assert "SFR 0.250 m" in legend and "MWF speed 2.50 turn/s" in legend
             assert "MWB speed 0.00 turn/s" in legend
             assert "STALE" not in legend and not panel.has_class("-stale")
+            # g: the picture back in their place, and g again the plot
+            await press(pilot, "g")
+            await until(pilot, lambda: app.picture.display and not panel.display,
+                        "the picture back")
+            await press(pilot, "g")
+            await until(pilot, lambda: panel.display and not app.trends.display, "the plot")
             # none picked: the default graphs again
             await pick(pilot, app, "SFR", "MWF.speed", "MWB.speed")  # Enter drops each
             await until(pilot, lambda: app.trends.display and not panel.display,
