@@ -4,6 +4,7 @@ the picture docs/console-80x24.svg (README links it).
     python scripts/console_screenshot.py [OUT.svg] [--size 80x24]
     python scripts/console_screenshot.py --parameters [docs/console-parameters.svg]
     python scripts/console_screenshot.py --connections [docs/console-connections.svg]
+    python scripts/console_screenshot.py docs/console-plots.svg --plot SFR,SFL,MTF.lift
 
 The simulated robot at 10x, started with s, taken once a segment stands over
 the first tread.  ``--parameters``: the parameters screen (``i``) between
@@ -11,7 +12,9 @@ runs, the cursor on motors.wheel_speed (OUT); then that value changed to 0.5
 and its diff shown before it is used (OUT-diff.svg; nothing is written: the
 diff is answered no).  ``--connections``: the connection manager (u) instead,
 with fake boards served on a pty for it to list (their registry, and the
-recent URLs, in a temporary directory of their own).
+recent URLs, in a temporary directory of their own).  ``--plot KEYS``:
+those signals plotted (key v; the keys as console/signals.py names them),
+in the graphs' place.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from pathlib import Path
 
 from textual.widgets import Input
 
+from stairbot.console import plotting
 from stairbot.console.app import build_app
 
 
@@ -54,10 +58,17 @@ async def shoot_parameters(out: Path, width: int, height: int) -> None:
         await pilot.press("escape")
 
 
-async def shoot(out: Path, width: int, height: int) -> None:
+async def shoot(out: Path, width: int, height: int, plot: list[str]) -> None:
     app = build_app(speed="10x")
     async with app.run_test(size=(width, height)) as pilot:
         await app.workers.wait_for_complete()
+        if plot:
+            plotting.plot(app, plot)
+            picked = [s.key for s in app.plotting.picked]
+            if picked != plot:
+                known = ", ".join(s.key for s in app.plotting.signals(app))
+                raise SystemExit(f"--plot: {', '.join(k for k in plot if k not in picked)}"
+                                 f" is no signal of this robot; allowed: {known}")
         await pilot.press("s")
         for _ in range(2400):
             scene = app.state.view().scene
@@ -112,6 +123,7 @@ def main() -> None:
                    help="the parameters screen (i) with a change's diff")
     p.add_argument("--connections", action="store_true",
                    help="the connection manager (u), with fake boards to list")
+    p.add_argument("--plot", default="", help="signals to plot, comma-separated (SFR,MTF.lift)")
     args = p.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     if args.parameters:
@@ -122,7 +134,7 @@ def main() -> None:
         with_fake_boards(Path(args.out), width, height)
     else:
         args.out = args.out or "docs/console-80x24.svg"
-        asyncio.run(shoot(Path(args.out), width, height))
+        asyncio.run(shoot(Path(args.out), width, height, [k for k in args.plot.split(",") if k]))
     print(args.out)
 
 

@@ -34,6 +34,7 @@ from stairbot.console import (
     motion_gate,
     paint,
     params_screen,
+    plotting,
     recent,
     watching,
 )
@@ -90,6 +91,7 @@ class StairbotConsole(App[None]):
         Binding("z", "zoom", "zoom", show=False),
         Binding("t", "top_view", "top view", show=False),
         Binding("g", "graphs", "graphs", show=False),
+        Binding("v", "plots", "plot signals", show=False),
         Binding("h", "ask_control", "ask control", show=False),
         Binding("e", "event_filter", "filter events", show=False),
         Binding("slash", "event_search", "search events", show=False, key_display="/"),
@@ -133,6 +135,8 @@ class StairbotConsole(App[None]):
         self.log_panel = EventLog(id="log")
         self.trends = TrendsPanel(engine.config.motors.lift_travel_per_turn,
                                   side_pair=side_pair, id="trends")
+        self.plotting = plotting.Plotting()
+        """The signals plotted (v) in the graphs' place (console/plotting.py)."""
         self.main_area = Horizontal(id="main")
         self.small_notice = Static(id="too-small", markup=False)
         """Says the terminal is too small, in the panels' place (paint.lay_out)."""
@@ -151,6 +155,7 @@ class StairbotConsole(App[None]):
                 yield self.picture
                 yield self.top_view
                 yield self.trends
+                yield self.plotting.panel
                 yield self.log_panel
             with Vertical(id="right"):
                 yield self.sensors
@@ -380,6 +385,10 @@ class StairbotConsole(App[None]):
 
     def action_graphs(self) -> None:
         choices.graphs(self)
+
+    def action_plots(self) -> None:
+        """Pick signals to plot (:func:`~stairbot.console.plotting.pick`)."""
+        plotting.pick(self)
 
     def action_ask_control(self) -> None:
         watching.ask_control(self)

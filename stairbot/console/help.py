@@ -36,6 +36,8 @@ COMMANDS: tuple[tuple[str, str, str], ...] = (
     ("top_view", "Top view / side view", "The stairwell and the robot seen from above, or "
                                          "the side view again (key: t)"),
     ("graphs", "Graphs", "Pitch, distance sensors and lifts over the last 30 s (key: g)"),
+    ("plots", "Plot signals", "Pick up to 4 signals (sensors, motors, lifts, IMU, link) "
+                              "to plot in the graphs' place (key: v)"),
     ("ask_control", "Ask for control", "Watching another console's robot: ask its "
                                        "operator to hand control over (key: h)"),
     ("event_filter", "Filter the events", "Every event, errors, warnings, phases, the "
@@ -69,6 +71,10 @@ KEYS
   g       graphs: pitch, distance sensors, lifts over the last
           30 s of robot time (36 rows or more: under the
           picture; fewer: in its place until g again)
+  v       plot signals: pick up to 4 (each sensor, motor speed
+          and count, lifts, pitch and roll, link figures) to
+          plot over robot time in the graphs' place; none
+          picked: the graphs again
   e       the event list: every event, errors, warnings (and
           errors), phases, the link's; e again: the next
   /       the event list: only events whose text holds a word

@@ -64,6 +64,9 @@ class History:
     def __init__(self, window_s: float = WINDOW_S) -> None:
         self.window_s = window_s
         self._rows: deque[Row] = deque()
+        self._snaps: deque[Snapshot] = deque()
+        """The readings the rows came from, row for row: the plots (key v,
+        console/plotting.py) read any signal out of them."""
 
     def add(self, snap: Snapshot) -> None:
         """Keep ``snap``'s values if it is newer than the last; a clock that
@@ -74,14 +77,21 @@ class History:
             if snap.time_s == last:
                 return
             if snap.time_s < last:
-                rows.clear()
+                self.clear()
         rows.append(row_of(snap))
+        self._snaps.append(snap)
         start = snap.time_s - self.window_s
         while rows[0][0] < start:
             rows.popleft()
+            self._snaps.popleft()
 
     def clear(self) -> None:
         self._rows.clear()
+        self._snaps.clear()
 
     def rows(self) -> tuple[Row, ...]:
         return tuple(self._rows)
+
+    def readings(self) -> tuple[Snapshot, ...]:
+        """The readings kept, oldest first, one a row."""
+        return tuple(self._snaps)

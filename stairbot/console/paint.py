@@ -62,7 +62,8 @@ def lay_out(app: StairbotConsole, rows: int | None = None,
     is_tall = tall(app, rows)
     app.screen_rows = rows if rows is not None else app.size.height
     wanted = is_tall if app.graphs is None else app.graphs
-    app.trends.display = wanted
+    app.trends.display = wanted and not app.plotting.picked
+    app.plotting.panel.display = wanted and bool(app.plotting.picked)  # v: in their place
     picture = is_tall or not wanted
     app.picture.display = picture and not app.top_shown
     app.top_view.display = picture and app.top_shown
@@ -108,6 +109,7 @@ def show(app: StairbotConsole, v: StateView) -> None:
                   replay=app.replaying)
     if app.trends.display:
         app.trends.show(v.history, age)
+    app.plotting.follow(app, v)
     if v.events:
         log = app.log_panel
         log.add(v.events)

@@ -25,6 +25,7 @@ from textual.screen import Screen
 from textual.widget import Widget
 from textual.widgets import Static
 
+from stairbot.console import plotting
 from stairbot.console.app import REFRESH_HZ, StairbotConsole
 from stairbot.console.engine import ConsoleEngine
 from stairbot.console.help import HelpScreen
@@ -59,6 +60,9 @@ KEYS
   shift+← → back / forward {SEEK_LONG_S:g} s (also [ and ])
   Home End  the start / the end
   g         graphs (pitch, distance sensors, lifts; last 30 s)
+  v         plot signals you pick, with a timeline of the
+            recording's errors, pauses and phase changes
+  , .       to the previous / next of those markers
   e /       the event list: filter by kind / search its text
   z         picture zoom
   t         top view: a recording holds no pose seen from
@@ -105,6 +109,9 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
         Binding("q", "quit_console('q')", "quit"),
         Binding("question_mark", "help", "help", key_display="?"),
         Binding("g", "graphs", "graphs", show=False),
+        Binding("v", "plots", "plot signals", show=False),
+        Binding("comma", "marker(-1)", "previous marker", show=False, key_display=","),
+        Binding("full_stop", "marker(1)", "next marker", show=False, key_display="."),
         Binding("z", "zoom", "zoom", show=False),
         Binding("t", "top_view", "top view", show=False),
         Binding("ctrl+q", "quit_console('ctrl+q')", "quit", show=False, priority=True),
@@ -118,6 +125,9 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
         ("seek_to('start')", "To the start", "Back to the recording's start (key: Home)"),
         ("seek_to('end')", "To the end", "On to the recording's end (key: End)"),
         ("graphs", "Graphs", "Pitch, distance sensors and lifts over 30 s (key: g)"),
+        ("plots", "Plot signals", "Pick signals to plot, with the recording's markers (key: v)"),
+        ("marker(-1)", "Previous marker", "Back to the previous error, pause or phase (key: ,)"),
+        ("marker(1)", "Next marker", "On to the next error, pause or phase (key: .)"),
         ("zoom", "Zoom the picture", "Auto, whole flight, or follow the robot (key: z)"),
         ("top_view", "Top view / side view", "The top view: not in a recording (key: t)"),
         ("help", "Help", "Every key, and how to read the screen (key: ?)"),
@@ -126,6 +136,7 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
     def __init__(self, player: ReplayPlayer, engine: ConsoleEngine) -> None:
         super().__init__(engine, player.robot_name, player.source.parts[0].scenario)
         self.player = player
+        self.plotting.replay(player)
         self._rewinds = player.rewinds
         self.title = f"stairbot replay · {player.source.path}"
 
@@ -198,6 +209,11 @@ class ReplayConsole(StairbotConsole, inherit_bindings=False):
 
     def action_seek_to(self, where: str) -> None:
         self.player.seek(self.player.start_s if where == "start" else self.player.end_s)
+        self.show_player()
+
+    def action_marker(self, direction: int) -> None:
+        """To the next (1) or previous (-1) error, pause or phase change."""
+        plotting.jump(self, int(direction))
         self.show_player()
 
     # -- what a live console does to a robot -------------------------------------

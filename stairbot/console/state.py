@@ -303,6 +303,12 @@ class LiveState:
         with self._lock:
             return self._snapshot
 
+    def readings(self) -> tuple[Snapshot, ...]:
+        """Every reading of the graphs' window, oldest first (console/history.py),
+        without copying the rest as :meth:`view` does: the plots' (key v)."""
+        with self._lock:
+            return self._history.readings()
+
     @property
     def version(self) -> int:
         with self._lock:
