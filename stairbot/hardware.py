@@ -178,6 +178,20 @@ class Robot(Protocol):
 
 
 @dataclass(frozen=True, slots=True)
+class TruthMargins:
+    """The least of each margin a simulation measured over a run, from its
+    physics (:mod:`stairbot.fakes.margin_watch` defines each); None: never
+    measured."""
+
+    stability_m: float | None
+    """How far the centre of mass stood inside its loaded wheels' span, m."""
+    edge_m: float | None
+    """How far a loaded wheel's centre stood past its tread's nosing, m."""
+    stroke_m: float | None
+    """The lift travel left at the more extended lift, m."""
+
+
+@dataclass(frozen=True, slots=True)
 class Truth:
     """What only a simulation knows of itself: for summaries, sweeps and the
     console's picture, never for the controller."""
@@ -213,6 +227,8 @@ class Truth:
     """... across flight 1, from its centre line (+ = left)."""
     flight1_yaw_deg: float | None = None
     """The robot's heading from straight up flight 1, degrees (+ = turned left)."""
+    margins: TruthMargins | None = None
+    """The least margins so far; None: a robot that cannot tell."""
 
 
 @runtime_checkable

@@ -52,6 +52,7 @@ from stairbot.hardware import (
     Snapshot,
     Speeds,
     Truth,
+    TruthMargins,
 )
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
@@ -180,14 +181,16 @@ class SimRobot:
         """Whether the robot fell (and why), its pitch now and the most it
         pitched, how far segment 2 is from where it started, how far it stands
         before the stairs, its first contact with a wall, the frame it is in
-        and its pose in flight 1's frame."""
+        its pose in flight 1's frame, and the least margins so far."""
         w = self.world
         x, y, yaw = self.flight1_pose()
         return Truth(fell=w.fell, fall_reason=w.fall_reason, pitch_deg=w.pitch_deg(),
                      max_pitch_deg=w.max_pitch_deg, offset_m=self.offset_m(),
                      clear_of_stairs_m=self.clear_of_stairs_m(),
                      wall_contact=self.wall_contact, flight=self.well.flight,
-                     flight1_x_m=x, flight1_y_m=y, flight1_yaw_deg=math.degrees(yaw))
+                     flight1_x_m=x, flight1_y_m=y, flight1_yaw_deg=math.degrees(yaw),
+                     margins=TruthMargins(w.margins.stability_m, w.margins.edge_m,
+                                          w.margins.stroke_m))
 
     def scene(self) -> Scene:
         """The stairs and the robot's pose, for drawing."""

@@ -28,6 +28,7 @@ try:  # the C functions behind pymunk's Body properties, without the Python wrap
 except ImportError:  # pragma: no cover - another pymunk layout: the public API is used
     _cp = _ffi = None
 from stairbot.fakes.fall_watch import FallWatch
+from stairbot.fakes.margin_watch import MarginWatch
 from stairbot.fakes.robot_bodies import CAT_STAIRS, PIN_REACH, build_robot
 from stairbot.fakes.stairs import StairsProfile, stairs_outline
 from stairbot.fakes.world_params import WorldParams
@@ -100,6 +101,7 @@ class World:
             self._ptrs = [(b._body, w[1]._body)
                           for b, w in zip(self.segments, self.wheels, strict=True)]
         self._px, self._py, self._pa = [0.0] * 3, [0.0] * 3, [0.0] * 3
+        self._bodies: list[float] = []  # the batch reader's last read, when it is at hand
         self._wheel_turns, self._lifts = [0.0] * 3, [0.0, 0.0]
         self._stroke, self._stall = config.motors.lift_travel, p.lift_stall
         self._cp_step: tuple[Callable[[Any, float], None], Any] | None = None
@@ -110,6 +112,8 @@ class World:
                           for pair in self.motors]
         self._fetch()
         self.falls = FallWatch(p, self.all_wheels, self._py)
+        self.margins = MarginWatch(self.segments, self.boxes, self.all_wheels, self.radius,
+                                   p.stairs_radius, config.motors.lift_travel, p.contact_check_s)
         self.start_x = self._px[1]
 
     # -- the stairs, and a change of frame ---------------------------------------------
@@ -180,7 +184,7 @@ class World:
         if self._read_bodies is not None:
             (px[0], py[0], pa[0], _x, _y, _a, _x, _y, front0,
              px[1], py[1], pa[1], _x, _y, _a, _x, _y, front1,
-             px[2], py[2], pa[2], _x, _y, _a, _x, _y, front2) = self._read_bodies()
+             px[2], py[2], pa[2], _x, _y, _a, _x, _y, front2) = self._bodies = self._read_bodies()
             wa = (front0, front1, front2)
         elif self._ptrs is not None:
             get_pos, get_angle = _cp.cpBodyGetPosition, _cp.cpBodyGetAngle
@@ -280,7 +284,7 @@ class World:
 
     def advance(self, seconds: float) -> None:
         """Step the physics ``seconds`` (whole physics steps), moving the lifts at
-        their set speeds within their stroke, then check stability."""
+        their set speeds within their stroke, then check stability and the margins."""
         dt = self.params.dt
         n = round((self.time + seconds) / dt) - self._steps_done  # as _steps_for
         if n <= 0:
@@ -292,6 +296,30 @@ class World:
         if not self.falls.fell:  # the stability check, on the new state
             self._fetch()
             self.falls.check(self.time, self._py, self._pa)
+            if self.margins.due(n * dt, self._lifts):
+                self._look_at_margins()
+
+    def _look_at_margins(self) -> None:
+        """Where the robot touches the stairs now (:class:`MarginWatch`); the
+        edge margin of the wheels that stand: none while a wheel drives, and
+        not those of the segment the lifts move (segment 1 or 3 when one
+        lift moves, the middle one when both do)."""
+        px, py, pa = self._px, self._py, self._pa
+        b = self._bodies
+        if b:  # each segment's (x, y, angle), then its rear and front wheels'
+            wheels = [(b[3], b[4]), (b[6], b[7]), (b[12], b[13]), (b[15], b[16]),
+                      (b[21], b[22]), (b[24], b[25])]
+        else:
+            wheels = [(w.position.x, w.position.y) for w in self.all_wheels]
+        up0, up1 = self.lift_speed
+        if self._rates[0] != 0.0 or self._rates[1] != 0.0 or self._rates[2] != 0.0:
+            judged: tuple[int, ...] = ()
+        elif up0 != 0.0:
+            judged = (0, 2) if up1 != 0.0 else (1, 2)
+        else:
+            judged = (0, 1) if up1 != 0.0 else (0, 1, 2)
+        self.margins.look(self.outline, [(px[0], py[0], pa[0]), (px[1], py[1], pa[1]),
+                                         (px[2], py[2], pa[2])], wheels, judged)
 
     def _set_lifts(self, seconds: float) -> None:
         """Aim each moving lift's pin at where the screw will be in ``seconds``; the

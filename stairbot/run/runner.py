@@ -34,6 +34,7 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import RobotConfig
 from stairbot.run.journal import JournalWriter
+from stairbot.run.margins import Margins
 from stairbot.run.robots import RobotSession
 
 Latch = Literal["estop", "clear"]
@@ -149,6 +150,8 @@ class RunResult:
     longest such lateness, on a clock that waits for real time (a loaded
     machine, a stalled host); None on a simulated clock, which cannot fall
     behind (``to_dict`` then leaves the key out)."""
+    margins: Margins | None = None
+    """How close the run came to failing (:class:`~stairbot.run.margins.Margins`)."""
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -284,6 +287,7 @@ def run(
         wall_contact=truth.wall_contact if truth is not None else None,
         awaits_consent=awaits_consent(ctl.context) and not fell,
         host_behind=clock.host_behind() if isinstance(clock, CountsLateTicks) else None,
+        margins=Margins.of(truth, ctl.config, ctl.sensor_holds),
     )
     if journal is not None:
         with contextlib.suppress(OutputError):  # the result still stands

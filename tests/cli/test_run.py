@@ -42,6 +42,19 @@ def test_json_prints_one_object_and_progress_goes_to_stderr(
     assert "ascent 3" in err  # the phase lines went to stderr
 
 
+def test_json_holds_the_run_s_margins(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--json", "-q", "--scenario", "step_too_high"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    margins = data["margins"]
+    assert set(margins) == {"stability_m", "pitch_deg", "edge_m", "stroke_m", "sensor_holds"}
+    # it squared up to the riser and turned on its middle wheels, the ends lifted
+    assert 0.0 < margins["stability_m"] < 0.05
+    assert margins["pitch_deg"] == pytest.approx(15.0 - data["max_pitch_deg"], abs=0.01)
+    assert margins["edge_m"] is None  # it never stood on a tread
+    assert 0.0 <= margins["stroke_m"] < 0.2
+    assert margins["sensor_holds"] == 0
+
+
 def test_text_mode_prints_phase_lines_then_a_summary(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", "--scenario", "step_too_high"]) == 0
     out = capsys.readouterr().out

@@ -47,6 +47,9 @@ def test_quick_spec_end_to_end(tmp_path: Path) -> None:
     for r in records:
         assert r["result"] is not None and r["wall_s"] > 0
         assert r["facts"]["zone"] in ("inside", "band", "outside")
+        margins = r["result"]["margins"]  # each case's least margins (docs/envelope.md)
+        assert margins["stability_m"] is not None and margins["stroke_m"] is not None
+        assert (margins["edge_m"] is None) == (r["result"]["steps_climbed"] == 0)
         if r["verdict"] in PASSING:
             assert "reproduce" not in r
         else:

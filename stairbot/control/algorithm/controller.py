@@ -78,6 +78,8 @@ class Controller:
         self._started = context.phase_started_s is not None
         self._held: str | None = None
         self._held_since: float | None = None
+        self.sensor_holds = 0
+        """The sensor holds of this controller's ticks (a resumed program's start at 0)."""
         self._time = context.phase_started_s or 0.0
         m = config.motors
         self._vmax = {mo: m.lift_speed if mo in LIFT_MOTORS else m.wheel_speed for mo in MotorId}
@@ -265,6 +267,7 @@ class Controller:
             self._sensor_since, self._sensor_link = snap.time_s, dict(snap.health)
             if wait > 0.0:
                 ctx.pauses += 1
+                self.sensor_holds += 1
                 self._emit(EventKind.PAUSE, f"sensor hold: {why} in {phase.label}: all motors "
                            f"stopped, lifts holding, waiting up to {wait:g} s", snap.time_s,
                            {"resume_phase": phase.value, "sensors": list(errors),
