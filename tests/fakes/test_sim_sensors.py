@@ -96,5 +96,6 @@ def test_a_timed_model_tells_each_reading_its_age() -> None:
 
 def test_every_allowed_tilt_limit_stops_before_the_simulation_counts_a_fall() -> None:
     fields = {f.name: f.type for f in mi.type_info(Safety).fields}  # type: ignore[attr-defined]
-    most = fields["max_pitch_deg"].le
+    pitch = fields["max_pitch_deg"]
+    most = (pitch.type if isinstance(pitch, mi.Metadata) else pitch).le  # (under its unit)
     assert CFG.safety.max_pitch_deg < most < WorldParams().pitch_limit_deg
