@@ -97,6 +97,16 @@ class RunChannels:
         if channel is not None and message is not None:
             channel.log(message, log_time=self.origin_ns)
 
+    def open_pose(self, topic: str, description: str) -> None:
+        """The pose channel ``topic`` (kept while the topic stays).  A live
+        server opens it before it starts (:mod:`stairbot.recording.live`):
+        a viewer that subscribes at once to a channel advertised while it is
+        connected may be told it does not exist (foxglove-sdk 0.30.3)."""
+        with self.lock:
+            if self._pose_channel is None or self._pose_channel.topic() != topic:
+                self._pose_channel = FrameTransformsChannel(
+                    topic, context=self.context, metadata={"source": description})
+
     # -- what a run logs -----------------------------------------------------------
     def watch(self, pose: PoseSource, scenario: Scenario) -> None:
         """Ticks from now on come from a robot on ``scenario``, posed by
@@ -104,9 +114,7 @@ class RunChannels:
         pose is."""
         with self.lock:
             self._pose = pose
-            if self._pose_channel is None or self._pose_channel.topic() != pose.topic:
-                self._pose_channel = FrameTransformsChannel(
-                    pose.topic, context=self.context, metadata={"source": pose.description})
+            self.open_pose(pose.topic, pose.description)
             ns = self.origin_ns
             self._scene_message = messages.scene(pose.stairs(), scenario.width, self.config, ns)
             self._scene.log(self._scene_message, log_time=ns)
