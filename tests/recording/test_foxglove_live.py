@@ -233,6 +233,9 @@ def test_a_port_in_use_is_refused(command: list[str],
     assert err.count("\n") == 1 and f"127.0.0.1:{port}" in err and "the port is in use" in err
 
 
-def test_the_console_refuses_foxglove_with_serve(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["console", "--serve", "8000", "--foxglove"]) == EXIT_INPUT
-    assert "--foxglove" in capsys.readouterr().err
+@pytest.mark.parametrize("other", [["--serve", "8000"], ["--replay", "run.mcap"]])
+def test_the_console_refuses_foxglove_with_serve_or_replay(
+        other: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["console", *other, "--foxglove"]) == EXIT_INPUT
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--foxglove" in err
