@@ -53,6 +53,10 @@ EXTERNAL: dict[str, tuple[str, str]] = {
              "(needs the extra stairbot[plot])"),
 }
 
+FOXGLOVE_PORT = 8765
+"""``--foxglove`` alone: Foxglove's own default port (stairbot.recording.live,
+which this module does not import: it loads the Foxglove SDK)."""
+
 ROBOT_HELP = ("robot URL: sim:// (the simulation, default), serial://PORT?baud=N, "
               "can://INTERFACE/CHANNEL?bitrate=N")
 SCENARIO_HELP = ("scenario TOML file, or the name of a shipped scenario (see "
@@ -100,6 +104,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="record the run to FILE: FILE.mcap as MCAP (every tick: pose, "
                         "motors, sensors, link; phases and events; for Foxglove), any "
                         "other name the event stream, one JSON object a line")
+    r.add_argument("--foxglove", metavar="[HOST:]PORT", nargs="?", const=str(FOXGLOVE_PORT),
+                   help="show the run live in Foxglove: foxglove-sdk's WebSocket server with "
+                        "the topics of the MCAP record (docs/recording.md), stopped when the "
+                        f"run ends; alone: 127.0.0.1:{FOXGLOVE_PORT}; PORT 0: any free port.  "
+                        "HOST is 127.0.0.1 unless given: only this machine can connect.  A "
+                        "simulation is paced to the wall clock unless --time-scale is given")
     r.add_argument("--calibrate-only", action="store_true",
                    help="only square up to the first riser (calibration), then stop; "
                         "[expect] is not checked: exit 0 when calibration completes")

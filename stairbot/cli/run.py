@@ -15,7 +15,7 @@ from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from types import FrameType
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from stairbot.cli.common import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_MISMATCH, EXIT_OK, PROG, ask
 from stairbot.control.algorithm import limits
@@ -27,6 +27,9 @@ from stairbot.inputs.scenario import Scenario, expectation_mismatches, load_scen
 from stairbot.recording.record import EventRecord, RecordsTicks, open_record
 from stairbot.run.paths import unused_path
 from stairbot.text import printable
+
+if TYPE_CHECKING:  # the Foxglove SDK loads only for --foxglove or a .mcap record
+    from stairbot.recording.live import LiveServer
 
 
 def _load_inputs(args: argparse.Namespace) -> tuple[RobotConfig, Scenario]:
@@ -40,15 +43,30 @@ def _load_inputs(args: argparse.Namespace) -> tuple[RobotConfig, Scenario]:
     return config, scenario
 
 
+def _live_server(text: str | None, config: RobotConfig,
+                 url: str) -> contextlib.AbstractContextManager[LiveServer | None]:
+    """``--foxglove [HOST:]PORT``: foxglove-sdk's WebSocket server for the
+    run, said on stderr, stopped when the run ends (InputError when the
+    address is bad or cannot be listened on: nothing is left running)."""
+    if text is None:
+        return contextlib.nullcontext()
+    from stairbot.recording.live import serving
+
+    return serving(text, config, url, lambda line: print(f"{PROG}: {line}", file=sys.stderr,
+                                                    flush=True))
+
+
 @contextmanager
-def _record_file(path: str | None, config: RobotConfig) -> Iterator[EventRecord | None]:
-    """The run's record: MCAP for FILE.mcap, else JSON lines (InputError when
-    it cannot be opened; a write the disk refuses raises OutputError once,
-    then the record is silent and ``failed`` says why)."""
+def _record_file(path: str | None, config: RobotConfig,
+                 live: LiveServer | None) -> Iterator[EventRecord | None]:
+    """The run's record: MCAP for FILE.mcap (on the live server's channels,
+    with ``--foxglove``), else JSON lines (InputError when it cannot be
+    opened; a write the disk refuses raises OutputError once, then the
+    record is silent and ``failed`` says why)."""
     if path is None:
         yield None
         return
-    f = open_record(path, config)
+    f = open_record(path, config, live.channels if live is not None else None)
     try:
         yield f
     finally:
@@ -119,7 +137,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     from stairbot.run.runner import RunControl, board_identity, run
 
     progress: TextIO = sys.stderr if args.json else sys.stdout
-    options = RobotOptions(realtime=args.realtime, time_scale=args.time_scale,
+    # --foxglove: a simulation paced to the wall clock, to be watched, unless
+    # --time-scale sets another pace
+    realtime = args.realtime or (args.foxglove is not None and args.time_scale is None)
+    options = RobotOptions(realtime=realtime, time_scale=args.time_scale,
                            allow_latched=args.resume)
     from_top = args.from_top or scenario.start.on == "top"
     if args.calibrate_only and from_top:
@@ -159,10 +180,18 @@ def cmd_run(args: argparse.Namespace) -> int:
               file=sys.stderr, flush=True)
         return None
 
-    with _record_file(unused_record(args.record), config) as record:
+    with _live_server(args.foxglove, config, args.robot) as live, \
+            _record_file(unused_record(args.record), config, live) as record:
+        feed = live.feed(record) if live is not None else None
+        if realtime and not args.realtime and args.robot.startswith("sim:"):
+            print(f"{PROG}: --foxglove: the simulation runs at the wall clock's pace, to be "
+                  "watched (--time-scale X for another)", file=sys.stderr, flush=True)
+
         def sink(event: Event) -> None:
             if record is not None:  # OutputError (a full disk) ends the run
                 record.write(event)
+            if feed is not None:
+                feed.write(event)
             if not args.quiet and event.kind is not EventKind.SUMMARY:
                 print(printable(event.line()), file=progress, flush=True)
 
@@ -193,11 +222,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         controller = journal = None
         tap = None
         try:
-            if isinstance(record, RecordsTicks):  # MCAP: every tick, and the pose
+            # every tick, and the pose: to an MCAP record (and the live server
+            # on its channels), else to the live server alone
+            ticking = record if isinstance(record, RecordsTicks) else feed
+            if ticking is not None:
                 from stairbot.recording.pose import pose_source
 
-                record.watch(pose_source(session.sim, config, scenario), scenario, args.robot)
-                tap = record.tick
+                ticking.watch(pose_source(session.sim, config, scenario), scenario, args.robot)
+                tap = ticking.tick
             if args.resume:
                 resumed = resume_run(path, args.robot, session, config, sink, yes=args.yes,
                                      out=progress, confirm=ask)

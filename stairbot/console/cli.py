@@ -1,6 +1,8 @@
 """``stairbot console [--robot URL] [--scenario FILE|NAME] [--config FILE]
-[--record FILE] [--speed 1x|10x|max] [--serve [HOST:]PORT]``: the operator
-console, in this terminal or (``--serve``) in a browser.  ``stairbot console
+[--record FILE] [--speed 1x|10x|max] [--serve [HOST:]PORT] [--foxglove
+[HOST:]PORT]``: the operator console, in this terminal or (``--serve``) in a
+browser; ``--foxglove`` shows its runs live in Foxglove
+(stairbot/recording/live.py).  ``stairbot console
 --replay FILE [--speed 1x|10x|max]`` plays a recording instead, as
 ``stairbot replay FILE`` does (console/replay_cli.py).
 
@@ -15,6 +17,8 @@ import argparse
 import os
 import sys
 from collections.abc import Sequence
+from contextlib import AbstractContextManager, nullcontext
+from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from stairbot.console.robot_holder import SPEEDS
@@ -22,9 +26,13 @@ from stairbot.console.serve import parse_bind, serve
 from stairbot.control.robot_config import config_for
 from stairbot.errors import InputError, RobotUrlError
 from stairbot.files import LineFile
+from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.paths import unused_path
 from stairbot.run.robots import known_schemes
+
+if TYPE_CHECKING:  # the Foxglove SDK loads only for --foxglove (or an MCAP record)
+    from stairbot.recording.live import LiveServer
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -63,6 +71,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "127.0.0.1 unless given: only this machine can connect.  Give "
                         "0.0.0.0 (every interface) or another address of this machine only "
                         "to let other machines command the robot")
+    p.add_argument("--foxglove", metavar="[HOST:]PORT", nargs="?", const="8765",
+                   help="show the console's runs live in Foxglove: foxglove-sdk's WebSocket "
+                        "server with the topics of the MCAP record, stopped when the console "
+                        "ends; alone: 127.0.0.1:8765; PORT 0: any free port.  HOST is "
+                        "127.0.0.1 unless given: only this machine can connect")
     return p
 
 
@@ -106,15 +119,38 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.record:
         check_record(args.record)
     if bind is not None:
+        if args.foxglove is not None:
+            raise InputError("--foxglove", None, "each browser tab of --serve runs a console "
+                             "of its own, and one port serves one: give --foxglove to a "
+                             "console in a terminal")
         return serve(args, *bind)
     from stairbot.console.app import build_app  # textual loads only when the screen opens
 
     app = build_app(config, url=args.robot, scenario=args.scenario, record=args.record,
                     speed=args.speed)
-    app.run()
+    with live_server(args.foxglove, config, args.robot) as live:
+        app.engine.live = live
+        if live is not None:
+            for line in live.lines():
+                app.state.note(line, "warning" if line.startswith("warning") else "information")
+        app.run()
     # Textual sets 1 when the app ended on an unhandled error (the engine
     # stopped the robot on the way out): not the exit of a clean quit.
     return app.return_code or 0
+
+
+def live_server(text: str | None, config: RobotConfig,
+                url: str) -> AbstractContextManager[LiveServer | None]:
+    """``--foxglove [HOST:]PORT``: the live server for the console's runs,
+    said on stderr (seen once the console ends), stopped when the console
+    ends.  InputError when the address is bad or cannot be listened on: the
+    screen never opens."""
+    if text is None:
+        return nullcontext()
+    from stairbot.recording.live import serving
+
+    return serving(text, config, url, lambda line: print(f"stairbot console: {line}",
+                                                    file=sys.stderr, flush=True))
 
 
 def _replay(args: argparse.Namespace) -> int:
@@ -124,7 +160,8 @@ def _replay(args: argparse.Namespace) -> int:
 
     given = [name for name, value in (("--robot", args.robot != "sim://"),
                                       ("--scenario", args.scenario), ("--config", args.config),
-                                      ("--record", args.record), ("--serve", args.serve))
+                                      ("--record", args.record), ("--serve", args.serve),
+                                      ("--foxglove", args.foxglove))
              if value]
     if given:
         raise InputError("--replay", None, f"plays a recording: no robot is opened, so "

@@ -288,9 +288,12 @@ class ConsoleEngine(RobotHolder):
         self._controller = ctl
         self._last_tick_s = snap.time_s
         self._watch_phase(ctl)
-        recorder = self.recorder
-        if isinstance(recorder, RecordsTicks) and self.robot is not None:
-            recorder.tick(snap, self.robot.sent)
+        recorder, feed = self.recorder, self.live_feed()
+        if self.robot is not None:
+            if isinstance(recorder, RecordsTicks):
+                recorder.tick(snap, self.robot.sent)
+            if feed is not None:
+                feed.tick(snap, self.robot.sent)
 
     def _watch_phase(self, ctl: Controller, final: bool = False) -> None:
         try:

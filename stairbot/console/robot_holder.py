@@ -34,7 +34,8 @@ from stairbot.run.robots import RobotOptions, RobotSession
 from stairbot.views.side_view import SceneView, scene_view, stairs_from_scenario
 from stairbot.views.top_view import TopPlan, TopPose, plan_of, top_pose
 
-if TYPE_CHECKING:  # the Foxglove SDK loads only when an MCAP record starts
+if TYPE_CHECKING:  # the Foxglove SDK loads only for an MCAP record or --foxglove
+    from stairbot.recording.live import LiveServer
     from stairbot.recording.mcap_sink import McapRecord
 
 LATCH_HINT = "EMERGENCY STOP latched — c clears it (after you look at the robot)"
@@ -92,6 +93,9 @@ class RobotHolder:
         self.clock: PacedClock | None = None
         self.scenario: Scenario | None = None
         self.recorder: JsonLinesRecord | McapRecord | None = None
+        self.live: LiveServer | None = None
+        """``--foxglove``: the live server, which an MCAP record started here
+        shares (its channels), else fed here; the console's owner stops it."""
         self._running = threading.Event()
         self._speed = "max"
         self._poller: threading.Thread | None = None
@@ -309,6 +313,9 @@ class RobotHolder:
         self.state.on_event(event)
         if self.recorder is not None:
             self.recorder.write(event)
+        feed = self.live_feed()
+        if feed is not None:
+            feed.write(event)
 
     def _say(self, event: Event) -> None:
         """An event from the UI thread: a refused record write stops the
@@ -326,11 +333,18 @@ class RobotHolder:
         """Tell an MCAP record which robot its ticks come from (and where it
         stands: the simulation's pose, or a dead-reckoned one)."""
         recorder, session, scenario = self.recorder, self.session, self.scenario
-        if isinstance(recorder, RecordsTicks) and session is not None and scenario is not None:
+        watchers = [r for r in (recorder, self.live_feed()) if isinstance(r, RecordsTicks)]
+        if watchers and session is not None and scenario is not None:
             from stairbot.recording.pose import pose_source
 
-            recorder.watch(pose_source(session.sim, self.config, scenario), scenario,
-                           session.url)
+            pose = pose_source(session.sim, self.config, scenario)
+            for watcher in watchers:
+                watcher.watch(pose, scenario, session.url)
+
+    def live_feed(self) -> LiveServer | None:
+        """The live server when the console logs to it itself: not while an
+        MCAP record on its channels does (every message to both)."""
+        return self.live.feed(self.recorder) if self.live is not None else None
 
     def start_recording(self, path: str) -> str:
         """Record from now on to ``path``, or, when a file is there already,
@@ -349,7 +363,8 @@ class RobotHolder:
             from stairbot.recording.mcap_sink import McapRecord
 
             try:
-                self.recorder = McapRecord(chosen, self.config)
+                self.recorder = McapRecord(chosen, self.config, channels=None if self.live is None
+                                           else self.live.channels)
                 self._watch_recording()
             except OutputError as exc:
                 self.stop_recording()

@@ -18,7 +18,6 @@ is another site (any page the operator has open may try
 from __future__ import annotations
 
 import argparse
-import errno
 import ipaddress
 import shlex
 import socket
@@ -26,9 +25,10 @@ import sys
 from typing import Any
 from urllib.parse import urlsplit
 
+from stairbot import listen
 from stairbot.errors import InputError
 
-DEFAULT_HOST = "127.0.0.1"
+OPTION = "--serve"
 EXTRA_HINT = ("`stairbot console --serve` needs the extra stairbot[serve]: "
               "pip install 'stairbot[serve]'")
 
@@ -36,45 +36,13 @@ EXTRA_HINT = ("`stairbot console --serve` needs the extra stairbot[serve]: "
 def parse_bind(text: str) -> tuple[str, int]:
     """``PORT``, ``HOST:PORT`` or ``[IPv6]:PORT`` as (host, port); the host is
     127.0.0.1 when not given.  Raises InputError naming ``--serve``."""
-    host, sep, port_text = text.rpartition(":")
-    if not sep:
-        host = DEFAULT_HOST
-    elif host.startswith("[") and host.endswith("]"):
-        host = host[1:-1]
-    elif ":" in host:
-        raise _bad(text, "write an IPv6 address in brackets: [::1]:8000")
-    if not host:
-        raise _bad(text, "HOST is empty; give HOST:PORT or PORT alone (host 127.0.0.1)")
-    if not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
-        raise _bad(text, f"PORT must be a number from 1 to 65535, not {port_text!r}")
-    if any(ch.isspace() or ch in "/?#@[]" for ch in host):
-        raise _bad(text, f"HOST {host!r} is not an address or a host name")
-    return host, int(port_text)
-
-
-def _bad(text: str, problem: str) -> InputError:
-    return InputError("--serve", None, f"{text!r}: {problem}")
+    return listen.parse_bind(text, OPTION)
 
 
 def check_listen(host: str, port: int) -> None:
     """InputError unless a server can listen on (host, port) now: the name
     resolves, the address is this machine's, the port is free and allowed."""
-    try:
-        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM,
-                                   flags=socket.AI_PASSIVE)
-    except (socket.gaierror, UnicodeError) as exc:
-        raise _bad(f"{host}:{port}", f"cannot resolve HOST: {exc}") from None
-    family, type_, proto, _, address = infos[0]
-    with socket.socket(family, type_, proto) as sock:
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as aiohttp does
-        try:
-            sock.bind(address)
-        except OSError as exc:
-            reason = {errno.EADDRINUSE: "the port is in use",
-                      errno.EADDRNOTAVAIL: "the address is not one of this machine's",
-                      errno.EACCES: "not allowed to listen there (ports below 1024 need root)",
-                      }.get(exc.errno or 0, exc.strerror or str(exc))
-            raise _bad(f"{host}:{port}", f"cannot listen: {reason}") from None
+    listen.check_listen(host, port, OPTION)
 
 
 def served_argv(args: argparse.Namespace) -> list[str]:

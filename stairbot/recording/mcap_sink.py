@@ -2,7 +2,10 @@
 the robot's pose as frame transforms, a 3-D scene of the stairs and the
 segments, the motors, the sensors, the link, the phases and events as logs,
 and the robot config, the scenario and the CAN database as attachments.
-The topics are in :mod:`stairbot.recording.topics`.
+The topics are in :mod:`stairbot.recording.topics`, the channels and their
+messages in :mod:`stairbot.recording.channels` (which a live Foxglove
+server, :mod:`stairbot.recording.live`, may share: the record is one sink
+of them).
 
 Crash safety: messages go into small zstd chunks, and the chunk in progress
 is finished and written out every :data:`FLUSH_PERIOD_S` of wall time or
@@ -24,7 +27,6 @@ import contextlib
 import json
 import logging
 import os
-import threading
 import time
 from collections.abc import Callable, Mapping
 from importlib import resources
@@ -32,23 +34,17 @@ from typing import Any
 
 import foxglove
 import msgspec
-from foxglove.channels import (
-    FrameTransformsChannel,
-    JointStatesChannel,
-    LogChannel,
-    SceneUpdateChannel,
-)
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
 from stairbot import __version__
 from stairbot.control.algorithm import limits
 from stairbot.errors import OutputError
-from stairbot.events import Event, EventKind
+from stairbot.events import Event
 from stairbot.files import shown
-from stairbot.hardware import LIFT_MOTORS, MotorId, SensorId, Snapshot, Speeds
+from stairbot.hardware import Snapshot, Speeds
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario
-from stairbot.recording import messages, topics
+from stairbot.recording.channels import RunChannels
 from stairbot.recording.pose import PoseSource
 from stairbot.recording.stream import AppendStream
 
@@ -74,47 +70,38 @@ def _options() -> MCAPWriteOptions:
                             profile="stairbot")
 
 
-def _r(x: float) -> float:
-    return round(x, 6)
-
-
 class McapRecord:
-    """An MCAP record at ``path`` (truncated first).  Raises InputError when
-    the file cannot be opened, OutputError when its start (header,
-    attachments) cannot be written.  :meth:`watch` says which robot the
-    ticks come from; :meth:`write` takes events, :meth:`tick` ticks."""
+    """An MCAP record at ``path`` (truncated first) of ``channels`` (a
+    :class:`~stairbot.recording.channels.RunChannels` of the record's own
+    when None: given, a live server on them sees the same messages).
+    Raises InputError when the file cannot be opened, OutputError when its
+    start (header, attachments) cannot be written.  :meth:`watch` says which
+    robot the ticks come from; :meth:`write` takes events, :meth:`tick`
+    ticks: each logs on the channels, to every sink of theirs."""
 
     def __init__(self, path: str | os.PathLike[str], config: RobotConfig, *,
                  wall: Callable[[], float] = time.monotonic,
-                 origin_ns: int | None = None) -> None:
+                 origin_ns: int | None = None,
+                 channels: RunChannels | None = None) -> None:
+        self.channels = RunChannels(config, origin_ns=origin_ns) if channels is None \
+            else channels
         self._stream = AppendStream(path, WHAT)
         self.path = self._stream.path
         self._config = config
         self._wall = wall
-        self._lock = threading.RLock()
-        self.origin_ns = time.time_ns() if origin_ns is None else origin_ns
-        self._pose: PoseSource | None = None
-        self._pose_channel: FrameTransformsChannel | None = None
+        self._lock = self.channels.lock
+        self.origin_ns = self.channels.origin_ns
         self._raised = False
         self._closed = False
         self._ticks = self._unflushed = 0
         self._last_flush = wall()
-        self._ctx = ctx = foxglove.Context()
         try:
-            self._writer = foxglove.open_mcap(self._stream, context=ctx,
+            self._writer = foxglove.open_mcap(self._stream, context=self.channels.context,
+                                              channel_filter=self.channels.for_record,
                                               writer_options=_options())
         except RuntimeError as exc:
             self._stream.close()
             raise self._stream.failed or OutputError(shown(self.path), WHAT, str(exc)) from None
-        self._scene = SceneUpdateChannel(topics.SCENE, context=ctx)
-        self._joints = JointStatesChannel(topics.JOINTS, context=ctx)
-        self._motors = foxglove.Channel(topics.MOTORS, schema=topics.MOTORS_SCHEMA, context=ctx)
-        self._sensors = foxglove.Channel(topics.SENSORS, schema=topics.SENSORS_SCHEMA,
-                                         context=ctx)
-        self._link = foxglove.Channel(topics.LINK, schema=topics.LINK_SCHEMA, context=ctx)
-        self._events = LogChannel(topics.EVENTS, context=ctx)
-        self._phase = LogChannel(topics.PHASE, context=ctx)
-        self._record = foxglove.Channel(topics.RECORD, schema=topics.RECORD_SCHEMA, context=ctx)
         try:
             with self._lock:
                 self._call(self._writer.write_metadata, "stairbot", {
@@ -143,18 +130,12 @@ class McapRecord:
         with self._lock:
             if self._silent():
                 return
-            ns = self.origin_ns
-            self._pose = pose
-            if self._pose_channel is None or self._pose_channel.topic() != pose.topic:
-                self._pose_channel = FrameTransformsChannel(
-                    pose.topic, context=self._ctx, metadata={"source": pose.description})
             self._call(self._writer.write_metadata, "robot", {
                 "url": robot, "scenario": scenario.name, "scenario_source": scenario.source,
                 "pose_topic": pose.topic, "pose": pose.description})
             self._attach("scenario.json", "application/json",
                          json.dumps(_scenario_dict(scenario), indent=1).encode())
-            self._call(self._scene.log, messages.scene(pose.stairs(), scenario.width,
-                                                       self._config, ns), log_time=ns)
+            self._call(self.channels.watch, pose, scenario)
             self._flush()
 
     def write(self, event: Event) -> None:
@@ -163,11 +144,7 @@ class McapRecord:
         with self._lock:
             if self._silent():
                 return
-            ns = self._ns(event.time_s)
-            self._call(self._events.log, messages.log(event, ns), log_time=ns)
-            if event.kind is EventKind.PHASE:
-                self._call(self._phase.log, messages.phase_log(event, ns), log_time=ns)
-            self._call(self._record.log, event.to_dict(), log_time=ns)
+            self._call(self.channels.write, event)
             if self._wall() - self._last_flush >= FLUSH_PERIOD_S:
                 self._flush()
 
@@ -178,16 +155,7 @@ class McapRecord:
         with self._lock:
             if self._silent():
                 return
-            ns = self._ns(snap.time_s)
-            if self._pose is not None and self._pose_channel is not None:
-                self._call(self._pose_channel.log,
-                           messages.frame_transforms(self._pose.poses(snap), ns), log_time=ns)
-            self._call(self._joints.log, messages.joint_states(snap, self._config, ns),
-                       log_time=ns)
-            self._call(self._motors.log, self._motors_message(snap, sent), log_time=ns)
-            self._call(self._sensors.log, _sensors_message(snap), log_time=ns)
-            self._call(self._link.log, {"time_s": _r(snap.time_s), "health": dict(snap.health)},
-                       log_time=ns)
+            self._call(self.channels.tick, snap, sent)
             self._ticks += 1
             self._unflushed += 1
             if (self._unflushed >= FLUSH_TICKS
@@ -226,9 +194,6 @@ class McapRecord:
     def _silent(self) -> bool:
         return self._closed or self._stream.failed is not None
 
-    def _ns(self, time_s: float) -> int:
-        return self.origin_ns + max(0, round(time_s * 1e9))
-
     def _call(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
         """Call the SDK; a write the disk refused (which the SDK logs, or
         raises as RuntimeError) raises OutputError here, once."""
@@ -250,37 +215,6 @@ class McapRecord:
         self._call(self._writer.flush)
         self._unflushed = 0
         self._last_flush = self._wall()
-
-    def _motors_message(self, snap: Snapshot, sent: Speeds | None) -> dict[str, Any]:
-        per_turn = self._config.motors.lift_travel_per_turn
-        out: dict[str, Any] = {"time_s": _r(snap.time_s), "sent": sent is not None}
-        for motor in MotorId:
-            state = snap.motors.get(motor)
-            if state is None:
-                continue
-            entry: dict[str, Any] = {
-                "turns": _r(state.turns), "speed_tps": _r(state.speed_tps),
-                "command_tps": None if sent is None else _r(float(sent.get(motor, 0.0))),
-                "fault": state.fault}
-            if motor in LIFT_MOTORS:
-                entry["extension_m"] = _r(state.turns * per_turn)
-            out[motor.value] = entry
-        return out
-
-
-def _sensors_message(snap: Snapshot) -> dict[str, Any]:
-    out: dict[str, Any] = {"time_s": _r(snap.time_s)}
-    for sensor in SensorId:
-        reading = snap.sensors.get(sensor)
-        if reading is not None:
-            out[sensor.value] = {"distance_m": _r(reading.distance_m),
-                                 "status": reading.status.value, "age_s": _r(reading.age_s)}
-    imu = snap.imu
-    out["imu"] = None if imu is None else {
-        "pitch_deg": _r(imu.pitch_deg), "roll_deg": _r(imu.roll_deg),
-        "pitch_rate_dps": _r(imu.pitch_rate_dps), "roll_rate_dps": _r(imu.roll_rate_dps),
-        "age_s": _r(imu.age_s)}
-    return out
 
 
 def _scenario_dict(scenario: Scenario) -> Mapping[str, Any]:

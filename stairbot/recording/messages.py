@@ -1,7 +1,7 @@
 """Foxglove's well-known messages built from what the host knows: the
 segments' frames, the stairs and the robot as a 3-D scene, the motors as
 joint states, events as logs.  (The JSON channels' messages are plain dicts,
-built in :mod:`stairbot.recording.mcap_sink`.)"""
+built in :mod:`stairbot.recording.channels`.)"""
 
 from __future__ import annotations
 

@@ -178,6 +178,12 @@ class DeadReckonedPose:
         return segment_poses(view.segments)
 
 
+def pose_kind(url: str) -> type[SimulationPose] | type[DeadReckonedPose]:
+    """Which pose a robot at ``url`` will have, before it is opened: the
+    simulation's for ``sim://`` (it runs in this process), else the estimate."""
+    return SimulationPose if url.split(":", 1)[0] == "sim" else DeadReckonedPose
+
+
 def pose_source(sim: HasScene | None, config: RobotConfig, scenario: Scenario) -> PoseSource:
     """The simulation's pose when the host is given the simulation, else the
     dead-reckoned estimate."""

@@ -17,6 +17,7 @@ from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario
 
 if TYPE_CHECKING:  # the pose module draws on the console's side view
+    from stairbot.recording.channels import RunChannels
     from stairbot.recording.pose import PoseSource
 
 MCAP_SUFFIX = ".mcap"
@@ -78,12 +79,14 @@ def is_mcap(path: str | os.PathLike[str]) -> bool:
     return str(path).lower().endswith(MCAP_SUFFIX)
 
 
-def open_record(path: str | os.PathLike[str], config: RobotConfig) -> EventRecord:
-    """The record at ``path``: MCAP for a name ending .mcap, else JSON lines.
-    Raises InputError when it cannot be opened, OutputError when an MCAP
-    file's start cannot be written (a full disk)."""
+def open_record(path: str | os.PathLike[str], config: RobotConfig,
+                channels: RunChannels | None = None) -> EventRecord:
+    """The record at ``path``: MCAP for a name ending .mcap (on ``channels``
+    when given: a live server's, which then sees what it records), else JSON
+    lines.  Raises InputError when it cannot be opened, OutputError when an
+    MCAP file's start cannot be written (a full disk)."""
     if is_mcap(path):
         from stairbot.recording.mcap_sink import McapRecord
 
-        return McapRecord(path, config)
+        return McapRecord(path, config, channels=channels)
     return JsonLinesRecord(path)
