@@ -23,7 +23,7 @@ from typing import Any, Unpack
 from textual import events, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
+from textual.containers import Container, Horizontal, Vertical
 from textual.screen import ModalScreen, Screen
 from textual.widget import Widget
 from textual.widgets import Footer, Static
@@ -36,6 +36,7 @@ from stairbot.console import (
     params_screen,
     plotting,
     recent,
+    roomy,
     watching,
 )
 from stairbot.console.engine import ConsoleEngine, EngineHooks
@@ -137,7 +138,7 @@ class StairbotConsole(App[None]):
                                   side_pair=side_pair, id="trends")
         self.plotting = plotting.Plotting()
         """The signals plotted (v) in the graphs' place (console/plotting.py)."""
-        self.main_area = Horizontal(id="main")
+        self.main_area = Container(id="main")  # a grid: console.tcss, console/roomy.py
         self.small_notice = Static(id="too-small", markup=False)
         """Says the terminal is too small, in the panels' place (paint.lay_out)."""
         self.screen_rows: int | None = None  # the screen's height, as the last resize said
@@ -156,12 +157,12 @@ class StairbotConsole(App[None]):
                 yield self.top_view
                 yield self.trends
                 yield self.plotting.panel
-                yield self.log_panel
             with Vertical(id="right"):
                 yield self.sensors
                 yield self.motors
                 yield self.phase
                 yield self.link
+            yield self.log_panel  # under the picture; roomy, under both (console/roomy.py)
         yield Footer(compact=True)
 
     def picture_note(self) -> str:
@@ -200,6 +201,7 @@ class StairbotConsole(App[None]):
     def refresh_view(self) -> None:
         """Copy the live state and update every panel that changed (the ages
         of the values shown change with the wall clock alone)."""
+        roomy.arrange(self)  # the panels' heights follow what they show, and the screen's
         view = self.state.view(events_after=self.shown_event)
         key = (view.version, age_key(view.read_age_s), age_key(view.top_age_s))
         if key == self.shown_key:

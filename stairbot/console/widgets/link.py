@@ -68,6 +68,8 @@ class LinkPanel(Static):
         super().__init__(id=id)
         self._last: object = None
         self.border_title = titled("link", None)
+        self.lines_shown = 1
+        """How many lines the panel shows (console/roomy.py sizes the column by it)."""
 
     def show(self, in_process: bool, time_s: float | None, speed: str,
              health: Mapping[str, float], age_s: float | None = None,
@@ -90,8 +92,10 @@ class LinkPanel(Static):
             out.append("  replay " if replay else "  speed ", "dim")
             out.append(SPEED_NAMES.get(speed, speed), "bold")
             self.update(without_status(out) if stale else out)
+            self.lines_shown = 1
         else:
             self.border_title = titled("recorded link health" if replay else "link health",
                                        age_s)
             lines = health_text(health)
             self.update(Group(*(without_status(line) for line in lines) if stale else lines))
+            self.lines_shown = len(lines)

@@ -1,0 +1,49 @@
+"""Where the event list goes on a screen taller than the right column needs.
+
+The right column (sensors, motors, phase, link) holds what it holds; on a
+tall screen, the rows under it would stay empty while the event list,
+under the picture, is squeezed to the left column's width.  There the
+console is *roomy*: the right column takes the rows it needs, level with
+the picture, and the event list runs the whole width under both.  On a
+screen with fewer than ``LOG_MIN_ROWS`` to spare (80x24) the right column
+runs the whole height and the event list stays under the picture.
+
+``#main`` is a two-column grid (console.tcss): the picture's column, the
+right column, the event list in the cell under the picture; roomy, the
+right column spans one row and the event list two columns.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from stairbot.console.app import StairbotConsole
+
+LOG_MIN_ROWS = 6
+"""The least rows the event list keeps under both columns, roomy."""
+
+PICTURE_SHARE = 0.6
+"""The share of the rows the picture's row keeps at least, roomy: as it has
+beside the event list otherwise (3fr to 2fr)."""
+
+
+def right_rows(app: StairbotConsole) -> int:
+    """The rows the right column's panels need: each one's border and lines."""
+    rows = 0
+    for panel in (app.sensors, app.motors, app.phase):
+        if panel.display:
+            rows += panel.outer_size.height
+    return rows + 1 + app.link.lines_shown
+
+
+def arrange(app: StairbotConsole) -> None:
+    """Lay ``#main`` out for its height now: roomy when the right column
+    leaves LOG_MIN_ROWS or more under it (once its panels are laid out)."""
+    rows = app.main_area.size.height
+    need = right_rows(app)
+    top = max(need, round(rows * PICTURE_SHARE))
+    roomy = app.sensors.outer_size.height > 0 and rows - top >= LOG_MIN_ROWS
+    main = app.main_area
+    main.set_class(roomy, "-roomy")
+    main.styles.grid_rows = f"{top} 1fr" if roomy else "3fr 2fr"  # (a change only relays out)
