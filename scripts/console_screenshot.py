@@ -5,6 +5,7 @@ the picture docs/console-80x24.svg (README links it).
     python scripts/console_screenshot.py --parameters [docs/console-parameters.svg]
     python scripts/console_screenshot.py --connections [docs/console-connections.svg]
     python scripts/console_screenshot.py docs/console-plots.svg --plot SFR,SFL,MTF.lift
+    python scripts/console_screenshot.py docs/console-events.svg --size 110x35 --events lift
 
 The simulated robot at 10x, started with s, taken once a segment stands over
 the first tread.  ``--parameters``: the parameters screen (``i``) between
@@ -14,7 +15,8 @@ diff is answered no).  ``--connections``: the connection manager (u) instead,
 with fake boards served on a pty for it to list (their registry, and the
 recent URLs, in a temporary directory of their own).  ``--plot KEYS``:
 those signals plotted (key v; the keys as console/signals.py names them),
-in the graphs' place.
+in the graphs' place.  ``--events WORD``: the event list filtered to the
+phases (e) holding WORD (/).
 """
 
 from __future__ import annotations
@@ -58,7 +60,8 @@ async def shoot_parameters(out: Path, width: int, height: int) -> None:
         await pilot.press("escape")
 
 
-async def shoot(out: Path, width: int, height: int, plot: list[str]) -> None:
+async def shoot(out: Path, width: int, height: int, plot: list[str],
+                events: str | None = None) -> None:
     app = build_app(speed="10x")
     async with app.run_test(size=(width, height)) as pilot:
         await app.workers.wait_for_complete()
@@ -75,6 +78,9 @@ async def shoot(out: Path, width: int, height: int, plot: list[str]) -> None:
             if scene is not None and max(scene.segment_steps()) >= 1:
                 break
             await asyncio.sleep(0.05)
+        if events is not None:  # e: phases and pauses only, then / and the word
+            await pilot.press("e", "e", "e")
+            app.log_panel.set_filter(search=events)
         await pilot.pause(0.3)
         app.save_screenshot(filename=out.name, path=str(out.parent))
         await pilot.press("space")
@@ -124,6 +130,8 @@ def main() -> None:
     p.add_argument("--connections", action="store_true",
                    help="the connection manager (u), with fake boards to list")
     p.add_argument("--plot", default="", help="signals to plot, comma-separated (SFR,MTF.lift)")
+    p.add_argument("--events", metavar="WORD", default=None,
+                   help="the event list filtered: phases only (e), holding WORD (/)")
     args = p.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     if args.parameters:
@@ -134,7 +142,8 @@ def main() -> None:
         with_fake_boards(Path(args.out), width, height)
     else:
         args.out = args.out or "docs/console-80x24.svg"
-        asyncio.run(shoot(Path(args.out), width, height, [k for k in args.plot.split(",") if k]))
+        asyncio.run(shoot(Path(args.out), width, height, [k for k in args.plot.split(",") if k],
+                          args.events))
     print(args.out)
 
 

@@ -139,6 +139,7 @@ class StairbotConsole(App[None]):
         self.plotting = plotting.Plotting()
         """The signals plotted (v) in the graphs' place (console/plotting.py)."""
         self.main_area = Container(id="main")  # a grid: console.tcss, console/roomy.py
+        self.roomy = roomy.Roomy()
         self.small_notice = Static(id="too-small", markup=False)
         """Says the terminal is too small, in the panels' place (paint.lay_out)."""
         self.screen_rows: int | None = None  # the screen's height, as the last resize said
@@ -176,6 +177,7 @@ class StairbotConsole(App[None]):
     def on_resize(self, event: events.Resize) -> None:
         # before the app's own size follows
         paint.lay_out(self, event.size.height, event.size.width)
+        self.roomy.reset()
 
     def on_mount(self) -> None:
         # SIGINT (Ctrl-C where the terminal sends signals, or `kill -INT`):
@@ -201,7 +203,7 @@ class StairbotConsole(App[None]):
     def refresh_view(self) -> None:
         """Copy the live state and update every panel that changed (the ages
         of the values shown change with the wall clock alone)."""
-        roomy.arrange(self)  # the panels' heights follow what they show, and the screen's
+        self.roomy.arrange(self)  # the panels' heights follow what they show, and the screen's
         view = self.state.view(events_after=self.shown_event)
         key = (view.version, age_key(view.read_age_s), age_key(view.top_age_s))
         if key == self.shown_key:

@@ -23,6 +23,9 @@ if TYPE_CHECKING:
 LOG_MIN_ROWS = 6
 """The least rows the event list keeps under both columns, roomy."""
 
+SLACK_ROWS = 2
+"""Rows the right column's row keeps beyond what its panels need now."""
+
 PICTURE_SHARE = 0.6
 """The share of the rows the picture's row keeps at least, roomy: as it has
 beside the event list otherwise (3fr to 2fr)."""
@@ -37,13 +40,29 @@ def right_rows(app: StairbotConsole) -> int:
     return rows + 1 + app.link.lines_shown
 
 
-def arrange(app: StairbotConsole) -> None:
-    """Lay ``#main`` out for its height now: roomy when the right column
-    leaves LOG_MIN_ROWS or more under it (once its panels are laid out)."""
-    rows = app.main_area.size.height
-    need = right_rows(app)
-    top = max(need, round(rows * PICTURE_SHARE))
-    roomy = app.sensors.outer_size.height > 0 and rows - top >= LOG_MIN_ROWS
-    main = app.main_area
-    main.set_class(roomy, "-roomy")
-    main.styles.grid_rows = f"{top} 1fr" if roomy else "3fr 2fr"  # (a change only relays out)
+class Roomy:
+    """The layout of ``#main``, kept as the panels grow: the right column's
+    row keeps the most rows its panels have needed since the screen's size
+    changed, and SLACK_ROWS more, so a panel that grows by a line or two
+    (a motor's commanded speed wrapping) hides nothing under it while the
+    layout catches up, and the picture's row does not jump with every
+    phase."""
+
+    def __init__(self) -> None:
+        self._need = 0
+
+    def reset(self) -> None:
+        """The screen's size changed: measure the right column again."""
+        self._need = 0
+
+    def arrange(self, app: StairbotConsole) -> None:
+        """Lay ``#main`` out for its height now: roomy when the right column
+        leaves LOG_MIN_ROWS or more under it (once its panels are laid out)."""
+        rows = app.main_area.size.height
+        if app.sensors.outer_size.height > 0:
+            self._need = max(self._need, right_rows(app) + SLACK_ROWS)
+        top = max(self._need, round(rows * PICTURE_SHARE))
+        roomy = self._need > 0 and rows - top >= LOG_MIN_ROWS
+        main = app.main_area
+        main.set_class(roomy, "-roomy")
+        main.styles.grid_rows = f"{top} 1fr" if roomy else "3fr 2fr"  # (a change only relays out)
