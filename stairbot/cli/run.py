@@ -346,6 +346,20 @@ def _link_line(link: dict[str, Any]) -> str:
         f"{k.replace('_', ' ')} {link[k]:g}" for k in keys if k in link)
 
 
+def _margins_line(m: dict[str, Any]) -> str:
+    """The least margins of the run (docs/envelope.md, "Margins"); the
+    physical ones only where the robot can tell them."""
+    mm = {k: f"{m[k] * 1000:.1f} mm" for k in ("stability_m", "edge_m", "stroke_m")
+          if m.get(k) is not None}
+    parts = [f"{name} {mm[key]}" for name, key in (("stability", "stability_m"),
+                                                   ("edge", "edge_m"), ("stroke", "stroke_m"))
+             if key in mm]
+    if m.get("pitch_deg") is not None:
+        parts.append(f"pitch {m['pitch_deg']:.1f} deg")
+    parts.append(f"sensor holds {m['sensor_holds']}")
+    return "  least margins     " + ", ".join(parts)
+
+
 def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str, config: str,
                    mismatches: list[str]) -> None:
     rtf = d.get("realtime_factor")
@@ -363,6 +377,7 @@ def _print_summary(d: dict[str, Any], scenario: Scenario, robot: str, config: st
         f"  fell              {'yes' if d['fell'] else 'no'}"
         f" (max pitch {_fmt(d.get('max_pitch_deg'), ' deg', 1)})",
         f"  offset from start {_fmt(d.get('final_offset_m'), ' m')}",
+        *([_margins_line(d["margins"])] if isinstance(d.get("margins"), dict) else []),
         *([f"  touched a wall    {d['wall_contact']}"] if d.get("wall_contact") else []),
         "  tilt              " + ("watched (IMU)" if d.get("tilt_watched")
                                   else "NOT watched: the robot config declares no IMU"),

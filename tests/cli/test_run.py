@@ -63,6 +63,7 @@ def test_text_mode_prints_phase_lines_then_a_summary(capsys: pytest.CaptureFixtu
     assert any("phase" in line and "calibration" in line for line in lines)
     summary = out[out.index("summary (step_too_high on sim://)"):]
     assert "outcome           completed (ascent ended: obstacle)" in summary
+    assert "  least margins     stability " in summary and "sensor holds 0" in summary
     assert "expected          yes" in summary
 
 
