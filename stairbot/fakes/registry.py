@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import sys
 import tempfile
@@ -29,6 +30,10 @@ from stairbot.drivers.port_lock import lock_dir
 
 MAX_ENTRY_BYTES = 4096
 """A registry file is a few hundred bytes; a larger one is not ours."""
+LATEST_START = 1e11
+"""An entry's start (seconds since the epoch) after this (the year 5138), or
+not a finite number, is not one stairbot wrote: the manager shows the start
+as a time of day, which such a number is not."""
 
 
 def registry_dir() -> Path:
@@ -163,4 +168,6 @@ def _read(path: Path) -> FakeBoards | None:
         raise ValueError(f"not a fake-boards entry ({type(exc).__name__})") from None
     if not isinstance(pid, int) or pid <= 0 or not (start is None or isinstance(start, int)):
         raise ValueError("not a fake-boards entry (pid)")
+    if not (math.isfinite(entry.started) and 0 <= entry.started <= LATEST_START):
+        raise ValueError("not a fake-boards entry (started)")
     return entry if alive(entry.pid, start) else None

@@ -264,3 +264,21 @@ def test_r_looks_again_from_the_list_and_is_a_letter_in_the_field(
             await until(pilot, lambda: len(app.screen_stack) == 1, "closed")
             assert app.url == "sim://"
     asyncio.run(go())
+
+
+@pytest.mark.parametrize("started", [1e300, float("nan"), -5.0])
+def test_a_registry_entry_with_an_impossible_start_is_a_line_not_an_empty_manager(
+        own_dirs: Path, started: float) -> None:
+    # a live pid (this process's), start time not known: the entry is believed
+    # but for its start, which no time of day can show
+    folder = registry.registry_dir()
+    folder.mkdir(parents=True)
+    entry = {"url": "serial:///dev/pts/996", "pid": os.getpid(), "proc_start": None,
+             "started": started, "wire": "serial", "scenario": "default",
+             "config": "reference", "serials": "motor board serial 3"}
+    (folder / "odd.json").write_text(json.dumps(entry))
+    listing = connections.gather(sim="the simulation", comports=lambda: [],
+                                 detect=lambda **_: [])
+    assert listing.group("Fake boards") == []
+    assert [e.url for e in listing.group("Simulation")] == ["sim://"]
+    assert any("odd.json ignored" in p and "started" in p for p in listing.problems)
