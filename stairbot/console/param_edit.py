@@ -46,7 +46,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from stairbot.console.params import shown_value
+import msgspec
+
+from stairbot.console.params import SECTIONS, shown_value
 from stairbot.control.robot_config import parse_config
 from stairbot.errors import ConfigError, InputError
 from stairbot.files import shown
@@ -170,7 +172,25 @@ class Parameters:
         except ConfigError as exc:
             where = exc.field or key
             raise InputError(where, None, exc.problem) from None
+        self.check_rest(config, overrides)
         return Edit(key, old, new, path, text, config, overrides)
+
+    def check_rest(self, config: RobotConfig, overrides: dict[str, Any]) -> None:
+        """InputError unless ``config`` (a file written here, as read back
+        now) holds the started config's values but for ``overrides``: the
+        file it extends is read again at each load, and a value changed there
+        since the console started (a geometry, a looser threshold) would
+        reach the next run unchecked and unshown."""
+        moved = [f"{key} {shown_value(value_of(self.started, key))} → "
+                 f"{shown_value(value_of(config, key))}"
+                 for key in _keys(self.started)
+                 if key not in overrides and value_of(config, key) != value_of(self.started, key)]
+        if moved:
+            raise InputError(shown(self.base), None,
+                             "changed since the console started (" + ", ".join(moved[:3])
+                             + (", ..." if len(moved) > 3 else "") + "); allowed: values as "
+                             "the console started with, but for those changed here (start "
+                             "the console again to use the file's new values)")
 
     def text(self, overrides: dict[str, Any]) -> str:
         """The file that extends :attr:`base` and sets ``overrides``."""
@@ -212,6 +232,12 @@ class Parameters:
         if self.written is None:
             return robot_shown(self.started.source)
         return f"{shown(self.written)} (extends {robot_shown(self.started.source)})"
+
+
+def _keys(cfg: RobotConfig) -> list[str]:
+    """Every ``section.name`` of a config."""
+    return [f"{section}.{name}" for section in SECTIONS
+            for name in msgspec.structs.asdict(getattr(cfg, section))]
 
 
 def _config_home() -> Path:
