@@ -19,6 +19,7 @@ import contextlib
 import json
 import math
 import os
+import stat
 import sys
 import tempfile
 import time
@@ -154,7 +155,12 @@ def running() -> tuple[list[FakeBoards], list[str]]:
 def _read(path: Path) -> FakeBoards | None:
     """One entry; None when its process is gone.  ValueError when it is not
     an entry stairbot wrote."""
-    with path.open("rb") as f:
+    # non-blocking: a FIFO given a registry name must not hold the reader
+    # (the manager's look, and the console's quit after it) until a writer comes
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise ValueError("not a regular file")
         data = f.read(MAX_ENTRY_BYTES + 1)
     if len(data) > MAX_ENTRY_BYTES:
         raise ValueError(f"larger than {MAX_ENTRY_BYTES} bytes")

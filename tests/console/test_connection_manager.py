@@ -11,6 +11,7 @@ import json
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -282,3 +283,22 @@ def test_a_registry_entry_with_an_impossible_start_is_a_line_not_an_empty_manage
     assert listing.group("Fake boards") == []
     assert [e.url for e in listing.group("Simulation")] == ["sim://"]
     assert any("odd.json ignored" in p and "started" in p for p in listing.problems)
+
+
+def test_a_fifo_in_the_registry_is_a_line_and_never_holds_the_look(own_dirs: Path) -> None:
+    # opened blocking, a FIFO waits for a writer: the manager looked forever
+    # and the console, quitting, waited for the look
+    folder = registry.registry_dir()
+    folder.mkdir(parents=True)
+    os.mkfifo(folder / "pipe.json")
+    looked: list[connections.Listing] = []
+    worker = threading.Thread(target=lambda: looked.append(connections.gather(
+        sim="the simulation", comports=lambda: [], detect=lambda **_: [])), daemon=True)
+    worker.start()
+    worker.join(timeout=30)  # only stops a broken test: the look never waits on anyone
+    if not looked:
+        with open(folder / "pipe.json", "w"):  # let the blocked look go
+            pass
+        raise AssertionError("the look waited on the FIFO")
+    assert any("pipe.json ignored: not a regular file" in p for p in looked[0].problems)
+    assert [e.url for e in looked[0].group("Simulation")] == ["sim://"]
