@@ -38,6 +38,7 @@ They change in the config file, for a console started on it.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import re
@@ -81,6 +82,9 @@ RUNTIME_SAFE: dict[str, Rule] = {
 }
 """The values the console may change between runs (the module's docstring
 says why each)."""
+
+MAX_NAMES = 9999
+"""The most numbered names (``NAME-params-N.toml``) a write tries."""
 
 WRITTEN_BY = ("# Written by the stairbot console (parameters, key i): the config it\n"
               "# extends, with the values the operator changed between runs.\n")
@@ -214,16 +218,20 @@ class Parameters:
         Raises OSError when the folder or the disk refuses it (nothing is
         taken then)."""
         self.folder.mkdir(parents=True, exist_ok=True)
-        path = edit.path
-        while True:
+        path, stem = edit.path, Path(self._name()).stem
+        for n in range(1, MAX_NAMES + 1):
             try:
                 with open(path, "x", encoding="utf-8") as out:
                     out.write(edit.text)
                     out.flush()
                     os.fsync(out.fileno())
                 break
-            except FileExistsError:  # taken since it was checked: the next free name
-                path = Path(unused_path(str(self.folder / self._name())))
+            except FileExistsError:  # taken (since it was checked, or by a directory,
+                # a FIFO, a dangling link, which unused_path lets keep their name)
+                path = self.folder / f"{stem}-{n}.toml"
+        else:
+            raise FileExistsError(errno.EEXIST, f"every name up to {stem}-{MAX_NAMES}.toml "
+                                  "is taken", str(self.folder))
         self.overrides, self.written = dict(edit.overrides), path
         return path
 

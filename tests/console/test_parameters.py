@@ -306,3 +306,22 @@ def test_an_edit_over_a_user_file_changed_since_the_start_is_refused(tmp_path: P
     # the file as it was: the change is taken
     base.write_text('extends = "reference"\n')
     assert params.propose(started, "motors.wheel_speed", "0.5").new == 0.5
+
+
+@pytest.mark.parametrize("taker", ["directory", "dangling link"])
+def test_a_name_taken_by_no_regular_file_is_stepped_past_not_looped_on(
+        config_home: Path, taker: str) -> None:
+    # a name held by something not a regular file: the write went on trying
+    # that same name forever, on the console's UI thread
+    config_home.mkdir(parents=True)
+    taken = config_home / "reference-params.toml"
+    if taker == "directory":
+        taken.mkdir()
+    else:
+        taken.symlink_to(config_home / "nowhere")
+    started = load_config()
+    params = Parameters(started)
+    change = params.propose(started, "motors.wheel_speed", "0.5")
+    written = params.write(change)
+    assert written == config_home / "reference-params-1.toml"
+    assert load_config(written).motors.wheel_speed == 0.5
