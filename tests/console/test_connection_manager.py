@@ -302,3 +302,25 @@ def test_a_fifo_in_the_registry_is_a_line_and_never_holds_the_look(own_dirs: Pat
         raise AssertionError("the look waited on the FIFO")
     assert any("pipe.json ignored: not a regular file" in p for p in looked[0].problems)
     assert [e.url for e in looked[0].group("Simulation")] == ["sim://"]
+
+
+def test_a_registry_full_of_junk_says_how_many_problems_it_cannot_show(
+        own_dirs: Path) -> None:
+    folder = registry.registry_dir()
+    folder.mkdir(parents=True)
+    for n in range(20):
+        (folder / f"junk{n:02}.json").write_text("{not json")
+
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            screen = await open_manager(pilot)
+            shown = notes(screen).splitlines()
+            assert len(shown) == 4
+            assert "junk00.json ignored" in shown[0]
+            assert shown[-1] == "... and 17 more problems like these"
+            box = screen.query_one("#connect-notes")
+            rows = [strip.text for strip in box.render_lines(box.content_region.reset_offset)]
+            assert rows[-1].strip() == shown[-1], rows  # the count is on screen, not cut
+    asyncio.run(go())
