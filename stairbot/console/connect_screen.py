@@ -28,10 +28,22 @@ from stairbot.console.connections import GROUPS, Listing
 EXAMPLES = "sim://  serial://PORT?baud=N  can://IF/CHANNEL"
 SHOWN_URL = 100
 """A URL longer than this is shown cut (the row opens it whole)."""
+NOTES_ROWS = 4
+"""The rows the problems found have under the list."""
 
 
 def _shown(url: str) -> str:
     return url if len(url) <= SHOWN_URL else f"{url[:SHOWN_URL - 1]}… ({len(url)} characters)"
+
+
+def _fitted(problems: list[str]) -> list[str]:
+    """The problems in the NOTES_ROWS the notes have: past them, how many
+    more (a registry full of junk is a line each, and the rows past the
+    last were cut without a word)."""
+    if len(problems) <= NOTES_ROWS:
+        return problems
+    more = len(problems) - (NOTES_ROWS - 1)
+    return [*problems[:NOTES_ROWS - 1], f"... and {more} more problems like these"]
 
 
 class ConnectScreen(ModalScreen[str | None]):
@@ -130,7 +142,7 @@ class ConnectScreen(ModalScreen[str | None]):
             f"Connect to a robot (open now: {_shown(self.current)}) · as found at "
             f"{time.strftime('%H:%M:%S')}")
         notes = self.query_one("#connect-notes", Static)
-        notes.update("\n".join(listing.problems))
+        notes.update("\n".join(_fitted(listing.problems)))
         notes.set_class(not listing.problems, "empty")
         self.listing = listing
 

@@ -38,6 +38,7 @@ They change in the config file, for a console started on it.
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import re
@@ -46,7 +47,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from stairbot.console.params import shown_value
+import msgspec
+
+from stairbot.console.params import SECTIONS, shown_value
 from stairbot.control.robot_config import parse_config
 from stairbot.errors import ConfigError, InputError
 from stairbot.files import shown
@@ -79,6 +82,9 @@ RUNTIME_SAFE: dict[str, Rule] = {
 }
 """The values the console may change between runs (the module's docstring
 says why each)."""
+
+MAX_NAMES = 9999
+"""The most numbered names (``NAME-params-N.toml``) a write tries."""
 
 WRITTEN_BY = ("# Written by the stairbot console (parameters, key i): the config it\n"
               "# extends, with the values the operator changed between runs.\n")
@@ -170,7 +176,25 @@ class Parameters:
         except ConfigError as exc:
             where = exc.field or key
             raise InputError(where, None, exc.problem) from None
+        self.check_rest(config, overrides)
         return Edit(key, old, new, path, text, config, overrides)
+
+    def check_rest(self, config: RobotConfig, overrides: dict[str, Any]) -> None:
+        """InputError unless ``config`` (a file written here, as read back
+        now) holds the started config's values but for ``overrides``: the
+        file it extends is read again at each load, and a value changed there
+        since the console started (a geometry, a looser threshold) would
+        reach the next run unchecked and unshown."""
+        moved = [f"{key} {shown_value(value_of(self.started, key))} → "
+                 f"{shown_value(value_of(config, key))}"
+                 for key in _keys(self.started)
+                 if key not in overrides and value_of(config, key) != value_of(self.started, key)]
+        if moved:
+            raise InputError(shown(self.base), None,
+                             "changed since the console started (" + ", ".join(moved[:3])
+                             + (", ..." if len(moved) > 3 else "") + "); allowed: values as "
+                             "the console started with, but for those changed here (start "
+                             "the console again to use the file's new values)")
 
     def text(self, overrides: dict[str, Any]) -> str:
         """The file that extends :attr:`base` and sets ``overrides``."""
@@ -194,16 +218,20 @@ class Parameters:
         Raises OSError when the folder or the disk refuses it (nothing is
         taken then)."""
         self.folder.mkdir(parents=True, exist_ok=True)
-        path = edit.path
-        while True:
+        path, stem = edit.path, Path(self._name()).stem
+        for n in range(1, MAX_NAMES + 1):
             try:
                 with open(path, "x", encoding="utf-8") as out:
                     out.write(edit.text)
                     out.flush()
                     os.fsync(out.fileno())
                 break
-            except FileExistsError:  # taken since it was checked: the next free name
-                path = Path(unused_path(str(self.folder / self._name())))
+            except FileExistsError:  # taken (since it was checked, or by a directory,
+                # a FIFO, a dangling link, which unused_path lets keep their name)
+                path = self.folder / f"{stem}-{n}.toml"
+        else:
+            raise FileExistsError(errno.EEXIST, f"every name up to {stem}-{MAX_NAMES}.toml "
+                                  "is taken", str(self.folder))
         self.overrides, self.written = dict(edit.overrides), path
         return path
 
@@ -212,6 +240,12 @@ class Parameters:
         if self.written is None:
             return robot_shown(self.started.source)
         return f"{shown(self.written)} (extends {robot_shown(self.started.source)})"
+
+
+def _keys(cfg: RobotConfig) -> list[str]:
+    """Every ``section.name`` of a config."""
+    return [f"{section}.{name}" for section in SECTIONS
+            for name in msgspec.structs.asdict(getattr(cfg, section))]
 
 
 def _config_home() -> Path:

@@ -243,10 +243,13 @@ class ParamsScreen(ModalScreen[None]):
         if self.console.engine.running:
             self.refuse(MID_RUN)
             return
+        taken = (self.params.overrides, self.params.written)
         try:
             path = self.params.write(change)
             cfg = load_config(path)
+            self.params.check_rest(cfg, change.overrides)
         except (StairbotError, OSError) as exc:
+            self.params.overrides, self.params.written = taken  # the runs keep their config
             self.refuse(f"not changed: cannot write or read the new config: {exc}")
             return
         self.console.engine.config = cfg

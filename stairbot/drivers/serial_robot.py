@@ -50,6 +50,7 @@ the ``SerialLink`` (``serial_link.py``) that frames messages for it.
 from __future__ import annotations
 
 import io
+import os
 from urllib.parse import urlencode
 
 import serial
@@ -117,6 +118,20 @@ class _LockedPort:
                 self.lock.release()
 
 
+def _own_terminal(path: str) -> bool:
+    """Whether ``path`` is the terminal this process runs in: ``/dev/tty``,
+    or the device of its standard input, output or error."""
+    if path == "/dev/tty":
+        return True
+    for fd in (0, 1, 2):
+        try:
+            if os.isatty(fd) and os.path.realpath(os.ttyname(fd)) == path:
+                return True
+        except OSError:
+            continue
+    return False
+
+
 def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     """Open a pyserial port; a tty gets the fast fd channel.  A device path
     is locked for this host first (``port_lock.py``): PortBusyError, one
@@ -124,6 +139,10 @@ def open_channel(port: str, baud: int, url: str) -> FdChannel | PortChannel:
     RobotUrlError in one line when it cannot open."""
     lock: PortLock | None = None
     key = serial_lock_key(port)
+    if key is not None and _own_terminal(key):
+        raise RobotUrlError(url, None, f"{port} is this program's own terminal, not a "
+                            "robot's port: opening it would read the operator's keys "
+                            "(the emergency stop's too) and write frames to the screen")
     if key is not None:  # one host at a time, however the URL spells the port
         try:
             lock = take_port_lock(key, f"serial port {port}")

@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
+import stat
 import sys
 import tempfile
 import time
@@ -29,6 +31,10 @@ from stairbot.drivers.port_lock import lock_dir
 
 MAX_ENTRY_BYTES = 4096
 """A registry file is a few hundred bytes; a larger one is not ours."""
+LATEST_START = 1e11
+"""An entry's start (seconds since the epoch) after this (the year 5138), or
+not a finite number, is not one stairbot wrote: the manager shows the start
+as a time of day, which such a number is not."""
 
 
 def registry_dir() -> Path:
@@ -149,7 +155,12 @@ def running() -> tuple[list[FakeBoards], list[str]]:
 def _read(path: Path) -> FakeBoards | None:
     """One entry; None when its process is gone.  ValueError when it is not
     an entry stairbot wrote."""
-    with path.open("rb") as f:
+    # non-blocking: a FIFO given a registry name must not hold the reader
+    # (the manager's look, and the console's quit after it) until a writer comes
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise ValueError("not a regular file")
         data = f.read(MAX_ENTRY_BYTES + 1)
     if len(data) > MAX_ENTRY_BYTES:
         raise ValueError(f"larger than {MAX_ENTRY_BYTES} bytes")
@@ -163,4 +174,6 @@ def _read(path: Path) -> FakeBoards | None:
         raise ValueError(f"not a fake-boards entry ({type(exc).__name__})") from None
     if not isinstance(pid, int) or pid <= 0 or not (start is None or isinstance(start, int)):
         raise ValueError("not a fake-boards entry (pid)")
+    if not (math.isfinite(entry.started) and 0 <= entry.started <= LATEST_START):
+        raise ValueError("not a fake-boards entry (started)")
     return entry if alive(entry.pid, start) else None

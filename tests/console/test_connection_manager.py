@@ -11,6 +11,7 @@ import json
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -263,4 +264,63 @@ def test_r_looks_again_from_the_list_and_is_a_letter_in_the_field(
             await press(pilot, "escape")
             await until(pilot, lambda: len(app.screen_stack) == 1, "closed")
             assert app.url == "sim://"
+    asyncio.run(go())
+
+
+@pytest.mark.parametrize("started", [1e300, float("nan"), -5.0])
+def test_a_registry_entry_with_an_impossible_start_is_a_line_not_an_empty_manager(
+        own_dirs: Path, started: float) -> None:
+    # a live pid (this process's), start time not known: the entry is believed
+    # but for its start, which no time of day can show
+    folder = registry.registry_dir()
+    folder.mkdir(parents=True)
+    entry = {"url": "serial:///dev/pts/996", "pid": os.getpid(), "proc_start": None,
+             "started": started, "wire": "serial", "scenario": "default",
+             "config": "reference", "serials": "motor board serial 3"}
+    (folder / "odd.json").write_text(json.dumps(entry))
+    listing = connections.gather(sim="the simulation", comports=lambda: [],
+                                 detect=lambda **_: [])
+    assert listing.group("Fake boards") == []
+    assert [e.url for e in listing.group("Simulation")] == ["sim://"]
+    assert any("odd.json ignored" in p and "started" in p for p in listing.problems)
+
+
+def test_a_fifo_in_the_registry_is_a_line_and_never_holds_the_look(own_dirs: Path) -> None:
+    # opened blocking, a FIFO waits for a writer: the manager looked forever
+    # and the console, quitting, waited for the look
+    folder = registry.registry_dir()
+    folder.mkdir(parents=True)
+    os.mkfifo(folder / "pipe.json")
+    looked: list[connections.Listing] = []
+    worker = threading.Thread(target=lambda: looked.append(connections.gather(
+        sim="the simulation", comports=lambda: [], detect=lambda **_: [])), daemon=True)
+    worker.start()
+    worker.join(timeout=30)  # only stops a broken test: the look never waits on anyone
+    if not looked:
+        with open(folder / "pipe.json", "w"):  # let the blocked look go
+            pass
+        raise AssertionError("the look waited on the FIFO")
+    assert any("pipe.json ignored: not a regular file" in p for p in looked[0].problems)
+    assert [e.url for e in looked[0].group("Simulation")] == ["sim://"]
+
+
+def test_a_registry_full_of_junk_says_how_many_problems_it_cannot_show(
+        own_dirs: Path) -> None:
+    folder = registry.registry_dir()
+    folder.mkdir(parents=True)
+    for n in range(20):
+        (folder / f"junk{n:02}.json").write_text("{not json")
+
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            screen = await open_manager(pilot)
+            shown = notes(screen).splitlines()
+            assert len(shown) == 4
+            assert "junk00.json ignored" in shown[0]
+            assert shown[-1] == "... and 17 more problems like these"
+            box = screen.query_one("#connect-notes")
+            rows = [strip.text for strip in box.render_lines(box.content_region.reset_offset)]
+            assert rows[-1].strip() == shown[-1], rows  # the count is on screen, not cut
     asyncio.run(go())

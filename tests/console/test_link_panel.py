@@ -28,3 +28,13 @@ def test_the_cans_bus_state_error_frames_and_a_flood_are_on_screen() -> None:
     assert "flood 0x000" in faults.plain
     _, off = health_text({"bus_state": 2.0, "flood_id": 0x1FFC0000})
     assert "BUS-OFF" in off.plain and "flood 0x1FFC0000" in off.plain
+
+
+def test_a_bus_off_and_a_flood_lead_the_fault_line_so_80_columns_never_cut_them() -> None:
+    # the link panel at 80x24 shows 39 characters of a line, and cuts the rest
+    _, faults = health_text({"frames_per_s": 3.0, "error_frames": 123.0, "lost": 45.0,
+                             "late": 67.0, "retries": 890.0, "duplicates": 12.0,
+                             "bus_state": 2.0, "flood_id": 0x1FFC0000})
+    seen = faults.plain[:39]
+    assert "BUS-OFF" in seen and "flood 0x1FFC0000" in seen
+    assert "errors 123" in faults.plain and "retries 890" in faults.plain

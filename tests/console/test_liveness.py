@@ -171,3 +171,11 @@ def test_a_bad_port_at_start_shows_its_whole_reason_and_keeps_it() -> None:
             await pilot.pause(0.2)
             assert reason in " ".join(shown(app.banner).split())
     asyncio.run(go())
+
+
+def test_the_strip_message_keeps_the_url_of_a_command_to_type() -> None:
+    url = "serial:///dev/pts/6"
+    shown = message_text(url, f"cannot open {url}: the motor board has its watchdog "
+                              f"tripped; check the robot, then `stairbot clear --robot {url}`")
+    assert shown.plain == (" cannot open the robot: the motor board has its watchdog "
+                           f"tripped; check the robot, then `stairbot clear --robot {url}`")

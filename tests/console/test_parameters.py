@@ -288,3 +288,40 @@ def test_a_file_changed_since_it_was_loaded_shows_no_sources(tmp_path: Path) -> 
     assert all(v.source is None for v in rows)
     assert f"{mine} changed since it was loaded" in note
     assert next(v for v in rows if v.key == "motors.wheel_speed").value == 0.8
+
+
+def test_an_edit_over_a_user_file_changed_since_the_start_is_refused(tmp_path: Path) -> None:
+    # the file the console started on loosens a threshold and speeds a lift
+    # up afterwards; a change of another value must not carry that into a run
+    base = tmp_path / "mine.toml"
+    base.write_text('extends = "reference"\n')
+    started = load_config(base)
+    params = Parameters(started)
+    base.write_text('extends = "reference"\n[safety]\nmax_pitch_deg = 30\n'
+                    '[motors]\nlift_speed = 11\n')
+    with pytest.raises(InputError, match="changed since the console started") as caught:
+        params.propose(started, "motors.wheel_speed", "0.5")
+    assert "safety.max_pitch_deg 15 → 30" in str(caught.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.toml"]
+    # the file as it was: the change is taken
+    base.write_text('extends = "reference"\n')
+    assert params.propose(started, "motors.wheel_speed", "0.5").new == 0.5
+
+
+@pytest.mark.parametrize("taker", ["directory", "dangling link"])
+def test_a_name_taken_by_no_regular_file_is_stepped_past_not_looped_on(
+        config_home: Path, taker: str) -> None:
+    # a name held by something not a regular file: the write went on trying
+    # that same name forever, on the console's UI thread
+    config_home.mkdir(parents=True)
+    taken = config_home / "reference-params.toml"
+    if taker == "directory":
+        taken.mkdir()
+    else:
+        taken.symlink_to(config_home / "nowhere")
+    started = load_config()
+    params = Parameters(started)
+    change = params.propose(started, "motors.wheel_speed", "0.5")
+    written = params.write(change)
+    assert written == config_home / "reference-params-1.toml"
+    assert load_config(written).motors.wheel_speed == 0.5

@@ -32,3 +32,26 @@ def test_a_dialog_is_never_covered_by_a_toast_nor_the_link_panel_console_defect_
             assert not app.screen.query(Toast) and not app._notifications
             assert "while it asks" in said(app)  # kept in the event list
     asyncio.run(go())
+
+
+def test_many_toasts_never_cover_the_robot_strip_at_the_top() -> None:
+    async def go() -> None:
+        app = build_app()
+        async with app.run_test(size=(80, 24), notifications=True) as pilot:
+            await ready(pilot)
+            for n in range(8):  # x pressed again and again: a toast each
+                app.say(f"no run is going on ({n})")
+            await until(pilot, lambda: len(app.screen.query(Toast)) == 8, "the toasts")
+            await pilot.pause(0.3)
+            seen = []
+            for toast in app.screen.query(Toast):
+                try:
+                    seen.append(app.screen.find_widget(toast).visible_region)
+                except Exception:  # noqa: BLE001 - scrolled out of the rack: not on screen
+                    continue
+            assert any(region.area for region in seen), "no toast in sight"
+            for region in seen:
+                assert not region.overlaps(app.banner.region), (region, app.banner.region)
+            newest = app.screen.query(Toast).last()
+            assert "(7)" in str(newest.render())
+    asyncio.run(go())

@@ -77,9 +77,14 @@ def strip_text(url: str, scenario: str, status: RunStatus, recording: str | None
 def message_text(url: str, message: str) -> Text:
     """The message with the URL (which the strip shows) said as "the robot",
     once: a long URL must not hide the reason (``no reading from the robot:
-    URL: link lost`` reads ``no reading from the robot: link lost``)."""
+    URL: link lost`` reads ``no reading from the robot: link lost``).  A
+    command in backquotes keeps its URL: ``stairbot clear --robot URL`` is
+    typed as it is shown."""
     if url:
-        message = message.replace(f": {url}: ", ": ").replace(url, "the robot")
+        parts = message.split("`")
+        message = "`".join(
+            part.replace(f": {url}: ", ": ").replace(url, "the robot") if i % 2 == 0
+            else part for i, part in enumerate(parts))
     return Text(f" {message}")
 
 

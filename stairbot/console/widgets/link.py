@@ -32,7 +32,9 @@ def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
     """Two lines: frames per second and round-trip times; errors (stray
     replies among them), lost and late replies, retries (red when not zero),
     and duplicated replies when there were any (ignored, so not red); on
-    CAN a bus that is not error-active, and the id of a flood, in red."""
+    CAN a bus that is not error-active, and the id of a flood, in red, at
+    the head of the line: the right column at 80x24 is 39 characters wide
+    and cuts the line's end."""
     if not health:
         return Text("no link figures yet  ", "dim"), Text()
     rates = Text(no_wrap=True, overflow="ellipsis")
@@ -43,6 +45,12 @@ def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
     rates.append("—" if med is None else f"{med:.2f}")
     rates.append("/" + ("—" if p99 is None else f"{p99:.2f}") + " ms  ")
     faults = Text(no_wrap=True, overflow="ellipsis")
+    state = BUS_STATES.get(health.get("bus_state", 0.0))
+    if state is not None:
+        faults.append(state + "  ", "bold red")
+    flood = health.get("flood_id", -1.0)
+    if flood >= 0:
+        faults.append(f"flood 0x{int(flood):03X}  ", "bold red")
     errors = sum(health.get(k, 0.0) for k in ERROR_KEYS)
     for label, value in (("errors", errors), ("lost", health.get("lost", 0.0)),
                          ("late", health.get("late", 0.0)),
@@ -50,12 +58,6 @@ def health_text(health: Mapping[str, float]) -> tuple[Text, Text]:
         _figure(faults, label, value, bad=value > 0)
     if health.get("duplicates", 0.0) > 0:
         _figure(faults, "dup", health["duplicates"])
-    state = BUS_STATES.get(health.get("bus_state", 0.0))
-    if state is not None:
-        faults.append(state + "  ", "bold red")
-    flood = health.get("flood_id", -1.0)
-    if flood >= 0:
-        faults.append(f"flood 0x{int(flood):03X}  ", "bold red")
     return rates, faults
 
 
