@@ -11,12 +11,14 @@ the console started with:
 
 * ``motors.wheel_speed``, ``motors.lift_speed``: the speeds the controller
   commands and the supervisor clamps to.  Lower only (at most the started
-  config's): the motors are the ones it was built with (the simulation's
-  world keeps their limits), and every timing that follows from a speed
-  (the phase timeout, how far the robot backs in one measurement) is worked
-  out again from the new one.
+  config's), and down to half of it: the motors are the ones it was built
+  with (the simulation's world keeps their limits), and every timing that
+  follows from a speed (the phase timeout, how far the robot backs in one
+  measurement) is worked out again from the new one, so a much slower robot
+  would be found stalled that much later.
 * ``algorithm.standing_wait``: how long the standing rule waits, motors
-  stopped, before it measures again; within the schema's bounds.
+  stopped, before it measures again; from half to twice the started
+  config's, within the schema's bounds.
 * ``algorithm.max_steps``: how many steps the ascent climbs before it
   turns to the descent; within the schema's bounds.
 * ``safety.max_pitch_deg``, ``safety.max_roll_deg``,
@@ -67,12 +69,19 @@ class Rule:
 
     way: Way
     why: str
+    share: tuple[float, float] | None = None
+    """The least and most share of the started config's value it may take
+    (None: the schema's bounds and ``way`` alone)."""
 
 
 RUNTIME_SAFE: dict[str, Rule] = {
-    "motors.wheel_speed": Rule("lower", "the wheels' motors are the ones the robot has"),
-    "motors.lift_speed": Rule("lower", "the lifts' motors are the ones the robot has"),
-    "algorithm.standing_wait": Rule("any", "the robot waits standing still"),
+    # at most half as fast: a slower robot's phase timeouts stretch with it, and a
+    # stalled robot is found that much later
+    "motors.wheel_speed": Rule("lower", "the wheels' motors are the ones the robot has",
+                               (0.5, 1.0)),
+    "motors.lift_speed": Rule("lower", "the lifts' motors are the ones the robot has",
+                              (0.5, 1.0)),
+    "algorithm.standing_wait": Rule("any", "the robot waits standing still", (0.5, 2.0)),
     "algorithm.max_steps": Rule("any", "the ascent turns to the descent sooner or later"),
     "safety.max_pitch_deg": Rule("lower", "a tighter threshold stops the robot sooner"),
     "safety.max_roll_deg": Rule("lower", "a tighter threshold stops the robot sooner"),
@@ -100,11 +109,16 @@ def allowed(key: str, started: RobotConfig) -> str:
     rule = RUNTIME_SAFE[key]
     unit = unit_at(ConfigFile, key) or ""
     bounds = describe_at(ConfigFile, key)
+    base = value_of(started, key)
+    if rule.share is not None:
+        lo, hi = (shown_value(base * f) for f in rule.share)
+        return (f"{bounds} {unit}, and from {lo} to {hi} {unit} (the config the console "
+                f"started with: {shown_value(base)})")
     if rule.way == "any":
         return f"{bounds} {unit}".strip()
-    base = shown_value(value_of(started, key))
     side = "at most" if rule.way == "lower" else "at least"
-    return f"{bounds} {unit}, and {side} {base} {unit} (the config the console started with)"
+    return (f"{bounds} {unit}, and {side} {shown_value(base)} {unit} (the config the "
+            "console started with)")
 
 
 @dataclass(frozen=True)
@@ -162,8 +176,10 @@ class Parameters:
             raise InputError(key, None, f"{shown_value(new)} is its value already; "
                              f"allowed: {what}")
         rule, base = RUNTIME_SAFE[key], value_of(self.started, key)
-        if isinstance(new, int | float) and (rule.way == "lower" and new > base
-                                             or rule.way == "higher" and new < base):
+        if isinstance(new, int | float) and (
+                rule.way == "lower" and new > base or rule.way == "higher" and new < base
+                or rule.share is not None and not base * rule.share[0] <= new
+                <= base * rule.share[1]):
             raise InputError(key, None, f"{shown_value(new)} is not allowed ({rule.why}); "
                              f"allowed: {what}")
         overrides = dict(self.overrides)

@@ -156,15 +156,24 @@ def test_a_bad_value_is_refused_with_what_is_allowed_and_nothing_written(
             await type_value(pilot, "2")  # faster than the motors it started with
             await until(pilot, lambda: "not changed" in message(app), "the refusal")
             assert "motors.wheel_speed" in message(app)
-            assert "at most 1 turns/s" in message(app)
+            assert "from 0.5 to 1 turns/s" in message(app)
+            await type_value(pilot, "0.3")  # slower than half: its timeouts would stretch
+            await until(pilot, lambda: "0.3 is not allowed" in message(app), "too slow")
+            assert "from 0.5 to 1 turns/s" in message(app)
             await type_value(pilot, "fast")
             await until(pilot, lambda: "'fast' is not allowed" in message(app), "refused")
             assert not isinstance(app.screen, DiffScreen)
             await press(pilot, "escape")
             await choose(pilot, "motors.lift_speed")
-            await type_value(pilot, "0.05")  # the config checks: too slow at the lifts
-            await until(pilot, lambda: "0.0002 to 1 m/s" in message(app), "refused")
+            await type_value(pilot, "0.05")  # less than half the lifts' speed
+            await until(pilot, lambda: "from 5 to 10 turns/s" in message(app), "refused")
             assert "motors.lift_speed" in message(app)
+            assert not isinstance(app.screen, DiffScreen)
+            await press(pilot, "escape")
+            await choose(pilot, "safety.stability_margin")
+            await type_value(pilot, "0.5")  # the config checks: no room on the middle wheels
+            await until(pilot, lambda: "leaves no room" in message(app), "refused")
+            assert "safety.stability_margin" in message(app)
             assert not isinstance(app.screen, DiffScreen)
         assert app.engine.config.motors == load_config().motors
     asyncio.run(go())
