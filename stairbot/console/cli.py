@@ -129,8 +129,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     app = build_app(config, url=args.robot, scenario=args.scenario, record=args.record,
                     speed=args.speed)
     with live_server(args.foxglove, config, args.robot) as live:
-        app.engine.live = live
         if live is not None:
+            app.engine.live = live
             for line in live.lines():
                 app.state.note(line, "warning" if line.startswith("warning") else "information")
         app.run()
