@@ -232,6 +232,9 @@ def run_boundary(spec: Spec, axis: str, tolerance: float | None, scan: int | Non
 
     t = target(spec, axis, tolerance, scan)
     pts = points(spec, axis)
+    for point in pts:  # both ends must make cases the loaders take, before any runs
+        for end in (t.low, t.high):
+            build_case(spec, point.base, (axis, end))
     folder = out or Path(f"boundary-{spec.name}-{axis}-{spec.hash[:8]}")
     store = ResultStore(folder, spec, False)
     per_round = max(1, jobs)
