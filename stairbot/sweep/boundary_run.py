@@ -29,6 +29,7 @@ from stairbot.sweep.bisect import Bracket, Search, changes, search
 from stairbot.sweep.boundary import Point, Published, Target, published
 from stairbot.sweep.cases import DIGITS, Case, build_case
 from stairbot.sweep.execute import run_cases
+from stairbot.sweep.heatmap import LETTERS
 from stairbot.sweep.spec import Spec
 from stairbot.sweep.store import ResultStore
 from stairbot.sweep.verdict import passing
@@ -177,9 +178,32 @@ def write_report(folder: Path, data: dict[str, Any]) -> Path:
     return path
 
 
+STRIP = 64
+"""Characters across the axis in a point's strip of probes."""
+
+
+def strip(t: Target, probes: list[tuple[float, str]], pubs: list[Published]) -> list[str]:
+    """The probes along the axis as letters (C climbed, R refused, S stranded,
+    ...; ! where probes of two behaviours share a character), the published
+    limits marked ^ under them."""
+    span = t.high - t.low
+    cells = ["."] * STRIP
+    for v, c in probes:
+        i = min(STRIP - 1, max(0, round((v - t.low) / span * (STRIP - 1))))
+        mark = LETTERS.get(c, "?")
+        cells[i] = mark if cells[i] in (".", mark) else "!"
+    under = [" "] * STRIP
+    for p in pubs:
+        under[min(STRIP - 1, max(0, round((p.value - t.low) / span * (STRIP - 1))))] = "^"
+    pad = " " * len(_fmt(t, t.low))
+    return [f"  {_fmt(t, t.low)} {''.join(cells)} {_fmt(t, t.high)}",
+            f"  {pad} {''.join(under).rstrip()}"]
+
+
 def lines(t: Target, k: int, total: int, r: PointResult, d: dict[str, Any]) -> list[str]:
     held = ", ".join(f"{p} = {v}" for p, v in r.point.held.items()) or "the base scenario"
     out = [f"point {k + 1}/{total} ({held}): {d['probes']} probes in {d['rounds']} rounds"]
+    out += strip(t, r.search.probes, r.published)
     for b, bd in zip(r.search.brackets, d["brackets"], strict=True):
         text = (f"  {b.low_is} -> {b.high_is} in [{_fmt(t, b.low)}, {_fmt(t, b.high)}] "
                 f"(width {_diff(t, b.width)})")

@@ -15,8 +15,8 @@ import pytest
 
 from stairbot.sweep.axes import SpecError
 from stairbot.sweep.bisect import changes, scan_values, search
-from stairbot.sweep.boundary import MAX_POINTS, points, published, target
-from stairbot.sweep.boundary_run import PointResult, behaviour, lines, point_dict
+from stairbot.sweep.boundary import MAX_POINTS, Published, points, published, target
+from stairbot.sweep.boundary_run import PointResult, behaviour, lines, point_dict, strip
 from stairbot.sweep.spec import parse_spec
 
 ROOT = Path(__file__).parents[2]
@@ -224,3 +224,13 @@ def test_a_rise_boundary_on_the_simulated_robot(tmp_path: Path) -> None:
     failing = [r for r in records if r["verdict"] not in ("climbed", "refused")]
     assert proc.returncode == (1 if failing else 0), proc.stderr
     assert "published max_step_rise_m 0.2020" in proc.stdout
+
+
+def test_the_strip_shows_the_probes_and_the_published_limits() -> None:
+    spec = parse_spec('[axes]\n"stairs.rise" = [0.1, 0.3]\n', "x.toml", ROOT)
+    t = target(spec, "stairs.rise", None, None)
+    probes = [(0.1, "climbed"), (0.2, "climbed"), (0.2001, "refused"), (0.3, "refused")]
+    row, marks = strip(t, probes, [Published(0.2, "inside", "outside", "max_step_rise_m")])
+    cells = row.split()[1]
+    assert cells[0] == "C" and cells[-1] == "R" and "!" in cells  # two behaviours, one cell
+    assert marks.index("^") == row.index("!")
