@@ -6,8 +6,8 @@ publishes.
   ``uniform``, ``normal`` (mean +- 2 sd) or ``randint``: ``--scan`` values
   across it), or ``stairs.rise`` / ``stairs.tread`` when the spec holds them
   at one value or not at all: the range then spans the robot's published
-  limits by 30 mm (rise: ``min_step_rise_m`` to ``max_step_rise_m``) or
-  60 mm (tread: ``min_tread_m``) either side.
+  limits: the rise from 10 mm (:data:`LOWEST_RISE_M`) to ``max_step_rise_m``
+  + 30 mm, the tread ``min_tread_m`` +- 60 mm.
 * **The points.**  The other axes stay as the spec makes them: a search for
   every combination of the other grid axes' values (at most
   :data:`MAX_POINTS`), each sampled axis at that grid point's first draw.
@@ -41,6 +41,10 @@ DEFAULT_SCAN = 12
 LIMIT_AXES = {"stairs.rise": 0.03, "stairs.tread": 0.06}
 """Axes searched across the robot's own limits when the spec gives no range:
 how far past them either way."""
+
+LOWEST_RISE_M = 0.01
+"""Where a rise search starts, at the lowest (unless the low-rise rule is
+lower still, less 30 mm)."""
 
 METRE_AXES = frozenset({"stairs.rise", "stairs.tread", "stairs.width", "start.distance",
                         "start.lateral", "sensors.noise", "stairs.rise_jitter",
@@ -133,7 +137,10 @@ def target(spec: Spec, axis: str, tolerance: float | None, scan: int | None) -> 
         cfg = config_of(build_case(spec, 0))
         pad = LIMIT_AXES[axis]
         if axis == "stairs.rise":
-            values = [max(0.005, limits.min_step_rise_m(cfg) - pad), cfg.max_step_rise_m + pad]
+            # from a kerb's lip, below every low-rise rule: a riser too low to see
+            # must be refused too, not only one too low to measure a tread against
+            values = [min(LOWEST_RISE_M, limits.min_step_rise_m(cfg) - pad),
+                      cfg.max_step_rise_m + pad]
         else:
             values = [max(0.01, limits.min_tread_m(cfg) - pad), limits.min_tread_m(cfg) + pad]
     metres = axis in METRE_AXES

@@ -160,7 +160,8 @@ def point_dict(t: Target, r: PointResult) -> dict[str, Any]:
         "brackets": [bracket_dict(t, b, r.published) for b in s.brackets],
         "published": [asdict(p) for p in r.published],
         "changes": len(s.brackets), "published_changes": len(r.published),
-        "monotonic": s.monotonic and len(s.brackets) <= max(1, len(r.published)),
+        "monotonic": s.monotonic,
+        "extra_changes": max(0, len(s.brackets) - len(r.published)),
         "non_monotonic": [{"low": g.low, "high": g.high,
                            "probes": [list(pr) for pr in g.probes]} for g in s.tangles],
         "probes": len(s.probes), "rounds": s.rounds, "exhausted": s.exhausted,
@@ -226,9 +227,9 @@ def lines(t: Target, k: int, total: int, r: PointResult, d: dict[str, Any]) -> l
     for g in r.search.tangles:
         seq = ", ".join(f"{_fmt(t, v)} {c}" for v, c in g.probes)
         out.append(f"  NON-MONOTONIC in [{_fmt(t, g.low)}, {_fmt(t, g.high)}]: {seq}")
-    if len(r.search.brackets) > max(1, len(r.published)):
-        out.append(f"  NON-MONOTONIC: {len(r.search.brackets)} changes of behaviour where the "
-                   f"published limits make {len(r.published)}")
+    if len(r.search.brackets) > len(r.published):
+        out.append(f"  MORE CHANGES THAN PUBLISHED: {len(r.search.brackets)} changes of "
+                   f"behaviour where the published limits make {len(r.published)}")
     unmatched = [p for p in r.published
                  if all(nearest(b, r.published) is not p for b in r.search.brackets)]
     for p in unmatched:
@@ -296,8 +297,10 @@ def run_boundary(spec: Spec, axis: str, tolerance: float | None, scan: int | Non
     path = write_report(folder, data)
     failing = prober.failing
     tangled = sum(1 for p in data["points"] if not p["monotonic"])
+    extra = sum(1 for p in data["points"] if p["extra_changes"])
     print(printable(f"boundary {axis}: {prober.count} probe(s) in {folder} ({path.name}); "
-                    f"{failing} failing; {tangled} point(s) non-monotonic"), flush=True)
+                    f"{failing} failing; {tangled} point(s) non-monotonic; {extra} with more "
+                    "changes than published"), flush=True)
     if interrupted:
         return 130
     return 1 if failing else 0

@@ -105,6 +105,8 @@ def test_the_report_says_non_monotonic() -> None:
     text = "\n".join(lines(t, 0, 1, r, d))
     assert not d["monotonic"] and d["non_monotonic"][0]["low"] == 0.0
     assert "NON-MONOTONIC in [0.0000, 0.3000]" in text
+    # three changes where the rules (here: none given) make fewer
+    assert d["extra_changes"] == 3 and "MORE CHANGES THAN PUBLISHED" in text
 
 
 def test_no_change_is_said_plainly() -> None:
