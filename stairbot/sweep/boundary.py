@@ -36,7 +36,13 @@ MAX_POINTS = 16
 runs: each is a search of its own, some 20 to 40 probes."""
 
 DEFAULT_SCAN = 12
-"""Values the scan probes across a range that is not a grid."""
+"""Values the scan probes across a range that is not a grid (at least)."""
+
+SCAN_STEP_M = 0.01
+"""The widest spacing of a default scan along an axis in metres: a region of
+another behaviour narrower than the spacing, with the same behaviour either
+side, is not seen (the reference robot strands on risers of 15 to 25 mm,
+between refusals at 10 and 30 mm)."""
 
 LIMIT_AXES = {"stairs.rise": 0.03, "stairs.tread": 0.06}
 """Axes searched across the robot's own limits when the spec gives no range:
@@ -158,7 +164,9 @@ def target(spec: Spec, axis: str, tolerance: float | None, scan: int | None) -> 
     if found is None or found.sampled or _range_of(found) is None:
         from stairbot.sweep.bisect import scan_values
 
-        values = scan_values(values[0], values[-1], scan or DEFAULT_SCAN, integer, DIGITS)
+        count = scan or max(DEFAULT_SCAN, 1 + math.ceil(
+            (values[-1] - values[0]) / SCAN_STEP_M - 1e-9) if metres else DEFAULT_SCAN)
+        values = scan_values(values[0], values[-1], count, integer, DIGITS)
     elif scan is not None:
         raise SpecError(spec.source, None, f"--scan: {axis} is a grid axis of this spec, "
                         "whose values are the scan; allowed: --scan only for a range the "

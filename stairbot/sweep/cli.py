@@ -81,7 +81,7 @@ def run_parser() -> argparse.ArgumentParser:
                         "(default 1 mm), else in the axis's unit")
     p.add_argument("--scan", metavar="N", type=_jobs,
                    help="with --boundary: values scanned across a range the spec does not "
-                        "list (default 12)")
+                        "list (default 12, or 10 mm apart on an axis in metres)")
     _plot_options(p)
     return p
 
