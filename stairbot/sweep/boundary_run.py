@@ -113,6 +113,11 @@ def _diff(t: Target, v: float) -> str:
 
 
 def nearest(b: Bracket, pubs: list[Published]) -> Published | None:
+    """The published limit a bracket between two passing behaviours measures
+    (None for a change to a failing one: no limit publishes where a robot
+    fails)."""
+    if not (passing(b.low_is) and passing(b.high_is)):
+        return None
     return min(pubs, key=lambda p: abs(p.value - b.middle), default=None)
 
 
@@ -142,7 +147,9 @@ def bracket_dict(t: Target, b: Bracket, pubs: list[Published]) -> dict[str, Any]
         "width": round(b.width, 9), "middle": round(b.middle, 9),
         "within_tolerance": b.width <= t.tolerance + 1e-12 or t.integer and b.width <= 1,
     }
-    if p is not None:
+    out["failing_side"] = [side for side, c in (("last", b.low_is), ("first", b.high_is))
+                           if not passing(c)]
+    if p is not None and not out["failing_side"]:
         how, off = judge_limit(b, p)
         out["published"] = {"name": p.name, "value": p.value, "zone_below": p.below,
                             "zone_above": p.above}
@@ -161,7 +168,9 @@ def point_dict(t: Target, r: PointResult) -> dict[str, Any]:
         "published": [asdict(p) for p in r.published],
         "changes": len(s.brackets), "published_changes": len(r.published),
         "monotonic": s.monotonic,
-        "extra_changes": max(0, len(s.brackets) - len(r.published)),
+        # changes between two passing behaviours beyond those the rules make
+        "extra_changes": max(0, sum(1 for b in s.brackets if passing(b.low_is)
+                                    and passing(b.high_is)) - len(r.published)),
         "non_monotonic": [{"low": g.low, "high": g.high,
                            "probes": [list(pr) for pr in g.probes]} for g in s.tangles],
         "probes": len(s.probes), "rounds": s.rounds, "exhausted": s.exhausted,
@@ -217,6 +226,9 @@ def lines(t: Target, k: int, total: int, r: PointResult, d: dict[str, Any]) -> l
                      f"{how} by {_diff(t, bd['off_by'])}")
             if how != "agrees" and bd["off_by"] <= t.tolerance:
                 text += " (within the tolerance)"
+        if bd["failing_side"]:
+            text += (f"; FAILING ({' and '.join({b.low_is, b.high_is} - {'climbed', 'refused'})}"
+                     ") on one side: a finding, no published limit to compare")
         if not bd["within_tolerance"]:
             text += " [NOT narrowed to the tolerance: probe budget spent]"
         out.append(text)
@@ -227,9 +239,10 @@ def lines(t: Target, k: int, total: int, r: PointResult, d: dict[str, Any]) -> l
     for g in r.search.tangles:
         seq = ", ".join(f"{_fmt(t, v)} {c}" for v, c in g.probes)
         out.append(f"  NON-MONOTONIC in [{_fmt(t, g.low)}, {_fmt(t, g.high)}]: {seq}")
-    if len(r.search.brackets) > len(r.published):
-        out.append(f"  MORE CHANGES THAN PUBLISHED: {len(r.search.brackets)} changes of "
-                   f"behaviour where the published limits make {len(r.published)}")
+    if d["extra_changes"]:
+        out.append(f"  MORE CHANGES THAN PUBLISHED: {len(r.published) + d['extra_changes']} "
+                   "changes between passing behaviours where the published limits make "
+                   f"{len(r.published)}")
     unmatched = [p for p in r.published
                  if all(nearest(b, r.published) is not p for b in r.search.brackets)]
     for p in unmatched:

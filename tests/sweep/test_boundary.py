@@ -236,3 +236,21 @@ def test_the_strip_shows_the_probes_and_the_published_limits() -> None:
     cells = row.split()[1]
     assert cells[0] == "C" and cells[-1] == "R" and "!" in cells  # two behaviours, one cell
     assert marks.index("^") == row.index("!")
+
+
+def test_a_change_to_a_failing_behaviour_is_a_finding_not_a_limit() -> None:
+    # stranded on the lowest risers, refused, then climbed: the rules publish one change
+    fake = Fake(lambda v: "stranded" if v < 0.02 else "refused" if v < 0.07 else "climbed")
+    spec = parse_spec('[axes]\n"stairs.rise" = [0.01, 0.1]\n', "x.toml", ROOT)
+    t = target(spec, "stairs.rise", None, None)
+    found = search([0.01, 0.04, 0.1], fake, 0.001, 2)
+    pub = [Published(0.075, "outside", "inside", "min_rise_for(0.28)")]
+    r = PointResult(points(spec, "stairs.rise")[0], found, pub, 0)
+    d = point_dict(t, r)
+    low, high = d["brackets"]
+    assert low["failing_side"] == ["last"] and "published" not in low
+    assert high["published"]["name"] == "min_rise_for(0.28)"
+    # it climbs from 0.07, below the 0.075 the rules need: better than published
+    assert high["published_is"] == "conservative" and d["extra_changes"] == 0
+    text = "\n".join(lines(t, 0, 1, r, d))
+    assert "FAILING (stranded) on one side" in text and "MORE CHANGES" not in text
