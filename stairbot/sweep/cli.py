@@ -23,7 +23,7 @@ from rich.console import Console
 from stairbot.errors import OutputError
 from stairbot.inputs.config import shipped_configs
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
-from stairbot.sweep.spec import SpecError
+from stairbot.sweep.spec import Spec, SpecError
 from stairbot.sweep.verdict import passing
 from stairbot.text import printable
 
@@ -72,6 +72,16 @@ def run_parser() -> argparse.ArgumentParser:
                    help="run the cases on this robot config (a file, or a shipped robot: "
                         f"{', '.join(shipped_configs())}) instead of the spec's")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress, no tables")
+    p.add_argument("--boundary", metavar="AXIS",
+                   help="find where the verdict changes along AXIS (climbed/refused, "
+                        "pass/fail) by scan and bisection, beside the published limit "
+                        "(docs/envelope.md, \"Boundaries\")")
+    p.add_argument("--tolerance", metavar="MM", type=float,
+                   help="with --boundary: bracket width, in mm for an axis in metres "
+                        "(default 1 mm), else in the axis's unit")
+    p.add_argument("--scan", metavar="N", type=_jobs,
+                   help="with --boundary: values scanned across a range the spec does not "
+                        "list (default 12, or 10 mm apart on an axis in metres)")
     _plot_options(p)
     return p
 
@@ -112,6 +122,8 @@ def cmd_sweep(argv: list[str]) -> int:
     spec = load_spec(args.spec)
     if args.config is not None:
         spec = with_config(spec, args.config)
+    if args.boundary is not None or args.tolerance is not None or args.scan is not None:
+        return _boundary(args, spec)
     cases = check_spec(spec, args.limit)  # a bad spec never starts work
     jobs = args.jobs or default_jobs()
     folder = args.out or Path(f"sweep-{spec.name}-{spec.hash[:8]}")
@@ -148,6 +160,19 @@ def cmd_sweep(argv: list[str]) -> int:
     if out.interrupted:
         return EXIT_INTERRUPTED
     return EXIT_FAILURES if failing else EXIT_OK
+
+
+def _boundary(args: argparse.Namespace, spec: Spec) -> int:
+    from stairbot.sweep.boundary_run import run_boundary
+    from stairbot.sweep.execute import default_jobs
+
+    if args.boundary is None:
+        raise SpecError("stairbot sweep", None, "--tolerance and --scan go with --boundary AXIS")
+    if args.resume or args.limit is not None:
+        raise SpecError("stairbot sweep", None, "--resume and --limit do not go with "
+                        "--boundary; allowed: a new --out folder for each search")
+    return run_boundary(spec, args.boundary, args.tolerance, args.scan,
+                        args.jobs or default_jobs(), args.dask, args.out, args.quiet)
 
 
 def cmd_report(argv: list[str]) -> int:
