@@ -9,6 +9,7 @@ from typing import Any
 
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.control.robot_config import load_config
+from stairbot.errors import LinkLostError
 from stairbot.events import Event, EventKind
 from stairbot.hardware import (
     Imu,
@@ -137,3 +138,26 @@ def make_still_app(simulated: bool = True, wired: bool | None = None,
     values' ages are pinned at 0 (a stopped clock) unless ``ages_wall`` is given."""
     kw.setdefault("ages_wall", lambda: 0.0)
     return build_app(load_config(), open_fn=still_open(simulated, wired), **kw)
+
+
+class ScriptedRobot(StillRobot):
+    """Reads whatever the test last put in ``snap``; ``silent``: answers no
+    read (the console's idle poll then reads nothing)."""
+
+    def __init__(self, first: Snapshot) -> None:
+        super().__init__()
+        self.snap = first
+        self.silent = False
+
+    def read(self) -> Snapshot:
+        if self.silent:
+            raise LinkLostError("link lost: no reply (the test's robot is silent)")
+        return self.snap
+
+
+def scripted_app(robot: ScriptedRobot, ages: list[float]) -> StairbotConsole:
+    """The console on ``robot``, its values' ages by the wall clock ``ages[0]``."""
+    def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
+        return RobotSession(robot, StillClock(), url, True, StillSim())
+
+    return build_app(load_config(), open_fn=open_fn, ages_wall=lambda: ages[0])

@@ -7,16 +7,14 @@ robot's clock, and stop and dim with the readings when those go stale."""
 from __future__ import annotations
 
 import asyncio
-from typing import Any
 
 from pilot import press, ready, until
-from still_robot import StillClock, StillRobot, StillSim
+from still_robot import ScriptedRobot, scripted_app
 
 from stairbot.console.app import StairbotConsole, build_app
 from stairbot.console.freshness import STALE_S
 from stairbot.console.history import SERIES, History
 from stairbot.control.robot_config import load_config
-from stairbot.errors import LinkLostError
 from stairbot.hardware import (
     Imu,
     MotorId,
@@ -26,7 +24,6 @@ from stairbot.hardware import (
     SensorStatus,
     Snapshot,
 )
-from stairbot.run.robots import RobotSession
 
 PER_TURN = load_config().motors.lift_travel_per_turn
 
@@ -40,26 +37,6 @@ def snap(t: float, pitch: float, sfr: float = 0.3, mtf_turns: float = 0.0,
     return Snapshot(t, sensors, motors, imu=Imu(pitch, 0.0))
 
 
-class ScriptedRobot(StillRobot):
-    """Reads whatever the test last put in ``snap``; ``silent``: answers no
-    read (the console's idle poll then reads nothing)."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.snap = snap(0.0, 0.0)
-        self.silent = False
-
-    def read(self) -> Snapshot:
-        if self.silent:
-            raise LinkLostError("link lost: no reply (the test's robot is silent)")
-        return self.snap
-
-
-def scripted_app(robot: ScriptedRobot, ages: list[float]) -> StairbotConsole:
-    def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
-        return RobotSession(robot, StillClock(), url, True, StillSim())
-
-    return build_app(load_config(), open_fn=open_fn, ages_wall=lambda: ages[0])
 
 
 def feed(app: StairbotConsole, robot: ScriptedRobot, snaps: list[Snapshot]) -> None:
@@ -81,7 +58,7 @@ def test_history_keeps_the_window_by_robot_time_and_ignores_repeats() -> None:
 
 
 def test_graphs_fit_80x24_in_the_pictures_place_and_cut_nothing_else() -> None:
-    robot, ages = ScriptedRobot(), [0.0]
+    robot, ages = ScriptedRobot(snap(0.0, 0.0)), [0.0]
 
     async def go() -> None:
         app = scripted_app(robot, ages)
@@ -108,7 +85,7 @@ def test_graphs_fit_80x24_in_the_pictures_place_and_cut_nothing_else() -> None:
 
 
 def test_on_a_tall_screen_the_graphs_show_under_the_picture() -> None:
-    robot, ages = ScriptedRobot(), [0.0]
+    robot, ages = ScriptedRobot(snap(0.0, 0.0)), [0.0]
 
     async def go() -> None:
         app = scripted_app(robot, ages)
@@ -123,7 +100,7 @@ def test_on_a_tall_screen_the_graphs_show_under_the_picture() -> None:
 
 
 def test_graphs_draw_the_readings_and_stop_and_dim_when_they_go_stale() -> None:
-    robot, ages = ScriptedRobot(), [0.0]
+    robot, ages = ScriptedRobot(snap(0.0, 0.0)), [0.0]
     snaps = [snap(10 + i * 0.02, pitch=i / 10, sfr=0.2 + i / 1000, mtf_turns=i)
              for i in range(50)]
 

@@ -12,21 +12,19 @@ import math
 from typing import Any
 
 from pilot import press, ready, until
-from still_robot import StillClock, StillRobot, StillSim
+from still_robot import ScriptedRobot, scripted_app
 from textual.widgets import SelectionList
 
-from stairbot.console.app import StairbotConsole, build_app
+from stairbot.console.app import StairbotConsole
 from stairbot.console.freshness import STALE_S
 from stairbot.console.markers import markers_of, step
 from stairbot.console.plot_picker import PlotPicker
 from stairbot.console.replay_app import build_replay_app
 from stairbot.console.signals import Samples, catalogue, fits, thin
 from stairbot.control.robot_config import load_config
-from stairbot.errors import LinkLostError
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 from stairbot.recording.replay_source import ReplaySource, Tick
-from stairbot.run.robots import RobotSession
 
 CONFIG = load_config()
 PER_TURN = CONFIG.motors.lift_travel_per_turn
@@ -44,25 +42,6 @@ def snap(t: float, sfr: float = 0.3, mwf_speed: float = 0.0, mtf_turns: float = 
     return Snapshot(t, sensors, motors, health or {}, imu=Imu(pitch, 1.5))
 
 
-class ScriptedRobot(StillRobot):
-    """Reads what the test last put in ``snap``; ``silent``: no read answers."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.snap = snap(0.0)
-        self.silent = False
-
-    def read(self) -> Snapshot:
-        if self.silent:
-            raise LinkLostError("link lost: no reply (the test's robot is silent)")
-        return self.snap
-
-
-def scripted_app(robot: ScriptedRobot, ages: list[float]) -> StairbotConsole:
-    def open_fn(url: str, config: Any, scenario: Any, options: Any) -> RobotSession:
-        return RobotSession(robot, StillClock(), url, True, StillSim())
-
-    return build_app(CONFIG, open_fn=open_fn, ages_wall=lambda: ages[0])
 
 
 def read(app: StairbotConsole, robot: ScriptedRobot, *snaps: Snapshot) -> None:
@@ -136,7 +115,7 @@ def test_thinning_keeps_the_ends_and_each_buckets_lowest_and_highest() -> None:
 
 
 def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values() -> None:
-    robot, ages = ScriptedRobot(), [0.0]
+    robot, ages = ScriptedRobot(snap(0.0)), [0.0]
 
     async def go() -> None:
         app = scripted_app(robot, ages)
@@ -182,7 +161,7 @@ def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values
 
 
 def test_the_picker_refuses_a_fifth_signal_or_a_third_unit_and_says_why() -> None:
-    robot, ages = ScriptedRobot(), [0.0]
+    robot, ages = ScriptedRobot(snap(0.0)), [0.0]
 
     async def go() -> None:
         app = scripted_app(robot, ages)
@@ -216,7 +195,7 @@ def test_the_picker_refuses_a_fifth_signal_or_a_third_unit_and_says_why() -> Non
 
 
 def test_a_stale_signal_says_stale_and_is_not_drawn_on() -> None:
-    robot, ages = ScriptedRobot(), [0.0]
+    robot, ages = ScriptedRobot(snap(0.0)), [0.0]
 
     async def go() -> None:
         app = scripted_app(robot, ages)
