@@ -28,6 +28,7 @@ from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass, replace
 from functools import cache
+from pathlib import Path
 from typing import Any
 
 from stairbot.control.robot_config import parse_config
@@ -192,8 +193,11 @@ class SearchStore(ResultStore):
     """The results store, writing each case's ``search`` field (objective,
     score, normalised margin, parameters) into its line."""
 
-    objective: str = obj.DEFAULT
-    params: dict[int, dict[str, Any]]
+    def __init__(self, folder: Path, spec: Spec, resume: bool,
+                 objective: str = obj.DEFAULT) -> None:
+        super().__init__(folder, spec, resume)
+        self.objective = objective
+        self.params: dict[int, dict[str, Any]] = {}  # case index -> the trial's parameters
 
     def append(self, record: dict[str, Any], case: Case) -> None:
         scale = _scales(case.config_text)
@@ -213,7 +217,6 @@ def search(spec: Spec, plan: Plan, store: SearchStore, executor: Executor, jobs:
     dims = space(optuna, spec)
     fixed = fixed_values(spec)
     dists = {p: d.distribution for p, d in dims.items()}
-    store.objective, store.params = plan.objective, {}
     study = open_study(optuna, plan, dims, store.records)
     todo = [i for i in range(plan.n) if i not in store.done]
     seeds = grid_seeds(spec, dims, plan.n, plan.seed)

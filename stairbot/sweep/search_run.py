@@ -68,7 +68,7 @@ def cmd_search(spec: Spec, args: argparse.Namespace) -> int:
     jobs = args.jobs or default_jobs()
     folder = args.out or Path(f"sweep-{spec.name}-{spec.hash[:8]}-search-{plan.objective}")
     _check_folder(folder, plan)
-    store = SearchStore(folder, spec, args.resume)
+    store = SearchStore(folder, spec, args.resume, plan.objective)
     meta = {**meta_of(spec), "total": plan.n, "search": describe(spec, plan, jobs)}
     console = Console()
     try:
