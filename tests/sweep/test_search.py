@@ -110,6 +110,17 @@ def test_the_same_seed_chooses_the_same_cases(spec: Path, first: Path, tmp_path:
     assert [r["axes"] for r in lines(other)] != [a[i][0] for i in range(4)]
 
 
+def test_a_search_on_dask_chooses_the_same_cases(spec: Path, first: Path,
+                                                 tmp_path: Path) -> None:
+    pytest.importorskip("distributed")
+    out = tmp_path / "d"
+    proc = sweep(str(spec), "--search", str(N), "--seed", "7", "-j", "2", "--dask", "local",
+                 "--out", str(out), "-q")
+    assert proc.returncode in (0, 1), proc.stderr
+    local = {r["case"]: (r["axes"], r["verdict"], r["search"]) for r in lines(first)}
+    assert {r["case"]: (r["axes"], r["verdict"], r["search"]) for r in lines(out)} == local
+
+
 def test_resume_finishes_to_n_without_repeating_a_case(spec: Path, tmp_path: Path) -> None:
     out = tmp_path / "r"
     sweep(str(spec), "--search", "4", "-j", "2", "--out", str(out), "-q")
