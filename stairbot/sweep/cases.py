@@ -109,10 +109,13 @@ def _jitter(spec: Spec, index: int, stairs: dict[str, Any], values: dict[str, An
     stairs["steps"] = steps
 
 
-def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None) -> Case:
+def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None,
+               chosen: dict[str, Any] | None = None) -> Case:
     """Case ``index`` (with one axis forced to a value, to check a distribution's
-    edges).  Raises SpecError when the loaders refuse what the axes make."""
-    values = {p: _round(v) for p, v in spec.axis_values(index).items()}
+    edges; or with every axis's value ``chosen``, as a search chooses them).
+    Raises SpecError when the loaders refuse what the axes make."""
+    axes = spec.axis_values(index) if chosen is None else chosen
+    values = {p: _round(v) for p, v in axes.items()}
     if override is not None:
         values[override[0]] = _round(override[1])
     scen = copy.deepcopy(_base(spec.scenario_text))

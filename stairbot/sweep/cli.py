@@ -3,6 +3,7 @@
 ::
 
     stairbot sweep SPEC.toml [-j N | --dask ADDRESS|local] [--out DIR] [--resume]
+    stairbot sweep SPEC.toml --search N [--objective NAME] [--seed S] [...]
     stairbot sweep check SPEC.toml
     stairbot sweep report RESULTS [--x AXIS --y AXIS] [--png FILE]
 
@@ -22,6 +23,7 @@ from rich.console import Console
 
 from stairbot.errors import OutputError
 from stairbot.inputs.config import shipped_configs
+from stairbot.sweep.coverage import print_margins, print_search_worst, search_line
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.spec import Spec, SpecError
 from stairbot.sweep.verdict import passing
@@ -71,6 +73,14 @@ def run_parser() -> argparse.ArgumentParser:
     p.add_argument("--config", metavar="FILE|NAME",
                    help="run the cases on this robot config (a file, or a shipped robot: "
                         f"{', '.join(shipped_configs())}) instead of the spec's")
+    p.add_argument("--seed", metavar="S", type=int,
+                   help="the spec's [sweep] seed replaced (every draw; a search's sampler)")
+    p.add_argument("--search", metavar="N", type=_jobs,
+                   help="N cases chosen by an optimiser minimising --objective (needs "
+                        "stairbot[search])")
+    p.add_argument("--objective", metavar="NAME",
+                   help="what --search minimises: margin (default: the smallest normalised "
+                        "margin), stability_m, edge_m, stroke_m or pitch_deg")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress, no tables")
     p.add_argument("--boundary", metavar="AXIS",
                    help="find where the verdict changes along AXIS (climbed/refused, "
@@ -122,8 +132,19 @@ def cmd_sweep(argv: list[str]) -> int:
     spec = load_spec(args.spec)
     if args.config is not None:
         spec = with_config(spec, args.config)
+    if args.seed is not None:
+        from stairbot.sweep.search import with_seed
+
+        spec = with_seed(spec, args.seed)
     if args.boundary is not None or args.tolerance is not None or args.scan is not None:
+        if args.search is not None or args.objective is not None:
+            raise SpecError("--boundary", None, "--boundary and --search each choose the "
+                            "cases: give one of them")
         return _boundary(args, spec)
+    if args.search is not None or args.objective is not None:
+        from stairbot.sweep.search_run import cmd_search
+
+        return cmd_search(spec, args)
     cases = check_spec(spec, args.limit)  # a bad spec never starts work
     jobs = args.jobs or default_jobs()
     folder = args.out or Path(f"sweep-{spec.name}-{spec.hash[:8]}")
@@ -147,6 +168,7 @@ def cmd_sweep(argv: list[str]) -> int:
     meta = meta_of(spec)
     if not args.quiet:
         print_summary(records, meta, console, spec.report.worst)
+        print_margins(records, meta, console)
         png = draw(records, meta, folder, console, args.x, args.y, args.png, not args.no_png)
         if png is not None:
             print(f"heat map: {printable(png)}")
@@ -188,12 +210,15 @@ def cmd_report(argv: list[str]) -> int:
     meta = read_meta(args.results)
     records = list({r["case"]: r for r in read_records(args.results)}.values())
     console = Console()
-    print_summary(records, meta, console,
-                  args.worst if args.worst is not None else int(meta["report"]["worst"]))
+    worst = args.worst if args.worst is not None else int(meta["report"]["worst"])
+    print_summary(records, meta, console, worst)
+    print_search_worst(records, meta, console, worst)
+    print_margins(records, meta, console)
     png = draw(records, meta, args.results, console, args.x, args.y, args.png, not args.no_png)
     if png is not None:
         print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     print(printable(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
-                    f"{counts_line(counts_of(records))}"), file=sys.stdout)
+                    f"{counts_line(counts_of(records))}{search_line(records, meta)}"),
+          file=sys.stdout)
     return EXIT_FAILURES if failing else EXIT_OK

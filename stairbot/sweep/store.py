@@ -27,6 +27,7 @@ from stairbot import __version__
 from stairbot.files import LineFile, writing
 from stairbot.sweep import tomlw
 from stairbot.sweep.cases import Case
+from stairbot.sweep.coverage import extent
 from stairbot.sweep.spec import Spec, SpecError
 from stairbot.sweep.verdict import passing
 
@@ -41,7 +42,8 @@ def meta_of(spec: Spec) -> dict[str, Any]:
     return {
         "name": spec.name, "hash": spec.hash, "source": spec.source,
         "description": spec.description, "seed": spec.seed, "total": spec.total,
-        "axes": [{"path": a.path, "kind": a.kind, "describe": a.describe()} for a in spec.axes],
+        "axes": [{"path": a.path, "kind": a.kind, "describe": a.describe(),
+                  "extent": extent(a)} for a in spec.axes],
         "rules": {"rise_margin_m": spec.rules.rise_margin_m,
                   "tread_margin_m": spec.rules.tread_margin_m, "home_m": spec.rules.home_m},
         "report": {"x": spec.report.x, "y": spec.report.y, "worst": spec.report.worst,
