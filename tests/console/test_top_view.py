@@ -38,7 +38,9 @@ def drawn(app: StairbotConsole) -> str:
 
 
 def caption(app: StairbotConsole) -> str:
-    return drawn(app).splitlines()[-1]
+    """The top view's last line ("" before it has drawn anything: a test waits on)."""
+    lines = drawn(app).splitlines()
+    return lines[-1] if lines else ""
 
 
 def title(widget: Any) -> str:
