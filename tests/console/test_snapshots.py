@@ -8,6 +8,7 @@ from typing import Any
 
 import pytest
 from still_robot import show_climbing
+from textual.widgets import Input
 
 from stairbot.console.app import StairbotConsole
 
@@ -39,5 +40,8 @@ def test_layout_wired_robot_confirmation(snap_compare: Any,
         await pilot.app.workers.wait_for_complete()
         await pilot.press("s")
         await pilot.pause(0.3)
+        for field in pilot.app.screen.query(Input):  # the same picture whenever it is taken
+            field.cursor_blink = False
+        await pilot.pause(0.1)
     assert snap_compare(still_app(simulated=False, url="serial://loop://"),
                         terminal_size=(80, 24), run_before=asked)
