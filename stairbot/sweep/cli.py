@@ -127,7 +127,7 @@ def cmd_sweep(argv: list[str]) -> int:
     from stairbot.sweep.cases import check_spec
     from stairbot.sweep.execute import default_jobs, open_executor, run_cases
     from stairbot.sweep.spec import load_spec, with_config
-    from stairbot.sweep.store import ResultStore, meta_of
+    from stairbot.sweep.store import ResultStore, meta_of, stopped_for_room
 
     spec = load_spec(args.spec)
     if args.config is not None:
@@ -159,9 +159,7 @@ def cmd_sweep(argv: list[str]) -> int:
             finally:
                 view.close()
     except OutputError as exc:  # a full disk: the cases already written stay
-        raise OutputError(exc.path, exc.what, f"{exc.problem}; the sweep stopped, "
-                          f"{len(store.done)} finished case(s) kept in {folder}: rerun with "
-                          "--resume once there is room") from None
+        raise stopped_for_room(exc, "the sweep", len(store.done), folder) from None
     finally:
         store.close()
     records = [r for r in store.records if r["case"] < len(cases)]

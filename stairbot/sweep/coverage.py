@@ -22,6 +22,7 @@ from rich.table import Table
 
 from stairbot.sweep.axes import Axis
 from stairbot.sweep.objective import MARGINS
+from stairbot.sweep.report import short
 from stairbot.text import printable
 
 
@@ -132,18 +133,11 @@ def print_search_worst(records: list[dict[str, Any]], meta: dict[str, Any], cons
     for r in by_score(records)[:worst]:
         m = (r.get("result") or {}).get("margins") or {}
         margins = ", ".join(f"{k.split('_')[0]}={_f(m.get(k))}" for k in MARGINS)
-        axes = ", ".join(f"{k.split('.')[-1]}={_short(v)}" for k, v in r.get("axes", {}).items())
+        axes = ", ".join(f"{k.split('.')[-1]}={short(v)}" for k, v in r.get("axes", {}).items())
         t.add_row(str(r["case"]), _f((r.get("search") or {}).get("score")),
                   printable(r.get("verdict")), margins, printable(axes))
     console.print(t)
 
-
-def _short(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    if isinstance(value, list):
-        return f"[{len(value)} item(s)]"
-    return str(value)
 
 
 def search_line(records: list[dict[str, Any]], meta: dict[str, Any]) -> str:

@@ -95,7 +95,8 @@ class ProgressView:
             self.progress.stop()
 
 
-def _short(value: Any) -> str:
+def short(value: Any) -> str:
+    """An axis value as a table shows it: floats to 4 digits, lists by length."""
     if isinstance(value, float):
         return f"{value:.4g}"
     if isinstance(value, list):
@@ -130,7 +131,7 @@ def print_summary(records: list[dict[str, Any]], meta: dict[str, Any], console: 
     for col in ("case", "verdict", "axes", "why", "reproduce"):
         wt.add_column(col, overflow="fold")
     for r in bad:
-        axes = ", ".join(f"{k.split('.')[-1]}={_short(v)}" for k, v in r.get("axes", {}).items())
+        axes = ", ".join(f"{k.split('.')[-1]}={short(v)}" for k, v in r.get("axes", {}).items())
         wt.add_row(plain(r["case"]), f"[{STYLE[r['verdict']]}]{r['verdict']}[/]", plain(axes),
                    plain(str(r.get("why", ""))[:90]), plain(r.get("reproduce", "")))
     console.print(wt)

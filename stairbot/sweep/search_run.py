@@ -20,7 +20,7 @@ from stairbot.sweep.objective import DEFAULT, check_objective
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.search import Plan, SearchStore, describe, load_optuna, search
 from stairbot.sweep.spec import Spec, SpecError
-from stairbot.sweep.store import META, ResultsError, meta_of, read_meta
+from stairbot.sweep.store import META, ResultsError, meta_of, read_meta, stopped_for_room
 from stairbot.sweep.verdict import passing
 from stairbot.text import printable
 
@@ -82,9 +82,7 @@ def cmd_search(spec: Spec, args: argparse.Namespace) -> int:
             finally:
                 view.close()
     except OutputError as exc:  # a full disk: the cases already written stay
-        raise OutputError(exc.path, exc.what, f"{exc.problem}; the search stopped, "
-                          f"{len(store.done)} finished case(s) kept in {folder}: rerun with "
-                          "--resume once there is room") from None
+        raise stopped_for_room(exc, "the search", len(store.done), folder) from None
     finally:
         store.close()
     records = [r for r in store.records if r["case"] < plan.n]

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from stairbot import __version__
+from stairbot.errors import OutputError
 from stairbot.files import LineFile, writing
 from stairbot.sweep import tomlw
 from stairbot.sweep.cases import Case
@@ -191,3 +192,10 @@ def expect_for(facts: dict[str, Any]) -> dict[str, Any]:
     if facts["zone"] == "outside":
         return {"outcome": "completed", "ascent_end": "obstacle", "max_final_offset_m": home}
     return {"outcome": "completed", "max_final_offset_m": home}
+
+
+def stopped_for_room(exc: OutputError, what: str, kept: int, folder: Path) -> OutputError:
+    """A full disk stopped ``what`` (the sweep, the search): the error again,
+    saying the ``kept`` finished cases stay in ``folder`` and how to go on."""
+    return OutputError(exc.path, exc.what, f"{exc.problem}; {what} stopped, {kept} finished "
+                       f"case(s) kept in {folder}: rerun with --resume once there is room")
