@@ -5,7 +5,7 @@
     stairbot sweep SPEC.toml [-j N | --dask ADDRESS|local] [--out DIR] [--resume]
     stairbot sweep SPEC.toml --search N [--objective NAME] [--seed S] [...]
     stairbot sweep check SPEC.toml
-    stairbot sweep report RESULTS [--x AXIS --y AXIS] [--png FILE]
+    stairbot sweep report RESULTS [--x AXIS --y AXIS] [--png FILE] [--margin NAME]
 
 Exit codes: 0 no case unsafe, stranded, wrong or error; 1 some are (the counts
 are on the last line); 2 a bad spec, folder or option (one line, nothing ran);
@@ -24,6 +24,8 @@ from rich.console import Console
 from stairbot.errors import OutputError
 from stairbot.inputs.config import shipped_configs
 from stairbot.sweep.coverage import print_margins, print_search_worst, search_line
+from stairbot.sweep.margin_map import FIELDS as MARGIN_FIELDS
+from stairbot.sweep.margin_map import margin_name
 from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
 from stairbot.sweep.spec import Spec, SpecError
 from stairbot.sweep.verdict import passing
@@ -54,6 +56,10 @@ def _plot_options(p: argparse.ArgumentParser) -> None:
                    help="where to write the PNG heat map (default: RESULTS/heatmap.png; "
                         "needs stairbot[plot])")
     p.add_argument("--no-png", action="store_true", help="draw the heat map in the terminal only")
+    p.add_argument("--margin", metavar="NAME", type=margin_name,
+                   help="also a map of that margin's least value per cell (one of "
+                        f"{', '.join(MARGIN_FIELDS)}; its PNG beside the verdict map's, "
+                        "heatmap-NAME.png)")
 
 
 def run_parser() -> argparse.ArgumentParser:
@@ -167,8 +173,8 @@ def cmd_sweep(argv: list[str]) -> int:
     if not args.quiet:
         print_summary(records, meta, console, spec.report.worst)
         print_margins(records, meta, console)
-        png = draw(records, meta, folder, console, args.x, args.y, args.png, not args.no_png)
-        if png is not None:
+        for png in draw(records, meta, folder, console, args.x, args.y, args.png,
+                        not args.no_png, args.margin):
             print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     rate = f"{out.ran / out.wall_s * 60:.0f} cases/min" if out.wall_s > 0 and out.ran else "-"
@@ -212,8 +218,8 @@ def cmd_report(argv: list[str]) -> int:
     print_summary(records, meta, console, worst)
     print_search_worst(records, meta, console, worst)
     print_margins(records, meta, console)
-    png = draw(records, meta, args.results, console, args.x, args.y, args.png, not args.no_png)
-    if png is not None:
+    for png in draw(records, meta, args.results, console, args.x, args.y, args.png,
+                    not args.no_png, args.margin):
         print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     print(printable(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "

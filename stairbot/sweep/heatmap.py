@@ -5,6 +5,7 @@ limits drawn on both."""
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -110,7 +111,7 @@ def worst(cell: Counter[str]) -> str | None:
     return max(cell, key=lambda v: cell[v])
 
 
-def _limit_for(axis: str, limits: dict[str, float]) -> tuple[str, float] | None:
+def limit_for(axis: str, limits: dict[str, float]) -> tuple[str, float] | None:
     if axis in RISE_AXES and "limit_rise_m" in limits:
         return "max_step_rise_m", limits["limit_rise_m"]
     if axis in TREAD_AXES and "limit_tread_m" in limits:
@@ -118,40 +119,56 @@ def _limit_for(axis: str, limits: dict[str, float]) -> tuple[str, float] | None:
     return None
 
 
-def terminal(grid: Grid) -> Text:
-    """Rows: y from high to low; a cell is the worst verdict's letter on its
-    colour (count of non-passing cases when more than one); ◀ and ▲ mark the
-    row and column holding a limit."""
+def frame(grid: Grid, cell: Callable[[int, int], tuple[str, str]], width: int = 3) -> Text:
+    """The map's frame: rows y from high to low, each cell's text (centred in
+    ``width`` characters) and style from ``cell(row, column)``, ◀ and ▲
+    marking the row and column holding a limit, the column labels written
+    downwards.  The limit's name goes beside its ◀ where the row fits in 80
+    columns, else under the map."""
     out = Text()
     x_name, y_name = printable(grid.x), printable(grid.y)
-    ylim, xlim = _limit_for(grid.y, grid.limits), _limit_for(grid.x, grid.limits)
+    ylim, xlim = limit_for(grid.y, grid.limits), limit_for(grid.x, grid.limits)
     lw = max([len(s) for s in grid.by.labels] + [len(y_name)])
+    row_end = f" ◀ {ylim[0]} {ylim[1]:.3f}" if ylim else ""
+    if lw + 1 + width * len(grid.bx.labels) + len(row_end) > 80:
+        row_end = " ◀"
     out.append(f"{y_name:>{lw}}\n", style="bold")
     for i in reversed(range(len(grid.by.labels))):
         out.append(f"{grid.by.labels[i]:>{lw}} ")
-        for cell in grid.cells[i]:
-            w = worst(cell)
-            if w is None:
-                out.append(" · ")
-                continue
-            bad = sum(n for v, n in cell.items() if SEVERITY.get(v, 0) > 0)
-            mark = LETTERS[w] + (str(min(bad, 9)) if bad > 1 else " ")
-            out.append(f"{mark:^3}", style=f"bold white on {COLOURS[w]}")
+        for j in range(len(grid.bx.labels)):
+            mark, style = cell(i, j)
+            out.append(f"{mark:^{width}}", style=style)
         if ylim and grid.by.edges and grid.by.edges[i] <= ylim[1] < grid.by.edges[i + 1]:
-            out.append(f" ◀ {ylim[0]} {ylim[1]:.3f}")
+            out.append(row_end)
         out.append("\n")
     out.append(" " * (lw + 1))
     for j in range(len(grid.bx.labels)):
         e = grid.bx.edges
         hit = xlim and e and e[j] <= xlim[1] < e[j + 1]
-        out.append(" ▲ " if hit else "   ")
+        out.append(f"{'▲' if hit else ' ':^{width}}")
     out.append("\n")
     labels = [lab[:8] for lab in grid.bx.labels]
     for k in range(max((len(lab) for lab in labels), default=0)):  # column labels, vertical
-        out.append(" " * (lw + 1) + "".join(f" {lab[k] if k < len(lab) else ' '} "
+        out.append(" " * (lw + 1) + "".join(f"{lab[k] if k < len(lab) else ' ':^{width}}"
                                             for lab in labels) + "\n")
     out.append(" " * (lw + 1) + x_name + (f"  (▲ {xlim[0]} {xlim[1]:.3f})" if xlim else "")
+               + (f"  (◀ {ylim[0]} {ylim[1]:.3f})" if ylim and row_end == " ◀" else "")
                + "\n")
+    return out
+
+
+def terminal(grid: Grid) -> Text:
+    """The verdict map: a cell is the worst verdict's letter on its colour
+    (count of non-passing cases when more than one), · where no case fell."""
+    def cell(i: int, j: int) -> tuple[str, str]:
+        c = grid.cells[i][j]
+        w = worst(c)
+        if w is None:
+            return "·", ""
+        bad = sum(n for v, n in c.items() if SEVERITY.get(v, 0) > 0)
+        return LETTERS[w] + (str(min(bad, 9)) if bad > 1 else " "), f"bold white on {COLOURS[w]}"
+
+    out = frame(grid, cell)
     for v in VERDICTS:
         out.append(f" {LETTERS[v]} ", style=f"bold white on {COLOURS[v]}")
         out.append(f" {v} ")
@@ -159,20 +176,49 @@ def terminal(grid: Grid) -> Text:
     return out
 
 
-def png(grid: Grid, path: Path, title: str, margins: tuple[float, float]) -> Path:
-    """Write the heat map as a PNG.  Raises ExtraMissing without matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        from matplotlib.colors import to_rgba
-        from matplotlib.patches import Patch, Rectangle
-    except ImportError:
-        from stairbot.sweep.execute import ExtraMissing
-        raise ExtraMissing("the PNG heat map", "plot") from None
-    fig, ax = plt.subplots(figsize=(9, 6.5), dpi=110)
+def cell_edges(grid: Grid) -> tuple[list[float], list[float]]:
+    """The cells' edges in plot units: a numeric axis's bin edges, a category
+    axis's positions 0, 1, ... +- 0.5."""
     ex = grid.bx.edges or [k - 0.5 for k in range(len(grid.bx.labels) + 1)]
     ey = grid.by.edges or [k - 0.5 for k in range(len(grid.by.labels) + 1)]
+    return ex, ey
+
+
+def decorate(ax: Any, grid: Grid, title: str, margins: tuple[float, float]) -> None:
+    """What every heat-map PNG draws around its cells: the axes' extent and
+    labels, the robot's limits (solid) with the verdict rules' margins
+    (dotted), the comfort rule on a tread x rise map, and the title."""
+    ex, ey = cell_edges(grid)
+    ax.set_xlim(ex[0], ex[-1])
+    ax.set_ylim(ey[0], ey[-1])
+    if grid.bx.edges is None:
+        ax.set_xticks(range(len(grid.bx.labels)), grid.bx.labels)
+    if grid.by.edges is None:
+        ax.set_yticks(range(len(grid.by.labels)), grid.by.labels)
+    for axis, line, margin in ((grid.y, ax.axhline, margins[0]), (grid.x, ax.axvline, margins[1])):
+        lim = limit_for(axis, grid.limits)
+        if lim:
+            line(lim[1], color="black", linewidth=2, label=f"{lim[0]} = {lim[1]:.3f} m")
+            line(lim[1] - margin, color="black", linewidth=0.8, linestyle=":")
+            line(lim[1] + margin, color="black", linewidth=0.8, linestyle=":")
+    if grid.x in TREAD_AXES and grid.y in RISE_AXES:
+        for s in COMFORT:  # 2R + T = s  ->  R = (s - T) / 2
+            ax.plot([ex[0], ex[-1]], [(s - ex[0]) / 2, (s - ex[-1]) / 2], color="grey",
+                    linestyle="--", linewidth=1)
+        ax.plot([], [], color="grey", linestyle="--", label="2R+T = 0.59 / 0.65 m (comfort rule)")
+    ax.set_xlabel(grid.x)
+    ax.set_ylabel(grid.y)
+    ax.set_title(title, fontsize=10)
+
+
+def png(grid: Grid, path: Path, title: str, margins: tuple[float, float]) -> Path:
+    """Write the heat map as a PNG.  Raises ExtraMissing without matplotlib."""
+    plt = pyplot()
+    from matplotlib.colors import to_rgba
+    from matplotlib.patches import Patch, Rectangle
+
+    fig, ax = plt.subplots(figsize=(9, 6.5), dpi=110)
+    ex, ey = cell_edges(grid)
     small = len(grid.bx.labels) * len(grid.by.labels) <= 400
     for i, row in enumerate(grid.cells):
         for j, cell in enumerate(row):
@@ -187,32 +233,31 @@ def png(grid: Grid, path: Path, title: str, margins: tuple[float, float]) -> Pat
                 ax.text((ex[j] + ex[j + 1]) / 2, (ey[i] + ey[i + 1]) / 2,
                         f"{bad}/{sum(cell.values())}", ha="center", va="center", fontsize=6,
                         color="white")
-    ax.set_xlim(ex[0], ex[-1])
-    ax.set_ylim(ey[0], ey[-1])
-    if grid.bx.edges is None:
-        ax.set_xticks(range(len(grid.bx.labels)), grid.bx.labels)
-    if grid.by.edges is None:
-        ax.set_yticks(range(len(grid.by.labels)), grid.by.labels)
-    for axis, line, margin in ((grid.y, ax.axhline, margins[0]), (grid.x, ax.axvline, margins[1])):
-        lim = _limit_for(axis, grid.limits)
-        if lim:
-            line(lim[1], color="black", linewidth=2, label=f"{lim[0]} = {lim[1]:.3f} m")
-            line(lim[1] - margin, color="black", linewidth=0.8, linestyle=":")
-            line(lim[1] + margin, color="black", linewidth=0.8, linestyle=":")
-    if grid.x in TREAD_AXES and grid.y in RISE_AXES:
-        for s in COMFORT:  # 2R + T = s  ->  R = (s - T) / 2
-            ax.plot([ex[0], ex[-1]], [(s - ex[0]) / 2, (s - ex[-1]) / 2], color="grey",
-                    linestyle="--", linewidth=1)
-        ax.plot([], [], color="grey", linestyle="--", label="2R+T = 0.59 / 0.65 m (comfort rule)")
-    ax.set_xlabel(grid.x)
-    ax.set_ylabel(grid.y)
-    ax.set_title(title, fontsize=10)
+    decorate(ax, grid, title, margins)
     handles = [Patch(color=COLOURS[v], label=v) for v in VERDICTS]
     lines, labels = ax.get_legend_handles_labels()
     ax.legend(handles=handles + lines, labels=list(VERDICTS) + labels, fontsize=7,
               loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    return save(fig, path)
+
+
+def pyplot() -> Any:
+    """matplotlib.pyplot on the Agg backend (files only, no window).  Raises
+    ExtraMissing without matplotlib."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        from stairbot.sweep.execute import ExtraMissing
+        raise ExtraMissing("the PNG heat map", "plot") from None
+    return plt
+
+
+def save(fig: Any, path: Path) -> Path:
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
+    import matplotlib.pyplot as plt
     plt.close(fig)
     return path

@@ -153,28 +153,42 @@ def choose_axes(meta: dict[str, Any], x: str | None, y: str | None) -> tuple[str
 
 def draw(records: list[dict[str, Any]], meta: dict[str, Any], folder: Path, console: Console,
          x: str | None = None, y: str | None = None, png: Path | None = None,
-         want_png: bool = True) -> Path | None:
-    """The terminal heat map, and the PNG (default RESULTS/heatmap.png) when
-    matplotlib is there; returns the PNG's path or None."""
+         want_png: bool = True, margin: str | None = None) -> list[Path]:
+    """The terminal heat map of verdicts, then with ``margin`` the map of that
+    margin's least per cell (:mod:`stairbot.sweep.margin_map`); and their PNGs
+    (default RESULTS/heatmap.png and RESULTS/heatmap-MARGIN.png) when
+    matplotlib is there.  Returns the PNGs written."""
     axes = choose_axes(meta, x, y)
     if axes is None or not records:
-        return None
+        return []
     rep = meta.get("report", {})
     grid = heatmap.Grid.build(records, axes[0], axes[1], int(rep.get("bins", 12)))
     console.print(heatmap.terminal(grid))
+    mgrid = None
+    if margin is not None:
+        from stairbot.sweep import margin_map
+
+        mgrid = margin_map.MarginGrid.build(records, grid, margin)
+        console.print(margin_map.terminal(mgrid))
     if not want_png:
-        return None
+        return []
     rules = meta.get("rules", {})
-    title = (f"sweep {meta.get('name')} ({meta.get('hash', '')[:12]}): {len(records)} cases; "
-             + counts_line(counts_of(records)))
+    limit_margins = (float(rules.get("rise_margin_m", 0.01)),
+                     float(rules.get("tread_margin_m", 0.01)))
+    head = f"sweep {meta.get('name')} ({meta.get('hash', '')[:12]}): {len(records)} cases; "
     from stairbot.sweep.execute import ExtraMissing
 
     try:
-        return heatmap.png(grid, png or folder / "heatmap.png", title,
-                           (float(rules.get("rise_margin_m", 0.01)),
-                            float(rules.get("tread_margin_m", 0.01))))
+        out = [heatmap.png(grid, png or folder / "heatmap.png",
+                           head + counts_line(counts_of(records)), limit_margins)]
+        if mgrid is not None:
+            out.append(margin_map.png(
+                mgrid, margin_map.png_path(folder, png, mgrid.name),
+                head + f"least {mgrid.name} per cell ({mgrid.counted} cases have it)",
+                limit_margins))
+        return out
     except ExtraMissing as exc:
         if png is not None:  # asked for by name: a missing extra is an error
             raise
         console.print(f"no PNG heat map: {exc.problem}")
-        return None
+        return []

@@ -90,8 +90,8 @@ def cmd_search(spec: Spec, args: argparse.Namespace) -> int:
         print_summary(records, meta, console, spec.report.worst)
         print_search_worst(records, meta, console, spec.report.worst)
         print_margins(records, meta, console)
-        png = draw(records, meta, folder, console, args.x, args.y, args.png, not args.no_png)
-        if png is not None:
+        for png in draw(records, meta, folder, console, args.x, args.y, args.png,
+                        not args.no_png, args.margin):
             print(f"heat map: {printable(png)}")
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     state = "interrupted; rerun with --resume" if out.interrupted else (
