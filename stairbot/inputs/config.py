@@ -130,7 +130,11 @@ class RobotConfig:
         a little to the nose-down pitch that the cantilevered segment 1 puts on
         the wheels of segment 2: the beam must still clear the tread
         LENGTH_OF_A_ROBOT + SAFE_LENGTH ahead.  The simulated robot loses under
-        1 mm (docs/algorithm.md, ascent 3)."""
+        1 mm (docs/algorithm.md, ascent 3).  What the robot publishes
+        (:func:`stairbot.control.algorithm.limits.max_step_rise_m`) also takes
+        off how high over the step the front pair's lowest ray must look to
+        read past the riser (a cone looking down meets the step's own tread
+        nearer than the sensor reads)."""
         lift_at_sight = self.motors.lift_travel - (
             self.sensors.front_height + self.algorithm.drive_clearance
         )
@@ -149,6 +153,14 @@ class RobotConfig:
         s = self.sensors
         fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
         return math.radians(max(0.0, s.front_tilt_deg + fov / 2.0))
+
+    @property
+    def front_cone_bottom_rad(self) -> float:
+        """How far below level the front pair's lowest ray looks: half the
+        cone less the mount's tilt (0 when none looks down)."""
+        s = self.sensors
+        fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
+        return math.radians(max(0.0, fov / 2.0 - s.front_tilt_deg))
 
     def min_rise_for(self, tread_m: float) -> float:
         """Lowest next riser it can measure a tread of ``tread_m`` against:

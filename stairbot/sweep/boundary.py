@@ -146,7 +146,7 @@ def target(spec: Spec, axis: str, tolerance: float | None, scan: int | None) -> 
             # from a kerb's lip, below every low-rise rule: a riser too low to see
             # must be refused too, not only one too low to measure a tread against
             values = [min(LOWEST_RISE_M, limits.min_step_rise_m(cfg) - pad),
-                      cfg.max_step_rise_m + pad]
+                      limits.max_step_rise_m(cfg) + pad]
         else:
             values = [max(0.01, limits.min_tread_m(cfg) - pad), limits.min_tread_m(cfg) + pad]
     metres = axis in METRE_AXES
@@ -241,7 +241,7 @@ def _name(spec: Spec, base: int, axis: str, value: float) -> str:
 
     stairs = tomllib.loads(scen).get("stairs", {})
     if axis == "stairs.rise":
-        figures["max_step_rise_m"] = cfg.max_step_rise_m
+        figures["max_step_rise_m"] = limits.max_step_rise_m(cfg)
         figures["min_step_rise_m"] = limits.min_step_rise_m(cfg)
         treads = {float(s["tread"]) for s in stairs.get("steps", [])} or (
             {float(stairs["tread"])} if "tread" in stairs else set())

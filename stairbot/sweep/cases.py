@@ -156,7 +156,7 @@ def build_case(spec: Spec, index: int, override: tuple[str, Any] | None = None,
     facts = {
         "zone": z, "count": len(scenario.steps), "max_rise_m": max_rise,
         "min_tread_m": min_tread if math.isfinite(min_tread) else None,
-        "limit_rise_m": round(config.max_step_rise_m, DIGITS),
+        "limit_rise_m": round(limits.max_step_rise_m(config), DIGITS),
         "limit_tread_m": round(limits.min_tread_m(config), DIGITS),
         "expected_steps": min(len(scenario.steps), config.algorithm.max_steps),
         "faults": len(scenario.faults), "home_m": spec.rules.home_m,

@@ -125,7 +125,8 @@ def zone(scenario: Scenario, config: RobotConfig, rules: Rules) -> tuple[str, fl
     last = len(scenario.steps) - 1
     treads = [s.tread for i, s in enumerate(steps) if not (i == last and scenario.top == "landing")]
     min_tread = min(treads, default=math.inf)
-    lr, lo, lt = config.max_step_rise_m, limits.min_step_rise_m(config), limits.min_tread_m(config)
+    lr, lo, lt = (limits.max_step_rise_m(config), limits.min_step_rise_m(config),
+                  limits.min_tread_m(config))
     rm, tm = rules.rise_margin_m, rules.tread_margin_m
     # how far each riser clears what the front cone needs to measure the tread
     # before it, and each measured tread's own riser what the robot asks of it

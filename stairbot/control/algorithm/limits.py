@@ -40,6 +40,35 @@ def square_range_m(cfg: RobotConfig) -> float:
     return min(cone, quiet_range_m(cfg))
 
 
+def sight_clearance_m(cfg: RobotConfig) -> float:
+    """How far above a step's top the front beam must stand before the pair
+    reads past the riser, when nothing stands ahead within its range (a
+    landing, a long tread): the cone's lowest ray, looking
+    :attr:`~stairbot.inputs.config.RobotConfig.front_cone_bottom_rad` down,
+    meets the step's own tread, and the pair reads "too near" until that ray
+    meets it at least its least range away (min_range x sin of the angle);
+    nor may it graze the edge, approach_gap ahead.  0 for a cone whose
+    lowest ray runs level or up, and for a ranger that hears no echo from a
+    surface met that far off its normal (``echo_incidence_deg``: the tread
+    is then no target).  A Sharp's 4-degree spot, level, reading from 0.10 m:
+    3.5 mm."""
+    down = cfg.front_cone_bottom_rad
+    if down <= 0.0:
+        return 0.0
+    echo = cfg.sensors.spec(back=False).echo_incidence_deg
+    if echo is not None and 90.0 - math.degrees(down) > echo:
+        return 0.0
+    near = cfg.sensors.range(back=False)[0]
+    return max(near * math.sin(down), cfg.algorithm.approach_gap * math.tan(down))
+
+
+def max_step_rise_m(cfg: RobotConfig) -> float:
+    """Highest rise it climbs: what the lift lets the beam see over
+    (:attr:`~stairbot.inputs.config.RobotConfig.max_step_rise_m`) less
+    :func:`sight_clearance_m`.  Higher steps are refused (too high)."""
+    return cfg.max_step_rise_m - sight_clearance_m(cfg)
+
+
 def min_tread_m(cfg: RobotConfig) -> float:
     """Shortest tread it enters, measured at the first sight over the riser
     as the reading less the approach's gap: LENGTH_OF_A_ROBOT + SAFE_LENGTH;
@@ -130,7 +159,7 @@ def derived(cfg: RobotConfig) -> dict[str, float]:
     out["wheel_circumference_m"] = cfg.wheel_circumference
     out["wheel_speed_m_s"] = float(cfg.wheel_speed_m_s)
     out["lift_speed_m_s"] = float(cfg.lift_speed_m_s)
-    out["max_step_rise_m"] = float(cfg.max_step_rise_m)
+    out["max_step_rise_m"] = float(max_step_rise_m(cfg))
     out["min_tread_m"] = float(min_tread_m(cfg))
     out["min_step_rise_m"] = float(min_step_rise_m(cfg))
     out.update(reach(cfg))
