@@ -174,11 +174,13 @@ def test_pause_stops_time_and_play_goes_on(recorded: dict[str, Path]) -> None:
             app.advance()
             assert app.player.position == 1.5 and "▶ 1×" in app.banner.plain
             await press(pilot, "p")
-            assert not app.player.playing and "⏸ 1× · t = 1.5 s" in app.banner.plain
+            await until(pilot, lambda: not app.player.playing, "paused")
+            assert "⏸ 1× · t = 1.5 s" in app.banner.plain
             clock.t += 5.0
             app.advance()
             assert app.player.position == 1.5  # paused: the clock moved, the replay did not
             await press(pilot, "p")
+            await until(pilot, lambda: app.player.playing, "playing again")
             clock.t += 0.5
             app.advance()
             assert app.player.position == 2.0
@@ -187,7 +189,8 @@ def test_pause_stops_time_and_play_goes_on(recorded: dict[str, Path]) -> None:
             assert app.player.position == app.player.end_s and not app.player.playing
             assert "■" in app.banner.plain
             await press(pilot, "p")  # at the end: from the start again
-            assert app.player.playing and app.player.position == app.player.start_s
+            await until(pilot, lambda: app.player.playing, "playing from the start")
+            assert app.player.position == app.player.start_s
     run(go)
 
 
