@@ -47,8 +47,12 @@ def banner(app: StairbotConsole) -> str:
 
 async def say_yes(pilot: Any) -> None:
     """Answer a question that lets the robot move (MotionConfirm): type
-    ``yes`` into it, then Enter."""
+    ``yes`` into it, then Enter, and wait until it has closed (its answer's
+    callback may start a run before the question leaves the screen: a key
+    pressed meanwhile would go into its field)."""
+    question = pilot.app.screen
     await press(pilot, "y", "e", "s", "enter")
+    await until(pilot, lambda: question not in pilot.app.screen_stack, "the question closes")
 
 
 async def ready(pilot: Any) -> None:

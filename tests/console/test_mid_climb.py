@@ -78,7 +78,7 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
     with lockstep_boards(tmp_path) as boards:
-        url = boards.url
+        url = boards.url + "&timeout=2"  # a loaded machine may be slow to answer
         journal = default_path(url, boards.identity)
         assert journal is not None
         killed = kill_mid_lift(url, journal, dict(os.environ), tmp_path)
@@ -114,7 +114,9 @@ def test_boards_left_mid_climb_resume_from_the_journal_once_confirmed(
                 await until(pilot, lambda: isinstance(app.screen, ConfirmScreen), "resume?")
                 await say_yes(pilot)
                 await until(pilot, lambda: app.engine.running, "resumed")
-                await until(pilot, lambda: not app.engine.running, "the run ends")
+                # the rest of five steps up and down over the wire: on a loaded
+                # machine, minutes
+                await until(pilot, lambda: not app.engine.running, "the run ends", bound_s=600)
                 result = app.state.view().result
                 assert result is not None
                 assert (result.outcome, result.steps_climbed, result.steps_descended) == (

@@ -174,11 +174,13 @@ def test_pause_stops_time_and_play_goes_on(recorded: dict[str, Path]) -> None:
             app.advance()
             assert app.player.position == 1.5 and "▶ 1×" in app.banner.plain
             await press(pilot, "p")
-            assert not app.player.playing and "⏸ 1× · t = 1.5 s" in app.banner.plain
+            await until(pilot, lambda: not app.player.playing, "paused")
+            assert "⏸ 1× · t = 1.5 s" in app.banner.plain
             clock.t += 5.0
             app.advance()
             assert app.player.position == 1.5  # paused: the clock moved, the replay did not
             await press(pilot, "p")
+            await until(pilot, lambda: app.player.playing, "playing again")
             clock.t += 0.5
             app.advance()
             assert app.player.position == 2.0
@@ -187,7 +189,8 @@ def test_pause_stops_time_and_play_goes_on(recorded: dict[str, Path]) -> None:
             assert app.player.position == app.player.end_s and not app.player.playing
             assert "■" in app.banner.plain
             await press(pilot, "p")  # at the end: from the start again
-            assert app.player.playing and app.player.position == app.player.start_s
+            await until(pilot, lambda: app.player.playing, "playing from the start")
+            assert app.player.position == app.player.start_s
     run(go)
 
 
@@ -198,19 +201,23 @@ def test_speed_changes_how_fast_the_recording_goes(recorded: dict[str, Path]) ->
         app = replay_app(recorded["mcap"], clock)
         async with app.run_test(size=(80, 24)) as pilot:
             await press(pilot, "plus")
-            assert app.player.speed == 2.0 and "▶ 2×" in app.banner.plain
+            await until(pilot, lambda: app.player.speed == 2.0, "twice as fast")
+            assert "▶ 2×" in app.banner.plain
             assert "replay 2×" in shown(app.link)
             clock.t += 1.0
             app.advance()
             assert app.player.position == 2.0
             await press(pilot, "minus", "minus", "minus")
-            assert app.player.speed == 0.25 and "0.25×" in app.banner.plain
+            await until(pilot, lambda: app.player.speed == 0.25, "a quarter as fast")
+            assert "0.25×" in app.banner.plain
             clock.t += 2.0
             app.advance()
             assert app.player.position == 2.5
             for _ in range(10):
                 await press(pilot, "plus")
-            assert app.player.speed == 50.0  # the fastest, not beyond
+            await until(pilot, lambda: app.player.speed == 50.0, "the fastest")
+            await pilot.pause(0.2)  # every plus handled: still the fastest, not beyond
+            assert app.player.speed == 50.0
     run(go)
 
 
@@ -224,16 +231,18 @@ def test_seek_keys_go_to_the_right_time_and_back_replays_the_events(
             await press(pilot, "end")
             end = app.player.end_s
             assert end == events[-1]["time_s"] > 6.0  # the recording's last event
+            await until(pilot, lambda: app.player.position == end, "at the end")
             await until(pilot, lambda: len(app.log_panel._kept) == len(events), "every event")
             assert said(app) == [e["message"] for e in events]  # the whole list, in order
             await press(pilot, "left")
-            assert app.player.position == pytest.approx(end - 1)
+            await until(pilot, lambda: app.player.position == pytest.approx(end - 1), "1 s back")
             await press(pilot, "shift+left")
-            assert app.player.position == pytest.approx(end - 6)
+            await until(pilot, lambda: app.player.position == pytest.approx(end - 6), "5 s back")
             await press(pilot, "right_square_bracket")
-            assert app.player.position == pytest.approx(end - 1)
+            await until(pilot, lambda: app.player.position == pytest.approx(end - 1),
+                        "5 s on")
             await press(pilot, "home")
-            assert app.player.position == 0.0
+            await until(pilot, lambda: app.player.position == 0.0, "at the start")
             at_start = [e["message"] for e in events if e["time_s"] <= 0.0]
             assert said(app) == at_start  # sought back: the list as it was at 0 s
             await until(pilot, lambda: len(app.log_panel._kept) == len(at_start),
@@ -241,6 +250,7 @@ def test_seek_keys_go_to_the_right_time_and_back_replays_the_events(
             await press(pilot, "left")
             assert app.player.position == 0.0  # not before the start
             await press(pilot, "right", "right")
+            await until(pilot, lambda: app.player.position == 2.0, "at 2 s")
             assert said(app) == [e["message"] for e in events if e["time_s"] <= 2.0]
             phases = [e for e in events if e["kind"] == "phase" and e["time_s"] <= 2.0]
             assert app.state.view().phase == phases[-1]["phase"]
@@ -254,7 +264,8 @@ def test_t_in_a_replay_shows_no_top_view_and_says_why(recorded: dict[str, Path])
         app = replay_app(recorded["mcap"], Clock(), playing=False)
         async with app.run_test(size=(80, 24)) as pilot:
             await press(pilot, "right", "t")
-            assert app.top_view.display and not app.picture.display
+            await until(pilot, lambda: app.top_view.display, "the top view")
+            assert not app.picture.display
             text = app.top_view.render().plain
             assert not any(0x2800 < ord(ch) < 0x2900 for ch in text)
             assert "a recording holds no pose seen from above" in " ".join(text.split())
@@ -310,6 +321,7 @@ def test_a_recording_cut_short_plays_what_it_holds(recorded: dict[str, Path],
         app = build_replay_app(source, clock=Clock(), playing=False)
         async with app.run_test(size=(80, 24)) as pilot:
             await press(pilot, "end")
+            await until(pilot, lambda: app.player.position == source.end_s, "at the end")
             assert f"cut short: the file ends at {source.end_s:.1f} s" in app.banner.plain
             snap = app.state.view().snapshot
             assert snap is not None and snap.time_s == max(

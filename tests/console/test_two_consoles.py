@@ -30,7 +30,9 @@ def boards_url(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[str]
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
     monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
     with fake_boards(tmp_path) as url:
-        yield url
+        # replies waited for 2 s, not 0.05: on a loaded machine the boards'
+        # process may not be scheduled in time (lockstep: it never runs ahead)
+        yield url + "&timeout=2"
 
 
 @pytest.mark.parametrize("wire", ["serial", "can"])
