@@ -13,7 +13,16 @@ from __future__ import annotations
 import statistics
 from typing import Any
 
-from stairbot.control.algorithm import blind, long_tread, lost, motion, sight, split_top, undo_first
+from stairbot.control.algorithm import (
+    blind,
+    blocked,
+    long_tread,
+    lost,
+    motion,
+    sight,
+    split_top,
+    undo_first,
+)
 from stairbot.control.algorithm.families import LiftFirst
 from stairbot.control.algorithm.lift_first import (
     LIFT_FIRST,
@@ -24,6 +33,7 @@ from stairbot.control.algorithm.lift_first import (
 from stairbot.control.algorithm.modes import AscentEnd, Purpose
 from stairbot.control.algorithm.moves import (
     KEY_TICKS,
+    RISER_KEYS,
     drive_phase,
     lift,
     lift_phase,
@@ -70,6 +80,8 @@ def _approach(t: Tick, w: ApproachWork) -> Step:
     cfg, ctx = t.cfg, t.ctx
     if lost.limping(t):
         return lost.limp_down(t)
+    if w.blocked_since is not None:
+        return blocked.step(t, w)
     sfr, sfl = motion.pair(t.snap)
     if motion.far(sfr, cfg) or motion.far(sfl, cfg):
         # A riser does not vanish from in front of a robot on the floor: stand
@@ -83,16 +95,13 @@ def _approach(t: Tick, w: ApproachWork) -> Step:
                                    RISER_LOST_WAIT_S))
     w.still_since = None
     reading = _riser_ahead(t, w)
+    if blocked.went_away(t, w):
+        return stay(NO_MOTION)
     safe = cfg.SAFE_DISTANCE_IN_FRONT_OF_STEP
     if reading <= safe:
         return go("at_safe_distance")
     remaining = cfg.wheel_turns(reading - safe) + cfg.NUMBER_OF_HORIZONTAL_TURNS_FOR_APPROACH
     return stay(motion.drive(cfg, 1, remaining))
-
-
-RISER_KEYS = 15
-"""Ascent 2 places the riser by the median of this many ticks' readings
-(plus the odometer), once it has KEY_TICKS of them."""
 
 
 def _riser_ahead(t: Tick, w: ApproachWork) -> float:
@@ -116,11 +125,17 @@ def _riser_ahead(t: Tick, w: ApproachWork) -> float:
     return reading
 
 
+BLOCKED = "the riser placed went away (blocked.BLOCKED_M): a step below the beams"
+
 APPROACH = PhaseDef(
     P.ASCENT_APPROACH, "ascent 2 — approach to SAFE_DISTANCE_IN_FRONT_OF_STEP", FLOW, _approach,
     ApproachWork, watches="front",
     on={"at_safe_distance": Exit(P.ASCENT_APPROACH_TURNS, "reads "
                                                          "SAFE_DISTANCE_IN_FRONT_OF_STEP"),
+        "blocked_on_the_floor": Exit(P.DESCENT_FINISH, BLOCKED + "; none climbed"),
+        "blocked_steps_climbed": Exit(P.DESCENT_BACK_OFF, BLOCKED + "; number_of_steps > 0"),
+        "blocked_after_turn": Exit(P.LANDING_RETURN, BLOCKED + "; the first step after a "
+                                                             "landing's turn"),
         **LIMP_DOWN,
         FAILED: Exit(P.ERROR, "riser lost (nothing ahead, standing RISER_LOST_WAIT_S); "
                               + FAULT)})

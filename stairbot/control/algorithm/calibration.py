@@ -117,6 +117,14 @@ def _check(t: Tick, w: StandingWork) -> Step:
                                                       sfl.distance_m))
         cal.case = CalibrationCase.ONE
         t.say(say.case_one(cfg.LENGTH_OF_INFINITY), case="1")
+        home = ctx.start.home_wheel
+        here = motion.wheel_position(t.snap)
+        if home is not None and here - home > motion.WHEEL_DONE:
+            # It closed in on a riser it no longer sees (one below the beams
+            # it drove up to): descent 7 backs the distance home.
+            ctx.start.wheel = here
+            t.say(say.CASE_ONE_CLOSED_IN)
+            return go("nothing_ahead_closed_in")
         return end(Outcome.STOPPED, say.CASE_ONE_END)
     if cal.purpose is Purpose.START:
         if ctx.start.home_wheel is None:
@@ -225,6 +233,8 @@ CHECK = PhaseDef(
         ENDED: Exit(P.DONE, "case 1: both read ≥ LENGTH_OF_INFINITY (nothing ahead); "
                             "calibrate-only: squared up (checked)"),
         "too_far": Exit(P.CAL_CLOSE_IN, "start: the nearer reads farther than square_range_m"),
+        "nothing_ahead_closed_in": Exit(P.DESCENT_FINISH, "case 1 after closing in: back to "
+                                                          "where the program began"),
         "case_found": Exit(P.CAL_LIFT, "start: case 2 (SFR ≠ SFL), 2W (too far apart for one "
                                        "riser) or case 3 (SFR = SFL); later: SFR ≠ SFL"),
         "off_climb_heading": Exit(P.CAL_LIFT, "descent 1: turned from the heading the step "

@@ -50,6 +50,9 @@ KEY_TICKS = 5
 """The surface a reading drive starts on is the median of its first this many
 ticks' readings (less what the wheels drove), not of the first alone: that
 may be a stray (an outlier just after the pair came into range)."""
+RISER_KEYS = 15
+"""Ascent 2 places the riser by the median of this many ticks' readings
+(plus the odometer), once it has KEY_TICKS of them."""
 
 
 def jump_limit(cfg: RobotConfig, distance_m: float) -> float:

@@ -155,6 +155,25 @@ class ApproachWork(Work):
     """When a beam began reading "nothing ahead" (the approach stands)."""
     riser_keys: list[float] = field(default_factory=list)
     """The mean reading plus the odometer, on its last RISER_KEYS ticks."""
+    nearest_riser: float | None = None
+    """The nearest the riser was placed on the odometer (turns): where it
+    stands while the wheels carry the robot."""
+    placings: list[float] = field(default_factory=list)
+    """Where the riser was placed while it held (turns), one a place: each
+    one more than HELD_M from the one before (the pair reads another surface)."""
+    held_wheel: float | None = None
+    """The odometer on the last tick the riser was placed near its nearest."""
+    blocked_since: float | None = None
+    """When the placed riser went away (the approach stands, then places the
+    robot: :mod:`~stairbot.control.algorithm.blocked`)."""
+    blocked_wheel: float | None = None
+    """The odometer then."""
+    went_m: float = 0.0
+    """How far on the riser was placed then."""
+    back_target: float | None = None
+    """Where backing off the step ends, on the odometer."""
+    level_keys: list[float] = field(default_factory=list)
+    """Backed off and standing: the mean reading plus the odometer, a tick each."""
 
 
 @dataclass

@@ -17,6 +17,15 @@ def riser_lost(steps: int, sfr: float, sfl: float, wait_s: float) -> str:
             f"for {wait_s:g} s")
 
 
+def below_the_sensors(steps: int, front_height: float, went_m: float,
+                      slip_m: float | None) -> str:
+    slipped = "" if slip_m is None else (
+        f"; the wheels slipped {slip_m:.3f} m" if slip_m > 0 else "; the wheels did not slip")
+    return (f"step {steps + 1} is below the front sensors ({front_height:.3f} m up): "
+            f"driving on, the riser they read went {went_m:.3f} m further away{slipped}; "
+            "the ascent ends (obstacle)")
+
+
 def at_riser(gap: float) -> str:
     return f"at the riser: {gap:.3f} m from it"
 

@@ -146,3 +146,7 @@ def away_too_far(where: str, max_rad: float, sfr: float, sfl: float) -> str:
     return (f"calibration ({where}) turned "
             f"{math.degrees(max_rad):.0f}° away from the side wall and the "
             f"readings still do not fit one riser (SFR {sfr:.3f} m, SFL {sfl:.3f} m)")
+
+
+CASE_ONE_CLOSED_IN = ("nothing ahead after closing in: the riser closed in on is below the "
+                      "beams; back to where the program began")
