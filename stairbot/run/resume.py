@@ -141,6 +141,8 @@ def describe(state: JournalState) -> list[str]:
 
 
 _TIMES = ("phase_started_s", "pause_started_s")
+_WORK_TIMES = ("still_since", "blocked_since")
+"""A phase's own timers (its work's): standing since, blocked since."""
 
 
 def moved_on(context: dict[str, Any], shift: float) -> dict[str, Any]:
@@ -152,8 +154,10 @@ def moved_on(context: dict[str, Any], shift: float) -> dict[str, Any]:
         if isinstance(data.get(key), int | float):
             data[key] = float(data[key]) + shift
     work = data.get("work")
-    if isinstance(work, dict) and isinstance(work.get("still_since"), int | float):
-        work["still_since"] = float(work["still_since"]) + shift
+    if isinstance(work, dict):
+        for key in _WORK_TIMES:
+            if isinstance(work.get(key), int | float):
+                work[key] = float(work[key]) + shift
     return data
 
 

@@ -16,6 +16,7 @@ import pytest
 
 from stairbot.control.robot_config import load_config
 from stairbot.inputs.scenario import parse_scenario
+from stairbot.run.resume import moved_on
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult, run
 
@@ -89,3 +90,15 @@ def test_a_riser_closed_in_on_and_lost_at_the_start_sends_the_robot_home(rise: f
     assert result.final_offset_m is not None and result.final_offset_m <= HOME_M, \
         result.to_dict()
     assert any("nothing ahead after closing in" in m for m in said), said
+
+
+def test_a_resume_moves_the_blocked_stand_on_with_the_phase_timers() -> None:
+    """A host killed while the approach stands blocked resumes with the time
+    it stood still not counted: the stand's start moves on with the phase's
+    own timers (else a clock begun again would stand it until the phase
+    timed out)."""
+    saved = {"phase_started_s": 10.0, "work": {"still_since": 11.0, "blocked_since": 12.0,
+                                               "went_m": 0.05}}
+    moved = moved_on(saved, -5.0)
+    assert (moved["phase_started_s"], moved["work"]["still_since"],
+            moved["work"]["blocked_since"], moved["work"]["went_m"]) == (5.0, 6.0, 7.0, 0.05)
