@@ -2,8 +2,9 @@
 (stairbot.drivers.serial_wire and messages, with the simulation's messages):
 the test vectors both ways, random frames of the Python encoder decoded and
 encoded by C field by field, mutated frames refused by both for the same
-reason, the board checks of docs/protocol.md section 3, and a short run of
-the sanitized fuzz harness (benchmarks/fuzz_firmware.py).
+reason, the board checks of docs/protocol.md section 3 (by hand and against
+the Python fake boards), and a short run of the sanitized fuzz harness
+(benchmarks/fuzz_firmware.py).
 
 The C side is firmware/test/sbtool.c, built here with the C compiler named
 by $CC, else cc, gcc or clang from PATH; without one the tests skip."""
@@ -17,6 +18,7 @@ import random
 import shutil
 import subprocess
 import sys
+from collections.abc import Mapping
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -37,6 +39,9 @@ from stairbot.drivers.serial_wire import (
     parse_body,
 )
 from stairbot.fakes import sim_messages as sim
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.boards import make_boards
+from stairbot.hardware import BASE_SENSORS, MotorId, MotorState, SensorReading, Snapshot, Truth
 
 ROOT = Path(__file__).resolve().parents[2]
 FIRMWARE = ROOT / "firmware"
@@ -318,3 +323,74 @@ def test_fuzz_harness_short_run(tmp_path: Path) -> None:
     assert lines["findings"] == "0"
     assert lines["frames"].startswith("20000")
     assert int(lines["accepted"]) > 1000 and int(lines["rejected"]) > 1000
+
+
+class StandingRobot:
+    """A robot that stands still at time 0: enough for the fake boards to answer."""
+
+    def read(self) -> Snapshot:
+        return Snapshot(0.0, {s: SensorReading(0.5) for s in BASE_SENSORS},
+                        {mid: MotorState(0.0, 0.0) for mid in MotorId})
+
+    def command(self, speeds: Mapping[MotorId, float]) -> None:
+        pass
+
+    def stop_all(self) -> None:
+        pass
+
+    def truth(self) -> Truth:
+        return Truth(False, None, 0.0, 0.0, 0.0)
+
+    def diagnostics(self) -> dict[str, object]:
+        return {}
+
+    def close(self) -> None:
+        pass
+
+
+class StillClock:
+    def now(self) -> float:
+        return 0.0
+
+    def advance(self, dt: float) -> None:
+        pass
+
+
+def fake_board_result(board: int, msg: m.Message | RawMessage) -> int:
+    """What the Python fake board (a fresh one, leased to the sender, nothing
+    latched, no motor moving) answers ``msg`` with: the Ack's result, or 0
+    (OK) for any other reply."""
+    world = BoardWorld(StandingRobot(), StillClock(), lockstep=True)  # type: ignore[arg-type]
+    fake = make_boards(world)[board]
+    (owner,) = fake.handle([m.Claim(m.LEASE_MS, 7)], 0x2A)
+    assert isinstance(owner, m.Owner) and owner.result == m.ClaimResult.GRANTED
+    (reply, *_) = fake.handle([msg], 0x2A)
+    return reply.result if isinstance(reply, m.Ack) else 0
+
+
+def test_board_checks_match_the_fake_boards(sbtool: Path) -> None:
+    """The C checks against the Python fake boards (an implementation of
+    section 3 of their own; the fake motor board runs the simulation, so it is
+    held against the caps "motor_sim"), over 300 random requests of every
+    type, replies and unknown types among them."""
+    rng = random.Random(3)
+    requests = [c for c in m.MESSAGES.values() if not c.REPLY]
+    msgs: list[m.Message | RawMessage] = []
+    for _ in range(300):
+        if rng.random() < 0.15:
+            msg = random_message(rng)
+        else:
+            cls = rng.choice(requests)
+            names = [f.name for f in dataclasses.fields(cls)]
+            codes = [c for c in cls.FORMAT.lstrip("<") if c != "x"]
+            near = {"channel": (0, 8), "axis": (0, 3), "mask": (0, 255), "timeout_ms": (0, 2)}
+            wide = {"B": (0, 255), "H": (0, 65535), "h": (-32768, 32767), "I": (0, 2**32 - 1),
+                    "i": (-2**31, 2**31 - 1)}
+            msg = cls(*(rng.randint(*near.get(n, wide[c])) for n, c in zip(names, codes,
+                                                                            strict=True)))
+        msgs.append(msg)
+    bodies = [frame_body(Frame(1, 1, (x,), False, 0x2A)).hex() for x in msgs]
+    answers = ask(sbtool, [f"check {caps} {b}" for caps in ("motor_sim", "sensor")
+                           for b in bodies])
+    expected = [f"ok {fake_board_result(board, x)}" for board in (1, 2) for x in msgs]
+    assert answers == expected
