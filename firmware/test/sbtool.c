@@ -184,21 +184,17 @@ static void run(char *cmd)
 {
     char *save = NULL;
     char *verb = strtok_r(cmd, " ", &save);
-    char *rest = verb ? save : NULL;
-    if (verb == NULL) {
-        printf("err usage");
+    if (verb != NULL && strcmp(verb, "enc") == 0) {
+        cmd_enc(save);
         return;
     }
-    if (strcmp(verb, "enc") == 0) {
-        cmd_enc(rest);
-        return;
-    }
-    char *first = strtok_r(NULL, " ", &save);
-    char *second = strtok_r(NULL, " ", &save);
-    long n = first ? unhex(strcmp(verb, "check") == 0 ? (second ? second : "") : first, bytes) : -1;
+    bool check = verb != NULL && strcmp(verb, "check") == 0;
+    char *board = check ? strtok_r(NULL, " ", &save) : NULL;
+    char *hex = strtok_r(NULL, " ", &save);
+    long n = hex ? unhex(hex, bytes) : -1;
     sb_frame f;
     uint8_t body[SB_MAX_BODY];
-    if (n < 0) {
+    if (n < 0 || (check && board == NULL)) {
         printf("err usage");
     } else if (strcmp(verb, "body") == 0) {
         answer_frame(sb_frame_parse(bytes, (size_t)n, &f), &f);
@@ -206,8 +202,8 @@ static void run(char *cmd)
         answer_frame(sb_wire_decode(bytes, (size_t)n, body, &f), &f);
     } else if (strcmp(verb, "stream") == 0) {
         cmd_stream(n);
-    } else if (strcmp(verb, "check") == 0) {
-        cmd_check(first, n);
+    } else if (check) {
+        cmd_check(board, n);
     } else if (strcmp(verb, "crc") == 0) {
         printf("%04x", sb_crc16(bytes, (size_t)n));
     } else {
