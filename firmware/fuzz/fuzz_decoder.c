@@ -187,17 +187,80 @@ static void check_accepted(const uint8_t *body, size_t n, const sb_frame *f, uns
     }
 }
 
+/* A frame's body for mutation m: valid, long, or random bytes. */
+static size_t make_body(int m, uint8_t *body)
+{
+    size_t n;
+    if (m == M_RANDOM_BODY) {
+        n = below(300);
+        for (size_t k = 0; k < n; k++) body[k] = (uint8_t)rnd();
+        if (below(2)) fix_crc(body, n);
+        return n;
+    }
+    if (m == M_LONG) { /* near 247 message bytes (what stuffs in 254) and 255 (the length byte's most) */
+        n = valid_body(body, 40);
+        while (n < SB_MAX_BODY - 10 + below(20)) n = insert(body, n, n - 2, 1);
+        if (below(2)) body[3] = (uint8_t)(n - SB_MIN_BODY);
+        fix_crc(body, n);
+        return n;
+    }
+    return valid_body(body, 6);
+}
+
+/* What goes on the line for mutation m: the body stuffed (its stuffed bytes
+ * flipped, or 01 01 added) or random bytes; its length, 0 when it did not stuff. */
+static size_t make_wire(int m, const uint8_t *body, size_t n, uint8_t *wire)
+{
+    size_t wn = 0;
+    if (m == M_RANDOM_WIRE) {
+        wn = below(300);
+        for (size_t k = 0; k < wn; k++) wire[k] = (uint8_t)(below(8) ? rnd() | 1u : rnd());
+        return wn;
+    }
+    if (sb_cobs_encode(body, n, wire, WIRE_CAP - 2, &wn) != SB_OK) return 0;
+    if (m == M_WIRE_FLIP) {
+        for (uint32_t k = 1 + below(3); k; k--) wire[below((uint32_t)wn)] ^= (uint8_t)(1u << below(8));
+    } else if (m == M_ONE_ONE) {
+        wire[wn++] = 1;
+        wire[wn++] = 1;
+    }
+    return wn;
+}
+
+typedef struct {
+    unsigned long accepted, rejected, body_accepted;
+    unsigned long by_err[SB_ERR_COUNT], by_mutation[M_COUNT], undetected_by[M_COUNT];
+} counts;
+
+static void report(unsigned long frames, const counts *c, const sb_reader *reader)
+{
+    unsigned long undetected = 0;
+    for (int k = 0; k < M_COUNT; k++) undetected += c->undetected_by[k];
+    printf("frames %lu\naccepted %lu\nrejected %lu\nfindings %lu\n", frames, c->accepted,
+           c->rejected, findings);
+    printf("body_accepted %lu\nundetected_corruptions %lu\n", c->body_accepted, undetected);
+    for (int e = 1; e < SB_ERR_COUNT; e++) {
+        if (c->by_err[e]) printf("rejected_%s %lu\n", sb_err_name((sb_err)e), c->by_err[e]);
+    }
+    for (int k = 0; k < M_COUNT; k++) printf("mutation_%s %lu\n", MUTATION[k], c->by_mutation[k]);
+    for (int k = 0; k < M_COUNT; k++) {
+        if (c->undetected_by[k]) printf("undetected_%s %lu\n", MUTATION[k], c->undetected_by[k]);
+    }
+    printf("reader_frames %u\nreader_crc_errors %u\nreader_malformed %u\nreader_overruns %u\n",
+           (unsigned)reader->stats.frames, (unsigned)reader->stats.crc_errors,
+           (unsigned)reader->stats.malformed, (unsigned)reader->stats.overruns);
+}
+
 int main(int argc, char **argv)
 {
     unsigned long frames = argc > 1 ? strtoul(argv[1], NULL, 10) : 1000000UL;
     unsigned long seed = argc > 2 ? strtoul(argv[2], NULL, 10) : 1UL;
-    unsigned long accepted = 0, rejected = 0, body_accepted = 0, undetected = 0;
-    unsigned long undetected_by[M_COUNT] = {0};
-    unsigned long by_err[SB_ERR_COUNT] = {0}, by_mutation[M_COUNT] = {0};
+    static counts c;
     static sb_reader reader;
     uint8_t body[BODY_CAP], orig[BODY_CAP], wire[WIRE_CAP];
-    uint8_t *unstuffed = exact_copy(wire, SB_MAX_BODY); /* exactly what sb_wire_decode may fill */
+    uint8_t *unstuffed = calloc(SB_MAX_BODY, 1); /* exactly what sb_wire_decode may fill */
     sb_frame f;
+    if (unstuffed == NULL) return 2;
     rng_state = seed * 0x9E3779B97F4A7C15ULL + 1;
     for (int t = 0; t < 256; t++) {
         if (sb_type_known((uint8_t)t)) known[n_known++] = (uint8_t)t;
@@ -205,78 +268,47 @@ int main(int argc, char **argv)
     sb_reader_init(&reader);
     for (unsigned long i = 0; i < frames; i++) {
         int m = (int)below(M_COUNT);
-        size_t n = 0, wn = 0;
-        by_mutation[m]++;
-        if (m == M_RANDOM_BODY) {
-            n = below(300);
-            for (size_t k = 0; k < n; k++) body[k] = (uint8_t)rnd();
-            if (below(2)) fix_crc(body, n);
-        } else if (m == M_LONG) { /* a frame near 247 (what stuffs in 254) and 255 message bytes */
-            n = valid_body(body, 40);
-            while (n < SB_MAX_BODY - 10 + below(20)) n = insert(body, n, n - 2, 1);
-            if (below(2)) { body[3] = (uint8_t)(n - SB_MIN_BODY); }
-            fix_crc(body, n);
-        } else {
-            n = valid_body(body, 6);
-        }
-        memcpy(orig, body, n);
-        size_t orig_n = n;
         bool crc_fixed = false;
-        n = mutate(m, body, n, &crc_fixed);
+        c.by_mutation[m]++;
+        size_t orig_n = make_body(m, body);
+        memcpy(orig, body, orig_n);
+        size_t n = mutate(m, body, orig_n, &crc_fixed);
+
         /* the body itself, as a board whose transport hands it bodies would parse it */
         uint8_t *input = exact_copy(body, n);
         if (sb_frame_parse(input, n, &f) == SB_OK) {
-            body_accepted++;
+            c.body_accepted++;
             check_accepted(input, n, &f, i);
         } else if (m == M_NONE) {
             finding("a valid frame was refused", i);
         }
         free(input);
-        if (m == M_RANDOM_WIRE) {
-            wn = below(300);
-            for (size_t k = 0; k < wn; k++) wire[k] = (uint8_t)(below(8) ? rnd() | 1u : rnd());
-        } else if (sb_cobs_encode(body, n, wire, WIRE_CAP, &wn) != SB_OK) {
+
+        /* the line's bytes, decoded alone and fed to one endless stream */
+        size_t wn = make_wire(m, body, n, wire);
+        if (wn == 0 && m != M_RANDOM_WIRE) {
             finding("a body did not stuff", i);
             continue;
-        }
-        if (m == M_WIRE_FLIP) {
-            for (uint32_t k = 1 + below(3); k; k--) wire[below((uint32_t)wn)] ^= (uint8_t)(1u << below(8));
-        } else if (m == M_ONE_ONE) {
-            wire[wn++] = 1;
-            wire[wn++] = 1;
         }
         input = exact_copy(wire, wn);
         sb_err err = sb_wire_decode(input, wn, unstuffed, &f);
         free(input);
         if (err == SB_OK) {
-            accepted++;
-            /* a corruption the CRC let through (about 1 in 65536 of random ones) */
-            bool same = f.msgs_len + (size_t)SB_MIN_BODY == orig_n && memcmp(unstuffed, orig, orig_n) == 0;
+            c.accepted++;
+            /* a corruption the CRC let through (a CRC-16 passes about 1 in 65536) */
+            bool same = f.msgs_len + (size_t)SB_MIN_BODY == orig_n
+                        && memcmp(unstuffed, orig, orig_n) == 0;
             if (!crc_fixed && !same && m != M_NONE && m != M_LONG && m != M_RANDOM_BODY
                 && m != M_RANDOM_WIRE)
-                undetected_by[m]++;
+                c.undetected_by[m]++;
         } else {
-            rejected++;
-            by_err[err]++;
+            c.rejected++;
+            c.by_err[err]++;
         }
-        for (size_t k = 0; k < wn; k++) {
-            if (sb_reader_push(&reader, wire[k], &f)) (void)f;
-        }
-        sb_reader_push(&reader, 0, &f);
+        for (size_t k = 0; k < wn; k++) (void)sb_reader_push(&reader, wire[k], &f);
+        (void)sb_reader_push(&reader, 0, &f);
     }
     free(unstuffed);
-    printf("frames %lu\naccepted %lu\nrejected %lu\nfindings %lu\n", frames, accepted, rejected, findings);
-    for (int k = 0; k < M_COUNT; k++) undetected += undetected_by[k];
-    printf("body_accepted %lu\nundetected_corruptions %lu\n", body_accepted, undetected);
-    for (int e = 1; e < SB_ERR_COUNT; e++) {
-        if (by_err[e]) printf("rejected_%s %lu\n", sb_err_name((sb_err)e), by_err[e]);
-    }
-    for (int k = 0; k < M_COUNT; k++) printf("mutation_%s %lu\n", MUTATION[k], by_mutation[k]);
-    for (int k = 0; k < M_COUNT; k++) {
-        if (undetected_by[k]) printf("undetected_%s %lu\n", MUTATION[k], undetected_by[k]);
-    }
-    printf("reader_frames %u\nreader_crc_errors %u\nreader_malformed %u\nreader_overruns %u\n",
-           (unsigned)reader.stats.frames, (unsigned)reader.stats.crc_errors,
-           (unsigned)reader.stats.malformed, (unsigned)reader.stats.overruns);
+    report(frames, &c, &reader);
     return findings ? 1 : 0;
 }
