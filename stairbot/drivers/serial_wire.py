@@ -56,6 +56,9 @@ FROM_BOARD = 0x80
 FRAMING_3 = 0x10  # always set: the header has a length byte (protocol 3.0)
 MAX_FRAME = 254  # stuffed bytes between delimiters; longer runs are dropped as garbage
 HEADER = 4  # addr, session, seq, len
+MAX_MESSAGE_BYTES = MAX_FRAME - 1 - HEADER - 2
+"""What fits in MAX_FRAME stuffed bytes: COBS adds one byte to a body under 254,
+and the header and CRC take the rest (247)."""
 MIN_BODY = HEADER + 2  # and the crc
 
 
@@ -104,8 +107,9 @@ def frame_body(frame: Frame) -> bytes:
             raise CodecError(f"payload of {len(payload)} bytes, at most {MAX_PAYLOAD}")
         out += bytes((code, len(payload)))
         out += payload
-    if len(out) - HEADER > 0xFF:
-        raise CodecError(f"{len(out) - HEADER} message bytes, at most 255 in a frame")
+    if len(out) - HEADER > MAX_MESSAGE_BYTES:
+        raise CodecError(f"{len(out) - HEADER} message bytes, at most {MAX_MESSAGE_BYTES} in "
+                         "a frame (its stuffed bytes must fit in MAX_FRAME)")
     out[HEADER - 1] = len(out) - HEADER
     out += crc16(bytes(out)).to_bytes(2, "big")
     return bytes(out)

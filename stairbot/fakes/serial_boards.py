@@ -213,8 +213,8 @@ class SerialBoardServer:
             self._write(wire)
 
     def _reply_frame(self, frame: Frame, replies: list[Message]) -> bytes:
-        """The reply frame: the replies that fit in one frame (255 message
-        bytes), in order; a request asking for more has the rest left off
+        """The reply frame: the replies that fit in one frame (247 message
+        bytes, MAX_MESSAGE_BYTES), in order; a request asking for more has the rest left off
         (counted as ``cut``), as a board's fixed reply buffer would."""
         kept = list(replies)
         while True:

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import (
     MAX_FRAME,
+    MAX_MESSAGE_BYTES,
     CodecError,
     CrcError,
     Frame,
@@ -184,3 +185,25 @@ def test_a_byte_added_or_lost_after_the_header_is_never_a_frame(
         st.booleans(), label="fix crc") else bad
     with pytest.raises(CodecError):
         parse_body(bad)
+
+
+def test_a_frame_too_long_to_stuff_into_max_frame_is_never_made() -> None:
+    """247 message bytes stuff into MAX_FRAME (254); one more would make a
+    frame the receiver drops as an overrun when its bytes come one at a
+    time (the C core's cross-check found the sender allowing 255)."""
+    def raw(total: int) -> Frame:
+        msgs, left = [], total
+        while left:
+            n = min(8, left - 2)
+            msgs.append(RawMessage(0x60, bytes(n)))  # a type no table names
+            left -= 2 + n
+        return Frame(1, 1, tuple(msgs), session=9)
+
+    assert MAX_MESSAGE_BYTES == 247
+    wire = encode_frame(raw(247))
+    assert len(wire) - 1 <= MAX_FRAME
+    reader = FrameReader()
+    got = [f for b in wire for f in reader.feed(bytes([b]))]
+    assert len(got) == 1 and reader.stats.overruns == 0, reader.stats
+    with pytest.raises(CodecError, match="at most 247"):
+        encode_frame(raw(257))
