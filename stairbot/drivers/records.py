@@ -323,8 +323,10 @@ class MotorTelemetry(Message):
     turns_mt: int
 
     def fields(self) -> tuple[int, ...]:
-        return ((self.channel & 0x0F) | ((self.mode & 0x0F) << 4), self.fault,
-                self.speed_mtps, self.turns_mt)
+        if not (0 <= self.channel <= 0x0F and 0 <= self.mode <= 0x0F):
+            raise CodecError(f"MotorTelemetry: channel {self.channel} and mode {self.mode} "
+                             "must each fit a nibble (0-15)")
+        return (self.channel | (self.mode << 4), self.fault, self.speed_mtps, self.turns_mt)
 
     @classmethod
     def from_fields(cls, values: tuple[int, ...]) -> MotorTelemetry:

@@ -207,3 +207,12 @@ def test_a_frame_too_long_to_stuff_into_max_frame_is_never_made() -> None:
     assert len(got) == 1 and reader.stats.overruns == 0, reader.stats
     with pytest.raises(CodecError, match="at most 247"):
         encode_frame(raw(257))
+
+
+@pytest.mark.parametrize(("channel", "mode"), [(17, 0), (0, 16), (-1, 0)])
+def test_motor_telemetry_refuses_a_channel_or_mode_its_nibble_cannot_hold(channel: int,
+                                                                           mode: int) -> None:
+    """Channel 17 went out as channel 1 (the C encoder's cross-check)."""
+    with pytest.raises(CodecError, match="nibble"):
+        encode_frame(Frame(1, 1, (m.MotorTelemetry(channel, mode, 0, 0, 0),), from_board=True,
+                           session=9))
