@@ -16,10 +16,10 @@ to the start position by the odometer on the floor.  So on the floor the
 robot first backs BACK_OFF_M off the step (level again: pressed against it
 the pair pitches and reads past the riser), stands until its filtered
 readings stand for where it is, and places the riser again: the slip is how
-much further on it stands now than its nearest place, and the start position
-moves on by that.  A slip larger than the turns driven since the riser last
-stood at its nearest place is no slip (the pair reads another surface now):
-the odometer is kept.
+much further on it stands now than a place it held while the wheels carried
+the robot (:func:`_slip` says which), and the start position moves on by
+that.  No such place (the pair saw over the riser, or reads another surface
+now): the odometer is kept.
 """
 
 from __future__ import annotations
