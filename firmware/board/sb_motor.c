@@ -184,7 +184,8 @@ static sb_msg owner_reply(const sb_motor_board *b, uint8_t result)
     sb_msg o;
     sb_msg_init(&o, SB_OWNER);
     uint32_t left = lease_left_ms(b);
-    uint32_t cs = (left + 5) / 10;
+    uint32_t cs = left / 10, rest = left % 10; /* nearest, a half to even (Python's round) */
+    if (rest > 5 || (rest == 5 && (cs & 1u))) cs++;
     o.body.owner.result = result;
     o.body.owner.session = (left > 0 && b->has_owner) ? b->owner : 0;
     o.body.owner.lease_cs = (uint8_t)(cs > 255 ? 255 : cs);

@@ -22,6 +22,9 @@ void plant_init(plant *p)
 void plant_advance(plant *p, uint32_t t_ms)
 {
     uint32_t dt = t_ms - p->now_ms;
+    if (dt == 0) {
+        return; /* nothing moves in no time: the measured speeds stay those of this instant */
+    }
     p->now_ms = t_ms;
     int16_t limit[SB_MOTORS];
     plant_limits(limit);
