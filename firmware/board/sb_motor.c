@@ -256,7 +256,7 @@ static sb_msg speeds(sb_motor_board *b, uint8_t type, const int16_t v[SB_MOTORS]
     if (r != SB_ACK_OK) return ack(type, r);
     b->commanded_ms = now(b);
     for (uint8_t ch = 0; ch < SB_MOTORS; ch++) {
-        if (mask >> ch & 1u) run_one(b, ch, v[ch]);
+        if (((unsigned)mask >> ch) & 1u) run_one(b, ch, v[ch]);
     }
     return ack(type, SB_ACK_OK);
 }
@@ -283,7 +283,7 @@ static sb_msg stop_or_brake(sb_motor_board *b, uint8_t type, uint8_t mask)
 {
     b->commanded_ms = now(b);
     for (uint8_t ch = 0; ch < SB_MOTORS; ch++) {
-        if (!(mask >> ch & 1u)) continue;
+        if (!(((unsigned)mask >> ch) & 1u)) continue;
         bool brake = type == SB_BRAKE && !is_lift(ch);
         set_one(b, ch, 0, brake ? SB_MODE_BRAKE : SB_MODE_IDLE);
     }

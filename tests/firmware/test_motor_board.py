@@ -451,11 +451,13 @@ def random_request(rng: random.Random) -> m.Message | RawMessage:
 
 
 FRAMES = 4000
+SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
 
 
 def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
         tmp_path: Path) -> None:
-    """4,000 frames of two hosts (sessions 7 and 9, each with its own
+    """The C board built with AddressSanitizer and UBSan (no report), and
+    4,000 frames of two hosts (sessions 7 and 9, each with its own
     sequence numbers, a frame now and then sent again as a retry is), with
     the clock moving 0 to 400 ms between them: every reply frame the same,
     field by field, but Owner.lease_cs (the fake rounds a float: within 1);
@@ -467,11 +469,15 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
         pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
     exe = tmp_path / "sbboard"
     sources = [str(p) for d in ("core", "board") for p in sorted((FIRMWARE / d).glob("*.c"))]
-    subprocess.run([cc, "-std=c11", "-O2", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion",
-                    "-Wshadow", "-Werror", *(f"-I{FIRMWARE / d}" for d in ("core", "board",
-                                                                          "native")),
-                    *sources, str(FIRMWARE / "native" / "plant.c"),
-                    str(FIRMWARE / "test" / "sbboard.c"), "-o", str(exe)], check=True)
+    built = subprocess.run([cc, "-std=c11", "-O1", "-g", *SANITIZE, "-Wall", "-Wextra",
+                            "-Wpedantic", "-Wconversion", "-Wshadow", "-Werror",
+                            *(f"-I{FIRMWARE / d}" for d in ("core", "board", "native")),
+                            *sources, str(FIRMWARE / "native" / "plant.c"),
+                            str(FIRMWARE / "test" / "sbboard.c"), "-o", str(exe)],
+                           capture_output=True, text=True, check=False)
+    if built.returncode != 0 and "sanitize" in built.stderr:
+        pytest.skip(f"{cc} cannot build with {' '.join(SANITIZE)}: {built.stderr.strip()}")
+    assert built.returncode == 0, built.stderr
     boot, lift_mt = 0xB007, 103_000  # the lifts start 2 turns from the ends of their stroke
     robot = PlantRobot(lift_mt)
     world = BoardWorld(robot, PlantClock(robot))  # type: ignore[arg-type]
@@ -496,8 +502,9 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
         commands += [f"t {t_ms}", f"w {wire.hex()}"]
         frames.append((t_ms, wire))
     with subprocess.Popen([str(exe), str(boot), str(lift_mt)], stdin=subprocess.PIPE,
-                          stdout=subprocess.PIPE, text=True) as proc:
-        out, _ = proc.communicate("".join(c + "\n" for c in commands), timeout=60)
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+        out, err = proc.communicate("".join(c + "\n" for c in commands), timeout=60)
+    assert proc.returncode == 0 and not err, err  # no sanitizer report
     answers = out.splitlines()[1::2]
     assert len(answers) == len(frames)
     seen: set[str] = set()
