@@ -7,6 +7,8 @@
  *   w HEX       stuffed bytes (with their delimiters), fed one by one   -> HEX... of the
  *               reply frames (stuffed, delimited), or "-" for none
  *   b 0|1       the e-stop input released or pressed                   -> ok
+ *   s           the plant: each motor's position (micro-turns), then each
+ *               motor's commanded speed (milli-turns/s)                 -> 12 numbers
  *
  * Started as "sbboard BOOT [LIFT_MT]": Owner.boot is BOOT (decimal); the
  * lifts start at +LIFT_MT (MTF) and -LIFT_MT (MTB) milli-turns, near the
@@ -69,6 +71,10 @@ int main(int argc, char **argv)
                 any = any || n > 0;
             }
             puts(any ? "" : "-");
+        } else if (line[0] == 's') {
+            for (int ch = 0; ch < SB_MOTORS; ch++) printf("%lld ", (long long)world.position_umt[ch]);
+            for (int ch = 0; ch < SB_MOTORS; ch++) printf("%d ", world.command[ch]);
+            puts("");
         } else {
             puts("err command");
         }
