@@ -241,8 +241,9 @@ class StairbotConsole(App[None]):
                            "control)", "information")
                 return
             why = _why(exc)
-            message = f"cannot open {why}" if why.startswith(f"{url}: ") else \
-                f"cannot open {url}: {why}"
+            message = why if why.startswith("cannot open ") else \
+                f"cannot open {why}" if why.startswith(f"{url}: ") else \
+                f"cannot open {url}: {why}"  # said once: 80x24 keeps the banner one line
             self._tell(message, "error")
             if previous is not None and self.engine.session is None and previous != (url,
                                                                                        scenario):
