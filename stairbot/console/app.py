@@ -145,6 +145,8 @@ class StairbotConsole(App[None]):
         self.screen_rows: int | None = None  # the screen's height, as the last resize said
         self.graphs: bool | None = None
         """The operator's choice of graphs (g); None: by the screen's size."""
+        self.own_config: RobotConfig | None = None
+        """The console's own config while fake boards' is borrowed (console/board_robot.py)."""
 
     # -- layout ------------------------------------------------------------------
     def compose(self) -> ComposeResult:
