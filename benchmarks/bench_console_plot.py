@@ -14,7 +14,11 @@ from the measured cost), and the share of the UI thread those redraws take
 at that rate; and, for comparison, the share a redraw at every refresh of
 the screen (REFRESH_HZ) would take.
 
-    python benchmarks/bench_console_plot.py [--rounds N]
+    python benchmarks/bench_console_plot.py [--rounds N] [--noisy]
+
+``--noisy``: distances that jump every reading (a sawtooth, as a sensor
+that flickers between a tread and the floor), which plotext draws as many
+long vertical strokes: its dearest case.
 """
 
 from __future__ import annotations
@@ -38,10 +42,12 @@ TICK_S = 0.02
 PICKED = ("SFR", "SFL", "MTF.lift", "MTB.lift")
 
 
-def reading(t: float) -> Snapshot:
+def reading(t: float, noisy: bool = False) -> Snapshot:
     """A reading at robot time ``t``: distances that rise and fall over a
-    step (a riser passing under them), lifts that move up and down."""
-    sensors = {s: SensorReading(0.2 + 0.1 * math.sin(t / (2 + i)))
+    step (a riser passing under them; ``noisy``: a sawtooth that jumps every
+    reading), lifts that move up and down."""
+    sensors = {s: SensorReading(0.2 + 0.1 * ((t * 7.3 * (i + 1)) % 1.0 if noisy
+                                             else math.sin(t / (2 + i))))
                for i, s in enumerate(SensorId) if s.value in ("SFR", "SFL", "SBR", "SBL")}
     motors = {m: MotorState(5 * math.sin(t / (4 + i)), speed_tps=0.5)
               for i, m in enumerate(MotorId)}
@@ -61,7 +67,7 @@ def median_max(xs: list[float]) -> str:
     return f"median {statistics.median(xs) * 1000:6.1f} ms, max {max(xs) * 1000:6.1f} ms"
 
 
-async def measure(size: tuple[int, int], rounds: int) -> None:
+async def measure(size: tuple[int, int], rounds: int, noisy: bool) -> None:
     app = Bench()
     readings: list[Reading] = []
     async with app.run_test(size=size) as pilot:
@@ -69,14 +75,14 @@ async def measure(size: tuple[int, int], rounds: int) -> None:
         panel = app.panel
         config = load_config()
         n = int(WINDOW_S / TICK_S)
-        snaps = [reading(i * TICK_S) for i in range(n)]
+        snaps = [reading(i * TICK_S, noisy) for i in range(n)]
         known = by_key(catalogue(snaps, config.motors.lift_travel_per_turn))
         picked = tuple(known[k] for k in PICKED)
         readings = [(s.time_s, s) for s in snaps]
         shows: list[float] = []
         builds: list[float] = []
         for r in range(rounds):
-            more = reading((n + r) * TICK_S)
+            more = reading((n + r) * TICK_S, noisy)
             readings = readings[1:] + [(more.time_s, more)]
             panel.redraw()
             t0 = time.thread_time()
@@ -90,8 +96,8 @@ async def measure(size: tuple[int, int], rounds: int) -> None:
         cost = statistics.median(shows) + statistics.median(builds)
         period = panel.period_for(cost)
         w, h = panel.plot.size
-        print(f"{size[0]}x{size[1]} (plot {w}x{h}), {len(readings)} readings, "
-              f"{len(picked)} signals, {rounds} rounds:")
+        print(f"{size[0]}x{size[1]} (plot {w}x{h}), {len(readings)} "
+              f"{'noisy ' if noisy else ''}readings, {len(picked)} signals, {rounds} rounds:")
         print(f"  show  {median_max(shows)}")
         print(f"  build {median_max(builds)}")
         print(f"  throttle: at most one redraw every {period:.2f} s "
@@ -103,9 +109,11 @@ async def measure(size: tuple[int, int], rounds: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=20)
+    parser.add_argument("--noisy", action="store_true",
+                        help="distances that jump every reading (plotext's dearest case)")
     args = parser.parse_args()
     for size in ((80, 24), (160, 50)):
-        asyncio.run(measure(size, args.rounds))
+        asyncio.run(measure(size, args.rounds, args.noisy))
 
 
 if __name__ == "__main__":
