@@ -145,6 +145,8 @@ class StairbotConsole(App[None]):
         self.screen_rows: int | None = None  # the screen's height, as the last resize said
         self.graphs: bool | None = None
         """The operator's choice of graphs (g); None: by the screen's size."""
+        self.own_config: RobotConfig | None = None
+        """The console's own config while fake boards' is borrowed (console/board_robot.py)."""
 
     # -- layout ------------------------------------------------------------------
     def compose(self) -> ComposeResult:
@@ -241,8 +243,9 @@ class StairbotConsole(App[None]):
                            "control)", "information")
                 return
             why = _why(exc)
-            message = f"cannot open {why}" if why.startswith(f"{url}: ") else \
-                f"cannot open {url}: {why}"
+            message = why if why.startswith("cannot open ") else \
+                f"cannot open {why}" if why.startswith(f"{url}: ") else \
+                f"cannot open {url}: {why}"  # said once: 80x24 keeps the banner one line
             self._tell(message, "error")
             if previous is not None and self.engine.session is None and previous != (url,
                                                                                        scenario):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from stairbot.console import board_robot
 from stairbot.console.connect_screen import ConnectScreen
 from stairbot.console.modals import AskScreen, Notice
 from stairbot.console.paint import lay_out, tall
@@ -32,18 +33,17 @@ def choose_robot(app: StairbotConsole) -> None:
         return
 
     def chosen(url: str | None) -> None:
-        if url:
-            app.open_robot(url, app.scenario)
+        if url:  # fake boards of another robot: a question first
+            board_robot.open_chosen(app, url, manager.listing)
 
-    app.push_screen(ConnectScreen(app.url, sim_line(app)), chosen)
+    manager = ConnectScreen(app.url, sim_line(app))
+    app.push_screen(manager, chosen)
 
 
 def sim_line(app: StairbotConsole) -> str:
     """What ``sim://`` opens in this console: its robot (set at start: the
     panels are built for it) on the scenario ``o`` chooses."""
-    source = app.engine.config.source
-    robot = "reference" if source.startswith("<default") else \
-        source.removeprefix("<robot ").removesuffix(">")
+    robot = board_robot.robot_name(board_robot.own_config(app))
     return (f"{robot} robot, {app.scenario or 'default'} stairs (o: the stairs; "
             f"another robot: stairbot console --config {'|'.join(shipped('configs'))})")
 

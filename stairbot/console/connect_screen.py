@@ -3,7 +3,8 @@ one line each (console/connections.py), and a URL field for anything not
 listed.  Enter on a row, or on the field, dismisses with that URL, which
 the console opens the way it opens every URL (``StairbotConsole.open_robot``:
 a bad one is a message and the robot open before stays); Escape dismisses
-with None and nothing changes; ``r`` (outside the field), F5 or the button
+with None and nothing changes; Enter on an empty field says what it
+wants (:data:`EMPTY`) and the manager stays; ``r`` (outside the field), F5 or the button
 looks again.  Looking runs on a worker thread: a slow source never holds
 the screen, nor the emergency stop key, which the app takes before any
 screen sees it.
@@ -28,6 +29,8 @@ from stairbot.console.connections import GROUPS, Listing
 EXAMPLES = "sim://  serial://PORT?baud=N  can://IF/CHANNEL"
 SHOWN_URL = 100
 """A URL longer than this is shown cut (the row opens it whole)."""
+EMPTY = "enter a URL or pick one from the list"
+"""What Enter on an empty URL field says (the manager stays open)."""
 NOTES_ROWS = 4
 """The rows the problems found have under the list."""
 
@@ -64,6 +67,8 @@ class ConnectScreen(ModalScreen[str | None]):
     ConnectScreen #robots { height: 1fr; min-height: 3; }
     ConnectScreen #connect-notes { color: $warning; height: auto; max-height: 4; }
     ConnectScreen #connect-notes.empty { display: none; }
+    ConnectScreen #connect-why { color: $warning; width: 100%; height: auto; }
+    ConnectScreen #connect-why.empty { display: none; }
     ConnectScreen .hint { color: $text-muted; width: 100%; }
     ConnectScreen .buttons { height: 1; align: center middle; }
     ConnectScreen Button { margin: 0 2; }
@@ -88,6 +93,7 @@ class ConnectScreen(ModalScreen[str | None]):
             yield OptionList(id="robots")
             yield Static("", id="connect-notes", classes="empty", markup=False)
             yield Input(value=self.current, placeholder=EXAMPLES, id="url")
+            yield Static("", id="connect-why", classes="empty", markup=False)
             yield Label("Enter opens the row, or the URL typed below · r/F5 looks again · "
                         "Esc closes · space is the EMERGENCY STOP even here: no spaces",
                         classes="hint", markup=False)
@@ -163,7 +169,21 @@ class ConnectScreen(ModalScreen[str | None]):
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         event.stop()
-        self.dismiss(event.value.strip())
+        url = event.value.strip()
+        if not url:
+            self.why(EMPTY)
+            return
+        self.dismiss(url)
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        if event.value.strip():
+            self.why("")
+
+    def why(self, words: str) -> None:
+        """Say under the field why Enter did not open it ("": nothing)."""
+        line = self.query_one("#connect-why", Static)
+        line.update(words)
+        line.set_class(not words, "empty")
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         event.stop()

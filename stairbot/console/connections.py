@@ -55,6 +55,9 @@ class Entry:
     group: str
     url: str
     description: str
+    robot: str | None = None
+    """Fake boards: the robot they simulate, as they registered (a shipped
+    name or a config file)."""
 
 
 @dataclass
@@ -98,7 +101,7 @@ def _fake_boards(out: Listing) -> None:
         since = time.strftime("%H:%M:%S", time.localtime(b.started))
         out.entries.append(Entry("Fake boards", b.url,
                                  f"pid {b.pid} since {since}, {b.config} robot, "
-                                 f"{b.scenario} stairs ({b.serials})"))
+                                 f"{b.scenario} stairs ({b.serials})", robot=b.config))
 
 
 def _serial_ports(out: Listing, comports: Callable[[], Any]) -> None:

@@ -13,8 +13,9 @@ from rich.text import Text
 
 from stairbot.console.freshness import age_words, is_stale
 from stairbot.console.limp_gate import limping_words
+from stairbot.console.roomy import message_rows
 from stairbot.console.state import StateView
-from stairbot.console.widgets.banner import liveness
+from stairbot.console.widgets.banner import MESSAGE_LINES, liveness
 from stairbot.console.words import carried_by
 from stairbot.hardware import MotorId
 from stairbot.views.reckon import dead_reckon
@@ -74,6 +75,8 @@ def lay_out(app: StairbotConsole, rows: int | None = None,
 def show(app: StairbotConsole, v: StateView) -> None:
     """Every panel, from ``v`` (a copy of the live state)."""
     age = v.read_age_s
+    # the right column stays whole (a fault's reason keeps two lines)
+    app.banner.room = message_rows(app, MESSAGE_LINES, fault=v.status.robot == "fault")
     app.banner.show(v.url, v.scenario, v.status, v.recording,
                     limping_words(v.limping) if v.limping else "",
                     "" if app.replaying else liveness(age, v.status), v.boards,

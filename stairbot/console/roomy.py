@@ -40,6 +40,23 @@ def right_rows(app: StairbotConsole) -> int:
     return rows + 1 + app.link.lines_shown
 
 
+FAULT_LINES = 2
+"""The least lines a FAULT's message keeps (the robot cannot be read or
+opened: its reason is the news, and the link's figures are not live)."""
+
+
+def message_rows(app: StairbotConsole, most: int, *, fault: bool = False) -> int:
+    """How many lines the banner's message may take (at most ``most``, at
+    least one, or FAULT_LINES for a ``fault``) and leave every line of the
+    right column on the screen: the screen's rows less the footer, the
+    banner's strip and the right column's panels (80x24: one line; the rest
+    of a longer message is in the event list)."""
+    rows = app.screen_rows if app.screen_rows is not None else app.size.height
+    if app.sensors.outer_size.height == 0:  # not laid out yet: nothing to go by
+        return most
+    return min(most, max(FAULT_LINES if fault else 1, rows - 2 - right_rows(app)))
+
+
 class Roomy:
     """The layout of ``#main``, kept as the panels grow: the right column's
     row keeps the most rows its panels have needed since the screen's size

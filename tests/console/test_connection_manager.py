@@ -324,3 +324,27 @@ def test_a_registry_full_of_junk_says_how_many_problems_it_cannot_show(
             rows = [strip.text for strip in box.render_lines(box.content_region.reset_offset)]
             assert rows[-1].strip() == shown[-1], rows  # the count is on screen, not cut
     asyncio.run(go())
+
+
+def test_enter_on_an_empty_url_field_says_why_and_keeps_the_manager(own_dirs: Path) -> None:
+    """Issue 35's closing note: an empty field and Enter closed the manager
+    without a word."""
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            screen = await open_manager(pilot)
+            await type_into(pilot, "   ")
+            await pilot.pause(0.2)
+            assert app.screen is screen  # still open
+            why = str(screen.query_one("#connect-why").render())
+            assert why == "enter a URL or pick one from the list"
+            assert screen.query_one("#connect-why").display
+            assert app.url == "sim://"
+            field = screen.query_one(Input)
+            assert field.has_focus  # typing goes on where it was
+            await press(pilot, "x")
+            await until(pilot, lambda: not screen.query_one("#connect-why").display,
+                        "the line goes once something is typed")
+            assert app.screen is screen and field.value.strip() == "x"
+    asyncio.run(go())

@@ -21,6 +21,7 @@ from stairbot.console.markers import markers_of, step
 from stairbot.console.plot_picker import PlotPicker
 from stairbot.console.replay_app import build_replay_app
 from stairbot.console.signals import Samples, catalogue, fits, thin
+from stairbot.console.widgets.plots import MIN_PERIOD_S
 from stairbot.control.robot_config import load_config
 from stairbot.events import Event, EventKind
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
@@ -130,7 +131,9 @@ def test_picked_signals_are_plotted_with_their_names_units_and_the_states_values
             read(app, robot, *(snap(10 + i * 0.1, sfr=0.2 + i / 100, mwf_speed=i / 2)
                                for i in range(1, 6)))
             await until(pilot, lambda: len(panel.shown) == 3 and panel.shown[0].xs[-1] == 10.5,
-                        "the plot drawn")
+                        "the legend")
+            # the lines, within the throttle's period
+            await until(pilot, lambda: panel.drawn[0][0][-1:] == [10.5], "the plot drawn")
             sfr, mwf, mwb = panel.shown
             state = app.state.view().snapshot
             assert state is not None
@@ -222,6 +225,55 @@ def test_a_stale_signal_says_stale_and_is_not_drawn_on() -> None:
             assert panel.plain_legend.count("STALE") == 2
             assert all(s.stale for s in panel.shown)
             assert len(panel.shown[1].xs) == points and panel.shown[1].xs[-1] == 20.4
+    asyncio.run(go())
+
+
+def test_the_plot_redraws_at_most_once_a_period_and_says_stale_at_once() -> None:
+    """Many readings a refresh: the legend follows each at once, the lines
+    (plotext's costly build) at most once a throttle period of the panel's
+    clock, and not at all while the panel is hidden; a stale signal says
+    STALE in the legend at once, the throttle holding its lines."""
+    robot, ages, clock = ScriptedRobot(snap(0.0)), [0.0], [1000.0]
+
+    async def go() -> None:
+        app = scripted_app(robot, ages)
+        panel = app.plotting.panel
+        panel.clock = lambda: clock[0]
+        async with app.run_test(size=(100, 40)) as pilot:
+            await ready(pilot)
+            await pick(pilot, app, "SFR", "SFL")
+            await until(pilot, lambda: panel.draws >= 1 and panel.plot.builds >= 1, "drawn")
+            await pilot.pause(0.3)
+            draws, builds = panel.draws, panel.plot.builds
+            assert panel.period_s >= MIN_PERIOD_S
+            for i in range(1, 301):  # 300 readings, 10 between two refreshes
+                read(app, robot, snap(30 + i * 0.02, sfr=0.2 + i / 10000))
+                if i % 10 == 0:
+                    await pilot.pause(0.1)
+            await until(pilot, lambda: "SFR 0.230 m" in panel.plain_legend,
+                        "the legend at the last reading")
+            await pilot.pause(0.3)
+            assert panel.draws == draws  # the clock stood still: no lines drawn
+            assert panel.plot.builds == builds
+            # a stale sensor: STALE in the legend at once, the lines held back
+            read(app, robot, snap(36.1, sfr_age=STALE_S + 1))
+            await until(pilot, lambda: "SFR 0.300 m STALE" in panel.plain_legend, "STALE")
+            assert panel.draws == draws and panel.plot.builds == builds
+            # a period later, the lines held back are drawn, once
+            clock[0] += panel.period_s
+            await until(pilot, lambda: panel.draws == draws + 1, "the lines caught up")
+            await until(pilot, lambda: panel.plot.builds == builds + 1, "plotext built them")
+            assert panel.drawn[0][0][-1] == 36.1
+            await pilot.pause(0.3)
+            assert panel.draws == draws + 1  # nothing new: nothing drawn
+            # hidden (g): nothing drawn, whatever comes and however long
+            await press(pilot, "g")
+            await until(pilot, lambda: not panel.display, "the plot hidden")
+            for i in range(1, 51):
+                read(app, robot, snap(40 + i * 0.02))
+            clock[0] += 100.0
+            await pilot.pause(0.5)
+            assert panel.draws == draws + 1 and panel.plot.builds == builds + 1
     asyncio.run(go())
 
 

@@ -2,7 +2,10 @@
 live, always (the run's state and latch, then LIVE/DOWN and the age of the
 last reading, the boards, the URL: cut at the screen's edge, never wrapped);
 under it, while there is one, the one thing the operator must know now (an
-emergency stop, a lost link, how the run ended), whole up to four lines; a
+emergency stop, a lost link, how the run ended), whole up to four lines, or
+fewer where the screen has no more rows to spare (:attr:`Banner.room`:
+80x24 keeps one, so the right column's panels stay on the screen; a
+FAULT's reason two); a
 longer one is cut there, and told whole to ``told`` (the event list) once."""
 
 from __future__ import annotations
@@ -20,6 +23,9 @@ SEVERITY_CLASSES = ("-info", "-good", "-warning", "-error", "-estop")
 MESSAGE_LINES = 4
 """The banner's lines for its message, under the strip (its max-height: 5)."""
 CUT = " … (whole in the events)"
+CUT_SHORT = " …"
+"""The cut of a message kept to one line (80x24), where every column counts;
+the message is the event list's newest line, whole."""
 
 
 def liveness(age_s: float | None, status: RunStatus) -> str:
@@ -104,6 +110,8 @@ class Banner(Static):
         self._last: object = None
         self.plain = ""  # the text shown, for tests and logs
         self.strip = ""  # its first line
+        self.room = MESSAGE_LINES
+        """The lines the message may take now (console/roomy.py: message_rows)."""
 
     def show(self, url: str, scenario: str, status: RunStatus, recording: str | None = None,
              degraded: str = "", link: str = "", boards: str = "", replay: bool = False,
@@ -113,7 +121,7 @@ class Banner(Static):
         ``watching``: another console controls the robot shown."""
         width = self.content_region.width
         key = (url, scenario, status, recording, degraded, link, boards, replay, watching,
-               width)
+               width, self.room)
         if key == self._last:
             return
         self._last = key
@@ -147,18 +155,23 @@ class Banner(Static):
         self.add_class("-estop" if status.estopped else f"-{status.severity}")
 
     def _fit(self, message: Text, width: int, status: RunStatus) -> Text:
-        """``message`` whole if it wraps to MESSAGE_LINES at ``width``; else its
-        first lines, the last ending in CUT, and the whole told once."""
+        """``message`` whole if it wraps to :attr:`room` lines at ``width``;
+        else its first lines, the last ending in CUT, and the whole told once."""
         if width <= len(CUT) + 1:
             return message
         lines = message.wrap(self.app.console, width)
-        if len(lines) <= MESSAGE_LINES:
+        room = max(1, min(self.room, MESSAGE_LINES))
+        if len(lines) <= room:
             return message
-        last = lines[MESSAGE_LINES - 1]
-        last.truncate(width - len(CUT))
+        last = lines[room - 1]
+        cut = CUT if room > 1 else CUT_SHORT
+        if room == 1:  # the line as the width holds it, not as it wrapped
+            last = message.copy()
+            last.no_wrap = True
+        last.truncate(width - len(cut))
         last.rstrip()
-        last.append(CUT)
+        last.append(cut)
         if self._told is not None and self._cut != status.message:
             self._cut = status.message
             self._told(status.message, status.severity)
-        return Text("\n").join([*lines[:MESSAGE_LINES - 1], last])
+        return Text("\n").join([*lines[:room - 1], last])

@@ -13,15 +13,25 @@ STALE, as every panel of robot values does.
 
 In a replay a timeline stands under the plot: the whole recording, its
 errors, pauses and phase changes marked (console/markers.py), the position
-on it."""
+on it.
+
+plotext draws the plot into text on the UI thread, and that costs tens of
+milliseconds on a large terminal (``python benchmarks/bench_console_plot.py``),
+time the UI thread does not spend elsewhere.  So the lines are drawn at most
+once a :meth:`PlotPanel.period_for` of the measured cost of the last
+redraw: :data:`PLOT_SHARE` of the UI thread at most, never more often than
+every :data:`MIN_PERIOD_S`.  The legend and the title (the values, STALE)
+follow every reading at once: they cost little.  A hidden panel draws
+nothing (console/plotting.py does not hand it readings)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 
 from rich.text import Text
-from textual.app import ComposeResult
+from textual.app import ComposeResult, RenderResult
 from textual.containers import Vertical
 from textual.widgets import Static
 from textual_plotext import PlotextPlot
@@ -34,6 +44,14 @@ COLOURS: tuple[tuple[int, int, int], ...] = (
     (0, 200, 220), (255, 150, 0), (220, 80, 220), (90, 210, 90))
 """Each picked signal's line and legend colour, in the order picked."""
 STALE_COLOUR = (128, 128, 128)
+PLOT_SHARE = 0.1
+"""The largest share of the UI thread's time the plot's redraws may take."""
+MIN_PERIOD_S = 0.25
+"""The lines are redrawn at most this often (4 a second), however cheap."""
+MAX_PERIOD_S = 2.0
+"""...and at least this often while readings come, however dear."""
+CATCH_UP_S = 0.1
+"""How often the panel looks whether lines held back by the throttle are due."""
 DIGITS = {"m": 3, "mm": 0, "°": 1, "°/s": 1, "turn/s": 2, "turns": 2, "ms": 1,
           "frames/s": 0, "count": 0}
 
@@ -45,6 +63,25 @@ def value_words(value: float | None, unit: str) -> str:
     if math.isnan(value):
         return "ERROR"
     return f"{value:.{DIGITS.get(unit, 2)}f}{'' if unit == '°' else ' '}{unit}"
+
+
+class TimedPlot(PlotextPlot):
+    """plotext's widget, counting its builds and timing the last one in CPU
+    time of the thread that draws (the UI thread)."""
+
+    def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
+        super().__init__(id=id)
+        self.builds = 0
+        """How many times plotext drew the plot into text."""
+        self.build_s = 0.0
+        """What the last build cost (CPU seconds of the UI thread)."""
+
+    def render(self) -> RenderResult:
+        start = time.thread_time()
+        out = super().render()
+        self.builds += 1
+        self.build_s = time.thread_time() - start
+        return out
 
 
 class PlotPanel(Vertical):
@@ -60,11 +97,14 @@ class PlotPanel(Vertical):
     PlotPanel .plot-timeline { height: 2; display: none; }
     """
 
-    def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
+    def __init__(self, *, id: str | None = None,  # noqa: A002
+                 clock: Callable[[], float] = time.monotonic) -> None:
         super().__init__(id=id)
+        self.clock = clock
+        """The clock the throttle goes by (seconds; a test moves its own)."""
         self.border_title = titled("plots", None)
         self.legend = Static("", classes="plot-legend", markup=False)
-        self.plot = PlotextPlot(id="plot")
+        self.plot = TimedPlot(id="plot")
         self.timeline = Static("", classes="plot-timeline", markup=False)
         self.shown: tuple[Series, ...] = ()
         """The signals' series as last shown, for the legend (and tests)."""
@@ -74,6 +114,36 @@ class PlotPanel(Vertical):
         self.plain_legend = ""
         self.plain_timeline = ""
         self._last: object = None
+        self.draws = 0
+        """How many times the lines were handed to plotext (each a build)."""
+        self.drawn_at: float | None = None
+        """When (:attr:`clock`) the lines were last handed over (None: not yet)."""
+        self.show_s = 0.0
+        """What the last handover cost (CPU seconds)."""
+        self._owed: Sequence[Reading] | None = None
+        """Readings the throttle held back: drawn once :meth:`due`."""
+
+    def on_mount(self) -> None:
+        self.set_interval(CATCH_UP_S, self._catch_up)
+
+    @staticmethod
+    def period_for(cost_s: float) -> float:
+        """The least time between two redraws that cost ``cost_s`` each, so
+        they take at most PLOT_SHARE of the UI thread."""
+        return min(max(cost_s / PLOT_SHARE, MIN_PERIOD_S), MAX_PERIOD_S)
+
+    @property
+    def period_s(self) -> float:
+        """The throttle's period now, by what the last redraw cost."""
+        return self.period_for(self.show_s + self.plot.build_s)
+
+    def due(self) -> bool:
+        """Whether the lines may be drawn again now."""
+        return self.drawn_at is None or self.clock() - self.drawn_at >= self.period_s
+
+    def _catch_up(self) -> None:
+        if self._owed is not None and self.display and self.due():
+            self._draw(self._owed)
 
     def compose(self) -> ComposeResult:
         yield self.legend
@@ -81,8 +151,10 @@ class PlotPanel(Vertical):
         yield self.timeline
 
     def redraw(self) -> None:
-        """Draw at the next :meth:`show`, even if nothing changed."""
+        """Draw at the next :meth:`show`, even if nothing changed, and the
+        lines at once (new signals picked)."""
         self._last = None
+        self.drawn_at = None
 
     def show(self, picked: Sequence[Signal], readings: Sequence[Reading],
              read_age_s: float | None) -> None:
@@ -99,7 +171,10 @@ class PlotPanel(Vertical):
         self.set_class(stale, "-stale")
         self.shown = tuple(series(s, readings, read_age_s) for s in picked)
         self._legend()
-        self._draw(readings)
+        if self.due():
+            self._draw(readings)
+        else:
+            self._owed = readings
 
     def _legend(self) -> None:
         """One entry a signal, as many a line as the width holds (an entry is
@@ -127,6 +202,11 @@ class PlotPanel(Vertical):
         self.plain_legend = out.plain
 
     def _draw(self, readings: Sequence[Reading]) -> None:
+        """Hand the lines to plotext (it draws them at the next refresh)."""
+        start = time.thread_time()
+        self._owed = None
+        self.drawn_at = self.clock()
+        self.draws += 1
         plt = self.plot.plt
         plt.clear_data()
         units = units_of(s.signal for s in self.shown)
@@ -147,6 +227,7 @@ class PlotPanel(Vertical):
             first, last = readings[0][0], readings[-1][0]
             plt.xlim(first, last if last > first else first + 1.0)
         self.plot.refresh()
+        self.show_s = time.thread_time() - start
 
     def show_timeline(self, markers: Sequence[Marker], start_s: float, end_s: float,
                       position: float) -> None:
