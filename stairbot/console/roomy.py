@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from stairbot.console.widgets.banner import MESSAGE_LINES
+
 if TYPE_CHECKING:
     from stairbot.console.app import StairbotConsole
 
@@ -40,9 +42,10 @@ def right_rows(app: StairbotConsole) -> int:
     return rows + 1 + app.link.lines_shown
 
 
-FAULT_LINES = 2
-"""The least lines a FAULT's message keeps (the robot cannot be read or
-opened: its reason is the news, and the link's figures are not live)."""
+FAULT_LINES = MESSAGE_LINES
+"""The lines a FAULT's message keeps, whatever the screen: the robot cannot
+be read or opened, its reason is the news (an operator must read why, whole),
+and the link's figures are not live."""
 
 
 def message_rows(app: StairbotConsole, most: int, *, fault: bool = False) -> int:

@@ -29,7 +29,7 @@ def test_a_message_too_long_for_the_banner_is_whole_in_the_events_console_defect
             await until(pilot, lambda: "FAULT" in app.banner.plain, "the refusal")
             await pilot.pause(0.3)
             lines = app.banner.plain.split("\n")
-            room = app.banner.room  # 80x24: what the right column leaves, or a fault's 2
+            room = app.banner.room  # a fault's: all four lines, at 80x24 too
             assert room == (MESSAGE_LINES if rows == 30 else FAULT_LINES)
             cut = CUT if room > 1 else CUT_SHORT
             assert len(lines) == 1 + room and lines[-1].endswith(cut), lines

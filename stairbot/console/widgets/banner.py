@@ -5,7 +5,7 @@ under it, while there is one, the one thing the operator must know now (an
 emergency stop, a lost link, how the run ended), whole up to four lines, or
 fewer where the screen has no more rows to spare (:attr:`Banner.room`:
 80x24 keeps one, so the right column's panels stay on the screen; a
-FAULT's reason two); a
+FAULT's reason keeps all four); a
 longer one is cut there, and told whole to ``told`` (the event list) once."""
 
 from __future__ import annotations
