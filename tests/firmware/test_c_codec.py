@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import random
-import shutil
 import subprocess
 import sys
 from collections.abc import Mapping
@@ -24,9 +22,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from firmware_build import find_cc
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import (
+    MAX_MESSAGE_BYTES,
     CodecError,
     CrcError,
     Frame,
@@ -49,16 +49,6 @@ VECTORS: dict[str, Any] = json.loads(
     resources.files("stairbot.drivers").joinpath("vectors_serial.json").read_text())
 BY_NAME = {c.__name__: c for c in m.MESSAGES.values()}  # with the simulation's (sim)
 assert sim.StepTo.__name__ in BY_NAME
-MAX_MSG_BYTES = 247  # what stuffs into 254 bytes: docs/protocol.md, section 5
-
-
-def find_cc() -> str | None:
-    names = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
-    for name in names:
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
 
 
 @pytest.fixture(scope="module")
@@ -179,7 +169,7 @@ def random_frame(rng: random.Random) -> Frame:
     for _ in range(rng.randint(1, 30)):
         msg = random_message(rng)
         n = 2 + len(msg.payload if isinstance(msg, RawMessage) else m.encode(msg)[1])
-        if size + n > MAX_MSG_BYTES:
+        if size + n > MAX_MESSAGE_BYTES:
             break
         msgs.append(msg)
         size += n
@@ -271,7 +261,7 @@ def test_a_frame_stuffs_into_254_bytes(sbtool: Path) -> None:
     """The writer fills a frame up to 247 message bytes, which stuff into 254
     with the delimiter after them; the decoder refuses a longer run."""
     big = Frame(1, 1, (m.Status(1, 1, 1, 1),) * 24 + (m.Heartbeat(1), m.Ack(1, 2)), True)
-    assert len(frame_body(big)) - 6 == MAX_MSG_BYTES
+    assert len(frame_body(big)) - 6 == MAX_MESSAGE_BYTES
     over = Frame(1, 1, big.messages + (m.Identify(),), True)
     long_wire = bytes.fromhex("ff") + b"\x01" * 254  # 255 stuffed bytes, no 0x00 in them
     stream_bytes = long_wire + b"\x00" + encode_frame(big)  # an overrun, then a frame
