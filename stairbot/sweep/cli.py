@@ -23,10 +23,10 @@ from rich.console import Console
 
 from stairbot.errors import OutputError
 from stairbot.inputs.config import shipped_configs
-from stairbot.sweep.coverage import print_margins, print_search_worst, search_line
+from stairbot.sweep.coverage import print_report, search_line
 from stairbot.sweep.margin_map import FIELDS as MARGIN_FIELDS
 from stairbot.sweep.margin_map import margin_name
-from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
+from stairbot.sweep.report import ProgressView, counts_line, counts_of
 from stairbot.sweep.spec import Spec, SpecError
 from stairbot.sweep.verdict import passing
 from stairbot.text import printable
@@ -171,11 +171,7 @@ def cmd_sweep(argv: list[str]) -> int:
     records = [r for r in store.records if r["case"] < len(cases)]
     meta = meta_of(spec)
     if not args.quiet:
-        print_summary(records, meta, console, spec.report.worst)
-        print_margins(records, meta, console)
-        for png in draw(records, meta, folder, console, args.x, args.y, args.png,
-                        not args.no_png, args.margin):
-            print(f"heat map: {printable(png)}")
+        print_report(records, meta, folder, console, args, spec.report.worst)
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     rate = f"{out.ran / out.wall_s * 60:.0f} cases/min" if out.wall_s > 0 and out.ran else "-"
     state = "interrupted; rerun with --resume" if out.interrupted else (
@@ -215,12 +211,7 @@ def cmd_report(argv: list[str]) -> int:
     records = list({r["case"]: r for r in read_records(args.results)}.values())
     console = Console()
     worst = args.worst if args.worst is not None else int(meta["report"]["worst"])
-    print_summary(records, meta, console, worst)
-    print_search_worst(records, meta, console, worst)
-    print_margins(records, meta, console)
-    for png in draw(records, meta, args.results, console, args.x, args.y, args.png,
-                    not args.no_png, args.margin):
-        print(f"heat map: {printable(png)}")
+    print_report(records, meta, args.results, console, args, worst)
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     print(printable(f"sweep {meta.get('name')}: {len(records)}/{meta.get('total')} case(s): "
                     f"{counts_line(counts_of(records))}{search_line(records, meta)}"),

@@ -12,9 +12,11 @@ An axis's extent (what coverage divides by) is written into sweep.json by
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import statistics
+from pathlib import Path
 from typing import Any
 
 from rich.console import Console
@@ -22,7 +24,7 @@ from rich.table import Table
 
 from stairbot.sweep.axes import Axis
 from stairbot.sweep.objective import MARGINS
-from stairbot.sweep.report import short
+from stairbot.sweep.report import draw, print_summary, short
 from stairbot.text import printable
 
 
@@ -149,3 +151,16 @@ def search_line(records: list[dict[str, Any]], meta: dict[str, Any]) -> str:
     s = (best.get("search") or {}).get("score")
     return (f"; lowest {info.get('objective')} {_f(s)} (case {best['case']}, "
             f"{best.get('verdict')})")
+
+
+def print_report(records: list[dict[str, Any]], meta: dict[str, Any], folder: Path,
+                 console: Console, args: argparse.Namespace, worst: int) -> None:
+    """What a sweep prints at its end, and `sweep report` again: the verdict
+    table and worst cases, a search's worst by its objective, the margins,
+    and the heat maps (``args``: the options cli's ``_plot_options`` adds)."""
+    print_summary(records, meta, console, worst)
+    print_search_worst(records, meta, console, worst)
+    print_margins(records, meta, console)
+    for png in draw(records, meta, folder, console, args.x, args.y, args.png,
+                    not args.no_png, args.margin):
+        print(f"heat map: {printable(png)}")

@@ -14,10 +14,10 @@ from rich.console import Console
 
 from stairbot.errors import OutputError
 from stairbot.files import writing
-from stairbot.sweep.coverage import print_margins, print_search_worst, search_line
+from stairbot.sweep.coverage import print_report, search_line
 from stairbot.sweep.execute import default_jobs, open_executor
 from stairbot.sweep.objective import DEFAULT, check_objective
-from stairbot.sweep.report import ProgressView, counts_line, counts_of, draw, print_summary
+from stairbot.sweep.report import ProgressView, counts_line, counts_of
 from stairbot.sweep.search import Plan, SearchStore, describe, load_optuna, search
 from stairbot.sweep.spec import Spec, SpecError
 from stairbot.sweep.store import META, ResultsError, meta_of, read_meta, stopped_for_room
@@ -87,12 +87,7 @@ def cmd_search(spec: Spec, args: argparse.Namespace) -> int:
         store.close()
     records = [r for r in store.records if r["case"] < plan.n]
     if not args.quiet:
-        print_summary(records, meta, console, spec.report.worst)
-        print_search_worst(records, meta, console, spec.report.worst)
-        print_margins(records, meta, console)
-        for png in draw(records, meta, folder, console, args.x, args.y, args.png,
-                        not args.no_png, args.margin):
-            print(f"heat map: {printable(png)}")
+        print_report(records, meta, folder, console, args, spec.report.worst)
     failing = sum(1 for r in records if not passing(str(r["verdict"])))
     state = "interrupted; rerun with --resume" if out.interrupted else (
         f"{failing} not passing" if failing else "all passing")
