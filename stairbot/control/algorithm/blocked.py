@@ -77,7 +77,8 @@ def step(t: Tick, w: ApproachWork) -> Step:
     assert w.blocked_since is not None
     if t.snap.time_s - w.blocked_since < STOP_S:
         return stay(NO_MOTION)
-    on_the_floor = ctx.number_of_steps == 0 and not landing.turned_here(t)
+    turned = landing.turned_here(t)
+    on_the_floor = ctx.number_of_steps == 0 and not turned
     slip = 0.0
     if on_the_floor:
         here = motion.wheel_position(t.snap)
@@ -100,7 +101,7 @@ def step(t: Tick, w: ApproachWork) -> Step:
     t.say(say.below_the_sensors(ctx.number_of_steps, cfg.sensors.front_height, w.went_m,
                                 slip_m if on_the_floor else None),
           ascent_end="obstacle", slip_m=slip_m)
-    if landing.turned_here(t):
+    if turned:
         return go("blocked_after_turn")
     return go("blocked_steps_climbed" if ctx.number_of_steps > 0 else "blocked_on_the_floor")
 
@@ -128,8 +129,8 @@ def _placed(t: Tick, w: ApproachWork) -> float | None:
 def _slip(t: Tick, w: ApproachWork, placed: float) -> float:
     """Turns the wheels made without the robot: how much further on the
     riser is placed now than a place it held at, at least as far as it
-    went before it was found gone (BLOCKED_M, less HELD_M) and at most the turns driven since
-    it last held and over the placing's lag (the filtered readings'
+    went before it was found gone (BLOCKED_M, less HELD_M) and at most the
+    turns driven since it last held and over the placing's lag (the filtered readings'
     settle_s and RISER_KEYS ticks: it is seen to go that late); the least
     such, or none.  Places, not the nearest alone: the pair may have read
     a riser beyond before it read this one, and pressed against the step it

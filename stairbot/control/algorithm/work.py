@@ -152,7 +152,8 @@ class ApproachWork(Work):
     """Ascent 2's approach to SAFE_DISTANCE_IN_FRONT_OF_STEP."""
 
     still_since: float | None = None
-    """When a beam began reading "nothing ahead" (the approach stands)."""
+    """When a beam began reading "nothing ahead" (the approach stands); once
+    blocked, when the robot stood backed off the step."""
     riser_keys: list[float] = field(default_factory=list)
     """The mean reading plus the odometer, on its last RISER_KEYS ticks."""
     nearest_riser: float | None = None
