@@ -20,7 +20,7 @@ from stairbot.console.connections import Listing
 from stairbot.console.modals import ChoiceScreen
 from stairbot.control.robot_config import load_config
 from stairbot.errors import StairbotError
-from stairbot.inputs.config import RobotConfig
+from stairbot.inputs.config import RobotConfig, source_ref
 from stairbot.views.top_view import RobotShape
 
 if TYPE_CHECKING:
@@ -29,10 +29,7 @@ if TYPE_CHECKING:
 
 def robot_name(config: RobotConfig) -> str:
     """``reference``, ``heavy_middle``, or the file the config was read from."""
-    source = config.source
-    if source.startswith("<default"):
-        return "reference"
-    return source.removeprefix("<robot ").removesuffix(">")
+    return source_ref(config.source)
 
 
 def same_robot(a: RobotConfig, b: RobotConfig) -> bool:

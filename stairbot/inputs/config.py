@@ -292,11 +292,8 @@ def config_text(path: str | Path | None, beside: Path | None = None) -> tuple[st
 def robot_shown(source: str) -> str:
     """A config's source as a person reads it: a shipped robot as its name
     ("reference (shipped)", "landings (shipped)"), a file as its path."""
-    if source == f"<default {DEFAULT_CONFIG_NAME}>":
-        return f"{REFERENCE} (shipped)"
-    if source.startswith("<robot ") and source.endswith(">"):
-        return f"{source[len('<robot '):-1]} (shipped)"
-    return source
+    ref = source_ref(source)
+    return source if ref == source else f"{ref} (shipped)"
 
 
 SHIPPED_DIR = "configs"
