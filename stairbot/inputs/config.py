@@ -147,20 +147,22 @@ class RobotConfig:
         return self.MAX_OF_VERTICAL_TURNS * self.motors.lift_travel_per_turn
 
     @property
+    def _front_fov_deg(self) -> float:
+        """The front pair's cone: the config's ``front_fov_deg``, else its model's."""
+        s = self.sensors
+        return s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
+
+    @property
     def front_cone_top_rad(self) -> float:
         """How far above level the front pair's highest ray looks: the mount's
         tilt plus half the cone (0 for one level ray)."""
-        s = self.sensors
-        fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
-        return math.radians(max(0.0, s.front_tilt_deg + fov / 2.0))
+        return math.radians(max(0.0, self.sensors.front_tilt_deg + self._front_fov_deg / 2.0))
 
     @property
     def front_cone_bottom_rad(self) -> float:
         """How far below level the front pair's lowest ray looks: half the
         cone less the mount's tilt (0 when none looks down)."""
-        s = self.sensors
-        fov = s.spec(back=False).fov_deg if s.front_fov_deg is None else s.front_fov_deg
-        return math.radians(max(0.0, fov / 2.0 - s.front_tilt_deg))
+        return math.radians(max(0.0, self._front_fov_deg / 2.0 - self.sensors.front_tilt_deg))
 
     def min_rise_for(self, tread_m: float) -> float:
         """Lowest next riser it can measure a tread of ``tread_m`` against:
