@@ -78,8 +78,16 @@ static bool may_move(const sb_motor_board *b)
 
 /* -- status ------------------------------------------------------------------ */
 
+/* The whole board's fault (the simulated world failed), 0 when none. */
+static uint8_t board_fault(const sb_motor_board *b)
+{
+    return b->hal->board_fault ? b->hal->board_fault(b->hal->ctx) : SB_FAULT_NONE;
+}
+
 static uint8_t fault_code(const sb_motor_board *b)
 {
+    uint8_t whole = board_fault(b);
+    if (whole != SB_FAULT_NONE) return whole;
     if (b->estop) return SB_FAULT_ESTOP;
     if (b->watchdog_tripped) return SB_FAULT_WATCHDOG;
     return b->fault;
@@ -92,7 +100,8 @@ static sb_msg status(const sb_motor_board *b)
     uint8_t flags = b->cfg.simulated ? SB_FLAG_SIMULATED : 0;
     if (b->estop) flags |= SB_FLAG_ESTOP;
     if (b->watchdog_tripped) flags |= SB_FLAG_WATCHDOG;
-    if (b->fault != SB_FAULT_NONE) flags |= SB_FLAG_FAULT;
+    if (b->cfg.lockstep) flags |= SB_FLAG_LOCKSTEP;
+    if (b->fault != SB_FAULT_NONE || board_fault(b) != SB_FAULT_NONE) flags |= SB_FLAG_FAULT;
     s.body.status.flags = flags;
     s.body.status.fault = fault_code(b);
     s.body.status.watchdog_ms = b->watchdog_ms;
@@ -362,6 +371,29 @@ static void answer(sb_motor_board *b, const sb_msg *msg, reply_out *out)
     case SB_STOP: case SB_BRAKE:
         r = stop_or_brake(b, msg->type, m->motor_mask.mask);
         break;
+    case SB_STEP_TO: {
+        uint32_t done = 0;
+        if (!b->hal->step_to || !b->hal->step_to(b->hal->ctx, m->time_us.time_us, &done)) {
+            r = ack(msg->type, SB_ACK_NOT_SUPPORTED);
+            break;
+        }
+        sb_motor_poll(b); /* the plant moved on: the watchdog, the hold and the Moves */
+        sb_msg_init(&r, SB_STEP_DONE);
+        r.body.time_us.time_us = done;
+        break;
+    }
+    case SB_GET_TRUTH: {
+        sb_plant_truth t;
+        if (!b->hal->truth || !b->hal->truth(b->hal->ctx, &t)) {
+            r = ack(msg->type, SB_ACK_NOT_SUPPORTED);
+            break;
+        }
+        sb_msg_init(&r, SB_TRUTH);
+        r.body.truth.flags = t.fell ? 1u : 0u;
+        r.body.truth.max_pitch_cdeg = t.max_pitch_cdeg;
+        r.body.truth.offset_mm = t.offset_mm;
+        break;
+    }
     default:
         r = ack(msg->type, SB_ACK_NOT_SUPPORTED);
         break;
@@ -384,7 +416,9 @@ static void obey(sb_motor_board *b, const sb_msg *msg, uint8_t session, reply_ou
     } else if (owned(msg->type) && !sb_motor_owns(b, session)) {
         r = ack(msg->type, SB_ACK_NOT_OWNER);
     } else {
-        sb_ack_result c = sb_check_request(&SB_MOTOR_BOARD, msg);
+        sb_board_caps caps = SB_MOTOR_BOARD;
+        caps.simulation = b->hal->step_to != NULL; /* a board on a simulated plant */
+        sb_ack_result c = sb_check_request(&caps, msg);
         if (c == SB_ACK_OK) {
             answer(b, msg, out);
             return;

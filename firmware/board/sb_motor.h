@@ -33,6 +33,7 @@ typedef struct {
     uint32_t boot;                   /* drawn at power-up (Owner.boot), not 0 */
     int16_t limit_mtps[SB_MOTORS];   /* each motor's speed limit (> 0) */
     bool simulated;                  /* Status flag SIMULATED: a board on a simulated plant */
+    bool lockstep;                   /* Status flag LOCKSTEP: its plant moves only on StepTo */
 } sb_motor_config;
 
 typedef struct {

@@ -78,6 +78,13 @@ static bool estop_input(void *ctx)
 
 sb_hal plant_hal(plant *p)
 {
-    sb_hal h = {p, now_ms, set_motor, encoder_turns, encoder_speed, motor_fault, estop_input};
+    sb_hal h = {0};
+    h.ctx = p;
+    h.now_ms = now_ms;
+    h.set_motor = set_motor;
+    h.encoder_turns = encoder_turns;
+    h.encoder_speed = encoder_speed;
+    h.motor_fault = motor_fault;
+    h.estop_input = estop_input;
     return h;
 }

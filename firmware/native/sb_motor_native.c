@@ -151,7 +151,7 @@ int main(int argc, char **argv)
     uint64_t t0 = mono_ms();
     plant_init(&world);
     sb_hal hal = plant_hal(&world);
-    sb_motor_config cfg = {(uint16_t)serial, boot_id(), {0}, true};
+    sb_motor_config cfg = {(uint16_t)serial, boot_id(), {0}, true, false};
     plant_limits(cfg.limit_mtps);
     sb_motor_init(&board, &hal, &cfg);
     sb_reader_init(&reader);

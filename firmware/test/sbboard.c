@@ -46,7 +46,7 @@ int main(int argc, char **argv)
         world.position_umt[5] = -lift_umt;
     }
     sb_hal hal = plant_hal(&world);
-    sb_motor_config cfg = {1, argc > 1 ? (uint32_t)strtoul(argv[1], NULL, 10) : 1u, {0}, true};
+    sb_motor_config cfg = {1, argc > 1 ? (uint32_t)strtoul(argv[1], NULL, 10) : 1u, {0}, true, false};
     plant_limits(cfg.limit_mtps);
     sb_motor_init(&board, &hal, &cfg);
     sb_reader_init(&reader);
