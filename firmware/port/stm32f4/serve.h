@@ -1,0 +1,37 @@
+/* What every board image does around its board (board/): the host's frames
+ * in from a USART, each answered on it; the time between them slept away;
+ * and the boot id. */
+#ifndef SB_SERVE_H
+#define SB_SERVE_H
+
+#include <stdint.h>
+
+#include "sb_frame.h"
+#include "sb_reader.h"
+#include "uart.h"
+
+/* A board's frame handler (sb_motor_frame's shape): the reply's length in
+ * out, 0 for none. */
+typedef size_t (*sb_frame_fn)(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE]);
+
+typedef struct {
+    sb_uart *uart;
+    sb_reader reader;
+    uint8_t reply[SB_MAX_WIRE];
+} sb_server;
+
+void serve_init(sb_server *s, sb_uart *uart);
+
+/* Every byte waiting, each frame handed to on_frame and its reply sent. */
+void serve_bytes(sb_server *s, sb_frame_fn on_frame, void *board);
+
+/* Sleeps until an interrupt (a byte, or SysTick's next millisecond) unless
+ * a byte is already waiting. */
+void serve_idle(const sb_server *s);
+
+/* The boot id (Owner.boot, never 0): the word a loader wrote at the start of
+ * RAM (sb_boot_seed: QEMU's `-device loader,addr=...,data=...`), else the
+ * RNG's, else one drawn from SysTick's counter. */
+uint32_t serve_boot_id(void);
+
+#endif
