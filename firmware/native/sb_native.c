@@ -159,6 +159,7 @@ static int plant_recv(void *ctx, uint32_t timeout_ms)
 
 sb_plant_io sb_native_plant_io(int *fd)
 {
+    signal(SIGPIPE, SIG_IGN); /* a plant gone is seen as EOF or an error, not a signal */
     sb_plant_io io = {fd, plant_send, plant_recv};
     return io;
 }
