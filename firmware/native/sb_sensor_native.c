@@ -31,7 +31,7 @@ static void report(void *board, FILE *out)
 {
     const sb_sensor_board *b = board;
     fprintf(out, "%u frames, %u duplicates answered from the cache, %u replies cut",
-            (unsigned)b->common.frames, (unsigned)b->common.duplicates, (unsigned)b->common.cut);
+            (unsigned)b->base.frames, (unsigned)b->base.duplicates, (unsigned)b->base.cut);
 }
 
 static bool ask_plant(void *ctx, uint32_t wall_ms)

@@ -16,7 +16,9 @@ Wire faults act here, on the bytes, in both directions.
 from __future__ import annotations
 
 import contextlib
+import os
 import select
+import shutil
 import socket
 import subprocess
 from dataclasses import dataclass
@@ -43,6 +45,16 @@ class FirmwareError(InputError):
         super().__init__("--firmware", None, problem)
 
 
+def find_cc() -> str | None:
+    """The C compiler $CC names, else cc, gcc or clang from PATH; None without one."""
+    names = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
+    for name in names:
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
 def build_native(build_dir: Path | None = None) -> Path:
     """``make -C firmware`` the native programs (into ``build_dir``, default
     firmware/build); the directory holding them.  FirmwareError names what
@@ -51,9 +63,14 @@ def build_native(build_dir: Path | None = None) -> Path:
     if not (FIRMWARE / "Makefile").is_file():
         raise FirmwareError(f"no firmware sources at {FIRMWARE}: --firmware needs a source "
                             "checkout of stairbot (its firmware/ directory)")
+    cc = find_cc()
+    if cc is None:
+        raise FirmwareError("--firmware native needs a C compiler (cc, gcc or clang on PATH, "
+                            "or $CC; Debian: apt-get install gcc make)")
     targets = [str(out / name) for name in PROGRAMS.values()]
     try:
-        made = subprocess.run(["make", "-s", "-C", str(FIRMWARE), f"BUILD={out}", *targets],
+        made = subprocess.run(["make", "-s", "-C", str(FIRMWARE), f"BUILD={out}", f"CC={cc}",
+                               *targets],
                               capture_output=True, text=True, check=False)
     except FileNotFoundError as exc:
         raise FirmwareError("--firmware native needs make and a C compiler "
@@ -236,4 +253,4 @@ def _address(wire: bytes) -> int | None:
     return body[0] & 0x0F if body and not body[0] & 0x80 else None
 
 
-__all__ = ["FirmwareBoardServer", "FirmwareError", "build_native"]
+__all__ = ["FirmwareBoardServer", "FirmwareError", "build_native", "find_cc"]

@@ -4,26 +4,17 @@ the calling test skips, saying so."""
 
 from __future__ import annotations
 
-import os
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
+from stairbot.fakes.firmware_boards import find_cc
+
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 WARNINGS = ["-std=c11", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow", "-Werror"]
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
 WHEEL_LIMIT, LIFT_LIMIT = 1000, 10000  # the native plant's limits, mturn/s (native/plant.h)
-
-
-def find_cc() -> str | None:
-    names = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
-    for name in names:
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
 
 
 def build(exe: Path, dirs: tuple[str, ...], files: tuple[str, ...], flags: list[str]) -> Path:
