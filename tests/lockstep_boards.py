@@ -49,16 +49,20 @@ class Boards:
 def lockstep_boards(cwd: Path, env: dict[str, str] | None = None,
                     stop: signal.Signals = signal.SIGINT, *,
                     scenario: str | None = None,
-                    config: str | None = None, can: str | None = None) -> Iterator[Boards]:
+                    config: str | None = None, can: str | None = None,
+                    firmware: str | None = None) -> Iterator[Boards]:
     """Serve fake boards in lockstep (on ``scenario``, default the default
     stairs; for ``config``, default the reference robot) on a pty, or on the
     CAN bus ``can`` names (``udp_multicast/GROUP?port=N``), until the block
     ends, then stop them with ``stop`` (unless the block did), killing them
-    after 10 s.  ``cwd`` elsewhere than the source tree: the installed
-    package runs."""
+    after 10 s.  ``firmware``: serve the boards' C firmware of that kind
+    (``--firmware native``) instead of the Python fakes.  ``cwd`` elsewhere
+    than the source tree: the installed package runs."""
     more = (*(() if scenario is None else ("--scenario", scenario)),
             *(() if config is None else ("--config", config)))
     wire = ("--serial",) if can is None else ("--can", can)
+    if firmware is not None:
+        wire += ("--firmware", firmware)
     proc = stairbot("fake-boards", *wire, "--lockstep", *more, env=env, cwd=cwd)
     assert proc.stdout is not None
     boards = Boards(proc.stdout.readline().strip(), proc)

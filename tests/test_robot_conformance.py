@@ -1,7 +1,9 @@
 """Every robot keeps the Robot protocol (stairbot/hardware.py): the same tests,
 parametrised over the robots stairbot ships -- ``sim://``, ``serial://`` (fake
-boards on a pseudo-terminal) and ``can://`` (fake boards on python-can's
-virtual bus) -- each opened with ``open_robot(url, config, options)``.
+boards on a pseudo-terminal), ``can://`` (fake boards on python-can's
+virtual bus) and ``serial://`` to the boards' C firmware (firmware/, built
+natively, on the same simulated world: ``fake-boards --firmware native``)
+-- each opened with ``open_robot(url, config, options)``.
 
 The fake boards run in lockstep, so every robot's time is simulated: motion is
 measured in turns after the clock advances, never against the wall clock.  The
@@ -24,6 +26,7 @@ import math
 import threading
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import can
 import pytest
@@ -33,7 +36,9 @@ from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
+from stairbot.fakes.firmware_boards import FirmwareBoardServer, build_native, find_cc
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
+from stairbot.fakes.sim import motor_limits
 from stairbot.hardware import (
     BASE_SENSORS,
     LIFT_MOTORS,
@@ -60,7 +65,7 @@ TICK = CONFIG.algorithm.tick
 FORWARD = dict.fromkeys(WHEEL_MOTORS, 1.0)  # turns/s: 0.5 s moves each wheel ~0.5 turn
 MOVED = 0.1  # turns: a wheel that turned at least this far moved
 STILL = 0.02  # turns: a wheel that turned less than this stood still
-ROBOTS = ("sim", "serial", "can")
+ROBOTS = ("sim", "serial", "can", "firmware")
 _channels = itertools.count()
 
 
@@ -188,6 +193,29 @@ def open_serial(aged: bool = False) -> Iterator[Rig]:
         pty.close()
 
 
+def open_firmware(build_dir: Path, aged: bool = False) -> Iterator[Rig]:
+    """The boards' C firmware in lockstep, its programs on the world's plant
+    link, the relay served on a thread."""
+    world = _world(aged)
+    pty = PtyPair()
+    try:
+        server = FirmwareBoardServer(pty.master, world, build_dir, motor_limits(CONFIG), (1, 2))
+        try:
+            yield from _served("firmware", server, f"serial://{pty.path}?lockstep=1&timeout=0.5")
+        finally:
+            server.close()
+    finally:
+        pty.close()
+
+
+@pytest.fixture(scope="session")
+def native_firmware(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The boards' native programs, built once (skipped, saying why, without a C compiler)."""
+    if find_cc() is None:
+        pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
+    return build_native(tmp_path_factory.mktemp("firmware"))
+
+
 def open_can(aged: bool = False) -> Iterator[Rig]:
     """Fake boards in lockstep on a fresh python-can virtual channel, served
     on a thread (one process: a virtual bus does not leave it)."""
@@ -215,7 +243,10 @@ def rig(request: pytest.FixtureRequest) -> Iterator[Rig]:
     if not_yet is not None:
         why, raises = not_yet
         request.applymarker(pytest.mark.xfail(reason=why, raises=raises, strict=True))
-    yield from OPENERS[kind]()
+    if kind == "firmware":
+        yield from open_firmware(request.getfixturevalue("native_firmware"))
+    else:
+        yield from OPENERS[kind]()
 
 
 # -- the protocol --------------------------------------------------------------------
@@ -415,10 +446,12 @@ def test_ages_and_imu_arrive_as_the_simulation_reports_them(rig: Rig) -> None:
         rig.drive(FORWARD, 0.1)
 
 
-@pytest.fixture(params=("serial", "can"))
+@pytest.fixture(params=("serial", "can", "firmware"))
 def aged_rig(request: pytest.FixtureRequest) -> Iterator[Rig]:
-    opener = {"serial": open_serial, "can": open_can}[request.param]
-    yield from opener(aged=True)
+    if request.param == "firmware":
+        yield from open_firmware(request.getfixturevalue("native_firmware"), aged=True)
+    else:
+        yield from {"serial": open_serial, "can": open_can}[request.param](aged=True)
 
 
 def test_ages_and_an_imu_that_move_each_tick_cross_the_wire(aged_rig: Rig) -> None:

@@ -3,8 +3,8 @@
  * motor's limit (the default robot's: wheels 1 turn/s, lifts 10 turns/s);
  * a lift stops at the end of its stroke (+-105 turns: 0.21 m at 2 mm a
  * turn) and says LIMIT while it is driven against it. */
-#ifndef SB_PLANT_H
-#define SB_PLANT_H
+#ifndef SB_TRIVIAL_PLANT_H
+#define SB_TRIVIAL_PLANT_H
 
 #include <stdbool.h>
 #include <stdint.h>

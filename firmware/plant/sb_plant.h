@@ -21,6 +21,7 @@
 #define SB_PLANT_MOTORS 6
 #define SB_PLANT_SENSORS 6 /* at most: 4, or 6 with the side pair */
 #define SB_PLANT_AXES 2
+#define SB_PLANT_FAULT_SIMULATION 8 /* MotorFault SIMULATION */
 
 /* The byte stream to the plant. */
 typedef struct {
@@ -62,6 +63,8 @@ typedef struct {
     sb_plant_range range[SB_PLANT_SENSORS];
     bool imu_fitted;
     sb_imu_sample imu[SB_PLANT_AXES];
+    volatile bool estop_pressed; /* the board's e-stop button (the port sets it) */
+    uint8_t seq;         /* the last request's */
     /* counts */
     uint32_t queries;
     uint32_t lost;       /* answers that did not come, or came malformed */

@@ -7,6 +7,12 @@ opens a pseudo-terminal, prints its path (the line ``serial://PATH``, plus
 ``?lockstep=1`` when in lockstep) and serves both boards on it, backed by the
 same physics world as ``sim://``, until interrupted.
 
+    stairbot fake-boards --serial --firmware native [...]
+
+serves the boards' C firmware (firmware/, built with make on first use)
+instead of the Python fakes, on the same pty and the same world
+(``stairbot.fakes.firmware_boards``).
+
     stairbot fake-boards --can udp_multicast/GROUP[?port=P&lan=1] [...]
 
 serves them on a CAN bus instead (``stairbot.fakes.can_boards.main``) and
@@ -31,9 +37,10 @@ from stairbot.args import bounded
 from stairbot.control.robot_config import config_for
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import launch_serials, make_boards, serials_words
+from stairbot.fakes.firmware_boards import FirmwareBoardServer, build_native
 from stairbot.fakes.registry import registered
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
-from stairbot.fakes.sim import SimClock, SimRobot
+from stairbot.fakes.sim import SimClock, SimRobot, motor_limits
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
 from stairbot.run.robots import TIME_SCALE_MAX, TIME_SCALE_MIN
@@ -49,6 +56,9 @@ def build_parser() -> argparse.ArgumentParser:
     wire.add_argument("--can", metavar="INTERFACE/CHANNEL",
                       help="serve on a CAN bus, e.g. udp_multicast/239.74.163.2: on loopback "
                       "only (127.0.0.1, TTL 0) unless the URL adds ?lan=1")
+    p.add_argument("--firmware", choices=("native",), default=None,
+                   help="serve the boards' C firmware (firmware/) on the pty instead of the "
+                        "Python fakes: native = Linux programs built with make (serial only)")
     p.add_argument("--scenario", help="scenario TOML file or shipped scenario name")
     p.add_argument("--config", help="robot config TOML file or shipped robot's name "
                    "(default: the scenario's robot, else the reference robot)")
@@ -109,7 +119,10 @@ def stop_on_signals(stop: Callable[[], None]) -> None:
 def main(argv: list[str]) -> int:
     """Run the subcommand; returns the exit code (InputError propagates to the
     CLI, which prints one line and exits 2)."""
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.can is not None and args.firmware is not None:
+        parser.error("--firmware serves the serial wire only: use --serial with it")
     if args.can is not None:
         can_main = import_module("stairbot.fakes.can_boards").main
         code: int = can_main(argv)
@@ -120,25 +133,42 @@ def main(argv: list[str]) -> int:
         print(f"stairbot fake-boards: {note}", file=sys.stderr, flush=True)
     world = make_world(config, scenario, args.lockstep)
     pty = PtyPair()
-    boards = make_boards(world, launch_serials())
-    server = SerialBoardServer(pty.master, world, boards, faults_from(args),
-                               time_scale=args.time_scale)
+    serials = launch_serials()
+    server: SerialBoardServer
+    if args.firmware is not None:
+        try:
+            server = FirmwareBoardServer(pty.master, world, build_native(),
+                                         motor_limits(config), serials, faults_from(args),
+                                         time_scale=args.time_scale)
+        except BaseException:
+            pty.close()
+            raise
+        words = f"C firmware ({args.firmware}), motor board serial {serials[0]}, " \
+                f"sensor board serial {serials[1]}"
+    else:
+        boards = make_boards(world, serials)
+        server = SerialBoardServer(pty.master, world, boards, faults_from(args),
+                                   time_scale=args.time_scale)
+        words = serials_words(boards)
     stop_on_signals(server.stop)
     suffix = "?lockstep=1" if args.lockstep else (
         f"?time_scale={args.time_scale:g}" if args.time_scale != 1.0 else "")
     url = f"serial://{pty.path}{suffix}"
     print(url, flush=True)
-    print(f"fake boards ({serials_words(boards)}) serving on {pty.path} (Ctrl-C to stop)",
+    print(f"fake boards ({words}) serving on {pty.path} (Ctrl-C to stop)",
           file=sys.stderr, flush=True)
     try:
         with registered(url, wire="serial", scenario=scenario.name,
                         config=args.config or scenario.robot or "reference",
-                        serials=serials_words(boards)):
+                        serials=words):
             server.serve()
     except KeyboardInterrupt:
         pass
     finally:
         pty.close()
+        if isinstance(server, FirmwareBoardServer):
+            for line in server.close():
+                print(line, file=sys.stderr)
         s = server.stats
         print(f"fake boards: {s.frames_rx} frames in, {s.frames_tx} out, {s.crc_errors} CRC "
               f"errors, {s.malformed} malformed, {s.duplicates} repeats, {s.injected} faults "

@@ -230,6 +230,13 @@ class SerialBoardServer:
             return wire
 
     # -- serving -------------------------------------------------------------------
+    def _side_fds(self) -> list[int]:
+        """Descriptors besides the line that :meth:`serve` waits on (none here)."""
+        return []
+
+    def _side_ready(self, fd: int) -> None:
+        """One of :meth:`_side_fds` is readable."""
+
     def stop(self) -> None:
         self._stop.set()
 
@@ -242,8 +249,11 @@ class SerialBoardServer:
             timeout = pacer.step()
             if self._late:
                 timeout = min(timeout, max(0.0, min(t for t, _ in self._late) - time.monotonic()))
-            ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout))
-            if ready:
+            ready, _, _ = select.select([self.fd, *self._side_fds()], [], [], max(0.0, timeout))
+            for fd in ready:
+                if fd != self.fd:
+                    self._side_ready(fd)
+            if self.fd in ready:
                 try:
                     data = os.read(self.fd, 4096)
                 except OSError:

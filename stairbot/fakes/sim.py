@@ -66,6 +66,12 @@ _MWF, _MWB, _MWR, _MWL, _MTF, _MTB = (MotorId.MWF, MotorId.MWB, MotorId.MWR, Mot
 _ZEROS: dict[MotorId, float] = dict(ZERO_SPEEDS)  # copied by every command (a dict copies fast)
 
 
+def motor_limits(config: RobotConfig) -> dict[MotorId, float]:
+    """Each motor's speed limit, turns/s: a command beyond it is clamped."""
+    mc = config.motors
+    return {mid: mc.lift_speed if mid in LIFT_MOTORS else mc.wheel_speed for mid in MotorId}
+
+
 class SimRobot:
     """The simulated robot (see the module docstring): a Robot, with the
     capabilities HasTruth (``truth()``) and HasScene (``scene()``)."""
@@ -85,10 +91,8 @@ class SimRobot:
         self.wall_contact: str | None = None
         """The first contact of the footprint with a wall (see Truth.wall_contact)."""
         self._imu = SimImu(self.world)
-        m = config.motors
-        self._limits = {mid: m.lift_speed if mid in LIFT_MOTORS else m.wheel_speed
-                        for mid in MotorId}
-        self._per_turn = m.lift_travel_per_turn
+        self._limits = motor_limits(config)
+        self._per_turn = config.motors.lift_travel_per_turn
         self._speeds = dict(ZERO_SPEEDS)
         self._applied_along = math.nan  # cos(yaw) when the world's motors were last set
         self._diff_turns = 0.0  # differential part of MWR (MWL gets minus this)

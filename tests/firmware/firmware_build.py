@@ -4,26 +4,17 @@ the calling test skips, saying so."""
 
 from __future__ import annotations
 
-import os
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
+from stairbot.fakes.firmware_boards import find_cc
+
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 WARNINGS = ["-std=c11", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow", "-Werror"]
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
 WHEEL_LIMIT, LIFT_LIMIT = 1000, 10000  # the native plant's limits, mturn/s (native/plant.h)
-
-
-def find_cc() -> str | None:
-    names = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
-    for name in names:
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
 
 
 def build(exe: Path, dirs: tuple[str, ...], files: tuple[str, ...], flags: list[str]) -> Path:
@@ -35,7 +26,7 @@ def build(exe: Path, dirs: tuple[str, ...], files: tuple[str, ...], flags: list[
         pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
     sources = [str(p) for d in dirs for p in sorted((FIRMWARE / d).glob("*.c"))]
     sources += [str(FIRMWARE / f) for f in files]
-    includes = [f"-I{FIRMWARE / d}" for d in ("core", "board", "native")]
+    includes = [f"-I{FIRMWARE / d}" for d in ("core", "board", "plant", "native")]
     built = subprocess.run([cc, *WARNINGS, *flags, *includes, *sources, "-o", str(exe)],
                            capture_output=True, text=True, check=False)
     if built.returncode != 0 and "sanitize" in built.stderr and SANITIZE[0] in flags:

@@ -51,7 +51,8 @@ class Boards:
 
 
 def build_native(out: Path) -> Path:
-    return build(out / "sb_motor_native", ("core", "board", "native"), (), ["-O2"])
+    return build(out / "sb_motor_native", ("core", "board", "plant"),
+                 ("native/plant.c", "native/sb_native.c", "native/sb_motor_native.c"), ["-O2"])
 
 
 @pytest.fixture(scope="module", params=["c", "python"])

@@ -1,0 +1,256 @@
+"""The boards' C firmware on the simulated robot: ``stairbot fake-boards --firmware native``.
+
+Each board's program (``firmware/build/sb_motor_native``,
+``sb_sensor_native``) runs as a child process holding two sockets: its
+host line and its plant link.  :class:`FirmwareBoardServer` serves the pty
+the host opens (``serial://PATH``) as :class:`SerialBoardServer` does, but
+relays each host frame, as bytes, to the board it addresses and each
+board's reply back, as one serial pair shared by both boards would carry
+them; it answers both plant links from one
+:class:`~stairbot.fakes.board_world.BoardWorld` and, unless in lockstep,
+advances the world as wall time passes.  The firmware keeps its own lease,
+watchdog, latches and duplicate cache: nothing of ``boards.py`` is used.
+Wire faults act here, on the bytes, in both directions.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import shutil
+import socket
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+from cobs import cobs
+
+from stairbot.drivers import messages as m
+from stairbot.errors import InputError
+from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.plant_link import PlantLink
+from stairbot.fakes.serial_boards import SerialBoardServer, WireFaults
+from stairbot.hardware import MotorId
+
+FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
+PROGRAMS = {int(m.Board.MOTOR): "sb_motor_native", int(m.Board.SENSOR): "sb_sensor_native"}
+HELLO_S = 5.0  # how long a board's program may take to greet its plant
+
+
+class FirmwareError(InputError):
+    """The firmware could not be built or started; the message says why and what to do."""
+
+    def __init__(self, problem: str) -> None:
+        super().__init__("--firmware", None, problem)
+
+
+def find_cc() -> str | None:
+    """The C compiler $CC names, else cc, gcc or clang from PATH; None without one."""
+    names = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
+    for name in names:
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def build_native(build_dir: Path | None = None) -> Path:
+    """``make -C firmware`` the native programs (into ``build_dir``, default
+    firmware/build); the directory holding them.  FirmwareError names what
+    is missing when they cannot be built."""
+    out = build_dir or FIRMWARE / "build"
+    if not (FIRMWARE / "Makefile").is_file():
+        raise FirmwareError(f"no firmware sources at {FIRMWARE}: --firmware needs a source "
+                            "checkout of stairbot (its firmware/ directory)")
+    cc = find_cc()
+    if cc is None:
+        raise FirmwareError("--firmware native needs a C compiler (cc, gcc or clang on PATH, "
+                            "or $CC; Debian: apt-get install gcc make)")
+    targets = [str(out / name) for name in PROGRAMS.values()]
+    try:
+        made = subprocess.run(["make", "-s", "-C", str(FIRMWARE), f"BUILD={out}", f"CC={cc}",
+                               *targets],
+                              capture_output=True, text=True, check=False)
+    except FileNotFoundError as exc:
+        raise FirmwareError("--firmware native needs make and a C compiler "
+                            "(Debian: apt-get install make gcc)") from exc
+    if made.returncode != 0:
+        last = (made.stderr.strip().splitlines() or ["(no output)"])[-1]
+        raise FirmwareError(f"building the native firmware failed: {last} "
+                            f"(make -C {FIRMWARE} shows the whole error; it needs a C compiler)")
+    return out
+
+
+@dataclass
+class _Line:
+    """Bytes of one stream cut into delimited frames."""
+
+    pending: bytearray
+
+    def frames(self, data: bytes) -> list[bytes]:
+        self.pending += data
+        out = []
+        while (end := self.pending.find(0)) >= 0:
+            frame = bytes(self.pending[:end + 1])
+            del self.pending[:end + 1]
+            if len(frame) > 1:
+                out.append(frame)
+        return out
+
+
+class FirmwareBoard:
+    """One board's program, its two sockets, and its plant link."""
+
+    def __init__(self, address: int, exe: Path, plant: PlantLink) -> None:
+        self.address = address
+        self.exe = exe
+        self.plant = plant
+        self.host, host_child = socket.socketpair()
+        self.link, link_child = socket.socketpair()
+        self.replies = _Line(bytearray())
+        try:
+            self.proc = subprocess.Popen(
+                [str(exe), "--host-fd", str(host_child.fileno()),
+                 "--plant-fd", str(link_child.fileno())],
+                pass_fds=(host_child.fileno(), link_child.fileno()),
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        except OSError as exc:
+            raise FirmwareError(f"cannot start {exe}: {exc}") from exc
+        finally:
+            host_child.close()
+            link_child.close()
+        for s in (self.host, self.link):
+            s.setblocking(False)
+
+    def serve_plant(self) -> bool:
+        """Answer what the board asked its plant; False once it closed the link."""
+        try:
+            data = self.link.recv(4096)
+        except BlockingIOError:
+            return True
+        except OSError:
+            data = b""
+        if not data:
+            return False
+        answer = self.plant.feed(data)
+        if answer:
+            self.link.sendall(answer)
+        return True
+
+    def send(self, wire: bytes) -> None:
+        with contextlib.suppress(BlockingIOError, BrokenPipeError, ConnectionResetError):
+            self.host.sendall(wire)
+
+    def close(self) -> str:
+        """Stop the program; what it printed on stderr (its counts)."""
+        for s in (self.host, self.link):
+            with contextlib.suppress(OSError):
+                s.close()
+        if self.proc.poll() is None:
+            self.proc.terminate()
+        try:
+            _, err = self.proc.communicate(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            _, err = self.proc.communicate()
+        return err.decode(errors="replace").strip()
+
+
+class FirmwareBoardServer(SerialBoardServer):
+    """Serve the C boards on ``fd`` (a pty's master), each board's program
+    started from ``build_dir`` on ``world``.  ``serials``: the motor board's
+    and the sensor board's serial numbers, which their plants give them."""
+
+    def __init__(self, fd: int, world: BoardWorld, build_dir: Path,
+                 limits_tps: dict[MotorId, float], serials: tuple[int, int],
+                 faults: WireFaults | None = None, time_scale: float = 1.0,
+                 step_s: float = 0.005) -> None:
+        super().__init__(fd, world, {}, faults, time_scale, step_s)
+        self.firmware: dict[int, FirmwareBoard] = {}
+        self.serials = dict(zip(PROGRAMS, serials, strict=True))
+        self._inbox = _Line(bytearray())
+        try:
+            for address, name in PROGRAMS.items():
+                plant = PlantLink(world, address, self.serials[address], limits_tps)
+                self.firmware[address] = FirmwareBoard(address, build_dir / name, plant)
+            self._await_hello()
+        except BaseException:
+            self.close()
+            raise
+
+    def _await_hello(self) -> None:
+        left = HELLO_S
+        waiting = {b.link.fileno(): b for b in self.firmware.values()}
+        while any(not b.plant.greeted for b in self.firmware.values()):
+            ready, _, _ = select.select(list(waiting), [], [], min(left, 0.1))
+            for fd in ready:
+                waiting[fd].serve_plant()
+            left -= 0.1 if not ready else 0.0
+            dead = [b for b in self.firmware.values() if b.proc.poll() is not None]
+            if dead or left <= 0:
+                board = (dead or [b for b in self.firmware.values() if not b.plant.greeted])[0]
+                raise FirmwareError(f"{board.exe.name} did not start: "
+                                    f"{board.close() or 'it never greeted its plant'}")
+
+    # -- the host's frames in ---------------------------------------------------------------
+    def receive(self, data: bytes) -> None:
+        """Relay each frame the host sent to the board it addresses (a frame
+        whose address cannot be read to both, as a shared line would); wire
+        faults act on whole frames, as in :class:`SerialBoardServer`."""
+        f = self.faults
+        for wire in self._inbox.frames(data):
+            if self._chance(f.drop):
+                continue
+            if self._chance(f.corrupt):
+                wire = self._corrupt(wire)
+            copies = 2 if self._chance(f.duplicate) else 1
+            address = _address(wire)
+            targets = [self.firmware[address]] if address in self.firmware else \
+                list(self.firmware.values())
+            self.stats.frames_rx += 1
+            for board in targets:
+                board.send(wire * copies)
+
+    # -- the boards' replies and plants --------------------------------------------------------
+    def _side_fds(self) -> list[int]:
+        return [s.fileno() for b in self.firmware.values() for s in (b.host, b.link)]
+
+    def _side_ready(self, fd: int) -> None:
+        for board in self.firmware.values():
+            if fd == board.link.fileno():
+                if not board.serve_plant():
+                    self.stop()  # the program ended: nothing more to serve
+            elif fd == board.host.fileno():
+                self._relay_replies(board)
+
+    def _relay_replies(self, board: FirmwareBoard) -> None:
+        try:
+            data = board.host.recv(4096)
+        except BlockingIOError:
+            return
+        if not data:
+            self.stop()
+            return
+        for wire in board.replies.frames(data):
+            if not self._silent(board.address):
+                self._write(wire)
+        if self._out:
+            out, self._out = bytes(self._out), bytearray()
+            self._write_all(out)
+
+    def close(self) -> list[str]:
+        """Stop every board's program; the lines they printed."""
+        return [line for b in self.firmware.values() if (line := b.close())]
+
+
+def _address(wire: bytes) -> int | None:
+    """The board a host frame addresses, or None when it cannot be read."""
+    try:
+        body = cobs.decode(wire[:-1])
+    except cobs.DecodeError:
+        return None
+    return body[0] & 0x0F if body and not body[0] & 0x80 else None
+
+
+__all__ = ["FirmwareBoardServer", "FirmwareError", "build_native", "find_cc"]

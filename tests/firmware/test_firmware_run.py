@@ -1,0 +1,47 @@
+"""The whole ascent and descent on the boards' C firmware: `stairbot
+fake-boards --serial --firmware native --lockstep` in another process (the
+motor and sensor boards' Linux programs on the simulated robot's plant
+link), the runner in this one on serial://<pty>, ending as sim:// does."""
+
+from __future__ import annotations
+
+import signal
+from pathlib import Path
+
+import pytest
+from lockstep_boards import lockstep_boards
+
+from stairbot.control.robot_config import load_config
+from stairbot.fakes.firmware_boards import find_cc
+from stairbot.inputs.scenario import load_scenario
+from stairbot.run.robots import RobotOptions, open_robot
+from stairbot.run.runner import RunResult, run
+
+SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "fell")
+
+
+@pytest.fixture(autouse=True)
+def _compiler() -> None:
+    if find_cc() is None:
+        pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
+
+
+def test_the_default_run_on_the_native_firmware_ends_as_sim_does(tmp_path: Path) -> None:
+    config, scenario = load_config(), load_scenario()
+    sim = run(open_robot("sim://", config, RobotOptions(world=scenario)), config)
+    with lockstep_boards(tmp_path, stop=signal.SIGTERM, firmware="native") as boards:
+        session = open_robot(boards.url + "&timeout=2", config)
+        try:
+            wire: RunResult = run(session, config)
+            health = session.robot.diagnostics()["link"]
+            truth = session.robot.truth()  # type: ignore[attr-defined]
+        finally:
+            session.close()
+    assert boards.returncode == 0, boards.stderr
+    assert "sb_motor_native:" in boards.stderr and "sb_sensor_native:" in boards.stderr
+    assert sim.outcome == "completed" and sim.steps_climbed == 5
+    assert {k: getattr(wire, k) for k in SAME} == {k: getattr(sim, k) for k in SAME}
+    assert wire.sim_time_s == pytest.approx(sim.sim_time_s, abs=1.0)
+    assert wire.final_offset_m is not None and wire.final_offset_m < 0.05
+    assert not truth.fell
+    assert isinstance(health, dict) and health["lost"] == 0 and health["crc_errors"] == 0
