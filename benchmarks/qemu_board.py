@@ -1,0 +1,130 @@
+"""A board image of the qemu-stm32f4 port (firmware/port/stm32f4) run in
+qemu-system-arm, its USART1 on a new pseudo-terminal: what
+bench_qemu_link.py and tests/firmware/test_qemu_board.py drive with the
+host's own serial driver.
+
+    make -C firmware qemu      # the images this runs (arm-none-eabi-gcc, picolibc)
+
+QEMU's netduinoplus2 is an STM32F405: its first -serial is USART1 (the
+host's line), its second USART2 (the plant link).  QEMU names the pty it
+opened on its standard output ("char device redirected to /dev/pts/N
+(label serial0)").  The board's boot id (Owner.boot) is written into its
+RAM before reset by QEMU's generic loader, at the image's ``sb_boot_seed``
+(the STM32F405 QEMU models has no RNG)."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import time
+import tty
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from stairbot.drivers import messages as m
+from stairbot.drivers.serial_link import FdChannel, SerialLink
+from stairbot.errors import LinkLostError
+
+FIRMWARE = Path(__file__).resolve().parents[1] / "firmware"
+TOOLS = ("make", "arm-none-eabi-gcc", "arm-none-eabi-nm", "qemu-system-arm")
+MACHINE = "netduinoplus2"
+START_S = 10.0  # QEMU starts in well under a second; the pty is polled for a host every second
+PTY_LINE = re.compile(r"char device redirected to (/dev/pts/\d+) \(label (\w+)\)")
+
+
+def missing_tools() -> list[str]:
+    """What of make, the Arm cross compiler and QEMU is not on PATH
+    (Debian: make gcc-arm-none-eabi picolibc-arm-none-eabi qemu-system-arm)."""
+    return [tool for tool in TOOLS if shutil.which(tool) is None]
+
+
+def build_images(out: Path) -> Path:
+    """``make -C firmware qemu`` into ``out``; the directory holding the images."""
+    made = subprocess.run(["make", "-s", "-C", str(FIRMWARE), f"BUILD={out}", "qemu"],
+                          capture_output=True, text=True, check=False)
+    if made.returncode != 0:
+        raise RuntimeError(f"make -C firmware qemu failed:\n{made.stdout}{made.stderr}")
+    return out / "qemu"
+
+
+def symbol_address(elf: Path, name: str) -> int:
+    """Where the image's linker put ``name``."""
+    listed = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True,
+                            check=True).stdout
+    for line in listed.splitlines():
+        fields = line.split()
+        if len(fields) == 3 and fields[2] == name:
+            return int(fields[0], 16)
+    raise RuntimeError(f"{elf} has no symbol {name}")
+
+
+@dataclass
+class QemuBoard:
+    proc: subprocess.Popen[str]
+    path: str  # USART1's pty: what a host opens (serial://PATH)
+    boot: int  # the boot id the board was given
+
+
+def _pty(proc: subprocess.Popen[str]) -> str:
+    """The pty QEMU opened for serial0 (USART1), from its output."""
+    assert proc.stdout is not None
+    seen = []
+    for line in proc.stdout:
+        seen.append(line)
+        found = PTY_LINE.search(line)
+        if found and found.group(2) == "serial0":
+            return found.group(1)
+    raise RuntimeError(f"qemu named no pty for serial0: {''.join(seen)}")
+
+
+def _await_board(path: str, board: m.Board) -> None:
+    """Wait until the board answers Identify (QEMU notices a host on the
+    pty within a second; the board answers once it has booted)."""
+    fd = os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+    tty.setraw(fd)
+    link = SerialLink(FdChannel(fd), timeout_s=0.2)
+    end = time.monotonic() + START_S
+    try:
+        while True:
+            try:
+                link.exchange(board, [m.Identify()])
+                return
+            except LinkLostError:
+                if time.monotonic() > end:
+                    raise
+    finally:
+        link.close()
+
+
+@contextmanager
+def run_board(elf: Path, boot: int, board: m.Board = m.Board.MOTOR,
+              usart2: str = "null") -> Iterator[QemuBoard]:
+    """``elf`` running in QEMU with boot id ``boot``, USART1 on a new pty
+    (held open here, so that QEMU keeps it connected between hosts) and
+    USART2 on the chardev ``usart2``; stopped on leaving."""
+    seed = symbol_address(elf, "sb_boot_seed")
+    proc = subprocess.Popen(
+        ["qemu-system-arm", "-M", MACHINE, "-nographic", "-monitor", "none",
+         "-serial", "pty", "-serial", usart2, "-kernel", str(elf),
+         "-device", f"loader,addr={seed:#x},data={boot:#x},data-len=4"],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    keeper = -1
+    try:
+        path = _pty(proc)
+        keeper = os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+        tty.setraw(keeper)
+        _await_board(path, board)
+        yield QemuBoard(proc, path, boot)
+    finally:
+        proc.terminate()
+        try:
+            proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+        if keeper >= 0:
+            os.close(keeper)

@@ -1,0 +1,124 @@
+"""The motor board of the qemu-stm32f4 port (firmware/port/stm32f4:
+sb_motor_qemu.elf, the trivial plant behind its HAL) in qemu-system-arm's
+netduinoplus2 (an STM32F405), its USART1 on a pty, driven by the host's own
+serial driver (SerialLink, handshake.open_board) as test_motor_board.py
+drives the native board: Identify and the protocol version, the boot id the
+image was given, one owner, speeds and counters in ReadAll, the watchdog
+tripping and latching, the e-stop latched until Clear.
+
+Skips, saying so, without make, arm-none-eabi-gcc (with picolibc) or
+qemu-system-arm (scripts/test installs them).  Each test has its own QEMU,
+stopped when it ends."""
+
+from __future__ import annotations
+
+import secrets
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from board_host import LEASE_MS, MOTOR, NONCE, flags, host, ok, one, owner, read_all, until
+from firmware_build import LIFT_LIMIT, WHEEL_LIMIT
+
+from stairbot.drivers import messages as m
+from stairbot.drivers.handshake import check_version
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from qemu_board import QemuBoard, build_images, missing_tools, run_board  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def images(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    missing = missing_tools()
+    if missing:
+        pytest.skip(f"no {', '.join(missing)} on PATH: scripts/test installs make, "
+                    "gcc-arm-none-eabi, picolibc-arm-none-eabi and qemu-system-arm")
+    return build_images(tmp_path_factory.mktemp("qemu"))
+
+
+@pytest.fixture
+def board(images: Path) -> Iterator[QemuBoard]:
+    with run_board(images / "sb_motor_qemu.elf", secrets.randbits(32) | 1) as running:
+        yield running
+
+
+def test_identify_the_protocol_version_and_one_owner(board: QemuBoard) -> None:
+    with host(board.path) as link:
+        ident, status = link.exchange(MOTOR, [m.Identify(), m.GetStatus()]).messages
+        assert isinstance(ident, m.Ident) and isinstance(status, m.Status)
+        assert (ident.board, ident.protocol_major, ident.protocol_minor, ident.channels,
+                ident.serial) == (MOTOR, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, 6, 1)
+        check_version(f"serial://{board.path}", MOTOR, ident)
+        assert status.flags & m.StatusFlag.SIMULATED and not status.flags & m.StatusFlag.LOCKSTEP
+        assert one(link, m.GetSensor(0)) == ok(m.GetSensor, m.AckResult.NOT_SUPPORTED)
+        assert one(link, m.GetMotor(6)) == ok(m.GetMotor, m.AckResult.BAD_CHANNEL)
+    with owner(board.path) as first, host(board.path, avoid=first.session) as second:
+        claimed = one(first, m.Claim(LEASE_MS, NONCE))
+        assert isinstance(claimed, m.Owner) and claimed.result == m.ClaimResult.GRANTED
+        assert claimed.boot == board.boot  # the id QEMU's loader wrote before reset
+        held = one(second, m.Claim(LEASE_MS, NONCE + 1))
+        assert isinstance(held, m.Owner) and held.result == m.ClaimResult.HELD
+        assert (held.session, held.boot) == (first.session, board.boot)
+        assert one(second, m.Run(0, 500)) == ok(m.Run, m.AckResult.NOT_OWNER)
+        assert read_all(second)[1][0].mode == m.MotorMode.IDLE
+
+
+def test_speeds_clamped_and_the_counters_on_the_boards_clock(board: QemuBoard) -> None:
+    with owner(board.path) as link:
+        assert one(link, m.SetLiftSpeeds(2000, -2000)) == ok(m.SetLiftSpeeds)
+        first, before = read_all(link)
+        until("the lifts to move", lambda: all(
+            abs(a.turns_mt - b.turns_mt) > 50 for a, b in zip(
+                read_all(link)[1][4:], before[4:], strict=True)))
+        status, tel = read_all(link)
+        assert [t.mode for t in tel[4:]] == [m.MotorMode.RUN] * 2
+        assert (tel[4].speed_mtps, tel[5].speed_mtps) == (2000, -2000)
+        # the plant integrates on SysTick's milliseconds: 2 milli-turns each
+        elapsed_ms = status.uptime_ms - first.uptime_ms
+        assert elapsed_ms > 0
+        assert tel[4].turns_mt - before[4].turns_mt == 2 * elapsed_ms
+        assert tel[5].turns_mt - before[5].turns_mt == -2 * elapsed_ms
+        assert one(link, m.SetWheelSpeeds(500, -500, 5000, -32767)) == ok(m.SetWheelSpeeds)
+        assert one(link, m.SetLiftSpeeds(20000, 0)) == ok(m.SetLiftSpeeds)
+        clamped = [500, -500, WHEEL_LIMIT, -WHEEL_LIMIT, LIFT_LIMIT, 0]  # each motor's limit
+        until("the measured speeds", lambda: [
+            t.speed_mtps for t in read_all(link)[1]] == clamped)
+        assert [t.mode for t in read_all(link)[1]] == [m.MotorMode.RUN] * 5 + [m.MotorMode.IDLE]
+        assert one(link, m.Stop(m.ALL_MOTORS_MASK)) == ok(m.Stop)
+
+
+def test_the_watchdog_stops_the_motors_and_latches_until_clear(board: QemuBoard) -> None:
+    with owner(board.path) as link, host(board.path, avoid=link.session) as other:
+        assert one(link, m.SetWheelSpeeds(300, 300, 300, 300)) == ok(m.SetWheelSpeeds)
+        # the owner falls silent; another host's polling does not feed its watchdog
+        until("the watchdog", lambda: bool(read_all(other)[0].flags & m.StatusFlag.WATCHDOG))
+        status, tel = read_all(link)
+        assert status.fault == m.MotorFault.WATCHDOG
+        assert all(t.mode == m.MotorMode.HOLD for t in tel), tel
+        until("every motor stopped", lambda: all(t.speed_mtps == 0 for t in read_all(other)[1]))
+        # latched: a frame after the timeout does not un-trip it; motion is refused
+        assert one(link, m.Run(0, 300)) == ok(m.Run, m.AckResult.WATCHDOG)
+        assert flags(one(link, m.GetStatus())) & m.StatusFlag.WATCHDOG
+        cleared = one(link, m.Clear(0x02))
+        assert not flags(cleared) & m.StatusFlag.WATCHDOG
+        assert all(t.mode == m.MotorMode.HOLD for t in read_all(link)[1])  # nothing restarts
+        assert one(link, m.Run(0, 300)) == ok(m.Run)
+        assert one(link, m.Stop(m.ALL_MOTORS_MASK)) == ok(m.Stop)
+
+
+def test_the_estop_latches_until_the_owners_clear(board: QemuBoard) -> None:
+    with owner(board.path) as link, host(board.path, avoid=link.session) as other:
+        assert one(link, m.SetWheelSpeeds(300, 300, 300, 300)) == ok(m.SetWheelSpeeds)
+        stopped = one(other, m.EStop())  # anyone may stop the robot
+        assert flags(stopped) & m.StatusFlag.ESTOP
+        assert isinstance(stopped, m.Status) and stopped.fault == m.MotorFault.ESTOP
+        assert all(t.mode == m.MotorMode.HOLD for t in read_all(link)[1])
+        assert one(link, m.SetWheelSpeeds(300, 300, 300, 300)) == ok(
+            m.SetWheelSpeeds, m.AckResult.ESTOP)
+        assert flags(one(link, m.Clear(0x06))) & m.StatusFlag.ESTOP  # only bit 0x01 clears it
+        assert one(other, m.Clear(0x01)) == ok(m.Clear, m.AckResult.NOT_OWNER)
+        assert flags(one(link, m.Clear(0x01))) & 0x07 == 0
+        assert all(t.mode != m.MotorMode.RUN for t in read_all(link)[1])
+        assert one(link, m.Run(0, 300)) == ok(m.Run)
+        assert one(link, m.Stop(m.ALL_MOTORS_MASK)) == ok(m.Stop)
