@@ -21,12 +21,13 @@ import select
 import shutil
 import socket
 import subprocess
+import time
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 
-from cobs import cobs
-
 from stairbot.drivers import messages as m
+from stairbot.drivers.serial_wire import CodecError, decode_frame
 from stairbot.errors import InputError
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.plant_link import PlantLink
@@ -36,6 +37,7 @@ from stairbot.hardware import MotorId
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 PROGRAMS = {int(m.Board.MOTOR): "sb_motor_native", int(m.Board.SENSOR): "sb_sensor_native"}
 HELLO_S = 5.0  # how long a board's program may take to greet its plant
+REPLY_WAIT_S = 0.1  # how long the line waits on a board's reply before the next frame
 
 
 class FirmwareError(InputError):
@@ -170,6 +172,8 @@ class FirmwareBoardServer(SerialBoardServer):
         self.firmware: dict[int, FirmwareBoard] = {}
         self.serials = dict(zip(PROGRAMS, serials, strict=True))
         self._inbox = _Line(bytearray())
+        self._queue: deque[tuple[int | None, bytes, int]] = deque()  # (address, wire, copies)
+        self._flight: tuple[int, int, float] | None = None  # (address, replies due, deadline)
         try:
             for address, name in PROGRAMS.items():
                 plant = PlantLink(world, address, self.serials[address], limits_tps)
@@ -195,9 +199,9 @@ class FirmwareBoardServer(SerialBoardServer):
 
     # -- the host's frames in ---------------------------------------------------------------
     def receive(self, data: bytes) -> None:
-        """Relay each frame the host sent to the board it addresses (a frame
-        whose address cannot be read to both, as a shared line would); wire
-        faults act on whole frames, as in :class:`SerialBoardServer`."""
+        """Queue each frame the host sent for the board it addresses (a frame
+        that is not a valid host frame for both, as a shared line would carry
+        it); wire faults act on whole frames, as in :class:`SerialBoardServer`."""
         f = self.faults
         for wire in self._inbox.frames(data):
             if self._chance(f.drop):
@@ -205,12 +209,28 @@ class FirmwareBoardServer(SerialBoardServer):
             if self._chance(f.corrupt):
                 wire = self._corrupt(wire)
             copies = 2 if self._chance(f.duplicate) else 1
-            address = _address(wire)
-            targets = [self.firmware[address]] if address in self.firmware else \
-                list(self.firmware.values())
             self.stats.frames_rx += 1
-            for board in targets:
-                board.send(wire * copies)
+            self._queue.append((_address(wire), wire, copies))
+        self._pump()
+
+    def _pump(self) -> None:
+        """Hand on queued frames, one request in flight at a time: the next
+        waits for the board's reply (or REPLY_WAIT_S), so the boards see the
+        host's frames in the order it sent them -- a StepTo to the motor board
+        is done before the sensor board reads the world for the next ReadAll."""
+        now = time.monotonic()
+        if self._flight is not None and now < self._flight[2]:
+            return
+        self._flight = None
+        while self._queue:
+            address, wire, copies = self._queue.popleft()
+            if address is None:  # no board answers it: to both, nothing awaited
+                for board in self.firmware.values():
+                    board.send(wire * copies)
+                continue
+            self.firmware[address].send(wire * copies)
+            self._flight = (address, copies, now + REPLY_WAIT_S)
+            return
 
     # -- the boards' replies and plants --------------------------------------------------------
     def _side_fds(self) -> list[int]:
@@ -224,6 +244,9 @@ class FirmwareBoardServer(SerialBoardServer):
             elif fd == board.host.fileno():
                 self._relay_replies(board)
 
+    def _idle(self) -> None:
+        self._pump()  # a reply that never came frees the line after REPLY_WAIT_S
+
     def _relay_replies(self, board: FirmwareBoard) -> None:
         try:
             data = board.host.recv(4096)
@@ -233,11 +256,15 @@ class FirmwareBoardServer(SerialBoardServer):
             self.stop()
             return
         for wire in board.replies.frames(data):
+            if self._flight is not None and self._flight[0] == board.address:
+                address, left, deadline = self._flight
+                self._flight = (address, left - 1, deadline) if left > 1 else None
             if not self._silent(board.address):
                 self._write(wire)
         if self._out:
             out, self._out = bytes(self._out), bytearray()
             self._write_all(out)
+        self._pump()
 
     def close(self) -> list[str]:
         """Stop every board's program; the lines they printed."""
@@ -245,12 +272,13 @@ class FirmwareBoardServer(SerialBoardServer):
 
 
 def _address(wire: bytes) -> int | None:
-    """The board a host frame addresses, or None when it cannot be read."""
+    """The board a valid host frame addresses; None for anything else (no
+    board answers a frame failing its checks, or a board's own)."""
     try:
-        body = cobs.decode(wire[:-1])
-    except cobs.DecodeError:
+        frame = decode_frame(wire[:-1])
+    except CodecError:
         return None
-    return body[0] & 0x0F if body and not body[0] & 0x80 else None
+    return None if frame.from_board else frame.board
 
 
 __all__ = ["FirmwareBoardServer", "FirmwareError", "build_native", "find_cc"]

@@ -237,6 +237,9 @@ class SerialBoardServer:
     def _side_ready(self, fd: int) -> None:
         """One of :meth:`_side_fds` is readable."""
 
+    def _idle(self) -> None:
+        """Called once each time round :meth:`serve`'s loop."""
+
     def stop(self) -> None:
         self._stop.set()
 
@@ -253,6 +256,7 @@ class SerialBoardServer:
             for fd in ready:
                 if fd != self.fd:
                     self._side_ready(fd)
+            self._idle()
             if self.fd in ready:
                 try:
                     data = os.read(self.fd, 4096)
