@@ -1,16 +1,14 @@
 """A board image of the qemu-stm32f4 port (firmware/port/stm32f4) run in
-qemu-system-arm, its USART1 on a new pseudo-terminal: what
-bench_qemu_link.py and tests/firmware/test_qemu_board.py drive with the
-host's own serial driver.
+qemu-system-arm by firmware/port/stm32f4/sb_qemu.sh, its USART1 on a new
+pseudo-terminal: what bench_qemu_link.py and tests/firmware/test_qemu_board.py
+drive with the host's own serial driver.
 
     make -C firmware qemu      # the images this runs (arm-none-eabi-gcc, picolibc)
 
-QEMU's netduinoplus2 is an STM32F405: its first -serial is USART1 (the
-host's line), its second USART2 (the plant link).  QEMU names the pty it
-opened on its standard output ("char device redirected to /dev/pts/N
-(label serial0)").  The board's boot id (Owner.boot) is written into its
-RAM before reset by QEMU's generic loader, at the image's ``sb_boot_seed``
-(the STM32F405 QEMU models has no RNG)."""
+QEMU names the pty it opened on its standard output ("char device
+redirected to /dev/pts/N (label serial0)").  The board's boot id
+(Owner.boot) is the one given here, which QEMU's loader writes into the
+image's RAM before reset (the STM32F405 QEMU models has no RNG)."""
 
 from __future__ import annotations
 
@@ -30,8 +28,8 @@ from stairbot.drivers.serial_link import FdChannel, SerialLink
 from stairbot.errors import LinkLostError
 
 FIRMWARE = Path(__file__).resolve().parents[1] / "firmware"
+RUN = FIRMWARE / "port" / "stm32f4" / "sb_qemu.sh"
 TOOLS = ("make", "arm-none-eabi-gcc", "arm-none-eabi-nm", "qemu-system-arm")
-MACHINE = "netduinoplus2"
 START_S = 10.0  # QEMU starts in well under a second; the pty is polled for a host every second
 PTY_LINE = re.compile(r"char device redirected to (/dev/pts/\d+) \(label (\w+)\)")
 
@@ -49,17 +47,6 @@ def build_images(out: Path) -> Path:
     if made.returncode != 0:
         raise RuntimeError(f"make -C firmware qemu failed:\n{made.stdout}{made.stderr}")
     return out / "qemu"
-
-
-def symbol_address(elf: Path, name: str) -> int:
-    """Where the image's linker put ``name``."""
-    listed = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True,
-                            check=True).stdout
-    for line in listed.splitlines():
-        fields = line.split()
-        if len(fields) == 3 and fields[2] == name:
-            return int(fields[0], 16)
-    raise RuntimeError(f"{elf} has no symbol {name}")
 
 
 @dataclass
@@ -101,17 +88,13 @@ def _await_board(path: str, board: m.Board) -> None:
 
 
 @contextmanager
-def run_board(elf: Path, boot: int, board: m.Board = m.Board.MOTOR,
-              usart2: str = "null") -> Iterator[QemuBoard]:
+def run_board(elf: Path, boot: int, board: m.Board = m.Board.MOTOR) -> Iterator[QemuBoard]:
     """``elf`` running in QEMU with boot id ``boot``, USART1 on a new pty
-    (held open here, so that QEMU keeps it connected between hosts) and
-    USART2 on the chardev ``usart2``; stopped on leaving."""
-    seed = symbol_address(elf, "sb_boot_seed")
-    proc = subprocess.Popen(
-        ["qemu-system-arm", "-M", MACHINE, "-nographic", "-monitor", "none",
-         "-serial", "pty", "-serial", usart2, "-kernel", str(elf),
-         "-device", f"loader,addr={seed:#x},data={boot:#x},data-len=4"],
-        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    (held open here, so that QEMU keeps it connected between hosts), USART2
+    on nothing; stopped on leaving."""
+    proc = subprocess.Popen([str(RUN), str(elf), "--boot", f"{boot:x}"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
     keeper = -1
     try:
         path = _pty(proc)

@@ -4,7 +4,11 @@ netduinoplus2 (an STM32F405), its USART1 on a pty, driven by the host's own
 serial driver (SerialLink, handshake.open_board) as test_motor_board.py
 drives the native board: Identify and the protocol version, the boot id the
 image was given, one owner, speeds and counters in ReadAll, the watchdog
-tripping and latching, the e-stop latched until Clear.
+tripping and latching, the e-stop latched until Clear.  And the image on the
+plant link (sb_motor_qemu_link.elf, USART2 on a socket answered by
+stairbot.fakes.plant_link from a lockstep world), started as the fake
+boards start the native programs (FirmwareBoard): its serial number, clock
+and motors are the world's, and StepTo and GetTruth reach it.
 
 Skips, saying so, without make, arm-none-eabi-gcc (with picolibc) or
 qemu-system-arm (scripts/test installs them).  Each test has its own QEMU,
@@ -12,8 +16,11 @@ stopped when it ends."""
 
 from __future__ import annotations
 
+import os
 import secrets
+import select
 import sys
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -21,11 +28,21 @@ import pytest
 from board_host import LEASE_MS, MOTOR, NONCE, flags, host, ok, one, owner, read_all, until
 from firmware_build import LIFT_LIMIT, WHEEL_LIMIT
 
+from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
-from stairbot.drivers.handshake import check_version
+from stairbot.drivers.handshake import check_version, open_board, release_board
+from stairbot.drivers.serial_link import FdChannel, SerialLink
+from stairbot.fakes import sim_messages as sm
+from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.firmware_boards import FirmwareBoard
+from stairbot.fakes.plant_link import PlantLink
+from stairbot.fakes.sim import motor_limits
+from stairbot.inputs.scenario import load_scenario
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from qemu_board import QemuBoard, build_images, missing_tools, run_board  # noqa: E402
+
+PLANT_SERIAL = 4321
 
 
 @pytest.fixture(scope="module")
@@ -122,3 +139,61 @@ def test_the_estop_latches_until_the_owners_clear(board: QemuBoard) -> None:
         assert all(t.mode != m.MotorMode.RUN for t in read_all(link)[1])
         assert one(link, m.Run(0, 300)) == ok(m.Run)
         assert one(link, m.Stop(m.ALL_MOTORS_MASK)) == ok(m.Stop)
+
+
+@pytest.fixture
+def linked(images: Path) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
+    """The plant-link image on a lockstep world, its plant answered by a
+    thread, and a host's link on its USART1."""
+    config = load_config()
+    plant = PlantLink(make_world(config, load_scenario(), lockstep=True), int(MOTOR),
+                      PLANT_SERIAL, motor_limits(config))
+    board = FirmwareBoard(int(MOTOR), images / "sb_motor_qemu_link", plant)
+    done = threading.Event()
+
+    def serve() -> None:
+        while not done.is_set():
+            ready, _, _ = select.select([board.link], [], [], 0.05)
+            if ready and not board.serve_plant():
+                return
+
+    server = threading.Thread(target=serve, daemon=True)
+    server.start()
+    link = SerialLink(FdChannel(os.dup(board.host.fileno())), timeout_s=0.5, retries=10)
+    try:
+        yield board, link
+    finally:
+        link.close()
+        done.set()
+        server.join()
+        board.close()
+
+
+def test_the_plant_link_image_runs_on_the_worlds_clock_and_steps(
+        linked: tuple[FirmwareBoard, SerialLink]) -> None:
+    board, link = linked
+    ident, status = link.exchange(MOTOR, [m.Identify(), m.GetStatus()]).messages
+    assert isinstance(ident, m.Ident) and ident.serial == PLANT_SERIAL  # the plant's hello
+    assert board.plant.greeted
+    assert isinstance(status, m.Status)
+    assert status.flags & (m.StatusFlag.SIMULATED | m.StatusFlag.LOCKSTEP) == (
+        m.StatusFlag.SIMULATED | m.StatusFlag.LOCKSTEP)
+    open_board(link, "qemu", MOTOR, lockstep=True, watchdog_ms=250, hold_ms=0, nonce=NONCE,
+               lease_ms=LEASE_MS, wait_s=lambda _s: None)
+    try:
+        # in lockstep the board's clock is the world's: it stands still until a StepTo
+        before, tel0 = read_all(link)
+        assert one(link, m.SetWheelSpeeds(500, 500, 500, 500)) == ok(m.SetWheelSpeeds)
+        assert read_all(link)[0].uptime_ms == before.uptime_ms
+        target = round(board.plant.world.now() * 1e6) + 200_000
+        assert one(link, sm.StepTo(target)) == sm.StepDone(target)
+        after, tel = read_all(link)
+        assert after.uptime_ms - before.uptime_ms == 200
+        assert all(t.mode == m.MotorMode.RUN for t in tel[:4])
+        assert all(b.turns_mt > a.turns_mt for a, b in zip(tel0[:4], tel[:4], strict=True))
+        truth = one(link, sm.GetTruth())
+        assert isinstance(truth, sm.Truth) and not truth.flags & 1
+        assert one(link, m.Stop(m.ALL_MOTORS_MASK)) == ok(m.Stop)
+        assert board.plant.stats.commands > 0 and board.plant.stats.steps == 1
+    finally:
+        release_board(link, MOTOR, NONCE)

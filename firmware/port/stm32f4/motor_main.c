@@ -1,15 +1,24 @@
 /* sb_motor_qemu: the motor board (board/sb_motor.c) on the STM32F405,
- * serving the host's serial protocol on USART1 (QEMU's first -serial),
- * with the trivial plant (native/plant.c) behind its HAL on SysTick's
- * clock.  No e-stop input: QEMU models no GPIO on this machine. */
+ * serving the host's serial protocol on USART1 (QEMU's first -serial).
+ * Behind its HAL: the trivial plant (native/plant.c) on SysTick's clock;
+ * or, built with SB_PLANT_LINK (sb_motor_qemu_link.elf), the simulated
+ * robot over the plant link (plant/sb_plant.c) on USART2, which gives the
+ * board its clock, serial number, speed limits and lockstep.  No e-stop
+ * input: QEMU models no GPIO on this machine. */
 #include "clock.h"
-#include "plant.h"
 #include "sb_motor.h"
 #include "serve.h"
 
-#ifndef SB_SERIAL
-#define SB_SERIAL 1
+#ifdef SB_PLANT_LINK
+#include "plant_io.h"
+#include "sb_plant.h"
+#define PLANT_BAUD 115200u
+#define PLANT_TIMEOUT_MS 2000u
+#else
+#include "plant.h"
 #endif
+
+#define SERIAL 1
 #define HOST_BAUD 115200u
 
 static size_t motor_frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE])
@@ -19,20 +28,44 @@ static size_t motor_frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIR
 
 int main(void)
 {
-    static plant world;
     static sb_motor_board board;
     static sb_server server;
     clock_init();
-    serve_init(&server, uart_open(1, HOST_BAUD));
+    sb_uart *host = uart_open(1, HOST_BAUD);
+    serve_init(&server, host);
+    sb_motor_config cfg = {SERIAL, serve_boot_id(), {0}, true, false};
+#ifdef SB_PLANT_LINK
+    static sb_plant world;
+    static sb_plant_io io;
+    io = plant_io_on(uart_open(2, PLANT_BAUD));
+    while (!sb_plant_hello(&world, &io, SB_BOARD_MOTOR, PLANT_TIMEOUT_MS)) {
+        /* no plant yet: greet it again */
+    }
+    sb_hal hal = sb_plant_hal(&world);
+    cfg.serial = world.info.serial;
+    cfg.lockstep = world.info.lockstep;
+    for (unsigned ch = 0; ch < SB_MOTORS; ch++) cfg.limit_mtps[ch] = world.info.limit_mtps[ch];
+#else
+    static plant world;
     plant_init(&world);
     sb_hal hal = plant_hal(&world);
-    sb_motor_config cfg = {SB_SERIAL, serve_boot_id(), {0}, true, false};
     plant_limits(cfg.limit_mtps);
+#endif
     sb_motor_init(&board, &hal, &cfg);
+    uint32_t last_ms = clock_ms() - 1u;
     for (;;) {
-        plant_advance(&world, clock_ms());
+#ifdef SB_PLANT_LINK
+        /* the plant's state each millisecond, and before a host frame is handled */
+        if (clock_ms() != last_ms || uart_ready(host)) {
+            last_ms = clock_ms();
+            sb_plant_query(&world);
+        }
+#else
+        last_ms = clock_ms();
+        plant_advance(&world, last_ms);
+#endif
         sb_motor_poll(&board);
         serve_bytes(&server, motor_frame, &board);
-        serve_idle(&server);
+        uart_sleep(host);
     }
 }

@@ -50,11 +50,3 @@ void serve_bytes(sb_server *s, sb_frame_fn on_frame, void *board)
     }
 }
 
-void serve_idle(const sb_server *s)
-{
-    /* Masked, so that a byte arriving between the check and the sleep
-     * leaves its interrupt pending, which WFI wakes on. */
-    sb_irq_off();
-    if (!uart_ready(s->uart)) sb_wait_for_interrupt();
-    sb_irq_on();
-}

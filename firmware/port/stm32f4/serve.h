@@ -1,6 +1,5 @@
 /* What every board image does around its board (board/): the host's frames
- * in from a USART, each answered on it; the time between them slept away;
- * and the boot id. */
+ * in from a USART, each answered on it; and the boot id. */
 #ifndef SB_SERVE_H
 #define SB_SERVE_H
 
@@ -24,10 +23,6 @@ void serve_init(sb_server *s, sb_uart *uart);
 
 /* Every byte waiting, each frame handed to on_frame and its reply sent. */
 void serve_bytes(sb_server *s, sb_frame_fn on_frame, void *board);
-
-/* Sleeps until an interrupt (a byte, or SysTick's next millisecond) unless
- * a byte is already waiting. */
-void serve_idle(const sb_server *s);
 
 /* The boot id (Owner.boot, never 0): the word a loader wrote at the start of
  * RAM (sb_boot_seed: QEMU's `-device loader,addr=...,data=...`), else the

@@ -82,6 +82,15 @@ bool uart_ready(const sb_uart *u)
     return u->head != u->tail;
 }
 
+void uart_sleep(const sb_uart *u)
+{
+    /* Masked, so that a byte arriving between the check and the sleep
+     * leaves its interrupt pending, which WFI wakes on. */
+    sb_irq_off();
+    if (!uart_ready(u)) sb_wait_for_interrupt();
+    sb_irq_on();
+}
+
 int uart_getc(sb_uart *u)
 {
     uint32_t tail = u->tail;

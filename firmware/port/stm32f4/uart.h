@@ -26,6 +26,9 @@ sb_uart *uart_open(unsigned n, uint32_t baud);
 /* The next byte received, or -1 when none is waiting. */
 int uart_getc(sb_uart *u);
 bool uart_ready(const sb_uart *u);
+/* Sleeps until an interrupt (a byte on any USART, or SysTick's next
+ * millisecond) unless a byte is already waiting on u. */
+void uart_sleep(const sb_uart *u);
 void uart_write(sb_uart *u, const uint8_t *p, size_t n);
 
 #endif
