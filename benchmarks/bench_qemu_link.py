@@ -104,7 +104,7 @@ def main() -> int:
     args = p.parse_args()
     missing = missing_tools()
     if missing:
-        print(f"bench_qemu_link: no {', '.join(missing)} on PATH (Debian: make "
+        print(f"bench_qemu_link: missing {', '.join(missing)} (Debian: make "
               "gcc-arm-none-eabi picolibc-arm-none-eabi qemu-system-arm)", file=sys.stderr)
         return 2
     with tempfile.TemporaryDirectory() as tmp:

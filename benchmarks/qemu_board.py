@@ -35,9 +35,15 @@ PTY_LINE = re.compile(r"char device redirected to (/dev/pts/\d+) \(label (\w+)\)
 
 
 def missing_tools() -> list[str]:
-    """What of make, the Arm cross compiler and QEMU is not on PATH
+    """What of make, the Arm cross compiler, its picolibc and QEMU is missing
     (Debian: make gcc-arm-none-eabi picolibc-arm-none-eabi qemu-system-arm)."""
-    return [tool for tool in TOOLS if shutil.which(tool) is None]
+    missing = [tool for tool in TOOLS if shutil.which(tool) is None]
+    if "arm-none-eabi-gcc" not in missing:
+        specs = subprocess.run(["arm-none-eabi-gcc", "-print-file-name=picolibc.specs"],
+                               capture_output=True, text=True, check=False).stdout.strip()
+        if not Path(specs).is_absolute():  # the bare name: gcc found no such file
+            missing.append("picolibc")
+    return missing
 
 
 def build_images(out: Path) -> Path:

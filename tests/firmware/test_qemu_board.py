@@ -49,7 +49,7 @@ PLANT_SERIAL = 4321
 def images(tmp_path_factory: pytest.TempPathFactory) -> Path:
     missing = missing_tools()
     if missing:
-        pytest.skip(f"no {', '.join(missing)} on PATH: scripts/test installs make, "
+        pytest.skip(f"missing {', '.join(missing)}: scripts/test installs make, "
                     "gcc-arm-none-eabi, picolibc-arm-none-eabi and qemu-system-arm")
     return build_images(tmp_path_factory.mktemp("qemu"))
 
