@@ -37,6 +37,7 @@ from qemu_board import FIRMWARE, build_images, missing_tools, run_board  # noqa:
 from stairbot.drivers import messages as m  # noqa: E402
 from stairbot.drivers.handshake import open_board, release_board  # noqa: E402
 from stairbot.drivers.serial_link import FdChannel, SerialLink  # noqa: E402
+from stairbot.drivers.serial_wire import Frame, encode_frame  # noqa: E402
 
 MOTOR = m.Board.MOTOR
 NONCE = 0xBE7C
@@ -44,8 +45,9 @@ RUNS = 3
 WARMUP = 50
 
 
-def cycles_per_s(path: str, cycles: int) -> list[float]:
-    """RUNS measurements of ``cycles`` cycles each on the board at ``path``."""
+def cycles_per_s(path: str, cycles: int) -> tuple[list[float], list[float]]:
+    """RUNS measurements of ``cycles`` cycles each on the board at ``path``
+    (cycles/s), and every cycle's time (s)."""
     fd = os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
     tty.setraw(fd)
     link = SerialLink(FdChannel(fd), timeout_s=0.2)
@@ -63,25 +65,42 @@ def cycles_per_s(path: str, cycles: int) -> list[float]:
 
         for _ in range(WARMUP):
             cycle()
-        rates = []
+        rates, times = [], []
         for _ in range(RUNS):
             t0 = time.perf_counter()
             for _ in range(cycles):
+                c0 = time.perf_counter()
                 cycle()
+                times.append(time.perf_counter() - c0)
             rates.append(cycles / (time.perf_counter() - t0))
         link.exchange(MOTOR, [m.Stop(m.ALL_MOTORS_MASK), m.SetWatchdog(0, 0)])
-        return rates
+        return rates, times
     finally:
         release_board(link, MOTOR, NONCE)
         link.close()
 
 
-def report(name: str, rates: list[float]) -> None:
+def report(name: str, measured: tuple[list[float], list[float]]) -> None:
+    rates, times = measured
     shown = ", ".join(f"{r:.0f}" for r in rates)
-    print(f"  {name:34s} {statistics.median(rates):6.0f} cycles/s (median of {shown})")
+    ordered = sorted(times)
+    p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))]
+    print(f"  {name}: {statistics.median(rates):.0f} cycles/s (median of {shown}); "
+          f"a cycle {statistics.median(times) * 1e3:.2f} ms median, {p99 * 1e3:.2f} ms p99")
 
 
-def native_rates(build: Path, cycles: int) -> list[float] | None:
+def cycle_bytes() -> tuple[int, int]:
+    """(host -> board, board -> host) bytes on the wire per cycle."""
+    s = 0x5A  # a host session
+    out = [Frame(MOTOR, 1, (m.ReadAll(),), session=s),
+           Frame(MOTOR, 2, (m.SetWheelSpeeds(300, 300, 300, 300),), session=s)]
+    back = [Frame(MOTOR, 1, (m.Status(0, 0, 250, 0), *(
+                m.MotorTelemetry(c, 1, 0, 300, 123456) for c in range(6))), True, s),
+            Frame(MOTOR, 2, (m.Ack(m.SetWheelSpeeds.TYPE, 0),), True, s)]
+    return sum(len(encode_frame(f)) for f in out), sum(len(encode_frame(f)) for f in back)
+
+
+def native_rates(build: Path, cycles: int) -> tuple[list[float], list[float]] | None:
     """The same cycles against sb_motor_native on its own pty (None without
     a C compiler)."""
     if not any(shutil.which(cc) for cc in ("cc", "gcc", "clang")):
@@ -116,8 +135,9 @@ def main() -> int:
         print(f"{elf.name} (arm-none-eabi-gcc -Os, Cortex-M4): flash {text + data} bytes "
               f"(text {text} + data {data}), RAM {data + bss} bytes (data {data} + bss {bss}; "
               "the stack's 4 KB reserve apart)")
-        print(f"host control cycles (ReadAll + SetWheelSpeeds in flight together), "
-              f"{args.cycles} a run:")
+        tx, rx = cycle_bytes()
+        print(f"host control cycles (ReadAll + SetWheelSpeeds in flight together: {tx} bytes "
+              f"to the board, {rx} back), {args.cycles} a run:")
         with run_board(elf, secrets.randbits(32) | 1) as board:
             report(f"qemu netduinoplus2, USART1 on {board.path}", cycles_per_s(board.path,
                                                                                  args.cycles))

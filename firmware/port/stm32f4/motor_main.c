@@ -12,14 +12,14 @@
 #ifdef SB_PLANT_LINK
 #include "plant_io.h"
 #include "sb_plant.h"
-#define PLANT_BAUD 115200u
+#define PLANT_BAUD 1000000u
 #define PLANT_TIMEOUT_MS 2000u
 #else
 #include "plant.h"
 #endif
 
 #define SERIAL 1
-#define HOST_BAUD 115200u
+#define HOST_BAUD 1000000u /* the reference line: docs/protocol.md, section 5 */
 
 static size_t motor_frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE])
 {
