@@ -30,14 +30,16 @@ int main(void)
 {
     static sb_motor_board board;
     static sb_server server;
+    static sb_uart host_line;
     clock_init();
-    sb_uart *host = uart_open(1, HOST_BAUD);
+    sb_uart *host = uart_open(&host_line, 1, HOST_BAUD);
     serve_init(&server, host);
     sb_motor_config cfg = {SERIAL, serve_boot_id(), {0}, true, false};
 #ifdef SB_PLANT_LINK
     static sb_plant world;
     static sb_plant_io io;
-    io = plant_io_on(uart_open(2, PLANT_BAUD));
+    static sb_uart plant_line;
+    io = plant_io_on(uart_open(&plant_line, 2, PLANT_BAUD));
     while (!sb_plant_hello(&world, &io, SB_BOARD_MOTOR, PLANT_TIMEOUT_MS)) {
         /* no plant yet: greet it again */
     }

@@ -2,7 +2,7 @@
 
 #include "stm32f4.h"
 
-static sb_uart usart1, usart2; /* zeroed (.bss), not copied from flash */
+static sb_uart *volatile usart1, *volatile usart2; /* what the interrupts fill */
 
 /* Pins pin_a and pin_b of port A to alternate function 7 (the USARTs'). */
 static void pins_af7(uint32_t pin_a, uint32_t pin_b)
@@ -20,28 +20,27 @@ static void pins_af7(uint32_t pin_a, uint32_t pin_b)
     }
 }
 
-sb_uart *uart_open(unsigned n, uint32_t baud)
+sb_uart *uart_open(sb_uart *u, unsigned n, uint32_t baud)
 {
-    sb_uart *u;
     uint32_t clock, irq;
+    u->head = u->tail = u->dropped = 0;
     if (n == 1) {
         RCC_APB2ENR |= RCC_APB2ENR_USART1;
         pins_af7(9, 10);
-        u = &usart1;
         u->base = USART1_BASE;
+        usart1 = u;
         clock = SB_APB2_HZ;
         irq = IRQ_USART1;
     } else if (n == 2) {
         RCC_APB1ENR |= RCC_APB1ENR_USART2;
         pins_af7(2, 3);
-        u = &usart2;
         u->base = USART2_BASE;
+        usart2 = u;
         clock = SB_APB1_HZ;
         irq = IRQ_USART2;
     } else {
         return NULL;
     }
-    u->head = u->tail = u->dropped = 0;
     USART_BRR(u->base) = (clock + baud / 2u) / baud; /* 16x oversampling: mantissa.fraction */
     USART_CR1(u->base) = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE;
     sb_irq_enable(irq);
@@ -69,12 +68,12 @@ static void receive(sb_uart *u)
 
 void USART1_IRQHandler(void)
 {
-    receive(&usart1);
+    receive(usart1);
 }
 
 void USART2_IRQHandler(void)
 {
-    receive(&usart2);
+    receive(usart2);
 }
 
 bool uart_ready(const sb_uart *u)

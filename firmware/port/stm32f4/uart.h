@@ -20,9 +20,10 @@ typedef struct {
     volatile uint32_t dropped; /* bytes lost to a full ring or the USART's overrun */
 } sb_uart;
 
-/* USART n (1: PA9/PA10 on APB2, 2: PA2/PA3 on APB1) at baud, its receive
+/* USART n (1: PA9/PA10 on APB2, 2: PA2/PA3 on APB1) at baud into u (which
+ * lives as long as the program: its interrupt fills u's ring), its receive
  * interrupt enabled; NULL for another n. */
-sb_uart *uart_open(unsigned n, uint32_t baud);
+sb_uart *uart_open(sb_uart *u, unsigned n, uint32_t baud);
 
 /* The next byte received, or -1 when none is waiting. */
 int uart_getc(sb_uart *u);
