@@ -10,6 +10,12 @@ ms, fed by the cycles).  Each figure is the median of 3 runs of --cycles
 cycles on one QEMU; the same cycle against the native board on a pty
 (firmware/native, sb_motor_native) is printed beside it for comparison.
 
+Then lockstep ticks per second on the plant-link image
+(sb_motor_qemu_link.elf, its USART2 answered from the simulated robot by
+stairbot.fakes.plant_link): a tick is SetWheelSpeeds + StepTo (20 ms on)
+in one frame and a ReadAll in another, both in flight; the motor board
+alone, so what a lockstep run on QEMU's firmware would get at best.
+
     python benchmarks/bench_qemu_link.py [--cycles N]
 
 Needs make, arm-none-eabi-gcc with picolibc and qemu-system-arm (exit
@@ -32,17 +38,21 @@ import tty
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from qemu_board import FIRMWARE, build_images, missing_tools, run_board  # noqa: E402
+from qemu_board import FIRMWARE, build_images, missing_tools, run_board, run_linked  # noqa: E402
 
+from stairbot.control.robot_config import load_config  # noqa: E402
 from stairbot.drivers import messages as m  # noqa: E402
 from stairbot.drivers.handshake import open_board, release_board  # noqa: E402
 from stairbot.drivers.serial_link import FdChannel, SerialLink  # noqa: E402
 from stairbot.drivers.serial_wire import Frame, encode_frame  # noqa: E402
+from stairbot.fakes import sim_messages as sm  # noqa: E402
+from stairbot.inputs.scenario import load_scenario  # noqa: E402
 
 MOTOR = m.Board.MOTOR
 NONCE = 0xBE7C
 RUNS = 3
 WARMUP = 50
+TICK_US = 20_000
 
 
 def cycles_per_s(path: str, cycles: int) -> tuple[list[float], list[float]]:
@@ -117,6 +127,27 @@ def native_rates(build: Path, cycles: int) -> tuple[list[float], list[float]] | 
         proc.wait(10)
 
 
+def lockstep_ticks_per_s(program: Path, ticks: int) -> list[float]:
+    """RUNS measurements of ``ticks`` lockstep ticks each on the plant-link image."""
+    with run_linked(program, load_config(), load_scenario(), serial=1) as (board, link):
+        open_board(link, "qemu", MOTOR, lockstep=True, watchdog_ms=250, hold_ms=0,
+                   nonce=NONCE, lease_ms=5000, wait_s=time.sleep)
+        now_us = round(board.plant.world.now() * 1e6)
+        rates = []
+        for _ in range(RUNS):
+            t0 = time.perf_counter()
+            for _ in range(ticks):
+                now_us += TICK_US
+                step = link.request(MOTOR, [m.SetWheelSpeeds(300, 300, 300, 300),
+                                            sm.StepTo(now_us)], send=False)
+                read = link.request(MOTOR, [m.ReadAll()], send=False)
+                stepped, _ = link.wait([step, read])
+                assert stepped.messages[1] == sm.StepDone(now_us), stepped.messages
+            rates.append(ticks / (time.perf_counter() - t0))
+        release_board(link, MOTOR, NONCE)
+        return rates
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--cycles", type=int, default=1000, help="cycles a run (default 1000)")
@@ -144,6 +175,13 @@ def main() -> int:
         native = native_rates(Path(tmp), args.cycles)
         if native is not None:
             report("native sb_motor_native on a pty", native)
+        ticks = max(1, args.cycles // 5)
+        rates = lockstep_ticks_per_s(images / "sb_motor_qemu_link", ticks)
+        shown = ", ".join(f"{r:.0f}" for r in rates)
+        median = statistics.median(rates)
+        print(f"lockstep on the plant-link image (SetWheelSpeeds + StepTo 20 ms, ReadAll), "
+              f"{ticks} ticks a run: {median:.0f} ticks/s (median of {shown}) = "
+              f"{median * TICK_US / 1e6:.1f} x real time")
     return 0
 
 

@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import os
 import re
+import select
 import shutil
 import subprocess
+import threading
 import time
 import tty
 from collections.abc import Iterator
@@ -23,9 +25,15 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from stairbot.control.robot_config import RobotConfig
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_link import FdChannel, SerialLink
 from stairbot.errors import LinkLostError
+from stairbot.fakes.boards_cli import make_world
+from stairbot.fakes.firmware_boards import FirmwareBoard
+from stairbot.fakes.plant_link import PlantLink
+from stairbot.fakes.sim import motor_limits
+from stairbot.inputs.scenario import Scenario
 
 FIRMWARE = Path(__file__).resolve().parents[1] / "firmware"
 RUN = FIRMWARE / "port" / "stm32f4" / "sb_qemu.sh"
@@ -117,3 +125,36 @@ def run_board(elf: Path, boot: int, board: m.Board = m.Board.MOTOR) -> Iterator[
             proc.communicate()
         if keeper >= 0:
             os.close(keeper)
+
+
+@contextmanager
+def run_linked(program: Path, config: RobotConfig, scenario: Scenario, serial: int,
+               lockstep: bool = True) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
+    """The motor board's plant-link image run by ``program`` (make's
+    build/qemu/sb_motor_qemu_link) as the fake boards run the native
+    programs (FirmwareBoard: its USART1 and USART2 on sockets), its plant
+    answered from a world of ``config`` and ``scenario`` by a thread here,
+    and a host's link on its USART1.  The world does not move on its own:
+    in lockstep it moves on StepTo."""
+    plant = PlantLink(make_world(config, scenario, lockstep=lockstep), int(m.Board.MOTOR),
+                      serial, motor_limits(config))
+    board = FirmwareBoard(int(m.Board.MOTOR), program, plant)
+    done = threading.Event()
+
+    def serve() -> None:
+        while not done.is_set():
+            ready, _, _ = select.select([board.link], [], [], 0.05)
+            if ready and not board.serve_plant():
+                return
+
+    server = threading.Thread(target=serve, daemon=True)
+    server.start()
+    # retried queries cover the board's start: it greets its plant first
+    link = SerialLink(FdChannel(os.dup(board.host.fileno())), timeout_s=0.5, retries=10)
+    try:
+        yield board, link
+    finally:
+        link.close()
+        done.set()
+        server.join()
+        board.close()

@@ -16,11 +16,8 @@ stopped when it ends."""
 
 from __future__ import annotations
 
-import os
 import secrets
-import select
 import sys
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -31,16 +28,19 @@ from firmware_build import LIFT_LIMIT, WHEEL_LIMIT
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.drivers.handshake import check_version, open_board, release_board
-from stairbot.drivers.serial_link import FdChannel, SerialLink
+from stairbot.drivers.serial_link import SerialLink
 from stairbot.fakes import sim_messages as sm
-from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.firmware_boards import FirmwareBoard
-from stairbot.fakes.plant_link import PlantLink
-from stairbot.fakes.sim import motor_limits
 from stairbot.inputs.scenario import load_scenario
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from qemu_board import QemuBoard, build_images, missing_tools, run_board  # noqa: E402
+from qemu_board import (  # noqa: E402
+    QemuBoard,
+    build_images,
+    missing_tools,
+    run_board,
+    run_linked,
+)
 
 PLANT_SERIAL = 4321
 
@@ -143,30 +143,10 @@ def test_the_estop_latches_until_the_owners_clear(board: QemuBoard) -> None:
 
 @pytest.fixture
 def linked(images: Path) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
-    """The plant-link image on a lockstep world, its plant answered by a
-    thread, and a host's link on its USART1."""
-    config = load_config()
-    plant = PlantLink(make_world(config, load_scenario(), lockstep=True), int(MOTOR),
-                      PLANT_SERIAL, motor_limits(config))
-    board = FirmwareBoard(int(MOTOR), images / "sb_motor_qemu_link", plant)
-    done = threading.Event()
-
-    def serve() -> None:
-        while not done.is_set():
-            ready, _, _ = select.select([board.link], [], [], 0.05)
-            if ready and not board.serve_plant():
-                return
-
-    server = threading.Thread(target=serve, daemon=True)
-    server.start()
-    link = SerialLink(FdChannel(os.dup(board.host.fileno())), timeout_s=0.5, retries=10)
-    try:
-        yield board, link
-    finally:
-        link.close()
-        done.set()
-        server.join()
-        board.close()
+    """The plant-link image on a lockstep world, and a host's link on its USART1."""
+    with run_linked(images / "sb_motor_qemu_link", load_config(), load_scenario(),
+                    PLANT_SERIAL) as running:
+        yield running
 
 
 def test_the_plant_link_image_runs_on_the_worlds_clock_and_steps(
