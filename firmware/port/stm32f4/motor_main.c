@@ -12,8 +12,6 @@
 #ifdef SB_PLANT_LINK
 #include "plant_io.h"
 #include "sb_plant.h"
-#define PLANT_BAUD 1000000u
-#define PLANT_TIMEOUT_MS 2000u
 #else
 #include "plant.h"
 #endif
@@ -39,10 +37,8 @@ int main(void)
     static sb_plant world;
     static sb_plant_io io;
     static sb_uart plant_line;
-    io = plant_io_on(uart_open(&plant_line, 2, PLANT_BAUD));
-    while (!sb_plant_hello(&world, &io, SB_BOARD_MOTOR, PLANT_TIMEOUT_MS)) {
-        /* no plant yet: greet it again */
-    }
+    io = plant_io_open(&plant_line);
+    plant_start(&world, &io, SB_BOARD_MOTOR);
     sb_hal hal = sb_plant_hal(&world);
     cfg.serial = world.info.serial;
     cfg.lockstep = world.info.lockstep;
@@ -54,17 +50,14 @@ int main(void)
     plant_limits(cfg.limit_mtps);
 #endif
     sb_motor_init(&board, &hal, &cfg);
-    uint32_t last_ms = clock_ms() - 1u;
+#ifdef SB_PLANT_LINK
+    uint32_t last_ms = clock_ms();
+#endif
     for (;;) {
 #ifdef SB_PLANT_LINK
-        /* the plant's state each millisecond, and before a host frame is handled */
-        if (clock_ms() != last_ms || uart_ready(host)) {
-            last_ms = clock_ms();
-            sb_plant_query(&world);
-        }
+        plant_refresh(&world, host, &last_ms);
 #else
-        last_ms = clock_ms();
-        plant_advance(&world, last_ms);
+        plant_advance(&world, clock_ms());
 #endif
         sb_motor_poll(&board);
         serve_bytes(&server, motor_frame, &board);

@@ -2,6 +2,9 @@
 
 #include "clock.h"
 
+#define PLANT_BAUD 1000000u
+#define PLANT_TIMEOUT_MS 2000u /* how long the plant's answer is waited for */
+
 static void send(void *ctx, const uint8_t *p, size_t n)
 {
     uart_write(ctx, p, n);
@@ -21,8 +24,24 @@ static int recv(void *ctx, uint32_t timeout_ms)
     }
 }
 
-sb_plant_io plant_io_on(sb_uart *u)
+sb_plant_io plant_io_open(sb_uart *line)
 {
-    sb_plant_io io = {u, send, recv};
+    sb_plant_io io = {uart_open(line, 2, PLANT_BAUD), send, recv};
     return io;
+}
+
+void plant_start(sb_plant *p, const sb_plant_io *io, uint8_t board)
+{
+    while (!sb_plant_hello(p, io, board, PLANT_TIMEOUT_MS)) {
+        /* no plant yet: greet it again */
+    }
+}
+
+void plant_refresh(sb_plant *p, const sb_uart *host, uint32_t *last_ms)
+{
+    uint32_t now = clock_ms();
+    if (now != *last_ms || uart_ready(host)) {
+        *last_ms = now;
+        sb_plant_query(p);
+    }
 }
