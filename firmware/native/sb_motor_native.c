@@ -181,9 +181,9 @@ int main(int argc, char **argv)
     fprintf(stderr,
             "sb_motor_native: %u frames, %u duplicates answered from the cache, %u CRC errors, "
             "%u malformed, %u overruns, %u replies cut, %u replies dropped\n",
-            (unsigned)board.frames, (unsigned)board.duplicates, (unsigned)reader.stats.crc_errors,
+            (unsigned)board.base.frames, (unsigned)board.base.duplicates, (unsigned)reader.stats.crc_errors,
             (unsigned)reader.stats.malformed, (unsigned)reader.stats.overruns,
-            (unsigned)board.cut, overflows);
+            (unsigned)board.base.cut, overflows);
     if (slave >= 0) close(slave);
     close(fd);
     return 0;
