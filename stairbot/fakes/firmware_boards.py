@@ -239,11 +239,15 @@ class FirmwareBoardServer(SerialBoardServer):
             address, wire, copies = self._queue.popleft()
             if address is None:  # no board answers it: to both, nothing awaited
                 for board in self.firmware.values():
-                    board.send(wire * copies)
+                    self._hand_on(board, wire * copies)
                 continue
-            self.firmware[address].send(wire * copies)
+            self._hand_on(self.firmware[address], wire * copies)
             self._flight = (address, copies, now + REPLY_WAIT_S)
             return
+
+    def _hand_on(self, board: FirmwareBoard, wire: bytes) -> None:
+        """The bytes go down the board's line."""
+        board.send(wire)
 
     # -- the boards' replies and plants --------------------------------------------------------
     def _side_fds(self) -> list[int]:
