@@ -2,10 +2,11 @@
 the boards, and to both boards' confirmation, on serial and CAN at 0, 2 and
 10 % frame loss.
 
-    python benchmarks/bench_estop.py [--presses N] [--wire serial|can] [--loss P]
+    python benchmarks/bench_estop.py [--presses N] [--wire serial|can|firmware] [--loss P]
 
 The fake boards run in real time in a child process (serial: a pseudo-
-terminal; CAN: ``udp_multicast`` on loopback) and lose each frame, either
+terminal; CAN: ``udp_multicast`` on loopback; firmware: the boards' C
+firmware, natively, on a pseudo-terminal) and lose each frame, either
 way, with the given probability.  The host runs a control loop as the run
 loop does (ReadAll to both boards, then the speeds, every 20 ms), so that a
 press often comes while a read waits for, or retries, a lost reply.  Another
@@ -30,6 +31,7 @@ import sys
 import threading
 import time
 from multiprocessing.connection import Connection
+from pathlib import Path
 from typing import Any
 
 from stairbot.control.robot_config import load_config
@@ -38,12 +40,15 @@ from stairbot.drivers.board_robot import BoardRobot
 from stairbot.drivers.can_robot import open_bus, parse_can_url
 from stairbot.drivers.can_wire import CanFrame
 from stairbot.drivers.estop import ESTOP_CONFIRM_S
+from stairbot.drivers.serial_wire import CodecError, decode_frame
 from stairbot.errors import HardwareError
 from stairbot.events import Event, EventKind
 from stairbot.fakes.boards import make_boards
 from stairbot.fakes.boards_cli import make_world
 from stairbot.fakes.can_boards import CanBoardServer
+from stairbot.fakes.firmware_boards import FirmwareBoard, FirmwareBoardServer, build_native
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
+from stairbot.fakes.sim import motor_limits
 from stairbot.hardware import MotorId
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotOptions, open_robot
@@ -67,6 +72,19 @@ class NotingSerial(SerialBoardServer):
         super()._handle(frame)
 
 
+class NotingFirmware(FirmwareBoardServer):
+    """The boards' C firmware, noting each EStop frame handed on to a board."""
+
+    note_fd = -1
+
+    def _hand_on(self, board: FirmwareBoard, wire: bytes) -> None:
+        with contextlib.suppress(CodecError):
+            frame = decode_frame(wire.split(b"\x00")[0])
+            if any(isinstance(x, m.EStop) for x in frame.messages):
+                _note(self.note_fd, board.address)
+        super()._hand_on(board, wire)
+
+
 class NotingCan(CanBoardServer):
     """CAN boards that note each EStop frame that reaches them."""
 
@@ -78,11 +96,24 @@ class NotingCan(CanBoardServer):
         super()._handle(address, frame, data)
 
 
-def serve(wire: str, loss: float, where: Connection, note_fd: int) -> None:
-    """The child process: fake boards in real time, losing frames."""
+def serve(wire: str, loss: float, where: Connection, note_fd: int,
+          firmware_dir: Path | None) -> None:
+    """The child process: fake boards in real time, losing frames (the
+    firmware's native programs from ``firmware_dir``)."""
     world = make_world(load_config(), load_scenario(), lockstep=False)
     faults = WireFaults(drop=loss, seed=7)
-    if wire == "serial":
+    if wire == "firmware":
+        assert firmware_dir is not None
+        pty = PtyPair()
+        fw = NotingFirmware(pty.master, world, firmware_dir, motor_limits(load_config()), (1, 2),
+                            faults)
+        fw.note_fd = note_fd
+        where.send(f"serial://{pty.path}")
+        try:
+            fw.serve()
+        finally:
+            fw.close()
+    elif wire == "serial":
         pty = PtyPair()
         serial = NotingSerial(pty.master, world, make_boards(world), faults)
         serial.note_fd = note_fd
@@ -102,11 +133,12 @@ def percentile(xs: list[float], q: float) -> float:
     return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
-def measure(wire: str, loss: float, presses: int, seed: int) -> dict[str, Any]:
+def measure(wire: str, loss: float, presses: int, seed: int,
+            firmware_dir: Path | None = None) -> dict[str, Any]:
     ctx = mp.get_context("fork")
     parent, child = ctx.Pipe()
     note_r, note_w = os.pipe()
-    proc = ctx.Process(target=serve, args=(wire, loss, child, note_w), daemon=True)
+    proc = ctx.Process(target=serve, args=(wire, loss, child, note_w, firmware_dir), daemon=True)
     proc.start()
     os.close(note_w)
     url = parent.recv()
@@ -189,7 +221,9 @@ def ms(xs: list[float], q: float) -> str:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--presses", type=int, default=300)
-    p.add_argument("--wire", choices=("serial", "can"), action="append")
+    p.add_argument("--wire", choices=("serial", "can", "firmware"), action="append",
+                   help="default serial and can; firmware: the boards' C firmware (built with "
+                        "make) on the serial wire")
     p.add_argument("--loss", type=float, action="append",
                    help="frame loss, 0-1 (default: 0, 0.02 and 0.10)")
     p.add_argument("--seed", type=int, default=1)
@@ -197,6 +231,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.presses < 1:
         p.error("--presses must be at least 1")
     losses = args.loss or [0.0, 0.02, 0.10]
+    firmware_dir = build_native() if "firmware" in (args.wire or ()) else None
     if any(not 0.0 <= x < 1.0 for x in losses):
         p.error("--loss must be at least 0 and below 1")
     print(f"bench_estop: {args.presses} presses a row, give-up after "
@@ -205,7 +240,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{'missed':>6s} | {'confirmed: p50':>14s} {'p99':>7s} {'max':>7s} {'not':>4s}")
     for wire in args.wire or ["serial", "can"]:
         for loss in losses:
-            r = measure(wire, loss, args.presses, args.seed)
+            r = measure(wire, loss, args.presses, args.seed, firmware_dir)
             w, c = r["on_wire"], r["confirmed"]
             print(f"{wire:7s} {loss * 100:4.0f}% | {ms(w, 0.5):>16s} {ms(w, 0.99)} "
                   f"{ms(w, 1.0)} {r['missed']:6d} | {ms(c, 0.5):>14s} {ms(c, 0.99)} "

@@ -6,7 +6,11 @@ run), F refused (the host killed, the new host refused to resume before
 any Clear, the boards still latched), X UNSAFE (listed below the table with
 what was wrong).
 
-    python benchmarks/fault_matrix.py [-j 4] [--wire can|serial] [--fault NAME] [--phase NAME]
+    python benchmarks/fault_matrix.py [-j 4] [--wire can|serial|firmware] [--fault NAME]
+                                      [--phase NAME]
+
+``--wire firmware`` runs the cells on the boards' C firmware (built once with
+make into firmware/build) on the serial wire.
 
 Exit status 1 when any cell is unsafe or never had its fault injected.
 Most of a cell's time is the host waiting out timeouts, so -j may exceed
@@ -19,16 +23,18 @@ import sys
 import time
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
 
-from stairbot.fakes.fault_matrix import FAULTS, PHASES, WIRES, run_cell
+from stairbot.fakes.fault_matrix import ALL_WIRES, FAULTS, PHASES, WIRES, run_cell
 from stairbot.fakes.fault_rig import Cell
+from stairbot.fakes.firmware_boards import build_native
 
 LETTER = {"completed": "C", "stopped": "S", "resumed": "R", "refused": "F", "UNSAFE": "X"}
 
 
-def _one(args: tuple[str, str, str, int]) -> Cell:
-    fault, phase, wire, seed = args
-    return run_cell(fault, phase, wire, seed)
+def _one(args: tuple[str, str, str, int, Path | None]) -> Cell:
+    fault, phase, wire, seed, firmware_dir = args
+    return run_cell(fault, phase, wire, seed, firmware_dir=firmware_dir)
 
 
 def table(cells: list[Cell], wire: str) -> list[str]:
@@ -48,13 +54,15 @@ def table(cells: list[Cell], wire: str) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("-j", "--jobs", type=int, default=4)
-    ap.add_argument("--wire", choices=WIRES, action="append")
+    ap.add_argument("--wire", choices=ALL_WIRES, action="append",
+                    help="default: can and serial; firmware = the C boards, built natively")
     ap.add_argument("--fault", choices=sorted(FAULTS), action="append")
     ap.add_argument("--phase", choices=PHASES, action="append")
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args(argv)
-    todo = [(f, p, w, args.seed) for w in (args.wire or WIRES) for f in (args.fault or FAULTS)
-            for p in (args.phase or PHASES)]
+    firmware_dir = build_native() if "firmware" in (args.wire or ()) else None
+    todo = [(f, p, w, args.seed, firmware_dir) for w in (args.wire or WIRES)
+            for f in (args.fault or FAULTS) for p in (args.phase or PHASES)]
     t0 = time.perf_counter()
     cells: list[Cell] = []
     with ProcessPoolExecutor(args.jobs) as pool:
@@ -62,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
         for i, fut in enumerate(as_completed(futures), 1):
             c = fut.result()
             cells.append(c)
-            print(f"[{i}/{len(todo)}] {c.wire:6} {c.fault:20} {c.phase:22} {c.verdict:9} "
+            print(f"[{i}/{len(todo)}] {c.wire:8} {c.fault:20} {c.phase:22} {c.verdict:9} "
                   f"{c.wall_s:5.1f} s {c.reason[:90]}", file=sys.stderr, flush=True)
     for wire in args.wire or WIRES:
         print(f"\n## {wire}\n")

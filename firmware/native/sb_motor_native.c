@@ -34,7 +34,7 @@ static void report(void *board, FILE *out)
 {
     const sb_motor_board *b = board;
     fprintf(out, "%u frames, %u duplicates answered from the cache, %u replies cut",
-            (unsigned)b->frames, (unsigned)b->duplicates, (unsigned)b->cut);
+            (unsigned)b->base.frames, (unsigned)b->base.duplicates, (unsigned)b->base.cut);
 }
 
 static bool advance_trivial(void *ctx, uint32_t wall_ms)
@@ -45,11 +45,14 @@ static bool advance_trivial(void *ctx, uint32_t wall_ms)
     return true;
 }
 
+static sb_motor_board board;
+
 static bool ask_plant(void *ctx, uint32_t wall_ms)
 {
     (void)wall_ms;
     sb_plant *p = ctx;
     p->estop_pressed = sb_native_button != 0;
+    p->flags = sb_board_status(&board.base).body.status.flags;
     sb_plant_query(p);
     return true;
 }
@@ -61,7 +64,6 @@ int main(int argc, char **argv)
     if (bad) return bad;
     static plant trivial;
     static sb_plant plant_link;
-    static sb_motor_board board;
     static int plant_fd;
     sb_plant_io io = sb_native_plant_io(&plant_fd);
     sb_hal hal;

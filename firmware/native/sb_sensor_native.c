@@ -34,10 +34,14 @@ static void report(void *board, FILE *out)
             (unsigned)b->base.frames, (unsigned)b->base.duplicates, (unsigned)b->base.cut);
 }
 
+static sb_sensor_board board;
+
 static bool ask_plant(void *ctx, uint32_t wall_ms)
 {
     (void)wall_ms;
-    sb_plant_query(ctx);
+    sb_plant *p = ctx;
+    p->flags = sb_board_status(&board.base).body.status.flags;
+    sb_plant_query(p);
     return true;
 }
 
@@ -51,7 +55,6 @@ int main(int argc, char **argv)
         return 2;
     }
     static sb_plant plant_link;
-    static sb_sensor_board board;
     static int plant_fd;
     plant_fd = a.plant_fd;
     sb_plant_io io = sb_native_plant_io(&plant_fd);

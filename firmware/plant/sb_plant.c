@@ -159,7 +159,8 @@ bool sb_plant_query(sb_plant *p)
 {
     uint8_t body[BODY_MAX];
     bool motor = p->info.board == 1;
-    size_t len = ask(p, K_QUERY, motor ? K_MOTOR_STATE : K_SENSOR_STATE, body, 0);
+    body[2] = p->flags;
+    size_t len = ask(p, K_QUERY, motor ? K_MOTOR_STATE : K_SENSOR_STATE, body, 1);
     if (len == 0) return false;
     p->queries++;
     bool ok = motor ? read_motor_state(p, body, len) : read_sensor_state(p, body, len);

@@ -64,6 +64,7 @@ typedef struct {
     bool imu_fitted;
     sb_imu_sample imu[SB_PLANT_AXES];
     volatile bool estop_pressed; /* the board's e-stop button (the port sets it) */
+    uint8_t flags;       /* the board's Status.flags, sent with each query (the port keeps it) */
     uint8_t seq;         /* the last request's */
     /* counts */
     uint32_t queries;
@@ -74,8 +75,8 @@ typedef struct {
  * false when the plant does not answer within timeout_ms. */
 bool sb_plant_hello(sb_plant *p, const sb_plant_io *io, uint8_t board, uint32_t timeout_ms);
 
-/* Asks the plant for its state now; false (the last state kept, counted
- * in lost) when no answer comes. */
+/* Asks the plant for its state now, telling it the board's flags; false
+ * (the last state kept, counted in lost) when no answer comes. */
 bool sb_plant_query(sb_plant *p);
 
 /* The HAL on this plant: now_ms/now_us are the plant's time at the last

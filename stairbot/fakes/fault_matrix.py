@@ -58,7 +58,6 @@ from stairbot.fakes.fault_rig import (
     Cell,
     HostKilled,
     resume_watched,
-    run_on,
 )
 from stairbot.fakes.serial_boards import WireFaults
 from stairbot.hardware import Snapshot
@@ -68,7 +67,7 @@ from stairbot.run.journal import read_journal
 from stairbot.run.journaled import start_journal
 from stairbot.run.runner import RunResult, run
 
-LATE_S = {"can": 0.005, "serial": 0.12}  # a late frame: ten and six timeouts late
+LATE_S = {"can": 0.005, "serial": 0.12, "firmware": 0.3}  # ten, six and six timeouts late
 AFTER_S = 2.0  # world seconds run on after a stopped run, no host
 LIFT_HELD_TURNS = 1e-3  # a held lift's give under load is 1e-5 turns
 MOTOR, SENSOR = int(m.Board.MOTOR), int(m.Board.SENSOR)
@@ -110,6 +109,9 @@ def _faults() -> dict[str, Fault]:
 
 FAULTS: dict[str, Fault] = _faults()
 WIRES = ("can", "serial")
+"""The wires every cell runs on by default; "firmware" (the boards' C
+firmware on the serial wire, ``fake-boards --firmware native``) on request."""
+ALL_WIRES = (*WIRES, "firmware")
 
 
 class _DeadBoard:
@@ -145,9 +147,9 @@ def _after_stop(cell: Cell, result: RunResult, boards: BoardsOnWire, journal: Pa
         problems.append("stopped with no reason given")
     if alive and any(world.speeds().values()):
         problems.append(f"motors left running: {world.speeds()}")
-    run_on(world, boards.boards, 0.5)  # every watchdog has tripped by now
+    boards.run_on(0.5)  # every watchdog has tripped by now
     before = _lifts(world)
-    run_on(world, boards.boards, AFTER_S - 0.5)
+    boards.run_on(AFTER_S - 0.5)
     after = _lifts(world)
     if any(world.speeds().values()):
         problems.append(f"motors running {AFTER_S:.0f} s on: {world.speeds()}")
@@ -168,26 +170,29 @@ def _after_stop(cell: Cell, result: RunResult, boards: BoardsOnWire, journal: Pa
 
 
 def run_cell(fault_name: str, phase: str, wire: str = "can", seed: int = 1,
-             workdir: Path | None = None) -> Cell:
-    """Run one cell of the matrix and judge it (see the module docstring)."""
+             workdir: Path | None = None, firmware_dir: Path | None = None) -> Cell:
+    """Run one cell of the matrix and judge it (see the module docstring);
+    on the "firmware" wire, with the native programs in ``firmware_dir``
+    (default: built into firmware/build)."""
     fault = FAULTS[fault_name]
-    if phase not in PHASES or wire not in WIRES:
+    if phase not in PHASES or wire not in ALL_WIRES:
         raise ValueError(f"unknown phase {phase!r} or wire {wire!r}")
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
         if workdir is None:
             workdir = Path(stack.enter_context(tempfile.TemporaryDirectory()))
-        cell = _run(fault, phase, wire, seed, workdir / "journal.jsonl")
+        cell = _run(fault, phase, wire, seed, workdir / "journal.jsonl", firmware_dir)
     cell.wall_s = time.perf_counter() - t0
     return cell
 
 
-def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
+def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path,
+         firmware_dir: Path | None) -> Cell:
     config = load_config()
     scenario = parse_scenario(SCENARIO, "<fault matrix>")
     world = make_world(config, scenario, lockstep=True)
-    real = make_boards(world)
-    boards = BoardsOnWire(wire, world, real, config)
+    real = {} if wire == "firmware" else make_boards(world)
+    boards = BoardsOnWire(wire, world, real, config, firmware_dir)
     cell = Cell(fault.name, phase, wire, "UNSAFE")
     try:
         session = boards.open()
@@ -201,6 +206,12 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
             if fault.kind == "wire":
                 boards.server.set_faults(WireFaults(seed=seed, late_s=LATE_S[wire],
                                                     **fault.wire))  # type: ignore[arg-type]
+            elif fault.kind in ("kill", "hang") and boards.firmware is not None:
+                assert fault.board is not None
+                if fault.kind == "kill":
+                    boards.firmware.kill(fault.board)
+                else:
+                    boards.firmware.hang(fault.board)
             elif fault.kind in ("kill", "hang"):
                 assert fault.board is not None
                 if fault.kind == "kill":
@@ -236,7 +247,7 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path) -> Cell:
 
 def _resumed(cell: Cell, boards: BoardsOnWire, config: RobotConfig, journal: Path) -> Cell:
     """The host was killed: the world runs on, then a new host resumes."""
-    run_on(boards.world, boards.boards, HOST_DEAD_S)
+    boards.run_on(HOST_DEAD_S)
     boards.deaf(False)
     taken = resume_watched(boards, config, journal)
     cell.verdict, cell.reason = taken.verdict, taken.reason

@@ -24,8 +24,10 @@ from stairbot.errors import HardwareError, InputError
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board
 from stairbot.fakes.can_boards import CanBoardServer, InlineBus
+from stairbot.fakes.firmware_boards import FirmwareBoardServer, build_native
 from stairbot.fakes.lockstep import LockstepRobot
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer
+from stairbot.fakes.sim import motor_limits
 from stairbot.inputs.config import RobotConfig
 from stairbot.run.journaled import resume
 from stairbot.run.resume import ResumeRefused
@@ -49,12 +51,14 @@ noise = 0.001
 seed = 3
 """
 
-TIMEOUT_S = {"can": 0.0005, "serial": 0.02}
+TIMEOUT_S = {"can": 0.0005, "serial": 0.02, "firmware": 0.05}
 """The host's reply timeout on each wire: a lost frame costs this much wall
 time.  The CAN boards answer in the host's own thread (InlineBus), at once;
 the serial boards answer from a thread of their own, which must win the GIL
 from the host's threads first: four of Python's 5 ms switch intervals, so a
-reply is not taken for lost because the host held the GIL."""
+reply is not taken for lost because the host held the GIL.  The firmware's
+reply crosses two more processes (the board's program, which asks its plant
+here first)."""
 GRACE_S = 0.5  # the URLs' default grace period
 HOST_DEAD_S = 1.0  # world seconds between the host killed and the new host
 
@@ -84,23 +88,36 @@ class HostKilled(BaseException):
 
 
 class BoardsOnWire:
-    """The fake boards on one wire, and sessions of hosts opening them."""
+    """The fake boards on one wire, and sessions of hosts opening them.
+    ``wire``: "can" or "serial" (the Python fake boards ``boards``), or
+    "firmware" (the boards' C firmware on the serial wire, built natively
+    into ``firmware_dir``; ``boards`` is then empty)."""
 
     def __init__(self, wire: str, world: BoardWorld, boards: dict[int, Board],
-                 config: RobotConfig) -> None:
+                 config: RobotConfig, firmware_dir: Path | None = None) -> None:
         self.wire, self.world, self.boards, self.config = wire, world, boards, config
         self._thread: threading.Thread | None = None
+        self.firmware: FirmwareBoardServer | None = None
         if wire == "can":
             self.channel = f"fault-matrix-{uuid.uuid4().hex[:8]}"
             self.url = f"can://virtual/{self.channel}?lockstep=1"
             self.server: CanBoardServer | SerialBoardServer = CanBoardServer(
                 can.Bus(interface="virtual", channel=self.channel), world, dict(boards))
+            return
+        self.pty = PtyPair()
+        self.url = f"serial://{self.pty.path}?lockstep=1&timeout={TIMEOUT_S[wire]}"
+        if wire == "firmware":
+            self.firmware = FirmwareBoardServer(
+                self.pty.master, world, firmware_dir or build_native(), motor_limits(config),
+                (1, 2))
+            self.server = self.firmware
         else:
-            self.pty = PtyPair()
-            self.url = f"serial://{self.pty.path}?lockstep=1&timeout={TIMEOUT_S['serial']}"
             self.server = SerialBoardServer(self.pty.master, world, dict(boards))
-            self._thread = threading.Thread(target=self.server.serve, daemon=True)
-            self._thread.start()
+        self._serve()
+
+    def _serve(self) -> None:
+        self._thread = threading.Thread(target=self.server.serve, daemon=True)
+        self._thread.start()
 
     def open(self, allow_latched: bool = False) -> RobotSession:
         if isinstance(self.server, CanBoardServer):
@@ -118,6 +135,24 @@ class BoardsOnWire:
         else:
             vars(server).pop("receive", None)
 
+    def run_on(self, seconds: float) -> None:
+        """The world goes on with no host: the boards' watchdogs see time pass."""
+        if self.firmware is None:
+            run_on(self.world, self.boards, seconds)
+            return
+        self.firmware.stop()  # the firmware's plant links are served here meanwhile
+        if self._thread is not None:
+            self._thread.join(5)
+        self.firmware.run_on(seconds)
+        self.firmware.rearm()
+        self._serve()
+
+    def latched(self) -> bool:
+        """Whether a board holds a latch (its e-stop or its tripped watchdog)."""
+        if self.firmware is not None:
+            return self.firmware.latched()
+        return any(b.estop or b.watchdog_tripped for b in self.boards.values())
+
     def close(self) -> None:
         if isinstance(self.server, CanBoardServer):
             self.server.bus.shutdown()
@@ -125,6 +160,8 @@ class BoardsOnWire:
         self.server.stop()
         if self._thread is not None:
             self._thread.join(5)
+        if self.firmware is not None:
+            self.firmware.close()
         self.pty.close()
 
 
@@ -156,8 +193,8 @@ class Resumption:
 
 
 def latched(boards: BoardsOnWire) -> bool:
-    """Whether a fake board holds a latch (its e-stop or its tripped watchdog)."""
-    return any(b.estop or b.watchdog_tripped for b in boards.boards.values())
+    """Whether a board holds a latch (its e-stop or its tripped watchdog)."""
+    return boards.latched()
 
 
 def _link_failed(boards: BoardsOnWire, cleared: bool, exc: HardwareError) -> Resumption:
@@ -172,7 +209,7 @@ def _held(boards: BoardsOnWire, cleared: bool, why: str) -> Resumption:
     """A host that stopped on a failed link: the world run on with no host,
     "stopped" when every motor stands and a latch holds the boards, else
     "UNSAFE"."""
-    run_on(boards.world, boards.boards, HOST_DEAD_S)
+    boards.run_on(HOST_DEAD_S)
     held = latched(boards)
     if held and not any(boards.world.speeds().values()):
         return Resumption("stopped", why, cleared, held)

@@ -19,6 +19,7 @@ import contextlib
 import os
 import select
 import shutil
+import signal
 import socket
 import subprocess
 import time
@@ -38,6 +39,7 @@ FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 PROGRAMS = {int(m.Board.MOTOR): "sb_motor_native", int(m.Board.SENSOR): "sb_sensor_native"}
 HELLO_S = 5.0  # how long a board's program may take to greet its plant
 REPLY_WAIT_S = 0.1  # how long the line waits on a board's reply before the next frame
+HUNG_RESET_S = 0.25  # a hung board's independent watchdog: reset, outputs off
 
 
 class FirmwareError(InputError):
@@ -111,6 +113,7 @@ class FirmwareBoard:
         self.host, host_child = socket.socketpair()
         self.link, link_child = socket.socketpair()
         self.replies = _Line(bytearray())
+        self.hung_at: float | None = None  # world time it hung (SIGSTOP), None while it runs
         try:
             self.proc = subprocess.Popen(
                 [str(exe), "--host-fd", str(host_child.fileno()),
@@ -140,16 +143,24 @@ class FirmwareBoard:
             self.link.sendall(answer)
         return True
 
+    @property
+    def alive(self) -> bool:
+        """Running and not hung: it answers its host and asks its plant."""
+        return self.hung_at is None and self.proc.poll() is None
+
     def send(self, wire: bytes) -> None:
         with contextlib.suppress(BlockingIOError, BrokenPipeError, ConnectionResetError):
             self.host.sendall(wire)
 
     def close(self) -> str:
-        """Stop the program; what it printed on stderr (its counts)."""
+        """Stop the program; what it printed on stderr (its counts, unless
+        it was killed)."""
         for s in (self.host, self.link):
             with contextlib.suppress(OSError):
                 s.close()
         if self.proc.poll() is None:
+            if self.hung_at is not None:
+                self.proc.send_signal(signal.SIGCONT)
             self.proc.terminate()
         try:
             _, err = self.proc.communicate(timeout=5)
@@ -174,9 +185,11 @@ class FirmwareBoardServer(SerialBoardServer):
         self._inbox = _Line(bytearray())
         self._queue: deque[tuple[int | None, bytes, int]] = deque()  # (address, wire, copies)
         self._flight: tuple[int, int, float] | None = None  # (address, replies due, deadline)
+        self.killed: set[int] = set()
         try:
             for address, name in PROGRAMS.items():
-                plant = PlantLink(world, address, self.serials[address], limits_tps)
+                plant = PlantLink(world, address, self.serials[address], limits_tps,
+                                  after_step=self.after_step)
                 self.firmware[address] = FirmwareBoard(address, build_dir / name, plant)
             self._await_hello()
         except BaseException:
@@ -226,20 +239,27 @@ class FirmwareBoardServer(SerialBoardServer):
             address, wire, copies = self._queue.popleft()
             if address is None:  # no board answers it: to both, nothing awaited
                 for board in self.firmware.values():
-                    board.send(wire * copies)
+                    self._hand_on(board, wire * copies)
                 continue
-            self.firmware[address].send(wire * copies)
+            self._hand_on(self.firmware[address], wire * copies)
             self._flight = (address, copies, now + REPLY_WAIT_S)
             return
 
+    def _hand_on(self, board: FirmwareBoard, wire: bytes) -> None:
+        """The bytes go down the board's line."""
+        board.send(wire)
+
     # -- the boards' replies and plants --------------------------------------------------------
     def _side_fds(self) -> list[int]:
-        return [s.fileno() for b in self.firmware.values() for s in (b.host, b.link)]
+        """The plant links before the host lines: a board's motor command,
+        sent before its reply, reaches the world before the host sees the reply."""
+        return [b.link.fileno() for b in self.firmware.values()] + \
+            [b.host.fileno() for b in self.firmware.values()]
 
     def _side_ready(self, fd: int) -> None:
         for board in self.firmware.values():
             if fd == board.link.fileno():
-                if not board.serve_plant():
+                if not board.serve_plant() and board.address not in self.killed:
                     self.stop()  # the program ended: nothing more to serve
             elif fd == board.host.fileno():
                 self._relay_replies(board)
@@ -265,6 +285,71 @@ class FirmwareBoardServer(SerialBoardServer):
             out, self._out = bytes(self._out), bytearray()
             self._write_all(out)
         self._pump()
+
+    # -- faults of the boards themselves (the fault matrix) ---------------------------------------
+    def kill(self, address: int) -> None:
+        """The board loses power: its program is killed and its motors stop
+        (the lifts are self-locking and hold)."""
+        board = self.firmware[address]
+        self.killed.add(address)
+        if board.proc.poll() is None:
+            if board.hung_at is not None:
+                board.proc.send_signal(signal.SIGCONT)
+            board.proc.kill()
+            board.proc.wait()
+        self._power_off(address)
+
+    def hang(self, address: int) -> None:
+        """The board's program hangs (SIGSTOP): it answers nothing and its
+        motors run on as last told, until its independent watchdog -- a
+        hardware timer, :data:`HUNG_RESET_S` -- resets it, its outputs off."""
+        self.firmware[address].proc.send_signal(signal.SIGSTOP)
+        self.firmware[address].hung_at = self.world.now()
+
+    def _power_off(self, address: int) -> None:
+        if address == int(m.Board.MOTOR):
+            self.world.set_speeds(dict.fromkeys(m.MOTOR_CHANNELS, 0.0))
+
+    def after_step(self) -> None:
+        """The world moved on: a hung board whose independent watchdog ran
+        out is reset, its outputs off."""
+        for address, board in self.firmware.items():
+            if board.hung_at is not None and self.world.now() - board.hung_at >= HUNG_RESET_S:
+                self._power_off(address)
+
+    def latched(self) -> bool:
+        """Whether a running board says it holds a latch (its e-stop or its
+        tripped watchdog), as its last plant query reported its status."""
+        latches = int(m.StatusFlag.ESTOP | m.StatusFlag.WATCHDOG)
+        return any(b.plant.board_flags & latches for b in self.firmware.values() if b.alive)
+
+    def run_on(self, seconds: float) -> None:
+        """The world goes on with no host, in 10 ms steps, each running board
+        asking its plant after each (its watchdog sees the time pass).  Call
+        it while the server is not serving on another thread."""
+        t_us = round(self.world.now() * 1e6)
+        for _ in range(round(seconds / 0.01)):
+            t_us += 10_000
+            self.world.step_to(t_us)
+            self.after_step()
+            self._await_queries()
+
+    def _await_queries(self) -> None:
+        """Serve the plant links until each running board has asked once more
+        (or 0.5 s of wall time passed)."""
+        live = {b.link.fileno(): b for b in self.firmware.values() if b.alive}
+        asked = {fd: b.plant.stats.queries for fd, b in live.items()}
+        deadline = time.monotonic() + 0.5
+        while live and time.monotonic() < deadline:
+            ready, _, _ = select.select(list(live), [], [], 0.05)
+            for fd in ready:
+                live[fd].serve_plant()
+                if live[fd].plant.stats.queries > asked[fd]:
+                    del live[fd]
+
+    def rearm(self) -> None:
+        """Let :meth:`serve` run again after :meth:`stop`."""
+        self._stop.clear()
 
     def close(self) -> list[str]:
         """Stop every board's program; the lines they printed."""

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from cobs import cobs
@@ -78,11 +79,17 @@ class PlantLink:
     """One board's end of the plant link: feed it the bytes the board sent,
     send back what :meth:`feed` returns.  ``board``: 1 the motor board, 2
     the sensor board (it must greet as that board); ``serial``: the serial
-    number the plant gives it; ``limits_tps``: each motor's speed limit."""
+    number the plant gives it; ``limits_tps``: each motor's speed limit;
+    ``after_step``: called each time a StepTo moved the world.  A query
+    carries the board's Status.flags (``board_flags``), which the fault
+    matrix reads to see its latches without a host."""
 
     def __init__(self, world: BoardWorld, board: int, serial: int,
-                 limits_tps: dict[MotorId, float]) -> None:
+                 limits_tps: dict[MotorId, float],
+                 after_step: Callable[[], None] | None = None) -> None:
         self.world = world
+        self.after_step = after_step
+        self.board_flags = 0  # the board's Status.flags, as its last query said
         self.board = board
         self.serial = serial
         self.limits_tps = limits_tps
@@ -114,6 +121,7 @@ class PlantLink:
             self.greeted = True
             return encode(INFO, seq, self._info())
         if kind == QUERY:
+            (self.board_flags,) = struct.unpack("<B", fields)
             self.stats.queries += 1
             return encode(MOTOR_STATE if self.board == 1 else SENSOR_STATE, seq, self._fields())
         if kind == MOTOR:
@@ -130,6 +138,8 @@ class PlantLink:
                 return encode(STEPPED, seq, _STEPPED.pack(0, 0))
             self.stats.steps += 1
             done = self.world.step_to(time_us)
+            if self.after_step is not None:
+                self.after_step()
             return encode(STEPPED, seq, _STEPPED.pack(1, done & 0xFFFFFFFF))
         if kind == TRUTH:
             t = self.world.truth()

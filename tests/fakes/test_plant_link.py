@@ -57,11 +57,11 @@ def test_a_hello_from_the_other_board_is_refused_and_counted() -> None:
 def test_a_motor_command_and_a_step_move_the_counters_the_next_query_reports() -> None:
     plant = link(1)
     speed = struct.pack("<BhB", 0, 800, 0)  # MWF at 0.8 turn/s
-    before = answers(plant, encode(ord("Q"), 1))[0][2]
+    before = answers(plant, encode(ord("Q"), 1, b"\x00"))[0][2]
     [(kind, _, stepped)] = answers(plant, encode(ord("M"), 0, speed),
                                    encode(ord("S"), 2, struct.pack("<I", 500_000)))
     assert chr(kind) == "s" and struct.unpack("<BI", stepped) == (1, 500_000)
-    after = answers(plant, encode(ord("Q"), 3))[0][2]
+    after = answers(plant, encode(ord("Q"), 3, b"\x00"))[0][2]
     (t0, failed0), (t1, failed1) = struct.unpack_from("<QB", before), struct.unpack_from("<QB",
                                                                                           after)
     turns0, turns1 = struct.unpack_from("<i", before, 9)[0], struct.unpack_from("<i", after, 9)[0]
@@ -78,7 +78,7 @@ def test_a_plant_in_real_time_refuses_step_to() -> None:
 
 def test_the_sensor_state_holds_every_channel_and_the_imu() -> None:
     plant = link(2)
-    [(kind, _, fields)] = answers(plant, encode(ord("Q"), 9))
+    [(kind, _, fields)] = answers(plant, encode(ord("Q"), 9, b"\x00"))
     now_us, failed, channels = struct.unpack_from("<QBB", fields)
     assert chr(kind) == "n" and (failed, channels) == (0, 4)
     for ch in range(channels):

@@ -55,7 +55,7 @@ int main(void)
 #endif
     for (;;) {
 #ifdef SB_PLANT_LINK
-        plant_refresh(&world, host, &last_ms);
+        plant_refresh(&world, &board.base, host, &last_ms);
 #else
         plant_advance(&world, clock_ms());
 #endif

@@ -37,11 +37,12 @@ void plant_start(sb_plant *p, const sb_plant_io *io, uint8_t board)
     }
 }
 
-void plant_refresh(sb_plant *p, const sb_uart *host, uint32_t *last_ms)
+void plant_refresh(sb_plant *p, const sb_board *board, const sb_uart *host, uint32_t *last_ms)
 {
     uint32_t now = clock_ms();
     if (now != *last_ms || uart_ready(host)) {
         *last_ms = now;
+        p->flags = sb_board_status(board).body.status.flags;
         sb_plant_query(p);
     }
 }

@@ -4,6 +4,7 @@
 #ifndef SB_PLANT_IO_H
 #define SB_PLANT_IO_H
 
+#include "sb_board.h"
 #include "sb_plant.h"
 #include "uart.h"
 
@@ -14,9 +15,9 @@ sb_plant_io plant_io_open(sb_uart *line);
  * until it answers: the plant may come after the board. */
 void plant_start(sb_plant *p, const sb_plant_io *io, uint8_t board);
 
-/* Asks the plant for its state when SysTick's millisecond has moved on
- * since *last_ms, or when a host byte waits on host (so that a frame is
- * handled on the plant's state of now). */
-void plant_refresh(sb_plant *p, const sb_uart *host, uint32_t *last_ms);
+/* Asks the plant for its state, telling it the board's Status.flags, when
+ * SysTick's millisecond has moved on since *last_ms, or when a host byte
+ * waits on host (so that a frame is handled on the plant's state of now). */
+void plant_refresh(sb_plant *p, const sb_board *board, const sb_uart *host, uint32_t *last_ms);
 
 #endif
