@@ -129,7 +129,7 @@ def native_rates(build: Path, cycles: int) -> tuple[list[float], list[float]] | 
 
 def lockstep_ticks_per_s(program: Path, ticks: int) -> list[float]:
     """RUNS measurements of ``ticks`` lockstep ticks each on the plant-link image."""
-    with run_linked(program, load_config(), load_scenario(), serial=1) as (board, link):
+    with run_linked(program, MOTOR, load_config(), load_scenario(), serial=1) as (board, link):
         open_board(link, "qemu", MOTOR, lockstep=True, watchdog_ms=250, hold_ms=0,
                    nonce=NONCE, lease_ms=5000, wait_s=time.sleep)
         now_us = round(board.plant.world.now() * 1e6)

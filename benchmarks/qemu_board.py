@@ -128,17 +128,18 @@ def run_board(elf: Path, boot: int, board: m.Board = m.Board.MOTOR) -> Iterator[
 
 
 @contextmanager
-def run_linked(program: Path, config: RobotConfig, scenario: Scenario, serial: int,
-               lockstep: bool = True) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
-    """The motor board's plant-link image run by ``program`` (make's
-    build/qemu/sb_motor_qemu_link) as the fake boards run the native
-    programs (FirmwareBoard: its USART1 and USART2 on sockets), its plant
-    answered from a world of ``config`` and ``scenario`` by a thread here,
-    and a host's link on its USART1.  The world does not move on its own:
-    in lockstep it moves on StepTo."""
-    plant = PlantLink(make_world(config, scenario, lockstep=lockstep), int(m.Board.MOTOR),
+def run_linked(program: Path, address: m.Board, config: RobotConfig, scenario: Scenario,
+               serial: int, lockstep: bool = True
+               ) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
+    """A plant-link image run by ``program`` (make's build/qemu/sb_motor_qemu_link
+    or sb_sensor_qemu_link, the board at ``address``) as the fake boards run
+    the native programs (FirmwareBoard: its USART1 and USART2 on sockets),
+    its plant answered from a world of ``config`` and ``scenario`` by a
+    thread here, and a host's link on its USART1.  The world does not move
+    on its own: in lockstep it moves on the motor board's StepTo."""
+    plant = PlantLink(make_world(config, scenario, lockstep=lockstep), int(address),
                       serial, motor_limits(config))
-    board = FirmwareBoard(int(m.Board.MOTOR), program, plant)
+    board = FirmwareBoard(int(address), program, plant)
     done = threading.Event()
 
     def serve() -> None:

@@ -27,6 +27,7 @@ from firmware_build import LIFT_LIMIT, WHEEL_LIMIT
 
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
+from stairbot.drivers import units as u
 from stairbot.drivers.handshake import check_version, open_board, release_board
 from stairbot.drivers.serial_link import SerialLink
 from stairbot.fakes import sim_messages as sm
@@ -43,6 +44,7 @@ from qemu_board import (  # noqa: E402
 )
 
 PLANT_SERIAL = 4321
+SENSOR = m.Board.SENSOR
 
 
 @pytest.fixture(scope="module")
@@ -144,7 +146,15 @@ def test_the_estop_latches_until_the_owners_clear(board: QemuBoard) -> None:
 @pytest.fixture
 def linked(images: Path) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
     """The plant-link image on a lockstep world, and a host's link on its USART1."""
-    with run_linked(images / "sb_motor_qemu_link", load_config(), load_scenario(),
+    with run_linked(images / "sb_motor_qemu_link", MOTOR, load_config(), load_scenario(),
+                    PLANT_SERIAL) as running:
+        yield running
+
+
+@pytest.fixture
+def sensor_linked(images: Path) -> Iterator[tuple[FirmwareBoard, SerialLink]]:
+    """The sensor board's image on a lockstep world, and a host's link on its USART1."""
+    with run_linked(images / "sb_sensor_qemu_link", SENSOR, load_config(), load_scenario(),
                     PLANT_SERIAL) as running:
         yield running
 
@@ -177,3 +187,34 @@ def test_the_plant_link_image_runs_on_the_worlds_clock_and_steps(
         assert board.plant.stats.commands > 0 and board.plant.stats.steps == 1
     finally:
         release_board(link, MOTOR, NONCE)
+
+
+def test_the_sensor_image_reports_the_worlds_ranges_and_imu(
+        sensor_linked: tuple[FirmwareBoard, SerialLink]) -> None:
+    board, link = sensor_linked
+    ident, status = link.exchange(SENSOR, [m.Identify(), m.GetStatus()]).messages
+    assert isinstance(ident, m.Ident) and isinstance(status, m.Status)
+    channels = m.BASE_SENSOR_CHANNELS  # the default robot has no side pair
+    assert (ident.board, ident.serial, ident.channels) == (SENSOR, PLANT_SERIAL, channels)
+    assert status.flags & (m.StatusFlag.SIMULATED | m.StatusFlag.LOCKSTEP) == (
+        m.StatusFlag.SIMULATED | m.StatusFlag.LOCKSTEP)
+    _, *tel = link.exchange(SENSOR, [m.ReadAll()]).messages
+    ranges = [t for t in tel if isinstance(t, m.SensorTelemetry)]
+    imu = [t for t in tel if isinstance(t, m.ImuTelemetry)]
+    assert [t.channel for t in ranges] == list(range(channels))
+    assert [t.axis for t in imu] == [int(a) for a in m.IMU_AXES]
+    # the world stands still in lockstep: what it measures now is what the board said
+    snap = board.plant.world.snapshot()
+    assert snap is not None
+    for t in ranges:
+        want = u.reading_to_wire(t.channel, snap.sensors[m.SENSOR_CHANNELS[t.channel]], 0)
+        assert (t.status, t.distance_mm) == (want.status, want.distance_mm), (t, want)
+        assert abs(t.age_ms - want.age_ms) <= 1, (t, want)  # each side rounds to the ms
+    for t in imu:
+        want_imu = u.imu_to_wire(snap.imu, m.ImuAxis(t.axis))
+        assert (t.status, t.angle_cdeg, t.rate_ddps) == (
+            want_imu.status, want_imu.angle_cdeg, want_imu.rate_ddps), (t, want_imu)
+    assert any(t.status == m.SensorCode.OK for t in ranges), ranges
+    (refused,) = link.exchange(SENSOR, [m.GetMotor(0)]).messages  # the motor board's
+    assert refused == ok(m.GetMotor, m.AckResult.NOT_SUPPORTED)
+    assert board.plant.stats.queries > 0
