@@ -40,7 +40,11 @@ void plant_start(sb_plant *p, const sb_plant_io *io, uint8_t board)
 void plant_refresh(sb_plant *p, const sb_board *board, const sb_uart *host, uint32_t *last_ms)
 {
     uint32_t now = clock_ms();
-    if (now != *last_ms || uart_ready(host)) {
+    /* in lockstep the plant moves only on StepTo, which asks it itself: only
+     * a host frame needs its state (the sensor board's world is stepped
+     * through the motor board) */
+    bool tick = now != *last_ms && !p->info.lockstep;
+    if (tick || uart_ready(host)) {
         *last_ms = now;
         p->flags = sb_board_status(board).body.status.flags;
         sb_plant_query(p);

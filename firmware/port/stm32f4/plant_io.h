@@ -16,8 +16,9 @@ sb_plant_io plant_io_open(sb_uart *line);
 void plant_start(sb_plant *p, const sb_plant_io *io, uint8_t board);
 
 /* Asks the plant for its state, telling it the board's Status.flags, when
- * SysTick's millisecond has moved on since *last_ms, or when a host byte
- * waits on host (so that a frame is handled on the plant's state of now). */
+ * a host byte waits on host (so that a frame is handled on the plant's
+ * state of now), and, unless the plant is in lockstep, when SysTick's
+ * millisecond has moved on since *last_ms. */
 void plant_refresh(sb_plant *p, const sb_board *board, const sb_uart *host, uint32_t *last_ms);
 
 #endif
