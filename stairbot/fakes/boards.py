@@ -6,8 +6,9 @@ one host's lease (Claim: while it is live, only its holder may command
 motion, set the watchdog, clear or step the world, and only its frames feed
 the watchdog), per-board watchdog (no frame from the lease's holder for
 ``watchdog_ms`` -> every motor stops, lifts hold, a fault latches until an
-explicit Clear), latched emergency stop (anyone may stop the robot), fault
-latch, Move by turns; the motor board also answers the simulation's StepTo
+explicit Clear), latched emergency stop (anyone may stop the robot), each
+motor's fault latch (a lift at its limit is reported, not latched), Move by
+turns; the motor board also answers the simulation's StepTo
 and GetTruth.  Both are backed by one
 :class:`~stairbot.fakes.board_world.BoardWorld` (``board_world.py``).
 
@@ -28,6 +29,8 @@ from stairbot.drivers import units as u
 from stairbot.fakes import sim_messages as sim
 from stairbot.fakes.board_lease import Lease
 from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.motor_faults import FaultLatch
+from stairbot.hardware import MotorId, Snapshot
 
 FIRMWARE_VERSION = 0x0100
 DEFAULT_WATCHDOG_MS = 250
@@ -73,14 +76,20 @@ class Board:
             f |= m.StatusFlag.FAULT
         return int(f)
 
-    def fault_code(self) -> int:
+    def board_latch(self) -> m.MotorFault:
+        """The whole board's latch that every motor reports: SIMULATION,
+        ESTOP, WATCHDOG, in that order; NONE when none is set."""
         if self.world.failure is not None:
-            return int(m.MotorFault.SIMULATION)
+            return m.MotorFault.SIMULATION
         if self.estop:
-            return int(m.MotorFault.ESTOP)
+            return m.MotorFault.ESTOP
         if self.watchdog_tripped:
-            return int(m.MotorFault.WATCHDOG)
-        return int(self.fault)
+            return m.MotorFault.WATCHDOG
+        return m.MotorFault.NONE
+
+    def fault_code(self) -> int:
+        """Status.fault: the board's latch, else the first motor fault latched."""
+        return int(self.board_latch() or self.fault)
 
     def status(self) -> m.Status:
         uptime = int((self.world.now() - self._start) * 1000) & 0xFFFFFFFF
@@ -146,6 +155,10 @@ class Board:
         """Whether a motor of this board may be moving (none on the sensor board)."""
         return False
 
+    def clear_faults(self) -> None:
+        """Clear 0x04: every motor fault latch reset (no motor restarted)."""
+        self.fault = m.MotorFault.NONE
+
     def answer(self, msg: m.Message) -> list[m.Message]:
         if isinstance(msg, m.Identify):
             return [m.Ident(self.BOARD, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, self.CHANNELS,
@@ -167,13 +180,16 @@ class Board:
             if msg.mask & m.ClearMask.WATCHDOG:
                 self.watchdog_tripped = False
             if msg.mask & m.ClearMask.FAULTS:
-                self.fault = m.MotorFault.NONE
+                self.clear_faults()
             return [self.status()]
         return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
 
 
 class MotorBoard(Board):
-    """Six motors, channels in ``messages.MOTOR_CHANNELS`` order."""
+    """Six motors, channels in ``messages.MOTOR_CHANNELS`` order.  A motor
+    whose snapshot reports a fault other than LIMIT latches it when the
+    board reads its world (telemetry, a Move): the motor stops (HOLD) and
+    stays stopped until Clear 0x04."""
 
     BOARD = m.Board.MOTOR
     CHANNELS = len(m.MOTOR_CHANNELS)
@@ -181,17 +197,40 @@ class MotorBoard(Board):
     def __init__(self, world: BoardWorld, serial: int = 1) -> None:
         super().__init__(world, serial)
         self.modes = [m.MotorMode.IDLE] * self.CHANNELS
+        self.faults = FaultLatch()  # each motor's latched fault
         self._move_target: list[float | None] = [None] * self.CHANNELS
         self.peer: Board | None = None  # the sensor board, whose StepTo polls we share
         self._commanded = world.now()  # when the motors were last commanded
 
     def _set(self, speeds: dict[int, float], mode: m.MotorMode | None = None) -> None:
+        """Set the motors' speeds and modes (RUN, or IDLE at 0, unless
+        ``mode``), cancelling their Moves; a motor with a latched fault
+        stays stopped in HOLD whatever it is told."""
         self._commanded = self.world.now()
+        out: dict[MotorId, float] = {}
         for ch, tps in speeds.items():
-            self.modes[ch] = mode if mode is not None else (
-                m.MotorMode.RUN if tps != 0 else m.MotorMode.IDLE)
+            if self.faults.held(ch):
+                tps, self.modes[ch] = 0.0, m.MotorMode.HOLD
+            else:
+                self.modes[ch] = mode if mode is not None else (
+                    m.MotorMode.RUN if tps != 0 else m.MotorMode.IDLE)
             self._move_target[ch] = None
-        self.world.set_speeds({m.MOTOR_CHANNELS[ch]: tps for ch, tps in speeds.items()})
+            out[m.MOTOR_CHANNELS[ch]] = tps
+        self.world.set_speeds(out)
+
+    def _snapshot(self) -> Snapshot | None:
+        """The world now, its motors' faults latched (each motor's first;
+        Status.fault the board's first)."""
+        snap = self.world.snapshot()
+        new = self.faults.see(snap)
+        if new:
+            self.fault = self.faults.first
+            self._set({ch: 0.0 for ch in new})
+        return snap
+
+    def clear_faults(self) -> None:
+        super().clear_faults()
+        self.faults.clear()
 
     def halt(self) -> None:
         self._set({ch: 0.0 for ch in range(self.CHANNELS)}, m.MotorMode.HOLD)
@@ -200,15 +239,14 @@ class MotorBoard(Board):
         return any(mode in (m.MotorMode.RUN, m.MotorMode.MOVE) for mode in self.modes)
 
     def telemetry(self, ch: int) -> m.MotorTelemetry:
-        snap = self.world.snapshot()
+        """The motor now; its fault: the board's latch, else the motor's
+        latched fault, else LIMIT (a lift at the end of its stroke), else NONE."""
+        snap = self._snapshot()
         mid = m.MOTOR_CHANNELS[ch]
         turns = snap.motors[mid].turns if snap else 0.0
         speed = snap.motors[mid].speed_tps if snap else 0.0
-        fault = self.fault_code()
-        if fault == m.MotorFault.NONE and snap and snap.motors[mid].fault:
-            fault = int(m.MotorFault.LIMIT if "limit" in str(snap.motors[mid].fault)
-                        else m.MotorFault.DRIVER)
-        return m.MotorTelemetry(ch, int(self.modes[ch]), fault, u.speed_to_wire(speed),
+        fault = self.board_latch() or self.faults.of(ch, snap)
+        return m.MotorTelemetry(ch, int(self.modes[ch]), int(fault), u.speed_to_wire(speed),
                                 u.turns_to_wire(turns))
 
     def poll(self) -> None:
@@ -223,7 +261,7 @@ class MotorBoard(Board):
         for ch, target in enumerate(self._move_target):
             if target is None:
                 continue
-            snap = snap or self.world.snapshot()
+            snap = snap or self._snapshot()
             if snap is None:
                 continue
             turns = snap.motors[m.MOTOR_CHANNELS[ch]].turns
@@ -273,7 +311,7 @@ class MotorBoard(Board):
             self._set({ch: 0.0 for ch in chans})
             if isinstance(msg, m.Brake):
                 for ch in chans:
-                    if ch not in m.LIFT_CHANNELS:
+                    if ch not in m.LIFT_CHANNELS and not self.faults.held(ch):
                         self.modes[ch] = m.MotorMode.BRAKE
             return [m.Ack(msg.TYPE, m.AckResult.OK)]
         return super().answer(msg)
@@ -292,13 +330,14 @@ class MotorBoard(Board):
         refusal = self.refusal()
         if refusal is not m.AckResult.OK:
             return [m.Ack(msg.TYPE, refusal)]
-        snap = self.world.snapshot()
+        snap = self._snapshot()
         if snap is None:
             return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
         start = snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns
         speed = u.speed_from_wire(msg.speed_mtps) * (1 if msg.turns_mt >= 0 else -1)
         self._set({msg.channel: speed}, m.MotorMode.MOVE)
-        self._move_target[msg.channel] = start + u.turns_from_wire(msg.turns_mt)
+        if self.modes[msg.channel] == m.MotorMode.MOVE:  # not a motor held by its fault
+            self._move_target[msg.channel] = start + u.turns_from_wire(msg.turns_mt)
         if msg.turns_mt == 0:
             self._set({msg.channel: 0.0})
         return [m.Ack(msg.TYPE, m.AckResult.OK)]

@@ -30,8 +30,8 @@ HOST, NONCE = 0x2A, 7  # the session and nonce of the host these tests play
 
 class StubRobot:
     """Turns integrate the commanded speeds; ``fail`` makes read() raise;
-    ``ages`` (per sensor) and ``imu`` are what the snapshot reports, for
-    ``sensors`` (every SensorId unless told)."""
+    ``ages`` (per sensor), ``imu`` and ``motor_faults`` (per motor) are what
+    the snapshot reports, for ``sensors`` (every SensorId unless told)."""
 
     def __init__(self, sensors: tuple[SensorId, ...] = tuple(SensorId)) -> None:
         self.t = 0.0
@@ -43,6 +43,7 @@ class StubRobot:
         self.fail = False
         self.ages = {sid: 0.0 for sid in SensorId}
         self.imu: Imu | None = None
+        self.motor_faults: dict[MotorId, str] = {}
 
     def read(self) -> Snapshot:
         if self.fail:
@@ -50,7 +51,8 @@ class StubRobot:
         self.reads += 1
         return Snapshot(self.t, {s: SensorReading(0.5 + i / 10, age_s=self.ages[s])
                                  for i, s in enumerate(SensorId) if s in self.sensors},
-                        {k: MotorState(v, self.speeds[k]) for k, v in self.turns.items()},
+                        {k: MotorState(v, self.speeds[k], self.motor_faults.get(k))
+                         for k, v in self.turns.items()},
                         imu=self.imu)
 
     def command(self, speeds: Mapping[MotorId, float]) -> None:
@@ -469,3 +471,55 @@ def test_commands_each_tick_keep_the_motors_running(rig: tuple) -> None:
         motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(0, 0)], HOST)
         step(motor, world, 0.02)
     assert robot.speeds[MotorId.MWF] == 1.0 and motor.held_out == 0
+
+
+def test_a_lift_at_its_limit_says_limit_in_its_telemetry_only(rig: tuple) -> None:
+    """LIMIT latches nothing: no FAULT flag, Status.fault NONE, the mode as
+    commanded; it goes when the lift leaves the end of its stroke."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetLiftSpeeds(500, 0)], HOST)
+    robot.motor_faults[MotorId.MTF] = "lift limit"
+    step(motor, world, 0.01)
+    status, *tel = motor.handle([m.ReadAll()], HOST)
+    assert not status.flags & m.StatusFlag.FAULT and status.fault == m.MotorFault.NONE
+    assert (tel[4].fault, tel[4].mode) == (m.MotorFault.LIMIT, m.MotorMode.RUN)
+    assert [t.fault for t in tel[:4] + tel[5:]] == [m.MotorFault.NONE] * 5
+    motor.handle([m.SetLiftSpeeds(-500, 0)], HOST)  # away from the end: obeyed
+    assert robot.speeds[MotorId.MTF] == -0.5
+    del robot.motor_faults[MotorId.MTF]
+    step(motor, world, 0.01)
+    assert motor.handle([m.GetMotor(4)], HOST)[0].fault == m.MotorFault.NONE
+
+
+def test_a_motor_fault_latches_and_holds_that_motor_stopped_until_clear(rig: tuple) -> None:
+    """OVERCURRENT on MWB: that motor stops (HOLD) and reports it, the FAULT
+    flag and Status.fault say it; gone from the motor, it stays latched and
+    no command drives MWB until Clear 0x04, which restarts nothing.  A
+    later fault on another motor leaves Status.fault the first; a fault the
+    protocol has no name for is DRIVER."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
+    robot.motor_faults[MotorId.MWB] = "overcurrent"
+    step(motor, world, 0.01)
+    status, *tel = motor.handle([m.ReadAll()], HOST)
+    assert status.flags & m.StatusFlag.FAULT and status.fault == m.MotorFault.OVERCURRENT
+    assert (tel[1].fault, tel[1].mode) == (m.MotorFault.OVERCURRENT, m.MotorMode.HOLD)
+    assert (tel[0].fault, tel[0].mode) == (m.MotorFault.NONE, m.MotorMode.RUN)
+    assert robot.speeds[MotorId.MWB] == 0.0 and robot.speeds[MotorId.MWF] == 1.0
+    del robot.motor_faults[MotorId.MWB]
+    robot.motor_faults[MotorId.MTB] = "hot"
+    step(motor, world, 0.01)
+    for msg in (m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.Run(1, 500), m.Move(1, 300, 500),
+                m.Brake(0b10)):
+        assert motor.handle([msg], HOST) == [m.Ack(msg.TYPE, m.AckResult.OK)]
+        assert robot.speeds[MotorId.MWB] == 0.0 and motor.modes[1] == m.MotorMode.HOLD
+    status, *tel = motor.handle([m.ReadAll()], HOST)
+    assert status.fault == m.MotorFault.OVERCURRENT and tel[5].fault == m.MotorFault.DRIVER
+    del robot.motor_faults[MotorId.MTB]
+    step(motor, world, 0.01)
+    status = motor.handle([m.Clear(m.ClearMask.FAULTS)], HOST)[0]
+    assert not status.flags & m.StatusFlag.FAULT and status.fault == m.MotorFault.NONE
+    assert robot.speeds[MotorId.MWB] == 0.0  # nothing restarted
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
+    assert robot.speeds[MotorId.MWB] == 1.0
+    assert motor.handle([m.GetMotor(1)], HOST)[0].fault == m.MotorFault.NONE
