@@ -200,13 +200,14 @@ class MotorBoard(Board):
         self.faults = FaultLatch()  # each motor's latched fault
         self._move_target: list[float | None] = [None] * self.CHANNELS
         self.peer: Board | None = None  # the sensor board, whose StepTo polls we share
-        self._commanded = world.now()  # when the motors were last commanded
+        self._commanded = world.now()  # the host's last motion command: the hold counts from it
 
     def _set(self, speeds: dict[int, float], mode: m.MotorMode | None = None) -> None:
         """Set the motors' speeds and modes (RUN, or IDLE at 0, unless
         ``mode``), cancelling their Moves; a motor with a latched fault
-        stays stopped in HOLD whatever it is told."""
-        self._commanded = self.world.now()
+        stays stopped in HOLD whatever it is told.  The board's own speed
+        changes come here alone; a host's motion command through
+        :meth:`_command`."""
         out: dict[MotorId, float] = {}
         for ch, tps in speeds.items():
             if self.faults.held(ch):
@@ -217,6 +218,12 @@ class MotorBoard(Board):
             self._move_target[ch] = None
             out[m.MOTOR_CHANNELS[ch]] = tps
         self.world.set_speeds(out)
+
+    def _command(self, speeds: dict[int, float], mode: m.MotorMode | None = None) -> None:
+        """A motion command of the host, obeyed: :meth:`_set`, and the hold
+        restarts."""
+        self._commanded = self.world.now()
+        self._set(speeds, mode)
 
     def _snapshot(self) -> Snapshot | None:
         """The world now, its motors' faults latched (each motor's first;
@@ -273,7 +280,7 @@ class MotorBoard(Board):
         refusal = self.refusal()
         if refusal is not m.AckResult.OK:
             return [m.Ack(msg.TYPE, refusal)]
-        self._set(speeds)
+        self._command(speeds)
         return [m.Ack(msg.TYPE, m.AckResult.OK)]
 
     def answer(self, msg: m.Message) -> list[m.Message]:
@@ -308,7 +315,7 @@ class MotorBoard(Board):
             if msg.mask & ~m.ALL_MOTORS_MASK:
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]
             chans = [ch for ch in range(self.CHANNELS) if msg.mask >> ch & 1]
-            self._set({ch: 0.0 for ch in chans})
+            self._command({ch: 0.0 for ch in chans})
             if isinstance(msg, m.Brake):
                 for ch in chans:
                     if ch not in m.LIFT_CHANNELS and not self.faults.held(ch):
@@ -335,7 +342,7 @@ class MotorBoard(Board):
             return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
         start = snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns
         speed = u.speed_from_wire(msg.speed_mtps) * (1 if msg.turns_mt >= 0 else -1)
-        self._set({msg.channel: speed}, m.MotorMode.MOVE)
+        self._command({msg.channel: speed}, m.MotorMode.MOVE)
         if self.modes[msg.channel] == m.MotorMode.MOVE:  # not a motor held by its fault
             self._move_target[msg.channel] = start + u.turns_from_wire(msg.turns_mt)
         if msg.turns_mt == 0:

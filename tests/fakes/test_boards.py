@@ -523,3 +523,19 @@ def test_a_motor_fault_latches_and_holds_that_motor_stopped_until_clear(rig: tup
     motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
     assert robot.speeds[MotorId.MWB] == 1.0
     assert motor.handle([m.GetMotor(1)], HOST)[0].fault == m.MotorFault.NONE
+
+
+def test_a_move_reaching_its_stop_point_does_not_lengthen_another_motors_hold(
+        rig: tuple) -> None:
+    """The hold counts from the host's last motion command only: the wheels
+    commanded at 0 ms with a 100 ms hold stop by 110 ms, although a Move on
+    MTF (50 mturn at 1 turn/s) reached its stop point, the board's own
+    speed change, at 60 ms."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWatchdog(250, 100), m.SetWheelSpeeds(1000, 1000, 1000, 1000),
+                  m.Move(4, 50, 1000)], HOST)
+    step(motor, world, 0.06)
+    assert robot.speeds[MotorId.MTF] == 0.0 and motor.modes[4] == m.MotorMode.IDLE
+    assert robot.speeds[MotorId.MWF] == 1.0
+    step(motor, world, 0.05)  # 110 ms since the command, 50 ms since the Move stopped
+    assert all(v == 0.0 for v in robot.speeds.values()) and motor.held_out == 1
