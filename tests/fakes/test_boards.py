@@ -221,6 +221,8 @@ def test_step_to_is_idempotent_and_lockstep_only(rig: tuple) -> None:
     assert robot.t == pytest.approx(0.02)
     world.lockstep = False
     assert motor.handle([sim.StepTo(40_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    # the lease is checked first: another session is told NOT_OWNER, not NOT_SUPPORTED
+    assert motor.handle([sim.StepTo(40_000)], 0x15) == [m.Ack(0x7E, m.AckResult.NOT_OWNER)]
 
 
 def test_sensor_sample_counter_advances_with_new_measurements(rig: tuple) -> None:
