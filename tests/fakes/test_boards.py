@@ -541,3 +541,17 @@ def test_a_move_reaching_its_stop_point_does_not_lengthen_another_motors_hold(
     assert robot.speeds[MotorId.MWF] == 1.0
     step(motor, world, 0.05)  # 110 ms since the command, 50 ms since the Move stopped
     assert all(v == 0.0 for v in robot.speeds.values()) and motor.held_out == 1
+
+
+def test_the_watchdog_stays_armed_after_the_lease_is_given_up(rig: tuple) -> None:
+    """A host that gives its lease up mid-motion without switching the
+    watchdog off still has its motors stopped watchdog_ms after its last
+    frame, and the latch set, though another host is talking."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.Claim(0, NONCE)], HOST)
+    for _ in range(6):  # 300 ms; another host polls without a lease
+        step(motor, world, 0.05)
+        motor.handle([m.GetStatus()], OTHER)
+    status = motor.handle([m.GetStatus()], OTHER)[0]
+    assert status.flags & m.StatusFlag.WATCHDOG and status.fault == m.MotorFault.WATCHDOG
+    assert all(v == 0.0 for v in robot.speeds.values())
