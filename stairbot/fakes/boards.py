@@ -198,7 +198,7 @@ class MotorBoard(Board):
         super().__init__(world, serial)
         self.modes = [m.MotorMode.IDLE] * self.CHANNELS
         self.faults = FaultLatch()  # each motor's latched fault
-        self._move_target: list[float | None] = [None] * self.CHANNELS
+        self._move_target: list[int | None] = [None] * self.CHANNELS  # counter, mturn
         self.peer: Board | None = None  # the sensor board, whose StepTo polls we share
         self._commanded = world.now()  # the host's last motion command: the hold counts from it
 
@@ -271,7 +271,7 @@ class MotorBoard(Board):
             snap = snap or self._snapshot()
             if snap is None:
                 continue
-            turns = snap.motors[m.MOTOR_CHANNELS[ch]].turns
+            turns = u.turns_to_wire(snap.motors[m.MOTOR_CHANNELS[ch]].turns)  # as reported
             speed = self.world.speeds()[m.MOTOR_CHANNELS[ch]]
             if (speed >= 0 and turns >= target) or (speed < 0 and turns <= target):
                 self._set({ch: 0.0})
@@ -340,11 +340,11 @@ class MotorBoard(Board):
         snap = self._snapshot()
         if snap is None:
             return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
-        start = snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns
+        start = u.turns_to_wire(snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns)
         speed = u.speed_from_wire(msg.speed_mtps) * (1 if msg.turns_mt >= 0 else -1)
         self._command({msg.channel: speed}, m.MotorMode.MOVE)
         if self.modes[msg.channel] == m.MotorMode.MOVE:  # not a motor held by its fault
-            self._move_target[msg.channel] = start + u.turns_from_wire(msg.turns_mt)
+            self._move_target[msg.channel] = start + msg.turns_mt
         if msg.turns_mt == 0:
             self._set({msg.channel: 0.0})
         return [m.Ack(msg.TYPE, m.AckResult.OK)]

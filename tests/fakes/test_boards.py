@@ -555,3 +555,19 @@ def test_the_watchdog_stays_armed_after_the_lease_is_given_up(rig: tuple) -> Non
     status = motor.handle([m.GetStatus()], OTHER)[0]
     assert status.flags & m.StatusFlag.WATCHDOG and status.fault == m.MotorFault.WATCHDOG
     assert all(v == 0.0 for v in robot.speeds.values())
+
+
+def test_a_move_stops_when_the_counter_as_reported_lands_on_its_stop_point(
+        rig: tuple) -> None:
+    """A Move's stop point in integer milli-turns: from 3.276 turns, -397
+    mturn stops at a counter of 2.879 turns (2879 on the wire), where the
+    float sum 3.276 - 0.397 = 2.8789999999999996 lies a hair beyond it."""
+    robot, world, motor, _ = rig
+    robot.turns[MotorId.MWF] = 3.276
+    motor.handle([m.Move(0, -397, 1000)], HOST)
+    assert robot.speeds[MotorId.MWF] == -1.0
+    robot.speeds[MotorId.MWF] = 0.0  # the counter stands on the stop point from here on
+    robot.turns[MotorId.MWF] = 2.879
+    step(motor, world, 0.001)
+    tel = motor.handle([m.GetMotor(0)], HOST)[0]
+    assert (tel.mode, tel.turns_mt) == (m.MotorMode.IDLE, 2879)
