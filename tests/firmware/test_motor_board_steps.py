@@ -131,11 +131,7 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
     cache, every Ack result, every Claim result, both latches, Moves that
     reach their stop points, a lift at its limit, a reply frame cut at 247
     message bytes); after every frame the two plants stand in the same
-    place with their motors commanded alike.  (The fake sums a Move's stop
-    point in float turns, so a counter landing exactly on it may run on to
-    the next poll there, where the C board stops: firmware/README.md.  This
-    script's seed lands on none; seed 2 with 20,000 frames does, at frame
-    11,068.)"""
+    place with their motors commanded alike."""
     exe = build(tmp_path / "sbboard", ("core", "board"), ("native/plant.c", "test/sbboard.c"),
                 ["-O1", "-g", *SANITIZE])
     boot, lift_mt = 0xB007, 103_000  # the lifts start 2 turns from the ends of their stroke
