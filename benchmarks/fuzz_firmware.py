@@ -22,28 +22,18 @@ arguments, 3 when the compiler has no sanitizer runtime.
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from stairbot.fakes.firmware_boards import find_cc
 
 FIRMWARE = Path(__file__).resolve().parent.parent / "firmware"
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all",
             "-fno-omit-frame-pointer", "-g"]
 CFLAGS = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Wpedantic", "-Werror"]
 NO_SANITIZER = 3
-
-
-def find_cc() -> str | None:
-    """The C compiler: ``$CC`` when set, else the first of cc, gcc, clang on PATH."""
-    names = [os.environ["CC"]] if os.environ.get("CC") else ["cc", "gcc", "clang"]
-    for name in names:
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
 
 
 def sanitizer_problem(cc: str, build_dir: Path) -> str | None:

@@ -45,13 +45,19 @@ static uint8_t board_fault(const sb_board *b)
     return b->hal->board_fault ? b->hal->board_fault(b->hal->ctx) : SB_FAULT_NONE;
 }
 
-uint8_t sb_board_fault_code(const sb_board *b)
+uint8_t sb_board_latch(const sb_board *b)
 {
     uint8_t whole = board_fault(b);
     if (whole != SB_FAULT_NONE) return whole;
     if (b->estop) return SB_FAULT_ESTOP;
     if (b->watchdog_tripped) return SB_FAULT_WATCHDOG;
-    return b->fault;
+    return SB_FAULT_NONE;
+}
+
+uint8_t sb_board_fault_code(const sb_board *b)
+{
+    uint8_t latch = sb_board_latch(b);
+    return latch != SB_FAULT_NONE ? latch : b->fault;
 }
 
 sb_msg sb_board_status(const sb_board *b)

@@ -23,7 +23,10 @@
 #define SB_DEFAULT_WATCHDOG_MS 250u
 
 /* MotorFault, StatusFlag, ClearMask and ClaimResult (section 2, "Codes"). */
-enum { SB_FAULT_NONE = 0, SB_FAULT_ESTOP = 1, SB_FAULT_WATCHDOG = 2, SB_FAULT_LIMIT = 6 };
+enum {
+    SB_FAULT_NONE = 0, SB_FAULT_ESTOP = 1, SB_FAULT_WATCHDOG = 2, SB_FAULT_OVERCURRENT = 3,
+    SB_FAULT_LIMIT = 6, SB_FAULT_DRIVER = 7
+};
 enum {
     SB_FLAG_ESTOP = 0x01, SB_FLAG_WATCHDOG = 0x02, SB_FLAG_FAULT = 0x04,
     SB_FLAG_SIMULATED = 0x40, SB_FLAG_LOCKSTEP = 0x80
@@ -121,7 +124,10 @@ uint32_t sb_board_now(const sb_board *b);
 uint32_t sb_board_since(const sb_board *b, uint32_t then);
 /* Microseconds since power-up (the HAL's now_us, else now_ms * 1000). */
 uint32_t sb_board_now_us(const sb_board *b);
-/* Status.fault: the board's whole fault, then ESTOP, WATCHDOG, the latched fault. */
+/* The latch every motor reports: the board's whole fault, then ESTOP,
+ * WATCHDOG; NONE when none is set. */
+uint8_t sb_board_latch(const sb_board *b);
+/* Status.fault: sb_board_latch, else the first motor fault latched. */
 uint8_t sb_board_fault_code(const sb_board *b);
 sb_msg sb_board_status(const sb_board *b);
 sb_msg sb_board_ack(uint8_t type, sb_ack_result result);

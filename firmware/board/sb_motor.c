@@ -28,10 +28,15 @@ static int16_t clamp(const sb_motor_board *b, uint8_t ch, int32_t mtps)
     return (int16_t)(mtps > limit ? limit : (mtps < -limit ? -limit : mtps));
 }
 
-/* Sets one motor's speed (clamped) and mode; cancels its Move. */
+/* Sets one motor's speed (clamped) and mode; cancels its Move.  A motor
+ * with a latched fault stays stopped in HOLD whatever it is told. */
 static void set_one(sb_motor_board *b, uint8_t ch, int32_t mtps, uint8_t mode)
 {
     const sb_hal *h = b->base.hal;
+    if (b->latched[ch] != SB_FAULT_NONE) {
+        mtps = 0;
+        mode = SB_MODE_HOLD;
+    }
     b->speed[ch] = clamp(b, ch, mtps);
     b->mode[ch] = mode;
     b->moving_to[ch] = false;
@@ -48,7 +53,6 @@ static void run_one(sb_motor_board *b, uint8_t ch, int32_t mtps)
 static void halt(sb_board *base)
 {
     sb_motor_board *b = motor(base);
-    b->commanded_ms = sb_board_now(base);
     for (uint8_t ch = 0; ch < SB_MOTORS; ch++) {
         set_one(b, ch, 0, SB_MODE_HOLD);
     }
@@ -65,15 +69,45 @@ static bool may_move(const sb_board *base)
     return false;
 }
 
-static sb_msg telemetry(const sb_motor_board *b, uint8_t ch)
+/* -- faults (section 3, "Faults") ----------------------------------------------- */
+
+/* The motor's own fault as the HAL reports it: NONE, LIMIT (never latched),
+ * or a latching one (OVERCURRENT, STALL, ENCODER, DRIVER; any other code
+ * is taken for DRIVER). */
+static uint8_t motor_fault(const sb_motor_board *b, uint8_t ch)
+{
+    const sb_hal *h = b->base.hal;
+    uint8_t f = h->motor_fault ? h->motor_fault(h->ctx, ch) : SB_FAULT_NONE;
+    if (f == SB_FAULT_NONE || f == SB_FAULT_LIMIT) return f;
+    return (f >= SB_FAULT_OVERCURRENT && f <= SB_FAULT_DRIVER) ? f : (uint8_t)SB_FAULT_DRIVER;
+}
+
+/* Latches each motor's new latching fault: that motor stopped in HOLD, the
+ * first one latched the board's Status.fault. */
+static void see_faults(sb_motor_board *b)
+{
+    for (uint8_t ch = 0; ch < SB_MOTORS; ch++) {
+        uint8_t f = motor_fault(b, ch);
+        if (f == SB_FAULT_NONE || f == SB_FAULT_LIMIT || b->latched[ch] != SB_FAULT_NONE) {
+            continue;
+        }
+        b->latched[ch] = f;
+        if (b->base.fault == SB_FAULT_NONE) b->base.fault = f;
+        set_one(b, ch, 0, SB_MODE_HOLD);
+    }
+}
+
+/* A motor's telemetry, its fault the first of: the board's latch, the
+ * motor's latched fault, LIMIT, NONE. */
+static sb_msg telemetry(sb_motor_board *b, uint8_t ch)
 {
     sb_msg t;
     sb_msg_init(&t, SB_MOTOR_TELEMETRY);
     const sb_hal *h = b->base.hal;
-    uint8_t fault = sb_board_fault_code(&b->base);
-    if (fault == SB_FAULT_NONE && h->motor_fault) {
-        fault = h->motor_fault(h->ctx, ch);
-    }
+    see_faults(b);
+    uint8_t fault = sb_board_latch(&b->base);
+    if (fault == SB_FAULT_NONE) fault = b->latched[ch];
+    if (fault == SB_FAULT_NONE && motor_fault(b, ch) == SB_FAULT_LIMIT) fault = SB_FAULT_LIMIT;
     t.body.motor_telemetry.channel = ch;
     t.body.motor_telemetry.mode = b->mode[ch];
     t.body.motor_telemetry.fault = fault;
@@ -89,6 +123,7 @@ static void poll(sb_board *base)
 {
     sb_motor_board *b = motor(base);
     const sb_hal *h = base->hal;
+    see_faults(b);
     if (base->hold_ms && sb_board_since(base, b->commanded_ms) > base->hold_ms) {
         bool any = false;
         for (uint8_t ch = 0; ch < SB_MOTORS; ch++) {
@@ -97,17 +132,13 @@ static void poll(sb_board *base)
                 any = true;
             }
         }
-        if (any) {
-            b->held_out++;
-            b->commanded_ms = sb_board_now(base);
-        }
+        if (any) b->held_out++;
     }
     for (uint8_t ch = 0; ch < SB_MOTORS; ch++) {
         if (!b->moving_to[ch]) continue;
         int32_t turns = h->encoder_turns(h->ctx, ch);
         if ((b->speed[ch] >= 0 && turns >= b->target[ch])
             || (b->speed[ch] < 0 && turns <= b->target[ch])) {
-            b->commanded_ms = sb_board_now(base);
             run_one(b, ch, 0); /* the Move's stop point */
         }
     }
@@ -144,13 +175,14 @@ static sb_msg move(sb_motor_board *b, const sb_move *mv)
     if (r != SB_ACK_OK) return sb_board_ack(SB_MOVE, r);
     const sb_hal *h = b->base.hal;
     uint8_t ch = mv->channel;
+    see_faults(b);
     int32_t start = h->encoder_turns(h->ctx, ch);
     int32_t speed = mv->turns_mt >= 0 ? (int32_t)mv->speed_mtps : -(int32_t)mv->speed_mtps;
     b->commanded_ms = sb_board_now(&b->base);
     set_one(b, ch, speed, SB_MODE_MOVE);
     if (mv->turns_mt == 0) {
         run_one(b, ch, 0);
-    } else {
+    } else if (b->mode[ch] == SB_MODE_MOVE) { /* not a motor held by its fault */
         b->moving_to[ch] = true;
         b->target[ch] = (int32_t)((int64_t)start + mv->turns_mt); /* the counter wraps */
     }
@@ -200,6 +232,9 @@ static bool answer(sb_board *base, const sb_msg *msg, sb_reply *out)
     const sb_msg_body *m = &msg->body;
     sb_msg r;
     switch (msg->type) {
+    case SB_CLEAR: /* the common answer clears the rest (and Status.fault) */
+        if (m->clear.mask & SB_CLEAR_FAULTS) memset(b->latched, 0, sizeof b->latched);
+        return false;
     case SB_READ_ALL: {
         sb_msg tel[SB_MOTORS];
         for (uint8_t ch = 0; ch < SB_MOTORS; ch++) tel[ch] = telemetry(b, ch);

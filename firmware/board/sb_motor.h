@@ -30,18 +30,20 @@ typedef struct {
 typedef struct {
     sb_board base; /* first: the lease, the latches, the cache and the counts (sb_board.h) */
     int16_t limit_mtps[SB_MOTORS];
-    uint32_t commanded_ms; /* the motors' last command (the command hold counts from it) */
+    uint32_t commanded_ms; /* the host's last obeyed motion command (the command hold counts from it) */
     uint32_t held_out;     /* motors stopped by the command hold */
     uint8_t mode[SB_MOTORS];
     int16_t speed[SB_MOTORS]; /* commanded, clamped */
     bool moving_to[SB_MOTORS];
     int32_t target[SB_MOTORS];
+    uint8_t latched[SB_MOTORS]; /* each motor's latched fault (section 3, "Faults"; 0: none) */
 } sb_motor_board;
 
 /* Power-up: every motor IDLE at speed 0, no lease, watchdog 250 ms (not armed). */
 void sb_motor_init(sb_motor_board *b, const sb_hal *hal, const sb_motor_config *cfg);
 
-/* Checks the e-stop input, the watchdog, the command hold and the Moves'
+/* Checks the e-stop input, the watchdog, the motors' faults (latching
+ * OVERCURRENT, STALL, ENCODER and DRIVER), the command hold and the Moves'
  * stop points at the present time; call it often (every millisecond or so). */
 void sb_motor_poll(sb_motor_board *b);
 

@@ -68,7 +68,9 @@ static int16_t encoder_speed(void *ctx, uint8_t ch)
 
 static uint8_t motor_fault(void *ctx, uint8_t ch)
 {
-    return ((plant *)ctx)->at_limit[ch] ? SB_FAULT_LIMIT : SB_FAULT_NONE;
+    const plant *p = ctx;
+    if (p->injected[ch] != SB_FAULT_NONE) return p->injected[ch];
+    return p->at_limit[ch] ? SB_FAULT_LIMIT : SB_FAULT_NONE;
 }
 
 static bool estop_input(void *ctx)

@@ -22,6 +22,7 @@ typedef struct {
     int64_t position_umt[SB_MOTORS]; /* micro-turns */
     int16_t measured[SB_MOTORS];
     bool at_limit[SB_MOTORS];
+    uint8_t injected[SB_MOTORS];    /* a motor's own fault set by a test (MotorFault; 0: none) */
     volatile bool estop_pressed;
 } plant;
 

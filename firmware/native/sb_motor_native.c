@@ -20,41 +20,12 @@
 
 #define PLANT_TIMEOUT_MS 2000u
 
-static void poll_board(void *board)
-{
-    sb_motor_poll(board);
-}
+static plant trivial;
 
-static size_t frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE])
+static void advance_trivial(uint32_t wall_ms)
 {
-    return sb_motor_frame(board, f, out);
-}
-
-static void report(void *board, FILE *out)
-{
-    const sb_motor_board *b = board;
-    fprintf(out, "%u frames, %u duplicates answered from the cache, %u replies cut",
-            (unsigned)b->base.frames, (unsigned)b->base.duplicates, (unsigned)b->base.cut);
-}
-
-static bool advance_trivial(void *ctx, uint32_t wall_ms)
-{
-    plant *p = ctx;
-    p->estop_pressed = sb_native_button != 0;
-    plant_advance(p, wall_ms);
-    return true;
-}
-
-static sb_motor_board board;
-
-static bool ask_plant(void *ctx, uint32_t wall_ms)
-{
-    (void)wall_ms;
-    sb_plant *p = ctx;
-    p->estop_pressed = sb_native_button != 0;
-    p->flags = sb_board_status(&board.base).body.status.flags;
-    sb_plant_query(p);
-    return true;
+    trivial.estop_pressed = sb_native_button != 0;
+    plant_advance(&trivial, wall_ms);
 }
 
 int main(int argc, char **argv)
@@ -62,14 +33,14 @@ int main(int argc, char **argv)
     sb_native_args a = {"sb_motor_native", 0, -1, -1, NULL};
     int bad = sb_native_args_parse(argc, argv, &a);
     if (bad) return bad;
-    static plant trivial;
     static sb_plant plant_link;
+    static sb_motor_board board;
     static int plant_fd;
     sb_plant_io io = sb_native_plant_io(&plant_fd);
     sb_hal hal;
     sb_motor_config cfg = {a.serial ? (uint16_t)a.serial : 1u, sb_native_boot_id(), {0}, true,
                            false};
-    sb_native_board nb = {&board, poll_board, frame, report, advance_trivial, &trivial};
+    sb_native_board nb = {&board.base, NULL, advance_trivial};
     if (a.plant_fd >= 0) {
         plant_fd = a.plant_fd;
         if (!sb_plant_hello(&plant_link, &io, 1, PLANT_TIMEOUT_MS)) {
@@ -80,9 +51,10 @@ int main(int argc, char **argv)
         hal = sb_plant_hal(&plant_link);
         if (!a.serial) cfg.serial = plant_link.info.serial;
         cfg.lockstep = plant_link.info.lockstep;
-        for (unsigned ch = 0; ch < SB_MOTORS; ch++) cfg.limit_mtps[ch] = plant_link.info.limit_mtps[ch];
-        nb.refresh = ask_plant;
-        nb.refresh_ctx = &plant_link;
+        for (unsigned ch = 0; ch < SB_MOTORS; ch++) {
+            cfg.limit_mtps[ch] = plant_link.info.limit_mtps[ch];
+        }
+        nb.plant = &plant_link;
     } else {
         plant_init(&trivial);
         hal = plant_hal(&trivial);

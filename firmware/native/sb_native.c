@@ -198,7 +198,19 @@ static void send_reply(int fd, const uint8_t *p, size_t n, unsigned *overflows)
     }
 }
 
-int sb_native_serve(int fd, const sb_native_args *a, sb_native_board *nb)
+/* Brings the board's plant to the present. */
+static void refresh(const sb_native_board *nb, uint32_t wall_ms)
+{
+    if (nb->plant == NULL) {
+        nb->advance(wall_ms);
+        return;
+    }
+    nb->plant->estop_pressed = sb_native_button != 0;
+    nb->plant->flags = sb_board_status(nb->board).body.status.flags;
+    sb_plant_query(nb->plant);
+}
+
+int sb_native_serve(int fd, const sb_native_args *a, const sb_native_board *nb)
 {
     signal(SIGTERM, on_stop);
     signal(SIGINT, on_stop);
@@ -213,8 +225,8 @@ int sb_native_serve(int fd, const sb_native_args *a, sb_native_board *nb)
     while (!stopping) {
         struct pollfd in = {fd, POLLIN, 0};
         int ready = poll(&in, 1, 1);
-        if (!nb->refresh(nb->refresh_ctx, (uint32_t)(mono_ms() - t0))) break;
-        nb->poll(nb->board);
+        refresh(nb, (uint32_t)(mono_ms() - t0));
+        sb_board_poll(nb->board);
         if (ready <= 0 || !(in.revents & POLLIN)) continue;
         uint8_t buf[512];
         ssize_t n = read(fd, buf, sizeof buf);
@@ -228,13 +240,15 @@ int sb_native_serve(int fd, const sb_native_args *a, sb_native_board *nb)
         for (ssize_t i = 0; i < n; i++) {
             sb_frame frame;
             if (!sb_reader_push(&reader, buf[i], &frame)) continue;
-            size_t len = nb->frame(nb->board, &frame, reply);
+            size_t len = sb_board_frame(nb->board, &frame, reply);
             if (len > 0) send_reply(fd, reply, len, &overflows);
         }
     }
-    fprintf(stderr, "%s: ", a->name);
-    nb->report(nb->board, stderr);
-    fprintf(stderr, ", %u CRC errors, %u malformed, %u overruns, %u replies dropped\n",
+    const sb_board *b = nb->board;
+    fprintf(stderr,
+            "%s: %u frames, %u duplicates answered from the cache, %u replies cut, %u CRC "
+            "errors, %u malformed, %u overruns, %u replies dropped\n",
+            a->name, (unsigned)b->frames, (unsigned)b->duplicates, (unsigned)b->cut,
             (unsigned)reader.stats.crc_errors, (unsigned)reader.stats.malformed,
             (unsigned)reader.stats.overruns, overflows);
     close(fd);

@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "sb_board.h"
 #include "sb_frame.h"
 #include "sb_plant.h"
 
@@ -21,16 +22,13 @@ typedef struct {
     const char *path;  /* a tty to open (NULL: none given) */
 } sb_native_args;
 
-/* One board as the loop serves it. */
+/* One board as the loop serves it, and its plant: the plant link (asked
+ * before each poll, told the board's flags and its e-stop button), or else
+ * a plant the loop advances to the wall clock's milliseconds. */
 typedef struct {
-    void *board;
-    void (*poll)(void *board);
-    size_t (*frame)(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE]);
-    void (*report)(void *board, FILE *out); /* its counts, on exit */
-    /* Brings the board's plant to the present before each poll (the trivial
-     * plant advances, the plant link is asked); false: the plant is gone. */
-    bool (*refresh)(void *ctx, uint32_t wall_ms);
-    void *refresh_ctx;
+    sb_board *board;
+    sb_plant *plant;
+    void (*advance)(uint32_t wall_ms);
 } sb_native_board;
 
 /* The e-stop button: SIGUSR1 presses it, SIGUSR2 releases it. */
@@ -51,7 +49,7 @@ sb_plant_io sb_native_plant_io(int *fd);
 uint32_t sb_native_boot_id(void);
 
 /* Serves nb on fd until SIGTERM, SIGINT or the plant is gone; prints the
- * counts on stderr.  Returns the exit code. */
-int sb_native_serve(int fd, const sb_native_args *a, sb_native_board *nb);
+ * board's and the line's counts on stderr.  Returns the exit code. */
+int sb_native_serve(int fd, const sb_native_args *a, const sb_native_board *nb);
 
 #endif

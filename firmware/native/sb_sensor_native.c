@@ -17,34 +17,6 @@
 
 #define PLANT_TIMEOUT_MS 2000u
 
-static void poll_board(void *board)
-{
-    sb_sensor_poll(board);
-}
-
-static size_t frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE])
-{
-    return sb_sensor_frame(board, f, out);
-}
-
-static void report(void *board, FILE *out)
-{
-    const sb_sensor_board *b = board;
-    fprintf(out, "%u frames, %u duplicates answered from the cache, %u replies cut",
-            (unsigned)b->base.frames, (unsigned)b->base.duplicates, (unsigned)b->base.cut);
-}
-
-static sb_sensor_board board;
-
-static bool ask_plant(void *ctx, uint32_t wall_ms)
-{
-    (void)wall_ms;
-    sb_plant *p = ctx;
-    p->flags = sb_board_status(&board.base).body.status.flags;
-    sb_plant_query(p);
-    return true;
-}
-
 int main(int argc, char **argv)
 {
     sb_native_args a = {"sb_sensor_native", 0, -1, -1, NULL};
@@ -55,6 +27,7 @@ int main(int argc, char **argv)
         return 2;
     }
     static sb_plant plant_link;
+    static sb_sensor_board board;
     static int plant_fd;
     plant_fd = a.plant_fd;
     sb_plant_io io = sb_native_plant_io(&plant_fd);
@@ -66,7 +39,7 @@ int main(int argc, char **argv)
     sb_sensor_config cfg = {a.serial ? (uint16_t)a.serial : plant_link.info.serial,
                             sb_native_boot_id(), plant_link.info.channels, true,
                             plant_link.info.lockstep};
-    sb_native_board nb = {&board, poll_board, frame, report, ask_plant, &plant_link};
+    sb_native_board nb = {&board.base, &plant_link, NULL};
     int fd = sb_native_open_host(&a);
     if (fd < 0) return 1;
     sb_sensor_init(&board, &hal, &cfg);

@@ -7,6 +7,7 @@
  *   w HEX       stuffed bytes (with their delimiters), fed one by one   -> HEX... of the
  *               reply frames (stuffed, delimited), or "-" for none
  *   b 0|1       the e-stop input released or pressed                   -> ok
+ *   f CH CODE   motor CH's own fault is CODE (MotorFault; 0: none)       -> ok
  *   s           the plant: each motor's position (micro-turns), then each
  *               motor's commanded speed (milli-turns/s)                 -> 12 numbers
  *
@@ -55,6 +56,11 @@ int main(int argc, char **argv)
         if (line[0] == 't' && line[1] == ' ') {
             plant_advance(&world, (uint32_t)strtoul(line + 2, NULL, 10));
             sb_motor_poll(&board);
+            puts("ok");
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            char *end;
+            unsigned long ch = strtoul(line + 2, &end, 10);
+            if (ch < SB_MOTORS) world.injected[ch] = (uint8_t)strtoul(end, NULL, 10);
             puts("ok");
         } else if (line[0] == 'b' && line[1] == ' ') {
             world.estop_pressed = line[2] == '1';

@@ -74,7 +74,7 @@ def main(argv: list[str], confirm: Callable[[str], bool] = ask) -> int:
             return EXIT_OK
         for board, flags in sorted(robot.latched.items()):
             print(f"{args.robot}: the {m.Board(board).name.lower()} board has "
-                  f"{latch_names(flags)}")
+                  f"{latch_names(flags, robot.status[board].fault)}")
         _say_unfinished(args.robot, session)
         question = ("Look at the robot first: it may stand part way up a step, and the next "
                     "run starts from where it stands.  Clear these latches? [y/N] ")

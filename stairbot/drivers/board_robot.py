@@ -33,7 +33,7 @@ from stairbot.drivers import estop, link_loss, telemetry
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.board_replies import ReplyReader, identity, vars_of
-from stairbot.drivers.handshake import LATCHES, check_owned, open_boards, release_board
+from stairbot.drivers.handshake import check_owned, latches, open_boards, release_board
 from stairbot.drivers.health import HealthReport
 from stairbot.drivers.keepalive import Keepalive
 from stairbot.drivers.link import BoardLink, BusFaultError, Reply, Request
@@ -117,7 +117,7 @@ class BoardRobot:
             wait_s=self._wait_board_s, allow_latched=allow_latched, side_pair=side_pair,
             opened=self._sent_to)
         self.idents, self.status, self.boots = opened.idents, opened.status, opened.boots
-        self.latched = {b: s.flags & LATCHES for b, s in self.status.items() if s.flags & LATCHES}
+        self.latched = {b: latches(s) for b, s in self.status.items() if latches(s)}
         # an e-stop latch found when opening is this host's to hold
         self._estopped = any(s.flags & m.StatusFlag.ESTOP for s in self.status.values())
         # Heartbeats to any board the host has not addressed for ``feed_s``.

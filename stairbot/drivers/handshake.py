@@ -72,17 +72,33 @@ def check_sensor_channels(url: str, ident: m.Ident, side_pair: str | None) -> No
             f"channels 4-5 ({SIDE_NAMES}), or set [sensors] side_model = \"none\"")
 
 
-LATCHES = m.StatusFlag.ESTOP | m.StatusFlag.WATCHDOG
+MOTOR_FAULTS = (m.MotorFault.OVERCURRENT, m.MotorFault.STALL, m.MotorFault.ENCODER,
+                m.MotorFault.DRIVER)
+"""The motor faults a board latches until Clear 0x04 (docs/protocol.md, section 3)."""
 
 
-def latch_names(flags: int) -> str:
-    """The latches in a Status's flags, in words."""
+def latches(status: m.Status) -> int:
+    """The latches a Status shows, as its flags: the e-stop, the tripped
+    watchdog, and FAULT when Status.fault is a latched motor fault (a
+    simulated world's failure, SIMULATION, also sets FAULT, but no Clear
+    undoes it: it is no latch)."""
+    flags = status.flags & (m.StatusFlag.ESTOP | m.StatusFlag.WATCHDOG)
+    if status.flags & m.StatusFlag.FAULT and status.fault in MOTOR_FAULTS:
+        flags |= m.StatusFlag.FAULT
+    return flags
+
+
+def latch_names(flags: int, fault: int = m.MotorFault.NONE) -> str:
+    """The latches in a Status's flags (and its fault code), in words."""
     names = []
     if flags & m.StatusFlag.ESTOP:
         names.append("its emergency stop latched")
     if flags & m.StatusFlag.WATCHDOG:
         names.append("its watchdog tripped and latched (frames stopped coming while "
                      "it was armed)")
+    if flags & m.StatusFlag.FAULT:
+        what = m.MotorFault(fault).name if fault in MOTOR_FAULTS else "a"
+        names.append(f"{what} motor fault latched (that motor holds stopped until cleared)")
     return " and ".join(names)
 
 
@@ -193,9 +209,10 @@ def open_board(link: BoardLink, url: str, board: m.Board, *, lockstep: bool,
         raise RobotUrlError(url, "lockstep", f"the boards {state} in lockstep; {hint}")
     owner = claim_board(link, url, board, nonce=nonce, lease_ms=lease_ms,
                         wait_s=wait_s)
-    if status.flags & LATCHES and not allow_latched:
+    if latches(status) and not allow_latched:
         raise LatchedError(
-            f"{url}: the {name} board has {latch_names(status.flags)}; opening never "
+            f"{url}: the {name} board has {latch_names(latches(status), status.fault)}; "
+            f"opening never "
             f"clears a latch: check the robot, then `stairbot clear --robot {url}`",
             {name: {"serial": ident.serial}})
     # Setting up is the one place where a command frame is sent again after a

@@ -6,9 +6,11 @@ one host's lease (Claim: while it is live, only its holder may command
 motion, set the watchdog, clear or step the world, and only its frames feed
 the watchdog), per-board watchdog (no frame from the lease's holder for
 ``watchdog_ms`` -> every motor stops, lifts hold, a fault latches until an
-explicit Clear), latched emergency stop (anyone may stop the robot), fault
-latch, Move by turns; the motor board also answers the simulation's StepTo
-and GetTruth.  Both are backed by one
+explicit Clear), latched emergency stop (anyone may stop the robot), each
+motor's fault latch (a lift at its limit is reported, not latched), Move by
+turns; the motor board also answers the simulation's StepTo
+and GetTruth.  What both share is :class:`~stairbot.fakes.board_base.Board`
+(``board_base.py``); both are backed by one
 :class:`~stairbot.fakes.board_world.BoardWorld` (``board_world.py``).
 
 A transport (``serial_boards``, the CAN fake) feeds each valid host frame to
@@ -20,160 +22,21 @@ have passed.
 from __future__ import annotations
 
 import secrets
-import time
-from collections.abc import Sequence
 
 from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.fakes import sim_messages as sim
-from stairbot.fakes.board_lease import Lease
+from stairbot.fakes.board_base import Board
 from stairbot.fakes.board_world import BoardWorld
-
-FIRMWARE_VERSION = 0x0100
-DEFAULT_WATCHDOG_MS = 250
-
-# What only the holder of a live lease may send; anyone may query, stop or
-# brake (Stop, Brake) and latch the emergency stop.
-OWNED: tuple[type[m.Message], ...] = (
-    m.SetWatchdog, m.Clear, m.SetWheelSpeeds, m.SetLiftSpeeds, m.Run, m.Move, sim.StepTo)
-
-
-class Board:
-    """What both boards share: identity, watchdog, e-stop and fault latches."""
-
-    BOARD: m.Board = m.Board.MOTOR
-    CHANNELS = 0
-
-    def __init__(self, world: BoardWorld, serial: int = 1) -> None:
-        self.world = world
-        self.serial = serial
-        self.watchdog_ms = DEFAULT_WATCHDOG_MS
-        self.hold_ms = 0  # a speed command's life (SetWatchdog.hold_ms); 0: until changed
-        self.held_out = 0  # motors stopped because their command outlived hold_ms
-        self.estop = False
-        self.watchdog_tripped = False
-        self.fault = m.MotorFault.NONE
-        self._last_feed: float | None = None  # the watchdog arms when a lease is granted
-        self._start = world.now()
-        self.handled = 0
-        self.boot = secrets.randbits(32) or 1  # drawn at power-up (Owner.boot)
-        self.lease = Lease(time.monotonic if world.lockstep else world.now,
-                           lambda: self.watchdog_ms, self.boot)
-
-    # -- status ----------------------------------------------------------------
-    def flags(self) -> int:
-        f = m.StatusFlag.SIMULATED
-        if self.world.lockstep:
-            f |= m.StatusFlag.LOCKSTEP
-        if self.estop:
-            f |= m.StatusFlag.ESTOP
-        if self.watchdog_tripped:
-            f |= m.StatusFlag.WATCHDOG
-        if self.fault != m.MotorFault.NONE or self.world.failure is not None:
-            f |= m.StatusFlag.FAULT
-        return int(f)
-
-    def fault_code(self) -> int:
-        if self.world.failure is not None:
-            return int(m.MotorFault.SIMULATION)
-        if self.estop:
-            return int(m.MotorFault.ESTOP)
-        if self.watchdog_tripped:
-            return int(m.MotorFault.WATCHDOG)
-        return int(self.fault)
-
-    def status(self) -> m.Status:
-        uptime = int((self.world.now() - self._start) * 1000) & 0xFFFFFFFF
-        return m.Status(self.flags(), self.fault_code(), self.watchdog_ms, uptime)
-
-    def refusal(self) -> m.AckResult:
-        """Why a motion command is refused now (OK when it is not)."""
-        if self.estop:
-            return m.AckResult.ESTOP
-        if self.watchdog_tripped:
-            return m.AckResult.WATCHDOG
-        return m.AckResult.OK
-
-    # -- time ------------------------------------------------------------------
-    def poll(self) -> None:
-        """Check the watchdog (and, on the motor board, Moves) at the present time."""
-        if (self.watchdog_ms and self._last_feed is not None and not self.watchdog_tripped
-                and (self.world.now() - self._last_feed) * 1000 > self.watchdog_ms):
-            self.watchdog_tripped = True
-            self.halt()
-
-    def halt(self) -> None:
-        """Stop every motor this board drives (nothing on the sensor board)."""
-
-    # -- the lease ---------------------------------------------------------------
-    def owns(self, session: int) -> bool:
-        """Whether ``session`` holds a live lease of this board."""
-        return self.lease.owns(session)
-
-    def _claim(self, msg: m.Claim, session: int) -> m.Owner:
-        granted = self.lease.claim(msg, session)
-        if granted.result == m.ClaimResult.GRANTED:
-            self._last_feed = self.world.now()  # the watchdog is armed from now on
-        return granted
-
-    # -- messages --------------------------------------------------------------
-    def handle(self, msgs: Sequence[m.Message | m.RawMessage], session: int
-               ) -> list[m.Message]:
-        """The replies to one valid host frame of host session ``session``,
-        in order.  A frame of the lease's holder renews the lease and feeds
-        the watchdog; another session's commands that need the lease are
-        answered Ack(NOT_OWNER) and not executed."""
-        self.poll()  # a frame that comes too late does not un-trip the watchdog
-        if self.owns(session):
-            self._last_feed = self.world.now()
-            self.lease.renew()
-        self.handled += 1
-        out: list[m.Message] = []
-        for msg in msgs:
-            if isinstance(msg, m.RawMessage):
-                out.append(m.Ack(msg.type_code, m.AckResult.UNKNOWN_TYPE))
-            elif msg.REPLY:
-                out.append(m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED))
-            elif isinstance(msg, m.Claim):
-                out.append(self._claim(msg, session))
-            elif isinstance(msg, OWNED) and not self.owns(session):
-                out.append(m.Ack(msg.TYPE, m.AckResult.NOT_OWNER))
-            else:
-                out.extend(self.answer(msg))
-        return out
-
-    def may_move(self) -> bool:
-        """Whether a motor of this board may be moving (none on the sensor board)."""
-        return False
-
-    def answer(self, msg: m.Message) -> list[m.Message]:
-        if isinstance(msg, m.Identify):
-            return [m.Ident(self.BOARD, m.PROTOCOL_MAJOR, m.PROTOCOL_MINOR, self.CHANNELS,
-                            FIRMWARE_VERSION, self.serial)]
-        if isinstance(msg, m.Heartbeat | m.GetStatus):
-            return [self.status()]
-        if isinstance(msg, m.SetWatchdog):
-            if msg.timeout_ms == 0 and self.may_move():
-                return [m.Ack(msg.TYPE, m.AckResult.BAD_VALUE)]  # stop the motors first
-            self.watchdog_ms, self.hold_ms = msg.timeout_ms, msg.hold_ms
-            return [self.status()]
-        if isinstance(msg, m.EStop):
-            self.estop = True
-            self.halt()
-            return [self.status()]
-        if isinstance(msg, m.Clear):
-            if msg.mask & m.ClearMask.ESTOP:
-                self.estop = False
-            if msg.mask & m.ClearMask.WATCHDOG:
-                self.watchdog_tripped = False
-            if msg.mask & m.ClearMask.FAULTS:
-                self.fault = m.MotorFault.NONE
-            return [self.status()]
-        return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
+from stairbot.fakes.motor_faults import FaultLatch
+from stairbot.hardware import MotorId, Snapshot
 
 
 class MotorBoard(Board):
-    """Six motors, channels in ``messages.MOTOR_CHANNELS`` order."""
+    """Six motors, channels in ``messages.MOTOR_CHANNELS`` order.  A motor
+    whose snapshot reports a fault other than LIMIT latches it when the
+    board reads its world (telemetry, a Move): the motor stops (HOLD) and
+    stays stopped until Clear 0x04."""
 
     BOARD = m.Board.MOTOR
     CHANNELS = len(m.MOTOR_CHANNELS)
@@ -181,17 +44,47 @@ class MotorBoard(Board):
     def __init__(self, world: BoardWorld, serial: int = 1) -> None:
         super().__init__(world, serial)
         self.modes = [m.MotorMode.IDLE] * self.CHANNELS
-        self._move_target: list[float | None] = [None] * self.CHANNELS
+        self.faults = FaultLatch()  # each motor's latched fault
+        self._move_target: list[int | None] = [None] * self.CHANNELS  # counter, mturn
         self.peer: Board | None = None  # the sensor board, whose StepTo polls we share
-        self._commanded = world.now()  # when the motors were last commanded
+        self._commanded = world.now()  # the host's last motion command: the hold counts from it
 
     def _set(self, speeds: dict[int, float], mode: m.MotorMode | None = None) -> None:
-        self._commanded = self.world.now()
+        """Set the motors' speeds and modes (RUN, or IDLE at 0, unless
+        ``mode``), cancelling their Moves; a motor with a latched fault
+        stays stopped in HOLD whatever it is told.  The board's own speed
+        changes come here alone; a host's motion command through
+        :meth:`_command`."""
+        out: dict[MotorId, float] = {}
         for ch, tps in speeds.items():
-            self.modes[ch] = mode if mode is not None else (
-                m.MotorMode.RUN if tps != 0 else m.MotorMode.IDLE)
+            if self.faults.held(ch):
+                tps, self.modes[ch] = 0.0, m.MotorMode.HOLD
+            else:
+                self.modes[ch] = mode if mode is not None else (
+                    m.MotorMode.RUN if tps != 0 else m.MotorMode.IDLE)
             self._move_target[ch] = None
-        self.world.set_speeds({m.MOTOR_CHANNELS[ch]: tps for ch, tps in speeds.items()})
+            out[m.MOTOR_CHANNELS[ch]] = tps
+        self.world.set_speeds(out)
+
+    def _command(self, speeds: dict[int, float], mode: m.MotorMode | None = None) -> None:
+        """A motion command of the host, obeyed: :meth:`_set`, and the hold
+        restarts."""
+        self._commanded = self.world.now()
+        self._set(speeds, mode)
+
+    def _snapshot(self) -> Snapshot | None:
+        """The world now, its motors' faults latched (each motor's first;
+        Status.fault the board's first)."""
+        snap = self.world.snapshot()
+        new = self.faults.see(snap)
+        if new:
+            self.fault = self.faults.first
+            self._set({ch: 0.0 for ch in new})
+        return snap
+
+    def clear_faults(self) -> None:
+        super().clear_faults()
+        self.faults.clear()
 
     def halt(self) -> None:
         self._set({ch: 0.0 for ch in range(self.CHANNELS)}, m.MotorMode.HOLD)
@@ -200,15 +93,14 @@ class MotorBoard(Board):
         return any(mode in (m.MotorMode.RUN, m.MotorMode.MOVE) for mode in self.modes)
 
     def telemetry(self, ch: int) -> m.MotorTelemetry:
-        snap = self.world.snapshot()
+        """The motor now; its fault: the board's latch, else the motor's
+        latched fault, else LIMIT (a lift at the end of its stroke), else NONE."""
+        snap = self._snapshot()
         mid = m.MOTOR_CHANNELS[ch]
         turns = snap.motors[mid].turns if snap else 0.0
         speed = snap.motors[mid].speed_tps if snap else 0.0
-        fault = self.fault_code()
-        if fault == m.MotorFault.NONE and snap and snap.motors[mid].fault:
-            fault = int(m.MotorFault.LIMIT if "limit" in str(snap.motors[mid].fault)
-                        else m.MotorFault.DRIVER)
-        return m.MotorTelemetry(ch, int(self.modes[ch]), fault, u.speed_to_wire(speed),
+        fault = self.board_latch() or self.faults.of(ch, snap)
+        return m.MotorTelemetry(ch, int(self.modes[ch]), int(fault), u.speed_to_wire(speed),
                                 u.turns_to_wire(turns))
 
     def poll(self) -> None:
@@ -223,10 +115,10 @@ class MotorBoard(Board):
         for ch, target in enumerate(self._move_target):
             if target is None:
                 continue
-            snap = snap or self.world.snapshot()
+            snap = snap or self._snapshot()
             if snap is None:
                 continue
-            turns = snap.motors[m.MOTOR_CHANNELS[ch]].turns
+            turns = u.turns_to_wire(snap.motors[m.MOTOR_CHANNELS[ch]].turns)  # as reported
             speed = self.world.speeds()[m.MOTOR_CHANNELS[ch]]
             if (speed >= 0 and turns >= target) or (speed < 0 and turns <= target):
                 self._set({ch: 0.0})
@@ -235,7 +127,7 @@ class MotorBoard(Board):
         refusal = self.refusal()
         if refusal is not m.AckResult.OK:
             return [m.Ack(msg.TYPE, refusal)]
-        self._set(speeds)
+        self._command(speeds)
         return [m.Ack(msg.TYPE, m.AckResult.OK)]
 
     def answer(self, msg: m.Message) -> list[m.Message]:
@@ -270,10 +162,10 @@ class MotorBoard(Board):
             if msg.mask & ~m.ALL_MOTORS_MASK:
                 return [m.Ack(msg.TYPE, m.AckResult.BAD_CHANNEL)]
             chans = [ch for ch in range(self.CHANNELS) if msg.mask >> ch & 1]
-            self._set({ch: 0.0 for ch in chans})
+            self._command({ch: 0.0 for ch in chans})
             if isinstance(msg, m.Brake):
                 for ch in chans:
-                    if ch not in m.LIFT_CHANNELS:
+                    if ch not in m.LIFT_CHANNELS and not self.faults.held(ch):
                         self.modes[ch] = m.MotorMode.BRAKE
             return [m.Ack(msg.TYPE, m.AckResult.OK)]
         return super().answer(msg)
@@ -292,13 +184,14 @@ class MotorBoard(Board):
         refusal = self.refusal()
         if refusal is not m.AckResult.OK:
             return [m.Ack(msg.TYPE, refusal)]
-        snap = self.world.snapshot()
+        snap = self._snapshot()
         if snap is None:
             return [m.Ack(msg.TYPE, m.AckResult.NOT_SUPPORTED)]
-        start = snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns
+        start = u.turns_to_wire(snap.motors[m.MOTOR_CHANNELS[msg.channel]].turns)
         speed = u.speed_from_wire(msg.speed_mtps) * (1 if msg.turns_mt >= 0 else -1)
-        self._set({msg.channel: speed}, m.MotorMode.MOVE)
-        self._move_target[msg.channel] = start + u.turns_from_wire(msg.turns_mt)
+        self._command({msg.channel: speed}, m.MotorMode.MOVE)
+        if self.modes[msg.channel] == m.MotorMode.MOVE:  # not a motor held by its fault
+            self._move_target[msg.channel] = start + msg.turns_mt
         if msg.turns_mt == 0:
             self._set({msg.channel: 0.0})
         return [m.Ack(msg.TYPE, m.AckResult.OK)]

@@ -16,6 +16,7 @@ Wire faults act here, on the bytes, in both directions.
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import select
 import shutil
@@ -73,10 +74,15 @@ def build_native(build_dir: Path | None = None) -> Path:
                             "or $CC; Debian: apt-get install gcc make)")
     targets = [str(out / name) for name in PROGRAMS.values()]
     try:
-        made = subprocess.run(["make", "-s", "-C", str(FIRMWARE), f"BUILD={out}", f"CC={cc}",
-                               *targets],
-                              capture_output=True, text=True, check=False)
-    except FileNotFoundError as exc:
+        out.mkdir(parents=True, exist_ok=True)
+        with open(out / ".lock", "w") as lock:  # one make at a time in a build directory
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            made = subprocess.run(["make", "-s", "-C", str(FIRMWARE), f"BUILD={out}",
+                                   f"CC={cc}", *targets],
+                                  capture_output=True, text=True, check=False)
+    except OSError as exc:
+        if not isinstance(exc, FileNotFoundError):
+            raise FirmwareError(f"cannot build the native firmware in {out}: {exc}") from exc
         raise FirmwareError("--firmware native needs make and a C compiler "
                             "(Debian: apt-get install make gcc)") from exc
     if made.returncode != 0:
@@ -228,9 +234,10 @@ class FirmwareBoardServer(SerialBoardServer):
 
     def _pump(self) -> None:
         """Hand on queued frames, one request in flight at a time: the next
-        waits for the board's reply (or REPLY_WAIT_S), so the boards see the
-        host's frames in the order it sent them -- a StepTo to the motor board
-        is done before the sensor board reads the world for the next ReadAll."""
+        waits for a running board's reply (or REPLY_WAIT_S), so the boards see
+        the host's frames in the order it sent them -- a StepTo to the motor
+        board is done before the sensor board reads the world for the next
+        ReadAll."""
         now = time.monotonic()
         if self._flight is not None and now < self._flight[2]:
             return
@@ -241,9 +248,11 @@ class FirmwareBoardServer(SerialBoardServer):
                 for board in self.firmware.values():
                     self._hand_on(board, wire * copies)
                 continue
-            self._hand_on(self.firmware[address], wire * copies)
-            self._flight = (address, copies, now + REPLY_WAIT_S)
-            return
+            board = self.firmware[address]
+            self._hand_on(board, wire * copies)
+            if board.alive:  # a killed or hung board answers nothing: nothing awaited
+                self._flight = (address, copies, now + REPLY_WAIT_S)
+                return
 
     def _hand_on(self, board: FirmwareBoard, wire: bytes) -> None:
         """The bytes go down the board's line."""
@@ -253,8 +262,8 @@ class FirmwareBoardServer(SerialBoardServer):
     def _side_fds(self) -> list[int]:
         """The plant links before the host lines: a board's motor command,
         sent before its reply, reaches the world before the host sees the reply."""
-        return [b.link.fileno() for b in self.firmware.values()] + \
-            [b.host.fileno() for b in self.firmware.values()]
+        running = [b for a, b in self.firmware.items() if a not in self.killed]
+        return [b.link.fileno() for b in running] + [b.host.fileno() for b in running]
 
     def _side_ready(self, fd: int) -> None:
         for board in self.firmware.values():
@@ -273,7 +282,8 @@ class FirmwareBoardServer(SerialBoardServer):
         except BlockingIOError:
             return
         if not data:
-            self.stop()
+            if board.address not in self.killed:
+                self.stop()  # the program ended: nothing more to serve
             return
         for wire in board.replies.frames(data):
             if self._flight is not None and self._flight[0] == board.address:

@@ -27,6 +27,7 @@ from stairbot.drivers import messages as m
 from stairbot.drivers import units as u
 from stairbot.drivers.serial_wire import crc16
 from stairbot.fakes.board_world import BoardWorld
+from stairbot.fakes.motor_faults import wire_fault
 from stairbot.hardware import MotorId, Snapshot
 
 # Frame kinds: the board's requests in capitals, the plant's answers in small letters.
@@ -170,10 +171,7 @@ class PlantLink:
         out = bytearray()
         for mid in m.MOTOR_CHANNELS:
             state = snap.motors[mid] if snap else None
-            fault = 0
-            if state is not None and state.fault:
-                fault = int(m.MotorFault.LIMIT if "limit" in str(state.fault)
-                            else m.MotorFault.DRIVER)
+            fault = int(wire_fault(state.fault)) if state is not None else 0
             out += _MOTOR.pack(u.turns_to_wire(state.turns if state else 0.0),
                                u.speed_to_wire(state.speed_tps if state else 0.0), fault)
         return bytes(out)

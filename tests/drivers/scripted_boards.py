@@ -37,7 +37,8 @@ _channels = itertools.count()
 
 class Scripted:
     """The robot behind the fake boards: the snapshot the test sets, at the
-    world's time; with the side pair (``side_pair``) six readings, else four."""
+    world's time; with the side pair (``side_pair``) six readings, else four;
+    ``motor_faults``: what each motor reports (none unless set)."""
 
     def __init__(self, side_pair: bool = False) -> None:
         self.t = 0.0
@@ -45,11 +46,13 @@ class Scripted:
         self.ages: Mapping[SensorId, float] = dict.fromkeys(SensorId, 0.0)
         self.distances: Mapping[SensorId, float] = dict.fromkeys(SensorId, 0.5)
         self.imu: Imu | None = None
+        self.motor_faults: Mapping[MotorId, str] = {}
 
     def read(self) -> Snapshot:
         return Snapshot(self.t, {s: SensorReading(self.distances[s], age_s=self.ages[s])
                                  for s in self.sensors},
-                        {k: MotorState(0.0) for k in MotorId}, imu=self.imu)
+                        {k: MotorState(0.0, 0.0, self.motor_faults.get(k)) for k in MotorId},
+                        imu=self.imu)
 
     def command(self, speeds: Mapping[MotorId, float]) -> None:
         pass

@@ -30,8 +30,8 @@ HOST, NONCE = 0x2A, 7  # the session and nonce of the host these tests play
 
 class StubRobot:
     """Turns integrate the commanded speeds; ``fail`` makes read() raise;
-    ``ages`` (per sensor) and ``imu`` are what the snapshot reports, for
-    ``sensors`` (every SensorId unless told)."""
+    ``ages`` (per sensor), ``imu`` and ``motor_faults`` (per motor) are what
+    the snapshot reports, for ``sensors`` (every SensorId unless told)."""
 
     def __init__(self, sensors: tuple[SensorId, ...] = tuple(SensorId)) -> None:
         self.t = 0.0
@@ -43,6 +43,7 @@ class StubRobot:
         self.fail = False
         self.ages = {sid: 0.0 for sid in SensorId}
         self.imu: Imu | None = None
+        self.motor_faults: dict[MotorId, str] = {}
 
     def read(self) -> Snapshot:
         if self.fail:
@@ -50,7 +51,8 @@ class StubRobot:
         self.reads += 1
         return Snapshot(self.t, {s: SensorReading(0.5 + i / 10, age_s=self.ages[s])
                                  for i, s in enumerate(SensorId) if s in self.sensors},
-                        {k: MotorState(v, self.speeds[k]) for k, v in self.turns.items()},
+                        {k: MotorState(v, self.speeds[k], self.motor_faults.get(k))
+                         for k, v in self.turns.items()},
                         imu=self.imu)
 
     def command(self, speeds: Mapping[MotorId, float]) -> None:
@@ -219,6 +221,8 @@ def test_step_to_is_idempotent_and_lockstep_only(rig: tuple) -> None:
     assert robot.t == pytest.approx(0.02)
     world.lockstep = False
     assert motor.handle([sim.StepTo(40_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_SUPPORTED)]
+    # the lease is checked first: another session is told NOT_OWNER, not NOT_SUPPORTED
+    assert motor.handle([sim.StepTo(40_000)], 0x15) == [m.Ack(0x7E, m.AckResult.NOT_OWNER)]
 
 
 def test_sensor_sample_counter_advances_with_new_measurements(rig: tuple) -> None:
@@ -469,3 +473,101 @@ def test_commands_each_tick_keep_the_motors_running(rig: tuple) -> None:
         motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.SetLiftSpeeds(0, 0)], HOST)
         step(motor, world, 0.02)
     assert robot.speeds[MotorId.MWF] == 1.0 and motor.held_out == 0
+
+
+def test_a_lift_at_its_limit_says_limit_in_its_telemetry_only(rig: tuple) -> None:
+    """LIMIT latches nothing: no FAULT flag, Status.fault NONE, the mode as
+    commanded; it goes when the lift leaves the end of its stroke."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetLiftSpeeds(500, 0)], HOST)
+    robot.motor_faults[MotorId.MTF] = "lift limit"
+    step(motor, world, 0.01)
+    status, *tel = motor.handle([m.ReadAll()], HOST)
+    assert not status.flags & m.StatusFlag.FAULT and status.fault == m.MotorFault.NONE
+    assert (tel[4].fault, tel[4].mode) == (m.MotorFault.LIMIT, m.MotorMode.RUN)
+    assert [t.fault for t in tel[:4] + tel[5:]] == [m.MotorFault.NONE] * 5
+    motor.handle([m.SetLiftSpeeds(-500, 0)], HOST)  # away from the end: obeyed
+    assert robot.speeds[MotorId.MTF] == -0.5
+    del robot.motor_faults[MotorId.MTF]
+    step(motor, world, 0.01)
+    assert motor.handle([m.GetMotor(4)], HOST)[0].fault == m.MotorFault.NONE
+
+
+def test_a_motor_fault_latches_and_holds_that_motor_stopped_until_clear(rig: tuple) -> None:
+    """OVERCURRENT on MWB: that motor stops (HOLD) and reports it, the FAULT
+    flag and Status.fault say it; gone from the motor, it stays latched and
+    no command drives MWB until Clear 0x04, which restarts nothing.  A
+    later fault on another motor leaves Status.fault the first; a fault the
+    protocol has no name for is DRIVER."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
+    robot.motor_faults[MotorId.MWB] = "overcurrent"
+    step(motor, world, 0.01)
+    status, *tel = motor.handle([m.ReadAll()], HOST)
+    assert status.flags & m.StatusFlag.FAULT and status.fault == m.MotorFault.OVERCURRENT
+    assert (tel[1].fault, tel[1].mode) == (m.MotorFault.OVERCURRENT, m.MotorMode.HOLD)
+    assert (tel[0].fault, tel[0].mode) == (m.MotorFault.NONE, m.MotorMode.RUN)
+    assert robot.speeds[MotorId.MWB] == 0.0 and robot.speeds[MotorId.MWF] == 1.0
+    del robot.motor_faults[MotorId.MWB]
+    robot.motor_faults[MotorId.MTB] = "hot"
+    step(motor, world, 0.01)
+    for msg in (m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.Run(1, 500), m.Move(1, 300, 500),
+                m.Brake(0b10)):
+        assert motor.handle([msg], HOST) == [m.Ack(msg.TYPE, m.AckResult.OK)]
+        assert robot.speeds[MotorId.MWB] == 0.0 and motor.modes[1] == m.MotorMode.HOLD
+    status, *tel = motor.handle([m.ReadAll()], HOST)
+    assert status.fault == m.MotorFault.OVERCURRENT and tel[5].fault == m.MotorFault.DRIVER
+    del robot.motor_faults[MotorId.MTB]
+    step(motor, world, 0.01)
+    status = motor.handle([m.Clear(m.ClearMask.FAULTS)], HOST)[0]
+    assert not status.flags & m.StatusFlag.FAULT and status.fault == m.MotorFault.NONE
+    assert robot.speeds[MotorId.MWB] == 0.0  # nothing restarted
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000)], HOST)
+    assert robot.speeds[MotorId.MWB] == 1.0
+    assert motor.handle([m.GetMotor(1)], HOST)[0].fault == m.MotorFault.NONE
+
+
+def test_a_move_reaching_its_stop_point_does_not_lengthen_another_motors_hold(
+        rig: tuple) -> None:
+    """The hold counts from the host's last motion command only: the wheels
+    commanded at 0 ms with a 100 ms hold stop by 110 ms, although a Move on
+    MTF (50 mturn at 1 turn/s) reached its stop point, the board's own
+    speed change, at 60 ms."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWatchdog(250, 100), m.SetWheelSpeeds(1000, 1000, 1000, 1000),
+                  m.Move(4, 50, 1000)], HOST)
+    step(motor, world, 0.06)
+    assert robot.speeds[MotorId.MTF] == 0.0 and motor.modes[4] == m.MotorMode.IDLE
+    assert robot.speeds[MotorId.MWF] == 1.0
+    step(motor, world, 0.05)  # 110 ms since the command, 50 ms since the Move stopped
+    assert all(v == 0.0 for v in robot.speeds.values()) and motor.held_out == 1
+
+
+def test_the_watchdog_stays_armed_after_the_lease_is_given_up(rig: tuple) -> None:
+    """A host that gives its lease up mid-motion without switching the
+    watchdog off still has its motors stopped watchdog_ms after its last
+    frame, and the latch set, though another host is talking."""
+    robot, world, motor, _ = rig
+    motor.handle([m.SetWheelSpeeds(1000, 1000, 1000, 1000), m.Claim(0, NONCE)], HOST)
+    for _ in range(6):  # 300 ms; another host polls without a lease
+        step(motor, world, 0.05)
+        motor.handle([m.GetStatus()], OTHER)
+    status = motor.handle([m.GetStatus()], OTHER)[0]
+    assert status.flags & m.StatusFlag.WATCHDOG and status.fault == m.MotorFault.WATCHDOG
+    assert all(v == 0.0 for v in robot.speeds.values())
+
+
+def test_a_move_stops_when_the_counter_as_reported_lands_on_its_stop_point(
+        rig: tuple) -> None:
+    """A Move's stop point in integer milli-turns: from 3.276 turns, -397
+    mturn stops at a counter of 2.879 turns (2879 on the wire), where the
+    float sum 3.276 - 0.397 = 2.8789999999999996 lies a hair beyond it."""
+    robot, world, motor, _ = rig
+    robot.turns[MotorId.MWF] = 3.276
+    motor.handle([m.Move(0, -397, 1000)], HOST)
+    assert robot.speeds[MotorId.MWF] == -1.0
+    robot.speeds[MotorId.MWF] = 0.0  # the counter stands on the stop point from here on
+    robot.turns[MotorId.MWF] = 2.879
+    step(motor, world, 0.001)
+    tel = motor.handle([m.GetMotor(0)], HOST)[0]
+    assert (tel.mode, tel.turns_mt) == (m.MotorMode.IDLE, 2879)

@@ -45,6 +45,7 @@ class PlantRobot:
         self.umt[self.LIFTS[0]], self.umt[self.LIFTS[1]] = lift_mt * 1000, -lift_mt * 1000
         self.measured = {mid: 0 for mid in m.MOTOR_CHANNELS}
         self.at_limit = {mid: False for mid in m.MOTOR_CHANNELS}
+        self.injected: dict[MotorId, str | None] = {mid: None for mid in m.MOTOR_CHANNELS}
 
     def clamped(self, mid: MotorId) -> int:
         """The motor's commanded speed within its limit (mturn/s)."""
@@ -68,7 +69,7 @@ class PlantRobot:
             return (umt + 500) // 1000 if umt >= 0 else -((-umt + 500) // 1000)
         return Snapshot(Fraction(self.now_ms, 1000), {}, {  # type: ignore[arg-type]
             mid: MotorState(mt(self.umt[mid]) / 1000, self.measured[mid] / 1000,
-                            "lift limit" if self.at_limit[mid] else None)
+                            self.injected[mid] or ("lift limit" if self.at_limit[mid] else None))
             for mid in m.MOTOR_CHANNELS})
 
     def command(self, speeds: Mapping[MotorId, float]) -> None:
@@ -118,6 +119,8 @@ def random_request(rng: random.Random) -> m.Message | RawMessage:
 
 
 FRAMES = 4000
+FAULT_NAMES = {3: "overcurrent", 4: "stall", 5: "encoder", 7: "driver fault"}
+"""The motor faults a script injects (MotorFault code: the plant's words)."""
 
 
 def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
@@ -131,11 +134,7 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
     cache, every Ack result, every Claim result, both latches, Moves that
     reach their stop points, a lift at its limit, a reply frame cut at 247
     message bytes); after every frame the two plants stand in the same
-    place with their motors commanded alike.  (The fake sums a Move's stop
-    point in float turns, so a counter landing exactly on it may run on to
-    the next poll there, where the C board stops: firmware/README.md.  This
-    script's seed lands on none; seed 2 with 20,000 frames does, at frame
-    11,068.)"""
+    place with their motors commanded alike."""
     exe = build(tmp_path / "sbboard", ("core", "board"), ("native/plant.c", "test/sbboard.c"),
                 ["-O1", "-g", *SANITIZE])
     boot, lift_mt = 0xB007, 103_000  # the lifts start 2 turns from the ends of their stroke
@@ -151,6 +150,8 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
     commands, frames = [], []
     for _ in range(FRAMES):
         t_ms += rng.choice([0, 1, 3, 10, 30, 60, 100, 120, 250, 400])  # 100, 250: on a watchdog
+        if commands and commands[-2].startswith("f "):
+            t_ms += 1  # past the instant a fault was read at (the fake's world is read once)
         session = rng.choice([7, 7, 7, 9])
         if last[session] and rng.random() < 0.1:
             wire = last[session]  # a retry: the same bytes
@@ -159,25 +160,43 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
             msgs = tuple(random_request(rng) for _ in range(rng.choice([1, 1, 2, 3])))
             wire = encode_frame(Frame(MOTOR, seqs[session], msgs, session=session))
         last[session] = wire
-        commands += [f"t {t_ms}", f"w {wire.hex()}", "s"]
-        frames.append((t_ms, wire))
+        fault = None
+        if rng.random() < 0.02:
+            # a motor's own fault from the next instant (the fake reads its world once an
+            # instant), read by a ReadAll then, and gone after it: both boards latch it
+            # there (the C board as it polls, the fake as it reads)
+            t_ms += 1
+            fault = (rng.randrange(6), rng.choice(list(FAULT_NAMES)))
+            seqs[7] = (seqs[7] + 1) & 0xFF
+            wire = encode_frame(Frame(MOTOR, seqs[7], (m.ReadAll(),), session=7))
+            last[7] = wire
+            commands += [f"f {fault[0]} {fault[1]}", f"t {t_ms}", f"w {wire.hex()}",
+                         f"f {fault[0]} 0", "s"]
+        else:
+            commands += [f"t {t_ms}", f"w {wire.hex()}", "s"]
+        frames.append((t_ms, wire, fault))
     for seq in (200, 201):  # more replies than a frame holds: the rest left off, alike
         wire = encode_frame(Frame(MOTOR, seq, (m.ReadAll(),) * 4 + (m.Identify(),), session=7))
         commands += [f"t {t_ms}", f"w {wire.hex()}", "s"]
-        frames.append((t_ms, wire))
+        frames.append((t_ms, wire, None))
     with subprocess.Popen([str(exe), str(boot), str(lift_mt)], stdin=subprocess.PIPE,
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
         out, err = proc.communicate("".join(c + "\n" for c in commands), timeout=60)
     assert proc.returncode == 0 and not err, err  # no sanitizer report
-    answers, plants = out.splitlines()[1::3], out.splitlines()[2::3]
+    lines = [line for line in out.splitlines() if line != "ok"]  # t's and f's
+    answers, plants = lines[0::2], lines[1::2]
     assert len(answers) == len(plants) == len(frames)
     seen: set[str] = set()
     try:
-        for i, ((t, wire), c_hex, c_plant) in enumerate(zip(frames, answers, plants,
-                                                             strict=True)):
+        for i, ((t, wire, fault), c_hex, c_plant) in enumerate(zip(frames, answers, plants,
+                                                                    strict=True)):
+            if fault is not None:
+                robot.injected[m.MOTOR_CHANNELS[fault[0]]] = FAULT_NAMES[fault[1]]
             robot.advance_to(t)
             fake.poll()
             server.receive(wire)
+            if fault is not None:
+                robot.injected[m.MOTOR_CHANNELS[fault[0]]] = None
             py = theirs.recv(4096) if select.select([theirs], [], [], 0)[0] else b""
             # the plant in the same place, its motors commanded alike (the C board clamps
             # a speed to the motor's limit; behind the Python fake the plant does)
@@ -204,7 +223,8 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
     assert server.stats.duplicates > 50
     wanted = {f"ack {r.name}" for r in m.AckResult if r != m.AckResult.BAD_LENGTH}
     wanted |= {f"claim {r.name}" for r in m.ClaimResult}
-    wanted |= {"estop", "watchdog", "mode MOVE", "mode BRAKE", "mode HOLD", "fault LIMIT", "cut"}
+    wanted |= {"estop", "watchdog", "mode MOVE", "mode BRAKE", "mode HOLD", "fault LIMIT", "cut",
+               "status FAULT", *(f"fault {m.MotorFault(c).name}" for c in FAULT_NAMES)}
     assert wanted <= seen, wanted - seen
 
 
@@ -216,10 +236,12 @@ def reached(msg: m.Message | RawMessage) -> set[str]:
         return {f"claim {m.ClaimResult(msg.result).name}"}
     if isinstance(msg, m.Status):
         return ({"estop"} if msg.flags & m.StatusFlag.ESTOP else set()) | (
-            {"watchdog"} if msg.flags & m.StatusFlag.WATCHDOG else set())
+            {"watchdog"} if msg.flags & m.StatusFlag.WATCHDOG else set()) | (
+            {"status FAULT"} if msg.flags & m.StatusFlag.FAULT else set())
     if isinstance(msg, m.MotorTelemetry):
         return {f"mode {m.MotorMode(msg.mode).name}"} | (
-            {"fault LIMIT"} if msg.fault == m.MotorFault.LIMIT else set())
+            {f"fault {m.MotorFault(msg.fault).name}"} if msg.fault not in (
+                m.MotorFault.NONE, m.MotorFault.ESTOP, m.MotorFault.WATCHDOG) else set())
     return set()
 
 

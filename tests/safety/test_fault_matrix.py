@@ -13,6 +13,7 @@ from stairbot.drivers import board_robot
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.fakes import boards as fake_boards
 from stairbot.fakes.fault_matrix import FAULTS, PHASES, cells, run_cell
+from stairbot.fakes.firmware_boards import FirmwareBoardServer, find_cc
 from stairbot.hardware import MotorId
 
 # Each fault once on CAN; the 20 % faults in the descent, where less of the
@@ -30,12 +31,18 @@ CAN_PHASES = {
     "host killed": "ascent_lift_third",
 }
 SERIAL = [("late 5%", "descent_lower_second"), ("host killed", "cal_lift")]
+# The boards' C firmware on the serial wire: a board that hangs (its own
+# independent watchdog must stop its motors), one killed, a killed host, and
+# corrupted frames the firmware's own CRC check must refuse.
+FIRMWARE = [("motor board hung", "ascent_lift_second"), ("sensor board killed", "cal_turn"),
+            ("host killed", "descent_drive_first"), ("corrupt 5%", "ascent_drive_first")]
 
 if os.environ.get("STAIRBOT_FAULT_MATRIX") == "full":
     CELLS = list(cells())
 else:
     CELLS = [(f, p, "can") for f, p in CAN_PHASES.items()] + [(f, p, "serial")
                                                               for f, p in SERIAL]
+    CELLS += [(f, p, "firmware") for f, p in FIRMWARE]
 
 
 def expected(fault: str) -> set[str]:
@@ -56,6 +63,8 @@ def test_the_ci_subset_has_every_fault_and_real_phases() -> None:
 @pytest.mark.parametrize(("fault", "phase", "wire"), CELLS,
                          ids=[f"{w}-{f.replace(' ', '_')}-{p}" for f, p, w in CELLS])
 def test_a_fault_in_any_phase_ends_safe(fault: str, phase: str, wire: str) -> None:
+    if wire == "firmware" and find_cc() is None:
+        pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
     cell = run_cell(fault, phase, wire)
     assert cell.injected, cell.reason
     assert cell.safe, cell.reason
@@ -85,3 +94,16 @@ def test_the_judge_sees_motors_left_running(monkeypatch: pytest.MonkeyPatch) -> 
     cell = run_cell("sensor board killed", "cal_lift", "can")
     assert cell.verdict == "UNSAFE"
     assert "motors left running" in cell.reason and "a lift moved" in cell.reason
+
+
+def test_the_judge_sees_a_hung_firmware_board_left_driving(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The C motor board hung as segment 2 lifts with no independent watchdog
+    to reset it: its motors run on with no host, and the cell is UNSAFE --
+    so the firmware's cells can fail too."""
+    if find_cc() is None:
+        pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
+    monkeypatch.setattr(FirmwareBoardServer, "after_step", lambda self: None)
+    cell = run_cell("motor board hung", "ascent_lift_second", "firmware")
+    assert cell.verdict == "UNSAFE"
+    assert "motors running 2 s on" in cell.reason
