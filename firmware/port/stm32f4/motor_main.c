@@ -19,11 +19,6 @@
 #define SERIAL 1
 #define HOST_BAUD 1000000u /* the reference line: docs/protocol.md, section 5 */
 
-static size_t motor_frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE])
-{
-    return sb_motor_frame(board, f, out);
-}
-
 int main(void)
 {
     static sb_motor_board board;
@@ -59,8 +54,8 @@ int main(void)
 #else
         plant_advance(&world, clock_ms());
 #endif
-        sb_motor_poll(&board);
-        serve_bytes(&server, motor_frame, &board);
+        sb_board_poll(&board.base);
+        serve_bytes(&server, &board.base);
         uart_sleep(host);
     }
 }

@@ -11,11 +11,6 @@
 
 #define HOST_BAUD 1000000u /* the reference line: docs/protocol.md, section 5 */
 
-static size_t sensor_frame(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE])
-{
-    return sb_sensor_frame(board, f, out);
-}
-
 int main(void)
 {
     static sb_sensor_board board;
@@ -35,8 +30,8 @@ int main(void)
     uint32_t last_ms = clock_ms();
     for (;;) {
         plant_refresh(&world, &board.base, host, &last_ms);
-        sb_sensor_poll(&board);
-        serve_bytes(&server, sensor_frame, &board);
+        sb_board_poll(&board.base);
+        serve_bytes(&server, &board.base);
         uart_sleep(host);
     }
 }

@@ -39,13 +39,13 @@ void serve_init(sb_server *s, sb_uart *uart)
     sb_reader_init(&s->reader);
 }
 
-void serve_bytes(sb_server *s, sb_frame_fn on_frame, void *board)
+void serve_bytes(sb_server *s, sb_board *board)
 {
     int c;
     while ((c = uart_getc(s->uart)) >= 0) {
         sb_frame frame;
         if (!sb_reader_push(&s->reader, (uint8_t)c, &frame)) continue;
-        size_t len = on_frame(board, &frame, s->reply);
+        size_t len = sb_board_frame(board, &frame, s->reply);
         if (len > 0) uart_write(s->uart, s->reply, len);
     }
 }

@@ -5,13 +5,10 @@
 
 #include <stdint.h>
 
+#include "sb_board.h"
 #include "sb_frame.h"
 #include "sb_reader.h"
 #include "uart.h"
-
-/* A board's frame handler (sb_motor_frame's shape): the reply's length in
- * out, 0 for none. */
-typedef size_t (*sb_frame_fn)(void *board, const sb_frame *f, uint8_t out[SB_MAX_WIRE]);
 
 typedef struct {
     sb_uart *uart;
@@ -21,8 +18,9 @@ typedef struct {
 
 void serve_init(sb_server *s, sb_uart *uart);
 
-/* Every byte waiting, each frame handed to on_frame and its reply sent. */
-void serve_bytes(sb_server *s, sb_frame_fn on_frame, void *board);
+/* Every byte waiting, each frame handed to board (sb_board_frame) and its
+ * reply sent. */
+void serve_bytes(sb_server *s, sb_board *board);
 
 /* The boot id (Owner.boot, never 0): the word a loader wrote at the start of
  * RAM (sb_boot_seed: QEMU's `-device loader,addr=...,data=...`), else the
