@@ -7,10 +7,11 @@ opens a pseudo-terminal, prints its path (the line ``serial://PATH``, plus
 ``?lockstep=1`` when in lockstep) and serves both boards on it, backed by the
 same physics world as ``sim://``, until interrupted.
 
-    stairbot fake-boards --serial --firmware native [...]
+    stairbot fake-boards --serial --firmware native|qemu [...]
 
-serves the boards' C firmware (firmware/, built with make on first use)
-instead of the Python fakes, on the same pty and the same world
+serves the boards' C firmware (firmware/, built with make on first use:
+Linux programs, or STM32F405 images in qemu-system-arm) instead of the
+Python fakes, on the same pty and the same world
 (``stairbot.fakes.firmware_boards``).
 
     stairbot fake-boards --can udp_multicast/GROUP[?port=P&lan=1] [...]
@@ -37,7 +38,7 @@ from stairbot.args import bounded
 from stairbot.control.robot_config import config_for
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import launch_serials, make_boards, serials_words
-from stairbot.fakes.firmware_boards import FirmwareBoardServer, build_native
+from stairbot.fakes.firmware_boards import KINDS, FirmwareBoardServer, build_firmware
 from stairbot.fakes.registry import registered
 from stairbot.fakes.serial_boards import PtyPair, SerialBoardServer, WireFaults
 from stairbot.fakes.sim import SimClock, SimRobot, motor_limits
@@ -56,9 +57,10 @@ def build_parser() -> argparse.ArgumentParser:
     wire.add_argument("--can", metavar="INTERFACE/CHANNEL",
                       help="serve on a CAN bus, e.g. udp_multicast/239.74.163.2: on loopback "
                       "only (127.0.0.1, TTL 0) unless the URL adds ?lan=1")
-    p.add_argument("--firmware", choices=("native",), default=None,
+    p.add_argument("--firmware", choices=KINDS, default=None,
                    help="serve the boards' C firmware (firmware/) on the pty instead of the "
-                        "Python fakes: native = Linux programs built with make (serial only)")
+                        "Python fakes, built with make: native = Linux programs; qemu = "
+                        "STM32F405 images in qemu-system-arm (serial only)")
     p.add_argument("--scenario", help="scenario TOML file or shipped scenario name")
     p.add_argument("--config", help="robot config TOML file or shipped robot's name "
                    "(default: the scenario's robot, else the reference robot)")
@@ -137,9 +139,9 @@ def main(argv: list[str]) -> int:
     server: SerialBoardServer
     if args.firmware is not None:
         try:
-            server = FirmwareBoardServer(pty.master, world, build_native(),
+            server = FirmwareBoardServer(pty.master, world, build_firmware(args.firmware),
                                          motor_limits(config), serials, faults_from(args),
-                                         time_scale=args.time_scale)
+                                         time_scale=args.time_scale, kind=args.firmware)
         except BaseException:
             pty.close()
             raise

@@ -37,8 +37,14 @@ from stairbot.fakes.serial_boards import SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
 
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
+KINDS = ("native", "qemu")
 PROGRAMS = {int(m.Board.MOTOR): "sb_motor_native", int(m.Board.SENSOR): "sb_sensor_native"}
-HELLO_S = 5.0  # how long a board's program may take to greet its plant
+"""The native programs, by board address (in the build directory)."""
+QEMU_PROGRAMS = {int(m.Board.MOTOR): "qemu/sb_motor_qemu_link",
+                 int(m.Board.SENSOR): "qemu/sb_sensor_qemu_link"}
+"""The qemu-stm32f4 images' runners (firmware/port/stm32f4/sb_qemu.sh), by board address."""
+QEMU_TOOLS = ("arm-none-eabi-gcc", "qemu-system-arm")
+HELLO_S = 15.0  # how long a board's program may take to greet its plant (QEMU boots first)
 REPLY_WAIT_S = 0.1  # how long the line waits on a board's reply before the next frame
 HUNG_RESET_S = 0.25  # a hung board's independent watchdog: reset, outputs off
 
@@ -64,15 +70,33 @@ def build_native(build_dir: Path | None = None) -> Path:
     """``make -C firmware`` the native programs (into ``build_dir``, default
     firmware/build); the directory holding them.  FirmwareError names what
     is missing when they cannot be built."""
+    return build_firmware("native", build_dir)
+
+
+def programs(kind: str) -> dict[int, str]:
+    """Each board's program of firmware ``kind`` (native, qemu), by board
+    address, relative to the build directory."""
+    return QEMU_PROGRAMS if kind == "qemu" else PROGRAMS
+
+
+def build_firmware(kind: str, build_dir: Path | None = None) -> Path:
+    """Build both boards' programs of ``kind`` with make (native: the Linux
+    programs; qemu: the qemu-stm32f4 images and their runners) into
+    ``build_dir`` (default firmware/build); the directory.  FirmwareError
+    names what is missing when they cannot be built or run."""
     out = build_dir or FIRMWARE / "build"
     if not (FIRMWARE / "Makefile").is_file():
         raise FirmwareError(f"no firmware sources at {FIRMWARE}: --firmware needs a source "
                             "checkout of stairbot (its firmware/ directory)")
     cc = find_cc()
     if cc is None:
-        raise FirmwareError("--firmware native needs a C compiler (cc, gcc or clang on PATH, "
+        raise FirmwareError("--firmware needs a C compiler (cc, gcc or clang on PATH, "
                             "or $CC; Debian: apt-get install gcc make)")
-    targets = [str(out / name) for name in PROGRAMS.values()]
+    missing = [tool for tool in QEMU_TOOLS if kind == "qemu" and shutil.which(tool) is None]
+    if missing:
+        raise FirmwareError(f"--firmware qemu needs {' and '.join(missing)} (Debian: apt-get "
+                            "install gcc-arm-none-eabi picolibc-arm-none-eabi qemu-system-arm)")
+    targets = ["qemu"] if kind == "qemu" else [str(out / p) for p in PROGRAMS.values()]
     try:
         out.mkdir(parents=True, exist_ok=True)
         with open(out / ".lock", "w") as lock:  # one make at a time in a build directory
@@ -82,13 +106,13 @@ def build_native(build_dir: Path | None = None) -> Path:
                                   capture_output=True, text=True, check=False)
     except OSError as exc:
         if not isinstance(exc, FileNotFoundError):
-            raise FirmwareError(f"cannot build the native firmware in {out}: {exc}") from exc
-        raise FirmwareError("--firmware native needs make and a C compiler "
+            raise FirmwareError(f"cannot build the {kind} firmware in {out}: {exc}") from exc
+        raise FirmwareError("--firmware needs make and a C compiler "
                             "(Debian: apt-get install make gcc)") from exc
     if made.returncode != 0:
         last = (made.stderr.strip().splitlines() or ["(no output)"])[-1]
-        raise FirmwareError(f"building the native firmware failed: {last} "
-                            f"(make -C {FIRMWARE} shows the whole error; it needs a C compiler)")
+        raise FirmwareError(f"building the {kind} firmware failed: {last} "
+                            f"(make -C {FIRMWARE} shows the whole error)")
     return out
 
 
@@ -178,13 +202,14 @@ class FirmwareBoard:
 
 class FirmwareBoardServer(SerialBoardServer):
     """Serve the C boards on ``fd`` (a pty's master), each board's program
-    started from ``build_dir`` on ``world``.  ``serials``: the motor board's
-    and the sensor board's serial numbers, which their plants give them."""
+    of firmware ``kind`` (native, qemu) started from ``build_dir`` on
+    ``world``.  ``serials``: the motor board's and the sensor board's serial
+    numbers, which their plants give them."""
 
     def __init__(self, fd: int, world: BoardWorld, build_dir: Path,
                  limits_tps: dict[MotorId, float], serials: tuple[int, int],
                  faults: WireFaults | None = None, time_scale: float = 1.0,
-                 step_s: float = 0.005) -> None:
+                 step_s: float = 0.005, kind: str = "native") -> None:
         super().__init__(fd, world, {}, faults, time_scale, step_s)
         self.firmware: dict[int, FirmwareBoard] = {}
         self.serials = dict(zip(PROGRAMS, serials, strict=True))
@@ -193,7 +218,7 @@ class FirmwareBoardServer(SerialBoardServer):
         self._flight: tuple[int, int, float] | None = None  # (address, replies due, deadline)
         self.killed: set[int] = set()
         try:
-            for address, name in PROGRAMS.items():
+            for address, name in programs(kind).items():
                 plant = PlantLink(world, address, self.serials[address], limits_tps,
                                   after_step=self.after_step)
                 self.firmware[address] = FirmwareBoard(address, build_dir / name, plant)
@@ -376,4 +401,5 @@ def _address(wire: bytes) -> int | None:
     return None if frame.from_board else frame.board
 
 
-__all__ = ["FirmwareBoardServer", "FirmwareError", "build_native", "find_cc"]
+__all__ = ["KINDS", "FirmwareBoardServer", "FirmwareError", "build_firmware", "build_native",
+           "find_cc", "programs"]

@@ -1,10 +1,12 @@
 """The whole ascent and descent on the boards' C firmware: `stairbot
-fake-boards --serial --firmware native --lockstep` in another process (the
-motor and sensor boards' Linux programs on the simulated robot's plant
-link), the runner in this one on serial://<pty>, ending as sim:// does."""
+fake-boards --serial --firmware native|qemu --lockstep` in another process
+(the motor and sensor boards' Linux programs, or their STM32F405 images in
+qemu-system-arm, on the simulated robot's plant link), the runner in this
+one on serial://<pty>, ending as sim:// does."""
 
 from __future__ import annotations
 
+import shutil
 import signal
 from pathlib import Path
 
@@ -12,7 +14,7 @@ import pytest
 from lockstep_boards import lockstep_boards
 
 from stairbot.control.robot_config import load_config
-from stairbot.fakes.firmware_boards import find_cc
+from stairbot.fakes.firmware_boards import KINDS, QEMU_TOOLS, find_cc
 from stairbot.inputs.scenario import load_scenario
 from stairbot.run.robots import RobotOptions, open_robot
 from stairbot.run.runner import RunResult, run
@@ -20,16 +22,22 @@ from stairbot.run.runner import RunResult, run
 SAME = ("outcome", "ascent_end", "steps_climbed", "steps_descended", "pauses", "fell")
 
 
-@pytest.fixture(autouse=True)
-def _compiler() -> None:
+def needs(kind: str) -> None:
+    """Skip, saying why, without what building and running ``kind`` takes."""
     if find_cc() is None:
         pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
+    missing = [t for t in QEMU_TOOLS if kind == "qemu" and shutil.which(t) is None]
+    if missing:
+        pytest.skip(f"no {' or '.join(missing)}: scripts/test installs gcc-arm-none-eabi, "
+                    "picolibc-arm-none-eabi and qemu-system-arm")
 
 
-def test_the_default_run_on_the_native_firmware_ends_as_sim_does(tmp_path: Path) -> None:
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_default_run_on_the_firmware_ends_as_sim_does(kind: str, tmp_path: Path) -> None:
+    needs(kind)
     config, scenario = load_config(), load_scenario()
     sim = run(open_robot("sim://", config, RobotOptions(world=scenario)), config)
-    with lockstep_boards(tmp_path, stop=signal.SIGTERM, firmware="native") as boards:
+    with lockstep_boards(tmp_path, stop=signal.SIGTERM, firmware=kind) as boards:
         session = open_robot(boards.url + "&timeout=2", config)
         try:
             wire: RunResult = run(session, config)
@@ -38,7 +46,8 @@ def test_the_default_run_on_the_native_firmware_ends_as_sim_does(tmp_path: Path)
         finally:
             session.close()
     assert boards.returncode == 0, boards.stderr
-    assert "sb_motor_native:" in boards.stderr and "sb_sensor_native:" in boards.stderr
+    if kind == "native":  # the programs' counts (the QEMU images print nothing)
+        assert "sb_motor_native:" in boards.stderr and "sb_sensor_native:" in boards.stderr
     assert sim.outcome == "completed" and sim.steps_climbed == 5
     assert {k: getattr(wire, k) for k in SAME} == {k: getattr(sim, k) for k in SAME}
     assert wire.sim_time_s == pytest.approx(sim.sim_time_s, abs=1.0)
