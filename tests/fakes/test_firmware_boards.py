@@ -22,7 +22,8 @@ def test_qemu_without_its_tools_names_them_and_the_packages(
     with pytest.raises(FirmwareError) as refused:
         build_firmware("qemu")
     text = str(refused.value)
-    assert "needs qemu-system-arm" in text and "apt-get install" in text
+    assert "--firmware qemu needs" in text and "qemu-system-arm" in text
+    assert "apt-get install" in text
 
 
 def test_no_compiler_is_one_line_naming_what_to_install(monkeypatch: pytest.MonkeyPatch,
