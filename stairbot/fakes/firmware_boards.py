@@ -264,8 +264,9 @@ class FirmwareBoardServer(SerialBoardServer):
         board is done before the sensor board reads the world for the next
         ReadAll."""
         now = time.monotonic()
-        if self._flight is not None and now < self._flight[2]:
-            return
+        if self._flight is not None and now < self._flight[2] \
+                and self.firmware[self._flight[0]].alive:
+            return  # (a board killed or hung meanwhile will not answer: no wait for it)
         self._flight = None
         while self._queue:
             address, wire, copies = self._queue.popleft()
