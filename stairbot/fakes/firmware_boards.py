@@ -170,7 +170,10 @@ class FirmwareBoard:
             return False
         answer = self.plant.feed(data)
         if answer:
-            self.link.sendall(answer)
+            try:
+                self.link.sendall(answer)
+            except OSError:  # the program died with a question in flight
+                return False
         return True
 
     @property
