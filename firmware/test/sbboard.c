@@ -21,25 +21,17 @@
 #include "plant.h"
 #include "sb_motor.h"
 #include "sb_reader.h"
+#include "sbline.h"
 
 #define LINE_MAX_CHARS 4096
 
 static char line[LINE_MAX_CHARS];
-
-static int hexval(char c)
-{
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-}
 
 int main(int argc, char **argv)
 {
     static plant world;
     static sb_motor_board board;
     static sb_reader reader;
-    static uint8_t reply[SB_MAX_WIRE];
     plant_init(&world);
     if (argc > 2) {
         int64_t lift_umt = (int64_t)strtol(argv[2], NULL, 10) * 1000;
@@ -66,17 +58,7 @@ int main(int argc, char **argv)
             world.estop_pressed = line[2] == '1';
             puts("ok");
         } else if (line[0] == 'w' && line[1] == ' ') {
-            bool any = false;
-            for (const char *s = line + 2; s[0] && s[1]; s += 2) {
-                int hi = hexval(s[0]), lo = hexval(s[1]);
-                if (hi < 0 || lo < 0) break;
-                sb_frame frame;
-                if (!sb_reader_push(&reader, (uint8_t)(hi << 4 | lo), &frame)) continue;
-                size_t n = sb_motor_frame(&board, &frame, reply);
-                for (size_t i = 0; i < n; i++) printf("%02x", reply[i]);
-                any = any || n > 0;
-            }
-            puts(any ? "" : "-");
+            sb_line_feed(line + 2, &reader, &board.base);
         } else if (line[0] == 's') {
             for (int ch = 0; ch < SB_MOTORS; ch++) printf("%lld ", (long long)world.position_umt[ch]);
             for (int ch = 0; ch < SB_MOTORS; ch++) printf("%d ", world.command[ch]);

@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "sb_reader.h"
+#include "sbline.h"
 #include "sb_sensor.h"
 
 #define LINE_MAX_CHARS 4096
@@ -62,14 +63,6 @@ static bool imu_read(void *ctx, uint8_t axis, sb_imu_sample *out)
     if (!p->imu_fitted) return false;
     *out = p->imu[axis];
     return true;
-}
-
-static int hexval(char c)
-{
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
 }
 
 static bool has_arg(int argc, char **argv, const char *name)
@@ -115,7 +108,6 @@ int main(int argc, char **argv)
     static script_plant world;
     static sb_sensor_board board;
     static sb_reader reader;
-    static uint8_t reply[SB_MAX_WIRE];
     sb_hal hal = {0};
     hal.ctx = &world;
     hal.now_ms = now_ms;
@@ -136,17 +128,7 @@ int main(int argc, char **argv)
             bool is_range = line[0] == 'r';
             puts(set_reading(&world, line + (is_range ? 6 : 4), is_range) ? "ok" : "err reading");
         } else if (line[0] == 'w' && line[1] == ' ') {
-            bool any = false;
-            for (const char *s = line + 2; s[0] && s[1]; s += 2) {
-                int hi = hexval(s[0]), lo = hexval(s[1]);
-                if (hi < 0 || lo < 0) break;
-                sb_frame frame;
-                if (!sb_reader_push(&reader, (uint8_t)(hi << 4 | lo), &frame)) continue;
-                size_t n = sb_sensor_frame(&board, &frame, reply);
-                for (size_t i = 0; i < n; i++) printf("%02x", reply[i]);
-                any = any || n > 0;
-            }
-            puts(any ? "" : "-");
+            sb_line_feed(line + 2, &reader, &board.base);
         } else {
             puts("err command");
         }

@@ -87,3 +87,17 @@ def until(what: str, check: Callable[[], bool]) -> None:
     while not check():
         assert time.monotonic() < end, f"never came: {what}"
         time.sleep(0.02)
+
+
+def reached_by_any_board(msg: m.Message | m.RawMessage) -> set[str]:
+    """What a reply every board gives shows a step-by-step script reached:
+    each Ack result, each Claim result, the latches in a Status."""
+    if isinstance(msg, m.Ack):
+        return {f"ack {m.AckResult(msg.result).name}"}
+    if isinstance(msg, m.Owner):
+        return {f"claim {m.ClaimResult(msg.result).name}"}
+    if isinstance(msg, m.Status):
+        return ({"estop"} if msg.flags & m.StatusFlag.ESTOP else set()) | (
+            {"watchdog"} if msg.flags & m.StatusFlag.WATCHDOG else set()) | (
+            {"status FAULT"} if msg.flags & m.StatusFlag.FAULT else set())
+    return set()

@@ -26,7 +26,7 @@ def build(exe: Path, dirs: tuple[str, ...], files: tuple[str, ...], flags: list[
         pytest.skip("no C compiler on PATH (cc, gcc or clang, or $CC): scripts/test installs gcc")
     sources = [str(p) for d in dirs for p in sorted((FIRMWARE / d).glob("*.c"))]
     sources += [str(FIRMWARE / f) for f in files]
-    includes = [f"-I{FIRMWARE / d}" for d in ("core", "board", "plant", "native")]
+    includes = [f"-I{FIRMWARE / d}" for d in ("core", "board", "plant", "native", "test")]
     built = subprocess.run([cc, *WARNINGS, *flags, *includes, *sources, "-o", str(exe)],
                            capture_output=True, text=True, check=False)
     if built.returncode != 0 and "sanitize" in built.stderr and SANITIZE[0] in flags:

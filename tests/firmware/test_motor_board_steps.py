@@ -15,6 +15,7 @@ from collections.abc import Callable, Mapping
 from fractions import Fraction
 from pathlib import Path
 
+from board_host import reached_by_any_board
 from cobs import cobs
 from firmware_build import LIFT_LIMIT, SANITIZE, WHEEL_LIMIT, build
 
@@ -135,8 +136,8 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
     reach their stop points, a lift at its limit, a reply frame cut at 247
     message bytes); after every frame the two plants stand in the same
     place with their motors commanded alike."""
-    exe = build(tmp_path / "sbboard", ("core", "board"), ("native/plant.c", "test/sbboard.c"),
-                ["-O1", "-g", *SANITIZE])
+    exe = build(tmp_path / "sbboard", ("core", "board"),
+                ("native/plant.c", "test/sbline.c", "test/sbboard.c"), ["-O1", "-g", *SANITIZE])
     boot, lift_mt = 0xB007, 103_000  # the lifts start 2 turns from the ends of their stroke
     robot = PlantRobot(lift_mt)
     world = BoardWorld(robot, PlantClock(robot))  # type: ignore[arg-type]
@@ -230,19 +231,11 @@ def test_the_c_board_answers_as_the_python_fake_board_step_by_step(
 
 def reached(msg: m.Message | RawMessage) -> set[str]:
     """What a reply shows the script reached."""
-    if isinstance(msg, m.Ack):
-        return {f"ack {m.AckResult(msg.result).name}"}
-    if isinstance(msg, m.Owner):
-        return {f"claim {m.ClaimResult(msg.result).name}"}
-    if isinstance(msg, m.Status):
-        return ({"estop"} if msg.flags & m.StatusFlag.ESTOP else set()) | (
-            {"watchdog"} if msg.flags & m.StatusFlag.WATCHDOG else set()) | (
-            {"status FAULT"} if msg.flags & m.StatusFlag.FAULT else set())
     if isinstance(msg, m.MotorTelemetry):
         return {f"mode {m.MotorMode(msg.mode).name}"} | (
             {f"fault {m.MotorFault(msg.fault).name}"} if msg.fault not in (
                 m.MotorFault.NONE, m.MotorFault.ESTOP, m.MotorFault.WATCHDOG) else set())
-    return set()
+    return reached_by_any_board(msg)
 
 
 def first_difference(c: list[Frame], py: list[Frame]) -> str:

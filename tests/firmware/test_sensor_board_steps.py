@@ -18,6 +18,7 @@ from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from board_host import reached_by_any_board
 from firmware_build import FIRMWARE, SANITIZE, build
 
 from stairbot.drivers import messages as m
@@ -304,13 +305,6 @@ def alike(c: m.Message | RawMessage, py: m.Message | RawMessage, built: Readings
 
 def reached(msg: m.Message | RawMessage, built: Readings) -> set[str]:
     """What a reply shows the script reached."""
-    if isinstance(msg, m.Ack):
-        return {f"ack {m.AckResult(msg.result).name}"}
-    if isinstance(msg, m.Owner):
-        return {f"claim {m.ClaimResult(msg.result).name}"}
-    if isinstance(msg, m.Status):
-        return ({"estop"} if msg.flags & m.StatusFlag.ESTOP else set()) | (
-            {"watchdog"} if msg.flags & m.StatusFlag.WATCHDOG else set())
     if isinstance(msg, m.SensorTelemetry | m.ImuTelemetry):
         kind = "sensor" if isinstance(msg, m.SensorTelemetry) else "imu"
         code = (m.SensorCode if kind == "sensor" else m.ImuCode)(msg.status).name
@@ -325,7 +319,7 @@ def reached(msg: m.Message | RawMessage, built: Readings) -> set[str]:
         if isinstance(msg, m.ImuTelemetry) and abs(msg.rate_ddps) == m.INT16_MAX:
             out.add("imu rate at its limit")
         return out
-    return set()
+    return reached_by_any_board(msg)
 
 
 SEEDS = [(4, 45, 4000, []), (6, 46, 4000, ["nous"]), (6, 47, 400, ["norange", "noimu"])]
@@ -335,7 +329,7 @@ SEEDS = [(4, 45, 4000, []), (6, 46, 4000, ["nous"]), (6, 47, 400, ["norange", "n
 def sbsensor(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """sbsensor built with AddressSanitizer and UBSan, once for the runs."""
     return build(tmp_path_factory.mktemp("sbsensor") / "sbsensor", ("core", "board"),
-                 ("test/sbsensor.c",), ["-O1", "-g", *SANITIZE])
+                 ("test/sbline.c", "test/sbsensor.c"), ["-O1", "-g", *SANITIZE])
 
 
 @pytest.mark.parametrize(("channels", "seed", "count", "flags"), SEEDS)
@@ -388,7 +382,7 @@ def test_a_mutant_of_the_c_sensor_board_fails_the_comparison(tmp_path: Path, mut
     mutated = tmp_path / "sb_sensor.c"
     mutated.write_text(source.replace(old, new))
     exe = build(tmp_path / "sbsensor", ("core",), ("board/sb_board.c", str(mutated),
-                                                    "test/sbsensor.c"), ["-O1"])
+                                                    "test/sbline.c", "test/sbsensor.c"), ["-O1"])
     channels, seed, _, flags = SEEDS[0]
     script = make_script(seed, channels, 1500)
     with pytest.raises(RepliesDiffer):
