@@ -232,7 +232,8 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path,
             with contextlib.suppress(HardwareError):
                 session.close()
         if not cell.injected:
-            cell.reason = f"the run never entered {phase}"
+            ended = f" (it ended {result.outcome}: {result.error})" if result is not None else ""
+            cell.reason = f"the run never entered {phase}{ended}"
             return cell
         if result is None:
             return _resumed(cell, boards, config, journal)
