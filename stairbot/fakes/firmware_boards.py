@@ -25,14 +25,13 @@ import socket
 import subprocess
 import time
 from collections import deque
-from dataclasses import dataclass
 from pathlib import Path
 
 from stairbot.drivers import messages as m
 from stairbot.drivers.serial_wire import CodecError, decode_frame
 from stairbot.errors import InputError
 from stairbot.fakes.board_world import BoardWorld
-from stairbot.fakes.plant_link import PlantLink
+from stairbot.fakes.plant_link import Delimited, PlantLink
 from stairbot.fakes.serial_boards import SerialBoardServer, WireFaults
 from stairbot.hardware import MotorId
 
@@ -116,23 +115,6 @@ def build_firmware(kind: str, build_dir: Path | None = None) -> Path:
     return out
 
 
-@dataclass
-class _Line:
-    """Bytes of one stream cut into delimited frames."""
-
-    pending: bytearray
-
-    def frames(self, data: bytes) -> list[bytes]:
-        self.pending += data
-        out = []
-        while (end := self.pending.find(0)) >= 0:
-            frame = bytes(self.pending[:end + 1])
-            del self.pending[:end + 1]
-            if len(frame) > 1:
-                out.append(frame)
-        return out
-
-
 class FirmwareBoard:
     """One board's program, its two sockets, and its plant link."""
 
@@ -142,7 +124,7 @@ class FirmwareBoard:
         self.plant = plant
         self.host, host_child = socket.socketpair()
         self.link, link_child = socket.socketpair()
-        self.replies = _Line(bytearray())
+        self.replies = Delimited()
         self.hung_at: float | None = None  # world time it hung (SIGSTOP), None while it runs
         try:
             self.proc = subprocess.Popen(
@@ -216,7 +198,7 @@ class FirmwareBoardServer(SerialBoardServer):
         super().__init__(fd, world, {}, faults, time_scale, step_s)
         self.firmware: dict[int, FirmwareBoard] = {}
         self.serials = dict(zip(PROGRAMS, serials, strict=True))
-        self._inbox = _Line(bytearray())
+        self._inbox = Delimited()
         self._queue: deque[tuple[int | None, bytes, int]] = deque()  # (address, wire, copies)
         self._flight: tuple[int, int, float] | None = None  # (address, replies due, deadline)
         self.killed: set[int] = set()

@@ -45,6 +45,25 @@ _TRUTH = struct.Struct("<BBhi")
 _NEVER_US = 70_000_000  # a sample this old has an age beyond the wire's 65,535 ms
 
 
+class Delimited:
+    """A byte stream cut into 0x00-delimited frames, each kept with its
+    delimiter; empty frames (a lone delimiter) are skipped."""
+
+    def __init__(self) -> None:
+        self.pending = bytearray()
+
+    def frames(self, data: bytes) -> list[bytes]:
+        """The frames ``data`` completes (a partial one waits for the rest)."""
+        self.pending += data
+        out = []
+        while (end := self.pending.find(0)) >= 0:
+            frame = bytes(self.pending[:end + 1])
+            del self.pending[:end + 1]
+            if len(frame) > 1:
+                out.append(frame)
+        return out
+
+
 class PlantLinkError(ValueError):
     """A plant-link frame that cannot be read."""
 
@@ -96,19 +115,15 @@ class PlantLink:
         self.limits_tps = limits_tps
         self.stats = LinkStats()
         self.greeted = False
-        self._buffer = bytearray()
+        self._line = Delimited()
         self._state: tuple[float, bytes] | None = None  # (world time, the state's fields)
 
     def feed(self, data: bytes) -> bytes:
         """The answers to the complete frames in ``data`` (and those before it)."""
-        self._buffer += data
         out = bytearray()
-        while (end := self._buffer.find(0)) >= 0:
-            stuffed, self._buffer = bytes(self._buffer[:end]), self._buffer[end + 1:]
-            if not stuffed:
-                continue
+        for wire in self._line.frames(data):
             try:
-                kind, seq, fields = decode(stuffed)
+                kind, seq, fields = decode(wire[:-1])
                 out += self._answer(kind, seq, fields)
             except (PlantLinkError, struct.error):
                 self.stats.bad += 1
@@ -149,11 +164,14 @@ class PlantLink:
         raise PlantLinkError(f"unknown kind {kind:#04x}")
 
     def _info(self) -> bytes:
-        channels = (len(m.MOTOR_CHANNELS) if self.board == 1 else
-                    max(m.SIDE_SENSOR_CHANNELS) + 1 if self.world.side_pair
-                    else m.BASE_SENSOR_CHANNELS)
+        channels = len(m.MOTOR_CHANNELS) if self.board == 1 else self._sensor_channels()
         limits = [u.speed_to_wire(self.limits_tps[mid]) for mid in m.MOTOR_CHANNELS]
         return _INFO.pack(self.board, self.serial, int(self.world.lockstep), channels, *limits)
+
+    def _sensor_channels(self) -> int:
+        """The sensor board's range channels: 4, or 6 with the side pair."""
+        return max(m.SIDE_SENSOR_CHANNELS) + 1 if self.world.side_pair \
+            else m.BASE_SENSOR_CHANNELS
 
     def _fields(self) -> bytes:
         """The state's fields at the world's present time (kept while it stands)."""
@@ -177,8 +195,7 @@ class PlantLink:
         return bytes(out)
 
     def _sensors(self, snap: Snapshot | None, now_us: int) -> bytes:
-        channels = max(m.SIDE_SENSOR_CHANNELS) + 1 if self.world.side_pair \
-            else m.BASE_SENSOR_CHANNELS
+        channels = self._sensor_channels()
         out = bytearray((channels,))
         snap_us = round(snap.time_s * 1e6) if snap else now_us
         for ch in range(channels):
@@ -212,4 +229,4 @@ def _measured_us(snap_us: int, age_s: float) -> int:
     return (snap_us - round(age_s * 1e6)) & 0xFFFFFFFF
 
 
-__all__ = ["LinkStats", "PlantLink", "PlantLinkError", "decode", "encode"]
+__all__ = ["Delimited", "LinkStats", "PlantLink", "PlantLinkError", "decode", "encode"]
