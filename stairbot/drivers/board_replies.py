@@ -6,11 +6,19 @@ world behind fake boards ends the run), then turns the telemetry into
 stairbot's types (``telemetry.py``): every motor, the base sensors and the
 side pair on a robot whose config has one, and the IMU or None.  It keeps
 the IMU as last read and counts the replies whose IMU broke the protocol.
+
+A sensor's reading is repeated between its measurements, and the board
+numbers each measurement (SensorTelemetry.sample).  The reader keeps when
+each sensor's current sample was taken, so a repeated sample keeps its
+first reading's measurement time: the reply's transit, which varies from
+read to read on a real line, cannot make an old measurement look new (and
+count again where perception counts measurements in a row).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 from stairbot.drivers import messages as m
@@ -35,6 +43,8 @@ class ReplyReader:
         self._check_status = check_status
         self.imu_read = telemetry.ImuRead(None, "unknown")  # the IMU as last read
         self.imu_rejected = 0  # replies whose IMU broke the protocol
+        # per sensor: its current sample's number and when it was taken (robot clock)
+        self._taken: dict[SensorId, tuple[int, float]] = {}
 
     def status(self, board: m.Board, msgs: Sequence[Any]) -> m.Status:
         """The Status a ReadAll reply starts with, checked (``check_status``).
@@ -52,17 +62,36 @@ class ReplyReader:
         return telemetry.channels(m.Board.MOTOR, msgs[1:], m.MotorTelemetry,
                                   m.MOTOR_CHANNELS, u.state_from_wire)
 
-    def sensors(self, msgs: Sequence[Any], transit_s: float) -> dict[SensorId, SensorReading]:
-        """The sensor board's ReadAll reply as readings, after its Status: the
-        base four, and the side pair on a robot that has one
-        (``telemetry.sensors_of``).  HardwareError when the reply is not
-        that; BoardMismatchError (naming the URL) when the side pair lacks."""
+    def sensors(self, msgs: Sequence[Any], transit_s: float,
+                now: float | None = None) -> dict[SensorId, SensorReading]:
+        """The sensor board's ReadAll reply as readings at ``now`` (robot
+        clock), after its Status: the base four, and the side pair on a robot
+        that has one (``telemetry.sensors_of``).  A sample read before keeps
+        the measurement time it was first read with (the module docstring);
+        ``now`` None: each reading's age as the board and ``transit_s`` say.
+        HardwareError when the reply is not that; BoardMismatchError (naming
+        the URL) when the side pair lacks."""
         self.status(m.Board.SENSOR, msgs)
         try:
-            return telemetry.sensors_of(msgs[1:], lambda t: u.reading_from_wire(t, transit_s),
-                                        self.side_pair)
+            got = telemetry.sensors_of(msgs[1:], lambda t: (t.sample, u.reading_from_wire(
+                t, transit_s)), self.side_pair)
         except BoardMismatchError as exc:
             raise BoardMismatchError(f"{self.url}: {exc}") from None
+        if now is None:
+            return {sid: reading for sid, (_, reading) in got.items()}
+        return {sid: self._aged(sid, sample, reading, now)
+                for sid, (sample, reading) in got.items()}
+
+    def _aged(self, sid: SensorId, sample: int, reading: SensorReading,
+              now: float) -> SensorReading:
+        """``reading`` (sample number ``sample``) with the age of its sample's
+        earliest measurement time yet: a repeat is never younger than before."""
+        taken = now - reading.age_s
+        kept = self._taken.get(sid)
+        if kept is not None and kept[0] == sample and kept[1] <= taken:
+            return replace(reading, age_s=now - kept[1])
+        self._taken[sid] = (sample, taken)
+        return reading
 
     def imu(self, msgs: Sequence[Any], transit_s: float, now: float,
             sink: EventSink) -> Imu | None:

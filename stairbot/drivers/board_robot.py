@@ -174,7 +174,7 @@ class BoardRobot:
         now = self.clock.now()
         transit = max(0.0, now - sent)
         motors = self.replies.motors(fm.messages)
-        sensors = self.replies.sensors(fs.messages, transit)
+        sensors = self.replies.sensors(fs.messages, transit, now)
         imu = self.replies.imu(fs.messages, transit, now, self.sink)
         health = self.health()
         self.report.maybe_event(health, now, self.sink)

@@ -23,6 +23,7 @@ from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading
 T = TypeVar("T", m.MotorTelemetry, m.SensorTelemetry)
 K = TypeVar("K", MotorId, SensorId)
 V = TypeVar("V", MotorState, SensorReading)
+R = TypeVar("R")  # what sensors_of makes of each SensorTelemetry
 
 BASE_NAMES = ", ".join(s.value for s in m.SENSOR_CHANNELS[:m.BASE_SENSOR_CHANNELS])
 """SFR, SFL, SBR, SBL: channels 0-3, for messages."""
@@ -62,8 +63,8 @@ def channels(board: m.Board, msgs: Sequence[Any], kind: type[T], ids: Sequence[K
     return out
 
 
-def sensors_of(msgs: Sequence[Any], convert: Callable[[m.SensorTelemetry], SensorReading],
-               side_pair: str | None = None) -> dict[SensorId, SensorReading]:
+def sensors_of(msgs: Sequence[Any], convert: Callable[[m.SensorTelemetry], R],
+               side_pair: str | None = None) -> dict[SensorId, R]:
     """``{sensor: convert(telemetry)}`` for the SensorTelemetry in the sensor
     board's ReadAll reply (after its Status): channels 0-3 always, the side
     pair (4 SSR, 5 SSL) when ``side_pair`` names where the robot config gives
