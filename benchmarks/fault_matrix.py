@@ -3,14 +3,19 @@ table of docs/reliability.md: one row a fault, one column a phase, one
 letter a cell -- C completed, S stopped safe (lifts holding, a reason, a
 resumable journal), R resumed (the host killed, a new host finished the
 run), F refused (the host killed, the new host refused to resume before
-any Clear, the boards still latched), X UNSAFE (listed below the table with
-what was wrong).
+any Clear, the boards still latched), U untested (the run ended safely
+before its phase came, on each of its tries), X UNSAFE (listed below the
+table with what was wrong).
 
     python benchmarks/fault_matrix.py [-j 4] [--wire can|serial|firmware] [--fault NAME]
-                                      [--phase NAME]
+                                      [--phase NAME] [--tries N]
 
 ``--wire firmware`` runs the cells on the boards' C firmware (built once with
 make into firmware/build) on the serial wire.
+
+A cell whose run ended before its phase (a loaded machine's timeouts:
+they are wall time) is run again, up to ``--tries`` times in all; the
+counts say how many cells needed it.
 
 Exit status 1 when any cell is unsafe or never had its fault injected.
 Most of a cell's time is the host waiting out timeouts, so -j may exceed
@@ -29,7 +34,8 @@ from stairbot.fakes.fault_matrix import ALL_WIRES, FAULTS, PHASES, WIRES, run_ce
 from stairbot.fakes.fault_rig import Cell
 from stairbot.fakes.firmware_boards import build_native
 
-LETTER = {"completed": "C", "stopped": "S", "resumed": "R", "refused": "F", "UNSAFE": "X"}
+LETTER = {"completed": "C", "stopped": "S", "resumed": "R", "refused": "F", "untested": "U",
+          "UNSAFE": "X"}
 
 
 def _one(args: tuple[str, str, str, int, Path | None]) -> Cell:
@@ -59,28 +65,47 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--fault", choices=sorted(FAULTS), action="append")
     ap.add_argument("--phase", choices=PHASES, action="append")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--tries", type=int, default=3,
+                    help="runs at most of a cell that ends before its phase (default 3)")
     args = ap.parse_args(argv)
+    if args.tries < 1:
+        ap.error(f"--tries must be 1 or more, not {args.tries}")
     firmware_dir = build_native() if "firmware" in (args.wire or ()) else None
     todo = [(f, p, w, args.seed, firmware_dir) for w in (args.wire or WIRES)
             for f in (args.fault or FAULTS) for p in (args.phase or PHASES)]
     t0 = time.perf_counter()
     cells: list[Cell] = []
+    again: Counter[int] = Counter()  # cells by the try that tested them
     with ProcessPoolExecutor(args.jobs) as pool:
-        futures = [pool.submit(_one, t) for t in todo]
-        for i, fut in enumerate(as_completed(futures), 1):
+        futures = {pool.submit(_one, t): (t, 1) for t in todo}
+        done = 0
+        while futures:
+            fut = next(as_completed(futures))
+            task, tried = futures.pop(fut)
             c = fut.result()
+            print(f"[{done + 1}/{len(todo)}] {c.wire:8} {c.fault:20} {c.phase:22} "
+                  f"{c.verdict:9} {c.wall_s:5.1f} s {c.reason[:90]}", file=sys.stderr,
+                  flush=True)
+            if c.verdict == "untested" and tried < args.tries:
+                futures[pool.submit(_one, task)] = (task, tried + 1)
+                continue
+            done += 1
+            again[tried] += 1
             cells.append(c)
-            print(f"[{i}/{len(todo)}] {c.wire:8} {c.fault:20} {c.phase:22} {c.verdict:9} "
-                  f"{c.wall_s:5.1f} s {c.reason[:90]}", file=sys.stderr, flush=True)
     for wire in args.wire or WIRES:
         print(f"\n## {wire}\n")
         print("\n".join(table(cells, wire)))
     counts = Counter(c.verdict for c in cells)
     print(f"\n{len(cells)} cells in {time.perf_counter() - t0:.0f} s: "
-          + ", ".join(f"{k} {counts[k]}" for k in ("completed", "stopped", "resumed", "UNSAFE")))
-    bad = [c for c in cells if not c.safe]
+          + ", ".join(f"{k} {counts[k]}" for k in ("completed", "stopped", "resumed",
+                                                   "untested", "UNSAFE")))
+    if len(again) > 1:
+        print("run again after ending before their phase: "
+              + ", ".join(f"{n} cell(s) {k - 1} time(s)" for k, n in sorted(again.items())
+                          if k > 1))
+    bad = [c for c in cells if not c.safe or c.verdict == "untested"]
     for c in bad:
-        print(f"UNSAFE {c.wire} {c.fault} in {c.phase}: {c.reason}")
+        print(f"{c.verdict} {c.wire} {c.fault} in {c.phase}: {c.reason}")
     stops = Counter((c.fault, c.reason.split(": ", 1)[-1][:60]) for c in cells
                     if c.verdict == "stopped")
     for (fault, reason), n in sorted(stops.items()):

@@ -27,6 +27,12 @@ A cell is **safe** (:func:`run_cell`) when the run
   refused before any Clear, the boards still latched, is "refused": safe,
   but not what the matrix expects).
 
+A run that ends before its phase comes (the host's timeouts are wall time:
+a loaded machine can lose the link with no fault at all) tested nothing:
+its stop is judged as any other, and if safe the cell is **untested**, for
+``benchmarks/fault_matrix.py`` to run again.  When motors are left running,
+the reason names the boards that did not confirm the host's emergency stop.
+
 The flight, the boards on their wire and the resuming host are
 :mod:`stairbot.fakes.fault_rig`'s, shared with :mod:`stairbot.fakes.host_kills`.
 ``benchmarks/fault_matrix.py`` runs every cell and prints the table of
@@ -48,6 +54,7 @@ from stairbot.control.algorithm.phases import Mode
 from stairbot.control.robot_config import load_config
 from stairbot.drivers import messages as m
 from stairbot.errors import HardwareError
+from stairbot.events import Event, EventKind
 from stairbot.fakes.board_world import BoardWorld
 from stairbot.fakes.boards import Board, make_boards
 from stairbot.fakes.boards_cli import make_world
@@ -137,8 +144,9 @@ def _lifts(world: BoardWorld) -> tuple[float, ...]:
 
 
 def _after_stop(cell: Cell, result: RunResult, boards: BoardsOnWire, journal: Path,
-                alive: bool) -> Cell:
-    """Check a run that did not complete: see the module docstring."""
+                alive: bool, links: list[str]) -> Cell:
+    """Check a run that did not complete: see the module docstring.
+    ``links``: the host's LINK events of the run."""
     world = boards.world
     problems: list[str] = []
     if result.fell:
@@ -146,7 +154,9 @@ def _after_stop(cell: Cell, result: RunResult, boards: BoardsOnWire, journal: Pa
     if not result.error:
         problems.append("stopped with no reason given")
     if alive and any(world.speeds().values()):
-        problems.append(f"motors left running: {world.speeds()}")
+        unconfirmed = [t for t in links if t.startswith("emergency stop not confirmed")]
+        problems.append(f"motors left running: {world.speeds()}"
+                        + "".join(f" [{t}]" for t in unconfirmed))
     boards.run_on(0.5)  # every watchdog has tripped by now
     before = _lifts(world)
     boards.run_on(AFTER_S - 0.5)
@@ -223,8 +233,14 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path,
                 boards.deaf(True)
                 raise HostKilled
 
+        links: list[str] = []
+
+        def sink(event: Event) -> None:
+            if event.kind is EventKind.LINK:
+                links.append(event.message)
+
         try:
-            result = run(session, config, on_tick=inject, journal=writer)
+            result = run(session, config, sink, on_tick=inject, journal=writer)
         except HostKilled:
             result = None
         finally:
@@ -232,18 +248,31 @@ def _run(fault: Fault, phase: str, wire: str, seed: int, journal: Path,
             with contextlib.suppress(HardwareError):
                 session.close()
         if not cell.injected:
-            ended = f" (it ended {result.outcome}: {result.error})" if result is not None else ""
-            cell.reason = f"the run never entered {phase}{ended}"
-            return cell
+            return _untested(cell, result, boards, journal, links)
         if result is None:
             return _resumed(cell, boards, config, journal)
         if result.outcome == "completed" and not result.fell:
             cell.verdict, cell.reason = "completed", ""
             return cell
         alive = fault.kind == "wire" or fault.board != MOTOR
-        return _after_stop(cell, result, boards, journal, alive)
+        return _after_stop(cell, result, boards, journal, alive, links)
     finally:
         boards.close()
+
+
+def _untested(cell: Cell, result: RunResult | None, boards: BoardsOnWire, journal: Path,
+              links: list[str]) -> Cell:
+    """A run that never entered the cell's phase: UNSAFE if its own end was
+    (a stop judged as any other), else untested."""
+    assert result is not None  # the host is killed only in the phase
+    ended = f"the run never entered {cell.phase} (it ended {result.outcome}: {result.error})"
+    if result.outcome != "completed" or result.fell:
+        _after_stop(cell, result, boards, journal, True, links)
+        if not cell.safe:
+            cell.reason = f"{ended}; {cell.reason}"
+            return cell
+    cell.verdict, cell.reason = "untested", ended
+    return cell
 
 
 def _resumed(cell: Cell, boards: BoardsOnWire, config: RobotConfig, journal: Path) -> Cell:

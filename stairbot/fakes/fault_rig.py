@@ -67,8 +67,9 @@ HOST_DEAD_S = 1.0  # world seconds between the host killed and the new host
 class Cell:
     """One cell's run: ``verdict`` is "completed", "stopped", "resumed" (the
     host killed, the new host finished), "refused" (the host killed, the new
-    host refused to resume before touching the boards) or "UNSAFE";
-    ``reason`` the run's error, or what made it unsafe."""
+    host refused to resume before touching the boards), "untested" (the run
+    ended safely before its fault began) or "UNSAFE"; ``reason`` the run's
+    error, or what made it unsafe."""
 
     fault: str
     phase: str

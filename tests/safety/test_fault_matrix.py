@@ -12,6 +12,7 @@ import pytest
 from stairbot.drivers import board_robot
 from stairbot.drivers.board_robot import BoardRobot
 from stairbot.fakes import boards as fake_boards
+from stairbot.fakes import fault_matrix
 from stairbot.fakes.fault_matrix import FAULTS, PHASES, cells, run_cell
 from stairbot.fakes.firmware_boards import FirmwareBoardServer, find_cc
 from stairbot.hardware import MotorId
@@ -107,3 +108,43 @@ def test_the_judge_sees_a_hung_firmware_board_left_driving(
     cell = run_cell("motor board hung", "ascent_lift_second", "firmware")
     assert cell.verdict == "UNSAFE"
     assert "motors running 2 s on" in cell.reason
+
+
+def ended_early(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every run of the matrix ends with an error after 3 s of robot time,
+    in calibration, long before the descent."""
+    real_run = fault_matrix.run
+
+    def short(*args: object, **kwargs: object) -> object:
+        return real_run(*args, max_sim_time_s=3.0, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(fault_matrix, "run", short)
+
+
+def test_a_run_that_ends_safely_before_its_phase_is_untested(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    ended_early(monkeypatch)
+    cell = run_cell("drop 5%", "descent_finish", "can")
+    assert not cell.injected
+    assert cell.verdict == "untested"
+    assert cell.reason.startswith("the run never entered descent_finish (it ended error:")
+
+
+def test_a_run_that_ends_unsafely_before_its_phase_is_unsafe(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Its own stop leaves a lift driving: UNSAFE, though its fault never began."""
+    ended_early(monkeypatch)
+    command = BoardRobot.command
+
+    def lift_too(self: BoardRobot, speeds: dict[MotorId, float]) -> None:
+        command(self, {**speeds, MotorId.MTB: 0.5})
+
+    monkeypatch.setattr(BoardRobot, "command", lift_too)
+    for name in ("stop_all", "estop", "close"):
+        monkeypatch.setattr(BoardRobot, name, lambda self: None)
+    monkeypatch.setattr(fake_boards.Board, "poll", lambda self: None)
+    monkeypatch.setattr(board_robot, "COMMAND_HOLD_MS", 0)
+    cell = run_cell("drop 5%", "descent_finish", "can")
+    assert cell.verdict == "UNSAFE"
+    assert cell.reason.startswith("the run never entered descent_finish")
+    assert "motors left running" in cell.reason
