@@ -78,10 +78,9 @@ def test_a_fault_in_any_phase_ends_safe(fault: str, phase: str, wire: str) -> No
         assert "link lost" in cell.reason and f"from the {which} board for" in cell.reason
 
 
-def test_the_judge_sees_motors_left_running(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A host that drives a lift and does not stop it on a lost link, and
-    boards with no watchdog and no command hold: the cell is UNSAFE, so the
-    matrix can fail."""
+def careless_host(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A host that drives a lift in every command and never stops it, on
+    boards with no watchdog and no command hold."""
     command = BoardRobot.command
 
     def lift_too(self: BoardRobot, speeds: dict[MotorId, float]) -> None:
@@ -92,6 +91,13 @@ def test_the_judge_sees_motors_left_running(monkeypatch: pytest.MonkeyPatch) -> 
         monkeypatch.setattr(BoardRobot, name, lambda self: None)
     monkeypatch.setattr(fake_boards.Board, "poll", lambda self: None)
     monkeypatch.setattr(board_robot, "COMMAND_HOLD_MS", 0)
+
+
+def test_the_judge_sees_motors_left_running(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A host that drives a lift and does not stop it on a lost link, and
+    boards with no watchdog and no command hold: the cell is UNSAFE, so the
+    matrix can fail."""
+    careless_host(monkeypatch)
     cell = run_cell("sensor board killed", "cal_lift", "can")
     assert cell.verdict == "UNSAFE"
     assert "motors left running" in cell.reason and "a lift moved" in cell.reason
@@ -134,16 +140,7 @@ def test_a_run_that_ends_unsafely_before_its_phase_is_unsafe(
         monkeypatch: pytest.MonkeyPatch) -> None:
     """Its own stop leaves a lift driving: UNSAFE, though its fault never began."""
     ended_early(monkeypatch)
-    command = BoardRobot.command
-
-    def lift_too(self: BoardRobot, speeds: dict[MotorId, float]) -> None:
-        command(self, {**speeds, MotorId.MTB: 0.5})
-
-    monkeypatch.setattr(BoardRobot, "command", lift_too)
-    for name in ("stop_all", "estop", "close"):
-        monkeypatch.setattr(BoardRobot, name, lambda self: None)
-    monkeypatch.setattr(fake_boards.Board, "poll", lambda self: None)
-    monkeypatch.setattr(board_robot, "COMMAND_HOLD_MS", 0)
+    careless_host(monkeypatch)
     cell = run_cell("drop 5%", "descent_finish", "can")
     assert cell.verdict == "UNSAFE"
     assert cell.reason.startswith("the run never entered descent_finish")
