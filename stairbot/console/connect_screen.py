@@ -121,8 +121,8 @@ class ConnectScreen(ModalScreen[str | None]):
         self.app.call_from_thread(self._show, listing)
 
     def _show(self, listing: Listing) -> None:
-        if not self.is_attached:
-            return  # closed while it looked
+        if not self.is_attached or self not in self.app.screen_stack:
+            return  # closed while it looked (a closing screen loses its widgets first)
         options: list[Option] = []
         self.urls = {}
         for group in GROUPS:

@@ -348,3 +348,35 @@ def test_enter_on_an_empty_url_field_says_why_and_keeps_the_manager(own_dirs: Pa
                         "the line goes once something is typed")
             assert app.screen is screen and field.value.strip() == "x"
     asyncio.run(go())
+
+
+def test_a_look_that_ends_as_the_manager_closes_is_dropped(own_dirs: Path) -> None:
+    """The manager closed (Enter on a URL) while its look ran, and the look's
+    answer came back while the closing screen had lost its widgets but not
+    yet left the app: the list it would fill was gone, the worker failed and
+    took the console down with it (CI, after session 46)."""
+    release = threading.Event()
+
+    def slow_gather(**_: Any) -> connections.Listing:
+        release.wait(timeout=30)  # only stops a broken test
+        return connections.Listing()
+
+    async def go() -> None:
+        app = build_app(speed="max")
+        async with app.run_test(size=(80, 24)) as pilot:
+            await ready(pilot)
+            screen = ConnectScreen(app.url, "the simulation", gather=slow_gather)
+            app.push_screen(screen)
+            await until(pilot, lambda: app.screen is screen, "the manager")
+            screen.dismiss(None)
+            await screen.query_one("#connect").remove()  # closing: its widgets go first
+            assert screen.is_attached
+            screen._show(connections.Listing())  # the look's answer, now
+            release.set()
+            await pilot.pause(0.2)
+            assert app.is_running and app.screen is not screen
+            await press(pilot, "s")  # the console still runs
+            await until(pilot, lambda: app.engine.running or "ENDED" in banner(app), "a run")
+            await press(pilot, "x")
+            await until(pilot, lambda: not app.engine.running, "the run stops")
+    asyncio.run(go())
