@@ -44,7 +44,7 @@ class Board:
         self.handled = 0
         self.boot = secrets.randbits(32) or 1  # drawn at power-up (Owner.boot)
         self.lease = Lease(time.monotonic if world.lockstep else world.now,
-                           lambda: self.watchdog_ms, self.boot)
+                           lambda: self.watchdog_ms, self.boot, kept_by_holder=world.lockstep)
 
     # -- status ----------------------------------------------------------------
     def flags(self) -> int:

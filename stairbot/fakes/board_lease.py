@@ -14,13 +14,22 @@ class Lease:
     last frame came, on ``clock``: a lockstep board's world stands still
     while the host is away, so it counts the lease in wall time; otherwise
     on its own clock.  A lease lasts at least as long as the board's
-    watchdog (``watchdog_ms()``)."""
+    watchdog (``watchdog_ms()``).
+
+    ``kept_by_holder`` (lockstep): a lease that lapsed stays its holder's
+    until another session claims the board.  Wall time is there only so
+    that a host that went away can be replaced; the holder's own frames
+    after a pause in wall time -- a loaded machine that did not schedule
+    the host or the boards for a second, while the world stood still and
+    the watchdog, on the world's clock, did not trip -- renew it, as the
+    C boards, whose lockstep clock is the world's, do."""
 
     def __init__(self, clock: Callable[[], float], watchdog_ms: Callable[[], int],
-                 boot: int) -> None:
+                 boot: int, kept_by_holder: bool = False) -> None:
         self._clock = clock
         self._watchdog_ms = watchdog_ms
         self.boot = boot  # the board's boot id (Owner.boot)
+        self.kept_by_holder = kept_by_holder
         self.owner: int | None = None
         self.owner_nonce = 0
         self.lease_ms = 0
@@ -35,8 +44,9 @@ class Lease:
         return max(0.0, span - (self._clock() - self._seen))
 
     def owns(self, session: int) -> bool:
-        """Whether ``session`` holds a live lease."""
-        return self.owner == session and self.left_s() > 0
+        """Whether ``session`` holds a live lease (or, ``kept_by_holder``,
+        one that lapsed and nobody has claimed since)."""
+        return self.owner == session and (self.kept_by_holder or self.left_s() > 0)
 
     def renew(self) -> None:
         """A frame of the holder came now."""

@@ -449,6 +449,39 @@ def test_a_lease_released_or_lapsed_can_be_taken(rig: tuple,
     assert sensor.handle([m.Clear()], HOST) == [m.Ack(m.Clear.TYPE, m.AckResult.NOT_OWNER)]
 
 
+def test_a_lockstep_holder_silent_past_its_lease_in_wall_time_keeps_its_boards(
+        rig: tuple, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The world stood still while the holder said nothing for longer than
+    the lease (a loaded machine did not schedule it): its next frames are
+    obeyed and renew the lease; only another host's claim takes it."""
+    _, world, motor, _ = rig
+    clock = [1000.0]
+    monkeypatch.setattr(motor.lease, "_clock", lambda: clock[0])
+    motor.lease.renew()
+    clock[0] += 3 * m.LEASE_MS / 1000
+    assert motor.handle([sim.StepTo(20_000)], HOST) == [sim.StepDone(20_000)]
+    (ack,) = motor.handle([m.SetWheelSpeeds(100, 100, 100, 100)], HOST)
+    assert ack == m.Ack(m.SetWheelSpeeds.TYPE, m.AckResult.OK)
+    (held,) = motor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)  # renewed by those frames
+    assert held.result == m.ClaimResult.HELD and held.session == HOST
+    clock[0] += 3 * m.LEASE_MS / 1000
+    assert motor.handle([m.Claim(m.LEASE_MS, 5)], OTHER)[0].result == m.ClaimResult.GRANTED
+    assert motor.handle([sim.StepTo(40_000)], HOST) == [m.Ack(0x7E, m.AckResult.NOT_OWNER)]
+    assert world.now() == pytest.approx(0.02)
+
+
+def test_a_real_time_holder_silent_past_its_lease_loses_it() -> None:
+    """Off lockstep the lease counts the boards' own time: a holder silent
+    for longer than it holds nothing, whether or not another host claimed."""
+    robot = StubRobot()
+    world = BoardWorld(robot, StubClock(robot), lockstep=False)
+    motor = make_boards(world)[1]
+    motor.handle([m.Claim(m.LEASE_MS, NONCE), m.SetWatchdog(0)], HOST)
+    robot.t += 3 * m.LEASE_MS / 1000
+    assert motor.handle([m.SetWheelSpeeds(100, 100, 100, 100)], HOST) == [
+        m.Ack(m.SetWheelSpeeds.TYPE, m.AckResult.NOT_OWNER)]
+
+
 def test_a_speed_command_outlives_its_hold_and_stops_without_a_latch(rig: tuple) -> None:
     """A host that falls silent mid-drive: its motors stop after hold_ms (a
     wheel coasts, a lift holds), long before the watchdog latches."""
