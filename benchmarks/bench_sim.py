@@ -27,6 +27,11 @@ A script that prints figures, not a test: it asserts nothing.  Usage:
 
     python benchmarks/bench_sim.py [--repeat N] [--parts] [--scenario FILE|NAME] [--config FILE]
 
+It runs the build that is installed: with ``STAIRBOT_COMPILE=1 bash
+scripts/setup``, the modules of ``stairbot/compiled.py`` compiled by mypyc
+(``STAIRBOT_PURE=1`` runs them as Python).  ``--parts`` needs the
+pure-Python build: compiled modules call each other past the timers.
+
 (``--config`` chooses the robot, e.g. one whose ``[sensors] front_model`` and
 ``back_model`` name a realistic sensor preset.)
 """
@@ -40,6 +45,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from stairbot import compiled
 from stairbot.control.algorithm.bias import BiasWatch
 from stairbot.control.algorithm.controller import Controller
 from stairbot.control.perception import Perception
@@ -147,6 +153,12 @@ def print_parts(own: dict[str, float], cpu: float, ticks: int) -> None:
           f"{rest / max(own.get('physics', 0.0), 1e-9):.2f} x physics")
 
 
+def build_name() -> str:
+    if compiled.running_compiled():
+        return f"compiled: {len(compiled.MODULES)} modules by mypyc (stairbot/compiled.py)"
+    return "pure Python"
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeat", type=int, default=3, help="runs of each kind (median shown)")
@@ -171,6 +183,7 @@ def main() -> None:
         bare.append(sim / wall_b)
         bare_cpu.append(sim / cpu_b)
     assert result is not None
+    print(f"build               {build_name()}")
     print(f"sensor models       front {config.sensors.front_model}, "
           f"back {config.sensors.back_model}")
     print(f"scenario            {scenario.name}: outcome {result.outcome}, "
@@ -185,8 +198,12 @@ def main() -> None:
     print(f"{'full / bare time':<20}{ratio_w:<16.2f}{ratio_c:.2f}")
     print("(1.00: the controller, sensors and motors cost nothing over bare physics.  "
           "CPU time is steadier on a busy machine.)")
-    if args.parts:
+    if args.parts and compiled.running_compiled():
+        print(f"a tick by part      needs the pure-Python build ({compiled.PURE_ENV}=1): "
+              "compiled modules call each other directly, past the timers")
+    elif args.parts:
         print_parts(*parts_run(config, scenario))
+
 
 if __name__ == "__main__":
     main()

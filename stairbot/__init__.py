@@ -13,3 +13,7 @@ nothing of textual, pymunk, serial or can.
 """
 
 __version__ = "0.1.0"
+
+from stairbot import compiled as _compiled
+
+_compiled.guard()  # before any compiled module is imported: a stale one runs as Python

@@ -95,7 +95,7 @@ class MarginWatch:
         self._segment_mass = [(b.mass, b.center_of_gravity.x, b.center_of_gravity.y)
                               for b in segments]
         self._wheel_mass = [w.mass for w in wheels]
-        self._total = sum(b.mass for b in segments) + sum(self._wheel_mass)
+        self._total = sum((b.mass for b in segments), 0.0) + sum(self._wheel_mass, 0.0)
         self._outline: Sequence[Point] = ()
         self._treads: list[Tread] = []
         self._edges: list[tuple[Point, Point]] = []
