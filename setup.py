@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import runpy
+from importlib.machinery import EXTENSION_SUFFIXES
 from pathlib import Path
 
 from setuptools import setup
@@ -40,7 +41,16 @@ class BuildExt(build_ext):
         }}, indent=1) + "\n", "utf-8")
 
 
+def remove_extensions() -> None:
+    """Removes the extensions an earlier build left in the checkout: a module
+    since taken off the list would otherwise go on running compiled."""
+    for suffix in EXTENSION_SUFFIXES:
+        for path in [*(HERE / "stairbot").rglob(f"*{suffix}"), *HERE.glob(f"*__mypyc{suffix}")]:
+            path.unlink()
+
+
 manifest.unlink(missing_ok=True)  # until this build's extensions are in place
+remove_extensions()
 ext_modules = []
 if os.environ.get("STAIRBOT_COMPILE", "") not in ("", "0"):
     try:
