@@ -204,16 +204,24 @@ def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
     says the robot did not confirm."""
     from stairbot.errors import LinkLostError
 
+    class EstopRaises:
+        """The simulated robot, whose estop() raises (a wrapper: a compiled
+        robot's methods cannot be replaced on it)."""
+
+        def __init__(self, inner: Any) -> None:
+            self.inner = inner
+
+        def estop(self) -> None:
+            raise LinkLostError("motor board: no reply to EStop")
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self.inner, name)
+
     def broken_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
         from stairbot.run.robots import RobotSession, open_robot
 
         s = open_robot(url, config, replace(options, world=scenario))
-
-        def estop() -> None:
-            raise LinkLostError("motor board: no reply to EStop")
-
-        s.robot.estop = estop  # type: ignore[method-assign]
-        return RobotSession(s.robot, s.clock, s.url, s.simulated, s.sim)
+        return RobotSession(EstopRaises(s.robot), s.clock, s.url, s.simulated, s.sim)
 
     engine = ConsoleEngine(LiveState(), load_config(), open_fn=broken_open)
     engine.open("sim://", None)
