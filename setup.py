@@ -3,8 +3,7 @@ simulation's hot modules (``stairbot/compiled.py``'s MODULES) with mypyc
 and writes the manifest the package checks them against on import; without
 it (or when the build fails), any manifest an earlier compiled build left
 is removed, so extensions left beside the sources are not run
-(``stairbot.compiled.guard``).  The
-metadata is in pyproject.toml."""
+(``stairbot.compiled.guard``).  The metadata is in pyproject.toml."""
 
 from __future__ import annotations
 
@@ -25,6 +24,7 @@ NEEDS = ("STAIRBOT_COMPILE=1 type-checks the modules against stairbot's installe
          "dependencies: install stairbot, mypy and setuptools>=68 first, then build "
          "without isolation (pip install --no-build-isolation ...; or: "
          "STAIRBOT_COMPILE=1 bash scripts/setup), with a C compiler on the PATH")
+
 
 class BuildExt(build_ext):
     """Writes the manifest once the extensions are built, beside them: a

@@ -5,9 +5,10 @@ module from running code older than its source.
 A compiled build writes :data:`MANIFEST` beside this file: each module of
 :data:`MODULES` and the SHA-256 of the source it was compiled from.  On
 import, :func:`guard` compares those with the sources beside them.  When
-any differs (the checkout was edited or moved on since the build), or when
-``STAIRBOT_PURE=1`` asks for it, every module of the list is loaded from
-its ``.py`` instead: mypyc calls across the modules of one build directly,
+any differs (the checkout was edited or moved on since the build), an
+extension is missing, there is no manifest (a pure-Python build, perhaps
+over a compiled one), or ``STAIRBOT_PURE=1`` asks for it, every module of
+the list is loaded from its ``.py`` instead: mypyc calls across the modules of one build directly,
 so one stale module means none of them can be trusted.  A stale build is
 said on a terminal's stderr, with the command that rebuilds it (not where
 stderr is read by a program: a test, a pipe, a log).
