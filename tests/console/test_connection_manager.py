@@ -368,10 +368,10 @@ def test_a_look_that_ends_as_the_manager_closes_is_dropped(own_dirs: Path) -> No
             screen = ConnectScreen(app.url, "the simulation", gather=slow_gather)
             app.push_screen(screen)
             await until(pilot, lambda: app.screen is screen, "the manager")
-            screen.dismiss(None)
             await screen.query_one("#connect").remove()  # closing: its widgets go first
+            screen.dismiss(None)  # off the stack now; detached at the loop's next turn
             assert screen.is_attached
-            screen._show(connections.Listing())  # the look's answer, now
+            screen._show(connections.Listing())  # the look's answer, in between
             release.set()
             await pilot.pause(0.2)
             assert app.is_running and app.screen is not screen
