@@ -36,9 +36,8 @@ class BuildExt(build_ext):
             return
         package = HERE / "stairbot" if self.inplace else Path(self.build_lib) / "stairbot"
         package.mkdir(parents=True, exist_ok=True)
-        (package / compiled["MANIFEST"]).write_text(json.dumps({"modules": {
-            m: compiled["digest"](compiled["source_of"](m, HERE)) for m in compiled["MODULES"]
-        }}, indent=1) + "\n", "utf-8")
+        (package / compiled["MANIFEST"]).write_text(
+            json.dumps(compiled["manifest_of"](HERE), indent=1) + "\n", "utf-8")
 
 
 def remove_extensions() -> None:

@@ -8,8 +8,9 @@ import, :func:`guard` compares those with the sources beside them.  When
 any differs (the checkout was edited or moved on since the build), an
 extension is missing, there is no manifest (a pure-Python build, perhaps
 over a compiled one), or ``STAIRBOT_PURE=1`` asks for it, every module of
-the list is loaded from its ``.py`` instead: mypyc calls across the modules of one build directly,
-so one stale module means none of them can be trusted.  A stale build is
+the list is loaded from its ``.py`` instead: mypyc calls across the
+modules of one build directly, so one stale module means none of them can
+be trusted.  A stale build is
 said on a terminal's stderr, with the command that rebuilds it (not where
 stderr is read by a program: a test, a pipe, a log).
 
@@ -68,6 +69,12 @@ def digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+def manifest_of(root: Path = _ROOT) -> dict[str, dict[str, str]]:
+    """What a compiled build writes to :data:`MANIFEST` (setup.py): each
+    module of :data:`MODULES` and its source's SHA-256."""
+    return {"modules": {m: digest(source_of(m, root)) for m in MODULES}}
+
+
 def built(module: str, root: Path = _ROOT) -> bool:
     """Whether the module's compiled extension is beside its source."""
     source = source_of(module, root)
@@ -104,12 +111,11 @@ class _SourceFirst(importlib.abc.MetaPathFinder):
 _state = {"compiled": False}
 
 
-def decide(root: Path = _ROOT, manifest_path: Path | None = None,
-           pure: str = "") -> tuple[bool, str | None]:
+def decide(root: Path = _ROOT, pure: str = "") -> tuple[bool, str | None]:
     """Whether the compiled modules under ``root`` may run, and what to say
     when a compiled build cannot (None: nothing).  ``pure``: the value of
     ``STAIRBOT_PURE``."""
-    path = manifest_path or root / "stairbot" / MANIFEST
+    path = root / "stairbot" / MANIFEST
     if not path.is_file():
         return False, None  # a pure-Python build (extensions left by another are not run)
     if pure not in ("", "0"):

@@ -198,24 +198,29 @@ def test_estop_stops_the_robot_itself_without_waiting_for_the_next_tick() -> Non
         worker.join()
 
 
+class Wrapped:
+    """A robot that does what ``inner`` does, but for the methods a subclass
+    gives it."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner = inner
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.inner, name)
+
+
 def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
     """estop() never raises by the protocol; a driver that breaks it (a lost
     link) still gets every later command turned into a stop, and the banner
     says the robot did not confirm."""
     from stairbot.errors import LinkLostError
 
-    class EstopRaises:
+    class EstopRaises(Wrapped):
         """The simulated robot, whose estop() raises (a wrapper: a compiled
         robot's methods cannot be replaced on it)."""
 
-        def __init__(self, inner: Any) -> None:
-            self.inner = inner
-
         def estop(self) -> None:
             raise LinkLostError("motor board: no reply to EStop")
-
-        def __getattr__(self, name: str) -> Any:
-            return getattr(self.inner, name)
 
     def broken_open(url: str, config: Any, scenario: Any, options: Any) -> Any:
         from stairbot.run.robots import RobotSession, open_robot
@@ -235,11 +240,12 @@ def test_a_robot_whose_estop_raises_does_not_take_the_console_down() -> None:
     assert engine.state.view().commands == dict.fromkeys(MotorId, 0.0)
 
 
-class LosesTheLink:
+class LosesTheLink(Wrapped):
     """The simulated robot, whose link is lost at its 50th read."""
 
     def __init__(self, inner: Any) -> None:
-        self.inner, self.reads = inner, 0
+        super().__init__(inner)
+        self.reads = 0
 
     def read(self) -> Snapshot:
         from stairbot.errors import LinkLostError
@@ -249,9 +255,6 @@ class LosesTheLink:
             raise LinkLostError("link lost: no reply from the sensor board for 0.62 s")
         snap: Snapshot = self.inner.read()
         return snap
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.inner, name)
 
 
 def test_a_lost_link_leaves_the_robot_in_fault_not_ended() -> None:
