@@ -243,18 +243,22 @@ class FirmwareBoardServer(SerialBoardServer):
         self._pump()
 
     def _pump(self) -> None:
-        """Hand on queued frames, one request in flight at a time: the next
-        waits for a running board's reply (or REPLY_WAIT_S), so the boards see
-        the host's frames in the order it sent them -- a StepTo to the motor
-        board is done before the sensor board reads the world for the next
-        ReadAll."""
+        """Hand on queued frames, one board's requests in flight at a time:
+        frames to the board already answering follow at once (its line keeps
+        them in order, as the host's back-to-back frames reach a board on a
+        real line), and a frame to the other board waits for every reply due
+        (each within REPLY_WAIT_S of the last), so the boards see the host's
+        frames in the order it sent them -- a StepTo to the motor board is
+        done before the sensor board reads the world for the next ReadAll."""
         now = time.monotonic()
-        if self._flight is not None and now < self._flight[2] \
-                and self.firmware[self._flight[0]].alive:
-            return  # (a board killed or hung meanwhile will not answer: no wait for it)
-        self._flight = None
+        if self._flight is not None and (now >= self._flight[2]
+                                         or not self.firmware[self._flight[0]].alive):
+            self._flight = None  # (a board killed or hung meanwhile will not answer: no wait)
         while self._queue:
-            address, wire, copies = self._queue.popleft()
+            address, wire, copies = self._queue[0]
+            if self._flight is not None and address != self._flight[0]:
+                return
+            self._queue.popleft()
             if address is None:  # no board answers it: to both, nothing awaited
                 for board in self.firmware.values():
                     self._hand_on(board, wire * copies)
@@ -262,8 +266,8 @@ class FirmwareBoardServer(SerialBoardServer):
             board = self.firmware[address]
             self._hand_on(board, wire * copies)
             if board.alive:  # a killed or hung board answers nothing: nothing awaited
-                self._flight = (address, copies, now + REPLY_WAIT_S)
-                return
+                due = copies + (self._flight[1] if self._flight is not None else 0)
+                self._flight = (address, due, now + REPLY_WAIT_S)
 
     def _hand_on(self, board: FirmwareBoard, wire: bytes) -> None:
         """The bytes go down the board's line."""
@@ -298,8 +302,9 @@ class FirmwareBoardServer(SerialBoardServer):
             return
         for wire in board.replies.frames(data):
             if self._flight is not None and self._flight[0] == board.address:
-                address, left, deadline = self._flight
-                self._flight = (address, left - 1, deadline) if left > 1 else None
+                address, left, _ = self._flight
+                self._flight = (address, left - 1, time.monotonic() + REPLY_WAIT_S) \
+                    if left > 1 else None
             if not self._silent(board.address):
                 self._write(wire)
         if self._out:

@@ -5,16 +5,24 @@ from __future__ import annotations
 
 import select
 import shutil
+import socket
 from pathlib import Path
 
 import pytest
 
 from stairbot.cli.command import main
 from stairbot.control.robot_config import load_config
+from stairbot.drivers import messages as m
+from stairbot.drivers.serial_wire import Frame, encode_frame
 from stairbot.fakes import firmware_boards
 from stairbot.fakes.boards_cli import make_world
-from stairbot.fakes.firmware_boards import FirmwareBoard, FirmwareError, build_firmware
-from stairbot.fakes.plant_link import PlantLink
+from stairbot.fakes.firmware_boards import (
+    FirmwareBoard,
+    FirmwareBoardServer,
+    FirmwareError,
+    build_firmware,
+)
+from stairbot.fakes.plant_link import Delimited, PlantLink
 from stairbot.fakes.sim import motor_limits
 from stairbot.inputs.scenario import load_scenario
 
@@ -71,3 +79,62 @@ def test_a_board_killed_with_a_question_in_flight_ends_its_link_quietly(
         assert board.serve_plant() is False
     finally:
         board.close()
+
+
+class _Program:
+    """A board's program as the relay sees it: what it was handed, and the
+    socket its replies come back on (written to from the other end here)."""
+
+    def __init__(self, address: int, exe: Path, plant: PlantLink) -> None:
+        self.address = address
+        self.exe = exe
+        self.plant = plant
+        self.host, self.other = socket.socketpair()
+        self.link, self.plant_end = socket.socketpair()
+        self.replies = Delimited()
+        self.alive = True
+        self.handed: list[bytes] = []
+
+    def send(self, wire: bytes) -> None:
+        self.handed += Delimited().frames(wire)
+
+    def reply(self) -> None:
+        self.other.sendall(b"\x05reply\x00")
+
+    def close(self) -> str:
+        for s in (self.host, self.other, self.link, self.plant_end):
+            s.close()
+        return ""
+
+
+def test_a_boards_frames_go_on_together_and_the_other_boards_wait_for_every_reply(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The host's frames for the motor board are handed on at once (its
+    line keeps them in order); the sensor board's frame behind them waits
+    until the motor board has answered each, so a StepTo among them is done
+    before the sensor board reads the world."""
+    monkeypatch.setattr(firmware_boards, "FirmwareBoard", _Program)
+    monkeypatch.setattr(FirmwareBoardServer, "_await_hello", lambda self: None)
+    config = load_config()
+    line, host = socket.socketpair()
+    server = FirmwareBoardServer(line.fileno(), make_world(config, load_scenario(), True),
+                                 Path("build"), motor_limits(config), (7, 8))
+    motor, sensor = (server.firmware[int(b)] for b in (m.Board.MOTOR, m.Board.SENSOR))
+    assert isinstance(motor, _Program) and isinstance(sensor, _Program)
+    frames = [encode_frame(Frame(board, seq, (m.ReadAll(),), session=0x5A)) for board, seq in
+              ((m.Board.MOTOR, 1), (m.Board.MOTOR, 2), (m.Board.MOTOR, 3), (m.Board.SENSOR, 4))]
+    try:
+        server.receive(b"".join(frames))
+        assert motor.handed == frames[:3] and sensor.handed == []
+        for _ in range(2):
+            motor.reply()
+            server._side_ready(motor.host.fileno())  # as serve() does
+            assert sensor.handed == []
+        motor.reply()
+        server._side_ready(motor.host.fileno())  # as serve() does
+        assert sensor.handed == frames[3:]
+        assert host.recv(4096) == b"\x05reply\x00" * 3
+    finally:
+        server.close()
+        line.close()
+        host.close()
