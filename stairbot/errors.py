@@ -16,6 +16,12 @@ class StairbotError(Exception):
         return printable(super().__str__())
 
 
+class TransitionError(RuntimeError):
+    """A phase's step returned an outcome its record does not list: a bug in
+    the controller, not the robot's or the user's (raised by
+    :func:`stairbot.control.algorithm.transitions.exit_of`)."""
+
+
 class InputError(StairbotError):
     """Bad user input (config, scenario, URL): the CLI exits 2 with the message.
 

@@ -24,13 +24,13 @@ from stairbot.control.algorithm.transitions import (
     EXITS,
     STANDING_ARMED,
     TRANSITIONS,
-    TransitionError,
     allowed,
     mermaid,
 )
 from stairbot.control.algorithm.work import StandingWork
 from stairbot.control.robot_config import load_config
 from stairbot.control.tolerances import settle_s
+from stairbot.errors import TransitionError
 from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, Snapshot
 
 CFG = load_config("ideal")  # the algorithm's logic, on the readings it was written for

@@ -18,12 +18,9 @@ from stairbot.control.algorithm.phases import FLOWS, Phase
 from stairbot.control.algorithm.stability import UNSTABLE_EDGE
 from stairbot.control.algorithm.standing import DISAGREE, resumed
 from stairbot.control.algorithm.table import PHASES
+from stairbot.errors import TransitionError
 
 P = Phase
-
-
-class TransitionError(RuntimeError):
-    """A step returned an outcome its phase does not list: a bug."""
 
 
 def _table() -> dict[Phase, dict[str, Exit]]:
