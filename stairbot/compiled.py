@@ -1,4 +1,5 @@
-"""The simulation's hot modules, compiled by mypyc when stairbot is built
+"""The hot modules of a simulated run (the simulation, perception and the
+controller), compiled by mypyc when stairbot is built
 with ``STAIRBOT_COMPILE=1`` (setup.py), and the check that keeps a compiled
 module from running code older than its source.
 
@@ -32,7 +33,26 @@ from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
 
+_ROOT = Path(__file__).resolve().parent.parent
+
+
+def package_modules(package: str, but: Sequence[str] = (), root: Path = _ROOT) -> tuple[str, ...]:
+    """Every module of ``package`` (its ``.py`` files but ``__init__``),
+    except those named in ``but``, in name order."""
+    folder = root.joinpath(*package.split("."))
+    return tuple(f"{package}.{p.stem}" for p in sorted(folder.glob("*.py"))
+                 if p.stem != "__init__" and p.stem not in but)
+
+
 MODULES = (
+    # the controller, every phase and the evidence it keeps, but: phase.py,
+    # whose generic frozen dataclass (PhaseDef) mypyc compiles but cannot make
+    # at run time; and the context's dataclasses (context, work, families,
+    # limp), which a saved context is restored into by their type hints, and
+    # a compiled dataclass's hints lose their unions (``float | None`` reads
+    # as ``type``)
+    *package_modules("stairbot.control.algorithm",
+                     but=("phase", "context", "work", "families", "limp")),
     "stairbot.control.perception",
     "stairbot.control.robot_config",
     "stairbot.control.stuck",
@@ -52,13 +72,12 @@ MODULES = (
     "stairbot.fakes.world",
 )
 """The modules a compiled build compiles: the simulation's sensors, world
-and robot, and the perception and supervision every tick runs."""
+and robot; the perception and supervision every tick runs; the controller
+and its phases."""
 
 MANIFEST = "compiled.json"
 PURE_ENV = "STAIRBOT_PURE"
 REBUILD = "STAIRBOT_COMPILE=1 bash scripts/setup"
-
-_ROOT = Path(__file__).resolve().parent.parent
 
 
 def source_of(module: str, root: Path = _ROOT) -> Path:
