@@ -204,17 +204,28 @@ _to_edge = reading_drive(-1, step_tab, _edge_fallback, _at_edge,
 
 
 def _to_edge_step(t: Tick, w: EdgeWork) -> Step:
-    if w.refind_from is None:
-        step = _to_edge[1](t, w)
-        if w.edge_stop is not None:
-            return edge_stopped(w)
-        if w.square_yaw is not None:
-            return _turn_square(t, w)
-        if w.refind_from is None:
-            return _slowed(t, w, step)
+    if _refinding(w):
+        return refind(t, w)
+    step = _to_edge[1](t, w)
+    if w.edge_stop is not None:
+        return edge_stopped(w)
+    if w.square_yaw is not None:
+        return _turn_square(t, w)
+    if _refinding(w):
         # the watch found the pair past an edge it did not see crossed: this
         # tick's step (which may have ended the backing) is not taken
-    return refind(t, w)
+        return refind(t, w)
+    return _slowed(t, w, step)
+
+
+def _refinding(w: EdgeWork) -> bool:
+    """Whether backing up to the edge is finding the floor again
+    (``w.refind_from`` set).  A function, not a test of ``w.refind_from``
+    in :func:`_to_edge_step`: the step's edge watch may set it, and mypy
+    keeps an attribute narrowed across a call, so a second test there would
+    still take it for None (and compiled by mypyc, reading it as None raises
+    TypeError once it holds a float)."""
+    return w.refind_from is not None
 
 
 def _slowed(t: Tick, w: EdgeWork, step: Step) -> Step:
