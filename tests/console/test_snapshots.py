@@ -7,6 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
+from pilot import said, until
 from still_robot import show_climbing
 from textual.widgets import Input
 
@@ -30,6 +31,10 @@ def test_layout_emergency_stop(snap_compare: Any,
     async def stopped(pilot: Any) -> None:
         await climbing(pilot)
         await pilot.press("space")
+        # the stop's event reaches the state from the key's handler; then the
+        # list redraws on its timer
+        await until(pilot, lambda: "emergency stop by the operator" in said(pilot.app),
+                    "the e-stop's event")
         await pilot.pause(0.3)
     assert snap_compare(still_app(), terminal_size=(80, 24), run_before=stopped)
 
