@@ -1,6 +1,6 @@
 """The hot modules of a simulated run (the simulation, perception and the
-controller), compiled by mypyc when stairbot is built
-with ``STAIRBOT_COMPILE=1`` (setup.py), and the check that keeps a compiled
+controller), compiled by mypyc when stairbot is built with
+``STAIRBOT_COMPILE=1`` (setup.py), and the check that keeps a compiled
 module from running code older than its source.
 
 A compiled build writes :data:`MANIFEST` beside this file: each module of
@@ -11,9 +11,9 @@ extension is missing, there is no manifest (a pure-Python build, perhaps
 over a compiled one), or ``STAIRBOT_PURE=1`` asks for it, every module of
 the list is loaded from its ``.py`` instead: mypyc calls across the
 modules of one build directly, so one stale module means none of them can
-be trusted.  A stale build is
-said on a terminal's stderr, with the command that rebuilds it (not where
-stderr is read by a program: a test, a pipe, a log).
+be trusted.  A stale build is said on a terminal's stderr, with the
+command that rebuilds it (not where stderr is read by a program: a test,
+a pipe, a log).
 
 The compiled and the pure-Python modules run the same floating-point
 operations in the same order: a sweep gives the same verdicts, outcomes and
