@@ -62,13 +62,18 @@ class EventLog(RichLog):
     """Appends only the events it has not shown yet; keeps the last KEEP, and
     writes them again, wrapped afresh, when its width changes or the filter
     or the search does.  Its title says what is filtered and how many of
-    the events kept it lists."""
+    the events kept it lists.
+
+    It is anchored to its end (Textual's ``anchor``): the newest event stays
+    in view as events come and as the screen around it changes (the e-stop's
+    banner takes rows from it), until the operator scrolls up to read; back
+    at the end, it follows again."""
 
     DEFAULT_CSS = "EventLog { height: 1fr; }"
 
     def __init__(self, *, id: str | None = None) -> None:  # noqa: A002
         super().__init__(id=id, max_lines=4 * KEEP, min_width=1, wrap=True, markup=False,
-                         auto_scroll=True)
+                         auto_scroll=False)
         self.border_title = "events"
         self.last_seq = 0
         self._kept: deque[Event] = deque(maxlen=KEEP)
@@ -78,6 +83,9 @@ class EventLog(RichLog):
         self.search = ""
         """Only events whose message holds this (any case); "": every one."""
         self.listed = 0  # events the log lists now
+
+    def on_mount(self) -> None:
+        self.anchor()
 
     def shows(self, event: Event) -> bool:
         kinds = FILTERS[self.kinds]
