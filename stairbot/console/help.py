@@ -123,7 +123,9 @@ READING THE SCREEN
   Graphs: each line scaled to its own range, written after it;
   they stop when the readings stop, and dim with them when
   STALE.
-  Events: the run's events and everything the console said.
+  Events: the run's events and everything the console said,
+  the newest in view; scrolled up, the list holds its place
+  until scrolled back to its end.
 
   Escape or ? closes this help.
 """
