@@ -47,9 +47,8 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
-from functools import cached_property
 from typing import Literal
 
 from stairbot.fakes.sensors import active_faults, frozen, sensor_rng, stuck
@@ -102,61 +101,58 @@ class SensorModel:
     weak_range: float | None = None  # full beam, square to the target: too weak beyond
     max_incidence_deg: float | None = None  # ultrasonic: a ray's echo is lost beyond
 
+    # What casting needs, derived from the fields above once, when the model
+    # is made (a compiled build runs a cached_property's body at every read).
+    cone: tuple[ConeRay, ...] = field(init=False, repr=False, compare=False)
+    """The rays of a forward sensor's cone: a grid of ``rays`` x
+    ``rays_across`` angles within the circle of half-angle fov/2, each
+    weighted 1 on the axis falling to 0.5 at the rim; or, with
+    ``fov_across_deg``, a rectangle of them fov tall and fov_across wide,
+    each weighted 1 (a multizone sensor's block of zones, every direction
+    in it counted alike)."""
+    fan: tuple[ConeRay, ...] = field(init=False, repr=False, compare=False)
+    """The side-view rays only (a downward sensor's cone)."""
+    cone_index: tuple[tuple[float, ...], tuple[float, ...], tuple[tuple[int, int, float], ...]] \
+        = field(init=False, repr=False, compare=False)
+    """The :attr:`cone` for casting: its distinct angles up and across, and
+    its rays as the indexes of their two angles, with their weights (the
+    rays at one angle share its cast or its trigonometry)."""
+    cone_rows: tuple[tuple[int, tuple[tuple[int, float], ...]], ...] = field(
+        init=False, repr=False, compare=False)
+    """The rays of :attr:`cone_index` in their order, in runs at one angle
+    up: (the angle's index, the rays' indexes across and weights), per run."""
+    min_cos: float = field(init=False, repr=False, compare=False)
+    """The cosine of ``max_incidence_deg`` (1: none given)."""
+    tilt: float = field(init=False, repr=False, compare=False)
+    """``tilt_deg`` in radians."""
+
+    def __post_init__(self) -> None:
+        cone = self._grid(self.rays_across)
+        ups: dict[float, int] = {}
+        acrosses: dict[float, int] = {}
+        rays = tuple((ups.setdefault(up, len(ups)), acrosses.setdefault(across, len(acrosses)),
+                      weight) for up, across, weight in cone)
+        rows: list[tuple[int, list[tuple[int, float]]]] = []
+        for i_up, i_across, weight in rays:
+            if not rows or rows[-1][0] != i_up:
+                rows.append((i_up, []))
+            rows[-1][1].append((i_across, weight))
+        derived = {
+            "cone": cone, "fan": self._grid(1),
+            "cone_index": (tuple(ups), tuple(acrosses), rays),
+            "cone_rows": tuple((i_up, tuple(row)) for i_up, row in rows),
+            "min_cos": 1.0 if self.max_incidence_deg is None
+            else math.cos(math.radians(self.max_incidence_deg)),
+            "tilt": math.radians(self.tilt_deg),
+        }
+        for name, value in derived.items():
+            object.__setattr__(self, name, value)  # frozen: set once, here
+
     @property
     def single_ray(self) -> bool:
         """One ray straight along the mount: today's geometry, no cone."""
         return (self.rays == 1 and self.rays_across == 1 and self.tilt_deg == 0.0
                 and self.max_incidence_deg is None and self.weak_range is None)
-
-    @cached_property
-    def cone(self) -> tuple[ConeRay, ...]:
-        """The rays of a forward sensor's cone: a grid of ``rays`` x
-        ``rays_across`` angles within the circle of half-angle fov/2, each
-        weighted 1 on the axis falling to 0.5 at the rim; or, with
-        ``fov_across_deg``, a rectangle of them fov tall and fov_across wide,
-        each weighted 1 (a multizone sensor's block of zones, every direction
-        in it counted alike)."""
-        return self._grid(self.rays_across)
-
-    @cached_property
-    def min_cos(self) -> float:
-        """The cosine of ``max_incidence_deg`` (1: none given)."""
-        if self.max_incidence_deg is None:
-            return 1.0
-        return math.cos(math.radians(self.max_incidence_deg))
-
-    @cached_property
-    def cone_index(self) -> tuple[tuple[float, ...], tuple[float, ...],
-                                  tuple[tuple[int, int, float], ...]]:
-        """The :attr:`cone` for casting: its distinct angles up and across, and
-        its rays as the indexes of their two angles, with their weights (the
-        rays at one angle share its cast or its trigonometry)."""
-        ups: dict[float, int] = {}
-        acrosses: dict[float, int] = {}
-        rays = tuple((ups.setdefault(up, len(ups)), acrosses.setdefault(across, len(acrosses)),
-                      weight) for up, across, weight in self.cone)
-        return tuple(ups), tuple(acrosses), rays
-
-    @cached_property
-    def cone_rows(self) -> tuple[tuple[int, tuple[tuple[int, float], ...]], ...]:
-        """The rays of :attr:`cone_index` in their order, in runs at one angle
-        up: (the angle's index, the rays' indexes across and weights), per run."""
-        rows: list[tuple[int, list[tuple[int, float]]]] = []
-        for i_up, i_across, weight in self.cone_index[2]:
-            if not rows or rows[-1][0] != i_up:
-                rows.append((i_up, []))
-            rows[-1][1].append((i_across, weight))
-        return tuple((i_up, tuple(row)) for i_up, row in rows)
-
-    @cached_property
-    def tilt(self) -> float:
-        """``tilt_deg`` in radians."""
-        return math.radians(self.tilt_deg)
-
-    @cached_property
-    def fan(self) -> tuple[ConeRay, ...]:
-        """The side-view rays only (a downward sensor's cone)."""
-        return self._grid(1)
 
     def _grid(self, across: int) -> tuple[ConeRay, ...]:
         half = math.radians(self.fov_deg) / 2.0

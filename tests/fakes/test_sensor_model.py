@@ -224,3 +224,21 @@ def test_profile_agrees_with_brute_force_on_random_rays() -> None:
             assert got is None
         else:
             assert got == pytest.approx((x0 + (x1 - x0) * best, y0 + (y1 - y0) * best))
+
+
+def test_a_models_cone_tables_are_made_once_with_the_model_and_follow_a_replace() -> None:
+    """What the casts read every tick is made when the model is, not at each
+    read (a compiled build runs a cached_property's body at every read), and
+    a model replaced with other fields gets its own."""
+    from dataclasses import replace
+    cone = SensorModel(name="c", fov_deg=15.0, rays=5, rays_across=3, tilt_deg=2.0,
+                       max_incidence_deg=60.0)
+    for name in ("cone", "fan", "cone_rows"):
+        assert getattr(cone, name) is getattr(cone, name), name
+    assert cone.cone_index[2] is cone.cone_index[2]  # (compiled, the triple is boxed anew)
+    assert len(cone.fan) == 5 and len(cone.cone) > len(cone.fan)
+    assert cone.tilt == pytest.approx(math.radians(2.0))
+    assert cone.min_cos == pytest.approx(0.5)
+    narrow = replace(cone, rays=3, max_incidence_deg=None)
+    assert len(narrow.fan) == 3 and narrow.min_cos == 1.0
+    assert narrow != cone and replace(cone) == cone and hash(replace(cone)) == hash(cone)
