@@ -13,11 +13,14 @@ payloads cantools gives with ``scaling=False`` and padding bits zero
 (tests/drivers/test_can_layout.py checks every frame against cantools);
 :meth:`Layout.of` declines a frame it cannot read so (a big-endian or float
 signal, a multiplexed or container frame), which the codec then leaves to
-cantools.
+cantools.  A frame whose signals are whole bytes, 1, 2, 4 or 8 of them each,
+in order, is also packed with one :class:`struct.Struct` (pad bytes between
+and after): the same bytes, in one call.
 """
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -40,6 +43,7 @@ class Layout:
 
     length: int
     fields: tuple[Field, ...]
+    packer: struct.Struct | None = None  # the same layout, when struct can say it
 
     @classmethod
     def of(cls, frame: Any, signals: Sequence[Any]) -> Layout | None:
@@ -55,11 +59,13 @@ class Layout:
                 return None
             mask = (1 << sig.length) - 1
             fields.append(Field(sig.start, mask, 1 << (sig.length - 1) if sig.is_signed else 0))
-        return cls(frame.length, tuple(fields))
+        return cls(frame.length, tuple(fields), _packer(frame.length, signals))
 
     def pack(self, values: Sequence[int]) -> bytes:
         """The payload carrying ``values`` (raw integers that fit their
         signals: the codec checks that first), unused bits zero."""
+        if self.packer is not None:
+            return self.packer.pack(*values)
         word = 0
         for f, value in zip(self.fields, values, strict=True):
             word |= (value & f.mask) << f.shift
@@ -68,6 +74,8 @@ class Layout:
     def unpack(self, data: bytes) -> tuple[int, ...]:
         """The raw value of each signal in ``data`` (``length`` bytes: the
         codec checks that first)."""
+        if self.packer is not None:
+            return self.packer.unpack(data)
         word = int.from_bytes(data, "little")
         out = []
         for f in self.fields:
@@ -76,3 +84,22 @@ class Layout:
                 value -= f.mask + 1
             out.append(value)
         return tuple(out)
+
+
+_CODES = {8: "b", 16: "h", 32: "i", 64: "q"}
+
+
+def _packer(length: int, signals: Sequence[Any]) -> struct.Struct | None:
+    """A little-endian Struct of ``signals`` (plain little-endian integers,
+    in this order) when each is whole bytes of a struct size and each starts
+    after the one before; pad bytes fill the gaps.  Else None."""
+    fmt, at = "<", 0
+    for sig in signals:
+        code = _CODES.get(sig.length)
+        if code is None or sig.start % 8 or sig.start < at:
+            return None
+        fmt += "x" * ((sig.start - at) // 8) + (code if sig.is_signed else code.upper())
+        at = sig.start + sig.length
+    fmt += "x" * ((8 * length - at) // 8)
+    packer = struct.Struct(fmt)
+    return packer if packer.size == length else None

@@ -1,9 +1,11 @@
 """The codec's bit-field layouts give what cantools gives: every frame of the
 shipped and the simulation's DBC packed and unpacked both ways, at random and
-at every signal's extremes; frames a layout cannot read are left to cantools."""
+at every signal's extremes, by its Struct where it has one and by its bit
+fields; frames a layout cannot read are left to cantools."""
 
 from __future__ import annotations
 
+import dataclasses
 import random
 from typing import Any
 
@@ -28,8 +30,26 @@ def _extremes(sig: Any) -> tuple[int, int]:
 @pytest.mark.parametrize("frame", _frames(), ids=lambda f: f.name)
 def test_every_frame_packs_and_unpacks_as_cantools_does(frame: Any) -> None:
     signals = sorted(frame.signals, key=lambda s: s.start)
-    layout = Layout.of(frame, signals)
-    assert layout is not None, "every shipped frame is plain little-endian integers"
+    found = Layout.of(frame, signals)
+    assert found is not None, "every shipped frame is plain little-endian integers"
+    for layout in (found, dataclasses.replace(found, packer=None)):
+        _agrees(frame, signals, layout)
+
+
+def _packer(name: str) -> object:
+    frame = next(f for f in _frames() if f.name == name)
+    layout = Layout.of(frame, sorted(frame.signals, key=lambda s: s.start))
+    assert layout is not None
+    return layout.packer
+
+
+def test_most_frames_have_a_struct_and_nibbles_do_not() -> None:
+    assert _packer("MotorTelemetry_Motor") is None  # channel and mode share a byte
+    assert _packer("SensorTelemetry_Sensor") is not None
+    assert _packer("EStop_All") is not None
+
+
+def _agrees(frame: Any, signals: list[Any], layout: Layout) -> None:
     rng = random.Random(frame.frame_id)
     cases = [[_extremes(s)[0] for s in signals], [_extremes(s)[1] for s in signals],
              [0 for _ in signals]]
