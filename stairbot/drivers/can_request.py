@@ -48,6 +48,31 @@ def _key(msg: m.Message) -> int | None:
 
 # What a telemetry reply's key is, for messages (else a channel).
 _KEY_NAME: dict[type[m.Message], str] = {m.ImuTelemetry: "axis"}
+_KEYED = (m.MotorTelemetry, m.SensorTelemetry, m.ImuTelemetry)
+
+# (board, message class, channels, the class registered for its ANSWER) ->
+# the (kind, key) of each reply: all that expected_replies reads
+_REPLIES: dict[tuple[int, type[m.Message], int | None, type[m.Message] | None],
+               tuple[tuple[type[m.Message], int | None], ...]] = {}
+
+
+def replies_of(board: int, msg: m.Message,
+               channels: int | None = None) -> tuple[tuple[type[m.Message], int | None], ...]:
+    """The kind of each reply :func:`expected_replies` names, and its key:
+    for telemetry the channel (or IMU axis) it is the n-th of, else None.
+    Kept per board, message class, channels and the class the codec holds
+    for the message's ANSWER, so a class registered later is seen."""
+    cache_key = (board, type(msg), channels, m.MESSAGES.get(msg.ANSWER))
+    out = _REPLIES.get(cache_key)
+    if out is None:
+        seen: dict[type[m.Message], int] = {}
+        keyed: list[tuple[type[m.Message], int | None]] = []
+        for kind in expected_replies(board, msg, channels):
+            n = seen.get(kind, 0)
+            seen[kind] = n + 1
+            keyed.append((kind, n if kind in _KEYED else None))
+        out = _REPLIES[cache_key] = tuple(keyed)
+    return out
 
 
 class Due(NamedTuple):
@@ -128,12 +153,8 @@ class CanRequest(Request):
 
     def _all_due(self) -> Iterator[Due]:
         for i, msg in enumerate(self.messages):
-            seen: dict[type[m.Message], int] = {}
-            for kind in expected_replies(self.board, msg, self.channels):
-                n = seen.get(kind, 0)
-                seen[kind] = n + 1
-                keyed = kind in (m.MotorTelemetry, m.SensorTelemetry, m.ImuTelemetry)
-                yield Due(i, msg.TYPE, kind, n if keyed else None)
+            for kind, key in replies_of(self.board, msg, self.channels):
+                yield Due(i, msg.TYPE, kind, key)
 
     def index_of(self, seq: int) -> int | None:
         """Which message the frame ``seq`` carried; None if none of ours."""
@@ -146,7 +167,10 @@ class CanRequest(Request):
         def mine(due: Due) -> bool:
             return (index is None or due.part == index) and due.fits(msg)
 
-        pos = next((i for i, due in enumerate(self.todo) if mine(due)), None)
+        todo = self.todo
+        # the next reply due is the one that comes, but after a loss
+        pos = 0 if todo and mine(todo[0]) else next(
+            (i for i, due in enumerate(todo) if mine(due)), None)
         if pos is None:
             if any(mine(due) for due in self.taken):
                 return Offer.DUPLICATE

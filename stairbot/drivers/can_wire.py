@@ -39,6 +39,7 @@ import can
 import cantools
 
 from stairbot.drivers import messages as m
+from stairbot.drivers.can_layout import Layout
 
 DBC_NAME = "stairbot.dbc"
 BROADCAST = m.BROADCAST
@@ -93,9 +94,11 @@ class CanWire:
     def __init__(self, db: Any) -> None:
         self.db = db
         by_name = {cls.__name__: cls for cls in m.MESSAGES.values()}
-        # by base (the id's 11 high bits, the protocol 3.x id)
-        self._by_id: dict[int, tuple[int, type[m.Message], Any, tuple[str, ...]]] = {}
-        self._by_key: dict[tuple[int, int], tuple[int, Any, tuple[str, ...]]] = {}
+        # by base (the id's 11 high bits, the protocol 3.x id); each frame's
+        # Layout, or None where cantools itself packs it
+        self._by_id: dict[int, tuple[int, type[m.Message], Any, tuple[str, ...],
+                                     Layout | None]] = {}
+        self._by_key: dict[tuple[int, int], tuple[int, Any, tuple[str, ...], Layout | None]] = {}
         # per message class: (field name, signal name, lowest raw, highest raw)
         self._layout: dict[type[m.Message], tuple[tuple[str, str, int, int], ...]] = {}
         self.kinds: dict[int, int] = {}  # message type code -> kind
@@ -118,18 +121,19 @@ class CanWire:
             if frame.length != m.payload_size(cls.TYPE):
                 raise ValueError(f"{DBC_NAME}: {frame.name} is {frame.length} bytes; "
                                  f"{cls_name} is {m.payload_size(cls.TYPE)}")
-            names = tuple(s.name for s in sorted(frame.signals, key=lambda s: s.start))
+            signals = sorted(frame.signals, key=lambda s: s.start)
+            names = tuple(s.name for s in signals)
             n_fields = len(fields(cls))
             if len(names) != n_fields:
                 raise ValueError(f"{DBC_NAME}: {frame.name} has {len(names)} signals; "
                                  f"{cls_name} has {n_fields} fields")
-            self._by_id[base] = (board, cls, frame, names)
+            layout = Layout.of(frame, signals)
+            self._by_id[base] = (board, cls, frame, names, layout)
             self._layout[cls] = tuple(
                 (f.name, sig.name, -(1 << (sig.length - 1)) if sig.is_signed else 0,
                  (1 << (sig.length - 1)) - 1 if sig.is_signed else (1 << sig.length) - 1)
-                for f, sig in zip(fields(cls), sorted(frame.signals, key=lambda s: s.start),
-                                  strict=True))
-            self._by_key[(cls.TYPE, board)] = (base, frame, names)
+                for f, sig in zip(fields(cls), signals, strict=True))
+            self._by_key[(cls.TYPE, board)] = (base, frame, names, layout)
 
     def base(self, board: int, msg_type: type[m.Message]) -> int:
         """The base (``kind << 4 | board``) of ``msg_type`` for/from ``board``;
@@ -158,16 +162,20 @@ class CanWire:
         if not (0 <= session <= SESSION_MAX and 0 <= seq <= SEQ_MASK):
             raise m.CodecError(f"session {session} (0..{SESSION_MAX}) or seq {seq} "
                                f"(0..{SEQ_MASK}) out of range")
-        base, frame, _ = entry
-        raw: dict[str, int] = {}
-        for name, signal, low, high in self._layout[type(msg)]:
+        base, frame, _, layout = entry
+        spec = self._layout[type(msg)]
+        values = []
+        for name, signal, low, high in spec:
             value = getattr(msg, name)
             if not (isinstance(value, int) and low <= value <= high):
                 raise m.CodecError(f"{type(msg).__name__}.{name} = {value!r} does not fit "
                                    f"signal {signal} ({low}..{high})")
-            raw[signal] = value
+            values.append(value)
+        # the ranges are checked above, on the raw integers
+        if layout is not None:
+            return make_id(base, session, seq), layout.pack(values)
+        raw = {signal: value for (_, signal, _, _), value in zip(spec, values, strict=True)}
         try:
-            # the ranges are checked above, on the raw integers
             data = frame.encode(raw, scaling=False, strict=False)
         except (cantools.database.EncodeError, ValueError, TypeError) as exc:
             raise m.CodecError(f"{type(msg).__name__}: {exc}") from None
@@ -181,10 +189,12 @@ class CanWire:
         entry = self._by_id.get(base) if 0 <= frame_id < 1 << 29 else None
         if entry is None:
             raise m.CodecError(f"unknown CAN id 0x{frame_id:08X} (base 0x{base:03X})")
-        board, cls, frame, names = entry
+        board, cls, frame, names, layout = entry
         if len(data) != frame.length:
             raise m.CodecError(f"{frame.name}: {len(data)} data bytes, expected {frame.length}")
         try:
+            if layout is not None:
+                return CanFrame(board, cls(*layout.unpack(bytes(data))), session, seq)
             values = frame.decode(bytes(data), decode_choices=False, scaling=False)
             return CanFrame(board, cls(*(int(values[n]) for n in names)), session, seq)
         except Exception as exc:  # cantools' own errors; nothing may escape

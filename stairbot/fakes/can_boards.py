@@ -274,10 +274,15 @@ def main(argv: list[str]) -> int:
 
 
 class InlineBus:
-    """A host's bus with the fake boards served in the same thread: every
-    ``recv`` first lets the server handle what reached it.  Deterministic and
-    free of thread hand-offs, for tests and benchmarks on ``virtual``; the
-    frames still go through python-can and the DBC both ways."""
+    """A host's bus with the fake boards served in the same thread: a
+    ``recv`` that finds no frame waiting first lets the server handle what
+    reached it.  Deterministic and free of thread hand-offs, for tests and
+    benchmarks on ``virtual``; the frames still go through python-can and the
+    DBC both ways.  The frames the host reads, and their order, are those of
+    a server run before every ``recv``: the server handles the host's frames
+    in the order they were sent whenever it runs, and its replies queue
+    behind those already waiting; it only runs less often (once a burst of
+    replies is read, not once a frame)."""
 
     def __init__(self, bus: can.BusABC, server: CanBoardServer) -> None:
         self.bus = bus
@@ -288,6 +293,9 @@ class InlineBus:
         self.bus.send(msg, timeout)
 
     def recv(self, timeout: float | None = None) -> can.Message | None:
+        waiting = self.bus.recv(0.0)
+        if waiting is not None:
+            return waiting
         self.server.pump()
         return self.bus.recv(timeout)
 
