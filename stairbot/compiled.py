@@ -70,10 +70,11 @@ MODULES = (
     "stairbot.fakes.sim_sensors",
     "stairbot.fakes.stairs",
     "stairbot.fakes.world",
+    "stairbot.readings",
 )
 """The modules a compiled build compiles: the simulation's sensors, world
 and robot; the perception and supervision every tick runs; the controller
-and its phases."""
+and its phases; and the making of the readings they pass each other."""
 
 MANIFEST = "compiled.json"
 PURE_ENV = "STAIRBOT_PURE"

@@ -50,6 +50,7 @@ from stairbot.hardware import (
     Snapshot,
 )
 from stairbot.inputs.config import RobotConfig
+from stairbot.readings import sensor_reading, snapshot
 
 CONFIRM = 3
 """Measurements in a row that must agree before the kind seen changes."""
@@ -149,7 +150,7 @@ class Perception:
                         # immutable, and a new one costs: reuse an equal one (0.0 may be -0.0)
                         seen = track.seen_ok
                         if seen is None or seen.distance_m != m or m == 0.0:
-                            seen = track.seen_ok = SensorReading(m)
+                            seen = track.seen_ok = sensor_reading(m)
                         sensors[sid] = seen
                         continue
                 self._measured(track, reading, now, odometer)
@@ -163,12 +164,12 @@ class Perception:
                 # the common case, kept short: the median of recent OK measurements
                 if why:  # most often empty: nothing to look up
                     why.pop(sid, None)
-                sensors[sid] = SensorReading(kept - odometer if track.front else kept,
-                                             _STATUS_OK, age)
+                sensors[sid] = sensor_reading(kept - odometer if track.front else kept,
+                                              _STATUS_OK, age)
             else:
                 sensors[sid] = self._verdict(sid, track, now, odometer)
         self._stuck.judge(snap, sensors, self._why)
-        return Snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
+        return snapshot(snap.time_s, sensors, snap.motors, snap.health, snap.imu)
 
     def distrust(self, sensor: SensorId, why: str) -> bool:
         """The algorithm found ``sensor`` reading wrong (``why``): if its
@@ -227,23 +228,23 @@ class Perception:
         if age > track.max_age:
             why[sid] = (f"stale: its newest measurement is {age:.2f} s old "
                         f"(at most {track.max_age:.2f} s)")
-            return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
+            return sensor_reading(newest.distance_m, SensorStatus.ERROR, age)
         kind = track.kind
         if kind is _KIND_OK:
             m = track.median
             if m is not None:
                 if why:  # most often empty: nothing to look up
                     why.pop(sid, None)
-                return SensorReading(m - odometer if track.front else m, _STATUS_OK, age)
+                return sensor_reading(m - odometer if track.front else m, _STATUS_OK, age)
             why[sid] = "no valid measurement among its last ones"
-            return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
+            return sensor_reading(newest.distance_m, SensorStatus.ERROR, age)
         if kind is _KIND_ERROR:
             why[sid] = f"{CONFIRM} measurements in a row report an error"
-            return SensorReading(newest.distance_m, SensorStatus.ERROR, age)
+            return sensor_reading(newest.distance_m, SensorStatus.ERROR, age)
         if why:
             why.pop(sid, None)
         held = track.last_of_kind[kind]
-        return SensorReading(held.distance_m, SensorStatus.OUT_OF_RANGE, age)
+        return sensor_reading(held.distance_m, SensorStatus.OUT_OF_RANGE, age)
 
 
 def _median(values: Iterable[float]) -> float:

@@ -54,6 +54,7 @@ from typing import Literal
 from stairbot.fakes.sensors import active_faults, frozen, sensor_rng, stuck
 from stairbot.hardware import SensorId, SensorReading, SensorStatus
 from stairbot.inputs.scenario import Fault
+from stairbot.readings import sensor_reading
 
 Hit = tuple[float, float, float]  # distance m, cos(incidence), weight in the beam
 ConeRay = tuple[float, float, float]  # angle along the side view, across it (rad), weight
@@ -304,7 +305,7 @@ class ModelSensor:
         else:
             reading = self._far
         age = math.inf if current is None else t - current[0]
-        return reading if age == 0.0 else SensorReading(reading.distance_m, reading.status, age)
+        return reading if age == 0.0 else sensor_reading(reading.distance_m, reading.status, age)
 
     def age(self, t: float) -> float:
         """How old the published reading is at ``t`` (inf before the first)."""
@@ -362,11 +363,11 @@ class ModelSensor:
 
     def _quantized(self, d: float) -> SensorReading:
         if self.resolution <= 0.0:
-            return SensorReading(d, SensorStatus.OK)
+            return sensor_reading(d)
         # readings are whole multiples of the resolution: share one object per value
         k = round(d / self.resolution)
         reading = self._by_step.get(k)
         if reading is None:
             value = min(max(round(k * self.resolution, 9), self.min_range), self.max_range)
-            reading = self._by_step[k] = SensorReading(value, SensorStatus.OK)
+            reading = self._by_step[k] = sensor_reading(value)
         return reading

@@ -56,6 +56,7 @@ from stairbot.hardware import (
 )
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario, load_scenario
+from stairbot.readings import motor_state, snapshot
 from stairbot.run.robots import RobotOptions, RobotSession
 
 TURN_CLEARANCE = 0.003  # segments 1 and 3 must be this far off the ground to turn, m
@@ -119,7 +120,7 @@ class SimRobot:
             raise RobotFellError(w.fall_reason or "unstable")
         if self._snap is not None and self._snap_at == w.steps_done:
             return self._snap
-        snap = Snapshot(w.time, self.board.read(w.time), self._motor_states(), {},
+        snap = snapshot(w.time, self.board.read(w.time), self._motor_states(), {},
                         self._imu.read())
         self._snap, self._snap_at = snap, w.steps_done
         return snap
@@ -311,12 +312,12 @@ class SimRobot:
         mean, mean_speed = turns[1], tps[1]
         d, ds = self._diff_turns, self._diff_speed
         return {
-            _MWF: MotorState(turns[0], tps[0]),
-            _MWB: MotorState(turns[2], tps[2]),
-            _MWR: MotorState(mean + d, mean_speed + ds),
-            _MWL: MotorState(mean - d, mean_speed - ds),
-            _MTF: MotorState(lifts[0] / per_turn, lift_tps[0]),
-            _MTB: MotorState(lifts[1] / per_turn, lift_tps[1]),
+            _MWF: motor_state(turns[0], tps[0]),
+            _MWB: motor_state(turns[2], tps[2]),
+            _MWR: motor_state(mean + d, mean_speed + ds),
+            _MWL: motor_state(mean - d, mean_speed - ds),
+            _MTF: motor_state(lifts[0] / per_turn, lift_tps[0]),
+            _MTB: motor_state(lifts[1] / per_turn, lift_tps[1]),
         }
 
 

@@ -42,6 +42,7 @@ from stairbot.hardware import Imu, SensorId, SensorReading
 from stairbot.inputs.config import RobotConfig
 from stairbot.inputs.scenario import Scenario
 from stairbot.inputs.sensor_specs import rows_up
+from stairbot.readings import imu as make_imu
 
 _SFR, _SFL, _SBR, _SBL = SensorId.SFR, SensorId.SFL, SensorId.SBR, SensorId.SBL  # bound once
 _SSR, _SSL = SensorId.SSR, SensorId.SSL
@@ -73,7 +74,7 @@ class SimImu:
             rate = w.pitch_rate_dps(IMU_SEGMENT)  # nothing to average over yet
         else:
             rate = (pitch - last[1]) / (t - last[0])
-        return Imu(pitch, 0.0, rate, 0.0)
+        return make_imu(pitch, 0.0, rate, 0.0)
 
 
 class SimSensors:
