@@ -51,7 +51,7 @@ from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from typing import Literal
 
-from stairbot.fakes.sensors import active_faults, frozen, sensor_rng, stuck
+from stairbot.fakes.sensors import active_faults, frozen, gauss, sensor_rng, stuck
 from stairbot.hardware import SensorId, SensorReading, SensorStatus
 from stairbot.inputs.scenario import Fault
 from stairbot.readings import sensor_reading
@@ -227,8 +227,8 @@ class ModelSensor:
         self.resolution = resolution if model.resolution is None else model.resolution
         self.noise_a = noise if model.noise_a is None else model.noise_a
         self.noise_b = model.noise_b
-        rng = sensor_rng(seed, sensor)
-        self._gauss, self._uniform = rng.gauss, rng.random
+        rng = self._rng = sensor_rng(seed, sensor)
+        self._uniform = rng.random
         self.faults = tuple(f for f in faults if f.sensor == sensor.value)
         self._freezes = tuple(f for f in self.faults if f.kind == "freeze")
         self._stucks = tuple(f for f in self.faults if f.kind == "stuck")
@@ -337,7 +337,7 @@ class ModelSensor:
         if self._noisy:
             a = self.noise_a
             sigma = a + self.noise_b * true_distance if true_distance is not None else a
-            noise = self._gauss(0.0, sigma)
+            noise = gauss(self._rng, sigma)
         outliers, dropouts = self._outlier_rate, self._dropout_rate
         outlier = False
         if outliers > 0.0:

@@ -13,8 +13,10 @@ otherwise OK rounded to the resolution.
 
 from __future__ import annotations
 
+import math
 import random
 from collections.abc import Iterable
+from typing import Final
 
 from stairbot.hardware import SensorId
 from stairbot.inputs.scenario import Fault
@@ -23,6 +25,25 @@ from stairbot.inputs.scenario import Fault
 def sensor_rng(seed: int, sensor: SensorId) -> random.Random:
     """The noise generator of one sensor: independent per sensor, fixed per seed."""
     return random.Random(f"stairbot-sensor:{seed}:{sensor.value}")
+
+
+_TWO_PI: Final = 2.0 * math.pi
+
+
+def gauss(rng: random.Random, sigma: float) -> float:
+    """``rng.gauss(0.0, sigma)``: the same number, drawn the same way, and
+    ``rng`` left in the same state.  CPython's ``Random.gauss``
+    (Lib/random.py) is Python; written out here it is compiled with the
+    sensor models, which draw it for every measurement.
+    tests/fakes/test_sensor_noise.py holds the two to each other."""
+    z = rng.gauss_next  # type: ignore[attr-defined]
+    rng.gauss_next = None  # type: ignore[attr-defined]
+    if z is None:
+        x2pi = rng.random() * _TWO_PI
+        g2rad = math.sqrt(-2.0 * math.log(1.0 - rng.random()))
+        z = math.cos(x2pi) * g2rad
+        rng.gauss_next = math.sin(x2pi) * g2rad  # type: ignore[attr-defined]
+    return 0.0 + z * sigma
 
 
 def active_faults(faults: Iterable[Fault], t: float) -> tuple[float, bool]:
