@@ -41,20 +41,21 @@ class Plan:
     walls: Walls | None = None
     """Where the walls stand along x, left and right; None: as ``side_wall``
     says, the whole length."""
-    _left: tuple[Range, ...] = field(init=False, repr=False, default=())
-    _right: tuple[Range, ...] = field(init=False, repr=False, default=())
-    _left_all: bool = field(init=False, repr=False, default=False)
-    _right_all: bool = field(init=False, repr=False, default=False)
+    _left: tuple[Range, ...] = field(init=False, repr=False)  # set_walls sets these four
+    _right: tuple[Range, ...] = field(init=False, repr=False)
+    _left_all: bool = field(init=False, repr=False)
+    _right_all: bool = field(init=False, repr=False)
     # the trigonometry of the yaw, kept while the yaw stays the same (see yaw_trig)
-    _trig_of: float = field(init=False, repr=False, compare=False, default=math.nan)
-    _trig: tuple[float, float] = field(init=False, repr=False, compare=False,
-                                       default=(1.0, 0.0))
-    _turned_of: tuple[float, tuple[float, ...]] = field(init=False, repr=False, compare=False,
-                                                        default=(math.nan, ()))
-    _turned: list[tuple[float, float]] = field(init=False, repr=False, compare=False,
-                                               default_factory=list)
+    _trig_of: float = field(init=False, repr=False, compare=False)
+    _trig: tuple[float, float] = field(init=False, repr=False, compare=False)
+    _turned_of: tuple[float, tuple[float, ...]] = field(init=False, repr=False, compare=False)
+    _turned: list[tuple[float, float]] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        # the fields that are not the constructor's are set here: the __init__
+        # mypyc compiles for this module leaves their defaults unset
+        self._trig_of, self._trig = math.nan, (1.0, 0.0)
+        self._turned_of, self._turned = (math.nan, ()), []
         self.set_walls(self.walls)
 
     def set_walls(self, walls: Walls | None) -> None:
