@@ -10,6 +10,7 @@ within a fraction of a millimetre (wheels) or a few hundredths of a turn
 from __future__ import annotations
 
 import math
+from typing import Final
 
 from stairbot.hardware import (
     BACK_SENSORS,
@@ -42,9 +43,18 @@ averages the sensors' noise over a few ticks (calibration turns, standing rule).
 TURN_SPEED = 0.15
 """Calibration turning speed of MWR/MWL, turns/s: slow, so noise cannot stop it early."""
 
+# WHEEL_MOTORS, bound once for wheel_position (an enum's member is a slow look-up)
+_MWF: Final = WHEEL_MOTORS[0]
+_MWB: Final = WHEEL_MOTORS[1]
+_MWR: Final = WHEEL_MOTORS[2]
+_MWL: Final = WHEEL_MOTORS[3]
+
+
 def wheel_position(snap: Snapshot) -> float:
     """The drive's odometer: the mean of the four wheel counters, turns."""
-    return sum(snap.turns(m) for m in WHEEL_MOTORS) / len(WHEEL_MOTORS)
+    # written out (asked every tick): sum()'s additions, in WHEEL_MOTORS' order
+    m = snap.motors
+    return (0.0 + m[_MWF].turns + m[_MWB].turns + m[_MWR].turns + m[_MWL].turns) / 4
 
 
 def pair(snap: Snapshot, back: bool = False) -> tuple[SensorReading, SensorReading]:
@@ -62,14 +72,17 @@ def mean_distance(snap: Snapshot, back: bool = False) -> float:
 def far(reading: SensorReading, cfg: RobotConfig) -> bool:
     """The reading says "nothing ahead": at least LENGTH_OF_INFINITY, or out of
     range at the far end."""
-    return reading.status is not SensorStatus.ERROR and reading.distance_m >= cfg.LENGTH_OF_INFINITY
+    # cfg.algorithm's, not the config's property of the same name (asked every tick)
+    return (reading.status is not SensorStatus.ERROR
+            and reading.distance_m >= cfg.algorithm.LENGTH_OF_INFINITY)
 
 
 def measurable(snap: Snapshot, cfg: RobotConfig) -> bool:
     """Both front sensors give a usable distance: status OK and closer than
     LENGTH_OF_INFINITY.  Not measurable: out of range (too near or nothing
     ahead), an error, or "nothing ahead"."""
-    return all(r.ok and r.distance_m < cfg.LENGTH_OF_INFINITY for r in pair(snap))
+    infinity = cfg.algorithm.LENGTH_OF_INFINITY  # (asked every tick: the reads inline)
+    return all(r.status is _OK and r.distance_m < infinity for r in pair(snap))
 
 
 def pair_difference(snap: Snapshot, cfg: RobotConfig, back: bool = False) -> float | None:
@@ -81,7 +94,7 @@ def pair_difference(snap: Snapshot, cfg: RobotConfig, back: bool = False) -> flo
     r, left = sensors[r_id], sensors[l_id]
     if r.status is not _OK or left.status is not _OK:
         return None
-    if not back and max(r.distance_m, left.distance_m) >= cfg.LENGTH_OF_INFINITY:
+    if not back and max(r.distance_m, left.distance_m) >= cfg.algorithm.LENGTH_OF_INFINITY:
         return None
     return left.distance_m - r.distance_m
 
