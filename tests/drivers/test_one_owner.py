@@ -52,13 +52,26 @@ def real_time_boards(wire: str, env: dict[str, str]) -> Iterator[str]:
 @contextmanager
 def raw_link(wire: str, url: str) -> Iterator[BoardLink]:
     """A link to the boards that takes no lock and claims nothing: what a
-    host on another machine, or a program of its own, would be."""
-    link: BoardLink
-    if wire == "serial":
-        port, opts = parse_serial_url(url)
-        link = SerialLink(open_channel(port, int(opts["baud"]), url), timeout_s=0.2)
-    else:
-        link = CanLink(open_bus(parse_can_url(url)), timeout_s=0.2)
+    host on another machine, or a program of its own, would be.
+
+    Its session is not the lease holder's.  A link draws its session number
+    at random (1-1023 on CAN, 1-255 on serial), and one that draws the
+    holder's is the holder to a board, which knows a host by nothing else
+    (docs/protocol.md, "One host owns the boards"): such a link is closed
+    and another drawn.  Claim(0) with another host's nonce asks who holds
+    the lease and never takes or gives it up."""
+    while True:
+        link: BoardLink
+        if wire == "serial":
+            port, opts = parse_serial_url(url)
+            link = SerialLink(open_channel(port, int(opts["baud"]), url), timeout_s=0.2)
+        else:
+            link = CanLink(open_bus(parse_can_url(url)), timeout_s=0.2)
+        (owner,) = link.exchange(m.Board.MOTOR, [m.Claim(0, OTHER_NONCE)]).messages
+        assert isinstance(owner, m.Owner) and owner.result != m.ClaimResult.RELEASED, owner
+        if owner.session == 0 or owner.session != link.session:
+            break
+        link.close()
     try:
         yield link
     finally:
