@@ -17,8 +17,15 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any, Final
 
-from stairbot.hardware import Imu, MotorId, MotorState, SensorId, SensorReading, SensorStatus
-from stairbot.hardware import Snapshot as _Snapshot
+from stairbot.hardware import (
+    Imu,
+    MotorId,
+    MotorState,
+    SensorId,
+    SensorReading,
+    SensorStatus,
+    Snapshot,
+)
 
 # Final: mypyc keeps these in the module's C statics, not its dict
 _new: Final[Any] = object.__new__
@@ -42,11 +49,11 @@ _I_ROLL: Final = _setter(Imu, "roll_deg")
 _I_PITCH_RATE: Final = _setter(Imu, "pitch_rate_dps")
 _I_ROLL_RATE: Final = _setter(Imu, "roll_rate_dps")
 _I_AGE: Final = _setter(Imu, "age_s")
-_S_TIME: Final = _setter(_Snapshot, "time_s")
-_S_SENSORS: Final = _setter(_Snapshot, "sensors")
-_S_MOTORS: Final = _setter(_Snapshot, "motors")
-_S_HEALTH: Final = _setter(_Snapshot, "health")
-_S_IMU: Final = _setter(_Snapshot, "imu")
+_S_TIME: Final = _setter(Snapshot, "time_s")
+_S_SENSORS: Final = _setter(Snapshot, "sensors")
+_S_MOTORS: Final = _setter(Snapshot, "motors")
+_S_HEALTH: Final = _setter(Snapshot, "health")
+_S_IMU: Final = _setter(Snapshot, "imu")
 
 
 def sensor_reading(distance_m: float, status: SensorStatus = _STATUS_OK,
@@ -82,10 +89,10 @@ def imu(pitch_deg: float, roll_deg: float, pitch_rate_dps: float = 0.0,
 
 def snapshot(time_s: float, sensors: Mapping[SensorId, SensorReading],
              motors: Mapping[MotorId, MotorState], health: Mapping[str, float],
-             imu: Imu | None) -> _Snapshot:
+             imu: Imu | None) -> Snapshot:
     """``Snapshot(time_s, sensors, motors, health, imu)`` (every field given:
     ``health`` has no shared default to fall back on)."""
-    snap: _Snapshot = _new(_Snapshot)
+    snap: Snapshot = _new(Snapshot)
     _S_TIME(snap, time_s)
     _S_SENSORS(snap, sensors)
     _S_MOTORS(snap, motors)
